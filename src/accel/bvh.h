@@ -1,0 +1,52 @@
+/* Bounding volume hierarchy over a triangle soup: binned-SAH build, 32-byte nodes, closest-hit and
+ * any-hit traversal. The build reorders the triangles into leaf order; every method of microshadow
+ * names triangles by that order (prim ids), so the hit triangle can be excluded consistently. */
+#ifndef MS_BVH_H
+#define MS_BVH_H
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct ms_bvh_node {
+    float bmin[3];
+    uint32_t first;   /* interior: index of the left child (right = first + 1); leaf: first triangle */
+    float bmax[3];
+    uint32_t count;   /* 0 for interior nodes, else the number of triangles in the leaf */
+} ms_bvh_node;
+
+typedef struct ms_bvh {
+    ms_bvh_node *nodes;
+    uint32_t n_nodes;
+    float *tri;           /* 9 floats per triangle, leaf order */
+    uint32_t *tri_source; /* leaf-order index -> index in the soup given to the build */
+    uint32_t n_tris;
+    int depth;
+    double build_s;
+} ms_bvh;
+
+typedef struct ms_ray {
+    float o[3], d[3];
+    float tmin, tmax;     /* hit parameter range along d (d need not be unit) */
+} ms_ray;
+
+typedef struct ms_ray_hit {
+    float t, u, v;
+    uint32_t prim;        /* leaf-order triangle index, UINT32_MAX on a miss */
+} ms_ray_hit;
+
+/* Builds over n triangles (copied). Returns 0, or -1 when out of memory. */
+int ms_bvh_build(ms_bvh *b, const float *tri, size_t n);
+void ms_bvh_free(ms_bvh *b);
+
+/* 1 and the nearest hit in (tmin, tmax), or 0. */
+int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit);
+/* 1 if any triangle other than skip_prim is hit with t in [tmin, tmax]. */
+int ms_bvh_occluded(const ms_bvh *b, const ms_ray *r, uint32_t skip_prim);
+
+/* Two-sided Moller-Trumbore; 1 and t,u,v when the ray hits with t in [tmin, tmax]. Shared by the
+ * traversals and by tests as the per-triangle oracle. */
+int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3], float tmin, float tmax,
+                          float *t, float *u, float *v);
+
+#define MS_BVH_STACK 64
+
+#endif

@@ -1,0 +1,62 @@
+/* Primary visibility through our BVH, and the hit finishing every primary method shares. */
+#include "../shadow/method.h"
+#include "../core/vec.h"
+#include <math.h>
+
+void ms_hit_finish(const ms_render_ctx *ctx, const float o[3], const float d[3], float t, uint32_t prim,
+                   ms_hit *h)
+{
+    const float *tri = ctx->bvh->tri + 9 * (size_t)prim;
+    float e1[3], e2[3], n[3], p[3];
+    v3_sub(e1, tri + 3, tri);
+    v3_sub(e2, tri + 6, tri);
+    v3_cross(n, e1, e2);
+    v3_normalize(n, n);
+    if (v3_dot(n, d) > 0.0f) v3_scale(n, n, -1.0f);
+    v3_madd(p, o, d, t);
+    /* Lift the point off the surface towards the camera by a few ulps of the scene's size, so that
+     * rounding in p never puts it behind its own or a neighbouring triangle. */
+    const ms_bvh_node *root = &ctx->bvh->nodes[0];
+    float scale = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        scale = ms_maxf(scale, fabsf(p[a]));
+        scale = ms_maxf(scale, root->bmax[a] - root->bmin[a]);
+    }
+    v3_madd(h->p, p, n, 1e-5f * scale);
+    h->n[0] = n[0]; h->n[1] = n[1]; h->n[2] = n[2];
+    h->prim = prim;
+}
+
+static int bvh_primary_create(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
+{
+    (void)ctx; (void)err; (void)errlen;
+    *state = NULL;
+    return 0;
+}
+
+static void bvh_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int y0, int x1, int y1,
+                              ms_hit *out)
+{
+    (void)state;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            ms_ray r;
+            ms_ray_hit hit;
+            ms_hit *h = out++;
+            for (int a = 0; a < 3; a++) r.o[a] = ctx->cam.eye[a];
+            ms_camera_ray(&ctx->cam, x, y, r.d);
+            r.tmin = 0.0f;
+            r.tmax = INFINITY;
+            if (ms_bvh_closest(ctx->bvh, &r, &hit)) ms_hit_finish(ctx, r.o, r.d, hit.t, hit.prim, h);
+            else h->prim = UINT32_MAX;
+        }
+}
+
+static void bvh_primary_destroy(void *state) { (void)state; }
+
+const ms_primary_method ms_primary_bvh = {
+    .name = "bvh",
+    .create = bvh_primary_create,
+    .trace = bvh_primary_trace,
+    .destroy = bvh_primary_destroy,
+};

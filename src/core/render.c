@@ -1,0 +1,214 @@
+/* One frame: BVH build, primary visibility, shadows, shading, each phase timed on its own and run
+ * over 16x16 pixel tiles by OpenMP (dynamic scheduling: shadow cost varies wildly across a frame). */
+#include "microshadow.h"
+#include "pattern.h"
+#include "../shadow/method.h"
+#include "../scene/scene_internal.h"
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TILE 16
+#define MS_NEAR 1e-4f        /* segment parameter: occluders closer than this to the receiver are ignored */
+#define MS_FAR (1.0f - 1e-4f)/* ... and this close to the light plane (a light set into a ceiling) */
+#define MS_ALBEDO 0.8f
+
+void ms_render_options_default(ms_render_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->method = "scanline";
+    o->pattern = MS_PATTERN_GRID;
+    o->samples = 0;        /* the scene's */
+}
+
+void ms_frame_free(ms_frame *f)
+{
+    free(f->vis);
+    free(f->rgb);
+    memset(f, 0, sizeof *f);
+}
+
+typedef struct progress {
+    const ms_render_options *opt;
+    long done, total;      /* tiles over both passes */
+} progress;
+
+static void progress_tick(progress *p)
+{
+    long d;
+#pragma omp atomic capture
+    d = ++p->done;
+    if (p->opt->progress && omp_get_thread_num() == 0) p->opt->progress(p->opt->progress_user, (double)d / (double)p->total);
+}
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    double t_start = omp_get_wtime();
+    const ms_shadow_method *sm = ms_find_shadow_method(opt->method ? opt->method : "");
+    if (!sm) {
+        if (ms_method_available(opt->method ? opt->method : "") < 0)
+            snprintf(err, errlen, "method '%s' is not compiled into this build", opt->method);
+        else
+            snprintf(err, errlen, "unknown method '%s'", opt->method ? opt->method : "");
+        return -1;
+    }
+    const ms_primary_method *pm = ms_find_primary_method(sm->primary);
+    if (!pm) { snprintf(err, errlen, "primary method '%s' is not compiled into this build", sm->primary); return -1; }
+    int samples = opt->samples > 0 ? opt->samples : scene->samples;
+    int k = ms_samples_to_k(samples);
+    if (!k) { snprintf(err, errlen, "samples must be 256, 1024 or 4096 (got %d)", samples); return -1; }
+    if (sm->needs_grid && opt->pattern != MS_PATTERN_GRID) {
+        snprintf(err, errlen, "method '%s' needs --pattern grid", sm->name);
+        return -1;
+    }
+    int W = opt->width > 0 ? opt->width : scene->camera.width;
+    int H = opt->height > 0 ? opt->height : scene->camera.height;
+    if (W < 1 || H < 1 || W > MS_MAX_IMAGE_SIZE || H > MS_MAX_IMAGE_SIZE) {
+        snprintf(err, errlen, "width and height must be in [1, %d]", MS_MAX_IMAGE_SIZE);
+        return -1;
+    }
+    int threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
+
+    ms_render_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    if (ms_camera_basis_init(&ctx.cam, &scene->camera, W, H)) {
+        snprintf(err, errlen, "camera is degenerate (eye = target, or up parallel to the view)");
+        return -1;
+    }
+    ms_bvh bvh;
+    omp_set_num_threads(threads);
+    if (ms_bvh_build(&bvh, scene->tri, scene->n_tris)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
+    ctx.scene = scene;
+    ctx.bvh = &bvh;
+    ctx.light = scene->light;
+    ctx.pattern = opt->pattern;
+    ctx.k = k;
+    ctx.samples = k * k;
+    ctx.seed = opt->seed;
+    ctx.near = MS_NEAR;
+    ctx.far = MS_FAR;
+    ctx.threads = threads;
+
+    size_t npix = (size_t)W * H;
+    ms_hit *hits = malloc(npix * sizeof *hits);
+    out->vis = malloc(npix * sizeof(float));
+    out->rgb = malloc(npix * 3 * sizeof(float));
+    void *pstate = NULL, *sstate = NULL;
+    int rc = -1;
+    if (!hits || !out->vis || !out->rgb) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); goto fail; }
+    if (pm->create(&ctx, &pstate, err, errlen)) goto fail;
+    if (sm->create(&ctx, &sstate, err, errlen)) { pm->destroy(pstate); goto fail; }
+
+    int tx = (W + TILE - 1) / TILE, ty = (H + TILE - 1) / TILE, ntiles = tx * ty;
+    progress prog = { opt, 0, 2L * ntiles };
+
+    double t0 = omp_get_wtime();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int t = 0; t < ntiles; t++) {
+        int x0 = (t % tx) * TILE, y0 = (t / tx) * TILE;
+        int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
+        ms_hit tile[TILE * TILE];
+        pm->trace(pstate, &ctx, x0, y0, x1, y1, tile);
+        for (int y = y0; y < y1; y++)
+            memcpy(&hits[(size_t)y * W + x0], &tile[(y - y0) * (x1 - x0)], (size_t)(x1 - x0) * sizeof *tile);
+        progress_tick(&prog);
+    }
+    double t1 = omp_get_wtime();
+
+    uint64_t counters[MS_MAX_COUNTERS] = { 0 };
+    uint64_t visible = 0;
+#pragma omp parallel num_threads(threads)
+    {
+        uint64_t local[MS_MAX_COUNTERS] = { 0 };
+        uint64_t local_visible = 0;
+#pragma omp for schedule(dynamic, 1)
+        for (int t = 0; t < ntiles; t++) {
+            int x0 = (t % tx) * TILE, y0 = (t / tx) * TILE;
+            int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
+            ms_shadow_query q[TILE * TILE];
+            float v[TILE * TILE];
+            size_t where[TILE * TILE];
+            int n = 0;
+            for (int y = y0; y < y1; y++)
+                for (int x = x0; x < x1; x++) {
+                    size_t i = (size_t)y * W + x;
+                    const ms_hit *h = &hits[i];
+                    if (h->prim == UINT32_MAX) { out->vis[i] = -1.0f; continue; }
+                    memcpy(q[n].p, h->p, sizeof h->p);
+                    memcpy(q[n].n, h->n, sizeof h->n);
+                    q[n].prim = h->prim;
+                    q[n].px = (uint32_t)x;
+                    q[n].py = (uint32_t)y;
+                    where[n++] = i;
+                }
+            if (n) sm->visibility(sstate, &ctx, q, n, v, local);
+            for (int i = 0; i < n; i++) out->vis[where[i]] = v[i];
+            local_visible += (uint64_t)n;
+            progress_tick(&prog);
+        }
+#pragma omp critical(ms_counters)
+        {
+            for (int c = 0; c < MS_MAX_COUNTERS; c++) counters[c] += local[c];
+            visible += local_visible;
+        }
+    }
+    double t2 = omp_get_wtime();
+
+    /* Shading: the unshadowed irradiance is exact; shadows enter only through V. */
+    float *lum = malloc(npix * sizeof(float));
+    size_t nlum = 0;
+    const ms_light *L = &scene->light;
+    for (size_t i = 0; i < npix; i++) {
+        float *c = out->rgb + 3 * i;
+        if (hits[i].prim == UINT32_MAX) { c[0] = c[1] = c[2] = 0.0f; continue; }
+        float e = ms_light_irradiance(L, hits[i].p, hits[i].n) * MS_ALBEDO / (float)M_PI;
+        c[0] = e * L->emission.x * out->vis[i];
+        c[1] = e * L->emission.y * out->vis[i];
+        c[2] = e * L->emission.z * out->vis[i];
+        if (lum) lum[nlum++] = e * (0.2126f * L->emission.x + 0.7152f * L->emission.y + 0.0722f * L->emission.z);
+    }
+    out->exposure = 1.0f;
+    if (lum && nlum) {
+        qsort(lum, nlum, sizeof *lum, cmp_float);
+        float p99 = lum[(size_t)(0.99 * (double)(nlum - 1))];
+        if (p99 > 0.0f) out->exposure = 1.0f / p99;
+    }
+    free(lum);
+
+    out->width = W;
+    out->height = H;
+    ms_stats *st = &out->stats;
+    st->triangles = scene->n_tris;
+    st->load_s = scene->load_s;
+    st->build_s = bvh.build_s;
+    st->primary_s = t1 - t0;
+    st->shadow_s = t2 - t1;
+    st->samples = ctx.samples;
+    st->threads = threads;
+    st->width = W;
+    st->height = H;
+    st->method = sm->name;
+    st->pattern = opt->pattern == MS_PATTERN_GRID ? "grid" : "stratified";
+    st->visible_pixels = visible;
+    st->shadow_rays = visible * (uint64_t)ctx.samples;
+    st->n_counters = sm->n_counters;
+    for (int c = 0; c < sm->n_counters; c++) { st->counter_name[c] = sm->counter_names[c]; st->counter[c] = counters[c]; }
+    sm->destroy(sstate);
+    pm->destroy(pstate);
+    st->total_s = omp_get_wtime() - t_start + scene->load_s;
+    rc = 0;
+fail:
+    free(hits);
+    ms_bvh_free(&bvh);
+    if (rc) ms_frame_free(out);
+    return rc;
+}

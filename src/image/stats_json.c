@@ -1,0 +1,40 @@
+/* --stats: timings, sizes and the method's counters as JSON (cJSON). */
+#include "microshadow.h"
+#include "atomic_file.h"
+#include <cjson/cJSON.h>
+#include <stdlib.h>
+#include <string.h>
+
+int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen)
+{
+    const ms_stats *s = &f->stats;
+    cJSON *o = cJSON_CreateObject();
+    if (!o) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    cJSON_AddStringToObject(o, "version", MS_VERSION_STRING);
+    cJSON_AddStringToObject(o, "method", s->method);
+    cJSON_AddStringToObject(o, "pattern", s->pattern);
+    cJSON_AddNumberToObject(o, "triangles", (double)s->triangles);
+    cJSON_AddNumberToObject(o, "width", s->width);
+    cJSON_AddNumberToObject(o, "height", s->height);
+    cJSON_AddNumberToObject(o, "samples", s->samples);
+    cJSON_AddNumberToObject(o, "threads", s->threads);
+    cJSON_AddNumberToObject(o, "load_s", s->load_s);
+    cJSON_AddNumberToObject(o, "build_s", s->build_s);
+    cJSON_AddNumberToObject(o, "primary_s", s->primary_s);
+    cJSON_AddNumberToObject(o, "shadow_s", s->shadow_s);
+    cJSON_AddNumberToObject(o, "total_s", s->total_s);
+    cJSON_AddNumberToObject(o, "visible_pixels", (double)s->visible_pixels);
+    cJSON_AddNumberToObject(o, "shadow_rays", (double)s->shadow_rays);
+    cJSON_AddNumberToObject(o, "shadow_rays_per_s", s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s : 0.0);
+    cJSON *c = cJSON_AddObjectToObject(o, "counters");
+    for (int i = 0; c && i < s->n_counters; i++) cJSON_AddNumberToObject(c, s->counter_name[i], (double)s->counter[i]);
+    char *text = cJSON_Print(o);
+    cJSON_Delete(o);
+    if (!text) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    ms_atomic_file a;
+    if (ms_atomic_open(&a, path, err, errlen)) { free(text); return -1; }
+    fputs(text, a.f);
+    fputc('\n', a.f);
+    free(text);
+    return ms_atomic_commit(&a, err, errlen);
+}

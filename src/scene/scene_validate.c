@@ -1,0 +1,55 @@
+#include "microshadow.h"
+#include "scene_internal.h"
+#include "../camera/camera.h"
+#include "../core/vec.h"
+#include <math.h>
+#include <stdio.h>
+
+static int vec_ok(ms_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen)
+{
+    const ms_camera *c = &s->camera;
+    const ms_light *l = &s->light;
+    if (!vec_ok(c->eye) || !vec_ok(c->target) || !vec_ok(c->up) || !isfinite(c->fov_y)) {
+        snprintf(err, errlen, "%s: camera has a NaN or infinite value", what);
+        return -1;
+    }
+    if (!vec_ok(l->corner) || !vec_ok(l->edge_s) || !vec_ok(l->edge_t) || !vec_ok(l->emission)) {
+        snprintf(err, errlen, "%s: light has a NaN or infinite value", what);
+        return -1;
+    }
+    if (!(c->fov_y > 0.0f && c->fov_y < 180.0f)) {
+        snprintf(err, errlen, "%s: camera.fov_y must be in (0, 180) degrees", what);
+        return -1;
+    }
+    if (c->width < 1 || c->height < 1 || c->width > MS_MAX_IMAGE_SIZE || c->height > MS_MAX_IMAGE_SIZE) {
+        snprintf(err, errlen, "%s: camera width and height must be in [1, %d]", what, MS_MAX_IMAGE_SIZE);
+        return -1;
+    }
+    ms_camera_basis b;
+    if (c->eye.x == c->target.x && c->eye.y == c->target.y && c->eye.z == c->target.z) {
+        snprintf(err, errlen, "%s: camera.eye equals camera.target", what);
+        return -1;
+    }
+    if (ms_camera_basis_init(&b, c, c->width, c->height)) {
+        snprintf(err, errlen, "%s: camera.up is zero or parallel to the view direction", what);
+        return -1;
+    }
+    float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z }, T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z }, n[3];
+    v3_cross(n, S, T);
+    if (!(v3_len(n) > 1e-6f * v3_len(S) * v3_len(T))) {
+        snprintf(err, errlen, "%s: light has zero area (edge_s and edge_t are zero or parallel)", what);
+        return -1;
+    }
+    if (s->n_tris == 0) {
+        snprintf(err, errlen, "%s: the scene has no triangles", what);
+        return -1;
+    }
+    for (size_t i = 0; i < 9 * s->n_tris; i++)
+        if (!isfinite(s->tri[i])) {
+            snprintf(err, errlen, "%s: triangle %zu has a NaN or infinite coordinate", what, i / 9);
+            return -1;
+        }
+    return 0;
+}

@@ -1,0 +1,70 @@
+/* The plug-in interfaces: a primary-visibility method finds what each pixel sees, a shadow method
+ * answers V for visible points. Both see the same render context, so every method works on the same
+ * hit points and the same light samples. To add a method: implement one of these structs in its own
+ * file and list it in registry.c. */
+#ifndef MS_METHOD_H
+#define MS_METHOD_H
+#include <stddef.h>
+#include <stdint.h>
+#include "microshadow.h"
+#include "../accel/bvh.h"
+#include "../camera/camera.h"
+
+typedef struct ms_render_ctx {
+    const ms_scene *scene;
+    const ms_bvh *bvh;             /* triangles in leaf order; prim ids index bvh->tri */
+    ms_camera_basis cam;
+    ms_light light;
+    ms_pattern pattern;
+    int k, samples;                /* samples = k*k */
+    uint32_t seed;
+    float near, far;               /* occluding range of the segment parameter from hit point to sample */
+    int threads;
+} ms_render_ctx;
+
+/* One visible point: the pixel, its hit point (already offset off the surface towards the camera),
+ * the geometric normal facing the camera, and the hit triangle, which never occludes. */
+typedef struct ms_shadow_query {
+    float p[3];
+    float n[3];
+    uint32_t prim;
+    uint32_t px, py;
+} ms_shadow_query;
+
+typedef struct ms_shadow_method {
+    const char *name;
+    const char *primary;          /* primary-visibility method it pairs with ("bvh", "embree") */
+    int needs_grid;               /* 1: only the grid pattern fits (micro-rasterization) */
+    int n_counters;
+    const char *counter_names[MS_MAX_COUNTERS];
+    /* Per-frame set-up (shared, read-only afterwards); 0 or -1 with a message in err. */
+    int (*create)(const ms_render_ctx *ctx, void **state, char *err, size_t errlen);
+    /* V for n queries; thread-safe; adds to counters[n_counters] (thread-private). */
+    void (*visibility)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n, float *vis,
+                       uint64_t *counters);
+    void (*destroy)(void *state);
+} ms_shadow_method;
+
+typedef struct ms_hit {
+    float p[3], n[3];
+    uint32_t prim;               /* UINT32_MAX: the ray missed */
+} ms_hit;
+
+typedef struct ms_primary_method {
+    const char *name;
+    int (*create)(const ms_render_ctx *ctx, void **state, char *err, size_t errlen);
+    /* Hits for pixels [x0,x1) x [y0,y1), row-major into out. Thread-safe. */
+    void (*trace)(void *state, const ms_render_ctx *ctx, int x0, int y0, int x1, int y1, ms_hit *out);
+    void (*destroy)(void *state);
+} ms_primary_method;
+
+/* Known methods, compiled in or not (registry.c). */
+const ms_shadow_method *ms_find_shadow_method(const char *name);
+const ms_primary_method *ms_find_primary_method(const char *name);
+
+/* Finishes a hit from a ray and a hit triangle: the point offset off the surface towards the ray's
+ * origin, and the normal facing it. Shared by every primary method so that all agree on C. */
+void ms_hit_finish(const ms_render_ctx *ctx, const float o[3], const float d[3], float t, uint32_t prim,
+                   ms_hit *h);
+
+#endif

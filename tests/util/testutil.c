@@ -1,0 +1,129 @@
+#include "testutil.h"
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static void rm_tree(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d) return;
+    struct dirent *e;
+    char p[4096];
+    while ((e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+        snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+        struct stat st;
+        if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode)) { chmod(p, 0755); rm_tree(p); rmdir(p); }
+        else unlink(p);
+    }
+    closedir(d);
+}
+
+const char *tu_tmpdir(const char *test_name)
+{
+    static char path[4096];
+    mkdir(MS_TEST_TMPDIR, 0755);
+    snprintf(path, sizeof path, "%s/%s", MS_TEST_TMPDIR, test_name);
+    rm_tree(path);
+    mkdir(path, 0755);
+    return path;
+}
+
+const char *tu_path(char *buf, size_t n, const char *dir, const char *name)
+{
+    snprintf(buf, n, "%s/%s", dir, name);
+    return buf;
+}
+
+int tu_write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return -1;
+    fputs(text, f);
+    return fclose(f);
+}
+
+int tu_file_exists(const char *path) { return access(path, F_OK) == 0; }
+
+int tu_count_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d) return -1;
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+    closedir(d);
+    return n;
+}
+
+int tu_run_cli(const char *const *args, char *err_line, size_t n)
+{
+    char errpath[4096];
+    snprintf(errpath, sizeof errpath, "%s/cli-stderr-%d.txt", MS_TEST_TMPDIR, (int)getpid());
+    mkdir(MS_TEST_TMPDIR, 0755);
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        int nul = open("/dev/null", O_WRONLY);
+        if (fd >= 0) dup2(fd, 2);
+        if (nul >= 0) dup2(nul, 1);
+        const char *argv[64];
+        int a = 0;
+        argv[a++] = MS_CLI_PATH;
+        for (int i = 0; args[i] && a < 63; i++) argv[a++] = args[i];
+        argv[a] = NULL;
+        execv(MS_CLI_PATH, (char *const *)argv);
+        _exit(127);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (err_line && n) {
+        err_line[0] = 0;
+        FILE *f = fopen(errpath, "rb");
+        if (f) {
+            if (!fgets(err_line, (int)n, f)) err_line[0] = 0;
+            err_line[strcspn(err_line, "\n")] = 0;
+            fclose(f);
+        }
+    }
+    unlink(errpath);
+    if (WIFEXITED(status)) return WEXITSTATUS(status);
+    return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+int tu_have_shared_scenes(void)
+{
+    struct stat st;
+    if (stat(MS_SHARED_SCENES, &st) == 0 && S_ISDIR(st.st_mode)) return 1;
+    fprintf(stderr, "skipping: shared scenes not found at %s\n", MS_SHARED_SCENES);
+    return 0;
+}
+
+const char *tu_shared_scene(char *buf, size_t n, const char *rel)
+{
+    snprintf(buf, n, "%s/%s", MS_SHARED_SCENES, rel);
+    return buf;
+}
+
+float *tu_read_pfm(const char *path, int *w, int *h)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    char magic[3] = { 0 };
+    float scale;
+    if (fscanf(f, "%2s %d %d %f", magic, w, h, &scale) != 4 || strcmp(magic, "Pf") || scale >= 0) { fclose(f); return NULL; }
+    fgetc(f);
+    size_t npx = (size_t)*w * *h;
+    float *data = malloc(npx * sizeof(float));
+    if (!data) { fclose(f); return NULL; }
+    for (int y = *h - 1; y >= 0; y--)
+        if (fread(data + (size_t)y * *w, sizeof(float), (size_t)*w, f) != (size_t)*w) { free(data); fclose(f); return NULL; }
+    fclose(f);
+    return data;
+}

@@ -1,0 +1,28 @@
+/* Shared helpers for the cmocka tests. */
+#ifndef MS_TESTUTIL_H
+#define MS_TESTUTIL_H
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include "microshadow.h"
+
+/* A fresh directory under the build tree for this test program; returns its path. */
+const char *tu_tmpdir(const char *test_name);
+/* Path buf = dir/name. */
+const char *tu_path(char *buf, size_t n, const char *dir, const char *name);
+int tu_write_file(const char *path, const char *text);
+int tu_file_exists(const char *path);
+/* Number of entries in dir other than . and .. (to prove nothing was left behind). */
+int tu_count_entries(const char *dir);
+/* Runs the CLI with argv (NULL-terminated, without argv[0]); returns its exit status and the first
+ * line of its stderr in err_line. */
+int tu_run_cli(const char *const *args, char *err_line, size_t n);
+/* 1 if ../shared/scenes is present; prints a skip message otherwise. */
+int tu_have_shared_scenes(void);
+const char *tu_shared_scene(char *buf, size_t n, const char *rel);
+/* Reads a PFM written by ms_write_vis into a top-row-first array (caller frees). */
+float *tu_read_pfm(const char *path, int *w, int *h);
+
+#endif
