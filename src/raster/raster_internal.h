@@ -1,0 +1,211 @@
+/* Triangle setup shared by every micro-rasterization kernel (Woop 2010, sec. 3), and the internal
+ * entry points of the kernel variants. Header-only (static inline) so that each ISA variant compiles
+ * the setup with its own instruction set.
+ *
+ * Coordinates: the frame maps world X to light-index space m * (X - c): C at the origin, sample (i,j)
+ * at (i, j, 1), z = segment parameter. An edge equation e covers the homogeneous point (x, y, 1) when
+ * e . (x, y, 1) = e[0]*x + e[1]*y + e[2] >= 0; a sample is occluded when every active edge covers it. */
+#ifndef MS_RASTER_INTERNAL_H
+#define MS_RASTER_INTERNAL_H
+#include <math.h>
+#include <stdint.h>
+#include "raster.h"
+
+typedef struct ms_tri_setup {
+    float e[5][3]; /* active edges: U, V, W always, then N and/or F when the triangle reaches a clip plane */
+    int n;         /* number of active edges, 3..5 */
+    int x0, x1;    /* conservative column range, inclusive, within [0, k-1] */
+    int y0, y1;    /* conservative scanline range, inclusive, within [0, k-1] */
+} ms_tri_setup;
+
+/* Slack (in sample units) added to the projected bounding box: the box only prunes work, the edge
+ * equations decide, so widening it keeps rounding in the projection from ever dropping a sample. */
+#define MS_BOX_SLACK 1e-3f
+
+static inline float ms_minf(float a, float b) { return a < b ? a : b; }
+static inline float ms_maxf(float a, float b) { return a > b ? a : b; }
+static inline float ms_clampf(float x, float lo, float hi) { return ms_minf(ms_maxf(x, lo), hi); }
+
+/* Float to int for values already clamped to a small range (never NaN, never out of int range). */
+static inline int ms_ceil_i(float x) { return (int)ceilf(x); }
+static inline int ms_floor_i(float x) { return (int)floorf(x); }
+
+/* Triangle setup. Returns 0 when the triangle cannot occlude any sample (degenerate, culled, outside the
+ * near/far range or outside the buffer), 1 otherwise with s filled in. */
+static inline int ms_tri_setup_run(const ms_raster_frame *f, const float tri[9], ms_tri_setup *s)
+{
+    const int k = f->k;
+    float v[3][3], ed[3][3]; /* vertices V_i and edges ed[i] = V[i+2] - V[i+1] (opposite vertex i) */
+    for (int i = 0; i < 3; i++) {
+        const float *p = tri + 3 * i, *q = tri + 3 * ((i + 1) % 3), *r = tri + 3 * ((i + 2) % 3);
+        const float a0 = p[0] - f->c[0], a1 = p[1] - f->c[1], a2 = p[2] - f->c[2];
+        /* Edge vectors from world differences: exact for close vertices (Sterbenz), so they keep their
+         * full relative precision however far the triangle is from C. */
+        const float w0 = r[0] - q[0], w1 = r[1] - q[1], w2 = r[2] - q[2];
+        for (int j = 0; j < 3; j++) {
+            v[i][j] = f->m[j][0] * a0 + f->m[j][1] * a1 + f->m[j][2] * a2;
+            ed[i][j] = f->m[j][0] * w0 + f->m[j][1] * w1 + f->m[j][2] * w2;
+        }
+    }
+    const float zmin = ms_minf(ms_minf(v[0][2], v[1][2]), v[2][2]);
+    const float zmax = ms_maxf(ms_maxf(v[0][2], v[1][2]), v[2][2]);
+    /* Every point of the triangle has z in [zmin, zmax]: nothing between near and far, nothing to do.
+     * The negated form also rejects NaN coordinates. */
+    if (!(zmax >= f->near && zmin <= f->far)) return 0;
+
+    /* Edge equations U = V1 x V2, V = V2 x V0, W = V0 x V1 (sec. 3, eqs. 1-3). Departure: the triangle
+     * (C, V_a, V_b) has three sides V_a, V_b and E = V_b - V_a, and V_a x V_b = V_a x E = V_b x E; the
+     * rounding error of a cross product is eps times the product of its operands' lengths, so we take
+     * the two shortest sides. The plain V_a x V_b loses everything for a small triangle far from C
+     * (nearly parallel V_a, V_b), and V_a x E for a vertex next to C; this choice is accurate to a few
+     * eps relative to |U| unless C lies on the edge's line itself. */
+    float len2[3], elen2[3];
+    for (int i = 0; i < 3; i++) {
+        len2[i] = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
+        elen2[i] = ed[i][0] * ed[i][0] + ed[i][1] * ed[i][1] + ed[i][2] * ed[i][2];
+    }
+    float (*e)[3] = s->e;
+    for (int i = 0; i < 3; i++) {
+        const int ia = (i + 1) % 3, ib = (i + 2) % 3;
+        const int va_longest = len2[ia] >= len2[ib] && len2[ia] >= elen2[i];
+        const int e_longest = !va_longest && elen2[i] >= len2[ib];
+        const float *x = va_longest ? v[ib] : v[ia];
+        const float *y = e_longest ? v[ib] : ed[i];
+        e[i][0] = x[1] * y[2] - x[2] * y[1];
+        e[i][1] = x[2] * y[0] - x[0] * y[2];
+        e[i][2] = x[0] * y[1] - x[1] * y[0];
+    }
+    /* U+V+W = (V1 - V0) x (V2 - V0) = E1 x E2 = E2 x E0 = E0 x E1, the plane normal, from the two
+     * shortest edges (a sliver's two long edges are nearly parallel). D = det(V0, V1, V2) = V_i . (U+V+W)
+     * for any i, since the normal is orthogonal to the edges: the vertex nearest C rounds least. */
+    const int long_i = elen2[0] >= elen2[1] ? (elen2[0] >= elen2[2] ? 0 : 2) : (elen2[1] >= elen2[2] ? 1 : 2);
+    const float *sa = ed[(long_i + 1) % 3], *sb = ed[(long_i + 2) % 3];
+    float sn[3] = { sa[1] * sb[2] - sa[2] * sb[1], sa[2] * sb[0] - sa[0] * sb[2], sa[0] * sb[1] - sa[1] * sb[0] };
+    const int near_i = len2[0] <= len2[1] ? (len2[0] <= len2[2] ? 0 : 2) : (len2[1] <= len2[2] ? 1 : 2);
+    float d = v[near_i][0] * sn[0] + v[near_i][1] * sn[1] + v[near_i][2] * sn[2];
+    if (!(d != 0.0f)) return 0; /* the plane of the triangle contains C (or it has no area) */
+    if (f->cull_backfaces) {
+        /* World D = det(M) * light D with det(M) = 1 / det(m); the triangle faces away from C when the
+         * world D is positive. Only paid for when culling is on. */
+        const float (*m)[3] = (const float (*)[3])f->m;
+        const float detm = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        if (d * detm > 0.0f) return 0;
+    }
+    if (d < 0.0f) {
+        /* Two-sided: flip the winding rather than discard (the paper culls D <= 0). */
+        for (int i = 0; i < 3; i++)
+            for (int r = 0; r < 3; r++) e[i][r] = -e[i][r];
+        d = -d;
+        sn[0] = -sn[0]; sn[1] = -sn[1]; sn[2] = -sn[2];
+    }
+    int n = 3;
+    /* Clip edges (eqs. 7-8): N = (0,0,D) - near (U+V+W), F = far (U+V+W) - (0,0,D). Each is needed only
+     * when the triangle reaches its plane: the hit point is a convex combination of the vertices, so
+     * zmin >= near already implies n >= 0 wherever u, v, w >= 0 (and likewise for far). */
+    if (zmin < f->near) {
+        e[n][0] = -f->near * sn[0]; e[n][1] = -f->near * sn[1]; e[n][2] = d - f->near * sn[2];
+        n++;
+    }
+    if (zmax > f->far) {
+        e[n][0] = f->far * sn[0]; e[n][1] = f->far * sn[1]; e[n][2] = f->far * sn[2] - d;
+        n++;
+    }
+    s->n = n;
+
+    /* Conservative sample range (sec. 4): the bounding box of the projected vertices when the triangle
+     * lies in front of C; all of the buffer when it crosses the z = 0 plane (its projection is then
+     * unbounded or wraps through infinity). */
+    const float kmax = (float)(k - 1);
+    if (zmin > 0.0f) {
+        float xs[3], ys[3];
+        for (int i = 0; i < 3; i++) {
+            const float inv = 1.0f / v[i][2];
+            xs[i] = v[i][0] * inv;
+            ys[i] = v[i][1] * inv;
+        }
+        const float xlo = ms_minf(ms_minf(xs[0], xs[1]), xs[2]) - MS_BOX_SLACK;
+        const float xhi = ms_maxf(ms_maxf(xs[0], xs[1]), xs[2]) + MS_BOX_SLACK;
+        const float ylo = ms_minf(ms_minf(ys[0], ys[1]), ys[2]) - MS_BOX_SLACK;
+        const float yhi = ms_maxf(ms_maxf(ys[0], ys[1]), ys[2]) + MS_BOX_SLACK;
+        /* Clamp before converting: projections can be huge (z close to 0). */
+        s->x0 = ms_ceil_i(ms_clampf(xlo, -1.0f, kmax + 1.0f));
+        s->x1 = ms_floor_i(ms_clampf(xhi, -1.0f, kmax + 1.0f));
+        s->y0 = ms_ceil_i(ms_clampf(ylo, -1.0f, kmax + 1.0f));
+        s->y1 = ms_floor_i(ms_clampf(yhi, -1.0f, kmax + 1.0f));
+        if (s->x0 < 0) s->x0 = 0;
+        if (s->y0 < 0) s->y0 = 0;
+        if (s->x1 > k - 1) s->x1 = k - 1;
+        if (s->y1 > k - 1) s->y1 = k - 1;
+        if (s->x0 > s->x1 || s->y0 > s->y1) return 0;
+    } else {
+        s->x0 = 0; s->x1 = k - 1;
+        s->y0 = 0; s->y1 = k - 1;
+    }
+    return 1;
+}
+
+/* Per-sample edge test shared by Bounds and Hierarchical (same expression, same rounding). */
+static inline float ms_edge_eval(const float e[3], float x, float y) { return e[0] * x + (e[1] * y + e[2]); }
+
+/* Scanline setup (sec. 4, eq. 10): each edge with e_x != 0 becomes a bound on x, a*y + b, lower when
+ * e_x > 0 and upper when e_x < 0. Edges parallel to the x axis bound y instead and go into [y0, y1]. */
+typedef struct ms_scan_setup {
+    float al[5], bl[5]; /* lower bounds: x >= al*y + bl */
+    float au[5], bu[5]; /* upper bounds: x <= au*y + bu */
+    int nl, nu;
+    int y0, y1;
+} ms_scan_setup;
+
+/* An edge counts as parallel to x when e_x * k changes it by less than 2^-20 of its larger other
+ * coefficient over the whole buffer: it then differs from the exact test only for samples within a
+ * relative 1e-6 of the edge, a tie; and every slope kept stays below 2^20 k (finite, no overflow). */
+#define MS_FLAT_EDGE (1.0f / 1048576.0f)
+
+static inline int ms_scan_setup_run(const ms_raster_frame *f, const ms_tri_setup *t, ms_scan_setup *s)
+{
+    const int k = f->k;
+    const float kf = (float)k;
+    int nl = 0, nu = 0, y0 = t->y0, y1 = t->y1;
+    for (int i = 0; i < t->n; i++) {
+        const float ex = t->e[i][0], ey = t->e[i][1], ez = t->e[i][2];
+        const float ax = fabsf(ex) * kf, ay = fabsf(ey) * kf, az = fabsf(ez);
+        if (ax > MS_FLAT_EDGE * ms_maxf(ay, az)) {
+            const float r = -1.0f / ex;
+            if (ex > 0.0f) { s->al[nl] = ey * r; s->bl[nl] = ez * r; nl++; }
+            else           { s->au[nu] = ey * r; s->bu[nu] = ez * r; nu++; }
+        } else if (ay > MS_FLAT_EDGE * az) {
+            /* The paper tilts such an edge slightly (a possible light leak); bounding y is exact. */
+            const float yb = ms_clampf(-ez / ey, -1.0f, kf);
+            if (ey > 0.0f) { const int c = ms_ceil_i(yb); if (c > y0) y0 = c; }
+            else           { const int c = ms_floor_i(yb); if (c < y1) y1 = c; }
+        } else if (ez < 0.0f) {
+            return 0; /* constant and negative on the whole buffer */
+        }
+    }
+    s->nl = nl; s->nu = nu;
+    s->y0 = y0; s->y1 = y1;
+    return y0 <= y1;
+}
+
+/* Scalar kernels, one per (kernel, k). */
+void ms_scanline_16(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_scanline_32(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_scanline_64(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_bounds_16(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_bounds_32(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_bounds_64(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_hier_16(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_hier_32(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_hier_64(const ms_raster_frame *f, const float tri[9], void *buf);
+/* AVX-512 scanline kernels (several scanlines per instruction). */
+void ms_scanline_16_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_scanline_32_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_scanline_64_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
+
+/* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
+ * (0 when setup rejects it). */
+int ms_scanline_rows(const ms_raster_frame *f, const float tri[9]);
+
+#endif
