@@ -1,0 +1,490 @@
+/* Method "embree": the same V as "raytrace", computed by Intel Embree 3, the ray tracer our users
+ * would otherwise use. Everything we claim is a ratio against this method, and it is the independent
+ * cross-check of our answers (tests/test_embree.c). See docs/embree.md.
+ *
+ * Scene: ctx->bvh->tri (leaf order) as one Embree triangle geometry, so Embree's primID is our prim
+ * id; build quality high; two-sided (create fails if this Embree was built with back-face culling).
+ * The primary method "embree" and the shadow method "embree" share one RTCDevice/RTCScene: the first
+ * create() of a frame builds it, the other finds it in a small mutex-protected cache keyed by the
+ * frame's BVH and holds a reference; the last destroy() releases it.
+ *
+ * Shadow rays: per pixel the ctx->samples segments of the chosen pattern (ms_pattern_points), origin
+ * q.p, direction sample - q.p unnormalised, tnear = ctx->near, tfar = ctx->far, exactly as raytrace.
+ * Traced either as 16-wide packets (rtcOccluded16) or as one coherent stream per pixel (rtcOccluded1M
+ * with RTC_INTERSECT_CONTEXT_FLAG_COHERENT), chosen by the environment variable
+ *     MS_EMBREE_MODE=packet16 | stream      (default packet16: the faster here, docs/embree.md)
+ * read when the method is created.
+ *
+ * The hit triangle q.prim never occludes. Embree excludes it through a context filter function that
+ * rejects primID == q.prim, the prim passed in an extension of RTCIntersectContext. The filter is
+ * only needed when the receiver's own triangle can be hit at all: when all four light corners lie in
+ * front of the triangle's plane by at least 10x the hit point's own offset, every segment stays
+ * strictly on the front side (the margin is orders of magnitude above rounding), so Embree cannot
+ * report the triangle and the filter is left out for that pixel. Exactly consistent with raytrace
+ * either way; the choice is
+ *     MS_EMBREE_FILTER=plane | always | none (default plane; "none" is for measuring only: the
+ *                                              receiver's triangle then occludes, V is wrong)
+ *
+ * FTZ/DAZ: Embree wants flush-to-zero and denormals-are-zero; every entry point that calls into
+ * Embree sets them in MXCSR for the calling thread and restores the caller's MXCSR on return, so that
+ * other methods run on the same OpenMP threads are not affected.
+ *
+ * Timing: the Embree build happens in create(), which ms_render does not time; it is reported once per
+ * frame as the counter "embree_build_us". */
+#include "method.h"
+#include "../core/pattern.h"
+#include "../core/vec.h"
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <xmmintrin.h>
+#include <pmmintrin.h>
+
+enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US };
+enum eb_mode { EB_PACKET16, EB_STREAM };
+enum eb_filter { EB_FILTER_PLANE, EB_FILTER_ALWAYS, EB_FILTER_NONE };
+
+/* One Embree scene for one frame, shared by the primary and the shadow method. */
+typedef struct eb_shared {
+    struct eb_shared *next;
+    const ms_bvh *bvh;         /* key: the frame's BVH and its triangle array */
+    const float *tri;
+    uint32_t n_tris;
+    int refs;                  /* guarded by cache_lock */
+    RTCDevice dev;
+    RTCScene scene;
+    enum eb_mode mode;
+    enum eb_filter filter;
+    uint64_t build_us;
+    int build_reported;        /* set once by the visibility call that reports build_us */
+    char msg[256];             /* Embree's last error message (error callback) */
+} eb_shared;
+
+static pthread_mutex_t cache_lock = PTHREAD_MUTEX_INITIALIZER;
+static eb_shared *cache;
+
+/* RTCIntersectContext extended with what the filter needs; Embree hands the filter our pointer. */
+typedef struct eb_ictx {
+    struct RTCIntersectContext c;   /* must be first */
+    uint32_t skip;
+    uint64_t *cnt;
+} eb_ictx;
+
+/* ---- FTZ/DAZ around every call into Embree ---- */
+
+static unsigned eb_enter(void)
+{
+    unsigned saved = _mm_getcsr();
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    return saved;
+}
+
+static void eb_leave(unsigned saved) { _mm_setcsr(saved); }
+
+/* ---- errors ---- */
+
+static const char *eb_error_name(enum RTCError e)
+{
+    switch (e) {
+    case RTC_ERROR_NONE: return "no error";
+    case RTC_ERROR_UNKNOWN: return "unknown error";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+    }
+    return "unrecognised error";
+}
+
+static void eb_error_cb(void *user, enum RTCError code, const char *str)
+{
+    eb_shared *s = user;
+    snprintf(s->msg, sizeof s->msg, "%s%s%s", eb_error_name(code), str && *str ? ": " : "", str ? str : "");
+}
+
+/* 0 if the device has no pending error, else -1 and "Embree <what>: <error>" in err. */
+static int eb_check(eb_shared *s, const char *what, char *err, size_t errlen)
+{
+    enum RTCError e = rtcGetDeviceError(s->dev);
+    if (e == RTC_ERROR_NONE) return 0;
+    snprintf(err, errlen, "Embree %s failed: %s", what, s->msg[0] ? s->msg : eb_error_name(e));
+    return -1;
+}
+
+static double eb_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- the shared scene ---- */
+
+static void eb_free(eb_shared *s)
+{
+    if (s->scene) rtcReleaseScene(s->scene);
+    if (s->dev) rtcReleaseDevice(s->dev);
+    free(s);
+}
+
+static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t errlen)
+{
+    const ms_bvh *b = ctx->bvh;
+    char cfg[64];
+    snprintf(cfg, sizeof cfg, "threads=%d,set_affinity=0", ctx->threads > 0 ? ctx->threads : 0);
+    s->dev = rtcNewDevice(cfg);
+    if (!s->dev) {
+        snprintf(err, errlen, "Embree device creation failed: %s", eb_error_name(rtcGetDeviceError(NULL)));
+        return -1;
+    }
+    rtcSetDeviceErrorFunction(s->dev, eb_error_cb, s);
+    if (rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED)) {
+        snprintf(err, errlen, "this Embree was built with back-face culling; the embree method needs two-sided triangles");
+        return -1;
+    }
+    if (s->filter != EB_FILTER_NONE && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED)) {
+        snprintf(err, errlen, "this Embree was built without filter functions; the embree method needs them");
+        return -1;
+    }
+    if (s->mode == EB_PACKET16 && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) {
+        snprintf(err, errlen, "this Embree has no 16-wide packets on this CPU; try MS_EMBREE_MODE=stream");
+        return -1;
+    }
+    if (s->mode == EB_STREAM && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_RAY_STREAM_SUPPORTED)) {
+        snprintf(err, errlen, "this Embree has no ray streams; try MS_EMBREE_MODE=packet16");
+        return -1;
+    }
+
+    unsigned mx = eb_enter();
+    double t0 = eb_now();
+    int rc = -1;
+    s->scene = rtcNewScene(s->dev);
+    if (eb_check(s, "scene creation", err, errlen)) goto out;
+    rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (eb_check(s, "geometry creation", err, errlen)) goto out;
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    /* Embree's own buffers (they are padded for its SIMD loads; ours are not). */
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                       3 * (size_t)b->n_tris);
+    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                           b->n_tris);
+    if (!v || !ix || eb_check(s, "buffer allocation", err, errlen)) {
+        if (!err[0]) snprintf(err, errlen, "Embree buffer allocation failed");
+        rtcReleaseGeometry(g);
+        goto out;
+    }
+    memcpy(v, b->tri, 9 * sizeof(float) * (size_t)b->n_tris);
+    for (uint32_t i = 0; i < 3 * b->n_tris; i++) ix[i] = i;
+    rtcCommitGeometry(g);
+    unsigned id = rtcAttachGeometry(s->scene, g);
+    rtcReleaseGeometry(g);
+    if (eb_check(s, "geometry set-up", err, errlen)) goto out;
+    if (id != 0) { snprintf(err, errlen, "Embree gave geometry id %u, expected 0", id); goto out; }
+    rtcCommitScene(s->scene);
+    if (eb_check(s, "BVH build", err, errlen)) goto out;
+    rc = 0;
+out:
+    s->build_us = (uint64_t)((eb_now() - t0) * 1e6 + 0.5);
+    eb_leave(mx);
+    return rc;
+}
+
+static enum eb_mode eb_mode_from_env(void)
+{
+    const char *m = getenv("MS_EMBREE_MODE");
+    return m && strcmp(m, "stream") == 0 ? EB_STREAM : EB_PACKET16;
+}
+
+static enum eb_filter eb_filter_from_env(void)
+{
+    const char *f = getenv("MS_EMBREE_FILTER");
+    if (f && strcmp(f, "always") == 0) return EB_FILTER_ALWAYS;
+    if (f && strcmp(f, "none") == 0) return EB_FILTER_NONE;
+    return EB_FILTER_PLANE;
+}
+
+/* Finds or builds the frame's scene and takes a reference. */
+static int eb_acquire(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
+{
+    *state = NULL;
+    const char *m = getenv("MS_EMBREE_MODE"), *f = getenv("MS_EMBREE_FILTER");
+    if (m && *m && strcmp(m, "packet16") && strcmp(m, "stream")) {
+        snprintf(err, errlen, "MS_EMBREE_MODE must be packet16 or stream (got '%s')", m);
+        return -1;
+    }
+    if (f && *f && strcmp(f, "plane") && strcmp(f, "always") && strcmp(f, "none")) {
+        snprintf(err, errlen, "MS_EMBREE_FILTER must be plane, always or none (got '%s')", f);
+        return -1;
+    }
+    pthread_mutex_lock(&cache_lock);
+    eb_shared *s;
+    for (s = cache; s; s = s->next)
+        if (s->bvh == ctx->bvh && s->tri == ctx->bvh->tri && s->n_tris == ctx->bvh->n_tris) break;
+    if (s) {
+        s->refs++;
+    } else if (!(s = calloc(1, sizeof *s))) {
+        snprintf(err, errlen, "out of memory for the Embree scene");
+    } else {
+        s->bvh = ctx->bvh;
+        s->tri = ctx->bvh->tri;
+        s->n_tris = ctx->bvh->n_tris;
+        s->mode = eb_mode_from_env();
+        s->filter = eb_filter_from_env();
+        if (err && errlen) err[0] = '\0';
+        if (eb_build(ctx, s, err, errlen)) {
+            eb_free(s);
+            s = NULL;
+        } else {
+            s->refs = 1;
+            s->next = cache;
+            cache = s;
+        }
+    }
+    pthread_mutex_unlock(&cache_lock);
+    *state = s;
+    return s ? 0 : -1;
+}
+
+static void eb_release(void *state)
+{
+    eb_shared *s = state;
+    if (!s) return;
+    pthread_mutex_lock(&cache_lock);
+    int last = --s->refs == 0;
+    if (last)
+        for (eb_shared **p = &cache; *p; p = &(*p)->next)
+            if (*p == s) { *p = s->next; break; }
+    pthread_mutex_unlock(&cache_lock);
+    if (last) eb_free(s);
+}
+
+/* ---- shadow rays ---- */
+
+static void eb_filter_fn(const struct RTCFilterFunctionNArguments *a)
+{
+    const eb_ictx *c = (const eb_ictx *)a->context;
+    const unsigned *prim = (const unsigned *)a->hit + 5 * a->N;   /* RTCHitN primID lane array */
+    for (unsigned i = 0; i < a->N; i++)
+        if (a->valid[i] && prim[i] == c->skip) {
+            a->valid[i] = 0;
+            c->cnt[C_FILTER_REJECTS]++;
+        }
+}
+
+/* 1 if the segments from q.p to the light can cross the plane of q's own triangle within the
+ * occluding range, i.e. if Embree could report the receiver's triangle; see the header comment. */
+static int eb_needs_filter(const ms_render_ctx *ctx, const ms_shadow_query *q)
+{
+    const float *tri = ctx->bvh->tri + 9 * (size_t)q->prim;
+    float e1[3], e2[3], n[3], d[3];
+    v3_sub(e1, tri + 3, tri);
+    v3_sub(e2, tri + 6, tri);
+    v3_cross(n, e1, e2);
+    v3_normalize(n, n);
+    v3_sub(d, q->p, tri);
+    float dp = v3_dot(n, d);
+    if (dp < 0.0f) { v3_scale(n, n, -1.0f); dp = -dp; }
+    if (!(dp > 0.0f)) return 1;
+    const ms_light *L = &ctx->light;
+    const float c0[3] = { L->corner.x, L->corner.y, L->corner.z };
+    const float es[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, et[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
+    float c[4][3];
+    for (int a = 0; a < 3; a++) {
+        c[0][a] = c0[a];
+        c[1][a] = c0[a] + es[a];
+        c[2][a] = c0[a] + et[a];
+        c[3][a] = c0[a] + es[a] + et[a];
+    }
+    for (int i = 0; i < 4; i++) {
+        v3_sub(d, c[i], tri);
+        if (!(v3_dot(n, d) >= 10.0f * dp)) return 1;
+    }
+    return 0;
+}
+
+/* Scratch per visibility call: sample points and the ray storage of either mode. */
+typedef struct eb_scratch {
+    float *pts;
+    struct RTCRay *rays;       /* stream: ns rays */
+    struct RTCRay16 *r16;      /* packet16: one packet */
+} eb_scratch;
+
+static int eb_trace_stream(eb_shared *s, eb_ictx *ic, const ms_render_ctx *ctx, const ms_shadow_query *q,
+                           const eb_scratch *w, uint64_t *cnt)
+{
+    const int ns = ctx->samples;
+    struct RTCRay *r = w->rays;
+    for (int i = 0; i < ns; i++) {
+        r[i].org_x = q->p[0]; r[i].org_y = q->p[1]; r[i].org_z = q->p[2];
+        r[i].tnear = ctx->near;
+        r[i].dir_x = w->pts[3 * i] - q->p[0];
+        r[i].dir_y = w->pts[3 * i + 1] - q->p[1];
+        r[i].dir_z = w->pts[3 * i + 2] - q->p[2];
+        r[i].time = 0.0f;
+        r[i].tfar = ctx->far;
+        r[i].mask = 0xFFFFFFFFu;
+        r[i].id = (unsigned)i;
+        r[i].flags = 0;
+    }
+    rtcOccluded1M(s->scene, &ic->c, r, (unsigned)ns, sizeof *r);
+    cnt[C_CALLS]++;
+    int visible = 0;
+    for (int i = 0; i < ns; i++) visible += r[i].tfar >= 0.0f;   /* occluded: tfar = -inf */
+    return visible;
+}
+
+static int eb_trace_packet16(eb_shared *s, eb_ictx *ic, const ms_render_ctx *ctx, const ms_shadow_query *q,
+                             const eb_scratch *w, uint64_t *cnt)
+{
+    static const int valid[16] __attribute__((aligned(64))) = { -1, -1, -1, -1, -1, -1, -1, -1,
+                                                                -1, -1, -1, -1, -1, -1, -1, -1 };
+    const int ns = ctx->samples;
+    struct RTCRay16 *r = w->r16;
+    int visible = 0;
+    for (int base = 0; base < ns; base += 16) {
+        const float *pt = w->pts + 3 * base;
+        for (int l = 0; l < 16; l++) {
+            r->org_x[l] = q->p[0]; r->org_y[l] = q->p[1]; r->org_z[l] = q->p[2];
+            r->tnear[l] = ctx->near;
+            r->dir_x[l] = pt[3 * l] - q->p[0];
+            r->dir_y[l] = pt[3 * l + 1] - q->p[1];
+            r->dir_z[l] = pt[3 * l + 2] - q->p[2];
+            r->time[l] = 0.0f;
+            r->tfar[l] = ctx->far;
+            r->mask[l] = 0xFFFFFFFFu;
+            r->id[l] = (unsigned)(base + l);
+            r->flags[l] = 0;
+        }
+        rtcOccluded16(valid, s->scene, &ic->c, r);
+        cnt[C_CALLS]++;
+        for (int l = 0; l < 16; l++) visible += r->tfar[l] >= 0.0f;
+    }
+    return visible;
+}
+
+static void eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq, float *vis,
+                          uint64_t *cnt)
+{
+    eb_shared *s = state;
+    const int ns = ctx->samples;
+    if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) cnt[C_BUILD_US] += s->build_us;
+
+    eb_scratch w = { 0 };
+    w.pts = malloc((size_t)ns * 3 * sizeof(float));
+    if (s->mode == EB_STREAM) w.rays = aligned_alloc(64, (size_t)ns * sizeof *w.rays);
+    else w.r16 = aligned_alloc(64, sizeof *w.r16);
+    if (!w.pts || (!w.rays && !w.r16)) abort();
+
+    unsigned mx = eb_enter();
+    eb_ictx ic;
+    rtcInitIntersectContext(&ic.c);
+    ic.c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    ic.cnt = cnt;
+    for (int qi = 0; qi < nq; qi++) {
+        ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[qi].px, q[qi].py, ctx->seed, w.pts);
+        int filt = s->filter == EB_FILTER_ALWAYS || (s->filter == EB_FILTER_PLANE && eb_needs_filter(ctx, &q[qi]));
+        ic.c.filter = filt ? eb_filter_fn : NULL;
+        ic.skip = q[qi].prim;
+        cnt[C_FILTERED_PIXELS] += (uint64_t)filt;
+        int visible = s->mode == EB_STREAM ? eb_trace_stream(s, &ic, ctx, &q[qi], &w, cnt)
+                                           : eb_trace_packet16(s, &ic, ctx, &q[qi], &w, cnt);
+        cnt[C_RAYS] += (uint64_t)ns;
+        vis[qi] = (float)visible / (float)ns;
+    }
+    eb_leave(mx);
+    free(w.pts);
+    free(w.rays);
+    free(w.r16);
+}
+
+const ms_shadow_method ms_shadow_embree = {
+    .name = "embree",
+    .primary = "embree",
+    .needs_grid = 0,
+    .n_counters = 5,
+    .counter_names = { "rays", "embree_calls", "filtered_pixels", "filter_rejects", "embree_build_us" },
+    .create = eb_acquire,
+    .visibility = eb_visibility,
+    .destroy = eb_release,
+};
+
+/* ---- primary visibility: camera rays as 16-ray packets over 4x4 pixel blocks ---- */
+
+/* The hit parameter of ray (o, d) on the plane of tri, by the very operations of ms_intersect_triangle
+ * (so bit for bit the t the BVH primary finds on that triangle), without its inside test: Embree may
+ * report a triangle at an edge that our test would just miss. Embree's own t if the ray is parallel. */
+static float eb_plane_t(const float tri[9], const float o[3], const float d[3], float t_embree)
+{
+    float e1[3], e2[3], p[3], s[3], q[3];
+    v3_sub(e1, tri + 3, tri);
+    v3_sub(e2, tri + 6, tri);
+    v3_cross(p, d, e2);
+    float det = v3_dot(e1, p);
+    if (det == 0.0f) return t_embree;
+    float inv = 1.0f / det;
+    v3_sub(s, o, tri);
+    v3_cross(q, s, e1);
+    float t = v3_dot(e2, q) * inv;
+    return isfinite(t) && t > 0.0f ? t : t_embree;
+}
+
+static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int y0, int x1, int y1, ms_hit *out)
+{
+    eb_shared *s = state;
+    const int tw = x1 - x0;
+    unsigned mx = eb_enter();
+    struct RTCIntersectContext ic;
+    rtcInitIntersectContext(&ic);
+    ic.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    struct RTCRayHit16 rh __attribute__((aligned(64)));
+    int valid[16] __attribute__((aligned(64)));
+    for (int by = y0; by < y1; by += 4)
+        for (int bx = x0; bx < x1; bx += 4) {
+            for (int l = 0; l < 16; l++) {
+                int x = bx + (l & 3), y = by + (l >> 2);
+                float d[3] = { 0.0f, 0.0f, 1.0f };
+                valid[l] = x < x1 && y < y1 ? -1 : 0;
+                if (valid[l]) ms_camera_ray(&ctx->cam, x, y, d);
+                rh.ray.org_x[l] = ctx->cam.eye[0]; rh.ray.org_y[l] = ctx->cam.eye[1]; rh.ray.org_z[l] = ctx->cam.eye[2];
+                rh.ray.dir_x[l] = d[0]; rh.ray.dir_y[l] = d[1]; rh.ray.dir_z[l] = d[2];
+                rh.ray.tnear[l] = 0.0f;
+                rh.ray.tfar[l] = INFINITY;
+                rh.ray.time[l] = 0.0f;
+                rh.ray.mask[l] = 0xFFFFFFFFu;
+                rh.ray.id[l] = (unsigned)l;
+                rh.ray.flags[l] = 0;
+                rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+                rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+            }
+            rtcIntersect16(valid, s->scene, &ic, &rh);
+            for (int l = 0; l < 16; l++) {
+                if (!valid[l]) continue;
+                int x = bx + (l & 3), y = by + (l >> 2);
+                ms_hit *h = &out[(y - y0) * tw + (x - x0)];
+                if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) { h->prim = UINT32_MAX; continue; }
+                const float o[3] = { rh.ray.org_x[l], rh.ray.org_y[l], rh.ray.org_z[l] };
+                const float d[3] = { rh.ray.dir_x[l], rh.ray.dir_y[l], rh.ray.dir_z[l] };
+                uint32_t prim = rh.hit.primID[l];
+                /* Embree decides which triangle is seen; the hit parameter on it is recomputed by the
+                 * shared triangle test, so that a pixel that sees the same triangle gets the very same
+                 * point C as with the BVH primary (Embree's t differs by up to tens of ulps). */
+                ms_hit_finish(ctx, o, d, eb_plane_t(ctx->bvh->tri + 9 * (size_t)prim, o, d, rh.ray.tfar[l]), prim, h);
+            }
+        }
+    eb_leave(mx);
+}
+
+const ms_primary_method ms_primary_embree = {
+    .name = "embree",
+    .create = eb_acquire,
+    .trace = eb_primary_trace,
+    .destroy = eb_release,
+};
