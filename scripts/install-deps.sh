@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the Debian packages microshadow needs that are missing (root, or sudo when available).
+set -euo pipefail
+pkgs=(build-essential cmake pkg-config libassimp-dev libcjson-dev libpng-dev libopenexr-dev libembree-dev
+      libcmocka-dev gnuplot-nox)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+echo "installing: ${missing[*]}" >&2
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

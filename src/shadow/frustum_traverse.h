@@ -1,0 +1,25 @@
+/* Per-pixel light-frustum traversal of the BVH for the micro-rasterization methods (microraster.c).
+ * Instantiated per buffer width and ISA from frustum_traverse_impl.h; the variant is chosen at run
+ * time, the scalar one is always built (and selectable for tests with MS_FORCE_SCALAR=1). */
+#ifndef MS_FRUSTUM_TRAVERSE_H
+#define MS_FRUSTUM_TRAVERSE_H
+#include <stdint.h>
+#include "../accel/bvh.h"
+#include "../raster/raster.h"
+
+enum {
+    MS_FT_FRUSTA, MS_FT_NODES_VISITED, MS_FT_NODES_CULLED_FRUSTUM, MS_FT_NODES_CULLED_OCCLUDED,
+    MS_FT_TRIANGLES, MS_FT_EARLY_OUT, MS_FT_COUNTERS
+};
+
+enum { MS_FT_CULL_OCCLUDED = 1, MS_FT_ORDER_CHILDREN = 2 };
+
+/* Rasterizes every triangle (but `skip`) of the frustum from f->c to the light into buf (k x k, all
+ * ones on entry), stopping when buf is all zero. */
+typedef void (*ms_frustum_trace_fn)(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip,
+                                    void *buf, uint64_t *counters, int flags);
+
+ms_frustum_trace_fn ms_frustum_trace_select(int k, int scalar_only);
+const char *ms_frustum_trace_isa(int scalar_only);
+
+#endif
