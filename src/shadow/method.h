@@ -67,4 +67,8 @@ const ms_primary_method *ms_find_primary_method(const char *name);
 void ms_hit_finish(const ms_render_ctx *ctx, const float o[3], const float d[3], float t, uint32_t prim,
                    ms_hit *h);
 
+/* The reference answer for one point: how many of its k*k samples are unoccluded (raytrace.c).
+ * pts: scratch for 3*k*k floats; cnt: the raytrace method's 3 counters. */
+int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query *q, float *pts, uint64_t *cnt);
+
 #endif

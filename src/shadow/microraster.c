@@ -4,12 +4,22 @@
  * k x k occlusion buffer with the method's kernel (src/raster); V is the fraction of samples left
  * visible. The pixel's 3x3 light-space transform is set up once and shared by all its triangles.
  *
+ * Departure from the paper: a point that sees the light nearly edge-on (closer to the light's plane than
+ * 1e-3 of its distance to the light) makes the light-space transform near-singular, and float edge
+ * equations lose all precision there (light-space coordinates of 1e6 were seen on Sponza, with whole
+ * rows wrongly cleared). Such points are answered by the reference per-sample tracer instead, on the
+ * same samples; they are counted (pixels_traced_edge_on) and are few: the light barely reaches them.
+ *
  * MS_MICRORASTER_NO_OCCLUSION_CULL=1 and MS_MICRORASTER_NO_ORDER=1 switch off the coverage test and
  * the near-first child order, to measure what each buys. */
 #include "method.h"
 #include "frustum_traverse.h"
+#include <math.h>
+#include "../core/vec.h"
 #include <stdio.h>
 #include <stdlib.h>
+
+#define EDGE_ON 1e-3f
 
 typedef struct mr_state {
     ms_raster_fn raster;
@@ -50,26 +60,37 @@ static void mr_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
 {
     const mr_state *s = state;
     _Alignas(64) uint64_t buf[64];
+    float *pts = NULL;
     for (int qi = 0; qi < nq; qi++) {
         ms_grid g;
         ms_raster_frame f;
         ms_grid_for_pixel(&ctx->light, ctx->k, q[qi].px, q[qi].py, ctx->seed, &g);
+        float n[3], rel[3];
+        v3_cross(n, g.ds, g.dt);
+        v3_sub(rel, g.p0, q[qi].p);
+        float h = fabsf(v3_dot(n, rel)), d = v3_len(n) * v3_len(rel);
+        if (!(h > EDGE_ON * d) || ms_raster_frame_init(&f, q[qi].p, &g, ctx->near, ctx->far, 0) != 0) {
+            uint64_t rt_counters[MS_MAX_COUNTERS] = { 0 };
+            if (!pts && !(pts = malloc((size_t)ctx->samples * 3 * sizeof(float)))) abort();
+            vis[qi] = (float)ms_raytrace_visible_samples(ctx, &q[qi], pts, rt_counters) / (float)ctx->samples;
+            cnt[MS_FT_TRACED_EDGE_ON]++;
+            continue;
+        }
         ms_buffer_fill_visible(buf, ctx->k);
         cnt[MS_FT_FRUSTA]++;
-        /* A point on the light's plane sees the light edge-on: nothing to rasterize, V counts all. */
-        if (ms_raster_frame_init(&f, q[qi].p, &g, ctx->near, ctx->far, 0) == 0)
-            s->trace(ctx->bvh, &f, s->raster, q[qi].prim, buf, cnt, s->flags);
+        s->trace(ctx->bvh, &f, s->raster, q[qi].prim, buf, cnt, s->flags);
         vis[qi] = (float)ms_buffer_visible_count(buf, ctx->k) / (float)ctx->samples;
     }
+    free(pts);
 }
 
 static void mr_destroy(void *state) { free(state); }
 
-#define MICRORASTER_METHOD(ident, mname, create_fn)                                                         \
-    const ms_shadow_method ident = {                                                                        \
-        .name = mname, .primary = "bvh", .needs_grid = 1, .n_counters = MS_FT_COUNTERS,                     \
-        .counter_names = { "frusta", "nodes_visited", "nodes_culled_frustum", "nodes_culled_occluded",     \
-                           "triangles_rasterized", "pixels_early_out" },                                   \
+#define MICRORASTER_METHOD(ident, mname, create_fn)                                                   \
+    const ms_shadow_method ident = {                                                                  \
+        .name = mname, .primary = "bvh", .needs_grid = 1, .n_counters = MS_FT_COUNTERS,               \
+        .counter_names = { "frusta", "nodes_visited", "nodes_culled_frustum", "nodes_culled_occluded", \
+                           "triangles_rasterized", "pixels_early_out", "pixels_traced_edge_on" },    \
         .create = create_fn, .visibility = mr_visibility, .destroy = mr_destroy }
 
 MICRORASTER_METHOD(ms_shadow_scanline, "scanline", mr_create_scanline);

@@ -45,7 +45,9 @@ static int packet_enters(const packet *pk, const ms_bvh_node *n)
             t0 = mn > t0 ? mn : t0;
             t1 = mx < t1 ? mx : t1;
         }
-        hit |= (t0 <= t1) & pk->live[l];
+        /* Exit widened by 2*gamma(3) as in ms_bvh_occluded: rounding never culls a box that a ray
+         * through a vertex or along an edge really touches. */
+        hit |= (t0 <= t1 * (1.0f + 2.0f * 3.5762786e-07f)) & pk->live[l];
     }
     return hit;
 }
@@ -104,33 +106,37 @@ static int rt_create(const ms_render_ctx *ctx, void **state, char *err, size_t e
     return 0;
 }
 
+int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query *q, float *pts, uint64_t *cnt)
+{
+    const int ns = ctx->samples;
+    ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, pts);
+    int visible = 0;
+    for (int base = 0; base < ns; base += LANES) {
+        packet pk;
+        for (int a = 0; a < 3; a++) pk.o[a] = q->p[a];
+        pk.tmin = ctx->near;
+        pk.tmax = ctx->far;
+        for (int l = 0; l < LANES; l++) {
+            for (int a = 0; a < 3; a++) {
+                pk.d[a][l] = pts[3 * (base + l) + a] - pk.o[a];
+                pk.inv[a][l] = 1.0f / pk.d[a][l];
+            }
+            pk.live[l] = 1;
+        }
+        trace_packet(ctx->bvh, &pk, q->prim, cnt);
+        for (int l = 0; l < LANES; l++) visible += pk.live[l];
+    }
+    return visible;
+}
+
 static void rt_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
                           float *vis, uint64_t *cnt)
 {
     (void)state;
-    const int ns = ctx->samples;
-    float *pts = malloc((size_t)ns * 3 * sizeof(float));
+    float *pts = malloc((size_t)ctx->samples * 3 * sizeof(float));
     if (!pts) abort();
-    for (int qi = 0; qi < nq; qi++) {
-        ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[qi].px, q[qi].py, ctx->seed, pts);
-        int visible = 0;
-        for (int base = 0; base < ns; base += LANES) {
-            packet pk;
-            for (int a = 0; a < 3; a++) pk.o[a] = q[qi].p[a];
-            pk.tmin = ctx->near;
-            pk.tmax = ctx->far;
-            for (int l = 0; l < LANES; l++) {
-                for (int a = 0; a < 3; a++) {
-                    pk.d[a][l] = pts[3 * (base + l) + a] - pk.o[a];
-                    pk.inv[a][l] = 1.0f / pk.d[a][l];
-                }
-                pk.live[l] = 1;
-            }
-            trace_packet(ctx->bvh, &pk, q[qi].prim, cnt);
-            for (int l = 0; l < LANES; l++) visible += pk.live[l];
-        }
-        vis[qi] = (float)visible / (float)ns;
-    }
+    for (int qi = 0; qi < nq; qi++)
+        vis[qi] = (float)ms_raytrace_visible_samples(ctx, &q[qi], pts, cnt) / (float)ctx->samples;
     free(pts);
 }
 
