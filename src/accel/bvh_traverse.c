@@ -47,7 +47,10 @@ static inline float box_enter(const ms_bvh_node *n, const ray_pre *rp, float tmi
         t0 = lo > t0 ? lo : t0;
         t1 = hi < t1 ? hi : t1;
     }
-    return t0 <= t1 ? t0 : INFINITY;
+    /* Conservative: the exit distance is widened by 2*gamma(3) (Ize, "Robust BVH ray traversal", 2013)
+     * so that rounding in the slabs never culls a box that a ray through a vertex or along an edge of
+     * one of its triangles really touches, where ms_intersect_triangle reports a hit. */
+    return t0 <= t1 * (1.0f + 2.0f * 3.5762786e-07f) ? t0 : INFINITY;
 }
 
 int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
