@@ -2,6 +2,7 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 int ms_atomic_open(ms_atomic_file *a, const char *path, char *err, size_t errlen)
@@ -54,6 +55,13 @@ void ms_atomic_abort(ms_atomic_file *a)
 
 int ms_check_writable(const char *path, char *err, size_t errlen)
 {
+    /* A directory passes the temporary-file test beside it but fails the final rename, after the
+     * render and after the other outputs were written: refuse it up front. */
+    struct stat st;
+    if (path && stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        snprintf(err, errlen, "%s: cannot write: is a directory", path);
+        return -1;
+    }
     ms_atomic_file a;
     if (ms_atomic_open(&a, path, err, errlen)) return -1;
     ms_atomic_abort(&a);
