@@ -106,7 +106,9 @@ int main(int argc, char **argv)
         case 'h': case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("microshadow %s\n", MS_VERSION_STRING); return 0;
         default:
-            if (optopt) fprintf(stderr, "microshadow: option '-%c' is unknown or needs a value (see --help)\n", optopt);
+            /* optopt is the short option's character, or a long option's val (>= 256) when its value
+             * is missing: then argv[optind - 1] names it, as it does an unknown long option. */
+            if (optopt > 0 && optopt < 256) fprintf(stderr, "microshadow: option '-%c' is unknown or needs a value (see --help)\n", optopt);
             else fprintf(stderr, "microshadow: option '%s' is unknown or needs a value (see --help)\n", argv[optind - 1]);
             return EXIT_BAD_INPUT;
         }
