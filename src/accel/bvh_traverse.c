@@ -9,6 +9,7 @@ int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3]
     float e1[3], e2[3], p[3], s[3], q[3];
     v3_sub(e1, tri + 3, tri);
     v3_sub(e2, tri + 6, tri);
+    if (ms_triangle_degenerate(e1, e2)) return 0;
     v3_cross(p, d, e2);
     float det = v3_dot(e1, p);
     if (det == 0.0f) return 0;            /* ray parallel to the plane: two-sided, no culling */

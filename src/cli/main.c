@@ -62,6 +62,45 @@ static int parse_int(const char *opt, const char *s, long lo, long hi, long *out
     return 0;
 }
 
+/* All outputs or none: each is first written (atomically) under a staging name beside its target, and
+ * only when every one succeeded are they renamed into place; a failure removes the staged files. */
+static int write_outputs(const ms_frame *f, const char *png, const char *vis, const char *stats, char *err,
+                         size_t errlen)
+{
+    const char *path[3] = { png, vis, stats };
+    char staged[3][4200];
+    int written = 0, rc = 0;
+    for (int i = 0; i < 3 && !rc; i++) {
+        if (!path[i]) continue;
+        /* The staging name keeps the extension, which selects the visibility format. */
+        const char *slash = strrchr(path[i], '/');
+        int dir = slash ? (int)(slash - path[i] + 1) : 0;
+        snprintf(staged[i], sizeof staged[i], "%.*s.ms-stage-%ld-%s", dir, path[i], (long)getpid(), path[i] + dir);
+        rc = i == 0 ? ms_write_png(f, staged[i], err, errlen)
+           : i == 1 ? ms_write_vis(f, staged[i], err, errlen)
+                    : ms_write_stats_json(f, staged[i], err, errlen);
+        if (rc) {
+            /* Name the user's file in the message, not the staging one. */
+            char *at = strstr(err, staged[i]);
+            if (at) {
+                char rest[1024];
+                snprintf(rest, sizeof rest, "%s%s", path[i], at + strlen(staged[i]));
+                snprintf(at, errlen - (size_t)(at - err), "%s", rest);
+            }
+        } else {
+            written |= 1 << i;
+        }
+    }
+    for (int i = 0; i < 3 && !rc; i++)
+        if ((written >> i & 1) && rename(staged[i], path[i]) != 0) {
+            snprintf(err, errlen, "%s: cannot rename into place: %s", path[i], strerror(errno));
+            rc = -1;
+        }
+    for (int i = 0; i < 3; i++)
+        if (written >> i & 1) unlink(staged[i]);   /* a no-op for those renamed */
+    return rc ? EXIT_BAD_INPUT : 0;
+}
+
 int main(int argc, char **argv)
 {
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_STATS,
@@ -156,13 +195,8 @@ int main(int argc, char **argv)
         ms_scene_free(&scene);
         return EXIT_BAD_INPUT;
     }
-    int rc = 0;
-    if ((out_png && ms_write_png(&frame, out_png, err, sizeof err)) ||
-        (out_vis && ms_write_vis(&frame, out_vis, err, sizeof err)) ||
-        (out_stats && ms_write_stats_json(&frame, out_stats, err, sizeof err))) {
-        fprintf(stderr, "microshadow: %s\n", err);
-        rc = EXIT_BAD_INPUT;
-    }
+    int rc = write_outputs(&frame, out_png, out_vis, out_stats, err, sizeof err);
+    if (rc) fprintf(stderr, "microshadow: %s\n", err);
     if (!quiet && rc == 0) {
         const ms_stats *s = &frame.stats;
         fprintf(stderr, "%s: %zu triangles, %dx%d, %d samples, method %s, %d threads: build %.3fs, primary %.3fs, "

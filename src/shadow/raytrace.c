@@ -58,6 +58,7 @@ static void packet_triangle(packet *pk, const float *tri)
     float e1[3], e2[3], s[3], q[3];
     v3_sub(e1, tri + 3, tri);
     v3_sub(e2, tri + 6, tri);
+    if (ms_triangle_degenerate(e1, e2)) return;
     v3_sub(s, pk->o, tri);
     v3_cross(q, s, e1);            /* shared by all lanes: the origin is common */
     float sq = v3_dot(e2, q);
