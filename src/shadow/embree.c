@@ -17,11 +17,12 @@
  *
  * The hit triangle q.prim never occludes. Embree excludes it through a context filter function that
  * rejects primID == q.prim, the prim passed in an extension of RTCIntersectContext. The filter is
- * only needed when the receiver's own triangle can be hit at all: when all four light corners lie in
- * front of the triangle's plane by at least 10x the hit point's own offset, every segment stays
- * strictly on the front side (the margin is orders of magnitude above rounding), so Embree cannot
- * report the triangle and the filter is left out for that pixel. Exactly consistent with raytrace
- * either way; the choice is
+ * only needed when the receiver's own triangle can be hit within [near, far] at all. It cannot when
+ * all four light corners lie in front of the triangle's plane by at least 10x the hit point's own
+ * offset (every segment stays on the front side), nor when they all lie so far behind it that every
+ * segment crosses the plane at t < near/2; the margins are orders of magnitude above Embree's
+ * rounding, so for those pixels the filter is left out (eb_needs_filter). Exactly consistent with
+ * raytrace either way (the test checks bit-identical V against filtering every pixel); the choice is
  *     MS_EMBREE_FILTER=plane | always | none (default plane; "none" is for measuring only: the
  *                                              receiver's triangle then occludes, V is wrong)
  *
@@ -166,7 +167,8 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
     int rc = -1;
     s->scene = rtcNewScene(s->dev);
     if (eb_check(s, "scene creation", err, errlen)) goto out;
-    rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    /* The context filter must be enabled on the scene to be called at all ("none": plain Embree). */
+    if (s->filter != EB_FILTER_NONE) rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (eb_check(s, "geometry creation", err, errlen)) goto out;
@@ -303,11 +305,20 @@ static int eb_needs_filter(const ms_render_ctx *ctx, const ms_shadow_query *q)
         c[2][a] = c0[a] + et[a];
         c[3][a] = c0[a] + es[a] + et[a];
     }
+    /* The light's signed distance to the plane is affine on the light, so its corners bound every
+     * sample's. A segment to a sample at distance ds crosses the plane at t = dp / (dp - ds). */
+    float lo = INFINITY, hi = -INFINITY;
     for (int i = 0; i < 4; i++) {
         v3_sub(d, c[i], tri);
-        if (!(v3_dot(n, d) >= 10.0f * dp)) return 1;
+        float ds = v3_dot(n, d);
+        lo = ds < lo ? ds : lo;
+        hi = ds > hi ? ds : hi;
     }
-    return 0;
+    /* Light in front, beyond 10x the point's own offset: t < 0 or t > 1 (den = ds - dp >= 9 dp). */
+    if (lo >= 10.0f * dp) return 0;
+    /* Light far behind: every crossing at t < near/2, before the occluding range even begins. */
+    if (ctx->near > 0.0f && hi <= dp * (1.0f - 2.0f / ctx->near)) return 0;
+    return 1;
 }
 
 /* Scratch per visibility call: sample points and the ray storage of either mode. */
