@@ -30,8 +30,11 @@
  * Embree sets them in MXCSR for the calling thread and restores the caller's MXCSR on return, so that
  * other methods run on the same OpenMP threads are not affected.
  *
+ * Degenerate triangles (ms_triangle_degenerate), which every ray test of ours rejects, are given to
+ * Embree with zero area so that it never hits them either.
+ *
  * Timing: the Embree build happens in create(), which ms_render does not time; it is reported once per
- * frame as the counter "embree_build_us". */
+ * frame as the counter "embree_build_us" (and the degenerate triangles as "degenerate_triangles"). */
 #include "method.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
@@ -45,7 +48,7 @@
 #include <xmmintrin.h>
 #include <pmmintrin.h>
 
-enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US };
+enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US, C_DEGENERATE };
 enum eb_mode { EB_PACKET16, EB_STREAM };
 enum eb_filter { EB_FILTER_PLANE, EB_FILTER_ALWAYS, EB_FILTER_NONE };
 
@@ -60,8 +63,8 @@ typedef struct eb_shared {
     RTCScene scene;
     enum eb_mode mode;
     enum eb_filter filter;
-    uint64_t build_us;
-    int build_reported;        /* set once by the visibility call that reports build_us */
+    uint64_t build_us, n_degenerate;
+    int build_reported;        /* set once by the visibility call that reports build_us, n_degenerate */
     char msg[256];             /* Embree's last error message (error callback) */
 } eb_shared;
 
@@ -184,7 +187,17 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
         goto out;
     }
     memcpy(v, b->tri, 9 * sizeof(float) * (size_t)b->n_tris);
-    for (uint32_t i = 0; i < 3 * b->n_tris; i++) ix[i] = i;
+    /* Triangles our ray tests reject as thinner than float can represent (ms_triangle_degenerate) get
+     * all three indices on one vertex: zero area, which Embree never hits, and primIDs stay ours. */
+    for (uint32_t i = 0; i < b->n_tris; i++) {
+        const float *t = b->tri + 9 * (size_t)i;
+        float e1[3], e2[3];
+        v3_sub(e1, t + 3, t);
+        v3_sub(e2, t + 6, t);
+        int degenerate = ms_triangle_degenerate(e1, e2);
+        s->n_degenerate += (uint64_t)degenerate;
+        for (int c = 0; c < 3; c++) ix[3 * i + c] = 3 * i + (degenerate ? 0 : (unsigned)c);
+    }
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(s->scene, g);
     rtcReleaseGeometry(g);
@@ -386,7 +399,10 @@ static void eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
 {
     eb_shared *s = state;
     const int ns = ctx->samples;
-    if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) cnt[C_BUILD_US] += s->build_us;
+    if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) {
+        cnt[C_BUILD_US] += s->build_us;
+        cnt[C_DEGENERATE] += s->n_degenerate;
+    }
 
     eb_scratch w = { 0 };
     w.pts = malloc((size_t)ns * 3 * sizeof(float));
@@ -420,8 +436,9 @@ const ms_shadow_method ms_shadow_embree = {
     .name = "embree",
     .primary = "embree",
     .needs_grid = 0,
-    .n_counters = 5,
-    .counter_names = { "rays", "embree_calls", "filtered_pixels", "filter_rejects", "embree_build_us" },
+    .n_counters = 6,
+    .counter_names = { "rays", "embree_calls", "filtered_pixels", "filter_rejects", "embree_build_us",
+                       "degenerate_triangles" },
     .create = eb_acquire,
     .visibility = eb_visibility,
     .destroy = eb_release,
