@@ -14,6 +14,9 @@ enum {
 
 enum { MS_FT_CULL_OCCLUDED = 1, MS_FT_ORDER_CHILDREN = 2 };
 
+/* Slack, in samples per unit depth, for rounding at the frustum's sides and in the projection. */
+#define MS_TRAV_SIDE_SLACK 0.01f
+
 /* Rasterizes every triangle (but `skip`) of the frustum from f->c to the light into buf (k x k, all
  * ones on entry), stopping when buf is all zero. */
 typedef void (*ms_frustum_trace_fn)(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip,

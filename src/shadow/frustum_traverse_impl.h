@@ -23,8 +23,6 @@
 
 #ifndef MS_TRAV_COMMON
 #define MS_TRAV_COMMON
-/* Slack, in samples per unit depth, for rounding at the frustum's sides and in the projection. */
-#define MS_TRAV_SIDE_SLACK 0.01f
 typedef struct ms_node_view {
     float x0, x1, y0, y1;   /* projected bounds in sample units (valid when in_front) */
     float zmin;
