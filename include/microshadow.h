@@ -97,7 +97,9 @@ int ms_method_available(const char *name);
 
 typedef struct ms_stats {
     size_t triangles;
-    double load_s, build_s, primary_s, shadow_s, total_s;
+    /* Seconds: scene loading, our BVH build, the methods' own set-up (e.g. Embree's scene build), primary
+     * visibility, shadows, and all of it (total_s). */
+    double load_s, build_s, setup_s, primary_s, shadow_s, total_s;
     int samples, threads, width, height;
     const char *method;
     const char *pattern;

@@ -153,8 +153,8 @@ static void check_stats(const char *path, const ms_frame *fr, size_t tris)
     text[n] = 0;
     cJSON *o = cJSON_Parse(text);
     assert_non_null(o);
-    const char *num_keys[] = { "triangles", "load_s", "build_s", "primary_s", "shadow_s", "total_s", "samples", "threads" };
-    for (int i = 0; i < 8; i++) {
+    const char *num_keys[] = { "triangles", "load_s", "build_s", "setup_s", "primary_s", "shadow_s", "total_s", "samples", "threads" };
+    for (int i = 0; i < 9; i++) {
         const cJSON *x = cJSON_GetObjectItemCaseSensitive(o, num_keys[i]);
         if (!cJSON_IsNumber(x)) fail_msg("stats: '%s' missing or not a number", num_keys[i]);
         assert_true(x->valuedouble >= 0);
@@ -167,6 +167,7 @@ static void check_stats(const char *path, const ms_frame *fr, size_t tris)
     assert_true(cJSON_GetObjectItemCaseSensitive(o, "threads")->valueint >= 1);
     double total = cJSON_GetObjectItemCaseSensitive(o, "total_s")->valuedouble;
     double parts = cJSON_GetObjectItemCaseSensitive(o, "build_s")->valuedouble +
+                   cJSON_GetObjectItemCaseSensitive(o, "setup_s")->valuedouble +
                    cJSON_GetObjectItemCaseSensitive(o, "primary_s")->valuedouble +
                    cJSON_GetObjectItemCaseSensitive(o, "shadow_s")->valuedouble;
     assert_true(total >= parts * 0.999);

@@ -199,10 +199,10 @@ int main(int argc, char **argv)
     if (rc) fprintf(stderr, "microshadow: %s\n", err);
     if (!quiet && rc == 0) {
         const ms_stats *s = &frame.stats;
-        fprintf(stderr, "%s: %zu triangles, %dx%d, %d samples, method %s, %d threads: build %.3fs, primary %.3fs, "
+        fprintf(stderr, "%s: %zu triangles, %dx%d, %d samples, method %s, %d threads: build %.3fs, setup %.3fs, primary %.3fs, "
                 "shadow %.3fs (%.1f M shadow rays/s), total %.3fs -> %s\n",
                 scene_path ? scene_path : "built-in scene", s->triangles, s->width, s->height, s->samples, s->method,
-                s->threads, s->build_s, s->primary_s, s->shadow_s,
+                s->threads, s->build_s, s->setup_s, s->primary_s, s->shadow_s,
                 s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s * 1e-6 : 0.0, s->total_s, out_png);
     }
     ms_frame_free(&frame);

@@ -105,8 +105,10 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     void *pstate = NULL, *sstate = NULL;
     int rc = -1;
     if (!hits || !out->vis || !out->rgb) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); goto fail; }
+    const double t_setup = omp_get_wtime();
     if (pm->create(&ctx, &pstate, err, errlen)) goto fail;
     if (sm->create(&ctx, &sstate, err, errlen)) { pm->destroy(pstate); goto fail; }
+    const double setup_s = omp_get_wtime() - t_setup;
 
     int tx = (W + TILE - 1) / TILE, ty = (H + TILE - 1) / TILE, ntiles = tx * ty;
     progress prog = { opt, 0, 2L * ntiles };
@@ -190,6 +192,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     st->triangles = scene->n_tris;
     st->load_s = scene->load_s;
     st->build_s = bvh.build_s;
+    st->setup_s = setup_s;
     st->primary_s = t1 - t0;
     st->shadow_s = t2 - t1;
     st->samples = ctx.samples;

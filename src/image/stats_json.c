@@ -20,6 +20,7 @@ int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t e
     cJSON_AddNumberToObject(o, "threads", s->threads);
     cJSON_AddNumberToObject(o, "load_s", s->load_s);
     cJSON_AddNumberToObject(o, "build_s", s->build_s);
+    cJSON_AddNumberToObject(o, "setup_s", s->setup_s);
     cJSON_AddNumberToObject(o, "primary_s", s->primary_s);
     cJSON_AddNumberToObject(o, "shadow_s", s->shadow_s);
     cJSON_AddNumberToObject(o, "total_s", s->total_s);
