@@ -31,6 +31,8 @@ int ms_raster_frame_init(ms_raster_frame *f, const float c[3], const ms_grid *g,
     };
     for (int r = 0; r < 3; r++)
         for (int col = 0; col < 3; col++) f->m[r][col] = (float)(adj[r][col] * inv);
+    for (int r = 0; r < 3; r++)
+        for (int col = 0; col < 3; col++) f->mt[r][col] = (float)a[col][r];
     memcpy(f->c, c, sizeof f->c);
     f->near = near;
     f->far = far;

@@ -16,6 +16,7 @@
 
 typedef struct ms_raster_frame {
     float m[3][3];      /* light-index coords of world point X: m * (X - c) */
+    float mt[3][3];     /* rows ds, dt, p0 - c: the transpose of m's inverse, for world edge normals */
     float c[3];
     float near, far;    /* segment parameter range that occludes */
     int k;

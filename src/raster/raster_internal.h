@@ -35,64 +35,63 @@ static inline int ms_floor_i(float x) { return (int)floorf(x); }
 static inline int ms_tri_setup_run(const ms_raster_frame *f, const float tri[9], ms_tri_setup *s)
 {
     const int k = f->k;
-    float v[3][3], ed[3][3]; /* vertices V_i and edges ed[i] = V[i+2] - V[i+1] (opposite vertex i) */
+    /* World vectors from C: a[i] = P_i - C, and the world edges w[i] = P[i+2] - P[i+1] (opposite vertex
+     * i), exact for close vertices (Sterbenz), so they keep their full relative precision however far
+     * the triangle is from C. v[i] = m a[i], the light-index coordinates, serve the depth range and the
+     * projected box only. */
+    float a[3][3], w[3][3], v[3][3];
     for (int i = 0; i < 3; i++) {
         const float *p = tri + 3 * i, *q = tri + 3 * ((i + 1) % 3), *r = tri + 3 * ((i + 2) % 3);
-        const float a0 = p[0] - f->c[0], a1 = p[1] - f->c[1], a2 = p[2] - f->c[2];
-        /* Edge vectors from world differences: exact for close vertices (Sterbenz), so they keep their
-         * full relative precision however far the triangle is from C. */
-        const float w0 = r[0] - q[0], w1 = r[1] - q[1], w2 = r[2] - q[2];
-        for (int j = 0; j < 3; j++) {
-            v[i][j] = f->m[j][0] * a0 + f->m[j][1] * a1 + f->m[j][2] * a2;
-            ed[i][j] = f->m[j][0] * w0 + f->m[j][1] * w1 + f->m[j][2] * w2;
-        }
+        for (int j = 0; j < 3; j++) { a[i][j] = p[j] - f->c[j]; w[i][j] = r[j] - q[j]; }
     }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) v[i][j] = f->m[j][0] * a[i][0] + f->m[j][1] * a[i][1] + f->m[j][2] * a[i][2];
     const float zmin = ms_minf(ms_minf(v[0][2], v[1][2]), v[2][2]);
     const float zmax = ms_maxf(ms_maxf(v[0][2], v[1][2]), v[2][2]);
     /* Every point of the triangle has z in [zmin, zmax]: nothing between near and far, nothing to do.
      * The negated form also rejects NaN coordinates. */
     if (!(zmax >= f->near && zmin <= f->far)) return 0;
 
-    /* Edge equations U = V1 x V2, V = V2 x V0, W = V0 x V1 (sec. 3, eqs. 1-3). Departure: the triangle
-     * (C, V_a, V_b) has three sides V_a, V_b and E = V_b - V_a, and V_a x V_b = V_a x E = V_b x E; the
+    /* Edge equations U = V1 x V2, V = V2 x V0, W = V0 x V1 (sec. 3, eqs. 1-3), by the identity
+     * (m A) x (m B) = det(m) M^T (A x B): the cross product of world vectors from C, carried to light
+     * space by the rows of M^T (ds, dt, p0 - C), and the common factor det(m) dropped (the winding flip
+     * below absorbs its sign). Departure: the paper crosses light-space vertices. When C sees the light
+     * at a grazing angle m is ill-conditioned (entries of 1e3 and more), light-space vertices reach 1e4
+     * and their cross products cancel to a relative error of 1e-3: whole rows of samples went wrong.
+     * The world route makes each coefficient a plain dot product, and an edge's value at sample (i, j)
+     * u . (S_ij - C) up to rounding, whatever the frame's condition.
+     * The triangle (C, P_a, P_b) has three sides A, B and E = B - A, and A x B = A x E = B x E; the
      * rounding error of a cross product is eps times the product of its operands' lengths, so we take
-     * the two shortest sides. The plain V_a x V_b loses everything for a small triangle far from C
-     * (nearly parallel V_a, V_b), and V_a x E for a vertex next to C; this choice is accurate to a few
-     * eps relative to |U| unless C lies on the edge's line itself. */
+     * the two shortest sides: A x B loses everything for a small triangle far from C (nearly parallel
+     * A, B), and A x E for a vertex next to C. */
     float len2[3], elen2[3];
     for (int i = 0; i < 3; i++) {
-        len2[i] = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
-        elen2[i] = ed[i][0] * ed[i][0] + ed[i][1] * ed[i][1] + ed[i][2] * ed[i][2];
+        len2[i] = a[i][0] * a[i][0] + a[i][1] * a[i][1] + a[i][2] * a[i][2];
+        elen2[i] = w[i][0] * w[i][0] + w[i][1] * w[i][1] + w[i][2] * w[i][2];
     }
     float (*e)[3] = s->e;
     for (int i = 0; i < 3; i++) {
         const int ia = (i + 1) % 3, ib = (i + 2) % 3;
         const int va_longest = len2[ia] >= len2[ib] && len2[ia] >= elen2[i];
         const int e_longest = !va_longest && elen2[i] >= len2[ib];
-        const float *x = va_longest ? v[ib] : v[ia];
-        const float *y = e_longest ? v[ib] : ed[i];
-        e[i][0] = x[1] * y[2] - x[2] * y[1];
-        e[i][1] = x[2] * y[0] - x[0] * y[2];
-        e[i][2] = x[0] * y[1] - x[1] * y[0];
+        const float *x = va_longest ? a[ib] : a[ia];
+        const float *y = e_longest ? a[ib] : w[i];
+        const float u[3] = { x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0] };
+        for (int r = 0; r < 3; r++) e[i][r] = f->mt[r][0] * u[0] + f->mt[r][1] * u[1] + f->mt[r][2] * u[2];
     }
-    /* U+V+W = (V1 - V0) x (V2 - V0) = E1 x E2 = E2 x E0 = E0 x E1, the plane normal, from the two
-     * shortest edges (a sliver's two long edges are nearly parallel). D = det(V0, V1, V2) = V_i . (U+V+W)
-     * for any i, since the normal is orthogonal to the edges: the vertex nearest C rounds least. */
+    /* U+V+W is M^T of the plane normal E1 x E2 = E2 x E0 = E0 x E1, from the two shortest edges (a
+     * sliver's two long edges are nearly parallel). D = det(V0, V1, V2) = det(m) (P_i - C) . normal for
+     * any i, with the same factor det(m) dropped: the vertex nearest C rounds least. */
     const int long_i = elen2[0] >= elen2[1] ? (elen2[0] >= elen2[2] ? 0 : 2) : (elen2[1] >= elen2[2] ? 1 : 2);
-    const float *sa = ed[(long_i + 1) % 3], *sb = ed[(long_i + 2) % 3];
-    float sn[3] = { sa[1] * sb[2] - sa[2] * sb[1], sa[2] * sb[0] - sa[0] * sb[2], sa[0] * sb[1] - sa[1] * sb[0] };
+    const float *sa = w[(long_i + 1) % 3], *sb = w[(long_i + 2) % 3];
+    const float nw[3] = { sa[1] * sb[2] - sa[2] * sb[1], sa[2] * sb[0] - sa[0] * sb[2], sa[0] * sb[1] - sa[1] * sb[0] };
     const int near_i = len2[0] <= len2[1] ? (len2[0] <= len2[2] ? 0 : 2) : (len2[1] <= len2[2] ? 1 : 2);
-    float d = v[near_i][0] * sn[0] + v[near_i][1] * sn[1] + v[near_i][2] * sn[2];
+    float d = a[near_i][0] * nw[0] + a[near_i][1] * nw[1] + a[near_i][2] * nw[2];
     if (!(d != 0.0f)) return 0; /* the plane of the triangle contains C (or it has no area) */
-    if (f->cull_backfaces) {
-        /* World D = det(M) * light D with det(M) = 1 / det(m); the triangle faces away from C when the
-         * world D is positive. Only paid for when culling is on. */
-        const float (*m)[3] = (const float (*)[3])f->m;
-        const float detm = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        if (d * detm > 0.0f) return 0;
-    }
+    /* d is the world D = det(P0 - C, P1 - C, P2 - C): positive when the triangle faces away from C. */
+    if (f->cull_backfaces && d > 0.0f) return 0;
+    float sn[3];
+    for (int r = 0; r < 3; r++) sn[r] = f->mt[r][0] * nw[0] + f->mt[r][1] * nw[1] + f->mt[r][2] * nw[2];
     if (d < 0.0f) {
         /* Two-sided: flip the winding rather than discard (the paper culls D <= 0). */
         for (int i = 0; i < 3; i++)

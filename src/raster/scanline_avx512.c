@@ -46,7 +46,9 @@ static inline __attribute__((always_inline)) int ms_scan_vec_setup(const ms_rast
     __m256 W[3];
     for (int a = 0; a < 3; a++)
         W[a] = _mm256_sub_ps(_mm256_permutex2var_ps(T, ia[a], S), _mm256_permutex2var_ps(T, ib[a], S));
-    /* Light-index space: V[r] = row r of m times W (mul + add, not FMA, to round like the scalar setup). */
+    /* Light-index coordinates V[r] = row r of m times W (mul + add, not FMA, to round like the scalar
+     * setup), for the depth range and the projected box only; the edges come from W (see the scalar
+     * setup for why). */
     __m256 V[3];
     for (int r = 0; r < 3; r++)
         V[r] = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(f->m[r][0]), W[0]),
@@ -64,13 +66,13 @@ static inline __attribute__((always_inline)) int ms_scan_vec_setup(const ms_rast
      * slope division starts right after the edge equations instead of waiting for the normal. */
     if ((need != 0x07) != clip) return -1;
 
-    /* Squared lengths: lanes 0..2 of the vertices, 4..6 of the edges. */
-    const __m256 L = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(V[0], V[0]), _mm256_mul_ps(V[1], V[1])),
-                                   _mm256_mul_ps(V[2], V[2]));
+    /* Squared world lengths: lanes 0..2 of the vectors from C, 4..6 of the edges. */
+    const __m256 L = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(W[0], W[0]), _mm256_mul_ps(W[1], W[1])),
+                                   _mm256_mul_ps(W[2], W[2]));
     const __m256 L1 = _mm256_permutexvar_ps(rot1, L), L2 = _mm256_permutexvar_ps(rot2, L);
     const __m256 Le = _mm256_permutexvar_ps(ms_idx8(4, 5, 6, 7, 4, 5, 6, 7), L);
-    /* Edge i's operands (the two shortest sides of the triangle C, V_{i+1}, V_{i+2}) as permutation
-     * indices into V: x = V_{i+2} if V_{i+1} is the longest side, else V_{i+1}; y = V_{i+2} if the edge
+    /* Edge i's operands (the two shortest sides of the triangle C, P_{i+1}, P_{i+2}) as permutation
+     * indices into W: x = A_{i+2} if A_{i+1} is the longest side, else A_{i+1}; y = A_{i+2} if the edge
      * is the longest, else the edge. Lanes 4..6 compute the normal candidates E_{i+1} x E_{i+2} (their
      * indices are the same either way, so the masks need no lane restriction). */
     const __mmask8 va_longest = _mm256_cmp_ps_mask(L1, L2, _CMP_GE_OQ) & _mm256_cmp_ps_mask(L1, Le, _CMP_GE_OQ);
@@ -78,10 +80,18 @@ static inline __attribute__((always_inline)) int ms_scan_vec_setup(const ms_rast
     const __m256i ix = _mm256_mask_blend_epi32(va_longest, ms_idx8(1, 2, 0, 3, 5, 6, 4, 7), ms_idx8(2, 0, 1, 3, 5, 6, 4, 7));
     const __m256i iy = _mm256_mask_blend_epi32(e_longest, ms_idx8(4, 5, 6, 3, 6, 4, 5, 7), ms_idx8(2, 0, 1, 3, 6, 4, 5, 7));
     __m256 X[3], Y[3];
-    for (int r = 0; r < 3; r++) { X[r] = _mm256_permutexvar_ps(ix, V[r]); Y[r] = _mm256_permutexvar_ps(iy, V[r]); }
-    const __m256 ex = _mm256_sub_ps(_mm256_mul_ps(X[1], Y[2]), _mm256_mul_ps(X[2], Y[1]));
-    const __m256 ey = _mm256_sub_ps(_mm256_mul_ps(X[2], Y[0]), _mm256_mul_ps(X[0], Y[2]));
-    const __m256 ez = _mm256_sub_ps(_mm256_mul_ps(X[0], Y[1]), _mm256_mul_ps(X[1], Y[0]));
+    for (int r = 0; r < 3; r++) { X[r] = _mm256_permutexvar_ps(ix, W[r]); Y[r] = _mm256_permutexvar_ps(iy, W[r]); }
+    /* World normals u (of the edge planes through C, and in lanes 4..6 of the triangle's plane)... */
+    const __m256 ux = _mm256_sub_ps(_mm256_mul_ps(X[1], Y[2]), _mm256_mul_ps(X[2], Y[1]));
+    const __m256 uy = _mm256_sub_ps(_mm256_mul_ps(X[2], Y[0]), _mm256_mul_ps(X[0], Y[2]));
+    const __m256 uz = _mm256_sub_ps(_mm256_mul_ps(X[0], Y[1]), _mm256_mul_ps(X[1], Y[0]));
+    /* ...and in light space, M^T u (rows ds, dt, p0 - C). */
+    __m256 et[3];
+    for (int r = 0; r < 3; r++)
+        et[r] = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(f->mt[r][0]), ux),
+                                            _mm256_mul_ps(_mm256_set1_ps(f->mt[r][1]), uy)),
+                              _mm256_mul_ps(_mm256_set1_ps(f->mt[r][2]), uz));
+    const __m256 ex = et[0], ey = et[1], ez = et[2];
 
     /* Normal from the two shortest edges (the candidate of the longest edge), D from the vertex nearest
      * C. One-hot lane masks that pick the lowest lane among equals, like the scalar comparison chains
@@ -92,9 +102,11 @@ static inline __attribute__((always_inline)) int ms_scan_vec_setup(const ms_rast
     const __mmask8 near_m = (__mmask8)((_mm256_mask_cmp_ps_mask(0x03, L, L1, _CMP_LE_OQ) | _mm256_mask_cmp_ps_mask(0x04, L, L1, _CMP_LT_OQ)) &
                                        (_mm256_mask_cmp_ps_mask(0x01, L, L2, _CMP_LE_OQ) | _mm256_mask_cmp_ps_mask(0x06, L, L2, _CMP_LT_OQ)));
 #define MS_PICK(m, v) _mm256_broadcastss_ps(_mm256_castps256_ps128(_mm256_maskz_compress_ps((m), (v))))
+    const __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(MS_PICK(near_m, W[0]), MS_PICK(long_m, ux)),
+                                                 _mm256_mul_ps(MS_PICK(near_m, W[1]), MS_PICK(long_m, uy))),
+                                   _mm256_mul_ps(MS_PICK(near_m, W[2]), MS_PICK(long_m, uz)));
+    /* The light-space normal, for the clip edges only (dead code without them). */
     const __m256 sx = MS_PICK(long_m, ex), sy = MS_PICK(long_m, ey), sz = MS_PICK(long_m, ez);
-    const __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(MS_PICK(near_m, V[0]), sx), _mm256_mul_ps(MS_PICK(near_m, V[1]), sy)),
-                                   _mm256_mul_ps(MS_PICK(near_m, V[2]), sz));
 #undef MS_PICK
 
     /* Clip edges in lanes 3 (N = (-near sx, -near sy, d - near sz)) and 4 (F = (far sx, far sy,
@@ -122,13 +134,7 @@ static inline __attribute__((always_inline)) int ms_scan_vec_setup(const ms_rast
 
     const float d_s = _mm256_cvtss_f32(d);
     if (!(d_s != 0.0f)) return 0;
-    if (f->cull_backfaces) {
-        const float (*m)[3] = (const float (*)[3])f->m;
-        const float detm = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        if (d_s * detm > 0.0f) return 0;
-    }
+    if (f->cull_backfaces && d_s > 0.0f) return 0; /* world D > 0: facing away from C */
 
     /* Scanline setup over the 8 lanes (ms_scan_setup_run); the classification uses magnitudes only. */
     const __m256 absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
