@@ -202,6 +202,10 @@ void ms_hier_64(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_scanline_16_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_scanline_32_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_scanline_64_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
+/* AVX2 + FMA scanline kernels, for CPUs without AVX-512 (8 scanlines per instruction). */
+void ms_scanline_16_avx2(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_scanline_32_avx2(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_scanline_64_avx2(const ms_raster_frame *f, const float tri[9], void *buf);
 
 /* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
  * (0 when setup rejects it). */
