@@ -42,8 +42,13 @@ typedef void (*ms_raster_fn)(const ms_raster_frame *f, const float tri[9], void 
 ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k);
 ms_raster_fn ms_raster_kernel_scalar(ms_kernel_id id, int k);
 const char *ms_kernel_name(ms_kernel_id id);
-/* Name of the SIMD variant ms_raster_kernel picks for this CPU ("scalar", "avx2", "avx512"...). */
+/* Name of the SIMD variant ms_raster_kernel picks for this CPU: "avx512", else "avx2" (with FMA), else
+ * "scalar". */
 const char *ms_raster_isa(void);
+/* A given variant ("scalar", "avx2", "avx512"), e.g. to test or time AVX2 on an AVX-512 machine. NULL
+ * when the CPU lacks that ISA, the kernel has no such variant (only Scanline has SIMD ones), or k is not
+ * 16, 32, 64. */
+ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, const char *isa);
 
 void ms_buffer_fill_visible(void *buf, int k);
 int ms_buffer_all_occluded(const void *buf, int k);
