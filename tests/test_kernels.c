@@ -286,24 +286,42 @@ static void buffer_row_get(const void *buf, int k, int j, uint64_t *w)
 
 static long g_cat_count[CAT_COUNT], g_cat_ties[CAT_COUNT];
 
+/* The AVX2 Scanline variant, also on a CPU that dispatches to AVX-512; NULL (with a message, once per k)
+ * without AVX2+FMA. */
+static ms_raster_fn avx2_scanline(int k)
+{
+    ms_raster_fn fn = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx2");
+    if (fn == NULL) printf("  no AVX2+FMA on this CPU: the avx2 Scanline variant is skipped\n");
+    return fn;
+}
+
 static void run_random(int k, long n_tris, uint64_t seed)
 {
-    kernel_under_test kt[5] = {
+    kernel_under_test kt[6] = {
         { "scanline-scalar", ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, k), 0, 0 },
         { "scanline", ms_raster_kernel(MS_KERNEL_SCANLINE, k), 0, 0 },
         { "bounds", ms_raster_kernel_scalar(MS_KERNEL_BOUNDS, k), 0, 0 },
         { "hierarchical", ms_raster_kernel_scalar(MS_KERNEL_HIERARCHICAL, k), 0, 0 },
-        { "bounds-dispatch", ms_raster_kernel(MS_KERNEL_BOUNDS, k), 0, 0 },
     };
-    int nk = 5;
-    if (kt[4].fn == kt[2].fn) nk = 4; /* same function: no need to run it twice */
+    int nk = 4;
+    /* Same function as one already listed: no need to run it twice. */
+    const ms_raster_fn bounds_dispatch = ms_raster_kernel(MS_KERNEL_BOUNDS, k), avx2 = avx2_scanline(k);
+    if (bounds_dispatch != kt[2].fn) kt[nk++] = (kernel_under_test){ "bounds-dispatch", bounds_dispatch, 0, 0 };
+    int i_avx2 = -1;
+    if (avx2 != NULL && avx2 != kt[1].fn) {
+        i_avx2 = nk;
+        kt[nk++] = (kernel_under_test){ "scanline-avx2", avx2, 0, 0 };
+    }
+    /* The AVX-512 and AVX2 variants do the same arithmetic: reported (not asserted) when both run. */
+    const int cmp_simd = i_avx2 >= 0 && strcmp(ms_raster_isa(), "avx512") == 0;
+    long simd_diff = 0;
     for (int i = 0; i < nk; i++) assert_non_null(kt[i].fn);
     memset(g_cat_count, 0, sizeof g_cat_count);
     memset(g_cat_ties, 0, sizeof g_cat_ties);
     rng r = { seed };
     scene s;
     ms_raster_frame f;
-    uint64_t bufs[5][64];
+    uint64_t bufs[6][64];
     long occluded = 0, bounds_hier_diff = 0, frames = 0;
     clock_t t0 = clock();
     for (long t = 0; t < n_tris; t++) {
@@ -330,6 +348,12 @@ static void run_random(int k, long n_tris, uint64_t seed)
             buffer_row_get(bufs[2], k, j, &wb);
             buffer_row_get(bufs[3], k, j, &wh);
             bounds_hier_diff += wb != wh;
+            if (cmp_simd) {
+                uint64_t w512, w2;
+                buffer_row_get(bufs[1], k, j, &w512);
+                buffer_row_get(bufs[i_avx2], k, j, &w2);
+                simd_diff += w512 != w2;
+            }
             for (int i = 0; i < nk; i++) {
                 uint64_t got;
                 buffer_row_get(bufs[i], k, j, &got);
@@ -361,6 +385,7 @@ static void run_random(int k, long n_tris, uint64_t seed)
     printf("  triangles with a tie by category:");
     for (int c = 0; c < CAT_COUNT; c++) printf(" %s %ld/%ld", cat_name[c], g_cat_ties[c], g_cat_count[c]);
     printf("\n  bounds vs hierarchical: %ld differing scanlines\n", bounds_hier_diff);
+    if (cmp_simd) printf("  scanline avx512 vs avx2: %ld differing scanlines\n", simd_diff);
     for (int i = 0; i < nk; i++) assert_int_equal(kt[i].bad, 0);
     assert_int_equal(bounds_hier_diff, 0);
     /* Ties are rare (most come from the flat-edge and touch-clip categories, which put edges and
@@ -436,16 +461,21 @@ static void test_buffer_queries(void **state)
     }
 }
 
-/* A triangle given in light-index coordinates of an exact frame, run through every kernel. */
-static void all_kernels(const scene *s, const double v[9], int cull, uint64_t out[4][64])
+/* A triangle given in light-index coordinates of an exact frame, run through every kernel: scalar
+ * Scanline, dispatched Scanline, Bounds, Hierarchical and the AVX2 Scanline (the scalar one again
+ * without AVX2+FMA). */
+enum { NFNS = 5 };
+static void all_kernels(const scene *s, const double v[9], int cull, uint64_t out[NFNS][64])
 {
     ms_raster_frame f;
     assert_int_equal(ms_raster_frame_init(&f, s->c, &s->g, s->near, s->far, cull), 0);
     float tri[9];
     for (int i = 0; i < 3; i++) to_world(s, v + 3 * i, tri + 3 * i);
-    ms_raster_fn fns[4] = { ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, s->k), ms_raster_kernel(MS_KERNEL_SCANLINE, s->k),
-                            ms_raster_kernel(MS_KERNEL_BOUNDS, s->k), ms_raster_kernel(MS_KERNEL_HIERARCHICAL, s->k) };
-    for (int i = 0; i < 4; i++) {
+    ms_raster_fn avx2 = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, s->k, "avx2");
+    ms_raster_fn fns[NFNS] = { ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, s->k), ms_raster_kernel(MS_KERNEL_SCANLINE, s->k),
+                               ms_raster_kernel(MS_KERNEL_BOUNDS, s->k), ms_raster_kernel(MS_KERNEL_HIERARCHICAL, s->k),
+                               avx2 ? avx2 : ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, s->k) };
+    for (int i = 0; i < NFNS; i++) {
         ms_buffer_fill_visible(out[i], s->k);
         fns[i](&f, tri, out[i]);
     }
@@ -459,21 +489,21 @@ static void test_special_cases(void **state)
         int k = ks[t];
         scene s;
         exact_scene(&s, k);
-        uint64_t out[4][64];
+        uint64_t out[NFNS][64];
         /* Huge triangle at half depth: the whole buffer occluded; early out true. */
         double huge[9] = { -1000, -1000, 0.5, 5000, -1000, 0.5, -1000, 5000, 0.5 };
         all_kernels(&s, huge, 0, out);
-        for (int i = 0; i < 4; i++) assert_true(ms_buffer_all_occluded(out[i], k));
+        for (int i = 0; i < NFNS; i++) assert_true(ms_buffer_all_occluded(out[i], k));
         /* Both windings of a square's halves give the same shadow: an axis-aligned quad with edges on
          * scanlines y = 2 and y = 5 (exactly on samples) and columns x = 3 and x = 9, at depth 0.5. */
         for (int wind = 0; wind < 2; wind++) {
             double a[9] = { 3 * .5, 2 * .5, .5, 9 * .5, 2 * .5, .5, 9 * .5, 5 * .5, .5 };
             double b[9] = { 3 * .5, 2 * .5, .5, 9 * .5, 5 * .5, .5, 3 * .5, 5 * .5, .5 };
             if (wind) { for (int c = 0; c < 3; c++) { double x = a[3 + c]; a[3 + c] = a[6 + c]; a[6 + c] = x; x = b[3 + c]; b[3 + c] = b[6 + c]; b[6 + c] = x; } }
-            uint64_t oa[4][64], ob[4][64];
+            uint64_t oa[NFNS][64], ob[NFNS][64];
             all_kernels(&s, a, 0, oa);
             all_kernels(&s, b, 0, ob);
-            for (int i = 0; i < 4; i++) {
+            for (int i = 0; i < NFNS; i++) {
                 int vis_a = ms_buffer_visible_count(oa[i], k), vis_b = ms_buffer_visible_count(ob[i], k);
                 /* Closed edges: the rectangle's 7 x 4 samples plus the diagonal's shares overlap. */
                 assert_int_equal(k * k - vis_a, 7 * 4 - (wind ? 0 : 0) - (7 * 4 - (k * k - vis_a)));
@@ -495,20 +525,20 @@ static void test_special_cases(void **state)
         double *none[3] = { flat0, behind, beyond };
         for (int c = 0; c < 3; c++) {
             all_kernels(&s, none[c], 0, out);
-            for (int i = 0; i < 4; i++) assert_int_equal(ms_buffer_visible_count(out[i], k), k * k);
+            for (int i = 0; i < NFNS; i++) assert_int_equal(ms_buffer_visible_count(out[i], k), k * k);
         }
         /* A triangle crossing z = 0 whose front part covers the light: occludes everything in front. */
         double cross[9] = { -1000, -1000, -0.5, 5000 * .9, -1000 * .9, .9, -1000 * .9, 5000 * .9, .9 };
         all_kernels(&s, cross, 0, out);
-        for (int i = 1; i < 4; i++)
+        for (int i = 1; i < NFNS; i++)
             assert_int_equal(ms_buffer_visible_count(out[i], k), ms_buffer_visible_count(out[0], k));
         /* Culling: exactly one winding of a covering triangle occludes. */
         double wa[9] = { -1000, -1000, 0.5, 5000, -1000, 0.5, -1000, 5000, 0.5 };
         double wb[9] = { -1000, -1000, 0.5, -1000, 5000, 0.5, 5000, -1000, 0.5 };
-        uint64_t oa[4][64], ob[4][64];
+        uint64_t oa[NFNS][64], ob[NFNS][64];
         all_kernels(&s, wa, 1, oa);
         all_kernels(&s, wb, 1, ob);
-        for (int i = 0; i < 4; i++) {
+        for (int i = 0; i < NFNS; i++) {
             int va = ms_buffer_visible_count(oa[i], k), vb = ms_buffer_visible_count(ob[i], k);
             assert_true((va == 0 && vb == k * k) || (va == k * k && vb == 0));
         }
@@ -525,6 +555,11 @@ static void test_culling_random(void **state)
     (void)state;
     rng r = { 99 };
     long checked = 0, culled = 0;
+    /* Every kernel as dispatched, and the AVX2 Scanline when the CPU has it. */
+    ms_raster_fn fns[MS_KERNEL_COUNT + 1];
+    int nf = 0;
+    for (int kid = 0; kid < MS_KERNEL_COUNT; kid++) fns[nf++] = ms_raster_kernel((ms_kernel_id)kid, 32);
+    if (ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, "avx2")) fns[nf++] = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, "avx2");
     for (int t = 0; t < 20000; t++) {
         scene s;
         ms_raster_frame f0, f1;
@@ -539,12 +574,12 @@ static void test_culling_random(void **state)
         cross3(n, e1, e2);
         double facing = dot3(n, pc);
         if (fabs(facing) < 1e-3 * len3(n) * len3(pc)) continue;
-        for (int kid = 0; kid < MS_KERNEL_COUNT; kid++) {
+        for (int i = 0; i < nf; i++) {
             uint64_t a[16], b[16];
             ms_buffer_fill_visible(a, 32);
             ms_buffer_fill_visible(b, 32);
-            ms_raster_kernel((ms_kernel_id)kid, 32)(&f0, tri, a);
-            ms_raster_kernel((ms_kernel_id)kid, 32)(&f1, tri, b);
+            fns[i](&f0, tri, a);
+            fns[i](&f1, tri, b);
             if (facing > 0) assert_memory_equal(a, b, sizeof a);
             else assert_int_equal(ms_buffer_visible_count(b, 32), 32 * 32);
         }
@@ -564,7 +599,25 @@ static void test_kernel_table(void **state)
         assert_null(ms_raster_kernel_scalar((ms_kernel_id)id, 128));
     }
     assert_string_equal(ms_kernel_name(MS_KERNEL_SCANLINE), "scanline");
-    assert_non_null(ms_raster_isa());
+    /* Forced variants: scalar always; a SIMD one only for Scanline, only when the CPU has it, and the
+     * one ms_raster_isa names is the one ms_raster_kernel dispatches to. */
+    const char *isa = ms_raster_isa();
+    assert_true(strcmp(isa, "avx512") == 0 || strcmp(isa, "avx2") == 0 || strcmp(isa, "scalar") == 0);
+    const int ks[3] = { 16, 32, 64 };
+    for (int t = 0; t < 3; t++) {
+        const int k = ks[t];
+        for (int id = 0; id < MS_KERNEL_COUNT; id++)
+            assert_ptr_equal(ms_raster_kernel_isa((ms_kernel_id)id, k, "scalar"), ms_raster_kernel_scalar((ms_kernel_id)id, k));
+        assert_ptr_equal(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, isa), ms_raster_kernel(MS_KERNEL_SCANLINE, k));
+        assert_null(ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, "avx2"));
+        assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "sse"));
+        assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, NULL));
+        if (strcmp(isa, "scalar") != 0) assert_non_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx2"));
+        if (strcmp(isa, "avx512") != 0) assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx512"));
+    }
+    assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 8, "scalar"));
+    printf("kernel variant %s; avx2 variant %s\n", isa,
+           ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, "avx2") ? "available" : "not available (no AVX2+FMA)");
 }
 
 int main(void)
