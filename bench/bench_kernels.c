@@ -1,6 +1,8 @@
 /* Reproduces Woop 2010, Figure 2 on this machine: cycles per triangle (rdtsc, the median over the
  * triangles of a bin) against the number of samples the triangle occludes, for the Scanline, Bounds and
- * Hierarchical kernels on the 32x32 buffer (or --k 16/64), and the SIMD Scanline variant.
+ * Hierarchical kernels on the 32x32 buffer (or --k 16/64), the SIMD Scanline variant the CPU dispatches
+ * to (scanline_simd) and, when that is AVX-512 and the CPU has AVX2+FMA, the AVX2 variant
+ * (scanline_avx2), which is what CPUs without AVX-512 run.
  *
  *   bench_kernels [--csv] [--n TRIANGLES] [--k 16|32|64] [--seed S] [--passes P]
  *
@@ -103,13 +105,17 @@ int main(int argc, char **argv)
     double M[3][3];
     for (int r = 0; r < 3; r++) { M[r][0] = g.ds[r]; M[r][1] = g.dt[r]; M[r][2] = (double)g.p0[r] - c[r]; }
 
-    const kernel_entry kernels[] = {
+    kernel_entry kernels[5] = {
         { "scanline", ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, k) },
         { "bounds", ms_raster_kernel_scalar(MS_KERNEL_BOUNDS, k) },
         { "hierarchical", ms_raster_kernel_scalar(MS_KERNEL_HIERARCHICAL, k) },
         { "scanline_simd", ms_raster_kernel(MS_KERNEL_SCANLINE, k) },
     };
-    const int nk = (int)(sizeof kernels / sizeof kernels[0]);
+    int nk = 4;
+    /* A column of its own only when it is not already scanline_simd (a CPU without AVX-512). */
+    const ms_raster_fn avx2 = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx2");
+    const int i_avx2 = avx2 != NULL && avx2 != kernels[3].fn ? nk : -1;
+    if (i_avx2 >= 0) kernels[nk++] = (kernel_entry){ "scanline_avx2", avx2 };
 
     /* Triangles: centre on the light, size log-uniform from a third of a sample to 1.5 lights, vertices
      * in random directions at random depths. Kept only when they occlude something. */
@@ -230,19 +236,27 @@ int main(int argc, char **argv)
         m1 = m;
         at1[kk] = median_u32(tmp, m);
     }
-    printf("\n~400 samples (380..420, %zu triangles): scanline %u, bounds %u, hierarchical %u, scanline_simd %u cycles\n",
-           m400, at400[0], at400[1], at400[2], at400[3]);
-    printf("  hierarchical / scanline = %.1fx (paper 17x), hierarchical / scanline_simd = %.1fx\n",
+    printf("\n~400 samples (380..420, %zu triangles):", m400);
+    for (int kk = 0; kk < nk; kk++) printf("%s %s %u", kk ? "," : "", kernels[kk].name, at400[kk]);
+    printf(" cycles\n  hierarchical / scanline = %.1fx (paper 17x), hierarchical / scanline_simd = %.1fx",
            (double)at400[2] / at400[0], (double)at400[2] / at400[3]);
-    printf("1-sample triangles (%zu): scanline %u, bounds %u, hierarchical %u, scanline_simd %u cycles\n", m1, at1[0],
-           at1[1], at1[2], at1[3]);
-    printf("  scanline / bounds = %.2fx (paper 1.36x), scanline_simd / bounds = %.2fx\n", (double)at1[0] / at1[1],
+    if (i_avx2 >= 0)
+        printf(", hierarchical / scanline_avx2 = %.1fx, scanline / scanline_avx2 = %.1fx", (double)at400[2] / at400[i_avx2],
+               (double)at400[0] / at400[i_avx2]);
+    printf("\n1-sample triangles (%zu):", m1);
+    for (int kk = 0; kk < nk; kk++) printf("%s %s %u", kk ? "," : "", kernels[kk].name, at1[kk]);
+    printf(" cycles\n  scanline / bounds = %.2fx (paper 1.36x), scanline_simd / bounds = %.2fx", (double)at1[0] / at1[1],
            (double)at1[3] / at1[1]);
+    if (i_avx2 >= 0)
+        printf(", scanline_avx2 / bounds = %.2fx, scanline / scanline_avx2 = %.2fx", (double)at1[i_avx2] / at1[1],
+               (double)at1[0] / at1[i_avx2]);
+    printf("\n");
 
     /* Cost model cycles = setup + per_row * rows for the scalar Scanline kernel, fitted by least squares
      * on the median cycles of each iterated-row count (weighted by the number of triangles). The same
-     * fit for the SIMD variant, whose cost grows per group of 16 rows instead. */
-    for (int kk = 0; kk < nk; kk += 3) {
+     * fit for the SIMD variants, whose cost grows per group of 16 (AVX-512) or 8 (AVX2) rows instead. */
+    for (int kk = 0; kk < nk; kk++) {
+        if (kk == 1 || kk == 2) continue; /* Bounds and Hierarchical do not iterate scanlines */
         double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
         for (int r = 1; r <= k; r++) {
             size_t m = 0;
