@@ -1,39 +1,44 @@
 /* AVX-512 instances of the frustum traversal (chosen at run time; see frustum_traverse_impl.h for the
- * method). Same tests, same arithmetic and so the same decisions, counters and visiting order as the
- * AVX2 instance; what differs is the layout:
- *   - the two children of a node are adjacent 32-byte nodes: one 64-byte load, their 16 corners in one
- *     zmm per coordinate, one frustum test, one division and one min/max reduction for both;
+ * method). Same tests and the same arithmetic as the AVX2 and scalar instances, so the same decisions,
+ * counters and visiting order; what differs is the layout:
+ *   - the two children of a node are adjacent nodes: their 16 corners in one zmm per coordinate, one
+ *     frustum test, one division and one min/max reduction for both;
  *   - the projection and coverage work is done only when a child survives the frustum test;
- *   - a pushed node keeps its coverage test as a column mask and a row mask, so that the test on pop
- *     is a few vector ANDs against the buffer;
- *   - the frame's matrix, C and the clip constants are broadcast once per pixel. */
+ *   - a pushed node keeps its coverage test as a column mask and a row mask, so that the test on pop is
+ *     a few vector ANDs against the buffer;
+ *   - the frame's matrix, C and the clip constants are broadcast once per pixel;
+ *   - the grandchildren (or a leaf's triangles) are prefetched while the children are tested.
+ * The traversal is bound by the latency from a node to the decision where to go next (mispredicted
+ * branches wait for it), so the code shortens that chain where it can without changing a rounding. */
 #include "frustum_traverse.h"
 #include <immintrin.h>
 
 #define INLINE static inline __attribute__((always_inline))
 
-/* Per-pixel constants, broadcast once. */
+/* Per-pixel constants. */
 typedef struct trav_consts {
     __m512 m[3][3];   /* m[r][a] in every lane */
-    __m512 csub;      /* lanes 0-2 / 8-10: C, the other lanes unused */
-    __m512 slack, hi, near, far;
+    __m512 c[3];
+    __m512 slack, nslack, hi, near, far;
 } trav_consts;
 
 /* Coverage of a node as bit masks: columns i0..i1 and rows j0..j1 of the buffer it may reach. */
 typedef struct trav_cov { uint64_t cols, rows; } trav_cov;
 
 typedef struct trav_pair {
-    int out[2];       /* culled by the frustum */
-    int front[2];     /* every corner has z > 0 */
-    __m512 x, y, z;   /* lanes 0-7: corners of the first node, 8-15: of the second */
+    unsigned out;     /* bit h: node h is culled by the frustum */
+    unsigned front;   /* bit h: every corner of node h has z > 0 */
+    __m512 x, y, z;   /* lanes 0-7: corners of node 0, 8-15: of node 1 */
+    __m512 zmin;      /* the smallest corner z of each node, in all its lanes */
 } trav_pair;
 
 INLINE void consts_init(trav_consts *t, const ms_raster_frame *f, int K)
 {
     for (int r = 0; r < 3; r++)
         for (int a = 0; a < 3; a++) t->m[r][a] = _mm512_set1_ps(f->m[r][a]);
-    t->csub = _mm512_setr_ps(f->c[0], f->c[1], f->c[2], 0, 0, 0, 0, 0, f->c[0], f->c[1], f->c[2], 0, 0, 0, 0, 0);
+    for (int a = 0; a < 3; a++) t->c[a] = _mm512_set1_ps(f->c[a]);
     t->slack = _mm512_set1_ps(MS_TRAV_SIDE_SLACK);
+    t->nslack = _mm512_set1_ps(-MS_TRAV_SIDE_SLACK);
     t->hi = _mm512_set1_ps((float)(K - 1) + MS_TRAV_SIDE_SLACK);
     t->near = _mm512_set1_ps(f->near);
     t->far = _mm512_set1_ps(f->far);
@@ -47,35 +52,40 @@ INLINE uint64_t bytes_all_ones(uint64_t m)
     return ~(((t & lo7) + lo7) | t) & ~lo7;
 }
 
-/* Corners and frustum test of nodes p[0] and p[1] (only p[0] when `one`). The corners are computed as
- * in frustum_traverse_impl.h, operation for operation: base = m (bmin - C) summed left to right, the
+/* Corners and frustum test of nodes p[0] and q[0] (q = p for the root alone). The corners are computed
+ * as in frustum_traverse_impl.h, operation for operation: base = m (bmin - C) summed left to right, the
  * edges m[r][a] (bmax[a] - bmin[a]), and each corner base + edge x + edge y + edge z, adding only the
  * edges its bits select (the AVX2 code's fma by 0 or 1 rounds the same). */
-INLINE void view_pair(const trav_consts *t, const ms_bvh_node *p, int one, trav_pair *v)
+INLINE void view_pair(const trav_consts *t, const ms_bvh_node *p, const ms_bvh_node *q, trav_pair *v)
 {
-    const __m512 L = one ? _mm512_maskz_loadu_ps(0x00FF, p) : _mm512_loadu_ps(p);
-    /* lanes 0-2: bmin - C, lanes 4-6: bmax - bmin; same at 8-10, 12-14 for the second node. */
-    const __m512i lo_to_hi = _mm512_setr_epi32(0, 0, 0, 0, 0, 1, 2, 0, 0, 0, 0, 0, 8, 9, 10, 0);
-    const __m512 sub = _mm512_mask_permutexvar_ps(t->csub, 0x7070, lo_to_hi, L);
-    const __m512 d = _mm512_maskz_sub_ps(0x7777, L, sub);
+    /* Broadcast loads: node 0 in lanes 0-7, node 1 in 8-15 (shorter than a load and permutes). */
     __m512 rel[3], e[3];
     for (int a = 0; a < 3; a++) {
-        const __m512i ir = _mm512_setr_epi32(a, a, a, a, a, a, a, a, 8 + a, 8 + a, 8 + a, 8 + a, 8 + a, 8 + a, 8 + a, 8 + a);
-        rel[a] = _mm512_permutexvar_ps(ir, d);
-        e[a] = _mm512_permutexvar_ps(_mm512_add_epi32(ir, _mm512_set1_epi32(4)), d);
+        const __m512 lo = _mm512_mask_broadcastss_ps(_mm512_set1_ps(p->bmin[a]), 0xFF00, _mm_load_ss(&q->bmin[a]));
+        const __m512 hi = _mm512_mask_broadcastss_ps(_mm512_set1_ps(p->bmax[a]), 0xFF00, _mm_load_ss(&q->bmax[a]));
+        rel[a] = _mm512_sub_ps(lo, t->c[a]);
+        e[a] = _mm512_sub_ps(hi, lo);
     }
-    __m512 c[3];
+    __m512 c[3], base[3], ed[3][3];
     for (int r = 0; r < 3; r++) {
-        __m512 base = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(t->m[r][0], rel[0]), _mm512_mul_ps(t->m[r][1], rel[1])),
-                                    _mm512_mul_ps(t->m[r][2], rel[2]));
+        base[r] = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(t->m[r][0], rel[0]), _mm512_mul_ps(t->m[r][1], rel[1])),
+                                _mm512_mul_ps(t->m[r][2], rel[2]));
+        for (int a = 0; a < 3; a++) ed[r][a] = _mm512_mul_ps(t->m[r][a], e[a]);
         /* corner bits: x = lane bit 0, y = bit 1, z = bit 2 */
-        base = _mm512_mask_add_ps(base, 0xAAAA, base, _mm512_mul_ps(t->m[r][0], e[0]));
-        base = _mm512_mask_add_ps(base, 0xCCCC, base, _mm512_mul_ps(t->m[r][1], e[1]));
-        c[r] = _mm512_mask_add_ps(base, 0xF0F0, base, _mm512_mul_ps(t->m[r][2], e[2]));
+        __m512 s = _mm512_mask_add_ps(base[r], 0xAAAA, base[r], ed[r][0]);
+        s = _mm512_mask_add_ps(s, 0xCCCC, s, ed[r][1]);
+        c[r] = _mm512_mask_add_ps(s, 0xF0F0, s, ed[r][2]);
     }
+    /* Rounding is monotone, so the smallest corner z is the corner that adds exactly the negative edges:
+     * computed beside the corners rather than reduced from them. */
+    const __m512 zero = _mm512_setzero_ps();
+    __m512 zm = _mm512_add_ps(base[2], _mm512_min_ps(ed[2][0], zero));
+    zm = _mm512_add_ps(zm, _mm512_min_ps(ed[2][1], zero));
+    v->zmin = _mm512_add_ps(zm, _mm512_min_ps(ed[2][2], zero));
     const __m512 xs = c[0], ys = c[1], zs = c[2];
-    const __m512 az = _mm512_mul_ps(_mm512_abs_ps(zs), t->slack);
-    const __m512 naz = _mm512_sub_ps(_mm512_setzero_ps(), az);
+    const __m512 abz = _mm512_abs_ps(zs);
+    const __m512 az = _mm512_mul_ps(abz, t->slack);
+    const __m512 naz = _mm512_mul_ps(abz, t->nslack);   /* = -az exactly, one step shorter */
     const __m512 top = _mm512_fmadd_ps(t->hi, zs, az);
     const uint64_t o4 = (uint64_t)_mm512_cmp_ps_mask(xs, naz, _CMP_LT_OQ) |
                         (uint64_t)_mm512_cmp_ps_mask(xs, top, _CMP_GT_OQ) << 16 |
@@ -83,24 +93,12 @@ INLINE void view_pair(const trav_consts *t, const ms_bvh_node *p, int one, trav_
                         (uint64_t)_mm512_cmp_ps_mask(ys, top, _CMP_GT_OQ) << 48;
     const uint64_t o2 = (uint64_t)_mm512_cmp_ps_mask(zs, t->near, _CMP_LT_OQ) |
                         (uint64_t)_mm512_cmp_ps_mask(zs, t->far, _CMP_GT_OQ) << 16;
-    /* A node is out when, for some plane, all 8 of its corners are: a 0xFF byte (even bytes: first node). */
+    /* A node is out when, for some plane, all 8 of its corners are: a 0xFF byte (even bytes: node 0). */
     const uint64_t all = bytes_all_ones(o4) | bytes_all_ones(o2);
-    v->out[0] = (all & 0x0080008000800080ull) != 0;
-    v->out[1] = (all & 0x8000800080008000ull) != 0;
-    const unsigned fr = _mm512_cmp_ps_mask(zs, _mm512_setzero_ps(), _CMP_GT_OQ);
-    v->front[0] = (fr & 0xFF) == 0xFF;
-    v->front[1] = (fr >> 8) == 0xFF;
+    v->out = (unsigned)((all & 0x0080008000800080ull) != 0) | (unsigned)((all & 0x8000800080008000ull) != 0) << 1;
+    const unsigned fr = _mm512_cmp_ps_mask(zs, zero, _CMP_GT_OQ);
+    v->front = (unsigned)((fr & 0xFF) == 0xFF) | (unsigned)((fr >> 8) == 0xFF) << 1;
     v->x = xs; v->y = ys; v->z = zs;
-}
-
-/* The smallest z of each node's corners. */
-INLINE void zmin_pair(const trav_pair *v, float *z0, float *z1)
-{
-    __m512 z = _mm512_min_ps(v->z, _mm512_shuffle_f32x4(v->z, v->z, 0xB1));
-    z = _mm512_min_ps(z, _mm512_permute_ps(z, 0x4E));
-    z = _mm512_min_ps(z, _mm512_permute_ps(z, 0xB1));
-    *z0 = _mm512_cvtss_f32(z);
-    *z1 = _mm512_cvtss_f32(_mm512_castps128_ps512(_mm512_extractf32x4_ps(z, 2)));
 }
 
 /* Coverage masks of both nodes (as covers_live in frustum_traverse_impl.h: the projected bounds, widened
@@ -126,11 +124,13 @@ INLINE void cov_pair(const trav_consts *t, const trav_pair *v, int K, trav_cov *
     _Alignas(64) int32_t q[16];
     _mm512_store_si512(q, _mm512_cvttps_epi32(r));
     for (int h = 0; h < 2; h++) {
-        if (!v->front[h]) { cv[h].cols = cv[h].rows = ~0ull; continue; }
-        if (!((ok >> (4 * h)) & (ok >> (8 + 4 * h)) & 1)) { cv[h].cols = cv[h].rows = 0; continue; }
-        const int i0 = q[4 * h], i1 = -q[4 * h + 1], j0 = q[8 + 4 * h], j1 = -q[8 + 4 * h + 1];
-        cv[h].cols = (~0ull >> (63 - (i1 - i0))) << i0;
-        cv[h].rows = (~0ull >> (63 - (j1 - j0))) << j0;
+        /* Branch-free: the shifts stay in range whatever q holds for an empty or straddling node. */
+        const int i0 = q[4 * h] & 63, i1 = -q[4 * h + 1] & 63, j0 = q[8 + 4 * h] & 63, j1 = -q[8 + 4 * h + 1] & 63;
+        uint64_t cols = (~0ull >> ((63 - (i1 - i0)) & 63)) << i0, rows = (~0ull >> ((63 - (j1 - j0)) & 63)) << j0;
+        cols = (ok >> (4 * h)) & (ok >> (8 + 4 * h)) & 1 ? cols : 0;
+        const int front = (v->front >> h) & 1;
+        cv[h].cols = front ? cols : ~0ull;
+        cv[h].rows = front ? rows : ~0ull;
     }
 }
 
@@ -167,6 +167,18 @@ INLINE int all_zero(const void *buf, int K)
     return _mm512_test_epi64_mask(acc, acc) == 0;
 }
 
+/* The next step's data, fetched while this step's tests run: an interior child's pair of children, a
+ * leaf child's first triangles. */
+INLINE void prefetch_children(const ms_bvh *b, const ms_bvh_node *cn)
+{
+    for (int h = 0; h < 2; h++) {
+        const char *p = cn[h].count ? (const char *)(b->tri + 9 * (size_t)cn[h].first)
+                                    : (const char *)&b->nodes[cn[h].first];
+        _mm_prefetch(p, _MM_HINT_T0);
+        _mm_prefetch(p + 63, _MM_HINT_T0);
+    }
+}
+
 INLINE void trace(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip, void *buf,
                   uint64_t *cnt, int flags, const int K)
 {
@@ -177,9 +189,9 @@ INLINE void trace(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster
     trav_cov covs[MS_BVH_STACK];
     int sp = 0;
     trav_pair v;
-    view_pair(&t, &b->nodes[0], 1, &v);
+    view_pair(&t, &b->nodes[0], &b->nodes[0], &v);
     cnt[MS_FT_NODES_VISITED]++;
-    if (v.out[0]) { cnt[MS_FT_NODES_CULLED_FRUSTUM]++; return; }
+    if (v.out & 1) { cnt[MS_FT_NODES_CULLED_FRUSTUM]++; return; }
     uint64_t visited = 0, culled_frustum = 0, culled_occluded = 0, triangles = 0;
     uint32_t ni = 0;
     for (;;) {
@@ -193,26 +205,24 @@ INLINE void trace(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster
             if (all_zero(buf, K)) { cnt[MS_FT_EARLY_OUT]++; break; }
         } else {
             const uint32_t c0 = n->first;
-            view_pair(&t, &b->nodes[c0], 0, &v);
+            const ms_bvh_node *cn = &b->nodes[c0];
+            view_pair(&t, cn, cn + 1, &v);
+            prefetch_children(b, cn);
             visited += 2;
-            int k0 = !v.out[0], k1 = !v.out[1];
+            int k0 = !(v.out & 1), k1 = !(v.out & 2);
             culled_frustum += (uint64_t)(!k0 + !k1);
             trav_cov cv[2] = { { ~0ull, ~0ull }, { ~0ull, ~0ull } };
-            if (cull_occluded && (k0 | k1) && (v.front[0] | v.front[1])) {
+            if (cull_occluded && (k0 | k1) && v.front) {
                 cov_pair(&t, &v, K, cv);
                 if (k0 && !covers(buf, cv[0], K)) { k0 = 0; culled_occluded++; }
                 if (k1 && !covers(buf, cv[1], K)) { k1 = 0; culled_occluded++; }
             }
             if (k0 && k1) {
-                float z0, z1;
-                int far = 1;   /* the child pushed for later */
-                if (order) {
-                    zmin_pair(&v, &z0, &z1);
-                    far = z1 < z0 ? 0 : 1;
-                }
-                covs[sp] = cv[far];
-                stack[sp++] = c0 + (uint32_t)far;
-                ni = c0 + (uint32_t)!far;
+                /* A branch, not a select: a mispredicted guess costs less than always waiting for z. */
+                const float z0 = _mm512_cvtss_f32(v.zmin);
+                const float z1 = _mm512_cvtss_f32(_mm512_castps256_ps512(_mm512_extractf32x8_ps(v.zmin, 1)));
+                if (order && z1 < z0) { covs[sp] = cv[0]; stack[sp++] = c0; ni = c0 + 1; }
+                else { covs[sp] = cv[1]; stack[sp++] = c0 + 1; ni = c0; }
                 continue;
             }
             if (k0) { ni = c0; continue; }
