@@ -22,6 +22,12 @@ typedef struct ms_tri_setup {
  * equations decide, so widening it keeps rounding in the projection from ever dropping a sample. */
 #define MS_BOX_SLACK 1e-3f
 
+/* Relative bound (16 ulps) on the rounding of a light-space depth z = m[2] . (P - C), in units of its
+ * terms' magnitudes. At grazing light angles z is a small difference of large terms; depth decisions
+ * (rejection, which clip edges) are taken on z widened by this bound, so that they err towards clipping:
+ * an unneeded clip edge changes nothing, a missing one occludes samples behind the near plane. */
+#define MS_Z_REL 1e-6f
+
 static inline float ms_minf(float a, float b) { return a < b ? a : b; }
 static inline float ms_maxf(float a, float b) { return a > b ? a : b; }
 static inline float ms_clampf(float x, float lo, float hi) { return ms_minf(ms_maxf(x, lo), hi); }
@@ -46,8 +52,15 @@ static inline int ms_tri_setup_run(const ms_raster_frame *f, const float tri[9],
     }
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) v[i][j] = f->m[j][0] * a[i][0] + f->m[j][1] * a[i][1] + f->m[j][2] * a[i][2];
-    const float zmin = ms_minf(ms_minf(v[0][2], v[1][2]), v[2][2]);
-    const float zmax = ms_maxf(ms_maxf(v[0][2], v[1][2]), v[2][2]);
+    float zlo[3], zhi[3];
+    for (int i = 0; i < 3; i++) {
+        const float zerr = (fabsf(f->m[2][0]) * fabsf(a[i][0]) + fabsf(f->m[2][1]) * fabsf(a[i][1]) +
+                            fabsf(f->m[2][2]) * fabsf(a[i][2])) * MS_Z_REL;
+        zlo[i] = v[i][2] - zerr;
+        zhi[i] = v[i][2] + zerr;
+    }
+    const float zmin = ms_minf(ms_minf(zlo[0], zlo[1]), zlo[2]);
+    const float zmax = ms_maxf(ms_maxf(zhi[0], zhi[1]), zhi[2]);
     /* Every point of the triangle has z in [zmin, zmax]: nothing between near and far, nothing to do.
      * The negated form also rejects NaN coordinates. */
     if (!(zmax >= f->near && zmin <= f->far)) return 0;

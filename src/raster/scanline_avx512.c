@@ -56,9 +56,16 @@ static inline __attribute__((always_inline)) int ms_scan_vec_setup(const ms_rast
                              _mm256_mul_ps(_mm256_set1_ps(f->m[r][2]), W[2]));
     /* The other two lanes of each lane's triple (vertices 0..2, edges 4..6). */
     const __m256i rot1 = ms_idx8(1, 2, 0, 3, 5, 6, 4, 7), rot2 = ms_idx8(2, 0, 1, 3, 6, 4, 5, 7);
-    const __m256 z1 = _mm256_permutexvar_ps(rot1, V[2]), z2 = _mm256_permutexvar_ps(rot2, V[2]);
-    const __m256 zmin = _mm256_min_ps(_mm256_min_ps(V[2], z1), z2);
-    const __m256 zmax = _mm256_max_ps(_mm256_max_ps(V[2], z1), z2);
+    /* Depth range widened by the rounding bound of raster_internal.h (MS_Z_REL), same operations. */
+    const __m256 absm = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
+    const __m256 zerr = _mm256_mul_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(fabsf(f->m[2][0])), _mm256_and_ps(W[0], absm)),
+                                    _mm256_mul_ps(_mm256_set1_ps(fabsf(f->m[2][1])), _mm256_and_ps(W[1], absm))),
+                      _mm256_mul_ps(_mm256_set1_ps(fabsf(f->m[2][2])), _mm256_and_ps(W[2], absm))),
+        _mm256_set1_ps(MS_Z_REL));
+    const __m256 zl = _mm256_sub_ps(V[2], zerr), zh = _mm256_add_ps(V[2], zerr);
+    const __m256 zmin = _mm256_min_ps(_mm256_min_ps(zl, _mm256_permutexvar_ps(rot1, zl)), _mm256_permutexvar_ps(rot2, zl));
+    const __m256 zmax = _mm256_max_ps(_mm256_max_ps(zh, _mm256_permutexvar_ps(rot1, zh)), _mm256_permutexvar_ps(rot2, zh));
     const float zmin_s = _mm256_cvtss_f32(zmin), zmax_s = _mm256_cvtss_f32(zmax);
     if (!(zmax_s >= f->near && zmin_s <= f->far)) return 0;
     const __mmask8 need = (__mmask8)(0x07 | (zmin_s < f->near) << 3 | (zmax_s > f->far) << 4);
