@@ -120,18 +120,26 @@ INLINE void cov_pair(const trav_consts *t, const trav_pair *v, int K, trav_cov *
     r = _mm512_max_ps(r, _mm512_setr_ps(0, 1 - K, 0, 0, 0, 1 - K, 0, 0, 0, 1 - K, 0, 0, 0, 1 - K, 0, 0));
     /* lo <= hi per block, compared as floats (as the scalar code) before converting. */
     const __m512 nhi = _mm512_sub_ps(_mm512_setzero_ps(), _mm512_permute_ps(r, 0xB1));
-    const unsigned ok = _mm512_cmp_ps_mask(r, nhi, _CMP_LE_OQ);
-    _Alignas(64) int32_t q[16];
-    _mm512_store_si512(q, _mm512_cvttps_epi32(r));
-    for (int h = 0; h < 2; h++) {
-        /* Branch-free: the shifts stay in range whatever q holds for an empty or straddling node. */
-        const int i0 = q[4 * h] & 63, i1 = -q[4 * h + 1] & 63, j0 = q[8 + 4 * h] & 63, j1 = -q[8 + 4 * h + 1] & 63;
-        uint64_t cols = (~0ull >> ((63 - (i1 - i0)) & 63)) << i0, rows = (~0ull >> ((63 - (j1 - j0)) & 63)) << j0;
-        cols = (ok >> (4 * h)) & (ok >> (8 + 4 * h)) & 1 ? cols : 0;
-        const int front = (v->front >> h) & 1;
-        cv[h].cols = front ? cols : ~0ull;
-        cv[h].rows = front ? rows : ~0ull;
-    }
+    const __mmask16 ok = _mm512_cmp_ps_mask(r, nhi, _CMP_LE_OQ);
+    /* Per 64-bit lane 0 of a block: [lo, -hi] as int32; the mask (~0 >> (63 - (hi - lo))) << lo, 0 when
+     * empty. Computed in registers: a store and narrow reloads would stall store forwarding. */
+    const __m512i q = _mm512_cvttps_epi32(r);
+    const __m512i lo = _mm512_and_si512(q, _mm512_set1_epi64(0xFFFFFFFF)), nhi_i = _mm512_srai_epi64(q, 32);
+    const __m512i w = _mm512_add_epi64(_mm512_add_epi64(nhi_i, lo), _mm512_set1_epi64(63));
+    __m512i m = _mm512_sllv_epi64(_mm512_srlv_epi64(_mm512_set1_epi64(-1), w), lo);
+    /* ok: float bit 4b of block b -> 64-bit lane 2b; a node needs both its x and y ranges non-empty */
+    const unsigned okx = ok & (ok >> 8);
+    const __mmask8 keep = (__mmask8)((okx & 1) | ((okx >> 4) & 1) << 2);
+    m = _mm512_maskz_mov_epi64((__mmask8)(keep | keep << 4), m);
+    /* not wholly in front of C: may cover anything */
+    const __mmask8 fr = (__mmask8)((v->front & 1) | (v->front & 2) << 1);
+    m = _mm512_mask_mov_epi64(_mm512_set1_epi64(-1), (__mmask8)(fr | fr << 4), m);
+    const __m128i x01 = _mm512_castsi512_si128(m), x23 = _mm512_extracti64x2_epi64(m, 1);
+    const __m128i y01 = _mm512_extracti64x2_epi64(m, 2), y23 = _mm512_extracti64x2_epi64(m, 3);
+    cv[0].cols = (uint64_t)_mm_cvtsi128_si64(x01);
+    cv[1].cols = (uint64_t)_mm_cvtsi128_si64(x23);
+    cv[0].rows = (uint64_t)_mm_cvtsi128_si64(y01);
+    cv[1].rows = (uint64_t)_mm_cvtsi128_si64(y23);
 }
 
 /* 1 if a visible sample lies in the masked rows and columns of buf. */
