@@ -1,6 +1,8 @@
 /* Per-pixel light-frustum traversal of the BVH for the micro-rasterization methods (microraster.c).
- * Instantiated per buffer width and ISA from frustum_traverse_impl.h; the variant is chosen at run
- * time, the scalar one is always built (and selectable for tests with MS_FORCE_SCALAR=1). */
+ * Instantiated per buffer width for scalar and AVX2 from frustum_traverse_impl.h, and for AVX-512 in
+ * frustum_traverse_avx512.c; all take the same decisions. The best instance the CPU runs is chosen at
+ * run time; the scalar one is always built (forced by MS_FORCE_SCALAR=1), and MS_TRAVERSE_ISA=scalar
+ * or avx2 caps the choice, to compare the instances in one process. */
 #ifndef MS_FRUSTUM_TRAVERSE_H
 #define MS_FRUSTUM_TRAVERSE_H
 #include <stdint.h>
