@@ -111,26 +111,23 @@ INLINE void cov_pair(const trav_consts *t, const trav_pair *v, int K, trav_cov *
     /* 128-bit blocks: [px node0, px node1, py node0, py node1], 4 corners each after one min/max. */
     const __m512 a = _mm512_shuffle_f32x4(px, py, 0x88), b = _mm512_shuffle_f32x4(px, py, 0xDD);
     const __m512 mn = _mm512_min_ps(a, b);
-    const __m512 nmx = _mm512_sub_ps(_mm512_setzero_ps(), _mm512_max_ps(a, b));
+    /* Sign flip, exact (a zero's sign does not survive the slack subtraction below). */
+    const __m512 nmx = _mm512_xor_ps(_mm512_max_ps(a, b), _mm512_set1_ps(-0.0f));
     /* Per block: lane 0 the min, lane 1 minus the max. */
     __m512 r = _mm512_min_ps(_mm512_unpacklo_ps(mn, nmx), _mm512_unpackhi_ps(mn, nmx));
     r = _mm512_min_ps(r, _mm512_permute_ps(r, 0x4E));
     /* ceil(lo - slack) and, negated, floor(hi + slack); clamped to [0, K-1]. */
     r = _mm512_roundscale_ps(_mm512_sub_ps(r, t->slack), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
     r = _mm512_max_ps(r, _mm512_setr_ps(0, 1 - K, 0, 0, 0, 1 - K, 0, 0, 0, 1 - K, 0, 0, 0, 1 - K, 0, 0));
-    /* lo <= hi per block, compared as floats (as the scalar code) before converting. */
-    const __m512 nhi = _mm512_sub_ps(_mm512_setzero_ps(), _mm512_permute_ps(r, 0xB1));
-    const __mmask16 ok = _mm512_cmp_ps_mask(r, nhi, _CMP_LE_OQ);
-    /* Per 64-bit lane 0 of a block: [lo, -hi] as int32; the mask (~0 >> (63 - (hi - lo))) << lo, 0 when
-     * empty. Computed in registers: a store and narrow reloads would stall store forwarding. */
+    /* Per 64-bit lane 0 of a block: [lo, -hi] as int32; the mask (~0 >> (63 - (hi - lo))) << lo, built
+     * in registers (a store and narrow reloads would stall store forwarding). An empty range, lo > hi,
+     * gives a shift count of 64 or more and so 0, as the scalar code's float test lo <= hi: both are
+     * integral and >= 0 resp. <= K-1, and one too large for int32 converts to INT_MIN, which again
+     * gives a count of 64 or more. */
     const __m512i q = _mm512_cvttps_epi32(r);
     const __m512i lo = _mm512_and_si512(q, _mm512_set1_epi64(0xFFFFFFFF)), nhi_i = _mm512_srai_epi64(q, 32);
     const __m512i w = _mm512_add_epi64(_mm512_add_epi64(nhi_i, lo), _mm512_set1_epi64(63));
     __m512i m = _mm512_sllv_epi64(_mm512_srlv_epi64(_mm512_set1_epi64(-1), w), lo);
-    /* ok: float bit 4b of block b -> 64-bit lane 2b; a node needs both its x and y ranges non-empty */
-    const unsigned okx = ok & (ok >> 8);
-    const __mmask8 keep = (__mmask8)((okx & 1) | ((okx >> 4) & 1) << 2);
-    m = _mm512_maskz_mov_epi64((__mmask8)(keep | keep << 4), m);
     /* not wholly in front of C: may cover anything */
     const __mmask8 fr = (__mmask8)((v->front & 1) | (v->front & 2) << 1);
     m = _mm512_mask_mov_epi64(_mm512_set1_epi64(-1), (__mmask8)(fr | fr << 4), m);
