@@ -102,8 +102,9 @@ INLINE void view_pair(const trav_consts *t, const ms_bvh_node *p, const ms_bvh_n
 }
 
 /* Coverage masks of both nodes (as covers_live in frustum_traverse_impl.h: the projected bounds, widened
- * by the slack, rounded inwards to samples, clamped to the buffer). cols = 0 when no sample is inside;
- * all ones when a node is not wholly in front of C. */
+ * by the slack, rounded inwards to samples, clamped to the buffer). cols or rows = 0 when no sample is
+ * inside; both all ones when a node is not wholly in front of C, which covers a live sample since the
+ * buffer is never all zero during the traversal (it stops at the first leaf that makes it so). */
 INLINE void cov_pair(const trav_consts *t, const trav_pair *v, int K, trav_cov *cv)
 {
     const __m512 iz = _mm512_div_ps(_mm512_set1_ps(1.0f), v->z);
