@@ -5,10 +5,11 @@
  * visible. The pixel's 3x3 light-space transform is set up once and shared by all its triangles.
  *
  * Departure from the paper: a point that sees the light nearly edge-on (closer to the light's plane than
- * 1e-3 of its distance to the light) makes the light-space transform near-singular, and float edge
- * equations lose all precision there (light-space coordinates of 1e6 were seen on Sponza, with whole
- * rows wrongly cleared). Such points are answered by the reference per-sample tracer instead, on the
- * same samples; they are counted (pixels_traced_edge_on) and are few: the light barely reaches them.
+ * 1e-3 of its distance to the light) makes the light-space transform near-singular (light-space
+ * coordinates of 1e6 were seen on Sponza). The kernels' edge equations no longer depend on it (they are
+ * world cross products carried by M^T, raster_internal.h), but the traversal's node projections and the
+ * kernels' boxes do. Such points are answered by the reference per-sample tracer instead, on the same
+ * samples; they are counted (pixels_traced_edge_on) and are few: the light barely reaches them.
  *
  * MS_MICRORASTER_NO_OCCLUSION_CULL=1 and MS_MICRORASTER_NO_ORDER=1 switch off the coverage test and
  * the near-first child order, to measure what each buys. */
