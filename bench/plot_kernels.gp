@@ -17,4 +17,5 @@ sel(k) = (strcol(1) eq k) ? $3 : NaN
 plot csv using 2:(sel("hierarchical")) skip 1 with linespoints lw 2 pt 5 title "Hierarchical", \
      csv using 2:(sel("bounds")) skip 1 with linespoints lw 2 pt 9 title "Bounds", \
      csv using 2:(sel("scanline")) skip 1 with linespoints lw 2 pt 7 title "Scanline (scalar)", \
-     csv using 2:(sel("scanline_simd")) skip 1 with linespoints lw 2 pt 13 title "Scanline (AVX-512)"
+     csv using 2:(sel("scanline_simd")) skip 1 with linespoints lw 2 pt 13 title "Scanline (AVX-512)", \
+     csv using 2:(sel("scanline_avx2")) skip 1 with linespoints lw 2 pt 11 title "Scanline (AVX2)"
