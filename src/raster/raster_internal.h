@@ -201,6 +201,19 @@ static inline int ms_scan_setup_run(const ms_raster_frame *f, const ms_tri_setup
     return y0 <= y1;
 }
 
+/* The SIMD setups' rare path for edges parallel to the scanlines: lane i of yv is the clamped y where
+ * edge i crosses zero, a lower bound on y where bit i of up is set, an upper bound where bit i of dn is;
+ * they narrow [*y0, *y1], then clamped to the buffer. */
+static inline void ms_flat_y_bounds(const float yv[8], unsigned up, unsigned dn, int k, int *y0, int *y1)
+{
+    for (int i = 0; i < 5; i++) {
+        if (up >> i & 1) { const int c = ms_ceil_i(yv[i]); if (c > *y0) *y0 = c; }
+        if (dn >> i & 1) { const int c = ms_floor_i(yv[i]); if (c < *y1) *y1 = c; }
+    }
+    if (*y0 < 0) *y0 = 0;
+    if (*y1 > k - 1) *y1 = k - 1;
+}
+
 /* Scalar kernels, one per (kernel, k). */
 void ms_scanline_16(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_scanline_32(const ms_raster_frame *f, const float tri[9], void *buf);

@@ -206,12 +206,7 @@ static inline __attribute__((always_inline)) int ms_scan_vec_setup(const ms_rast
         const int dn = flat_bits & ~up;
         float yv[8];
         _mm256_storeu_ps(yv, yb);
-        for (int i = 0; i < 5; i++) {
-            if (up >> i & 1) { const int c = ms_ceil_i(yv[i]); if (c > y0) y0 = c; }
-            if (dn >> i & 1) { const int c = ms_floor_i(yv[i]); if (c < y1) y1 = c; }
-        }
-        if (y0 < 0) y0 = 0;
-        if (y1 > k - 1) y1 = k - 1;
+        ms_flat_y_bounds(yv, (unsigned)up, (unsigned)dn, k, &y0, &y1);
     }
     sv->y0 = y0;
     sv->y1 = y1;
