@@ -12,21 +12,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct rng { uint64_t s; } rng;
-static uint64_t rng_next(rng *r)
-{
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-static float rnd(rng *r) { return (float)((rng_next(r) >> 40) * (1.0 / 16777216.0)); }   /* [0,1) */
-static float rnd_in(rng *r, float lo, float hi) { return lo + (hi - lo) * rnd(r); }
+static float rnd(tu_rng *r) { return (float)((tu_rng_next(r) >> 40) * (1.0 / 16777216.0)); }   /* [0,1) */
+static float rnd_in(tu_rng *r, float lo, float hi) { return lo + (hi - lo) * rnd(r); }
 
 /* Soup kinds. */
 enum { SOUP_RANDOM, SOUP_GRID, SOUP_CLUSTER, SOUP_LONG };
 
-static float *make_soup(int kind, size_t n, rng *r, size_t *out_n)
+static float *make_soup(int kind, size_t n, tu_rng *r, size_t *out_n)
 {
     float *t = calloc(9 * (n + 64), sizeof(float));
     size_t m = 0;
@@ -152,7 +144,7 @@ typedef struct counts { long rays, closest_hits, any_hits, bad_closest, bad_any;
 static int g_verbose = 3;   /* print the first few mismatches in full */
 
 /* One ray through both traversals and both oracles. */
-static void check_ray(const ms_bvh *b, const float *soup, size_t n, const ms_ray *r, rng *g, counts *c,
+static void check_ray(const ms_bvh *b, const float *soup, size_t n, const ms_ray *r, tu_rng *g, counts *c,
                       const char *what)
 {
     float bt;
@@ -177,7 +169,7 @@ static void check_ray(const ms_bvh *b, const float *soup, size_t n, const ms_ray
         assert_int_equal(h.prim, UINT32_MAX);
     }
     /* Any-hit: with no skip, with the closest triangle skipped, and with a random triangle skipped. */
-    uint32_t skips[3] = { UINT32_MAX, got ? h.prim : UINT32_MAX, (uint32_t)(rng_next(g) % n) };
+    uint32_t skips[3] = { UINT32_MAX, got ? h.prim : UINT32_MAX, (uint32_t)(tu_rng_next(g) % n) };
     for (int k = 0; k < 3; k++) {
         long src = skips[k] == UINT32_MAX ? -1 : (long)b->tri_source[skips[k]];
         int want = brute_any(soup, n, r, src);
@@ -190,7 +182,7 @@ static void check_ray(const ms_bvh *b, const float *soup, size_t n, const ms_ray
     c->rays++;
 }
 
-static void random_dir(rng *g, float d[3])
+static void random_dir(tu_rng *g, float d[3])
 {
     do {
         for (int a = 0; a < 3; a++) d[a] = rnd_in(g, -1, 1);
@@ -199,7 +191,7 @@ static void random_dir(rng *g, float d[3])
 
 static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
 {
-    rng g = { seed };
+    tu_rng g = { seed };
     size_t m;
     float *soup = make_soup(kind, n, &g, &m);
     ms_bvh b;
@@ -209,8 +201,8 @@ static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
     memset(cs, 0, sizeof cs);
     for (int i = 0; i < nrays; i++) {
         ms_ray r;
-        const float *tri = soup + 9 * (rng_next(&g) % m);
-        int v0 = (int)(rng_next(&g) % 3), v1 = (v0 + 1) % 3;
+        const float *tri = soup + 9 * (tu_rng_next(&g) % m);
+        int v0 = (int)(tu_rng_next(&g) % 3), v1 = (v0 + 1) % 3;
         int type = i % 6;
         r.tmin = 0.0f;
         r.tmax = INFINITY;
@@ -232,7 +224,7 @@ static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
         case 3:   /* axis-parallel through a vertex (infinite inverse directions in the slab test) */
             for (int a = 0; a < 3; a++) { r.o[a] = tri[3 * v0 + a]; r.d[a] = 0.0f; }
             {
-                int ax = (int)(rng_next(&g) % 3);
+                int ax = (int)(tu_rng_next(&g) % 3);
                 r.o[ax] -= 20.0f;
                 r.d[ax] = 1.0f;
             }
@@ -296,7 +288,7 @@ static void test_axis_aligned_grid(void **st)
 static void test_grid_edges_and_vertices(void **st)
 {
     (void)st;
-    rng g = { 6 };
+    tu_rng g = { 6 };
     size_t m;
     float *soup = make_soup(SOUP_GRID, 10000, &g, &m);
     ms_bvh b;
@@ -348,7 +340,7 @@ static void test_cluster_and_slivers(void **st)
 static void test_triangle_oracle(void **st)
 {
     (void)st;
-    rng g = { 9 };
+    tu_rng g = { 9 };
     int hits = 0, misses = 0;
     for (int it = 0; it < 20000; it++) {
         float tri[9], o[3], d[3];

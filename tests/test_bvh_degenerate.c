@@ -9,16 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct rng { uint64_t s; } rng;
-static uint64_t rng_next(rng *r)
-{
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-static float rnd(rng *r) { return (float)((rng_next(r) >> 40) * (1.0 / 16777216.0)); }
-static float rnd_in(rng *r, float lo, float hi) { return lo + (hi - lo) * rnd(r); }
+static float rnd(tu_rng *r) { return (float)((tu_rng_next(r) >> 40) * (1.0 / 16777216.0)); }
+static float rnd_in(tu_rng *r, float lo, float hi) { return lo + (hi - lo) * rnd(r); }
 
 /* Zero-area triangles (a repeated vertex, or three collinear vertices) have no interior: whatever
  * ms_intersect_triangle reports for them, a reported hit point must lie on the segment they span
@@ -26,7 +18,7 @@ static float rnd_in(rng *r, float lo, float hi) { return lo + (hi - lo) * rnd(r)
 static void test_degenerate_triangles(void **st)
 {
     (void)st;
-    rng g = { 10 };
+    tu_rng g = { 10 };
     enum { N = 400 };
     float *soup = malloc(9 * N * sizeof(float));
     for (int m = 0; m < N; m++) {
@@ -42,7 +34,7 @@ static void test_degenerate_triangles(void **st)
     int spurious = 0, first = 1;
     long tests = 0;
     for (int it = 0; it < 4000; it++) {
-        const float *tri = soup + 9 * (rng_next(&g) % N);
+        const float *tri = soup + 9 * (tu_rng_next(&g) % N);
         float o[3], d[3];
         float f = rnd(&g);
         for (int k = 0; k < 3; k++) { o[k] = rnd_in(&g, -10, 10); d[k] = tri[k] + f * (tri[3 + k] - tri[k]) - o[k]; }

@@ -19,22 +19,15 @@
 #include <string.h>
 #include <time.h>
 #include <cmocka.h>
+#include "testutil.h"
 #include "raster/raster.h"
 
 #define TIE_REL 1e-5
 
 /* ---- random numbers ---- */
-typedef struct rng { uint64_t s; } rng;
-static uint64_t rng_next(rng *r)
-{
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-static double rng_unit(rng *r) { return (double)(rng_next(r) >> 11) * (1.0 / 9007199254740992.0); }
-static double rng_range(rng *r, double a, double b) { return a + (b - a) * rng_unit(r); }
-static int rng_int(rng *r, int n) { return (int)(rng_next(r) % (uint64_t)n); }
+static double rng_unit(tu_rng *r) { return (double)(tu_rng_next(r) >> 11) * (1.0 / 9007199254740992.0); }
+static double rng_range(tu_rng *r, double a, double b) { return a + (b - a) * rng_unit(r); }
+static int rng_int(tu_rng *r, int n) { return (int)(tu_rng_next(r) % (uint64_t)n); }
 
 /* ---- a frame: light, grid, projection centre ---- */
 typedef struct scene {
@@ -47,7 +40,7 @@ typedef struct scene {
     int grazing; /* C close to the light's plane: an ill-conditioned frame */
 } scene;
 
-static void scene_random(scene *s, rng *r, int k)
+static void scene_random(scene *s, tu_rng *r, int k)
 {
     s->k = k;
     s->exact = rng_int(r, 5) == 0;
@@ -74,7 +67,7 @@ static void scene_random(scene *s, rng *r, int k)
         l.corner = (ms_vec3){ (float)rng_range(r, -2, 2), (float)rng_range(r, -2, 2), (float)rng_range(r, -2, 2) };
         l.edge_s = (ms_vec3){ (float)es[0], (float)es[1], (float)es[2] };
         l.edge_t = (ms_vec3){ (float)et[0], (float)et[1], (float)et[2] };
-        ms_grid_for_pixel(&l, k, (uint32_t)rng_next(r), (uint32_t)rng_next(r), 7u, &s->g);
+        ms_grid_for_pixel(&l, k, (uint32_t)tu_rng_next(r), (uint32_t)tu_rng_next(r), 7u, &s->g);
         /* C in front of (or behind) the light, at 0.1 to 5 light sizes, laterally within a light size; or,
          * one frame in six, grazing: 1e-3 to 3e-2 light sizes off the light's plane and up to two sizes
          * aside, where the light-space transform is ill-conditioned (entries of 1e3 and more). */
@@ -118,7 +111,7 @@ static double q8(double x) { return floor(x * 8.0 + 0.5) / 8.0; }
  * light: in a grazing frame such a triangle is ill-conditioned in light-index space (how a wall or floor
  * triangle next to the receiver looks there), which the categories drawn in light-index space are not. */
 static double len3(const double a[3]);
-static void tri_world(const scene *s, rng *r, float tri[9])
+static void tri_world(const scene *s, tu_rng *r, float tri[9])
 {
     double target[3], cen[3];
     const double ls = rng_range(r, 0.0, 1.0) * s->k, lt = rng_range(r, 0.0, 1.0) * s->k;
@@ -130,7 +123,7 @@ static void tri_world(const scene *s, rng *r, float tri[9])
         for (int c = 0; c < 3; c++) tri[3 * v + c] = (float)(cen[c] + size * rng_range(r, -1.0, 1.0));
 }
 
-static int tri_random(const scene *s, rng *r, float tri[9])
+static int tri_random(const scene *s, tu_rng *r, float tri[9])
 {
     const double k = s->k;
     double v[3][3];
@@ -360,7 +353,7 @@ static void run_random(int k, long n_tris, uint64_t seed)
     for (int i = 0; i < nk; i++) assert_non_null(kt[i].fn);
     memset(g_cat_count, 0, sizeof g_cat_count);
     memset(g_cat_ties, 0, sizeof g_cat_ties);
-    rng r = { seed };
+    tu_rng r = { seed };
     scene s;
     ms_raster_frame f;
     uint64_t bufs[6][64];
@@ -450,7 +443,7 @@ static void test_random_64(void **state) { (void)state; run_random(64, scaled(15
 /* ---- targeted checks ---- */
 static void exact_scene(scene *s, int k)
 {
-    rng r = { 0 };
+    tu_rng r = { 0 };
     do scene_random(s, &r, k);
     while (!s->exact);
     s->near = 1e-4f;
@@ -460,7 +453,7 @@ static void exact_scene(scene *s, int k)
 static void test_frame_maps_samples(void **state)
 {
     (void)state;
-    rng r = { 42 };
+    tu_rng r = { 42 };
     for (int it = 0; it < 200; it++) {
         scene s;
         scene_random(&s, &r, 32);
@@ -599,7 +592,7 @@ static void test_special_cases(void **state)
 static void test_culling_random(void **state)
 {
     (void)state;
-    rng r = { 99 };
+    tu_rng r = { 99 };
     long checked = 0, culled = 0;
     /* Every kernel as dispatched, and the AVX2 Scanline when the CPU has it. */
     ms_raster_fn fns[MS_KERNEL_COUNT + 1];

@@ -25,4 +25,14 @@ const char *tu_shared_scene(char *buf, size_t n, const char *rel);
 /* Reads a PFM written by ms_write_vis into a top-row-first array (caller frees). */
 float *tu_read_pfm(const char *path, int *w, int *h);
 
+/* splitmix64: small, seedable, reproducible random numbers for the randomized tests. */
+typedef struct tu_rng { uint64_t s; } tu_rng;
+static inline uint64_t tu_rng_next(tu_rng *r)
+{
+    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
 #endif
