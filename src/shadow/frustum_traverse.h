@@ -27,4 +27,17 @@ typedef void (*ms_frustum_trace_fn)(const ms_bvh *b, const ms_raster_frame *f, m
 ms_frustum_trace_fn ms_frustum_trace_select(int k, int scalar_only);
 const char *ms_frustum_trace_isa(int scalar_only);
 
+/* Rasterizes the triangles of leaf n (but `skip`) into buf; returns how many. Shared by every instance. */
+static inline uint64_t ms_ft_raster_leaf(const ms_bvh *b, const ms_bvh_node *n, const ms_raster_frame *f,
+                                         ms_raster_fn raster, uint32_t skip, void *buf)
+{
+    uint64_t count = 0;
+    for (uint32_t i = n->first; i < n->first + n->count; i++) {
+        if (i == skip) continue;
+        raster(f, b->tri + 9 * (size_t)i, buf);
+        count++;
+    }
+    return count;
+}
+
 #endif

@@ -203,11 +203,7 @@ INLINE void trace(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster
     for (;;) {
         const ms_bvh_node *n = &b->nodes[ni];
         if (n->count) {
-            for (uint32_t i = n->first; i < n->first + n->count; i++) {
-                if (i == skip) continue;
-                raster(f, b->tri + 9 * (size_t)i, buf);
-                triangles++;
-            }
+            triangles += ms_ft_raster_leaf(b, n, f, raster, skip, buf);
             if (all_zero(buf, K)) { cnt[MS_FT_EARLY_OUT]++; break; }
         } else {
             const uint32_t c0 = n->first;

@@ -160,11 +160,7 @@ void TRAV_FN(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uin
     for (;;) {
         const ms_bvh_node *n = &b->nodes[ni];
         if (n->count) {
-            for (uint32_t i = n->first; i < n->first + n->count; i++) {
-                if (i == skip) continue;
-                raster(f, b->tri + 9 * (size_t)i, buf);
-                cnt[MS_FT_TRIANGLES]++;
-            }
+            cnt[MS_FT_TRIANGLES] += ms_ft_raster_leaf(b, n, f, raster, skip, buf);
             if (TRAV_LOCAL(all_zero)(buf)) { cnt[MS_FT_EARLY_OUT]++; return; }
         } else {
             const uint32_t c0 = n->first, c1 = n->first + 1;
