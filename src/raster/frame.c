@@ -30,9 +30,10 @@ int ms_raster_frame_init(ms_raster_frame *f, const float c[3], const ms_grid *g,
         { c02, a[0][1] * a[2][0] - a[0][0] * a[2][1], a[0][0] * a[1][1] - a[0][1] * a[1][0] },
     };
     for (int r = 0; r < 3; r++)
-        for (int col = 0; col < 3; col++) f->m[r][col] = (float)(adj[r][col] * inv);
-    for (int r = 0; r < 3; r++)
-        for (int col = 0; col < 3; col++) f->mt[r][col] = (float)a[col][r];
+        for (int col = 0; col < 3; col++) {
+            f->m[r][col] = (float)(adj[r][col] * inv);
+            f->mt[r][col] = (float)a[col][r];
+        }
     memcpy(f->c, c, sizeof f->c);
     f->near = near;
     f->far = far;
