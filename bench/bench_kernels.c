@@ -85,7 +85,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (ms_raster_kernel(MS_KERNEL_SCANLINE, k) == NULL || n < 100 || passes < 1) {
+    if (ms_raster_kernel(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO, NULL) == NULL || n < 100 || passes < 1) {
         fprintf(stderr, "bench_kernels: bad --k, --n or --passes\n");
         return 2;
     }
@@ -105,15 +105,16 @@ int main(int argc, char **argv)
     double M[3][3];
     for (int r = 0; r < 3; r++) { M[r][0] = g.ds[r]; M[r][1] = g.dt[r]; M[r][2] = (double)g.p0[r] - c[r]; }
 
+    ms_isa simd_isa = MS_ISA_AUTO;
     kernel_entry kernels[5] = {
-        { "scanline", ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, k) },
-        { "bounds", ms_raster_kernel_scalar(MS_KERNEL_BOUNDS, k) },
-        { "hierarchical", ms_raster_kernel_scalar(MS_KERNEL_HIERARCHICAL, k) },
-        { "scanline_simd", ms_raster_kernel(MS_KERNEL_SCANLINE, k) },
+        { "scanline", ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_SCALAR) },
+        { "bounds", ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_SCALAR) },
+        { "hierarchical", ms_raster_kernel_isa(MS_KERNEL_HIERARCHICAL, k, MS_ISA_SCALAR) },
+        { "scanline_simd", ms_raster_kernel(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO, &simd_isa) },
     };
     int nk = 4;
     /* A column of its own only when it is not already scanline_simd (a CPU without AVX-512). */
-    const ms_raster_fn avx2 = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx2");
+    const ms_raster_fn avx2 = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_AVX2);
     const int i_avx2 = avx2 != NULL && avx2 != kernels[3].fn ? nk : -1;
     if (i_avx2 >= 0) kernels[nk++] = (kernel_entry){ "scanline_avx2", avx2 };
 
@@ -181,7 +182,7 @@ int main(int argc, char **argv)
     const int nbins = bin_of(k * k) + 1;
     if (!csv) {
         printf("bench_kernels: k=%d, %ld triangles, %d passes, SIMD variant %s, TSC cycles (batches of %d)\n", k, n,
-               passes, ms_raster_isa(), (int)BATCH);
+               passes, ms_isa_name(simd_isa), (int)BATCH);
         (void)overhead;
         printf("%-12s %8s", "samples", "tris");
         for (int kk = 0; kk < nk; kk++) printf(" %14s", kernels[kk].name);

@@ -73,6 +73,22 @@ typedef enum ms_pattern {
     MS_PATTERN_STRATIFIED = 1  /* k x k jittered strata, jitter hashed from pixel, sample and seed */
 } ms_pattern;
 
+/* Instruction-set levels of the SIMD kernels and the traversal, in increasing order. As a cap,
+ * MS_ISA_AUTO (0) means none: the best level the CPU runs; a cap above the CPU gives the CPU's best. */
+typedef enum ms_isa {
+    MS_ISA_AUTO = 0,
+    MS_ISA_SCALAR = 1,  /* portable C */
+    MS_ISA_AVX2 = 2,    /* AVX2 + FMA + BMI1/2 + LZCNT + POPCNT */
+    MS_ISA_AVX512 = 3   /* the above + AVX-512 F/BW/VL/DQ */
+} ms_isa;
+
+/* "auto", "scalar", "avx2", "avx512". */
+const char *ms_isa_name(ms_isa isa);
+/* Parses one of those names; 0, or -1 for anything else. */
+int ms_isa_from_name(const char *name, ms_isa *out);
+/* The best level this CPU (and OS: saved register state) runs. */
+ms_isa ms_cpu_isa(void);
+
 typedef void (*ms_progress_fn)(void *user, double fraction_done);
 
 typedef struct ms_render_options {

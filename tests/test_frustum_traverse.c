@@ -2,8 +2,9 @@
  * arithmetic: on every frame they must leave bit-identical buffers and identical counters (nodes
  * visited, culled by the frustum and by coverage, triangles, early outs), for k = 16, 32, 64 and each
  * combination of the coverage cull and the child order. Frames: the hit points of a small render, and
- * random points inside the scene's bounds (boxes straddling C's plane, frames near-singular). Exits 77
- * when this CPU runs only one instance; the shared scenes are skipped when absent. */
+ * random points inside the scene's bounds (boxes straddling C's plane, frames near-singular). Also: the
+ * ISA cap is obeyed and reported. Exits 77 after that when this CPU (or the run's cap) allows only one
+ * instance; the shared scenes are skipped when absent. */
 #include "testutil.h"
 #include "shadow/method.h"
 #include "shadow/frustum_traverse.h"
@@ -17,22 +18,44 @@
 
 typedef struct isa_fns { const char *name[MAX_ISA]; ms_frustum_trace_fn fn[MAX_ISA][3]; int n; } isa_fns;
 
-/* The instances this CPU runs: scalar always, then each SIMD one the selector grants. */
+/* The instances this CPU runs (under the run's cap, MS_TEST_ISA): scalar always, then each SIMD one
+ * the selector grants when capped at it. */
 static isa_fns available(void)
 {
-    static const char *const wanted[] = { "avx2", "avx512" };
+    static const ms_isa wanted[] = { MS_ISA_AVX2, MS_ISA_AVX512 };
     isa_fns r = { { "scalar" }, { { 0 } }, 1 };
-    for (int w = 0; w < 3; w++) r.fn[0][w] = ms_frustum_trace_select(16 << w, 1);
+    for (int w = 0; w < 3; w++) r.fn[0][w] = ms_frustum_trace_select(16 << w, MS_ISA_SCALAR, NULL);
     for (int i = 0; i < 2; i++) {
-        setenv("MS_TRAVERSE_ISA", wanted[i], 1);
-        if (strcmp(ms_frustum_trace_isa(0), wanted[i]) == 0) {
-            r.name[r.n] = wanted[i];
-            for (int w = 0; w < 3; w++) r.fn[r.n][w] = ms_frustum_trace_select(16 << w, 0);
+        ms_isa chosen = MS_ISA_AUTO;
+        ms_frustum_trace_select(16, wanted[i], &chosen);
+        if (chosen == wanted[i] && tu_isa_allowed(wanted[i])) {
+            r.name[r.n] = ms_isa_name(wanted[i]);
+            for (int w = 0; w < 3; w++) r.fn[r.n][w] = ms_frustum_trace_select(16 << w, wanted[i], NULL);
             r.n++;
         }
     }
-    unsetenv("MS_TRAVERSE_ISA");
     return r;
+}
+
+/* The cap is obeyed and reported: scalar -> scalar; below the CPU -> the cap; above it or none -> the
+ * CPU's best; each choice is that ISA's instance. */
+static void test_isa_cap(void **state)
+{
+    (void)state;
+    const ms_isa best = ms_cpu_isa();
+    const ms_isa caps[] = { MS_ISA_AUTO, MS_ISA_SCALAR, MS_ISA_AVX2, MS_ISA_AVX512 };
+    for (int c = 0; c < 4; c++)
+        for (int k = 16; k <= 64; k *= 2) {
+            const ms_isa want = caps[c] == MS_ISA_AUTO || caps[c] > best ? best : caps[c];
+            ms_isa chosen = MS_ISA_AUTO;
+            const ms_frustum_trace_fn fn = ms_frustum_trace_select(k, caps[c], &chosen);
+            assert_int_equal(chosen, want);
+            assert_non_null(fn);
+            assert_ptr_equal(fn, ms_frustum_trace_isa(k, want));
+        }
+    assert_null(ms_frustum_trace_select(8, MS_ISA_AUTO, NULL));
+    for (ms_isa isa = MS_ISA_SCALAR; isa <= MS_ISA_AVX512; isa = (ms_isa)(isa + 1))
+        if (isa > best) assert_null(ms_frustum_trace_isa(32, isa));
 }
 
 typedef struct frames { ms_raster_frame *f; uint32_t *skip; int n; } frames;
@@ -97,7 +120,7 @@ static void compare_on_scene(const ms_scene *sc, const char *label, int size, in
                                      MS_FT_ORDER_CHILDREN, 0 };
     for (int w = 0; w < 3; w++) {
         const int k = 16 << w;
-        ms_raster_fn raster = ms_raster_kernel(MS_KERNEL_SCANLINE, k);
+        ms_raster_fn raster = ms_raster_kernel(MS_KERNEL_SCANLINE, k, tu_isa_cap(), NULL);
         assert_non_null(raster);
         frames fr = make_frames(sc, &bvh, k, size, n_random);
         /* all four flag sets at k = 32; the renderer's set at the other widths */
@@ -163,18 +186,21 @@ static void test_sibenik(void **state) { (void)state; shared_scene("sibenik/sibe
 int main(void)
 {
     isa_fns isa = available();
+    const struct CMUnitTest cap_tests[] = { cmocka_unit_test(test_isa_cap) };
+    const int rc = cmocka_run_group_tests(cap_tests, NULL, NULL);
     if (isa.n < 2) {
-        printf("skipping: only the scalar frustum traversal runs here (CPU without AVX2, or MS_FORCE_SCALAR=1)\n");
-        return 77;
+        printf("skipping the comparison: only the scalar frustum traversal runs here (CPU without AVX2, or "
+               "MS_TEST_ISA=scalar)\n");
+        return rc ? rc : 77;
     }
     printf("comparing the frustum traversal's instances:");
     for (int s = 0; s < isa.n; s++) printf(" %s", isa.name[s]);
-    printf("%s\n", isa.n < MAX_ISA ? " (no AVX-512 on this CPU)" : "");
+    printf("%s\n", isa.n < MAX_ISA ? " (no AVX-512 on this CPU, or capped)" : "");
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_default_scene),
         cmocka_unit_test(test_sponza),
         cmocka_unit_test(test_bunny),
         cmocka_unit_test(test_sibenik),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return cmocka_run_group_tests(tests, NULL, NULL) || rc;
 }

@@ -325,22 +325,24 @@ static long g_cat_count[CAT_COUNT], g_cat_ties[CAT_COUNT];
  * without AVX2+FMA. */
 static ms_raster_fn avx2_scanline(int k)
 {
-    ms_raster_fn fn = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx2");
-    if (fn == NULL) printf("  no AVX2+FMA on this CPU: the avx2 Scanline variant is skipped\n");
+    ms_raster_fn fn = tu_isa_allowed(MS_ISA_AVX2) ? ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_AVX2) : NULL;
+    if (fn == NULL) printf("  no AVX2+FMA on this CPU (or capped by MS_TEST_ISA): the avx2 Scanline variant is skipped\n");
     return fn;
 }
 
 static void run_random(int k, long n_tris, uint64_t seed)
 {
+    ms_isa chosen = MS_ISA_AUTO;
+    const ms_raster_fn dispatched = ms_raster_kernel(MS_KERNEL_SCANLINE, k, tu_isa_cap(), &chosen);
     kernel_under_test kt[6] = {
-        { "scanline-scalar", ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, k), 0, 0 },
-        { "scanline", ms_raster_kernel(MS_KERNEL_SCANLINE, k), 0, 0 },
-        { "bounds", ms_raster_kernel_scalar(MS_KERNEL_BOUNDS, k), 0, 0 },
-        { "hierarchical", ms_raster_kernel_scalar(MS_KERNEL_HIERARCHICAL, k), 0, 0 },
+        { "scanline-scalar", ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_SCALAR), 0, 0 },
+        { "scanline", dispatched, 0, 0 },
+        { "bounds", ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_SCALAR), 0, 0 },
+        { "hierarchical", ms_raster_kernel_isa(MS_KERNEL_HIERARCHICAL, k, MS_ISA_SCALAR), 0, 0 },
     };
     int nk = 4;
     /* Same function as one already listed: no need to run it twice. */
-    const ms_raster_fn bounds_dispatch = ms_raster_kernel(MS_KERNEL_BOUNDS, k), avx2 = avx2_scanline(k);
+    const ms_raster_fn bounds_dispatch = ms_raster_kernel(MS_KERNEL_BOUNDS, k, tu_isa_cap(), NULL), avx2 = avx2_scanline(k);
     if (bounds_dispatch != kt[2].fn) kt[nk++] = (kernel_under_test){ "bounds-dispatch", bounds_dispatch, 0, 0 };
     int i_avx2 = -1;
     if (avx2 != NULL && avx2 != kt[1].fn) {
@@ -348,7 +350,7 @@ static void run_random(int k, long n_tris, uint64_t seed)
         kt[nk++] = (kernel_under_test){ "scanline-avx2", avx2, 0, 0 };
     }
     /* The AVX-512 and AVX2 variants do the same arithmetic: reported (not asserted) when both run. */
-    const int cmp_simd = i_avx2 >= 0 && strcmp(ms_raster_isa(), "avx512") == 0;
+    const int cmp_simd = i_avx2 >= 0 && chosen == MS_ISA_AVX512;
     long simd_diff = 0;
     for (int i = 0; i < nk; i++) assert_non_null(kt[i].fn);
     memset(g_cat_count, 0, sizeof g_cat_count);
@@ -414,7 +416,7 @@ static void run_random(int k, long n_tris, uint64_t seed)
     }
     double secs = (double)(clock() - t0) / CLOCKS_PER_SEC;
     printf("k=%d: %ld triangles in %ld frames (%ld grazing), %.2f s, %ld occluded samples (oracle), kernel variant %s\n",
-           k, n_tris, frames, grazing_frames, secs, occluded, ms_raster_isa());
+           k, n_tris, frames, grazing_frames, secs, occluded, ms_isa_name(chosen));
     for (int i = 0; i < nk; i++)
         printf("  %-16s ties %ld (%.2e per sample), non-tie differences %ld\n", kt[i].name, kt[i].ties,
                (double)kt[i].ties / ((double)n_tris * k * k), kt[i].bad);
@@ -510,10 +512,10 @@ static void all_kernels(const scene *s, const double v[9], int cull, uint64_t ou
     assert_int_equal(ms_raster_frame_init(&f, s->c, &s->g, s->near, s->far, cull), 0);
     float tri[9];
     for (int i = 0; i < 3; i++) to_world(s, v + 3 * i, tri + 3 * i);
-    ms_raster_fn avx2 = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, s->k, "avx2");
-    ms_raster_fn fns[NFNS] = { ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, s->k), ms_raster_kernel(MS_KERNEL_SCANLINE, s->k),
-                               ms_raster_kernel(MS_KERNEL_BOUNDS, s->k), ms_raster_kernel(MS_KERNEL_HIERARCHICAL, s->k),
-                               avx2 ? avx2 : ms_raster_kernel_scalar(MS_KERNEL_SCANLINE, s->k) };
+    ms_raster_fn avx2 = tu_isa_allowed(MS_ISA_AVX2) ? ms_raster_kernel_isa(MS_KERNEL_SCANLINE, s->k, MS_ISA_AVX2) : NULL;
+    ms_raster_fn fns[NFNS] = { ms_raster_kernel_isa(MS_KERNEL_SCANLINE, s->k, MS_ISA_SCALAR), ms_raster_kernel(MS_KERNEL_SCANLINE, s->k, tu_isa_cap(), NULL),
+                               ms_raster_kernel(MS_KERNEL_BOUNDS, s->k, tu_isa_cap(), NULL), ms_raster_kernel(MS_KERNEL_HIERARCHICAL, s->k, tu_isa_cap(), NULL),
+                               avx2 ? avx2 : ms_raster_kernel_isa(MS_KERNEL_SCANLINE, s->k, MS_ISA_SCALAR) };
     for (int i = 0; i < NFNS; i++) {
         ms_buffer_fill_visible(out[i], s->k);
         fns[i](&f, tri, out[i]);
@@ -597,8 +599,9 @@ static void test_culling_random(void **state)
     /* Every kernel as dispatched, and the AVX2 Scanline when the CPU has it. */
     ms_raster_fn fns[MS_KERNEL_COUNT + 1];
     int nf = 0;
-    for (int kid = 0; kid < MS_KERNEL_COUNT; kid++) fns[nf++] = ms_raster_kernel((ms_kernel_id)kid, 32);
-    if (ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, "avx2")) fns[nf++] = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, "avx2");
+    for (int kid = 0; kid < MS_KERNEL_COUNT; kid++) fns[nf++] = ms_raster_kernel((ms_kernel_id)kid, 32, tu_isa_cap(), NULL);
+    if (tu_isa_allowed(MS_ISA_AVX2) && ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, MS_ISA_AVX2))
+        fns[nf++] = ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, MS_ISA_AVX2);
     for (int t = 0; t < 20000; t++) {
         scene s;
         ms_raster_frame f0, f1;
@@ -632,37 +635,78 @@ static void test_kernel_table(void **state)
 {
     (void)state;
     for (int id = 0; id < MS_KERNEL_COUNT; id++) {
-        assert_non_null(ms_raster_kernel((ms_kernel_id)id, 16));
-        assert_non_null(ms_raster_kernel_scalar((ms_kernel_id)id, 64));
-        assert_null(ms_raster_kernel((ms_kernel_id)id, 8));
-        assert_null(ms_raster_kernel_scalar((ms_kernel_id)id, 128));
+        assert_non_null(ms_raster_kernel((ms_kernel_id)id, 16, MS_ISA_AUTO, NULL));
+        assert_non_null(ms_raster_kernel_isa((ms_kernel_id)id, 64, MS_ISA_SCALAR));
+        assert_null(ms_raster_kernel((ms_kernel_id)id, 8, MS_ISA_AUTO, NULL));
+        assert_null(ms_raster_kernel_isa((ms_kernel_id)id, 128, MS_ISA_SCALAR));
     }
     assert_string_equal(ms_kernel_name(MS_KERNEL_SCANLINE), "scanline");
     /* Forced variants: scalar always; a SIMD one only for Scanline, only when the CPU has it, and the
-     * one ms_raster_isa names is the one ms_raster_kernel dispatches to. */
-    const char *isa = ms_raster_isa();
-    assert_true(strcmp(isa, "avx512") == 0 || strcmp(isa, "avx2") == 0 || strcmp(isa, "scalar") == 0);
+     * one the probe names is the one ms_raster_kernel dispatches to without a cap. */
+    const ms_isa isa = ms_cpu_isa();
+    assert_true(isa == MS_ISA_AVX512 || isa == MS_ISA_AVX2 || isa == MS_ISA_SCALAR);
     const int ks[3] = { 16, 32, 64 };
     for (int t = 0; t < 3; t++) {
         const int k = ks[t];
         for (int id = 0; id < MS_KERNEL_COUNT; id++)
-            assert_ptr_equal(ms_raster_kernel_isa((ms_kernel_id)id, k, "scalar"), ms_raster_kernel_scalar((ms_kernel_id)id, k));
-        assert_ptr_equal(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, isa), ms_raster_kernel(MS_KERNEL_SCANLINE, k));
-        assert_null(ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, "avx2"));
-        assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "sse"));
-        assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, NULL));
-        if (strcmp(isa, "scalar") != 0) assert_non_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx2"));
-        if (strcmp(isa, "avx512") != 0) assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, "avx512"));
+            assert_ptr_equal(ms_raster_kernel_isa((ms_kernel_id)id, k, MS_ISA_SCALAR),
+                             ms_raster_kernel((ms_kernel_id)id, k, MS_ISA_SCALAR, NULL));
+        assert_ptr_equal(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, isa), ms_raster_kernel(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO, NULL));
+        assert_null(ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_AVX2));
+        assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO));
+        assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, (ms_isa)7));
+        if (isa != MS_ISA_SCALAR) assert_non_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_AVX2));
+        if (isa != MS_ISA_AVX512) assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_AVX512));
     }
-    assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 8, "scalar"));
-    printf("kernel variant %s; avx2 variant %s\n", isa,
-           ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, "avx2") ? "available" : "not available (no AVX2+FMA)");
+    assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 8, MS_ISA_SCALAR));
+    printf("kernel variant %s; avx2 variant %s\n", ms_isa_name(isa),
+           ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, MS_ISA_AVX2) ? "available" : "not available (no AVX2+FMA)");
+}
+
+/* The ISA cap is obeyed and reported: a cap at or below the CPU's level gives that level (for Scanline;
+ * Bounds and Hierarchical are scalar only), a cap above it or none gives the CPU's best. Also the names. */
+static void test_isa_cap(void **state)
+{
+    (void)state;
+    const ms_isa best = ms_cpu_isa();
+    const ms_isa caps[] = { MS_ISA_AUTO, MS_ISA_SCALAR, MS_ISA_AVX2, MS_ISA_AVX512 };
+    for (int c = 0; c < 4; c++) {
+        const ms_isa want = caps[c] == MS_ISA_AUTO || caps[c] > best ? best : caps[c];
+        for (int k = 16; k <= 64; k *= 2) {
+            ms_isa chosen = MS_ISA_AUTO;
+            const ms_raster_fn fn = ms_raster_kernel(MS_KERNEL_SCANLINE, k, caps[c], &chosen);
+            assert_int_equal(chosen, want);
+            assert_ptr_equal(fn, ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, want));
+            chosen = MS_ISA_AUTO;
+            assert_ptr_equal(ms_raster_kernel(MS_KERNEL_HIERARCHICAL, k, caps[c], &chosen),
+                             ms_raster_kernel_isa(MS_KERNEL_HIERARCHICAL, k, MS_ISA_SCALAR));
+            assert_int_equal(chosen, MS_ISA_SCALAR);
+        }
+        printf("cap %-6s -> scanline %s (cpu %s)\n", ms_isa_name(caps[c]), ms_isa_name(want), ms_isa_name(best));
+    }
+    /* cap scalar gives scalar; cap avx2 on an AVX-512 CPU gives avx2 */
+    ms_isa chosen = MS_ISA_AUTO;
+    ms_raster_kernel(MS_KERNEL_SCANLINE, 32, MS_ISA_SCALAR, &chosen);
+    assert_int_equal(chosen, MS_ISA_SCALAR);
+    if (best == MS_ISA_AVX512) {
+        ms_raster_kernel(MS_KERNEL_SCANLINE, 32, MS_ISA_AVX2, &chosen);
+        assert_int_equal(chosen, MS_ISA_AVX2);
+    }
+    for (int c = 0; c < 4; c++) {
+        ms_isa back = (ms_isa)-1;
+        assert_int_equal(ms_isa_from_name(ms_isa_name(caps[c]), &back), 0);
+        assert_int_equal(back, caps[c]);
+    }
+    ms_isa dummy;
+    assert_int_equal(ms_isa_from_name("sse", &dummy), -1);
+    assert_int_equal(ms_isa_from_name(NULL, &dummy), -1);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_kernel_table),
+        cmocka_unit_test(test_isa_cap),
         cmocka_unit_test(test_frame_maps_samples),
         cmocka_unit_test(test_buffer_queries),
         cmocka_unit_test(test_special_cases),

@@ -2,8 +2,9 @@
 #ifndef MS_VEC_H
 #define MS_VEC_H
 #include <math.h>
+#include "cpu.h" /* the portable-file guard */
 
-/* Compare-based min/max: fminf/fmaxf compile to library calls without -ffast-math. */
+/* Compare-based min/max (the only definition): fminf/fmaxf compile to library calls without -ffast-math. */
 static inline float ms_minf(float a, float b) { return a < b ? a : b; }
 static inline float ms_maxf(float a, float b) { return a > b ? a : b; }
 

@@ -1,15 +1,16 @@
-/* Scalar Bounds and Hierarchical kernels, instantiated once per buffer width: define MS_K, MS_WORD and
- * MS_BLOCK (the side of a Hierarchical block) before including.
+/* Scalar Bounds and Hierarchical kernels, instantiated once per buffer width through core/perk_each.h
+ * (MS_K, MS_WORD); MS_BLOCK is the side of a Hierarchical block.
  *
  * Both evaluate e[0]*x + (e[1]*y + e[2]) per sample (ms_edge_eval). That float expression is monotone in
  * x and in y separately, so a block's extreme corner bounds every sample inside it even after rounding:
  * Hierarchical's trivial accepts and rejects agree exactly with the per-sample test, and both kernels,
  * restricted to the same bounding box, produce identical buffers bit for bit. */
-#define MS_CAT_(a, b) a##b
-#define MS_CAT(a, b) MS_CAT_(a, b)
-#define MS_BROW_FN MS_CAT(ms_bounds_row_, MS_K)
-#define MS_BOUNDS_FN MS_CAT(ms_bounds_, MS_K)
-#define MS_HIER_FN MS_CAT(ms_hier_, MS_K)
+/* Hierarchical blocks: 4x4 blocks of 4x4 samples (k = 16), 8x8 blocks of 4x4 (k = 32, the paper's
+ * best), 8x8 blocks of 8x8 (k = 64). */
+#define MS_BLOCK (MS_K == 64 ? 8 : 4)
+#define MS_BROW_FN MS_KFN(ms_bounds_row)
+#define MS_BOUNDS_FN MS_KFN(ms_bounds)
+#define MS_HIER_FN MS_KFN(ms_hier)
 
 /* Coverage mask of samples x0..x1 of scanline y: n is a compile-time constant at each call site. */
 static inline __attribute__((always_inline)) uint64_t MS_BROW_FN(const ms_tri_setup *t, const int n, int y,
@@ -28,7 +29,7 @@ static inline __attribute__((always_inline)) uint64_t MS_BROW_FN(const ms_tri_se
     return covered;
 }
 
-static uint64_t MS_CAT(ms_bounds_cover_, MS_K)(const ms_tri_setup *t, int y, int x0, int x1)
+static uint64_t MS_KFN(ms_bounds_cover)(const ms_tri_setup *t, int y, int x0, int x1)
 {
     switch (t->n) {
     case 3: return MS_BROW_FN(t, 3, y, x0, x1);
@@ -42,7 +43,7 @@ void MS_BOUNDS_FN(const ms_raster_frame *f, const float tri[9], void *out)
     ms_tri_setup t;
     if (!ms_tri_setup_run(f, tri, &t)) return;
     MS_WORD *buf = (MS_WORD *)out;
-    for (int y = t.y0; y <= t.y1; y++) buf[y] &= (MS_WORD)~MS_CAT(ms_bounds_cover_, MS_K)(&t, y, t.x0, t.x1);
+    for (int y = t.y0; y <= t.y1; y++) buf[y] &= (MS_WORD)~MS_KFN(ms_bounds_cover)(&t, y, t.x0, t.x1);
 }
 
 /* Greene-style two-level hierarchy: (k/B) x (k/B) blocks of B x B samples. A block is rejected when some
@@ -77,7 +78,7 @@ void MS_HIER_FN(const ms_raster_frame *f, const float tri[9], void *out)
                 for (int y = ry0; y <= ry1; y++) buf[y] &= (MS_WORD)~m;
             } else {
                 for (int y = ry0; y <= ry1; y++)
-                    buf[y] &= (MS_WORD)~MS_CAT(ms_bounds_cover_, MS_K)(&t, y, cx0, cx1);
+                    buf[y] &= (MS_WORD)~MS_KFN(ms_bounds_cover)(&t, y, cx0, cx1);
             }
         }
     }
@@ -86,6 +87,4 @@ void MS_HIER_FN(const ms_raster_frame *f, const float tri[9], void *out)
 #undef MS_BROW_FN
 #undef MS_BOUNDS_FN
 #undef MS_HIER_FN
-#undef MS_K
-#undef MS_WORD
 #undef MS_BLOCK

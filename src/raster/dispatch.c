@@ -1,62 +1,33 @@
-/* Kernel tables and the run-time choice of the SIMD variant. */
+/* Kernel tables and the run-time choice of the variant, under an explicit ISA cap (core/cpu.h). */
 #include <stddef.h>
-#include <string.h>
 #include "raster_internal.h"
 
-static int width_index(int k) { return k == 16 ? 0 : k == 32 ? 1 : k == 64 ? 2 : -1; }
-
-static ms_raster_fn scalar_fn(ms_kernel_id id, int k)
+ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, ms_isa isa)
 {
-    static const ms_raster_fn table[MS_KERNEL_COUNT][3] = {
-        [MS_KERNEL_SCANLINE] = { ms_scanline_16, ms_scanline_32, ms_scanline_64 },
-        [MS_KERNEL_BOUNDS] = { ms_bounds_16, ms_bounds_32, ms_bounds_64 },
-        [MS_KERNEL_HIERARCHICAL] = { ms_hier_16, ms_hier_32, ms_hier_64 },
+    static const ms_raster_fn scalar[MS_KERNEL_COUNT][3] = {
+        [MS_KERNEL_SCANLINE] = MS_PERK_TABLE(ms_scanline, scalar),
+        [MS_KERNEL_BOUNDS] = MS_PERK_TABLE(ms_bounds, scalar),
+        [MS_KERNEL_HIERARCHICAL] = MS_PERK_TABLE(ms_hier, scalar),
     };
-    const int w = width_index(k);
+    static const ms_raster_fn avx2[3] = MS_PERK_TABLE(ms_scanline, avx2);
+    static const ms_raster_fn avx512[3] = MS_PERK_TABLE(ms_scanline, avx512);
+    const int w = ms_k_index(k);
     if (w < 0 || (int)id < 0 || id >= MS_KERNEL_COUNT) return NULL;
-    return table[id][w];
+    if (isa == MS_ISA_SCALAR) return scalar[id][w];
+    /* Only Scanline has SIMD variants; a variant runs only where the probe grants its ISA. */
+    if (id != MS_KERNEL_SCANLINE || (isa != MS_ISA_AVX2 && isa != MS_ISA_AVX512) || ms_cpu_isa() < isa) return NULL;
+    return isa == MS_ISA_AVX512 ? avx512[w] : avx2[w];
 }
 
-ms_raster_fn ms_raster_kernel_scalar(ms_kernel_id id, int k) { return scalar_fn(id, k); }
-
-#if defined(__x86_64__) || defined(__i386__)
-static int have_avx512(void)
+ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k, ms_isa cap, ms_isa *chosen)
 {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-           __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
-}
-/* Everything the *_avx2.c files are compiled for (CMakeLists.txt), since the compiler may use any of it. */
-static int have_avx2(void)
-{
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-           __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("popcnt") && __builtin_cpu_supports("lzcnt");
-}
-#else
-static int have_avx512(void) { return 0; }
-static int have_avx2(void) { return 0; }
-#endif
-
-ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, const char *isa)
-{
-    const int w = width_index(k);
-    if (isa == NULL || w < 0) return NULL;
-    if (strcmp(isa, "scalar") == 0) return scalar_fn(id, k);
-    /* Only Scanline has SIMD variants: it is the kernel the renderer uses; Bounds and Hierarchical are
-     * the paper's baselines and stay scalar so that the comparison is like for like. */
-    if (id != MS_KERNEL_SCANLINE) return NULL;
-    static const ms_raster_fn avx512[3] = { ms_scanline_16_avx512, ms_scanline_32_avx512, ms_scanline_64_avx512 };
-    static const ms_raster_fn avx2[3] = { ms_scanline_16_avx2, ms_scanline_32_avx2, ms_scanline_64_avx2 };
-    if (strcmp(isa, "avx512") == 0) return have_avx512() ? avx512[w] : NULL;
-    if (strcmp(isa, "avx2") == 0) return have_avx2() ? avx2[w] : NULL;
+    /* From the capped level down to scalar, the first variant the kernel has. */
+    for (ms_isa isa = ms_isa_capped(cap); isa >= MS_ISA_SCALAR; isa = (ms_isa)(isa - 1)) {
+        const ms_raster_fn fn = ms_raster_kernel_isa(id, k, isa);
+        if (fn) {
+            if (chosen) *chosen = isa;
+            return fn;
+        }
+    }
     return NULL;
-}
-
-const char *ms_raster_isa(void) { return have_avx512() ? "avx512" : have_avx2() ? "avx2" : "scalar"; }
-
-ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k)
-{
-    if (id == MS_KERNEL_SCANLINE) return ms_raster_kernel_isa(id, k, ms_raster_isa());
-    return scalar_fn(id, k);
 }

@@ -12,6 +12,7 @@
 #ifndef MS_RASTER_H
 #define MS_RASTER_H
 #include <stdint.h>
+#include "microshadow.h"
 #include "../core/pattern.h"
 
 typedef struct ms_raster_frame {
@@ -37,18 +38,15 @@ typedef enum ms_kernel_id {
 /* Rasterizes one triangle (9 floats, world space) into buf. */
 typedef void (*ms_raster_fn)(const ms_raster_frame *f, const float tri[9], void *buf);
 
-/* The fastest variant this CPU runs (chosen at run time), or the portable scalar one. NULL for a k
- * other than 16, 32, 64. */
-ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k);
-ms_raster_fn ms_raster_kernel_scalar(ms_kernel_id id, int k);
-const char *ms_kernel_name(ms_kernel_id id);
-/* Name of the SIMD variant ms_raster_kernel picks for this CPU: "avx512", else "avx2" (with FMA), else
- * "scalar". */
-const char *ms_raster_isa(void);
-/* A given variant ("scalar", "avx2", "avx512"), e.g. to test or time AVX2 on an AVX-512 machine. NULL
- * when the CPU lacks that ISA, the kernel has no such variant (only Scanline has SIMD ones), or k is not
+/* The fastest variant of the kernel for k that this CPU runs at or below `cap` (MS_ISA_AUTO: no cap);
+ * *chosen (may be NULL) is set to its ISA. Only Scanline has SIMD variants (Bounds and Hierarchical are
+ * the paper's baselines and stay scalar, so the comparison is like for like). NULL for a k other than
  * 16, 32, 64. */
-ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, const char *isa);
+ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k, ms_isa cap, ms_isa *chosen);
+/* Exactly the given variant (MS_ISA_SCALAR, _AVX2, _AVX512), e.g. to test or time AVX2 on an AVX-512
+ * machine. NULL when the CPU lacks that ISA, the kernel has no such variant, or k is not 16, 32, 64. */
+ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, ms_isa isa);
+const char *ms_kernel_name(ms_kernel_id id);
 
 void ms_buffer_fill_visible(void *buf, int k);
 int ms_buffer_all_occluded(const void *buf, int k);

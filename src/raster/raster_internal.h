@@ -10,6 +10,8 @@
 #include <math.h>
 #include <stdint.h>
 #include "raster.h"
+#include "../core/perk.h"
+#include "../core/vec.h"
 
 typedef struct ms_tri_setup {
     float e[5][3]; /* active edges: U, V, W always, then N and/or F when the triangle reaches a clip plane */
@@ -28,8 +30,6 @@ typedef struct ms_tri_setup {
  * an unneeded clip edge changes nothing, a missing one occludes samples behind the near plane. */
 #define MS_Z_REL 1e-6f
 
-static inline float ms_minf(float a, float b) { return a < b ? a : b; }
-static inline float ms_maxf(float a, float b) { return a > b ? a : b; }
 static inline float ms_clampf(float x, float lo, float hi) { return ms_minf(ms_maxf(x, lo), hi); }
 
 /* Float to int for values already clamped to a small range (never NaN, never out of int range). */
@@ -214,24 +214,14 @@ static inline void ms_flat_y_bounds(const float yv[8], unsigned up, unsigned dn,
     if (*y1 > k - 1) *y1 = k - 1;
 }
 
-/* Scalar kernels, one per (kernel, k). */
-void ms_scanline_16(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_scanline_32(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_scanline_64(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_bounds_16(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_bounds_32(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_bounds_64(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_hier_16(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_hier_32(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_hier_64(const ms_raster_frame *f, const float tri[9], void *buf);
-/* AVX-512 scanline kernels (several scanlines per instruction). */
-void ms_scanline_16_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_scanline_32_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_scanline_64_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
-/* AVX2 + FMA scanline kernels, for CPUs without AVX-512 (8 scanlines per instruction). */
-void ms_scanline_16_avx2(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_scanline_32_avx2(const ms_raster_frame *f, const float tri[9], void *buf);
-void ms_scanline_64_avx2(const ms_raster_frame *f, const float tri[9], void *buf);
+/* The kernel instances (core/perk.h names): scalar Scanline, Bounds, Hierarchical; Scanline for AVX2 + FMA
+ * (8 scanlines per instruction) and AVX-512 (16), one source: scanline_simd_impl.h. */
+#define MS_RASTER_PARAMS (const ms_raster_frame *f, const float tri[9], void *buf)
+MS_PERK_DECLARE(void, ms_scanline, scalar, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_bounds, scalar, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_hier, scalar, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_scanline, avx2, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_scanline, avx512, MS_RASTER_PARAMS);
 
 /* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
  * (0 when setup rejects it). */

@@ -1,17 +1,8 @@
 /* Scalar Scanline kernels for 16x16, 32x32 and 64x64 buffers (scanline_impl.h). */
 #include "raster_internal.h"
 
-#define MS_K 16
-#define MS_WORD uint16_t
-#include "scanline_impl.h"
-
-#define MS_K 32
-#define MS_WORD uint32_t
-#include "scanline_impl.h"
-
-#define MS_K 64
-#define MS_WORD uint64_t
-#include "scanline_impl.h"
+#define MS_PERK_IMPL "raster/scanline_impl.h"
+#include "../core/perk_each.h"
 
 int ms_scanline_rows(const ms_raster_frame *f, const float tri[9])
 {

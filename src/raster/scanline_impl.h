@@ -1,9 +1,7 @@
-/* Scalar bit-parallel scanline kernel (Woop 2010, sec. 4), instantiated once per buffer width:
- * define MS_K (16, 32 or 64) and MS_WORD (its scanline type) before including. */
-#define MS_CAT_(a, b) a##b
-#define MS_CAT(a, b) MS_CAT_(a, b)
-#define MS_ROWS_FN MS_CAT(ms_scan_rows_, MS_K)
-#define MS_KERNEL_FN MS_CAT(ms_scanline_, MS_K)
+/* Scalar bit-parallel scanline kernel (Woop 2010, sec. 4), instantiated once per buffer width through
+ * core/perk_each.h (MS_K, MS_WORD). */
+#define MS_ROWS_FN MS_KFN(ms_scan_rows)
+#define MS_KERNEL_FN MS_KFN(ms_scanline)
 
 /* Clears the covered interval of scanlines y0..y1. nl and nu are compile-time constants at every call
  * site, so each (nl, nu) pair gets its own unrolled, branch-free loop: the paper's specialised loops by
@@ -59,5 +57,3 @@ void MS_KERNEL_FN(const ms_raster_frame *f, const float tri[9], void *out)
 
 #undef MS_ROWS_FN
 #undef MS_KERNEL_FN
-#undef MS_K
-#undef MS_WORD

@@ -1,13 +1,14 @@
 /* Per-pixel light-frustum traversal of the BVH for the micro-rasterization methods (microraster.c).
- * Instantiated per buffer width for scalar and AVX2 from frustum_traverse_impl.h, and for AVX-512 in
- * frustum_traverse_avx512.c; all take the same decisions. The best instance the CPU runs is chosen at
- * run time; the scalar one is always built (forced by MS_FORCE_SCALAR=1), and MS_TRAVERSE_ISA=scalar
- * or avx2 caps the choice, to compare the instances in one process. */
+ * One loop (frustum_traverse_loop.h) over per-ISA node tests: scalar and AVX2 from
+ * frustum_traverse_impl.h, AVX-512 in frustum_traverse_avx512.c; all take the same decisions. The best
+ * instance the CPU runs under the caller's ISA cap is chosen at run time; the scalar one is always
+ * built. */
 #ifndef MS_FRUSTUM_TRAVERSE_H
 #define MS_FRUSTUM_TRAVERSE_H
 #include <stdint.h>
 #include "../accel/bvh.h"
 #include "../raster/raster.h"
+#include "../core/perk.h"
 
 enum {
     MS_FT_FRUSTA, MS_FT_NODES_VISITED, MS_FT_NODES_CULLED_FRUSTUM, MS_FT_NODES_CULLED_OCCLUDED,
@@ -24,8 +25,17 @@ enum { MS_FT_CULL_OCCLUDED = 1, MS_FT_ORDER_CHILDREN = 2 };
 typedef void (*ms_frustum_trace_fn)(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip,
                                     void *buf, uint64_t *counters, int flags);
 
-ms_frustum_trace_fn ms_frustum_trace_select(int k, int scalar_only);
-const char *ms_frustum_trace_isa(int scalar_only);
+/* The best instance for k that the CPU runs at or below cap (MS_ISA_AUTO: no cap); *chosen (may be
+ * NULL) is set to its ISA. NULL for a k other than 16, 32, 64. */
+ms_frustum_trace_fn ms_frustum_trace_select(int k, ms_isa cap, ms_isa *chosen);
+/* Exactly the instance of that ISA; NULL when the CPU lacks it or k is not 16, 32, 64. */
+ms_frustum_trace_fn ms_frustum_trace_isa(int k, ms_isa isa);
+
+#define MS_FT_PARAMS \
+    (const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip, void *buf, uint64_t *cnt, int flags)
+MS_PERK_DECLARE(void, ms_frustum_trace, scalar, MS_FT_PARAMS);
+MS_PERK_DECLARE(void, ms_frustum_trace, avx2, MS_FT_PARAMS);
+MS_PERK_DECLARE(void, ms_frustum_trace, avx512, MS_FT_PARAMS);
 
 /* Rasterizes the triangles of leaf n (but `skip`) into buf; returns how many. Shared by every instance. */
 static inline uint64_t ms_ft_raster_leaf(const ms_bvh *b, const ms_bvh_node *n, const ms_raster_frame *f,

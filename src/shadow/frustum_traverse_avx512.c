@@ -1,5 +1,5 @@
 /* AVX-512 instances of the frustum traversal (chosen at run time; see frustum_traverse_impl.h for the
- * method). Same tests and the same arithmetic as the AVX2 and scalar instances, so the same decisions,
+ * method, frustum_traverse_loop.h for the loop they share). Same tests and the same arithmetic as the AVX2 and scalar instances, so the same decisions,
  * counters and visiting order; what differs is the layout:
  *   - the two children of a node are adjacent nodes: their 16 corners in one zmm per coordinate, one
  *     frustum test, one division and one min/max reduction for both;
@@ -185,81 +185,38 @@ INLINE void prefetch_children(const ms_bvh *b, const ms_bvh_node *cn)
     }
 }
 
-INLINE void trace(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip, void *buf,
-                  uint64_t *cnt, int flags, const int K)
+/* The loop's operations (frustum_traverse_loop.h): the two children tested in one pass; a pushed node
+ * keeps its coverage masks. */
+INLINE int root_out(const trav_consts *t, const ms_bvh *b)
 {
-    const int cull_occluded = flags & MS_FT_CULL_OCCLUDED, order = flags & MS_FT_ORDER_CHILDREN;
-    trav_consts t;
-    consts_init(&t, f, K);
-    uint32_t stack[MS_BVH_STACK];
-    trav_cov covs[MS_BVH_STACK];
-    int sp = 0;
     trav_pair v;
-    view_pair(&t, &b->nodes[0], &b->nodes[0], &v);
-    cnt[MS_FT_NODES_VISITED]++;
-    if (v.out & 1) { cnt[MS_FT_NODES_CULLED_FRUSTUM]++; return; }
-    uint64_t visited = 0, culled_frustum = 0, culled_occluded = 0, triangles = 0;
-    uint32_t ni = 0;
-    for (;;) {
-        const ms_bvh_node *n = &b->nodes[ni];
-        if (n->count) {
-            triangles += ms_ft_raster_leaf(b, n, f, raster, skip, buf);
-            if (all_zero(buf, K)) { cnt[MS_FT_EARLY_OUT]++; break; }
-        } else {
-            const uint32_t c0 = n->first;
-            const ms_bvh_node *cn = &b->nodes[c0];
-            view_pair(&t, cn, cn + 1, &v);
-            prefetch_children(b, cn);
-            visited += 2;
-            int k0 = !(v.out & 1), k1 = !(v.out & 2);
-            culled_frustum += (uint64_t)(!k0 + !k1);
-            trav_cov cv[2] = { { ~0ull, ~0ull }, { ~0ull, ~0ull } };
-            if (cull_occluded && (k0 | k1) && v.front) {
-                cov_pair(&t, &v, K, cv);
-                if (k0 && !covers(buf, cv[0], K)) { k0 = 0; culled_occluded++; }
-                if (k1 && !covers(buf, cv[1], K)) { k1 = 0; culled_occluded++; }
-            }
-            if (k0 && k1) {
-                /* A branch, not a select: a mispredicted guess costs less than always waiting for z. */
-                const float z0 = _mm512_cvtss_f32(v.zmin);
-                const float z1 = _mm512_cvtss_f32(_mm512_castps256_ps512(_mm512_extractf32x8_ps(v.zmin, 1)));
-                if (order && z1 < z0) { covs[sp] = cv[0]; stack[sp++] = c0; ni = c0 + 1; }
-                else { covs[sp] = cv[1]; stack[sp++] = c0 + 1; ni = c0; }
-                continue;
-            }
-            if (k0) { ni = c0; continue; }
-            if (k1) { ni = c0 + 1; continue; }
-        }
-        /* The buffer has changed since these nodes were pushed: some may be fully occluded by now. */
-        for (;;) {
-            if (sp == 0) goto done;
-            --sp;
-            if (!cull_occluded || covers(buf, covs[sp], K)) break;
-            culled_occluded++;
-        }
-        ni = stack[sp];
+    view_pair(t, &b->nodes[0], &b->nodes[0], &v);
+    return v.out & 1;
+}
+
+INLINE void children(const trav_consts *t, const ms_bvh *b, const ms_bvh_node *n, const void *buf, int cull_occluded,
+                     int keep[2], trav_cov cv[2], float z[2], uint64_t *culled_frustum, uint64_t *culled_occluded,
+                     const int K)
+{
+    const ms_bvh_node *cn = &b->nodes[n->first];
+    trav_pair v;
+    view_pair(t, cn, cn + 1, &v);
+    prefetch_children(b, cn);
+    int k0 = !(v.out & 1), k1 = !(v.out & 2);
+    *culled_frustum += (uint64_t)(!k0 + !k1);
+    cv[0] = cv[1] = (trav_cov){ ~0ull, ~0ull };
+    if (cull_occluded && (k0 | k1) && v.front) {
+        cov_pair(t, &v, K, cv);
+        if (k0 && !covers(buf, cv[0], K)) { k0 = 0; ++*culled_occluded; }
+        if (k1 && !covers(buf, cv[1], K)) { k1 = 0; ++*culled_occluded; }
     }
-done:
-    cnt[MS_FT_NODES_VISITED] += visited;
-    cnt[MS_FT_NODES_CULLED_FRUSTUM] += culled_frustum;
-    cnt[MS_FT_NODES_CULLED_OCCLUDED] += culled_occluded;
-    cnt[MS_FT_TRIANGLES] += triangles;
+    keep[0] = k0;
+    keep[1] = k1;
+    z[0] = _mm512_cvtss_f32(v.zmin);
+    z[1] = _mm512_cvtss_f32(_mm512_castps256_ps512(_mm512_extractf32x8_ps(v.zmin, 1)));
 }
 
-void ms_frustum_trace_k16_avx512(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip,
-                                 void *buf, uint64_t *cnt, int flags)
-{
-    trace(b, f, raster, skip, buf, cnt, flags, 16);
-}
-
-void ms_frustum_trace_k32_avx512(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip,
-                                 void *buf, uint64_t *cnt, int flags)
-{
-    trace(b, f, raster, skip, buf, cnt, flags, 32);
-}
-
-void ms_frustum_trace_k64_avx512(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip,
-                                 void *buf, uint64_t *cnt, int flags)
-{
-    trace(b, f, raster, skip, buf, cnt, flags, 64);
-}
+#define FT_CTX trav_consts
+#define FT_SAVED trav_cov
+#define MS_PERK_IMPL "shadow/frustum_traverse_avx512_impl.h"
+#include "../core/perk_each.h"

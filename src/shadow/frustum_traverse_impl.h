@@ -1,5 +1,7 @@
-/* Template of the frustum traversal: include with TRAV_K (16, 32, 64), TRAV_ROW_T (the scanline word)
- * and TRAV_FN (the function's name) defined. Uses AVX2 where the including file is compiled for it.
+/* The node tests of the scalar and AVX2 frustum traversals, instantiated per k through core/perk_each.h
+ * (MS_K, MS_WORD) by frustum_traverse_scalar.c and frustum_traverse_avx2.c; the loop is
+ * frustum_traverse_loop.h. The corners are computed with AVX2 only in the file that targets it
+ * (MS_TARGET_AVX2), with the same roundings as the portable code.
  *
  * The traversal works in the pixel's light-index space (the kernel's frame: C at the origin, sample
  * (i,j) at (i,j,1)), where the frustum from C to the samples is 0 <= x <= (k-1)z, 0 <= y <= (k-1)z,
@@ -13,13 +15,11 @@
  *   - order: the nearer child (smaller z: the larger projection) is visited first, so that large
  *     occluders fill the buffer early and the coverage test and the umbra early-out fire sooner. */
 #include <math.h>
-#ifdef __AVX2__
+#ifdef MS_TARGET_AVX2
 #include <immintrin.h>
 #endif
 
-#define TRAV_CAT2(a, b) a##_##b
-#define TRAV_CAT(a, b) TRAV_CAT2(a, b)
-#define TRAV_LOCAL(x) TRAV_CAT(TRAV_FN, x)
+#define TRAV_LOCAL(x) MS_KFN(x)
 
 #ifndef MS_TRAV_COMMON
 #define MS_TRAV_COMMON
@@ -29,6 +29,10 @@ typedef struct ms_node_view {
     int outside;            /* culled by the frustum */
     int in_front;           /* every corner has z > 0 */
 } ms_node_view;
+/* The loop's per-pixel constants (the frame) and what a pushed node keeps (its view). */
+typedef struct ms_ft_ctx { const ms_raster_frame *f; } ms_ft_ctx;
+#define FT_CTX ms_ft_ctx
+#define FT_SAVED ms_node_view
 #endif
 
 static inline void TRAV_LOCAL(view_node)(const ms_raster_frame *f, const ms_bvh_node *n, ms_node_view *v)
@@ -39,8 +43,8 @@ static inline void TRAV_LOCAL(view_node)(const ms_raster_frame *f, const ms_bvh_
         base[r] = f->m[r][0] * rel[0] + f->m[r][1] * rel[1] + f->m[r][2] * rel[2];
         for (int a = 0; a < 3; a++) col[a][r] = f->m[r][a] * e[a];
     }
-    const float hi = (float)(TRAV_K - 1) + MS_TRAV_SIDE_SLACK;
-#ifdef __AVX2__
+    const float hi = (float)(MS_K - 1) + MS_TRAV_SIDE_SLACK;
+#ifdef MS_TARGET_AVX2
     /* The 8 corners in one register per coordinate. */
     const __m256 bx = _mm256_setr_ps(0, 1, 0, 1, 0, 1, 0, 1), by = _mm256_setr_ps(0, 0, 1, 1, 0, 0, 1, 1),
                  bz = _mm256_setr_ps(0, 0, 0, 0, 1, 1, 1, 1);
@@ -116,10 +120,10 @@ static inline void TRAV_LOCAL(view_node)(const ms_raster_frame *f, const ms_bvh_
 
 /* 1 if a still-visible sample may lie in the node's projected bounds (a small margin absorbs rounding
  * in the projection). */
-static inline int TRAV_LOCAL(covers_live)(const ms_node_view *v, const TRAV_ROW_T *buf)
+static inline int TRAV_LOCAL(covers_live)(const ms_node_view *v, const MS_WORD *buf)
 {
     if (!v->in_front) return 1;
-    const float kmax = (float)(TRAV_K - 1);
+    const float kmax = (float)(MS_K - 1);
     float fx0 = ceilf(v->x0 - MS_TRAV_SIDE_SLACK), fx1 = floorf(v->x1 + MS_TRAV_SIDE_SLACK);
     float fy0 = ceilf(v->y0 - MS_TRAV_SIDE_SLACK), fy1 = floorf(v->y1 + MS_TRAV_SIDE_SLACK);
     fx0 = fx0 < 0.0f ? 0.0f : fx0; fy0 = fy0 < 0.0f ? 0.0f : fy0;
@@ -127,9 +131,9 @@ static inline int TRAV_LOCAL(covers_live)(const ms_node_view *v, const TRAV_ROW_
     if (!(fx0 <= fx1 && fy0 <= fy1)) return 0;
     int i0 = (int)fx0, i1 = (int)fx1, j0 = (int)fy0, j1 = (int)fy1;
     /* Bits i0..i1 of a row, built without shifting by the word size. */
-    const TRAV_ROW_T ones = (TRAV_ROW_T)~(TRAV_ROW_T)0;   /* cast after ~: uint16_t promotes to int */
-    TRAV_ROW_T mask = (TRAV_ROW_T)((TRAV_ROW_T)(ones >> (TRAV_K - 1 - (i1 - i0))) << i0);
-    TRAV_ROW_T any = 0;
+    const MS_WORD ones = (MS_WORD)~(MS_WORD)0;   /* cast after ~: uint16_t promotes to int */
+    MS_WORD mask = (MS_WORD)((MS_WORD)(ones >> (MS_K - 1 - (i1 - i0))) << i0);
+    MS_WORD any = 0;
     for (int j = j0; j <= j1; j++) any |= buf[j];
     if (!(any & mask)) return 0;
     for (int j = j0; j <= j1; j++)
@@ -137,62 +141,41 @@ static inline int TRAV_LOCAL(covers_live)(const ms_node_view *v, const TRAV_ROW_
     return 0;
 }
 
-static inline int TRAV_LOCAL(all_zero)(const TRAV_ROW_T *buf)
+static inline int TRAV_LOCAL(all_zero)(const MS_WORD *buf)
 {
-    TRAV_ROW_T any = 0;
-    for (int j = 0; j < TRAV_K; j++) any |= buf[j];
+    MS_WORD any = 0;
+    for (int j = 0; j < MS_K; j++) any |= buf[j];
     return any == 0;
 }
 
-void TRAV_FN(const ms_bvh *b, const ms_raster_frame *f, ms_raster_fn raster, uint32_t skip, void *bufp,
-             uint64_t *cnt, int flags)
+static inline void TRAV_LOCAL(ft_init)(ms_ft_ctx *t, const ms_raster_frame *f) { t->f = f; }
+
+static inline int TRAV_LOCAL(ft_root_out)(const ms_ft_ctx *t, const ms_bvh *b)
 {
-    TRAV_ROW_T *buf = bufp;
-    const int cull_occluded = flags & MS_FT_CULL_OCCLUDED, order = flags & MS_FT_ORDER_CHILDREN;
-    uint32_t stack[MS_BVH_STACK];
-    ms_node_view views[MS_BVH_STACK];
-    int sp = 0;
     ms_node_view v;
-    TRAV_LOCAL(view_node)(f, &b->nodes[0], &v);
-    cnt[MS_FT_NODES_VISITED]++;
-    if (v.outside) { cnt[MS_FT_NODES_CULLED_FRUSTUM]++; return; }
-    uint32_t ni = 0;
-    for (;;) {
-        const ms_bvh_node *n = &b->nodes[ni];
-        if (n->count) {
-            cnt[MS_FT_TRIANGLES] += ms_ft_raster_leaf(b, n, f, raster, skip, buf);
-            if (TRAV_LOCAL(all_zero)(buf)) { cnt[MS_FT_EARLY_OUT]++; return; }
-        } else {
-            const uint32_t c0 = n->first, c1 = n->first + 1;
-            ms_node_view v0, v1;
-            TRAV_LOCAL(view_node)(f, &b->nodes[c0], &v0);
-            TRAV_LOCAL(view_node)(f, &b->nodes[c1], &v1);
-            cnt[MS_FT_NODES_VISITED] += 2;
-            int k0 = !v0.outside, k1 = !v1.outside;
-            cnt[MS_FT_NODES_CULLED_FRUSTUM] += (uint64_t)(!k0 + !k1);
-            if (cull_occluded) {
-                if (k0 && !TRAV_LOCAL(covers_live)(&v0, buf)) { k0 = 0; cnt[MS_FT_NODES_CULLED_OCCLUDED]++; }
-                if (k1 && !TRAV_LOCAL(covers_live)(&v1, buf)) { k1 = 0; cnt[MS_FT_NODES_CULLED_OCCLUDED]++; }
-            }
-            if (k0 && k1) {
-                if (order && v1.zmin < v0.zmin) { views[sp] = v0; stack[sp++] = c0; ni = c1; }
-                else { views[sp] = v1; stack[sp++] = c1; ni = c0; }
-                continue;
-            }
-            if (k0) { ni = c0; continue; }
-            if (k1) { ni = c1; continue; }
-        }
-        /* The buffer has changed since these nodes were pushed: some may be fully occluded by now. */
-        for (;;) {
-            if (sp == 0) return;
-            --sp;
-            if (!cull_occluded || TRAV_LOCAL(covers_live)(&views[sp], buf)) break;
-            cnt[MS_FT_NODES_CULLED_OCCLUDED]++;
-        }
-        ni = stack[sp];
-    }
+    TRAV_LOCAL(view_node)(t->f, &b->nodes[0], &v);
+    return v.outside;
 }
 
-#undef TRAV_K
-#undef TRAV_ROW_T
-#undef TRAV_FN
+static inline int TRAV_LOCAL(ft_covers)(const ms_node_view *v, const void *buf) { return TRAV_LOCAL(covers_live)(v, buf); }
+static inline int TRAV_LOCAL(ft_all_zero)(const void *buf) { return TRAV_LOCAL(all_zero)(buf); }
+
+static inline __attribute__((always_inline)) void TRAV_LOCAL(ft_children)(const ms_ft_ctx *t, const ms_bvh *b, const ms_bvh_node *n,
+                                                                         const void *buf, int cull_occluded, int keep[2],
+                                                                         ms_node_view v[2], float z[2], uint64_t *culled_frustum,
+                                                                         uint64_t *culled_occluded)
+{
+    for (int h = 0; h < 2; h++) {
+        TRAV_LOCAL(view_node)(t->f, &b->nodes[n->first + (uint32_t)h], &v[h]);
+        keep[h] = !v[h].outside;
+        *culled_frustum += (uint64_t)!keep[h];
+        z[h] = v[h].zmin;
+    }
+    if (cull_occluded)
+        for (int h = 0; h < 2; h++)
+            if (keep[h] && !TRAV_LOCAL(covers_live)(&v[h], buf)) { keep[h] = 0; ++*culled_occluded; }
+}
+
+#include "frustum_traverse_loop.h"
+
+#undef TRAV_LOCAL

@@ -20,6 +20,12 @@ typedef struct ms_render_ctx {
     uint32_t seed;
     float near, far;               /* occluding range of the segment parameter from hit point to sample */
     int threads;
+    /* Switches of the micro-rasterization methods (zero: the defaults). isa_cap caps the instruction set
+     * of the kernels and the traversal (MS_ISA_AUTO: the CPU's best); no_occlusion_cull and
+     * no_child_order switch off the traversal's coverage test and near-first child order, to measure
+     * what each buys. */
+    ms_isa isa_cap;
+    int no_occlusion_cull, no_child_order;
 } ms_render_ctx;
 
 /* One visible point: the pixel, its hit point (already offset off the surface towards the camera),
@@ -43,6 +49,9 @@ typedef struct ms_shadow_method {
     void (*visibility)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n, float *vis,
                        uint64_t *counters);
     void (*destroy)(void *state);
+    /* Optional (NULL: the method has no ISA-dispatched code): the instruction sets its kernel and its
+     * traversal run, as chosen by create under ctx->isa_cap, for ms_stats. */
+    void (*isa_used)(const void *state, ms_isa *kernel, ms_isa *traversal);
 } ms_shadow_method;
 
 typedef struct ms_hit {

@@ -11,8 +11,8 @@
  * kernels' boxes do. Such points are answered by the reference per-sample tracer instead, on the same
  * samples; they are counted (pixels_traced_edge_on) and are few: the light barely reaches them.
  *
- * MS_MICRORASTER_NO_OCCLUSION_CULL=1 and MS_MICRORASTER_NO_ORDER=1 switch off the coverage test and
- * the near-first child order, to measure what each buys. */
+ * The render context's switches (method.h) cap the kernels' and the traversal's instruction set and
+ * switch off the coverage test and the near-first child order; the library reads no environment. */
 #include "method.h"
 #include "frustum_traverse.h"
 #include <math.h>
@@ -26,28 +26,21 @@ typedef struct mr_state {
     ms_raster_fn raster;
     ms_frustum_trace_fn trace;
     int flags;
+    ms_isa kernel_isa, trace_isa; /* what ran, for ms_stats */
 } mr_state;
-
-static int env_on(const char *name)
-{
-    const char *e = getenv(name);
-    return e && e[0] == '1';
-}
 
 static int mr_create_kernel(ms_kernel_id id, const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
 {
     mr_state *s = calloc(1, sizeof *s);
     if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
-    int scalar = env_on("MS_FORCE_SCALAR");
-    s->raster = scalar ? ms_raster_kernel_scalar(id, ctx->k) : ms_raster_kernel(id, ctx->k);
-    s->trace = ms_frustum_trace_select(ctx->k, scalar);
+    s->raster = ms_raster_kernel(id, ctx->k, ctx->isa_cap, &s->kernel_isa);
+    s->trace = ms_frustum_trace_select(ctx->k, ctx->isa_cap, &s->trace_isa);
     if (!s->raster || !s->trace) {
         free(s);
         snprintf(err, errlen, "no %s kernel for %d samples", ms_kernel_name(id), ctx->samples);
         return -1;
     }
-    s->flags = (env_on("MS_MICRORASTER_NO_OCCLUSION_CULL") ? 0 : MS_FT_CULL_OCCLUDED) |
-               (env_on("MS_MICRORASTER_NO_ORDER") ? 0 : MS_FT_ORDER_CHILDREN);
+    s->flags = (ctx->no_occlusion_cull ? 0 : MS_FT_CULL_OCCLUDED) | (ctx->no_child_order ? 0 : MS_FT_ORDER_CHILDREN);
     *state = s;
     return 0;
 }
@@ -87,12 +80,19 @@ static void mr_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
 
 static void mr_destroy(void *state) { free(state); }
 
+static void mr_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
+{
+    const mr_state *s = state;
+    *kernel = s->kernel_isa;
+    *traversal = s->trace_isa;
+}
+
 #define MICRORASTER_METHOD(ident, mname, create_fn)                                                   \
     const ms_shadow_method ident = {                                                                  \
         .name = mname, .primary = "bvh", .needs_grid = 1, .n_counters = MS_FT_COUNTERS,               \
         .counter_names = { "frusta", "nodes_visited", "nodes_culled_frustum", "nodes_culled_occluded", \
                            "triangles_rasterized", "pixels_early_out", "pixels_traced_edge_on" },    \
-        .create = create_fn, .visibility = mr_visibility, .destroy = mr_destroy }
+        .create = create_fn, .visibility = mr_visibility, .destroy = mr_destroy, .isa_used = mr_isa_used }
 
 MICRORASTER_METHOD(ms_shadow_scanline, "scanline", mr_create_scanline);
 MICRORASTER_METHOD(ms_shadow_bounds, "bounds", mr_create_bounds);

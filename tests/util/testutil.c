@@ -127,3 +127,20 @@ float *tu_read_pfm(const char *path, int *w, int *h)
     fclose(f);
     return data;
 }
+
+ms_isa tu_isa_cap(void)
+{
+    const char *e = getenv("MS_TEST_ISA");
+    ms_isa cap = MS_ISA_AUTO;
+    if (e && *e && ms_isa_from_name(e, &cap) != 0) {
+        fprintf(stderr, "MS_TEST_ISA=%s: expected auto, scalar, avx2 or avx512\n", e);
+        abort();
+    }
+    return cap;
+}
+
+int tu_isa_allowed(ms_isa isa)
+{
+    const ms_isa cap = tu_isa_cap();
+    return cap == MS_ISA_AUTO || isa <= cap;
+}

@@ -25,6 +25,13 @@ const char *tu_shared_scene(char *buf, size_t n, const char *rel);
 /* Reads a PFM written by ms_write_vis into a top-row-first array (caller frees). */
 float *tu_read_pfm(const char *path, int *w, int *h);
 
+/* The ISA cap of this test run: MS_TEST_ISA=scalar|avx2|avx512 in the environment of the test programs
+ * (read here only: the library reads no environment), MS_ISA_AUTO when unset. Tests pass it to the
+ * selection functions and run a forced SIMD variant only when tu_isa_allowed grants it, so that CI can run
+ * the whole suite on the portable path (.ci/run). An unknown value aborts the test. */
+ms_isa tu_isa_cap(void);
+int tu_isa_allowed(ms_isa isa);
+
 /* splitmix64: small, seedable, reproducible random numbers for the randomized tests. */
 typedef struct tu_rng { uint64_t s; } tu_rng;
 static inline uint64_t tu_rng_next(tu_rng *r)
