@@ -32,9 +32,11 @@ typedef struct ms_tri_setup {
 
 static inline float ms_clampf(float x, float lo, float hi) { return ms_minf(ms_maxf(x, lo), hi); }
 
-/* Float to int for values already clamped to a small range (never NaN, never out of int range). */
-static inline int ms_ceil_i(float x) { return (int)ceilf(x); }
-static inline int ms_floor_i(float x) { return (int)floorf(x); }
+/* Float to int for values already clamped to a small range (never NaN, never out of int range). Exact:
+ * truncation, then one step where it went the wrong way ((float)t is exact for |t| < 2^24). Not
+ * ceilf/floorf: without SSE4.1 (portable files) they are library calls. */
+static inline int ms_ceil_i(float x) { const int t = (int)x; return t + ((float)t < x); }
+static inline int ms_floor_i(float x) { const int t = (int)x; return t - ((float)t > x); }
 
 /* Triangle setup. Returns 0 when the triangle cannot occlude any sample (degenerate, culled, outside the
  * near/far range or outside the buffer), 1 otherwise with s filled in. */

@@ -12,8 +12,9 @@ static inline __attribute__((always_inline)) void MS_ROWS_FN(MS_WORD *buf, const
                                                              const int nu)
 {
     const float kmax = (float)(MS_K - 1);
-    for (int y = s->y0; y <= s->y1; y++) {
-        const float fy = (float)y;
+    /* fy counts along in float (exact: small integers), no int-to-float conversion per row. */
+    float fy = (float)s->y0;
+    for (int y = s->y0; y <= s->y1; y++, fy += 1.0f) {
         float lo = 0.0f, hi = kmax;
         for (int e = 0; e < nl; e++) lo = ms_maxf(lo, s->al[e] * fy + s->bl[e]);
         for (int e = 0; e < nu; e++) hi = ms_minf(hi, s->au[e] * fy + s->bu[e]);

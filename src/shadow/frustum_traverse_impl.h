@@ -57,12 +57,14 @@ static inline void TRAV_LOCAL(view_node)(const ms_raster_frame *f, const ms_bvh_
     const __m256 az = _mm256_mul_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), zs), _mm256_set1_ps(MS_TRAV_SIDE_SLACK));
     const __m256 naz = _mm256_sub_ps(_mm256_setzero_ps(), az);
     const __m256 top = _mm256_fmadd_ps(_mm256_set1_ps(hi), zs, az);
-    int out = (_mm256_movemask_ps(_mm256_cmp_ps(xs, naz, _CMP_LT_OQ)) == 0xFF) |
-              (_mm256_movemask_ps(_mm256_cmp_ps(xs, top, _CMP_GT_OQ)) == 0xFF) |
-              (_mm256_movemask_ps(_mm256_cmp_ps(ys, naz, _CMP_LT_OQ)) == 0xFF) |
-              (_mm256_movemask_ps(_mm256_cmp_ps(ys, top, _CMP_GT_OQ)) == 0xFF) |
-              (_mm256_movemask_ps(_mm256_cmp_ps(zs, _mm256_set1_ps(f->near), _CMP_LT_OQ)) == 0xFF) |
-              (_mm256_movemask_ps(_mm256_cmp_ps(zs, _mm256_set1_ps(f->far), _CMP_GT_OQ)) == 0xFF);
+    /* |= rather than one | chain: clang warns on | between comparisons (-Wbitwise-instead-of-logical),
+     * and || would add branches. */
+    int out = _mm256_movemask_ps(_mm256_cmp_ps(xs, naz, _CMP_LT_OQ)) == 0xFF;
+    out |= _mm256_movemask_ps(_mm256_cmp_ps(xs, top, _CMP_GT_OQ)) == 0xFF;
+    out |= _mm256_movemask_ps(_mm256_cmp_ps(ys, naz, _CMP_LT_OQ)) == 0xFF;
+    out |= _mm256_movemask_ps(_mm256_cmp_ps(ys, top, _CMP_GT_OQ)) == 0xFF;
+    out |= _mm256_movemask_ps(_mm256_cmp_ps(zs, _mm256_set1_ps(f->near), _CMP_LT_OQ)) == 0xFF;
+    out |= _mm256_movemask_ps(_mm256_cmp_ps(zs, _mm256_set1_ps(f->far), _CMP_GT_OQ)) == 0xFF;
     v->outside = out;
     v->in_front = _mm256_movemask_ps(_mm256_cmp_ps(zs, _mm256_setzero_ps(), _CMP_GT_OQ)) == 0xFF;
     /* Horizontal min/max of 8 lanes, four at a time: [x0, y0, z0, -x1-...]. */
