@@ -10,19 +10,16 @@
 
 static const char *const kernels[] = { "scanline", "bounds", "hierarchical" };
 
-typedef struct agreement { size_t pixels, differ, over; float max_diff; } agreement;
+typedef tu_agreement agreement;
 
 static agreement compare(const ms_frame *a, const ms_frame *b, int samples)
 {
-    agreement r = { (size_t)a->width * a->height, 0, 0, 0.0f };
-    for (size_t i = 0; i < r.pixels; i++) {
-        float d = fabsf(a->vis[i] - b->vis[i]);
-        if ((a->vis[i] < 0) != (b->vis[i] < 0)) d = 2.0f;   /* hit/miss must agree too */
-        r.differ += d > 0.0f;
-        r.over += d > 1.0f / (float)samples + 1e-6f;
-        if (d > r.max_diff) r.max_diff = d;
-    }
-    return r;
+    (void)samples;
+    agreement g = tu_compare_frames(a, b);
+    assert_int_equal(g.miss_mismatch, 0);
+    assert_true(g.s_differ_same_v * 1000 <= g.pixels);
+    assert_int_equal(g.s_beyond, 0);
+    return g;
 }
 
 static void render_ok(const ms_scene *sc, const char *method, int samples, int size, ms_frame *f)
@@ -48,9 +45,10 @@ static void agree_on_scene(const ms_scene *sc, const char *label, const int *sam
             ms_frame f;
             render_ok(sc, kernels[k], samples[s], size, &f);
             agreement a = compare(&f, &ref, samples[s]);
-            printf("%-14s %-12s N=%-4d differ %zu/%zu pixels (%.4f%%), max |dV| %.5f\n", label, kernels[k],
-                   samples[s], a.differ, a.pixels, 100.0 * (double)a.differ / (double)a.pixels, a.max_diff);
-            assert_int_equal(a.over, 0);
+            printf("%-14s %-12s N=%-4d differ %ld/%ld pixels (%.4f%%), max |dV| %.2f samples, max |dS| %.5f\n",
+                   label, kernels[k], samples[s], a.differ, a.pixels, 100.0 * (double)a.differ / (double)a.pixels,
+                   a.max_steps, a.max_ds);
+            assert_int_equal(a.beyond_one, 0);
             assert_true((double)a.differ <= 0.001 * (double)a.pixels);
             ms_frame_free(&f);
         }
@@ -160,7 +158,7 @@ static void test_open_quad_both_sides(void **state)
         printf("open quad winding %d: %zu umbra pixels\n", flip, dark);
         assert_true(dark > 50);
         agreement a = compare(&f, &ref, 1024);
-        assert_int_equal(a.over, 0);
+        assert_int_equal(a.beyond_one, 0);
         ms_frame_free(&f);
         ms_frame_free(&ref);
         ms_scene_free(&sc);
@@ -181,8 +179,8 @@ static void test_scalar_paths_match(void **state)
         render_ok(&sc, kernels[k], 1024, 80, &scalar);
         unsetenv("MS_FORCE_SCALAR");
         agreement a = compare(&simd, &scalar, 1024);
-        printf("default scene %s: scalar vs SIMD differ %zu pixels\n", kernels[k], a.differ);
-        assert_int_equal(a.over, 0);
+        printf("default scene %s: scalar vs SIMD differ %ld pixels\n", kernels[k], a.differ);
+        assert_int_equal(a.beyond_one, 0);
         assert_true((double)a.differ <= 0.001 * (double)a.pixels);
         ms_frame_free(&simd);
         ms_frame_free(&scalar);

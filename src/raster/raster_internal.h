@@ -224,6 +224,9 @@ void ms_bounds_64(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_hier_16(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_hier_32(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_hier_64(const ms_raster_frame *f, const float tri[9], void *buf);
+void ms_clear_halfplane_16(const float e[3], void *buf);
+void ms_clear_halfplane_32(const float e[3], void *buf);
+void ms_clear_halfplane_64(const float e[3], void *buf);
 /* AVX-512 scanline kernels (several scanlines per instruction). */
 void ms_scanline_16_avx512(const ms_raster_frame *f, const float tri[9], void *buf);
 void ms_scanline_32_avx512(const ms_raster_frame *f, const float tri[9], void *buf);

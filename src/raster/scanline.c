@@ -20,3 +20,13 @@ int ms_scanline_rows(const ms_raster_frame *f, const float tri[9])
     if (!ms_tri_setup_run(f, tri, &t) || !ms_scan_setup_run(f, &t, &s)) return 0;
     return s.y1 - s.y0 + 1;
 }
+
+void ms_raster_clear_halfplane(int k, const float e[3], void *buf)
+{
+    switch (k) {
+    case 16: ms_clear_halfplane_16(e, buf); break;
+    case 32: ms_clear_halfplane_32(e, buf); break;
+    case 64: ms_clear_halfplane_64(e, buf); break;
+    default: break;
+    }
+}
