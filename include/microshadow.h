@@ -45,6 +45,14 @@ extern "C" {
 
 #define MS_VERSION_STRING "0.1.0"
 
+/* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a pixel has 256, 1024 or 4096 light
+ * samples (a k x k grid, k = 16, 32, 64). */
+#define MS_MAX_IMAGE_SIZE 16384
+#define MS_SAMPLES_MIN 256
+#define MS_SAMPLES_DEFAULT 1024
+#define MS_SAMPLES_MAX 4096
+#define MS_DEFAULT_METHOD "scanline"
+
 typedef struct ms_vec3 { float x, y, z; } ms_vec3;
 
 /* Pinhole camera. Pixel (x,y), y = 0 the top row; the primary ray passes through (x+0.5, y+0.5).

@@ -213,7 +213,7 @@ static void test_primary_points(void **st)
     assert_int_equal(load_shared("sibenik/sibenik.json", &sc), 0);
     const int W = 96, H = 96;
     ms_bvh bvh;
-    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris), 0);
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 0), 0);
     ms_render_ctx ctx;
     tu_ctx_init(&ctx, &sc, &bvh, W, H, 16);
     const ms_primary_method *pb = ms_find_primary_method("bvh"), *pe = ms_find_primary_method("embree");

@@ -176,7 +176,7 @@ static void test_plane_cuts_light(void **st)
     ms_scene sc;
     const size_t nr = make_cut_scene(&sc, &rng);
     ms_bvh bvh;
-    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris), 0);
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 0), 0);
     enum { PER = 40 };
     ms_shadow_query q[5 * PER];
     const float *recv_tri[5 * PER];
@@ -281,7 +281,7 @@ static void test_two_lifts(void **st)
     ms_scene sc;
     bumpy_sphere(&sc, 48, 24, &rng);
     ms_bvh bvh;
-    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris), 0);
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 0), 0);
     const int W = 64, H = 64;
     ms_render_ctx ctx;
     tu_ctx_init(&ctx, &sc, &bvh, W, H, 32);

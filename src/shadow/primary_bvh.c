@@ -1,5 +1,5 @@
-/* Primary visibility through our BVH, and the hit finishing every primary method shares. */
-#include "../shadow/method.h"
+/* Primary method "bvh": camera rays through our BVH; and the hit finishing every primary method shares. */
+#include "method.h"
 #include "../core/vec.h"
 #include <math.h>
 

@@ -1,10 +1,9 @@
 /* One frame: BVH build, primary visibility, shadows, shading, each phase timed on its own and run
  * over 16x16 pixel tiles by OpenMP (dynamic scheduling: shadow cost varies wildly across a frame). */
 #include "microshadow.h"
-#include "pattern.h"
+#include "../core/pattern.h"
 #include "../shadow/method.h"
 #include "../shadow/receiver.h"
-#include "../scene/scene_internal.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -19,7 +18,7 @@
 void ms_render_options_default(ms_render_options *o)
 {
     memset(o, 0, sizeof *o);
-    o->method = "scanline";
+    o->method = MS_DEFAULT_METHOD;
     o->pattern = MS_PATTERN_GRID;
     o->samples = 0;        /* the scene's */
 }
@@ -56,12 +55,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
 {
     memset(out, 0, sizeof *out);
     double t_start = omp_get_wtime();
-    const ms_shadow_method *sm = ms_find_shadow_method(opt->method ? opt->method : "");
+    const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;   /* zeroed options: defaults */
+    const ms_shadow_method *sm = ms_find_shadow_method(method);
     if (!sm) {
-        if (ms_method_available(opt->method ? opt->method : "") < 0)
-            snprintf(err, errlen, "method '%s' is not compiled into this build", opt->method);
-        else
-            snprintf(err, errlen, "unknown method '%s'", opt->method ? opt->method : "");
+        if (ms_method_available(method) < 0) snprintf(err, errlen, "method '%s' is not compiled into this build", method);
+        else snprintf(err, errlen, "unknown method '%s'", method);
         return -1;
     }
     const ms_primary_method *pm = ms_find_primary_method(sm->primary);
@@ -88,8 +86,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         return -1;
     }
     ms_bvh bvh;
-    omp_set_num_threads(threads);
-    if (ms_bvh_build(&bvh, scene->tri, scene->n_tris)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
+    if (ms_bvh_build(&bvh, scene->tri, scene->n_tris, threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
     ctx.scene = scene;
     ctx.bvh = &bvh;
     ctx.light = scene->light;
