@@ -13,10 +13,22 @@
  *     ms_write_png(&frame, "out.png", err, sizeof err);
  *     ms_frame_free(&frame); ms_scene_free(&scene);
  *
- * Visibility V(pixel) is the fraction of the light's samples L(s_i,t_i) whose segment from the primary
- * hit point is unblocked by any triangle (two-sided, purely geometric; the hit triangle never occludes).
- * Every shadow method computes V on the same samples, so methods can be compared sample for sample.
- * Pixels whose primary ray misses the scene get V = -1.
+ * Visibility, defined once for every method (docs/design.md). For a pixel whose primary ray hits the scene
+ * at P on triangle T, with n the unit geometric normal of T turned towards the camera, and the light samples
+ * L_1..L_N of the pixel's pattern:
+ *   - a sample counts only when it lies strictly in front of the receiver's plane, (L_i - P) . n > 0;
+ *     samples behind are neither visible nor occluded;
+ *   - a sample in front is occluded when a triangle other than T meets the segment P + u (L_i - P) at a
+ *     parameter u in [1e-4, 1 - 1e-4] (two-sided, purely geometric);
+ *   - V = (unoccluded samples in front) / (samples in front), and V = 0 when no sample is in front;
+ *   - the shadow factor S = sum_i w_i v_i / sum_i w_i over the samples in front (v_i = 1 when unoccluded),
+ *     with the form-factor weight w_i = max(cos theta_r,i, 0) max(cos theta_l,i, 0) / r_i^2 (theta_r at
+ *     the receiver, theta_l at the light, whose emitting side is cross(edge_s, edge_t)); S = V when every
+ *     w_i is 0. E_unshadowed * S is exact where the light is wholly visible or hidden and converges to
+ *     the shadowed irradiance as N grows (a ratio estimator).
+ * P is the hit point itself, not lifted off the surface: V and S do not depend on which side of the
+ * surface rounding leaves it. Every shadow method computes V and S on the same samples, so methods can be
+ * compared sample for sample. Pixels whose primary ray misses the scene get V = S = -1.
  *
  * Errors: functions that can fail return 0 on success and non-zero on failure, writing one line of
  * text (naming the file where there is one) into the caller's buffer err[errlen].
@@ -32,6 +44,14 @@ extern "C" {
 #endif
 
 #define MS_VERSION_STRING "0.1.0"
+
+/* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a pixel has 256, 1024 or 4096 light
+ * samples (a k x k grid, k = 16, 32, 64). */
+#define MS_MAX_IMAGE_SIZE 16384
+#define MS_SAMPLES_MIN 256
+#define MS_SAMPLES_DEFAULT 1024
+#define MS_SAMPLES_MAX 4096
+#define MS_DEFAULT_METHOD "scanline"
 
 typedef struct ms_vec3 { float x, y, z; } ms_vec3;
 
@@ -120,7 +140,10 @@ typedef struct ms_stats {
     const char *method;
     const char *pattern;
     uint64_t visible_pixels;
-    uint64_t shadow_rays;          /* visible pixels x samples: the work every method answers */
+    uint64_t shadow_rays;          /* samples in front of the visible points: the segments every method answers */
+    uint64_t penumbra_pixels;      /* pixels with some but not all front samples visible: S needs weights */
+    double shadow_factor_s;        /* part of shadow_s spent resolving V and S from the sample masks
+                                    * (thread-seconds / threads) */
     int n_counters;                /* method-specific counters */
     const char *counter_name[MS_MAX_COUNTERS];
     uint64_t counter[MS_MAX_COUNTERS];
@@ -128,8 +151,10 @@ typedef struct ms_stats {
 
 typedef struct ms_frame {
     int width, height;
-    float *vis;       /* width*height, row 0 at the top; -1 where the primary ray missed */
-    float *rgb;       /* 3*width*height linear radiance: albedo/pi * E_unshadowed * V */
+    float *vis;       /* width*height, row 0 at the top: V; -1 where the primary ray missed */
+    float *shadow;    /* width*height: the shadow factor S; -1 where the primary ray missed */
+    uint16_t *front;  /* width*height: the samples in front of the receiver's plane (0..N); 0 on misses */
+    float *rgb;       /* 3*width*height linear radiance: albedo/pi * E_unshadowed * S * emission */
     float exposure;   /* scale that maps the 99th percentile of unshadowed radiance to 1 (for PNG) */
     ms_stats stats;
 } ms_frame;
@@ -141,6 +166,7 @@ void ms_frame_free(ms_frame *f);
 /* Outputs. Each is written to a temporary file beside the target and renamed at the end. */
 int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */
 int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .pfm or .exr, float V */
+int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
 int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
 
 /* Exact unshadowed irradiance at point p with unit normal n from the light (polygon form factor,

@@ -195,7 +195,7 @@ static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
     size_t m;
     float *soup = make_soup(kind, n, &g, &m);
     ms_bvh b;
-    assert_int_equal(ms_bvh_build(&b, soup, m), 0);
+    assert_int_equal(ms_bvh_build(&b, soup, m, 0), 0);
     check_structure(&b, soup, m);
     counts cs[6];
     memset(cs, 0, sizeof cs);
@@ -292,7 +292,7 @@ static void test_grid_edges_and_vertices(void **st)
     size_t m;
     float *soup = make_soup(SOUP_GRID, 10000, &g, &m);
     ms_bvh b;
-    assert_int_equal(ms_bvh_build(&b, soup, m), 0);
+    assert_int_equal(ms_bvh_build(&b, soup, m, 0), 0);
     counts c = { 0, 0, 0, 0, 0 };
     for (int i = -6; i <= 6; i++)
         for (int j = -6; j <= 6; j++) {

@@ -115,7 +115,7 @@ static void compare_on_scene(const ms_scene *sc, const char *label, int size, in
 {
     isa_fns isa = available();
     ms_bvh bvh;
-    assert_int_equal(ms_bvh_build(&bvh, sc->tri, sc->n_tris), 0);
+    assert_int_equal(ms_bvh_build(&bvh, sc->tri, sc->n_tris, 0), 0);
     static const int flag_sets[] = { MS_FT_CULL_OCCLUDED | MS_FT_ORDER_CHILDREN, MS_FT_CULL_OCCLUDED,
                                      MS_FT_ORDER_CHILDREN, 0 };
     for (int w = 0; w < 3; w++) {

@@ -34,7 +34,8 @@ typedef struct ms_ray_hit {
 } ms_ray_hit;
 
 /* Builds over n triangles (copied). Returns 0, or -1 when out of memory. */
-int ms_bvh_build(ms_bvh *b, const float *tri, size_t n);
+/* threads: OpenMP threads for the build (0: all cores); the caller's OpenMP settings are left alone. */
+int ms_bvh_build(ms_bvh *b, const float *tri, size_t n, int threads);
 void ms_bvh_free(ms_bvh *b);
 
 /* 1 and the nearest hit in (tmin, tmax), or 0. */

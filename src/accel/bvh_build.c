@@ -147,8 +147,9 @@ static void build_node(build_ctx *c, uint32_t ni, uint32_t first, uint32_t count
     }
 }
 
-int ms_bvh_build(ms_bvh *b, const float *tri, size_t n)
+int ms_bvh_build(ms_bvh *b, const float *tri, size_t n, int threads)
 {
+    if (threads <= 0) threads = omp_get_num_procs();
     memset(b, 0, sizeof *b);
     double t0 = omp_get_wtime();
     if (n == 0 || n > (size_t)UINT32_MAX / 2) return -1;
@@ -166,7 +167,7 @@ int ms_bvh_build(ms_bvh *b, const float *tri, size_t n)
         ms_bvh_free(b);
         return -1;
     }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t i = 0; i < n; i++) {
         const float *t = tri + 9 * i;
         box_empty(&c.tbox[i]);
@@ -175,7 +176,7 @@ int ms_bvh_build(ms_bvh *b, const float *tri, size_t n)
         c.idx[i] = (uint32_t)i;
     }
     c.next = 1;
-#pragma omp parallel
+#pragma omp parallel num_threads(threads)
 #pragma omp single
     build_node(&c, 0, 0, (uint32_t)n, 1);
 

@@ -26,6 +26,8 @@ int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t e
     cJSON_AddNumberToObject(o, "total_s", s->total_s);
     cJSON_AddNumberToObject(o, "visible_pixels", (double)s->visible_pixels);
     cJSON_AddNumberToObject(o, "shadow_rays", (double)s->shadow_rays);
+    cJSON_AddNumberToObject(o, "penumbra_pixels", (double)s->penumbra_pixels);
+    cJSON_AddNumberToObject(o, "shadow_factor_s", s->shadow_factor_s);
     cJSON_AddNumberToObject(o, "shadow_rays_per_s", s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s : 0.0);
     cJSON *c = cJSON_AddObjectToObject(o, "counters");
     for (int i = 0; c && i < s->n_counters; i++) cJSON_AddNumberToObject(c, s->counter_name[i], (double)s->counter[i]);

@@ -48,6 +48,10 @@ ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k, ms_isa cap, ms_isa *chosen
 ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, ms_isa isa);
 const char *ms_kernel_name(ms_kernel_id id);
 
+/* Clears, in a k x k buffer, every sample (i, j) with e . (i, j, 1) >= 0 (the Scanline kernel's setup and
+ * row loop for one edge: ties go to the cleared side, as for a triangle's edges). */
+void ms_raster_clear_halfplane(int k, const float e[3], void *buf);
+
 void ms_buffer_fill_visible(void *buf, int k);
 int ms_buffer_all_occluded(const void *buf, int k);
 int ms_buffer_visible_count(const void *buf, int k);

@@ -224,6 +224,7 @@ MS_PERK_DECLARE(void, ms_bounds, scalar, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_hier, scalar, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_scanline, avx2, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_scanline, avx512, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_clear_halfplane, scalar, (const float e[3], void *buf));
 
 /* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
  * (0 when setup rejects it). */

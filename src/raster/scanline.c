@@ -11,3 +11,10 @@ int ms_scanline_rows(const ms_raster_frame *f, const float tri[9])
     if (!ms_tri_setup_run(f, tri, &t) || !ms_scan_setup_run(f, &t, &s)) return 0;
     return s.y1 - s.y0 + 1;
 }
+
+void ms_raster_clear_halfplane(int k, const float e[3], void *buf)
+{
+    static void (*const fn[3])(const float e[3], void *buf) = MS_PERK_TABLE(ms_clear_halfplane, scalar);
+    const int w = ms_k_index(k);
+    if (w >= 0) fn[w](e, buf);
+}

@@ -2,6 +2,7 @@
  * core/perk_each.h (MS_K, MS_WORD). */
 #define MS_ROWS_FN MS_KFN(ms_scan_rows)
 #define MS_KERNEL_FN MS_KFN(ms_scanline)
+#define MS_HALFPLANE_FN MS_KFN(ms_clear_halfplane)
 
 /* Clears the covered interval of scanlines y0..y1. nl and nu are compile-time constants at every call
  * site, so each (nl, nu) pair gets its own unrolled, branch-free loop: the paper's specialised loops by
@@ -56,5 +57,22 @@ void MS_KERNEL_FN(const ms_raster_frame *f, const float tri[9], void *out)
 #undef MS_CASE
 }
 
+/* Clears every sample (x, y) with e . (x, y, 1) >= 0: a "triangle" of one active edge over the whole
+ * buffer, through the same setup and row loop, so that a half-plane (the receiver's horizon) is decided
+ * exactly like a triangle edge. */
+void MS_HALFPLANE_FN(const float e[3], void *out)
+{
+    ms_raster_frame f = { .k = MS_K };
+    ms_tri_setup t = { .n = 1, .x0 = 0, .x1 = MS_K - 1, .y0 = 0, .y1 = MS_K - 1 };
+    ms_scan_setup s;
+    t.e[0][0] = e[0]; t.e[0][1] = e[1]; t.e[0][2] = e[2];
+    if (!ms_scan_setup_run(&f, &t, &s)) return;
+    MS_WORD *buf = (MS_WORD *)out;
+    if (s.nl) MS_ROWS_FN(buf, &s, 1, 0);
+    else if (s.nu) MS_ROWS_FN(buf, &s, 0, 1);
+    else MS_ROWS_FN(buf, &s, 0, 0);   /* flat edge: whole rows in [y0, y1]; constant: all */
+}
+
+#undef MS_HALFPLANE_FN
 #undef MS_ROWS_FN
 #undef MS_KERNEL_FN

@@ -2,7 +2,6 @@
 #define MS_SCENE_INTERNAL_H
 #include <stddef.h>
 
-#define MS_MAX_IMAGE_SIZE 16384
 #define MS_DEFAULT_EMISSION 1.0f
 
 typedef struct ms_tri_soup { float *tri; size_t n, cap; } ms_tri_soup;

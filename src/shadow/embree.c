@@ -8,8 +8,9 @@
  * create() of a frame builds it, the other finds it in a small mutex-protected cache keyed by the
  * frame's BVH and holds a reference; the last destroy() releases it.
  *
- * Shadow rays: per pixel the ctx->samples segments of the chosen pattern (ms_pattern_points), origin
- * q.p, direction sample - q.p unnormalised, tnear = ctx->near, tfar = ctx->far, exactly as raytrace.
+ * Shadow rays: per pixel the segments to the samples of the chosen pattern (ms_pattern_points) that are
+ * in front of the receiver's plane (the front mask, receiver.h), origin q.p, direction sample - q.p
+ * unnormalised, tnear = ctx->near, tfar = ctx->far, exactly as raytrace.
  * Traced either as 16-wide packets (rtcOccluded16) or as one coherent stream per pixel (rtcOccluded1M
  * with RTC_INTERSECT_CONTEXT_FLAG_COHERENT), chosen by the environment variable
  *     MS_EMBREE_MODE=packet16 | stream      (default packet16: the faster here, docs/embree.md)
@@ -17,10 +18,10 @@
  *
  * The hit triangle q.prim never occludes. Embree excludes it through a context filter function that
  * rejects primID == q.prim, the prim passed in an extension of RTCIntersectContext. The filter is
- * only needed when the receiver's own triangle can be hit within [near, far] at all. It cannot when
- * all four light corners lie in front of the triangle's plane by at least 10x the hit point's own
- * offset (every segment stays on the front side), nor when they all lie so far behind it that every
- * segment crosses the plane at t < near/2; the margins are orders of magnitude above Embree's
+ * only needed when the receiver's own triangle can be hit within [near, far] at all. Only front samples
+ * are traced, so it cannot when rounding left the hit point on the front side of its triangle's plane,
+ * nor, when it left it behind by dp, when every light corner is higher above the point than 2|dp|/near
+ * (every segment crosses the plane at t < near/2); the margin is orders of magnitude above Embree's
  * rounding, so for those pixels the filter is left out (eb_needs_filter). Exactly consistent with
  * raytrace either way (the test checks bit-identical V against filtering every pixel); the choice is
  *     MS_EMBREE_FILTER=plane | always | none (default plane; "none" is for measuring only: the
@@ -36,6 +37,7 @@
  * Timing: the Embree build happens in create(), which ms_render does not time; it is reported once per
  * frame as the counter "embree_build_us" (and the degenerate triangles as "degenerate_triangles"). */
 #include "method.h"
+#include "receiver.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
 #include <embree3/rtcore.h>
@@ -294,88 +296,82 @@ static void eb_filter_fn(const struct RTCFilterFunctionNArguments *a)
         }
 }
 
-/* 1 if the segments from q.p to the light can cross the plane of q's own triangle within the
+/* 1 if a segment from q.p to a front sample can cross the plane of q's own triangle within the
  * occluding range, i.e. if Embree could report the receiver's triangle; see the header comment. */
 static int eb_needs_filter(const ms_render_ctx *ctx, const ms_shadow_query *q)
 {
     const float *tri = ctx->bvh->tri + 9 * (size_t)q->prim;
-    float e1[3], e2[3], n[3], d[3];
-    v3_sub(e1, tri + 3, tri);
-    v3_sub(e2, tri + 6, tri);
-    v3_cross(n, e1, e2);
-    v3_normalize(n, n);
+    float d[3];
     v3_sub(d, q->p, tri);
-    float dp = v3_dot(n, d);
-    if (dp < 0.0f) { v3_scale(n, n, -1.0f); dp = -dp; }
-    if (!(dp > 0.0f)) return 1;
+    /* The point's signed distance to its triangle's plane along q.n (unit) is non-zero only by rounding;
+     * `below` bounds how far under the plane it may be, the dot product's own rounding included. Above
+     * the plane a segment to a front sample never comes back to it. */
+    const float err = 1e-6f * (fabsf(q->n[0] * d[0]) + fabsf(q->n[1] * d[1]) + fabsf(q->n[2] * d[2]));
+    const float below = err - v3_dot(q->n, d);
+    if (below <= 0.0f) return 0;
+    /* Below it, the segment to a sample at height a = (L - P) . n > 0 crosses the plane at t <= below / a:
+     * before near/2 (outside the occluding range with a margin) when a > 2 below / near. The height is
+     * affine on the light, so its four corners bound every sample's. */
     const ms_light *L = &ctx->light;
     const float c0[3] = { L->corner.x, L->corner.y, L->corner.z };
     const float es[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, et[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
-    float c[4][3];
-    for (int a = 0; a < 3; a++) {
-        c[0][a] = c0[a];
-        c[1][a] = c0[a] + es[a];
-        c[2][a] = c0[a] + et[a];
-        c[3][a] = c0[a] + es[a] + et[a];
-    }
-    /* The light's signed distance to the plane is affine on the light, so its corners bound every
-     * sample's. A segment to a sample at distance ds crosses the plane at t = dp / (dp - ds). */
-    float lo = INFINITY, hi = -INFINITY;
-    for (int i = 0; i < 4; i++) {
-        v3_sub(d, c[i], tri);
-        float ds = v3_dot(n, d);
-        lo = ds < lo ? ds : lo;
-        hi = ds > hi ? ds : hi;
-    }
-    /* Light in front, beyond 10x the point's own offset: t < 0 or t > 1 (den = ds - dp >= 9 dp). */
-    if (lo >= 10.0f * dp) return 0;
-    /* Light far behind: every crossing at t < near/2, before the occluding range even begins. */
-    if (ctx->near > 0.0f && hi <= dp * (1.0f - 2.0f / ctx->near)) return 0;
-    return 1;
+    float rel[3];
+    v3_sub(rel, c0, q->p);
+    const float a0 = v3_dot(rel, q->n), as = v3_dot(es, q->n), at = v3_dot(et, q->n);
+    const float lo = ms_minf(ms_minf(a0, a0 + as), ms_minf(a0 + at, a0 + as + at));
+    return !(ctx->near > 0.0f && lo > 2.0f * below / ctx->near);
 }
 
 /* Scratch per visibility call: sample points and the ray storage of either mode. */
 typedef struct eb_scratch {
     float *pts;
-    struct RTCRay *rays;       /* stream: ns rays */
+    struct RTCRay *rays;       /* stream: the front samples' rays */
     struct RTCRay16 *r16;      /* packet16: one packet */
 } eb_scratch;
 
-static int eb_trace_stream(eb_shared *s, eb_ictx *ic, const ms_render_ctx *ctx, const ms_shadow_query *q,
-                           const eb_scratch *w, uint64_t *cnt)
+static void eb_ray_init(struct RTCRay *r, const ms_render_ctx *ctx, const float p[3], const float *pt, int id)
+{
+    r->org_x = p[0]; r->org_y = p[1]; r->org_z = p[2];
+    r->tnear = ctx->near;
+    r->dir_x = pt[0] - p[0];
+    r->dir_y = pt[1] - p[1];
+    r->dir_z = pt[2] - p[2];
+    r->time = 0.0f;
+    r->tfar = ctx->far;
+    r->mask = 0xFFFFFFFFu;
+    r->id = (unsigned)id;
+    r->flags = 0;
+}
+
+/* Both modes trace only the front samples and set their bits in vis when unoccluded. */
+static void eb_trace_stream(eb_shared *s, eb_ictx *ic, const ms_render_ctx *ctx, const ms_shadow_query *q,
+                            const eb_scratch *w, const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
     const int ns = ctx->samples;
     struct RTCRay *r = w->rays;
-    for (int i = 0; i < ns; i++) {
-        r[i].org_x = q->p[0]; r[i].org_y = q->p[1]; r[i].org_z = q->p[2];
-        r[i].tnear = ctx->near;
-        r[i].dir_x = w->pts[3 * i] - q->p[0];
-        r[i].dir_y = w->pts[3 * i + 1] - q->p[1];
-        r[i].dir_z = w->pts[3 * i + 2] - q->p[2];
-        r[i].time = 0.0f;
-        r[i].tfar = ctx->far;
-        r[i].mask = 0xFFFFFFFFu;
-        r[i].id = (unsigned)i;
-        r[i].flags = 0;
-    }
-    rtcOccluded1M(s->scene, &ic->c, r, (unsigned)ns, sizeof *r);
+    unsigned n = 0;
+    for (int i = 0; i < ns; i++)
+        if (ms_mask_get(front, i)) eb_ray_init(&r[n++], ctx, q->p, w->pts + 3 * i, i);
+    if (!n) return;
+    rtcOccluded1M(s->scene, &ic->c, r, n, sizeof *r);
     cnt[C_CALLS]++;
-    int visible = 0;
-    for (int i = 0; i < ns; i++) visible += r[i].tfar >= 0.0f;   /* occluded: tfar = -inf */
-    return visible;
+    cnt[C_RAYS] += n;
+    for (unsigned i = 0; i < n; i++)
+        if (r[i].tfar >= 0.0f) vis[r[i].id >> 6] |= UINT64_C(1) << (r[i].id & 63);   /* occluded: -inf */
 }
 
-static int eb_trace_packet16(eb_shared *s, eb_ictx *ic, const ms_render_ctx *ctx, const ms_shadow_query *q,
-                             const eb_scratch *w, uint64_t *cnt)
+static void eb_trace_packet16(eb_shared *s, eb_ictx *ic, const ms_render_ctx *ctx, const ms_shadow_query *q,
+                              const eb_scratch *w, const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
-    static const int valid[16] __attribute__((aligned(64))) = { -1, -1, -1, -1, -1, -1, -1, -1,
-                                                                -1, -1, -1, -1, -1, -1, -1, -1 };
+    _Alignas(64) int valid[16];
     const int ns = ctx->samples;
     struct RTCRay16 *r = w->r16;
-    int visible = 0;
     for (int base = 0; base < ns; base += 16) {
+        const unsigned lanes = (unsigned)(front[base >> 6] >> (base & 63) & 0xFFFFu);
+        if (!lanes) continue;
         const float *pt = w->pts + 3 * base;
         for (int l = 0; l < 16; l++) {
+            valid[l] = lanes >> l & 1u ? -1 : 0;
             r->org_x[l] = q->p[0]; r->org_y[l] = q->p[1]; r->org_z[l] = q->p[2];
             r->tnear[l] = ctx->near;
             r->dir_x[l] = pt[3 * l] - q->p[0];
@@ -389,16 +385,19 @@ static int eb_trace_packet16(eb_shared *s, eb_ictx *ic, const ms_render_ctx *ctx
         }
         rtcOccluded16(valid, s->scene, &ic->c, r);
         cnt[C_CALLS]++;
-        for (int l = 0; l < 16; l++) visible += r->tfar[l] >= 0.0f;
+        cnt[C_RAYS] += (uint64_t)__builtin_popcount(lanes);
+        uint64_t bits = 0;
+        for (int l = 0; l < 16; l++) bits |= (uint64_t)((lanes >> l & 1u) && r->tfar[l] >= 0.0f) << l;
+        vis[base >> 6] |= bits << (base & 63);
     }
-    return visible;
 }
 
-static void eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq, float *vis,
-                          uint64_t *cnt)
+static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                         const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
     eb_shared *s = state;
     const int ns = ctx->samples;
+    const size_t mw = (size_t)ctx->mask_words;
     if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) {
         cnt[C_BUILD_US] += s->build_us;
         cnt[C_DEGENERATE] += s->n_degenerate;
@@ -408,7 +407,7 @@ static void eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     w.pts = malloc((size_t)ns * 3 * sizeof(float));
     if (s->mode == EB_STREAM) w.rays = aligned_alloc(64, (size_t)ns * sizeof *w.rays);
     else w.r16 = aligned_alloc(64, sizeof *w.r16);
-    if (!w.pts || (!w.rays && !w.r16)) abort();
+    if (!w.pts || (!w.rays && !w.r16)) { free(w.pts); free(w.rays); free(w.r16); return -1; }
 
     unsigned mx = eb_enter();
     eb_ictx ic;
@@ -416,20 +415,23 @@ static void eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     ic.c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     ic.cnt = cnt;
     for (int qi = 0; qi < nq; qi++) {
+        const uint64_t *fm = front + qi * mw;
+        uint64_t *vm = vis + qi * mw;
+        memset(vm, 0, mw * sizeof *vm);
+        if (!ms_mask_count(fm, (int)mw)) continue;
         ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[qi].px, q[qi].py, ctx->seed, w.pts);
         int filt = s->filter == EB_FILTER_ALWAYS || (s->filter == EB_FILTER_PLANE && eb_needs_filter(ctx, &q[qi]));
         ic.c.filter = filt ? eb_filter_fn : NULL;
         ic.skip = q[qi].prim;
         cnt[C_FILTERED_PIXELS] += (uint64_t)filt;
-        int visible = s->mode == EB_STREAM ? eb_trace_stream(s, &ic, ctx, &q[qi], &w, cnt)
-                                           : eb_trace_packet16(s, &ic, ctx, &q[qi], &w, cnt);
-        cnt[C_RAYS] += (uint64_t)ns;
-        vis[qi] = (float)visible / (float)ns;
+        if (s->mode == EB_STREAM) eb_trace_stream(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
+        else eb_trace_packet16(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
     }
     eb_leave(mx);
     free(w.pts);
     free(w.rays);
     free(w.r16);
+    return 0;
 }
 
 const ms_shadow_method ms_shadow_embree = {

@@ -17,6 +17,7 @@ typedef struct ms_render_ctx {
     ms_light light;
     ms_pattern pattern;
     int k, samples;                /* samples = k*k */
+    int mask_words;                /* 64-bit words of one sample mask: samples / 64 (receiver.h) */
     uint32_t seed;
     float near, far;               /* occluding range of the segment parameter from hit point to sample */
     int threads;
@@ -28,8 +29,8 @@ typedef struct ms_render_ctx {
     int no_occlusion_cull, no_child_order;
 } ms_render_ctx;
 
-/* One visible point: the pixel, its hit point (already offset off the surface towards the camera),
- * the geometric normal facing the camera, and the hit triangle, which never occludes. */
+/* One visible point: the pixel, its hit point, the unit geometric normal facing the camera (its plane is
+ * the receiver's horizon), and the hit triangle, which never occludes. */
 typedef struct ms_shadow_query {
     float p[3];
     float n[3];
@@ -45,9 +46,12 @@ typedef struct ms_shadow_method {
     const char *counter_names[MS_MAX_COUNTERS];
     /* Per-frame set-up (shared, read-only afterwards); 0 or -1 with a message in err. */
     int (*create)(const ms_render_ctx *ctx, void **state, char *err, size_t errlen);
-    /* V for n queries; thread-safe; adds to counters[n_counters] (thread-private). */
-    void (*visibility)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n, float *vis,
-                       uint64_t *counters);
+    /* For n queries: front + i*ctx->mask_words holds the samples in front of query i's plane (receiver.h);
+     * the method writes to vis + i*ctx->mask_words the subset no triangle occludes (a sample behind is
+     * never visible). Thread-safe; adds to counters[n_counters] (thread-private). 0, or -1 when out of
+     * memory. */
+    int (*visibility)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n,
+                      const uint64_t *front, uint64_t *vis, uint64_t *counters);
     void (*destroy)(void *state);
     /* Optional (NULL: the method has no ISA-dispatched code): the instruction sets its kernel and its
      * traversal run, as chosen by create under ctx->isa_cap, for ms_stats. */
@@ -71,13 +75,15 @@ typedef struct ms_primary_method {
 const ms_shadow_method *ms_find_shadow_method(const char *name);
 const ms_primary_method *ms_find_primary_method(const char *name);
 
-/* Finishes a hit from a ray and a hit triangle: the point offset off the surface towards the ray's
- * origin, and the normal facing it. Shared by every primary method so that all agree on C. */
+/* Finishes a hit from a ray and a hit triangle: the point o + t d (not lifted: the horizon and the near
+ * range make V independent of which side of the surface rounding puts it), and the unit normal facing
+ * the ray's origin. Shared by every primary method so that all agree on the receiver. */
 void ms_hit_finish(const ms_render_ctx *ctx, const float o[3], const float d[3], float t, uint32_t prim,
                    ms_hit *h);
 
-/* The reference answer for one point: how many of its k*k samples are unoccluded (raytrace.c).
- * pts: scratch for 3*k*k floats; cnt: the raytrace method's 3 counters. */
-int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query *q, float *pts, uint64_t *cnt);
+/* The reference answer for one point (raytrace.c): writes to vis the front samples that are unoccluded and
+ * returns their number. pts: scratch for 3*k*k floats; cnt: the raytrace method's 3 counters. */
+int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query *q, float *pts,
+                                const uint64_t *front, uint64_t *vis, uint64_t *cnt);
 
 #endif

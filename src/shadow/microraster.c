@@ -1,8 +1,9 @@
 /* Methods "scanline", "bounds", "hierarchical": soft shadows by micro-rasterization (Woop 2010,
  * sec. 6). For every visible point C the frustum spanned by C and the light is traversed through the
  * BVH (frustum_traverse_impl.h); every triangle of a surviving leaf is rasterized into the pixel's
- * k x k occlusion buffer with the method's kernel (src/raster); V is the fraction of samples left
- * visible. The pixel's 3x3 light-space transform is set up once and shared by all its triangles.
+ * k x k occlusion buffer with the method's kernel (src/raster), which starts as the pixel's front mask
+ * (the receiver's horizon rasterized by the Scanline row loop, receiver.c); what is left is the visible
+ * mask. The pixel's 3x3 light-space transform is set up once and shared by all its triangles.
  *
  * Departure from the paper: a point that sees the light nearly edge-on (closer to the light's plane than
  * 1e-3 of its distance to the light) makes the light-space transform near-singular (light-space
@@ -15,10 +16,12 @@
  * switch off the coverage test and the near-first child order; the library reads no environment. */
 #include "method.h"
 #include "frustum_traverse.h"
+#include "receiver.h"
 #include <math.h>
 #include "../core/vec.h"
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define EDGE_ON 1e-3f
 
@@ -49,13 +52,19 @@ static int mr_create_scanline(const ms_render_ctx *c, void **s, char *e, size_t 
 static int mr_create_bounds(const ms_render_ctx *c, void **s, char *e, size_t n) { return mr_create_kernel(MS_KERNEL_BOUNDS, c, s, e, n); }
 static int mr_create_hier(const ms_render_ctx *c, void **s, char *e, size_t n) { return mr_create_kernel(MS_KERNEL_HIERARCHICAL, c, s, e, n); }
 
-static void mr_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq, float *vis,
-                          uint64_t *cnt)
+static int mr_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                         const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
     const mr_state *s = state;
-    _Alignas(64) uint64_t buf[64];
+    const size_t mw = (size_t)ctx->mask_words;
     float *pts = NULL;
     for (int qi = 0; qi < nq; qi++) {
+        const uint64_t *fm = front + qi * mw;
+        uint64_t *buf = vis + qi * mw;   /* the k x k occlusion buffer itself (receiver.h) */
+        /* The horizon is already rasterized: the buffer starts as the front mask, so samples behind count
+         * as neither visible nor occluded and the all-zero early-out means "every front sample occluded". */
+        memcpy(buf, fm, mw * sizeof *buf);
+        if (ms_mask_count(fm, (int)mw) == 0) continue;
         ms_grid g;
         ms_raster_frame f;
         ms_grid_for_pixel(&ctx->light, ctx->k, q[qi].px, q[qi].py, ctx->seed, &g);
@@ -65,17 +74,16 @@ static void mr_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
         float h = fabsf(v3_dot(n, rel)), d = v3_len(n) * v3_len(rel);
         if (!(h > EDGE_ON * d) || ms_raster_frame_init(&f, q[qi].p, &g, ctx->near, ctx->far, 0) != 0) {
             uint64_t rt_counters[MS_MAX_COUNTERS] = { 0 };
-            if (!pts && !(pts = malloc((size_t)ctx->samples * 3 * sizeof(float)))) abort();
-            vis[qi] = (float)ms_raytrace_visible_samples(ctx, &q[qi], pts, rt_counters) / (float)ctx->samples;
+            if (!pts && !(pts = malloc((size_t)ctx->samples * 3 * sizeof(float)))) return -1;
+            ms_raytrace_visible_samples(ctx, &q[qi], pts, fm, buf, rt_counters);
             cnt[MS_FT_TRACED_EDGE_ON]++;
             continue;
         }
-        ms_buffer_fill_visible(buf, ctx->k);
         cnt[MS_FT_FRUSTA]++;
         s->trace(ctx->bvh, &f, s->raster, q[qi].prim, buf, cnt, s->flags);
-        vis[qi] = (float)ms_buffer_visible_count(buf, ctx->k) / (float)ctx->samples;
     }
     free(pts);
+    return 0;
 }
 
 static void mr_destroy(void *state) { free(state); }

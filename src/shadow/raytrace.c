@@ -1,5 +1,5 @@
-/* Method "raytrace": the reference. One any-hit shadow segment per light sample through our BVH,
- * from the (offset) hit point to the sample, occluding for parameters in [near, far] and never by
+/* Method "raytrace": the reference. One any-hit shadow segment per light sample in front of the
+ * receiver's plane through our BVH, from the hit point to the sample, occluding for parameters in [near, far] and never by
  * the hit triangle. The k*k rays of a pixel share their origin and point at one small light, so they
  * are traced as 16-ray packets: a node is visited when any live ray of the packet enters it, and each
  * triangle is tested against the packet's rays that are still unoccluded. The lane loops are plain C
@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define LANES 16
 
@@ -107,12 +108,17 @@ static int rt_create(const ms_render_ctx *ctx, void **state, char *err, size_t e
     return 0;
 }
 
-int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query *q, float *pts, uint64_t *cnt)
+int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query *q, float *pts,
+                                const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
     const int ns = ctx->samples;
     ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, pts);
+    memset(vis, 0, (size_t)ctx->mask_words * sizeof *vis);
     int visible = 0;
     for (int base = 0; base < ns; base += LANES) {
+        /* Samples behind the receiver's plane are not traced (LANES divides 64: one word holds them). */
+        const uint64_t lanes = front[base >> 6] >> (base & 63) & ((UINT64_C(1) << LANES) - 1);
+        if (!lanes) continue;
         packet pk;
         for (int a = 0; a < 3; a++) pk.o[a] = q->p[a];
         pk.tmin = ctx->near;
@@ -122,23 +128,28 @@ int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query 
                 pk.d[a][l] = pts[3 * (base + l) + a] - pk.o[a];
                 pk.inv[a][l] = 1.0f / pk.d[a][l];
             }
-            pk.live[l] = 1;
+            pk.live[l] = (int)(lanes >> l & 1u);
         }
         trace_packet(ctx->bvh, &pk, q->prim, cnt);
-        for (int l = 0; l < LANES; l++) visible += pk.live[l];
+        uint64_t bits = 0;
+        for (int l = 0; l < LANES; l++) bits |= (uint64_t)(pk.live[l] != 0) << l;
+        vis[base >> 6] |= bits << (base & 63);
+        visible += __builtin_popcountll(bits);
     }
     return visible;
 }
 
-static void rt_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
-                          float *vis, uint64_t *cnt)
+static int rt_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                         const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
     (void)state;
     float *pts = malloc((size_t)ctx->samples * 3 * sizeof(float));
-    if (!pts) abort();
+    if (!pts) return -1;
+    const size_t mw = (size_t)ctx->mask_words;
     for (int qi = 0; qi < nq; qi++)
-        vis[qi] = (float)ms_raytrace_visible_samples(ctx, &q[qi], pts, cnt) / (float)ctx->samples;
+        ms_raytrace_visible_samples(ctx, &q[qi], pts, front + qi * mw, vis + qi * mw, cnt);
     free(pts);
+    return 0;
 }
 
 static void rt_destroy(void *state) { (void)state; }

@@ -1,7 +1,9 @@
 #include "testutil.h"
+#include "shadow/receiver.h"
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -126,6 +128,68 @@ float *tu_read_pfm(const char *path, int *w, int *h)
         if (fread(data + (size_t)y * *w, sizeof(float), (size_t)*w, f) != (size_t)*w) { free(data); fclose(f); return NULL; }
     fclose(f);
     return data;
+}
+
+tu_agreement tu_compare_frames(const ms_frame *a, const ms_frame *b)
+{
+    tu_agreement g = { 0 };
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    for (long i = 0; i < (long)a->width * a->height; i++) {
+        g.pixels++;
+        const float x = a->vis[i], y = b->vis[i];
+        if ((x < 0.0f) != (y < 0.0f)) { g.miss_mismatch++; g.differ++; continue; }
+        if (x < 0.0f) continue;
+        const double nf = a->front[i] > b->front[i] ? a->front[i] : b->front[i];
+        const double steps = fabs((double)x - (double)y) * nf;
+        const double ds = fabs((double)a->shadow[i] - (double)b->shadow[i]);
+        if (steps > 1e-3) g.differ++;
+        if (steps > 1.0 + 1e-3) g.beyond_one++;
+        if (steps > g.max_steps) g.max_steps = steps;
+        if (ds > g.max_ds) g.max_ds = ds;
+        if (steps <= 1e-3 && ds > 1e-6) g.s_differ_same_v++;
+        if (nf > 0 && ds > 8.0 * (steps + 1e-3) / nf) g.s_beyond++;
+    }
+    return g;
+}
+
+void tu_ctx_init(ms_render_ctx *ctx, const ms_scene *sc, const ms_bvh *bvh, int W, int H, int k)
+{
+    memset(ctx, 0, sizeof *ctx);
+    assert_int_equal(ms_camera_basis_init(&ctx->cam, &sc->camera, W, H), 0);
+    ctx->scene = sc;
+    ctx->bvh = bvh;
+    ctx->light = sc->light;
+    ctx->pattern = MS_PATTERN_GRID;
+    ctx->k = k;
+    ctx->samples = k * k;
+    ctx->mask_words = k * k / 64;
+    ctx->near = 1e-4f;
+    ctx->far = 1.0f - 1e-4f;
+    ctx->threads = 1;
+}
+
+int tu_shadow_vs(const ms_shadow_method *m, void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n,
+                 float *v, float *s, uint64_t *counters)
+{
+    const size_t mw = (size_t)ctx->mask_words;
+    uint64_t *front = calloc((size_t)n * mw + 1, sizeof *front), *vis = calloc((size_t)n * mw + 1, sizeof *vis);
+    float *pts = ctx->pattern == MS_PATTERN_GRID ? NULL : malloc((size_t)ctx->samples * 3 * sizeof *pts);
+    assert_non_null(front);
+    assert_non_null(vis);
+    for (int i = 0; i < n; i++) {
+        if (pts) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
+        ms_front_mask(ctx, &q[i], pts, front + i * mw);
+    }
+    int rc = m->visibility(state, ctx, q, n, front, vis, counters);
+    for (int i = 0; i < n && rc == 0; i++) {
+        if (pts) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
+        ms_resolve_vs(ctx, &q[i], pts, front + i * mw, vis + i * mw, &v[i], &s[i]);
+    }
+    free(front);
+    free(vis);
+    free(pts);
+    return rc;
 }
 
 ms_isa tu_isa_cap(void)

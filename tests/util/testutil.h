@@ -25,6 +25,30 @@ const char *tu_shared_scene(char *buf, size_t n, const char *rel);
 /* Reads a PFM written by ms_write_vis into a top-row-first array (caller frees). */
 float *tu_read_pfm(const char *path, int *w, int *h);
 
+/* Two frames of the same scene, pixel by pixel. A V difference is counted in samples: |dV| times the
+ * pixel's front count (the larger of the two, which agree where the hit points do). S must equal where V
+ * does (same masks, same weights) and may move by a few times 1/front per differing sample. */
+typedef struct tu_agreement {
+    long pixels, differ, beyond_one, miss_mismatch;
+    long s_differ_same_v;   /* V equal, S not */
+    long s_beyond;          /* |dS| > 8 * steps / front */
+    double max_steps;       /* largest |dV| in samples */
+    double max_ds;
+} tu_agreement;
+tu_agreement tu_compare_frames(const ms_frame *a, const ms_frame *b);
+
+/* Internal-API helpers for tests that drive shadow methods directly on chosen points. */
+struct ms_render_ctx;
+struct ms_shadow_query;
+struct ms_shadow_method;
+struct ms_bvh;
+/* A frame context as ms_render sets it up: grid pattern, k x k samples, the scene's camera at W x H. */
+void tu_ctx_init(struct ms_render_ctx *ctx, const ms_scene *sc, const struct ms_bvh *bvh, int W, int H, int k);
+/* V and S of n points by a shadow method (state from its create), through front masks and ms_resolve_vs
+ * exactly as ms_render does. Returns the method's visibility result (0 ok). */
+int tu_shadow_vs(const struct ms_shadow_method *m, void *state, const struct ms_render_ctx *ctx,
+                 const struct ms_shadow_query *q, int n, float *v, float *s, uint64_t *counters);
+
 /* The ISA cap of this test run: MS_TEST_ISA=scalar|avx2|avx512 in the environment of the test programs
  * (read here only: the library reads no environment), MS_ISA_AUTO when unset. Tests pass it to the
  * selection functions and run a forced SIMD variant only when tu_isa_allowed grants it, so that CI can run

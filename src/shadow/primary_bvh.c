@@ -1,5 +1,5 @@
-/* Primary visibility through our BVH, and the hit finishing every primary method shares. */
-#include "../shadow/method.h"
+/* Primary method "bvh": camera rays through our BVH; and the hit finishing every primary method shares. */
+#include "method.h"
 #include "../core/vec.h"
 #include <math.h>
 
@@ -7,22 +7,16 @@ void ms_hit_finish(const ms_render_ctx *ctx, const float o[3], const float d[3],
                    ms_hit *h)
 {
     const float *tri = ctx->bvh->tri + 9 * (size_t)prim;
-    float e1[3], e2[3], n[3], p[3];
+    float e1[3], e2[3], n[3];
     v3_sub(e1, tri + 3, tri);
     v3_sub(e2, tri + 6, tri);
     v3_cross(n, e1, e2);
     v3_normalize(n, n);
     if (v3_dot(n, d) > 0.0f) v3_scale(n, n, -1.0f);
-    v3_madd(p, o, d, t);
-    /* Lift the point off the surface towards the camera by a few ulps of the scene's size, so that
-     * rounding in p never puts it behind its own or a neighbouring triangle. */
-    const ms_bvh_node *root = &ctx->bvh->nodes[0];
-    float scale = 0.0f;
-    for (int a = 0; a < 3; a++) {
-        scale = ms_maxf(scale, fabsf(p[a]));
-        scale = ms_maxf(scale, root->bmax[a] - root->bmin[a]);
-    }
-    v3_madd(h->p, p, n, 1e-5f * scale);
+    /* Not lifted off the surface: rounding may leave p on either side of its triangle's plane, and V does
+     * not depend on which (segments to samples behind the plane are not drawn; occluders closer than the
+     * near parameter are ignored). */
+    v3_madd(h->p, o, d, t);
     h->n[0] = n[0]; h->n[1] = n[1]; h->n[2] = n[2];
     h->prim = prim;
 }

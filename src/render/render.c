@@ -1,9 +1,9 @@
 /* One frame: BVH build, primary visibility, shadows, shading, each phase timed on its own and run
  * over 16x16 pixel tiles by OpenMP (dynamic scheduling: shadow cost varies wildly across a frame). */
 #include "microshadow.h"
-#include "pattern.h"
+#include "../core/pattern.h"
 #include "../shadow/method.h"
-#include "../scene/scene_internal.h"
+#include "../shadow/receiver.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -18,7 +18,7 @@
 void ms_render_options_default(ms_render_options *o)
 {
     memset(o, 0, sizeof *o);
-    o->method = "scanline";
+    o->method = MS_DEFAULT_METHOD;
     o->pattern = MS_PATTERN_GRID;
     o->samples = 0;        /* the scene's */
 }
@@ -26,6 +26,8 @@ void ms_render_options_default(ms_render_options *o)
 void ms_frame_free(ms_frame *f)
 {
     free(f->vis);
+    free(f->shadow);
+    free(f->front);
     free(f->rgb);
     memset(f, 0, sizeof *f);
 }
@@ -53,12 +55,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
 {
     memset(out, 0, sizeof *out);
     double t_start = omp_get_wtime();
-    const ms_shadow_method *sm = ms_find_shadow_method(opt->method ? opt->method : "");
+    const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;   /* zeroed options: defaults */
+    const ms_shadow_method *sm = ms_find_shadow_method(method);
     if (!sm) {
-        if (ms_method_available(opt->method ? opt->method : "") < 0)
-            snprintf(err, errlen, "method '%s' is not compiled into this build", opt->method);
-        else
-            snprintf(err, errlen, "unknown method '%s'", opt->method ? opt->method : "");
+        if (ms_method_available(method) < 0) snprintf(err, errlen, "method '%s' is not compiled into this build", method);
+        else snprintf(err, errlen, "unknown method '%s'", method);
         return -1;
     }
     const ms_primary_method *pm = ms_find_primary_method(sm->primary);
@@ -85,14 +86,14 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         return -1;
     }
     ms_bvh bvh;
-    omp_set_num_threads(threads);
-    if (ms_bvh_build(&bvh, scene->tri, scene->n_tris)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
+    if (ms_bvh_build(&bvh, scene->tri, scene->n_tris, threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
     ctx.scene = scene;
     ctx.bvh = &bvh;
     ctx.light = scene->light;
     ctx.pattern = opt->pattern;
     ctx.k = k;
     ctx.samples = k * k;
+    ctx.mask_words = k * k / 64;
     ctx.seed = opt->seed;
     ctx.near = MS_NEAR;
     ctx.far = MS_FAR;
@@ -101,10 +102,12 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     size_t npix = (size_t)W * H;
     ms_hit *hits = malloc(npix * sizeof *hits);
     out->vis = malloc(npix * sizeof(float));
+    out->shadow = malloc(npix * sizeof(float));
+    out->front = malloc(npix * sizeof *out->front);
     out->rgb = malloc(npix * 3 * sizeof(float));
     void *pstate = NULL, *sstate = NULL;
     int rc = -1;
-    if (!hits || !out->vis || !out->rgb) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); goto fail; }
+    if (!hits || !out->vis || !out->shadow || !out->front || !out->rgb) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); goto fail; }
     const double t_setup = omp_get_wtime();
     if (pm->create(&ctx, &pstate, err, errlen)) goto fail;
     if (sm->create(&ctx, &sstate, err, errlen)) { pm->destroy(pstate); goto fail; }
@@ -127,45 +130,79 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     double t1 = omp_get_wtime();
 
     uint64_t counters[MS_MAX_COUNTERS] = { 0 };
-    uint64_t visible = 0;
+    uint64_t visible = 0, penumbra = 0, segments = 0;
+    double resolve_thread_s = 0.0;
+    int failed = 0;
+    const size_t mw = (size_t)ctx.mask_words;
+    const int stratified = ctx.pattern != MS_PATTERN_GRID;
 #pragma omp parallel num_threads(threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
-        uint64_t local_visible = 0;
+        uint64_t local_visible = 0, local_penumbra = 0, local_segments = 0;
+        double local_resolve = 0.0;
+        /* Per thread: the tile's front and visible masks, and the stratified pattern's points. */
+        uint64_t *front = aligned_alloc(64, TILE * TILE * mw * sizeof *front);
+        uint64_t *vmask = aligned_alloc(64, TILE * TILE * mw * sizeof *vmask);
+        float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
+        int ok = front && vmask && (pts || !stratified);
 #pragma omp for schedule(dynamic, 1)
         for (int t = 0; t < ntiles; t++) {
             int x0 = (t % tx) * TILE, y0 = (t / tx) * TILE;
             int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
             ms_shadow_query q[TILE * TILE];
-            float v[TILE * TILE];
             size_t where[TILE * TILE];
             int n = 0;
-            for (int y = y0; y < y1; y++)
+            for (int y = y0; y < y1 && ok; y++)
                 for (int x = x0; x < x1; x++) {
                     size_t i = (size_t)y * W + x;
                     const ms_hit *h = &hits[i];
-                    if (h->prim == UINT32_MAX) { out->vis[i] = -1.0f; continue; }
+                    if (h->prim == UINT32_MAX) { out->vis[i] = out->shadow[i] = -1.0f; out->front[i] = 0; continue; }
                     memcpy(q[n].p, h->p, sizeof h->p);
                     memcpy(q[n].n, h->n, sizeof h->n);
                     q[n].prim = h->prim;
                     q[n].px = (uint32_t)x;
                     q[n].py = (uint32_t)y;
+                    if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[n].px, q[n].py, ctx.seed, pts);
+                    const int nf = ms_front_mask(&ctx, &q[n], pts, front + (size_t)n * mw);
+                    out->front[i] = (uint16_t)nf;
+                    local_segments += (uint64_t)nf;
                     where[n++] = i;
                 }
-            if (n) sm->visibility(sstate, &ctx, q, n, v, local);
-            for (int i = 0; i < n; i++) out->vis[where[i]] = v[i];
+            if (n && ok && sm->visibility(sstate, &ctx, q, n, front, vmask, local)) ok = 0;
+            const double tr = omp_get_wtime();
+            for (int i = 0; i < n && ok; i++) {
+                if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
+                local_penumbra += (uint64_t)ms_resolve_vs(&ctx, &q[i], pts, front + (size_t)i * mw,
+                                                          vmask + (size_t)i * mw, &out->vis[where[i]],
+                                                          &out->shadow[where[i]]);
+            }
+            local_resolve += omp_get_wtime() - tr;
             local_visible += (uint64_t)n;
             progress_tick(&prog);
         }
+        free(front);
+        free(vmask);
+        free(pts);
 #pragma omp critical(ms_counters)
         {
             for (int c = 0; c < MS_MAX_COUNTERS; c++) counters[c] += local[c];
             visible += local_visible;
+            penumbra += local_penumbra;
+            segments += local_segments;
+            resolve_thread_s += local_resolve;
+            failed |= !ok;
         }
     }
     double t2 = omp_get_wtime();
+    if (failed) {
+        snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);
+        sm->destroy(sstate);
+        pm->destroy(pstate);
+        goto fail;
+    }
 
-    /* Shading: the unshadowed irradiance is exact; shadows enter only through V. */
+    /* Shading: the exact unshadowed irradiance times the shadow factor S (the ratio estimator: exact where
+     * the light is wholly visible or hidden, converging to the shadowed irradiance as k grows). */
     float *lum = malloc(npix * sizeof(float));
     size_t nlum = 0;
     const ms_light *L = &scene->light;
@@ -173,9 +210,9 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         float *c = out->rgb + 3 * i;
         if (hits[i].prim == UINT32_MAX) { c[0] = c[1] = c[2] = 0.0f; continue; }
         float e = ms_light_irradiance(L, hits[i].p, hits[i].n) * MS_ALBEDO / (float)M_PI;
-        c[0] = e * L->emission.x * out->vis[i];
-        c[1] = e * L->emission.y * out->vis[i];
-        c[2] = e * L->emission.z * out->vis[i];
+        c[0] = e * L->emission.x * out->shadow[i];
+        c[1] = e * L->emission.y * out->shadow[i];
+        c[2] = e * L->emission.z * out->shadow[i];
         if (lum) lum[nlum++] = e * (0.2126f * L->emission.x + 0.7152f * L->emission.y + 0.0722f * L->emission.z);
     }
     out->exposure = 1.0f;
@@ -202,7 +239,9 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     st->method = sm->name;
     st->pattern = opt->pattern == MS_PATTERN_GRID ? "grid" : "stratified";
     st->visible_pixels = visible;
-    st->shadow_rays = visible * (uint64_t)ctx.samples;
+    st->penumbra_pixels = penumbra;
+    st->shadow_factor_s = resolve_thread_s / threads;
+    st->shadow_rays = segments;
     st->n_counters = sm->n_counters;
     for (int c = 0; c < sm->n_counters; c++) { st->counter_name[c] = sm->counter_names[c]; st->counter[c] = counters[c]; }
     sm->destroy(sstate);

@@ -1,0 +1,40 @@
+/* What one receiver point sees of the light, the same for every shadow method (docs/design.md,
+ * "Visibility, precisely"):
+ *   - its front mask: the light samples strictly in front of its plane, (L_i - P) . n > 0; samples behind
+ *     are neither visible nor occluded;
+ *   - from a method's visible mask (the front samples no triangle occludes), V = visible / front (0 when
+ *     no sample is in front) and the shadow factor S = sum_vis w_i / sum_front w_i with the form-factor
+ *     weight w_i = max(cos theta_r, 0) max(cos theta_l, 0) / r_i^2 (S = V when every weight is 0: the
+ *     light is behind the point or edge-on, and E_unshadowed is 0 there anyway).
+ *
+ * Masks: ctx->mask_words 64-bit words per point; bit s of the little-endian bit stream is sample s = j*k + i,
+ * which is bit i of scanline j in the micro-rasterizer's k x k buffers (raster.h), so a buffer is a mask. */
+#ifndef MS_RECEIVER_H
+#define MS_RECEIVER_H
+#include <stdint.h>
+#include "method.h"
+#include "../core/pattern.h"
+
+#if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "sample masks alias the k x k scanline buffers as a little-endian bit stream"
+#endif
+
+static inline int ms_mask_get(const uint64_t *m, int s) { return (int)(m[s >> 6] >> (s & 63) & 1u); }
+
+/* The receiver's horizon as an edge in the grid's sample coordinates: h . (i, j, 1) = (S_ij - P) . n. */
+void ms_horizon_edge(const ms_grid *g, const float p[3], const float n[3], float h[3]);
+
+/* Writes q's front mask. pts: the pattern's sample points (3*k*k floats) for the stratified pattern, NULL
+ * for grid, where the horizon is rasterized by the Scanline row loop (ms_raster_clear_halfplane).
+ * Returns the number of samples in front. */
+int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, uint64_t *front);
+
+/* V and S from the front and visible masks (pts as above). Returns 1 when the weights had to be evaluated
+ * (penumbra: some but not all front samples visible), 0 when S follows from the counts. */
+int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, const uint64_t *front,
+                   const uint64_t *vis, float *v, float *s);
+
+/* Number of set bits in n words. */
+int ms_mask_count(const uint64_t *m, int n);
+
+#endif
