@@ -86,7 +86,9 @@ INLINE void view_pair(const trav_consts *t, const ms_bvh_node *p, const ms_bvh_n
     const __m512 abz = _mm512_abs_ps(zs);
     const __m512 az = _mm512_mul_ps(abz, t->slack);
     const __m512 naz = _mm512_mul_ps(abz, t->nslack);   /* = -az exactly, one step shorter */
-    const __m512 top = _mm512_fmadd_ps(t->hi, zs, az);
+    /* mul + add like the portable instance's hi * z + az (an FMA would round differently); hi * z runs
+     * beside az, so the chain is no longer. */
+    const __m512 top = _mm512_add_ps(_mm512_mul_ps(t->hi, zs), az);
     const uint64_t o4 = (uint64_t)_mm512_cmp_ps_mask(xs, naz, _CMP_LT_OQ) |
                         (uint64_t)_mm512_cmp_ps_mask(xs, top, _CMP_GT_OQ) << 16 |
                         (uint64_t)_mm512_cmp_ps_mask(ys, naz, _CMP_LT_OQ) << 32 |

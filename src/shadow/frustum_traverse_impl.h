@@ -56,7 +56,9 @@ static inline void TRAV_LOCAL(view_node)(const ms_raster_frame *f, const ms_bvh_
     const __m256 xs = c[0], ys = c[1], zs = c[2];
     const __m256 az = _mm256_mul_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), zs), _mm256_set1_ps(MS_TRAV_SIDE_SLACK));
     const __m256 naz = _mm256_sub_ps(_mm256_setzero_ps(), az);
-    const __m256 top = _mm256_fmadd_ps(_mm256_set1_ps(hi), zs, az);
+    /* mul + add like the portable instance's hi * z + az (an FMA would round differently, and could
+     * decide a corner on the boundary the other way); hi * z runs beside az, so it is no slower. */
+    const __m256 top = _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(hi), zs), az);
     /* |= rather than one | chain: clang warns on | between comparisons (-Wbitwise-instead-of-logical),
      * and || would add branches. */
     int out = _mm256_movemask_ps(_mm256_cmp_ps(xs, naz, _CMP_LT_OQ)) == 0xFF;
