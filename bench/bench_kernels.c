@@ -2,7 +2,9 @@
  * triangles of a bin) against the number of samples the triangle occludes, for the Scanline, Bounds and
  * Hierarchical kernels on the 32x32 buffer (or --k 16/64), the SIMD Scanline variant the CPU dispatches
  * to (scanline_simd) and, when that is AVX-512 and the CPU has AVX2+FMA, the AVX2 variant
- * (scanline_avx2), which is what CPUs without AVX-512 run.
+ * (scanline_avx2), which is what CPUs without AVX-512 run. "scanline" is the portable scalar kernel (the
+ * fallback, compiled for baseline x86-64); Bounds and Hierarchical are the ones the renderer dispatches
+ * to: their C compiled for the CPU's ISA.
  *
  *   bench_kernels [--csv] [--n TRIANGLES] [--k 16|32|64] [--seed S] [--passes P]
  *
@@ -108,8 +110,8 @@ int main(int argc, char **argv)
     ms_isa simd_isa = MS_ISA_AUTO;
     kernel_entry kernels[5] = {
         { "scanline", ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_SCALAR) },
-        { "bounds", ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_SCALAR) },
-        { "hierarchical", ms_raster_kernel_isa(MS_KERNEL_HIERARCHICAL, k, MS_ISA_SCALAR) },
+        { "bounds", ms_raster_kernel(MS_KERNEL_BOUNDS, k, MS_ISA_AUTO, NULL) },
+        { "hierarchical", ms_raster_kernel(MS_KERNEL_HIERARCHICAL, k, MS_ISA_AUTO, NULL) },
         { "scanline_simd", ms_raster_kernel(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO, &simd_isa) },
     };
     int nk = 4;

@@ -334,7 +334,7 @@ static void run_random(int k, long n_tris, uint64_t seed)
 {
     ms_isa chosen = MS_ISA_AUTO;
     const ms_raster_fn dispatched = ms_raster_kernel(MS_KERNEL_SCANLINE, k, tu_isa_cap(), &chosen);
-    kernel_under_test kt[6] = {
+    kernel_under_test kt[8] = {
         { "scanline-scalar", ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_SCALAR), 0, 0 },
         { "scanline", dispatched, 0, 0 },
         { "bounds", ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_SCALAR), 0, 0 },
@@ -343,7 +343,16 @@ static void run_random(int k, long n_tris, uint64_t seed)
     int nk = 4;
     /* Same function as one already listed: no need to run it twice. */
     const ms_raster_fn bounds_dispatch = ms_raster_kernel(MS_KERNEL_BOUNDS, k, tu_isa_cap(), NULL), avx2 = avx2_scanline(k);
-    if (bounds_dispatch != kt[2].fn) kt[nk++] = (kernel_under_test){ "bounds-dispatch", bounds_dispatch, 0, 0 };
+    const ms_raster_fn hier_dispatch = ms_raster_kernel(MS_KERNEL_HIERARCHICAL, k, tu_isa_cap(), NULL);
+    /* Bounds and Hierarchical compiled for the dispatched ISA: the same C, so the same buffers bit for bit
+     * as the portable ones (asserted below). */
+    int i_bd = -1, i_hd = -1;
+    if (bounds_dispatch != kt[2].fn) { i_bd = nk; kt[nk++] = (kernel_under_test){ "bounds-dispatch", bounds_dispatch, 0, 0 }; }
+    if (hier_dispatch != kt[3].fn) { i_hd = nk; kt[nk++] = (kernel_under_test){ "hier-dispatch", hier_dispatch, 0, 0 }; }
+    /* and Bounds compiled for AVX2 on an AVX-512 CPU */
+    const ms_raster_fn bounds_avx2 = tu_isa_allowed(MS_ISA_AVX2) ? ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_AVX2) : NULL;
+    int i_b2 = -1;
+    if (bounds_avx2 && bounds_avx2 != bounds_dispatch) { i_b2 = nk; kt[nk++] = (kernel_under_test){ "bounds-avx2", bounds_avx2, 0, 0 }; }
     int i_avx2 = -1;
     if (avx2 != NULL && avx2 != kt[1].fn) {
         i_avx2 = nk;
@@ -358,8 +367,8 @@ static void run_random(int k, long n_tris, uint64_t seed)
     tu_rng r = { seed };
     scene s;
     ms_raster_frame f;
-    uint64_t bufs[6][64];
-    long occluded = 0, bounds_hier_diff = 0, frames = 0, grazing_frames = 0;
+    uint64_t bufs[8][64];
+    long occluded = 0, bounds_hier_diff = 0, isa_build_diff = 0, frames = 0, grazing_frames = 0;
     clock_t t0 = clock();
     for (long t = 0; t < n_tris; t++) {
         if (t % 64 == 0) {
@@ -386,6 +395,13 @@ static void run_random(int k, long n_tris, uint64_t seed)
             buffer_row_get(bufs[2], k, j, &wb);
             buffer_row_get(bufs[3], k, j, &wh);
             bounds_hier_diff += wb != wh;
+            for (int c = 0; c < 3; c++) {
+                const int i = c == 2 ? i_b2 : c ? i_hd : i_bd;
+                if (i < 0) continue;
+                uint64_t wd;
+                buffer_row_get(bufs[i], k, j, &wd);
+                isa_build_diff += wd != (c == 1 ? wh : wb);
+            }
             if (cmp_simd) {
                 uint64_t w512, w2;
                 buffer_row_get(bufs[1], k, j, &w512);
@@ -422,10 +438,12 @@ static void run_random(int k, long n_tris, uint64_t seed)
                (double)kt[i].ties / ((double)n_tris * k * k), kt[i].bad);
     printf("  triangles with a tie by category:");
     for (int c = 0; c < CAT_COUNT; c++) printf(" %s %ld/%ld", cat_name[c], g_cat_ties[c], g_cat_count[c]);
-    printf("\n  bounds vs hierarchical: %ld differing scanlines\n", bounds_hier_diff);
+    printf("\n  bounds vs hierarchical: %ld differing scanlines; portable vs ISA-compiled bounds/hierarchical: %ld\n",
+           bounds_hier_diff, isa_build_diff);
     if (cmp_simd) printf("  scanline avx512 vs avx2: %ld differing scanlines\n", simd_diff);
     for (int i = 0; i < nk; i++) assert_int_equal(kt[i].bad, 0);
     assert_int_equal(bounds_hier_diff, 0);
+    assert_int_equal(isa_build_diff, 0);
     /* Ties are rare (most come from the flat-edge and touch-clip categories, which put edges and
      * vertices exactly on sample rows and clip planes on purpose): under one sample in a thousand. */
     for (int i = 0; i < nk; i++) assert_true(kt[i].ties * 1000 < n_tris * k * k);
@@ -641,8 +659,8 @@ static void test_kernel_table(void **state)
         assert_null(ms_raster_kernel_isa((ms_kernel_id)id, 128, MS_ISA_SCALAR));
     }
     assert_string_equal(ms_kernel_name(MS_KERNEL_SCANLINE), "scanline");
-    /* Forced variants: scalar always; a SIMD one only for Scanline, only when the CPU has it, and the
-     * one the probe names is the one ms_raster_kernel dispatches to without a cap. */
+    /* Forced variants: scalar always; a SIMD one only when the CPU has it, and the one the probe names is
+     * the one ms_raster_kernel dispatches to without a cap. */
     const ms_isa isa = ms_cpu_isa();
     assert_true(isa == MS_ISA_AVX512 || isa == MS_ISA_AVX2 || isa == MS_ISA_SCALAR);
     const int ks[3] = { 16, 32, 64 };
@@ -652,7 +670,9 @@ static void test_kernel_table(void **state)
             assert_ptr_equal(ms_raster_kernel_isa((ms_kernel_id)id, k, MS_ISA_SCALAR),
                              ms_raster_kernel((ms_kernel_id)id, k, MS_ISA_SCALAR, NULL));
         assert_ptr_equal(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, isa), ms_raster_kernel(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO, NULL));
-        assert_null(ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_AVX2));
+        for (int id = 0; id < MS_KERNEL_COUNT; id++)
+            assert_ptr_equal(ms_raster_kernel_isa((ms_kernel_id)id, k, isa), ms_raster_kernel((ms_kernel_id)id, k, MS_ISA_AUTO, NULL));
+        if (isa != MS_ISA_SCALAR) assert_non_null(ms_raster_kernel_isa(MS_KERNEL_BOUNDS, k, MS_ISA_AVX2));
         assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO));
         assert_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, (ms_isa)7));
         if (isa != MS_ISA_SCALAR) assert_non_null(ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, MS_ISA_AVX2));
@@ -663,8 +683,8 @@ static void test_kernel_table(void **state)
            ms_raster_kernel_isa(MS_KERNEL_SCANLINE, 32, MS_ISA_AVX2) ? "available" : "not available (no AVX2+FMA)");
 }
 
-/* The ISA cap is obeyed and reported: a cap at or below the CPU's level gives that level (for Scanline;
- * Bounds and Hierarchical are scalar only), a cap above it or none gives the CPU's best. Also the names. */
+/* The ISA cap is obeyed and reported: a cap at or below the CPU's level gives that level, a cap above it
+ * or none gives the CPU's best. Also the names. */
 static void test_isa_cap(void **state)
 {
     (void)state;
@@ -679,8 +699,8 @@ static void test_isa_cap(void **state)
             assert_ptr_equal(fn, ms_raster_kernel_isa(MS_KERNEL_SCANLINE, k, want));
             chosen = MS_ISA_AUTO;
             assert_ptr_equal(ms_raster_kernel(MS_KERNEL_HIERARCHICAL, k, caps[c], &chosen),
-                             ms_raster_kernel_isa(MS_KERNEL_HIERARCHICAL, k, MS_ISA_SCALAR));
-            assert_int_equal(chosen, MS_ISA_SCALAR);
+                             ms_raster_kernel_isa(MS_KERNEL_HIERARCHICAL, k, want));
+            assert_int_equal(chosen, want);
         }
         printf("cap %-6s -> scanline %s (cpu %s)\n", ms_isa_name(caps[c]), ms_isa_name(want), ms_isa_name(best));
     }

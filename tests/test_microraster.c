@@ -236,10 +236,10 @@ static void test_scalar_paths_match(void **state)
         uint64_t *scalar = method_masks(&sc, kernels[m], 32, 80, MS_ISA_SCALAR, &kern_scalar, &trav_scalar, &n_scalar);
         assert_int_equal(kern_scalar, MS_ISA_SCALAR);
         assert_int_equal(trav_scalar, MS_ISA_SCALAR);
-        /* uncapped: the traversal runs the CPU's best, the kernel too (Scanline) or scalar (baselines) */
+        /* uncapped: the kernel and the traversal run the CPU's best */
         if (tu_isa_cap() == MS_ISA_AUTO) {
             assert_int_equal(trav_simd, ms_cpu_isa());
-            assert_int_equal(kern_simd, m == 0 ? ms_cpu_isa() : MS_ISA_SCALAR);
+            assert_int_equal(kern_simd, ms_cpu_isa());
         }
         assert_int_equal(n_simd, n_scalar);
         /* per point: samples whose visibility differs (at most one, at a tie), and points that differ */

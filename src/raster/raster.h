@@ -39,12 +39,12 @@ typedef enum ms_kernel_id {
 typedef void (*ms_raster_fn)(const ms_raster_frame *f, const float tri[9], void *buf);
 
 /* The fastest variant of the kernel for k that this CPU runs at or below `cap` (MS_ISA_AUTO: no cap);
- * *chosen (may be NULL) is set to its ISA. Only Scanline has SIMD variants (Bounds and Hierarchical are
- * the paper's baselines and stay scalar, so the comparison is like for like). NULL for a k other than
- * 16, 32, 64. */
+ * *chosen (may be NULL) is set to its ISA. Scanline has SIMD kernels for AVX2 and AVX-512; Bounds and
+ * Hierarchical, the paper's baselines, are their portable C compiled for each ISA (identical buffers).
+ * NULL for a k other than 16, 32, 64. */
 ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k, ms_isa cap, ms_isa *chosen);
 /* Exactly the given variant (MS_ISA_SCALAR, _AVX2, _AVX512), e.g. to test or time AVX2 on an AVX-512
- * machine. NULL when the CPU lacks that ISA, the kernel has no such variant, or k is not 16, 32, 64. */
+ * machine. NULL when the CPU lacks that ISA, for MS_ISA_AUTO, or when k is not 16, 32, 64. */
 ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, ms_isa isa);
 const char *ms_kernel_name(ms_kernel_id id);
 

@@ -216,14 +216,20 @@ static inline void ms_flat_y_bounds(const float yv[8], unsigned up, unsigned dn,
     if (*y1 > k - 1) *y1 = k - 1;
 }
 
-/* The kernel instances (core/perk.h names): scalar Scanline, Bounds, Hierarchical; Scanline for AVX2 + FMA
- * (8 scanlines per instruction) and AVX-512 (16), one source: scanline_simd_impl.h. */
+/* The kernel instances (core/perk.h names): portable Scanline, Bounds, Hierarchical; SIMD Scanline for
+ * AVX2 + FMA (8 scanlines per instruction) and AVX-512 (16), one source: scanline_simd_impl.h. */
 #define MS_RASTER_PARAMS (const ms_raster_frame *f, const float tri[9], void *buf)
 MS_PERK_DECLARE(void, ms_scanline, scalar, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_bounds, scalar, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_hier, scalar, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_scanline, avx2, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_scanline, avx512, MS_RASTER_PARAMS);
+/* Bounds and Hierarchical compiled for AVX2 and AVX-512 (bounds_avx2.c, bounds_avx512.c): bit for bit the
+ * scalar ones. */
+MS_PERK_DECLARE(void, ms_bounds, avx2, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_hier, avx2, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_bounds, avx512, MS_RASTER_PARAMS);
+MS_PERK_DECLARE(void, ms_hier, avx512, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_clear_halfplane, scalar, (const float e[3], void *buf));
 
 /* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
