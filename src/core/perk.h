@@ -1,6 +1,9 @@
 /* The one idiom for instantiating code per buffer width k (16, 32, 64) and per ISA.
  *
- * A source defines MS_PERK_IMPL as the name of its *_impl.h and includes "core/perk_each.h", which
+ * A source defines MS_PERK_IMPL as the path of its *_impl.h from src/ (e.g. "raster/scanline_impl.h":
+ * the include is resolved from core/, so a bare name would not be found; tests/check_layers.sh does not
+ * see this computed include, and it is no dependency of core on the caller's folder but a call-back,
+ * like a template's) and includes "core/perk_each.h", which
  * includes the impl once per k with MS_K (16, 32, 64) and MS_WORD (uint16_t, uint32_t, uint64_t, the
  * scanline word) defined. Inside, MS_KFN(base) names the instance base_<k>_<isa>, the ISA taken from the
  * file's MS_TARGET_* macro (cpu.h): ms_scanline_32_avx2, ms_frustum_trace_64_scalar, ... K-dependent

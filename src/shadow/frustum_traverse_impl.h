@@ -19,7 +19,6 @@
 #include <immintrin.h>
 #endif
 
-#define TRAV_LOCAL(x) MS_KFN(x)
 
 #ifndef MS_TRAV_COMMON
 #define MS_TRAV_COMMON
@@ -35,7 +34,7 @@ typedef struct ms_ft_ctx { const ms_raster_frame *f; } ms_ft_ctx;
 #define FT_SAVED ms_node_view
 #endif
 
-static inline void TRAV_LOCAL(view_node)(const ms_raster_frame *f, const ms_bvh_node *n, ms_node_view *v)
+static inline void MS_KFN(view_node)(const ms_raster_frame *f, const ms_bvh_node *n, ms_node_view *v)
 {
     float rel[3], e[3], base[3], col[3][3];
     for (int a = 0; a < 3; a++) { rel[a] = n->bmin[a] - f->c[a]; e[a] = n->bmax[a] - n->bmin[a]; }
@@ -124,7 +123,7 @@ static inline void TRAV_LOCAL(view_node)(const ms_raster_frame *f, const ms_bvh_
 
 /* 1 if a still-visible sample may lie in the node's projected bounds (a small margin absorbs rounding
  * in the projection). */
-static inline int TRAV_LOCAL(covers_live)(const ms_node_view *v, const MS_WORD *buf)
+static inline int MS_KFN(covers_live)(const ms_node_view *v, const MS_WORD *buf)
 {
     if (!v->in_front) return 1;
     const float kmax = (float)(MS_K - 1);
@@ -145,41 +144,40 @@ static inline int TRAV_LOCAL(covers_live)(const ms_node_view *v, const MS_WORD *
     return 0;
 }
 
-static inline int TRAV_LOCAL(all_zero)(const MS_WORD *buf)
+static inline int MS_KFN(all_zero)(const MS_WORD *buf)
 {
     MS_WORD any = 0;
     for (int j = 0; j < MS_K; j++) any |= buf[j];
     return any == 0;
 }
 
-static inline void TRAV_LOCAL(ft_init)(ms_ft_ctx *t, const ms_raster_frame *f) { t->f = f; }
+static inline void MS_KFN(ft_init)(ms_ft_ctx *t, const ms_raster_frame *f) { t->f = f; }
 
-static inline int TRAV_LOCAL(ft_root_out)(const ms_ft_ctx *t, const ms_bvh *b)
+static inline int MS_KFN(ft_root_out)(const ms_ft_ctx *t, const ms_bvh *b)
 {
     ms_node_view v;
-    TRAV_LOCAL(view_node)(t->f, &b->nodes[0], &v);
+    MS_KFN(view_node)(t->f, &b->nodes[0], &v);
     return v.outside;
 }
 
-static inline int TRAV_LOCAL(ft_covers)(const ms_node_view *v, const void *buf) { return TRAV_LOCAL(covers_live)(v, buf); }
-static inline int TRAV_LOCAL(ft_all_zero)(const void *buf) { return TRAV_LOCAL(all_zero)(buf); }
+static inline int MS_KFN(ft_covers)(const ms_node_view *v, const void *buf) { return MS_KFN(covers_live)(v, buf); }
+static inline int MS_KFN(ft_all_zero)(const void *buf) { return MS_KFN(all_zero)(buf); }
 
-static inline __attribute__((always_inline)) void TRAV_LOCAL(ft_children)(const ms_ft_ctx *t, const ms_bvh *b, const ms_bvh_node *n,
+static inline __attribute__((always_inline)) void MS_KFN(ft_children)(const ms_ft_ctx *t, const ms_bvh *b, const ms_bvh_node *n,
                                                                          const void *buf, int cull_occluded, int keep[2],
                                                                          ms_node_view v[2], float z[2], uint64_t *culled_frustum,
                                                                          uint64_t *culled_occluded)
 {
     for (int h = 0; h < 2; h++) {
-        TRAV_LOCAL(view_node)(t->f, &b->nodes[n->first + (uint32_t)h], &v[h]);
+        MS_KFN(view_node)(t->f, &b->nodes[n->first + (uint32_t)h], &v[h]);
         keep[h] = !v[h].outside;
         *culled_frustum += (uint64_t)!keep[h];
         z[h] = v[h].zmin;
     }
     if (cull_occluded)
         for (int h = 0; h < 2; h++)
-            if (keep[h] && !TRAV_LOCAL(covers_live)(&v[h], buf)) { keep[h] = 0; ++*culled_occluded; }
+            if (keep[h] && !MS_KFN(covers_live)(&v[h], buf)) { keep[h] = 0; ++*culled_occluded; }
 }
 
 #include "frustum_traverse_loop.h"
 
-#undef TRAV_LOCAL
