@@ -111,17 +111,38 @@ ms_isa ms_cpu_isa(void);
 
 typedef void (*ms_progress_fn)(void *user, double fraction_done);
 
+/* How the embree method hands rays to Embree (docs/embree.md). */
+typedef enum ms_embree_mode {
+    MS_EMBREE_PACKET16 = 0,    /* rtcOccluded16 over groups of 16 samples (the faster here) */
+    MS_EMBREE_STREAM = 1       /* one coherent rtcOccluded1M stream per pixel */
+} ms_embree_mode;
+
+/* When the embree method filters out the receiver's own triangle. */
+typedef enum ms_embree_filter {
+    MS_EMBREE_FILTER_PLANE = 0,  /* only where a segment can meet its plane in the occluding range */
+    MS_EMBREE_FILTER_ALWAYS = 1, /* every pixel (same V, slower) */
+    MS_EMBREE_FILTER_NONE = 2    /* never: for measuring only, the receiver then occludes itself */
+} ms_embree_filter;
+
+/* Every field's zero means its default, so a zeroed struct renders with the defaults. */
 typedef struct ms_render_options {
-    const char *method;     /* shadow method by name: see ms_method_names() */
+    const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
     ms_pattern pattern;
-    int samples;            /* 256, 1024 or 4096 (k*k with k = 16, 32, 64) */
+    int samples;            /* 256, 1024 or 4096 (k*k with k = 16, 32, 64); 0: the scene's */
     int width, height;      /* 0: the scene camera's */
-    int threads;            /* 0: all cores */
+    int threads;            /* 0: all cores; the host's OpenMP settings are left alone */
     uint32_t seed;
     ms_progress_fn progress;/* may be NULL; called from one thread */
     void *progress_user;
+    ms_isa isa;             /* cap on the instruction set of kernels and traversal; MS_ISA_AUTO: the CPU's best */
+    /* Switches to measure what a part buys; leave them 0. */
+    int no_occlusion_cull;  /* micro-raster methods: no coverage cull of BVH nodes */
+    int no_child_order;     /* micro-raster methods: no near-first order of BVH children */
+    ms_embree_mode embree_mode;
+    ms_embree_filter embree_filter;
 } ms_render_options;
 
+/* Zeroes o and names the default method: the same as a zeroed struct. */
 void ms_render_options_default(ms_render_options *o);
 
 /* Names of the shadow methods compiled in, NULL-terminated. */
@@ -139,6 +160,8 @@ typedef struct ms_stats {
     int samples, threads, width, height;
     const char *method;
     const char *pattern;
+    const char *kernel_isa;        /* instruction set the method's kernel ran ("none" when it has none) */
+    const char *traversal_isa;     /* ... and its traversal */
     uint64_t visible_pixels;
     uint64_t shadow_rays;          /* samples in front of the visible points: the segments every method answers */
     uint64_t penumbra_pixels;      /* pixels with some but not all front samples visible: S needs weights */

@@ -19,11 +19,13 @@
 
 typedef tu_agreement agreement;
 
-static void render_or_fail(const ms_scene *sc, const char *method, ms_pattern pat, int samples, int w, int h,
-                           ms_frame *f)
+static void render_opts(const ms_scene *sc, const char *method, ms_pattern pat, int samples, int w, int h,
+                        ms_embree_mode mode, ms_embree_filter filter, ms_frame *f)
 {
     ms_render_options o;
-    ms_render_options_default(&o);
+    tu_render_options_default(&o);
+    o.embree_mode = mode;
+    o.embree_filter = filter;
     o.method = method;
     o.pattern = pat;
     o.samples = samples;
@@ -34,6 +36,12 @@ static void render_or_fail(const ms_scene *sc, const char *method, ms_pattern pa
     int rc = ms_render(sc, &o, f, err, sizeof err);
     if (rc) fprintf(stderr, "ms_render(%s): %s\n", method, err);
     assert_int_equal(rc, 0);
+}
+
+static void render_or_fail(const ms_scene *sc, const char *method, ms_pattern pat, int samples, int w, int h,
+                           ms_frame *f)
+{
+    render_opts(sc, method, pat, samples, w, h, MS_EMBREE_PACKET16, MS_EMBREE_FILTER_PLANE, f);
 }
 
 static agreement compare(const ms_frame *a, const ms_frame *b, int samples)
@@ -106,26 +114,25 @@ static void test_method_listed(void **st)
 }
 
 /* Bad settings of the measurement switches fail with a message instead of guessing. */
-static void test_bad_env(void **st)
+static void test_bad_switches(void **st)
 {
     (void)st;
     ms_scene sc;
     assert_int_equal(ms_scene_default(&sc), 0);
     ms_render_options o;
-    ms_render_options_default(&o);
+    tu_render_options_default(&o);
     o.method = "embree";
     o.samples = 256;
     o.width = o.height = 16;
     ms_frame f;
     char err[512] = "";
-    setenv("MS_EMBREE_MODE", "packet8", 1);
+    o.embree_mode = (ms_embree_mode)7;
     assert_int_not_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-    assert_non_null(strstr(err, "MS_EMBREE_MODE"));
-    unsetenv("MS_EMBREE_MODE");
-    setenv("MS_EMBREE_FILTER", "sometimes", 1);
+    assert_non_null(strstr(err, "embree: unknown mode 7"));
+    o.embree_mode = MS_EMBREE_STREAM;
+    o.embree_filter = (ms_embree_filter)9;
     assert_int_not_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-    assert_non_null(strstr(err, "MS_EMBREE_FILTER"));
-    unsetenv("MS_EMBREE_FILTER");
+    assert_non_null(strstr(err, "filter 9"));
     ms_scene_free(&sc);
 }
 
@@ -160,7 +167,7 @@ static void test_sibenik(void **st)
     ms_scene_free(&sc);
 }
 
-/* The per-pixel filter shortcut (MS_EMBREE_FILTER=plane, the default) is exact: bit-identical V to
+/* The per-pixel filter shortcut (filter "plane", the default) is exact: bit-identical V to
  * filtering every pixel. The stream path agrees with raytrace like the packet path. */
 static void test_filter_and_stream(void **st)
 {
@@ -170,12 +177,8 @@ static void test_filter_and_stream(void **st)
     enum { S = 64 };
     ms_frame plane, always, stream, rt;
     render_or_fail(&sc, "embree", MS_PATTERN_GRID, 256, S, S, &plane);
-    setenv("MS_EMBREE_FILTER", "always", 1);
-    render_or_fail(&sc, "embree", MS_PATTERN_GRID, 256, S, S, &always);
-    unsetenv("MS_EMBREE_FILTER");
-    setenv("MS_EMBREE_MODE", "stream", 1);
-    render_or_fail(&sc, "embree", MS_PATTERN_GRID, 256, S, S, &stream);
-    unsetenv("MS_EMBREE_MODE");
+    render_opts(&sc, "embree", MS_PATTERN_GRID, 256, S, S, MS_EMBREE_PACKET16, MS_EMBREE_FILTER_ALWAYS, &always);
+    render_opts(&sc, "embree", MS_PATTERN_GRID, 256, S, S, MS_EMBREE_STREAM, MS_EMBREE_FILTER_PLANE, &stream);
     render_or_fail(&sc, "raytrace", MS_PATTERN_GRID, 256, S, S, &rt);
 
     assert_true(plane.stats.counter[2] < plane.stats.visible_pixels);    /* the shortcut does skip pixels */
@@ -312,7 +315,7 @@ int main(void)
 {
     const struct CMUnitTest always[] = {
         cmocka_unit_test(test_method_listed),
-        cmocka_unit_test(test_bad_env),
+        cmocka_unit_test(test_bad_switches),
         cmocka_unit_test(test_default_scene),
     };
     int rc = cmocka_run_group_tests_name("embree (built-in scene)", always, NULL, NULL);
@@ -344,7 +347,7 @@ static void test_not_compiled(void **st)
     ms_scene sc;
     assert_int_equal(ms_scene_default(&sc), 0);
     ms_render_options o;
-    ms_render_options_default(&o);
+    tu_render_options_default(&o);
     o.method = "embree";
     ms_frame f;
     assert_int_not_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);

@@ -28,7 +28,7 @@ static agreement compare(const ms_frame *a, const ms_frame *b, int samples)
 static void render_ok(const ms_scene *sc, const char *method, int samples, int size, ms_frame *f)
 {
     ms_render_options o;
-    ms_render_options_default(&o);
+    tu_render_options_default(&o);
     o.method = method;
     o.samples = samples;
     o.width = o.height = size;
@@ -260,6 +260,38 @@ static void test_scalar_paths_match(void **state)
     ms_scene_free(&sc);
 }
 
+/* Through the public options: the cap reaches kernel and traversal, the stats name what ran, and a
+ * zeroed options struct renders with the defaults. */
+static void test_options_isa_and_defaults(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    ms_render_options o;
+    memset(&o, 0, sizeof o);
+    o.width = o.height = 48;
+    ms_frame a, b;
+    char err[256];
+    assert_int_equal(ms_render(&sc, &o, &a, err, sizeof err), 0);
+    assert_string_equal(a.stats.method, MS_DEFAULT_METHOD);
+    assert_int_equal(a.stats.samples, sc.samples);
+    assert_string_equal(a.stats.kernel_isa, ms_isa_name(ms_cpu_isa()));
+    assert_string_equal(a.stats.traversal_isa, ms_isa_name(ms_cpu_isa()));
+    o.isa = MS_ISA_SCALAR;
+    assert_int_equal(ms_render(&sc, &o, &b, err, sizeof err), 0);
+    assert_string_equal(b.stats.kernel_isa, "scalar");
+    assert_string_equal(b.stats.traversal_isa, "scalar");
+    agreement g = compare(&a, &b, sc.samples);
+    assert_int_equal(g.beyond_one, 0);
+    ms_frame_free(&a);
+    ms_frame_free(&b);
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &a, err, sizeof err), 0);
+    assert_string_equal(a.stats.kernel_isa, "none");
+    ms_frame_free(&a);
+    ms_scene_free(&sc);
+}
+
 static void test_default_scene_agrees(void **state)
 {
     (void)state;
@@ -295,6 +327,7 @@ int main(void)
         cmocka_unit_test(test_quad_exact),
         cmocka_unit_test(test_open_quad_both_sides),
         cmocka_unit_test(test_scalar_paths_match),
+        cmocka_unit_test(test_options_isa_and_defaults),
         cmocka_unit_test(test_default_scene_agrees),
         cmocka_unit_test(test_sponza_agrees),
         cmocka_unit_test(test_sibenik_agrees),

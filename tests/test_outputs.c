@@ -188,7 +188,7 @@ static void test_stats(void **st)
     ms_scene s;
     assert_int_equal(ms_scene_default(&s), 0);
     ms_render_options opt;
-    ms_render_options_default(&opt);
+    tu_render_options_default(&opt);
     opt.method = "raytrace";
     opt.samples = 256;
     opt.width = 24;

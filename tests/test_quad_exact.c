@@ -96,7 +96,7 @@ static void check_pattern(ms_pattern pat, double mae_max, double max_max)
     ms_scene s;
     make_quad_scene(&s);
     ms_render_options opt;
-    ms_render_options_default(&opt);
+    tu_render_options_default(&opt);
     opt.method = "raytrace";
     opt.pattern = pat;
     opt.samples = 1024;

@@ -17,7 +17,7 @@ static void render_one(const char *json)
     if (ms_scene_load(json, &s, err, sizeof err)) fail_msg("%s", err);
     assert_true(s.n_tris > 0);
     ms_render_options opt;
-    ms_render_options_default(&opt);
+    tu_render_options_default(&opt);
     opt.method = "raytrace";
     opt.samples = 256;
     opt.width = 64;

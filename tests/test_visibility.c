@@ -398,7 +398,7 @@ static void test_ceiling_from_below(void **st)
     for (size_t m = 0; m < N_METHODS; m++) {
         if (ms_method_available(methods[m]) != 1) continue;
         ms_render_options o;
-        ms_render_options_default(&o);
+        tu_render_options_default(&o);
         o.method = methods[m];
         ms_frame f;
         char err[256];
@@ -454,7 +454,7 @@ static void test_quad_shaded(void **st)
     const char *const shaded_methods[] = { "scanline", "raytrace" };
     for (int m = 0; m < 2; m++) {
         ms_render_options o;
-        ms_render_options_default(&o);
+        tu_render_options_default(&o);
         o.method = shaded_methods[m];
         ms_frame f;
         char err[256];

@@ -13,6 +13,8 @@ int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t e
     cJSON_AddStringToObject(o, "version", MS_VERSION_STRING);
     cJSON_AddStringToObject(o, "method", s->method);
     cJSON_AddStringToObject(o, "pattern", s->pattern);
+    cJSON_AddStringToObject(o, "kernel_isa", s->kernel_isa ? s->kernel_isa : "none");
+    cJSON_AddStringToObject(o, "traversal_isa", s->traversal_isa ? s->traversal_isa : "none");
     cJSON_AddNumberToObject(o, "triangles", (double)s->triangles);
     cJSON_AddNumberToObject(o, "width", s->width);
     cJSON_AddNumberToObject(o, "height", s->height);

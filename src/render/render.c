@@ -98,6 +98,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     ctx.near = MS_NEAR;
     ctx.far = MS_FAR;
     ctx.threads = threads;
+    ctx.isa_cap = opt->isa;
+    ctx.no_occlusion_cull = opt->no_occlusion_cull;
+    ctx.no_child_order = opt->no_child_order;
+    ctx.embree_mode = opt->embree_mode;
+    ctx.embree_filter = opt->embree_filter;
 
     size_t npix = (size_t)W * H;
     ms_hit *hits = malloc(npix * sizeof *hits);
@@ -237,6 +242,10 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     st->width = W;
     st->height = H;
     st->method = sm->name;
+    ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
+    if (sm->isa_used) sm->isa_used(sstate, &kisa, &tisa);
+    st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
+    st->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
     st->pattern = opt->pattern == MS_PATTERN_GRID ? "grid" : "stratified";
     st->visible_pixels = visible;
     st->penumbra_pixels = penumbra;

@@ -12,9 +12,8 @@
  * in front of the receiver's plane (the front mask, receiver.h), origin q.p, direction sample - q.p
  * unnormalised, tnear = ctx->near, tfar = ctx->far, exactly as raytrace.
  * Traced either as 16-wide packets (rtcOccluded16) or as one coherent stream per pixel (rtcOccluded1M
- * with RTC_INTERSECT_CONTEXT_FLAG_COHERENT), chosen by the environment variable
- *     MS_EMBREE_MODE=packet16 | stream      (default packet16: the faster here, docs/embree.md)
- * read when the method is created.
+ * with RTC_INTERSECT_CONTEXT_FLAG_COHERENT), chosen by ms_render_options.embree_mode (default packet16:
+ * the faster here, docs/embree.md).
  *
  * The hit triangle q.prim never occludes. Embree excludes it through a context filter function that
  * rejects primID == q.prim, the prim passed in an extension of RTCIntersectContext. The filter is
@@ -24,8 +23,8 @@
  * (every segment crosses the plane at t < near/2); the margin is orders of magnitude above Embree's
  * rounding, so for those pixels the filter is left out (eb_needs_filter). Exactly consistent with
  * raytrace either way (the test checks bit-identical V against filtering every pixel); the choice is
- *     MS_EMBREE_FILTER=plane | always | none (default plane; "none" is for measuring only: the
- *                                              receiver's triangle then occludes, V is wrong)
+ * ms_render_options.embree_filter: plane (default), always, or none (for measuring only: the receiver's
+ * triangle then occludes, V is wrong).
  *
  * FTZ/DAZ: Embree wants flush-to-zero and denormals-are-zero; every entry point that calls into
  * Embree sets them in MXCSR for the calling thread and restores the caller's MXCSR on return, so that
@@ -51,8 +50,6 @@
 #include <pmmintrin.h>
 
 enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US, C_DEGENERATE };
-enum eb_mode { EB_PACKET16, EB_STREAM };
-enum eb_filter { EB_FILTER_PLANE, EB_FILTER_ALWAYS, EB_FILTER_NONE };
 
 /* One Embree scene for one frame, shared by the primary and the shadow method. */
 typedef struct eb_shared {
@@ -63,8 +60,8 @@ typedef struct eb_shared {
     int refs;                  /* guarded by cache_lock */
     RTCDevice dev;
     RTCScene scene;
-    enum eb_mode mode;
-    enum eb_filter filter;
+    ms_embree_mode mode;
+    ms_embree_filter filter;
     uint64_t build_us, n_degenerate;
     int build_reported;        /* set once by the visibility call that reports build_us, n_degenerate */
     char msg[256];             /* Embree's last error message (error callback) */
@@ -154,16 +151,16 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
         snprintf(err, errlen, "this Embree was built with back-face culling; the embree method needs two-sided triangles");
         return -1;
     }
-    if (s->filter != EB_FILTER_NONE && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED)) {
+    if (s->filter != MS_EMBREE_FILTER_NONE && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED)) {
         snprintf(err, errlen, "this Embree was built without filter functions; the embree method needs them");
         return -1;
     }
-    if (s->mode == EB_PACKET16 && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) {
-        snprintf(err, errlen, "this Embree has no 16-wide packets on this CPU; try MS_EMBREE_MODE=stream");
+    if (s->mode == MS_EMBREE_PACKET16 && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) {
+        snprintf(err, errlen, "this Embree has no 16-wide packets on this CPU; try the stream mode");
         return -1;
     }
-    if (s->mode == EB_STREAM && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_RAY_STREAM_SUPPORTED)) {
-        snprintf(err, errlen, "this Embree has no ray streams; try MS_EMBREE_MODE=packet16");
+    if (s->mode == MS_EMBREE_STREAM && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_RAY_STREAM_SUPPORTED)) {
+        snprintf(err, errlen, "this Embree has no ray streams; try the packet16 mode");
         return -1;
     }
 
@@ -173,7 +170,7 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
     s->scene = rtcNewScene(s->dev);
     if (eb_check(s, "scene creation", err, errlen)) goto out;
     /* The context filter must be enabled on the scene to be called at all ("none": plain Embree). */
-    if (s->filter != EB_FILTER_NONE) rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    if (s->filter != MS_EMBREE_FILTER_NONE) rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (eb_check(s, "geometry creation", err, errlen)) goto out;
@@ -214,31 +211,12 @@ out:
     return rc;
 }
 
-static enum eb_mode eb_mode_from_env(void)
-{
-    const char *m = getenv("MS_EMBREE_MODE");
-    return m && strcmp(m, "stream") == 0 ? EB_STREAM : EB_PACKET16;
-}
-
-static enum eb_filter eb_filter_from_env(void)
-{
-    const char *f = getenv("MS_EMBREE_FILTER");
-    if (f && strcmp(f, "always") == 0) return EB_FILTER_ALWAYS;
-    if (f && strcmp(f, "none") == 0) return EB_FILTER_NONE;
-    return EB_FILTER_PLANE;
-}
-
 /* Finds or builds the frame's scene and takes a reference. */
 static int eb_acquire(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
 {
     *state = NULL;
-    const char *m = getenv("MS_EMBREE_MODE"), *f = getenv("MS_EMBREE_FILTER");
-    if (m && *m && strcmp(m, "packet16") && strcmp(m, "stream")) {
-        snprintf(err, errlen, "MS_EMBREE_MODE must be packet16 or stream (got '%s')", m);
-        return -1;
-    }
-    if (f && *f && strcmp(f, "plane") && strcmp(f, "always") && strcmp(f, "none")) {
-        snprintf(err, errlen, "MS_EMBREE_FILTER must be plane, always or none (got '%s')", f);
+    if ((unsigned)ctx->embree_mode > MS_EMBREE_STREAM || (unsigned)ctx->embree_filter > MS_EMBREE_FILTER_NONE) {
+        snprintf(err, errlen, "embree: unknown mode %d or filter %d", (int)ctx->embree_mode, (int)ctx->embree_filter);
         return -1;
     }
     pthread_mutex_lock(&cache_lock);
@@ -253,8 +231,8 @@ static int eb_acquire(const ms_render_ctx *ctx, void **state, char *err, size_t 
         s->bvh = ctx->bvh;
         s->tri = ctx->bvh->tri;
         s->n_tris = ctx->bvh->n_tris;
-        s->mode = eb_mode_from_env();
-        s->filter = eb_filter_from_env();
+        s->mode = ctx->embree_mode;
+        s->filter = ctx->embree_filter;
         if (err && errlen) err[0] = '\0';
         if (eb_build(ctx, s, err, errlen)) {
             eb_free(s);
@@ -405,7 +383,7 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
 
     eb_scratch w = { 0 };
     w.pts = malloc((size_t)ns * 3 * sizeof(float));
-    if (s->mode == EB_STREAM) w.rays = aligned_alloc(64, (size_t)ns * sizeof *w.rays);
+    if (s->mode == MS_EMBREE_STREAM) w.rays = aligned_alloc(64, (size_t)ns * sizeof *w.rays);
     else w.r16 = aligned_alloc(64, sizeof *w.r16);
     if (!w.pts || (!w.rays && !w.r16)) { free(w.pts); free(w.rays); free(w.r16); return -1; }
 
@@ -420,11 +398,11 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
         memset(vm, 0, mw * sizeof *vm);
         if (!ms_mask_count(fm, (int)mw)) continue;
         ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[qi].px, q[qi].py, ctx->seed, w.pts);
-        int filt = s->filter == EB_FILTER_ALWAYS || (s->filter == EB_FILTER_PLANE && eb_needs_filter(ctx, &q[qi]));
+        int filt = s->filter == MS_EMBREE_FILTER_ALWAYS || (s->filter == MS_EMBREE_FILTER_PLANE && eb_needs_filter(ctx, &q[qi]));
         ic.c.filter = filt ? eb_filter_fn : NULL;
         ic.skip = q[qi].prim;
         cnt[C_FILTERED_PIXELS] += (uint64_t)filt;
-        if (s->mode == EB_STREAM) eb_trace_stream(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
+        if (s->mode == MS_EMBREE_STREAM) eb_trace_stream(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
         else eb_trace_packet16(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
     }
     eb_leave(mx);

@@ -27,6 +27,8 @@ typedef struct ms_render_ctx {
      * what each buys. */
     ms_isa isa_cap;
     int no_occlusion_cull, no_child_order;
+    ms_embree_mode embree_mode;        /* embree: how rays are handed over, and when the receiver is filtered */
+    ms_embree_filter embree_filter;
 } ms_render_ctx;
 
 /* One visible point: the pixel, its hit point, the unit geometric normal facing the camera (its plane is

@@ -167,6 +167,7 @@ void tu_ctx_init(ms_render_ctx *ctx, const ms_scene *sc, const ms_bvh *bvh, int 
     ctx->near = 1e-4f;
     ctx->far = 1.0f - 1e-4f;
     ctx->threads = 1;
+    ctx->isa_cap = tu_isa_cap();
 }
 
 int tu_shadow_vs(const ms_shadow_method *m, void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n,
@@ -201,6 +202,12 @@ ms_isa tu_isa_cap(void)
         abort();
     }
     return cap;
+}
+
+void tu_render_options_default(ms_render_options *o)
+{
+    ms_render_options_default(o);
+    o->isa = tu_isa_cap();
 }
 
 int tu_isa_allowed(ms_isa isa)

@@ -54,6 +54,8 @@ int tu_shadow_vs(const struct ms_shadow_method *m, void *state, const struct ms_
  * selection functions and run a forced SIMD variant only when tu_isa_allowed grants it, so that CI can run
  * the whole suite on the portable path (.ci/run). An unknown value aborts the test. */
 ms_isa tu_isa_cap(void);
+/* ms_render_options_default with the run's ISA cap, for the tests that render whole frames. */
+void tu_render_options_default(ms_render_options *o);
 int tu_isa_allowed(ms_isa isa);
 
 /* splitmix64: small, seedable, reproducible random numbers for the randomized tests. */
