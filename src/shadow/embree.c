@@ -30,14 +30,17 @@
  * Embree sets them in MXCSR for the calling thread and restores the caller's MXCSR on return, so that
  * other methods run on the same OpenMP threads are not affected.
  *
- * Degenerate triangles (ms_triangle_degenerate), which every ray test of ours rejects, are given to
- * Embree with zero area so that it never hits them either.
+ * Robust mode (RTC_SCENE_FLAG_ROBUST) for the one scene, so for shadow and primary rays alike: Embree's
+ * watertight triangle test and conservative traversal, as ours (src/accel/ray_triangle.h): no ray
+ * slips between two triangles that share an edge. Every triangle is given as it is, slivers and
+ * zero-area ones included, as our ray tests take them all.
  *
  * Timing: the Embree build happens in create(), which ms_render does not time; it is reported once per
- * frame as the counter "embree_build_us" (and the degenerate triangles as "degenerate_triangles"). */
+ * frame as the counter "embree_build_us". */
 #include "method.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
+#include "../accel/ray_triangle.h"
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <pthread.h>
@@ -48,7 +51,7 @@
 #include <xmmintrin.h>
 #include <pmmintrin.h>
 
-enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US, C_DEGENERATE };
+enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US };
 enum eb_mode { EB_PACKET16, EB_STREAM };
 enum eb_filter { EB_FILTER_PLANE, EB_FILTER_ALWAYS, EB_FILTER_NONE };
 
@@ -63,8 +66,8 @@ typedef struct eb_shared {
     RTCScene scene;
     enum eb_mode mode;
     enum eb_filter filter;
-    uint64_t build_us, n_degenerate;
-    int build_reported;        /* set once by the visibility call that reports build_us, n_degenerate */
+    uint64_t build_us;
+    int build_reported;        /* set once by the visibility call that reports build_us */
     char msg[256];             /* Embree's last error message (error callback) */
 } eb_shared;
 
@@ -170,8 +173,10 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
     int rc = -1;
     s->scene = rtcNewScene(s->dev);
     if (eb_check(s, "scene creation", err, errlen)) goto out;
-    /* The context filter must be enabled on the scene to be called at all ("none": plain Embree). */
-    if (s->filter != EB_FILTER_NONE) rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    /* Robust: watertight, like our ray tests. The context filter must be enabled on the scene to be
+     * called at all ("none": no filter). */
+    rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_ROBUST |
+                               (s->filter != EB_FILTER_NONE ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION : RTC_SCENE_FLAG_NONE));
     rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (eb_check(s, "geometry creation", err, errlen)) goto out;
@@ -187,17 +192,7 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
         goto out;
     }
     memcpy(v, b->tri, 9 * sizeof(float) * (size_t)b->n_tris);
-    /* Triangles our ray tests reject as thinner than float can represent (ms_triangle_degenerate) get
-     * all three indices on one vertex: zero area, which Embree never hits, and primIDs stay ours. */
-    for (uint32_t i = 0; i < b->n_tris; i++) {
-        const float *t = b->tri + 9 * (size_t)i;
-        float e1[3], e2[3];
-        v3_sub(e1, t + 3, t);
-        v3_sub(e2, t + 6, t);
-        int degenerate = ms_triangle_degenerate(e1, e2);
-        s->n_degenerate += (uint64_t)degenerate;
-        for (int c = 0; c < 3; c++) ix[3 * i + c] = 3 * i + (degenerate ? 0 : (unsigned)c);
-    }
+    for (uint32_t i = 0; i < 3 * b->n_tris; i++) ix[i] = i;
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(s->scene, g);
     rtcReleaseGeometry(g);
@@ -399,10 +394,7 @@ static void eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
 {
     eb_shared *s = state;
     const int ns = ctx->samples;
-    if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) {
-        cnt[C_BUILD_US] += s->build_us;
-        cnt[C_DEGENERATE] += s->n_degenerate;
-    }
+    if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) cnt[C_BUILD_US] += s->build_us;
 
     eb_scratch w = { 0 };
     w.pts = malloc((size_t)ns * 3 * sizeof(float));
@@ -436,9 +428,8 @@ const ms_shadow_method ms_shadow_embree = {
     .name = "embree",
     .primary = "embree",
     .needs_grid = 0,
-    .n_counters = 6,
-    .counter_names = { "rays", "embree_calls", "filtered_pixels", "filter_rejects", "embree_build_us",
-                       "degenerate_triangles" },
+    .n_counters = 5,
+    .counter_names = { "rays", "embree_calls", "filtered_pixels", "filter_rejects", "embree_build_us" },
     .create = eb_acquire,
     .visibility = eb_visibility,
     .destroy = eb_release,
@@ -446,21 +437,18 @@ const ms_shadow_method ms_shadow_embree = {
 
 /* ---- primary visibility: camera rays as 16-ray packets over 4x4 pixel blocks ---- */
 
-/* The hit parameter of ray (o, d) on the plane of tri, by the very operations of ms_intersect_triangle
- * (so bit for bit the t the BVH primary finds on that triangle), without its inside test: Embree may
- * report a triangle at an edge that our test would just miss. Embree's own t if the ray is parallel. */
+/* The hit parameter of ray (o, d) on the plane of tri, by the very operations of the watertight test
+ * (ms_wt_evaluate: so bit for bit the t the BVH primary finds on that triangle), without its inside
+ * test: Embree may report a triangle at an edge that our test would just miss. Embree's own t if the
+ * ray is parallel to the plane. */
 static float eb_plane_t(const float tri[9], const float o[3], const float d[3], float t_embree)
 {
-    float e1[3], e2[3], p[3], s[3], q[3];
-    v3_sub(e1, tri + 3, tri);
-    v3_sub(e2, tri + 6, tri);
-    v3_cross(p, d, e2);
-    float det = v3_dot(e1, p);
-    if (det == 0.0f) return t_embree;
-    float inv = 1.0f / det;
-    v3_sub(s, o, tri);
-    v3_cross(q, s, e1);
-    float t = v3_dot(e2, q) * inv;
+    ms_wt_ray w;
+    ms_wt_eval e;
+    ms_wt_prepare(&w, o, d);
+    ms_wt_evaluate(&w, tri, &e);
+    if (e.det == 0.0f) return t_embree;
+    float t = e.t_scaled / e.det;
     return isfinite(t) && t > 0.0f ? t : t_embree;
 }
 

@@ -7,6 +7,7 @@
 #include "method.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
+#include "../accel/ray_triangle.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,7 +21,41 @@ typedef struct packet {
     float d[3][LANES], inv[3][LANES];
     float tmin, tmax;
     int live[LANES];        /* 1 while the ray is unoccluded */
+    /* Watertight test (ray_triangle.h), set up by packet_shear: one shear axis kz for all lanes (the
+     * origin is common, so each triangle is translated and permuted once per packet), per-lane
+     * shear; kz < 0 when no axis suits every lane and lanes are tested one by one. */
+    int kx, ky, kz;
+    float sx[LANES], sy[LANES], sz[LANES];
 } packet;
+
+/* The packet's shear. Any kz with d[kz] != 0 keeps the test watertight (the per-ray choice of the
+ * largest |d| only bounds the shear); the rays of a packet point at one small light, so one axis
+ * usually serves all lanes: the axis whose smallest |d[kz]| relative to its lane's largest |d| is
+ * largest, provided that is at least 1/2 (|Sx|, |Sy| <= 2, as accurate as the per-ray choice within a
+ * factor of 2). The winding swap of the paper is not needed: the test is two-sided. */
+static void packet_shear(packet *pk)
+{
+    float best = 0.0f;
+    pk->kz = -1;
+    for (int a = 0; a < 3; a++) {
+        float worst = INFINITY;
+        for (int l = 0; l < LANES; l++) {
+            float m = ms_maxf(fabsf(pk->d[0][l]), ms_maxf(fabsf(pk->d[1][l]), fabsf(pk->d[2][l])));
+            float r = fabsf(pk->d[a][l]) / m;
+            worst = r < worst ? r : worst;   /* NaN (a zero direction) leaves worst alone ... */
+            if (!(m > 0.0f)) worst = 0.0f;   /* ... and rules the common axis out */
+        }
+        if (worst >= 0.5f && worst > best) { best = worst; pk->kz = a; }
+    }
+    if (pk->kz < 0) return;
+    pk->kx = pk->kz + 1 == 3 ? 0 : pk->kz + 1;
+    pk->ky = pk->kx + 1 == 3 ? 0 : pk->kx + 1;
+    for (int l = 0; l < LANES; l++) {
+        pk->sx[l] = pk->d[pk->kx][l] / pk->d[pk->kz][l];
+        pk->sy[l] = pk->d[pk->ky][l] / pk->d[pk->kz][l];
+        pk->sz[l] = 1.0f / pk->d[pk->kz][l];
+    }
+}
 
 static int any_live(const int *live)
 {
@@ -29,11 +64,13 @@ static int any_live(const int *live)
     return a;
 }
 
-/* 1 if any live ray of the packet enters the node within [tmin, tmax]. */
+/* 1 if any live ray of the packet enters the node within [tmin, tmax]. The box is widened to match
+ * the watertight triangle test (ms_wt_widen_box), once for all lanes since the origin is common. */
 static int packet_enters(const packet *pk, const ms_bvh_node *n)
 {
     float lo[3], hi[3];
     for (int a = 0; a < 3; a++) { lo[a] = n->bmin[a] - pk->o[a]; hi[a] = n->bmax[a] - pk->o[a]; }
+    ms_wt_widen_box(lo, hi);
     int hit = 0;
     for (int l = 0; l < LANES; l++) {
         float t0 = pk->tmin, t1 = pk->tmax;
@@ -45,33 +82,61 @@ static int packet_enters(const packet *pk, const ms_bvh_node *n)
             t0 = mn > t0 ? mn : t0;
             t1 = mx < t1 ? mx : t1;
         }
-        /* Exit widened by 2*gamma(3) as in ms_bvh_occluded: rounding never culls a box that a ray
-         * through a vertex or along an edge really touches. */
-        hit |= (t0 <= t1 * (1.0f + 2.0f * 3.5762786e-07f)) & pk->live[l];
+        /* Exit widened by Ize's bound as in ms_bvh_occluded. */
+        hit |= (t0 <= t1 * MS_WT_FAR_SCALE) & pk->live[l];
     }
     return hit;
 }
 
-/* Moller-Trumbore against every live lane; clears the lanes the triangle blocks. */
+/* The watertight test (ray_triangle.h) against every live lane; clears the lanes the triangle blocks.
+ * The vertices relative to the common origin are computed and permuted once; the lane loops are
+ * branch-free so that they vectorise. Lanes with an edge function exactly 0 are redone in double
+ * (as ms_wt_evaluate does), in a scalar pass that is rarely taken. */
 static void packet_triangle(packet *pk, const float *tri)
 {
-    float e1[3], e2[3], s[3], q[3];
-    v3_sub(e1, tri + 3, tri);
-    v3_sub(e2, tri + 6, tri);
-    if (ms_triangle_degenerate(e1, e2)) return;
-    v3_sub(s, pk->o, tri);
-    v3_cross(q, s, e1);            /* shared by all lanes: the origin is common */
-    float sq = v3_dot(e2, q);
+    if (pk->kz < 0) {
+        for (int l = 0; l < LANES; l++) {
+            if (!pk->live[l]) continue;
+            const float d[3] = { pk->d[0][l], pk->d[1][l], pk->d[2][l] };
+            ms_wt_ray w;
+            float t, u, v;
+            ms_wt_prepare(&w, pk->o, d);
+            pk->live[l] = !ms_wt_intersect(&w, tri, pk->tmin, pk->tmax, &t, &u, &v);
+        }
+        return;
+    }
+    const int kx = pk->kx, ky = pk->ky, kz = pk->kz;
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = tri[a] - pk->o[a]; B[a] = tri[3 + a] - pk->o[a]; C[a] = tri[6 + a] - pk->o[a]; }
+    const float Ax = A[kx], Ay = A[ky], Az = A[kz], Bx = B[kx], By = B[ky], Bz = B[kz];
+    const float Cx = C[kx], Cy = C[ky], Cz = C[kz];
+    float U[LANES], V[LANES], W[LANES];
+    int zero = 0;
     for (int l = 0; l < LANES; l++) {
-        float d0 = pk->d[0][l], d1 = pk->d[1][l], d2 = pk->d[2][l];
-        float p0 = d1 * e2[2] - d2 * e2[1], p1 = d2 * e2[0] - d0 * e2[2], p2 = d0 * e2[1] - d1 * e2[0];
-        float det = e1[0] * p0 + e1[1] * p1 + e1[2] * p2;
-        float inv = 1.0f / det;
-        float u = (s[0] * p0 + s[1] * p1 + s[2] * p2) * inv;
-        float v = (d0 * q[0] + d1 * q[1] + d2 * q[2]) * inv;
-        float t = sq * inv;
-        int hit = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) & (u + v <= 1.0f) &
-                  (t >= pk->tmin) & (t <= pk->tmax);
+        const float sx = pk->sx[l], sy = pk->sy[l];
+        const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
+        const float cx = Cx - sx * Cz, cy = Cy - sy * Cz;
+        U[l] = ms_wt_edge(cx, cy, bx, by);
+        V[l] = ms_wt_edge(ax, ay, cx, cy);
+        W[l] = ms_wt_edge(bx, by, ax, ay);
+        zero |= (U[l] == 0.0f) | (V[l] == 0.0f) | (W[l] == 0.0f);
+    }
+    if (zero)
+        for (int l = 0; l < LANES; l++) {
+            if (U[l] != 0.0f && V[l] != 0.0f && W[l] != 0.0f) continue;
+            const float sx = pk->sx[l], sy = pk->sy[l];
+            const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
+            const float cx = Cx - sx * Cz, cy = Cy - sy * Cz;
+            U[l] = ms_wt_edge_d(cx, cy, bx, by);
+            V[l] = ms_wt_edge_d(ax, ay, cx, cy);
+            W[l] = ms_wt_edge_d(bx, by, ax, ay);
+        }
+    for (int l = 0; l < LANES; l++) {
+        const float u = U[l], v = V[l], w = W[l], sz = pk->sz[l];
+        const int mixed = ((u < 0.0f) | (v < 0.0f) | (w < 0.0f)) & ((u > 0.0f) | (v > 0.0f) | (w > 0.0f));
+        const float det = u + v + w;
+        const float t = (u * (sz * Az) + v * (sz * Bz) + w * (sz * Cz)) / det;
+        const int hit = !mixed & (det != 0.0f) & (t >= pk->tmin) & (t <= pk->tmax);
         pk->live[l] &= !hit;
     }
 }
@@ -124,6 +189,7 @@ int ms_raytrace_visible_samples(const ms_render_ctx *ctx, const ms_shadow_query 
             }
             pk.live[l] = 1;
         }
+        packet_shear(&pk);
         trace_packet(ctx->bvh, &pk, q->prim, cnt);
         for (int l = 0; l < LANES; l++) visible += pk.live[l];
     }

@@ -1,0 +1,135 @@
+/* Watertight ray/triangle intersection (Woop, Benthin, Wald, "Watertight Ray/Triangle Intersection",
+ * JCGT 2(1), 2013), shared by every ray test of ours: BVH closest and any hit (bvh_traverse.c), the
+ * shadow packets (src/shadow/raytrace.c) and Embree's primary t (src/shadow/embree.c).
+ *
+ * Per ray (ms_wt_prepare): kz = the axis of largest |d|, kx, ky the next two (swapped when d[kz] < 0
+ * to keep the winding), and the shear Sx = dx/dz, Sy = dy/dz, Sz = 1/dz that maps the ray onto the
+ * +z axis. Per triangle: the vertices relative to the origin, sheared to 2D; the edge functions
+ * U, V, W in float, recomputed in double when any is exactly 0 (the float products are exact in
+ * double, so the sign of a near-zero edge is exact); a hit when all three have one sign. Two
+ * triangles sharing an edge compute its edge function from the same two sheared vertices, with
+ * opposite signs bit for bit (round-to-nearest is symmetric), so no ray passes between them
+ * whatever the rounding (sec. 3). This needs the products to be rounded as written: no FMA
+ * contraction (GCC's default for -std=c11 is -ffp-contract=off; the pragma below is for clang).
+ *
+ * Departures from the paper, all deliberate:
+ *  - two-sided (its non-culling variant): accept U, V, W all >= 0 or all <= 0;
+ *  - the t range is decided on t = T / det itself (the paper compares T with t_far * det, sign
+ *    adjusted, to avoid the division). Then a hit means exactly "t in [tmin, tmax]" for the t we
+ *    report, so the closest hit is the minimum over the triangles whatever order they are tested in,
+ *    which the BVH tests compare bit for bit with brute force. The division happens only for rays
+ *    that passed the edge tests (packets compute it for all lanes, branch-free);
+ *  - u, v are the weights of vertices 1 and 2 (V / det, W / det), as Moller-Trumbore's were.
+ *
+ * Zero-area triangles need no special case: a repeated vertex gives U = V = W = 0 or mixed signs, so
+ * never a hit; a triangle of three collinear vertices is hit only by rays that pass within rounding of
+ * its segment, at a t between its vertices' (T / det is a convex combination of their depths). A
+ * sliver, however thin, is hit exactly where it is, so a closed mesh with slivers stays closed. */
+#ifndef MS_RAY_TRIANGLE_H
+#define MS_RAY_TRIANGLE_H
+#include <math.h>
+
+#ifdef __clang__
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+typedef struct ms_wt_ray {
+    float o[3];
+    int kx, ky, kz;
+    float sx, sy, sz;
+} ms_wt_ray;
+
+/* The axis of largest |d[a]| (the first on ties). */
+static inline int ms_wt_max_axis(const float d[3])
+{
+    const float x = fabsf(d[0]), y = fabsf(d[1]), z = fabsf(d[2]);
+    return x >= y ? (x >= z ? 0 : 2) : (y >= z ? 1 : 2);
+}
+
+static inline void ms_wt_prepare(ms_wt_ray *w, const float o[3], const float d[3])
+{
+    const int kz = ms_wt_max_axis(d);
+    int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+    if (d[kz] < 0.0f) { const int s = kx; kx = ky; ky = s; }
+    w->o[0] = o[0]; w->o[1] = o[1]; w->o[2] = o[2];
+    w->kx = kx; w->ky = ky; w->kz = kz;
+    /* d = 0 gives NaNs here, and NaN fails every test below: no hit. */
+    w->sx = d[kx] / d[kz];
+    w->sy = d[ky] / d[kz];
+    w->sz = 1.0f / d[kz];
+}
+
+/* 2D edge function x0*y1 - y0*x1 of two sheared vertices; *_d: the same in double, exact products. */
+static inline float ms_wt_edge(float x0, float y0, float x1, float y1) { return x0 * y1 - y0 * x1; }
+static inline float ms_wt_edge_d(float x0, float y0, float x1, float y1)
+{
+    return (float)((double)x0 * (double)y1 - (double)y0 * (double)x1);
+}
+
+/* The scaled quantities of one ray/triangle pair (sec. 3): edge functions U, V, W and the scaled
+ * hit distance T with det = U + V + W. */
+typedef struct ms_wt_eval { float u, v, w, t_scaled, det; } ms_wt_eval;
+
+static inline void ms_wt_evaluate(const ms_wt_ray *r, const float tri[9], ms_wt_eval *e)
+{
+    const int kx = r->kx, ky = r->ky, kz = r->kz;
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = tri[a] - r->o[a]; B[a] = tri[3 + a] - r->o[a]; C[a] = tri[6 + a] - r->o[a]; }
+    const float ax = A[kx] - r->sx * A[kz], ay = A[ky] - r->sy * A[kz];
+    const float bx = B[kx] - r->sx * B[kz], by = B[ky] - r->sy * B[kz];
+    const float cx = C[kx] - r->sx * C[kz], cy = C[ky] - r->sy * C[kz];
+    float U = ms_wt_edge(cx, cy, bx, by), V = ms_wt_edge(ax, ay, cx, cy), W = ms_wt_edge(bx, by, ax, ay);
+    if (U == 0.0f || V == 0.0f || W == 0.0f) {
+        U = ms_wt_edge_d(cx, cy, bx, by);
+        V = ms_wt_edge_d(ax, ay, cx, cy);
+        W = ms_wt_edge_d(bx, by, ax, ay);
+    }
+    e->u = U; e->v = V; e->w = W;
+    e->det = U + V + W;
+    const float az = r->sz * A[kz], bz = r->sz * B[kz], cz = r->sz * C[kz];
+    e->t_scaled = U * az + V * bz + W * cz;
+}
+
+/* 1 and t, u, v when the ray hits the triangle (two-sided) with t in [tmin, tmax]. */
+static inline int ms_wt_intersect(const ms_wt_ray *r, const float tri[9], float tmin, float tmax, float *t,
+                                  float *u, float *v)
+{
+    ms_wt_eval e;
+    ms_wt_evaluate(r, tri, &e);
+    if ((e.u < 0.0f || e.v < 0.0f || e.w < 0.0f) && (e.u > 0.0f || e.v > 0.0f || e.w > 0.0f)) return 0;
+    if (e.det == 0.0f) return 0;
+    const float tt = e.t_scaled / e.det;
+    if (!(tt >= tmin && tt <= tmax)) return 0;   /* also rejects NaN (a zero direction) */
+    *t = tt;
+    *u = e.v / e.det;
+    *v = e.w / e.det;
+    return 1;
+}
+
+/* Conservative box test to match (sec. 4 and Ize, "Robust BVH Ray Traversal", JCGT 2013): the
+ * triangle test decides on vertices rounded relative to the origin and sheared, so it may report a
+ * hit for a ray that passes, exactly, a few ulps of the vertices' distance outside the triangle, and
+ * so outside its box: a ray through a shared vertex on a box face may be given to the triangle of a
+ * box it does not enter. Boxes are therefore widened, in every axis, by MS_WT_BOX_REL times their
+ * largest coordinate relative to the origin (2^-16, about 250 ulps: far above those few ulps, far
+ * below anything that costs culling); the slab distances are then widened by Ize's 1 + 2 gamma(3)
+ * on top, for the rounding of the slab test itself. lo, hi: box corners minus the origin, in place. */
+#define MS_WT_BOX_REL (1.0f / 65536.0f)
+
+static inline void ms_wt_widen_box(float lo[3], float hi[3])
+{
+    float m = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        const float l = fabsf(lo[a]), h = fabsf(hi[a]);
+        m = l > m ? l : m;
+        m = h > m ? h : m;
+    }
+    const float e = m * MS_WT_BOX_REL;
+    for (int a = 0; a < 3; a++) { lo[a] -= e; hi[a] += e; }
+}
+
+/* Ize's widening of the exit distance, t_far * (1 + 2 gamma(3)) with gamma(n) = n u / (1 - n u),
+ * taken here with u = 2^-23 (twice the bound for round-to-nearest, as the code always had). */
+#define MS_WT_FAR_SCALE (1.0f + 2.0f * 3.5762786e-07f)
+
+#endif
