@@ -26,34 +26,32 @@ typedef struct packet {
      * shear; kz < 0 when no axis suits every lane and lanes are tested one by one. */
     int kx, ky, kz;
     float sx[LANES], sy[LANES], sz[LANES];
+    float margin;           /* box widening (ms_wt_box_margin), set by trace_packet */
 } packet;
 
 /* The packet's shear. Any kz with d[kz] != 0 keeps the test watertight (the per-ray choice of the
  * largest |d| only bounds the shear); the rays of a packet point at one small light, so one axis
- * usually serves all lanes: the axis whose smallest |d[kz]| relative to its lane's largest |d| is
- * largest, provided that is at least 1/2 (|Sx|, |Sy| <= 2, as accurate as the per-ray choice within a
- * factor of 2). The winding swap of the paper is not needed: the test is two-sided. */
+ * usually serves all lanes: lane 0's largest, provided every lane has |d[kz]| >= max|d| / 2 (|Sx|,
+ * |Sy| <= 2: as accurate as the per-ray choice within a factor of 2); else kz = -1 and the lanes are
+ * tested one by one. Sz is the lane's 1/d[kz] of the slab test and Sx = d[kx] * Sz (the paper
+ * divides; any shear that maps the ray onto the z axis serves). The winding swap of the paper is not
+ * needed: the test is two-sided. */
 static void packet_shear(packet *pk)
 {
-    float best = 0.0f;
-    pk->kz = -1;
-    for (int a = 0; a < 3; a++) {
-        float worst = INFINITY;
-        for (int l = 0; l < LANES; l++) {
-            float m = ms_maxf(fabsf(pk->d[0][l]), ms_maxf(fabsf(pk->d[1][l]), fabsf(pk->d[2][l])));
-            float r = fabsf(pk->d[a][l]) / m;
-            worst = r < worst ? r : worst;   /* NaN (a zero direction) leaves worst alone ... */
-            if (!(m > 0.0f)) worst = 0.0f;   /* ... and rules the common axis out */
-        }
-        if (worst >= 0.5f && worst > best) { best = worst; pk->kz = a; }
+    const float d0[3] = { pk->d[0][0], pk->d[1][0], pk->d[2][0] };
+    const int kz = ms_wt_max_axis(d0);
+    int ok = 1;
+    for (int l = 0; l < LANES; l++) {
+        const float m = ms_maxf(fabsf(pk->d[0][l]), ms_maxf(fabsf(pk->d[1][l]), fabsf(pk->d[2][l])));
+        ok &= 2.0f * fabsf(pk->d[kz][l]) >= m && m > 0.0f;
     }
-    if (pk->kz < 0) return;
-    pk->kx = pk->kz + 1 == 3 ? 0 : pk->kz + 1;
+    pk->kz = ok ? kz : -1;
+    pk->kx = kz + 1 == 3 ? 0 : kz + 1;
     pk->ky = pk->kx + 1 == 3 ? 0 : pk->kx + 1;
     for (int l = 0; l < LANES; l++) {
-        pk->sx[l] = pk->d[pk->kx][l] / pk->d[pk->kz][l];
-        pk->sy[l] = pk->d[pk->ky][l] / pk->d[pk->kz][l];
-        pk->sz[l] = 1.0f / pk->d[pk->kz][l];
+        pk->sz[l] = pk->inv[kz][l];
+        pk->sx[l] = pk->d[pk->kx][l] * pk->sz[l];
+        pk->sy[l] = pk->d[pk->ky][l] * pk->sz[l];
     }
 }
 
@@ -65,12 +63,11 @@ static int any_live(const int *live)
 }
 
 /* 1 if any live ray of the packet enters the node within [tmin, tmax]. The box is widened to match
- * the watertight triangle test (ms_wt_widen_box), once for all lanes since the origin is common. */
+ * the watertight triangle test (ms_wt_box_margin), once for all lanes since the origin is common. */
 static int packet_enters(const packet *pk, const ms_bvh_node *n)
 {
     float lo[3], hi[3];
-    for (int a = 0; a < 3; a++) { lo[a] = n->bmin[a] - pk->o[a]; hi[a] = n->bmax[a] - pk->o[a]; }
-    ms_wt_widen_box(lo, hi);
+    for (int a = 0; a < 3; a++) { lo[a] = (n->bmin[a] - pk->o[a]) - pk->margin; hi[a] = (n->bmax[a] - pk->o[a]) + pk->margin; }
     int hit = 0;
     for (int l = 0; l < LANES; l++) {
         float t0 = pk->tmin, t1 = pk->tmax;
@@ -89,9 +86,11 @@ static int packet_enters(const packet *pk, const ms_bvh_node *n)
 }
 
 /* The watertight test (ray_triangle.h) against every live lane; clears the lanes the triangle blocks.
- * The vertices relative to the common origin are computed and permuted once; the lane loops are
- * branch-free so that they vectorise. Lanes with an edge function exactly 0 are redone in double
- * (as ms_wt_evaluate does), in a scalar pass that is rarely taken. */
+ * The vertices relative to the common origin are computed and permuted once; the lane loop is
+ * branch-free so that it vectorises. As in the paper, the t range is tested on T against tmin and
+ * tmax scaled by det (sign adjusted), without a division: only the any-hit answer is needed here.
+ * A lane with an edge function exactly 0 is left to a scalar pass that redoes it in double (as
+ * ms_wt_evaluate does); it is rarely taken. */
 static void packet_triangle(packet *pk, const float *tri)
 {
     if (pk->kz < 0) {
@@ -110,35 +109,37 @@ static void packet_triangle(packet *pk, const float *tri)
     for (int a = 0; a < 3; a++) { A[a] = tri[a] - pk->o[a]; B[a] = tri[3 + a] - pk->o[a]; C[a] = tri[6 + a] - pk->o[a]; }
     const float Ax = A[kx], Ay = A[ky], Az = A[kz], Bx = B[kx], By = B[ky], Bz = B[kz];
     const float Cx = C[kx], Cy = C[ky], Cz = C[kz];
-    float U[LANES], V[LANES], W[LANES];
+    const float tmin = pk->tmin, tmax = pk->tmax;
     int zero = 0;
     for (int l = 0; l < LANES; l++) {
-        const float sx = pk->sx[l], sy = pk->sy[l];
+        const float sx = pk->sx[l], sy = pk->sy[l], sz = pk->sz[l];
         const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
         const float cx = Cx - sx * Cz, cy = Cy - sy * Cz;
-        U[l] = ms_wt_edge(cx, cy, bx, by);
-        V[l] = ms_wt_edge(ax, ay, cx, cy);
-        W[l] = ms_wt_edge(bx, by, ax, ay);
-        zero |= (U[l] == 0.0f) | (V[l] == 0.0f) | (W[l] == 0.0f);
+        const float u = ms_wt_edge(cx, cy, bx, by), v = ms_wt_edge(ax, ay, cx, cy), w = ms_wt_edge(bx, by, ax, ay);
+        const int z = (u == 0.0f) | (v == 0.0f) | (w == 0.0f);
+        const int mixed = ((u < 0.0f) | (v < 0.0f) | (w < 0.0f)) & ((u > 0.0f) | (v > 0.0f) | (w > 0.0f));
+        const float det = u + v + w;
+        const float T = u * (sz * Az) + v * (sz * Bz) + w * (sz * Cz);
+        const float Ts = det < 0.0f ? -T : T, adet = fabsf(det);
+        const int hit = !z & !mixed & (det != 0.0f) & (Ts >= tmin * adet) & (Ts <= tmax * adet);
+        zero |= z & pk->live[l];
+        pk->live[l] &= !hit;
     }
     if (zero)
         for (int l = 0; l < LANES; l++) {
-            if (U[l] != 0.0f && V[l] != 0.0f && W[l] != 0.0f) continue;
-            const float sx = pk->sx[l], sy = pk->sy[l];
+            const float sx = pk->sx[l], sy = pk->sy[l], sz = pk->sz[l];
             const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
             const float cx = Cx - sx * Cz, cy = Cy - sy * Cz;
-            U[l] = ms_wt_edge_d(cx, cy, bx, by);
-            V[l] = ms_wt_edge_d(ax, ay, cx, cy);
-            W[l] = ms_wt_edge_d(bx, by, ax, ay);
+            if (!pk->live[l] || (ms_wt_edge(cx, cy, bx, by) != 0.0f && ms_wt_edge(ax, ay, cx, cy) != 0.0f &&
+                                 ms_wt_edge(bx, by, ax, ay) != 0.0f))
+                continue;
+            const float u = ms_wt_edge_d(cx, cy, bx, by), v = ms_wt_edge_d(ax, ay, cx, cy), w = ms_wt_edge_d(bx, by, ax, ay);
+            if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) continue;
+            const float det = u + v + w;
+            const float T = u * (sz * Az) + v * (sz * Bz) + w * (sz * Cz);
+            const float Ts = det < 0.0f ? -T : T, adet = fabsf(det);
+            if (det != 0.0f && Ts >= tmin * adet && Ts <= tmax * adet) pk->live[l] = 0;
         }
-    for (int l = 0; l < LANES; l++) {
-        const float u = U[l], v = V[l], w = W[l], sz = pk->sz[l];
-        const int mixed = ((u < 0.0f) | (v < 0.0f) | (w < 0.0f)) & ((u > 0.0f) | (v > 0.0f) | (w > 0.0f));
-        const float det = u + v + w;
-        const float t = (u * (sz * Az) + v * (sz * Bz) + w * (sz * Cz)) / det;
-        const int hit = !mixed & (det != 0.0f) & (t >= pk->tmin) & (t <= pk->tmax);
-        pk->live[l] &= !hit;
-    }
 }
 
 static void trace_packet(const ms_bvh *b, packet *pk, uint32_t skip, uint64_t *cnt)
@@ -147,6 +148,7 @@ static void trace_packet(const ms_bvh *b, packet *pk, uint32_t skip, uint64_t *c
     int sp = 0;
     stack[sp++] = 0;
     cnt[C_PACKETS]++;
+    pk->margin = ms_wt_box_margin(b->nodes[0].bmin, b->nodes[0].bmax, pk->o);
     while (sp) {
         const ms_bvh_node *n = &b->nodes[stack[--sp]];
         cnt[C_NODE_VISITS]++;
