@@ -18,7 +18,8 @@
  *    adjusted, to avoid the division). Then a hit means exactly "t in [tmin, tmax]" for the t we
  *    report, so the closest hit is the minimum over the triangles whatever order they are tested in,
  *    which the BVH tests compare bit for bit with brute force. The division happens only for rays
- *    that passed the edge tests (packets compute it for all lanes, branch-free);
+ *    that passed the edge tests. The shadow packets (raytrace.c), which need only the any-hit
+ *    answer, keep the paper's division-free comparison and share one shear axis over 16 lanes;
  *  - u, v are the weights of vertices 1 and 2 (V / det, W / det), as Moller-Trumbore's were.
  *
  * Zero-area triangles need no special case: a repeated vertex gives U = V = W = 0 or mixed signs, so
