@@ -13,24 +13,21 @@ int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3]
     return ms_wt_intersect(&w, tri, tmin, tmax, t, u, v);
 }
 
-typedef struct ray_pre { float o[3], inv[3], margin; ms_wt_ray wt; } ray_pre;
+typedef struct ray_pre { float o_lo[3], o_hi[3], inv[3]; ms_wt_ray wt; } ray_pre;
 
 static void ray_prepare(ray_pre *rp, const ms_bvh *b, const ms_ray *r)
 {
-    for (int a = 0; a < 3; a++) {
-        rp->o[a] = r->o[a];
-        rp->inv[a] = 1.0f / r->d[a];     /* +-inf for axis-parallel rays; the slab test copes */
-    }
+    for (int a = 0; a < 3; a++) rp->inv[a] = 1.0f / r->d[a];   /* +-inf for axis-parallel rays; the slab test copes */
     ms_wt_prepare(&rp->wt, r->o, r->d);
-    rp->margin = ms_wt_box_margin(b->nodes[0].bmin, b->nodes[0].bmax, r->o);
+    ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, r->o, rp->o_lo, rp->o_hi);
 }
 
-/* Slab test on the box widened to match the watertight triangle test (ms_wt_box_margin); returns the
- * entry distance or +inf when the box is missed within [tmin, tmax]. */
+/* Slab test on the box widened to match the watertight triangle test (ms_wt_box_origins); returns
+ * the entry distance or +inf when the box is missed within [tmin, tmax]. */
 static inline float box_enter(const ms_bvh_node *n, const ray_pre *rp, float tmin, float tmax)
 {
     float lo[3], hi[3];
-    for (int a = 0; a < 3; a++) { lo[a] = (n->bmin[a] - rp->o[a]) - rp->margin; hi[a] = (n->bmax[a] - rp->o[a]) + rp->margin; }
+    for (int a = 0; a < 3; a++) { lo[a] = n->bmin[a] - rp->o_lo[a]; hi[a] = n->bmax[a] - rp->o_hi[a]; }
     float t0 = tmin, t1 = tmax;
     for (int a = 0; a < 3; a++) {
         float x = lo[a] * rp->inv[a], y = hi[a] * rp->inv[a];

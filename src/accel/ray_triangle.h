@@ -111,23 +111,28 @@ static inline int ms_wt_intersect(const ms_wt_ray *r, const float tri[9], float 
  * triangle test decides on vertices rounded relative to the origin and sheared, so it may report a
  * hit for a ray that passes, exactly, a few ulps of the vertices' distance outside the triangle, and
  * so outside its box: a ray through a shared vertex on a box face may be given to the triangle of a
- * box it does not enter. Boxes are therefore widened in every axis by MS_WT_BOX_REL times the largest
- * coordinate of the root box relative to the ray origin (2^-16, about 250 ulps of any vertex's
- * distance: far above those few ulps and the rounding of the widening itself, far below anything
- * that costs culling); one margin per ray, or per packet, bounds every node's own. The slab
+ * box it does not enter. Boxes are therefore widened in every axis by a margin e = MS_WT_BOX_REL
+ * times the largest of the root box's coordinates relative to the ray origin and the origin's own
+ * (2^-16, about 250 ulps of any vertex's distance: far above those few ulps, far below anything that
+ * costs culling); one margin per ray, or per packet, bounds every node's own. It is folded into two
+ * shifted origins, o + e and o - e, so that the slab test costs what it did: lo = bmin - (o + e),
+ * hi = bmax - (o - e); counting |o| in e keeps it far above the rounding of o +- e. The slab
  * distances are then widened by Ize's 1 + 2 gamma(3) on top, for the slab test's own rounding. */
 #define MS_WT_BOX_REL (1.0f / 65536.0f)
 
-/* The margin for a ray from o in a BVH whose root box is [lo, hi]. */
-static inline float ms_wt_box_margin(const float lo[3], const float hi[3], const float o[3])
+/* The shifted origins for a ray from o in a BVH whose root box is [lo, hi]. */
+static inline void ms_wt_box_origins(const float lo[3], const float hi[3], const float o[3], float o_lo[3],
+                                     float o_hi[3])
 {
     float m = 0.0f;
     for (int a = 0; a < 3; a++) {
-        const float l = fabsf(lo[a] - o[a]), h = fabsf(hi[a] - o[a]);
+        const float l = fabsf(lo[a] - o[a]), h = fabsf(hi[a] - o[a]), c = fabsf(o[a]);
         m = l > m ? l : m;
         m = h > m ? h : m;
+        m = c > m ? c : m;
     }
-    return m * MS_WT_BOX_REL;
+    const float e = m * MS_WT_BOX_REL;
+    for (int a = 0; a < 3; a++) { o_lo[a] = o[a] + e; o_hi[a] = o[a] - e; }
 }
 
 /* Ize's widening of the exit distance, t_far * (1 + 2 gamma(3)) with gamma(n) = n u / (1 - n u),

@@ -26,7 +26,7 @@ typedef struct packet {
      * shear; kz < 0 when no axis suits every lane and lanes are tested one by one. */
     int kx, ky, kz;
     float sx[LANES], sy[LANES], sz[LANES];
-    float margin;           /* box widening (ms_wt_box_margin), set by trace_packet */
+    float o_lo[3], o_hi[3]; /* the origin shifted by the box margin (ms_wt_box_origins), set by trace_packet */
 } packet;
 
 /* The packet's shear. Any kz with d[kz] != 0 keeps the test watertight (the per-ray choice of the
@@ -63,11 +63,11 @@ static int any_live(const int *live)
 }
 
 /* 1 if any live ray of the packet enters the node within [tmin, tmax]. The box is widened to match
- * the watertight triangle test (ms_wt_box_margin), once for all lanes since the origin is common. */
+ * the watertight triangle test (ms_wt_box_origins), once for all lanes since the origin is common. */
 static int packet_enters(const packet *pk, const ms_bvh_node *n)
 {
     float lo[3], hi[3];
-    for (int a = 0; a < 3; a++) { lo[a] = (n->bmin[a] - pk->o[a]) - pk->margin; hi[a] = (n->bmax[a] - pk->o[a]) + pk->margin; }
+    for (int a = 0; a < 3; a++) { lo[a] = n->bmin[a] - pk->o_lo[a]; hi[a] = n->bmax[a] - pk->o_hi[a]; }
     int hit = 0;
     for (int l = 0; l < LANES; l++) {
         float t0 = pk->tmin, t1 = pk->tmax;
@@ -148,7 +148,7 @@ static void trace_packet(const ms_bvh *b, packet *pk, uint32_t skip, uint64_t *c
     int sp = 0;
     stack[sp++] = 0;
     cnt[C_PACKETS]++;
-    pk->margin = ms_wt_box_margin(b->nodes[0].bmin, b->nodes[0].bmax, pk->o);
+    ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, pk->o, pk->o_lo, pk->o_hi);
     while (sp) {
         const ms_bvh_node *n = &b->nodes[stack[--sp]];
         cnt[C_NODE_VISITS]++;
