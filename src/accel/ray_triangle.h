@@ -14,17 +14,25 @@
  *
  * Departures from the paper, all deliberate:
  *  - two-sided (its non-culling variant): accept U, V, W all >= 0 or all <= 0;
- *  - the t range is decided on t = T / det itself (the paper compares T with t_far * det, sign
- *    adjusted, to avoid the division). Then a hit means exactly "t in [tmin, tmax]" for the t we
- *    report, so the closest hit is the minimum over the triangles whatever order they are tested in,
- *    which the BVH tests compare bit for bit with brute force. The division happens only for rays
- *    that passed the edge tests. The shadow packets (raytrace.c), which need only the any-hit
- *    answer, keep the paper's division-free comparison and share one shear axis over 16 lanes;
+ *  - t is not the paper's T / det but the distance to the triangle's plane, ((v - o) . N) / (d . N)
+ *    (as Moller-Trumbore and Embree compute it) with N from the two shortest edges and v the vertex
+ *    nearest the origin (ms_wt_plane), clamped into the range of the vertices' depths
+ *    Sz * (v - o)[kz] (where the hit lies; it bounds t for zero-area triangles, whose N is noise).
+ *    T / det interpolates the vertices' depths with barycentrics rounded to ulps of the vertices'
+ *    distance over the projected triangle's width, which a ray grazing a long triangle amplifies: in
+ *    Dabrovic Sponza a receiver 1.6e-5 beside a crease got t = +1.9e-4 instead of -5.2e-4 on its
+ *    neighbour, i.e. false occlusion (the plane form is accurate to the rounding of the distance);
+ *  - the t range is decided on that t itself (the paper compares T with t_far * det), so a hit
+ *    means exactly "t in [tmin, tmax]" for the t we report and the closest hit is the minimum over
+ *    the triangles whatever order they are tested in, which the BVH tests compare bit for bit with
+ *    brute force. The division happens only for rays that passed the edge tests. The shadow packets
+ *    (raytrace.c), which need only the any-hit answer, compare the plane distance with tmin and tmax
+ *    scaled by d . N, without a division or the clamp, and share one shear axis over 16 lanes;
  *  - u, v are the weights of vertices 1 and 2 (V / det, W / det), as Moller-Trumbore's were.
  *
  * Zero-area triangles need no special case: a repeated vertex gives U = V = W = 0 or mixed signs, so
  * never a hit; a triangle of three collinear vertices is hit only by rays that pass within rounding of
- * its segment, at a t between its vertices' (T / det is a convex combination of their depths). A
+ * its segment, at a t between its vertices' depths (the clamp of ms_wt_hit_t). A
  * sliver, however thin, is hit exactly where it is, so a closed mesh with slivers stays closed. */
 #ifndef MS_RAY_TRIANGLE_H
 #define MS_RAY_TRIANGLE_H
@@ -35,7 +43,7 @@
 #endif
 
 typedef struct ms_wt_ray {
-    float o[3];
+    float o[3], d[3];
     int kx, ky, kz;
     float sx, sy, sz;
 } ms_wt_ray;
@@ -53,6 +61,7 @@ static inline void ms_wt_prepare(ms_wt_ray *w, const float o[3], const float d[3
     int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
     if (d[kz] < 0.0f) { const int s = kx; kx = ky; ky = s; }
     w->o[0] = o[0]; w->o[1] = o[1]; w->o[2] = o[2];
+    w->d[0] = d[0]; w->d[1] = d[1]; w->d[2] = d[2];
     w->kx = kx; w->ky = ky; w->kz = kz;
     /* d = 0 gives NaNs here, and NaN fails every test below: no hit. */
     w->sx = d[kx] / d[kz];
@@ -67,9 +76,9 @@ static inline float ms_wt_edge_d(float x0, float y0, float x1, float y1)
     return (float)((double)x0 * (double)y1 - (double)y0 * (double)x1);
 }
 
-/* The scaled quantities of one ray/triangle pair (sec. 3): edge functions U, V, W and the scaled
- * hit distance T with det = U + V + W. */
-typedef struct ms_wt_eval { float u, v, w, t_scaled, det; } ms_wt_eval;
+/* The quantities of one ray/triangle pair (sec. 3): edge functions U, V, W, det = U + V + W, and the
+ * vertices' depths along the ray (ray parameters of their kz planes). */
+typedef struct ms_wt_eval { float u, v, w, det, za, zb, zc; } ms_wt_eval;
 
 static inline void ms_wt_evaluate(const ms_wt_ray *r, const float tri[9], ms_wt_eval *e)
 {
@@ -87,8 +96,42 @@ static inline void ms_wt_evaluate(const ms_wt_ray *r, const float tri[9], ms_wt_
     }
     e->u = U; e->v = V; e->w = W;
     e->det = U + V + W;
-    const float az = r->sz * A[kz], bz = r->sz * B[kz], cz = r->sz * C[kz];
-    e->t_scaled = U * az + V * bz + W * cz;
+    e->za = r->sz * A[kz]; e->zb = r->sz * B[kz]; e->zc = r->sz * C[kz];
+}
+
+/* The plane's normal N and the origin's offset (v - o) . N, so that t = offset / (d . N). N is the
+ * cross product of the two shortest edges (E_a x E_b = E_b x E_c = E_c x E_a for the cyclic edges
+ * E_a = v1 - v0, E_b = v2 - v1, E_c = v0 - v2): a sliver's two long edges are nearly parallel and
+ * their cross product loses its direction (a 10 x 0.02 triangle: 1e-4 of its vertices' distance in
+ * the offset). The offset is taken from the vertex nearest the origin, which rounds least. */
+static inline float ms_wt_plane(const float o[3], const float tri[9], float n[3])
+{
+    float E[3][3], V[3][3], le[3], lv[3];
+    for (int i = 0; i < 3; i++) {
+        const int j = i + 1 == 3 ? 0 : i + 1;
+        for (int a = 0; a < 3; a++) { E[i][a] = tri[3 * j + a] - tri[3 * i + a]; V[i][a] = tri[3 * i + a] - o[a]; }
+        le[i] = E[i][0] * E[i][0] + E[i][1] * E[i][1] + E[i][2] * E[i][2];
+        lv[i] = V[i][0] * V[i][0] + V[i][1] * V[i][1] + V[i][2] * V[i][2];
+    }
+    const int lng = le[0] >= le[1] ? (le[0] >= le[2] ? 0 : 2) : (le[1] >= le[2] ? 1 : 2);
+    const float *x = E[lng + 1 == 3 ? 0 : lng + 1], *y = E[lng + 2 >= 3 ? lng - 1 : lng + 2];
+    n[0] = x[1] * y[2] - x[2] * y[1];
+    n[1] = x[2] * y[0] - x[0] * y[2];
+    n[2] = x[0] * y[1] - x[1] * y[0];
+    const int nr = lv[0] <= lv[1] ? (lv[0] <= lv[2] ? 0 : 2) : (lv[1] <= lv[2] ? 1 : 2);
+    return V[nr][0] * n[0] + V[nr][1] * n[1] + V[nr][2] * n[2];
+}
+
+/* The hit distance for a ray that passed the edge tests: the plane distance, clamped into the
+ * vertices' depth range (NaN, from d . N = 0, becomes its low end). */
+static inline float ms_wt_hit_t(const ms_wt_ray *r, const float tri[9], const ms_wt_eval *e)
+{
+    float n[3];
+    const float num = ms_wt_plane(r->o, tri, n);
+    const float t = num / (r->d[0] * n[0] + r->d[1] * n[1] + r->d[2] * n[2]);
+    const float lo = e->za < e->zb ? (e->za < e->zc ? e->za : e->zc) : (e->zb < e->zc ? e->zb : e->zc);
+    const float hi = e->za > e->zb ? (e->za > e->zc ? e->za : e->zc) : (e->zb > e->zc ? e->zb : e->zc);
+    return !(t >= lo) ? lo : t > hi ? hi : t;
 }
 
 /* 1 and t, u, v when the ray hits the triangle (two-sided) with t in [tmin, tmax]. */
@@ -99,7 +142,7 @@ static inline int ms_wt_intersect(const ms_wt_ray *r, const float tri[9], float 
     ms_wt_evaluate(r, tri, &e);
     if ((e.u < 0.0f || e.v < 0.0f || e.w < 0.0f) && (e.u > 0.0f || e.v > 0.0f || e.w > 0.0f)) return 0;
     if (e.det == 0.0f) return 0;
-    const float tt = e.t_scaled / e.det;
+    const float tt = ms_wt_hit_t(r, tri, &e);
     if (!(tt >= tmin && tt <= tmax)) return 0;   /* also rejects NaN (a zero direction) */
     *t = tt;
     *u = e.v / e.det;

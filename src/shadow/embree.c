@@ -438,9 +438,9 @@ const ms_shadow_method ms_shadow_embree = {
 /* ---- primary visibility: camera rays as 16-ray packets over 4x4 pixel blocks ---- */
 
 /* The hit parameter of ray (o, d) on the plane of tri, by the very operations of the watertight test
- * (ms_wt_evaluate: so bit for bit the t the BVH primary finds on that triangle), without its inside
+ * (ms_wt_hit_t: so bit for bit the t the BVH primary finds on that triangle), without its inside
  * test: Embree may report a triangle at an edge that our test would just miss. Embree's own t if the
- * ray is parallel to the plane. */
+ * triangle is edge-on. */
 static float eb_plane_t(const float tri[9], const float o[3], const float d[3], float t_embree)
 {
     ms_wt_ray w;
@@ -448,7 +448,7 @@ static float eb_plane_t(const float tri[9], const float o[3], const float d[3], 
     ms_wt_prepare(&w, o, d);
     ms_wt_evaluate(&w, tri, &e);
     if (e.det == 0.0f) return t_embree;
-    float t = e.t_scaled / e.det;
+    float t = ms_wt_hit_t(&w, tri, &e);
     return isfinite(t) && t > 0.0f ? t : t_embree;
 }
 

@@ -25,7 +25,7 @@ typedef struct packet {
      * origin is common, so each triangle is translated and permuted once per packet), per-lane
      * shear; kz < 0 when no axis suits every lane and lanes are tested one by one. */
     int kx, ky, kz;
-    float sx[LANES], sy[LANES], sz[LANES];
+    float sx[LANES], sy[LANES];
     float o_lo[3], o_hi[3]; /* the origin shifted by the box margin (ms_wt_box_origins), set by trace_packet */
 } packet;
 
@@ -33,8 +33,8 @@ typedef struct packet {
  * largest |d| only bounds the shear); the rays of a packet point at one small light, so one axis
  * usually serves all lanes: lane 0's largest, provided every lane has |d[kz]| >= max|d| / 2 (|Sx|,
  * |Sy| <= 2: as accurate as the per-ray choice within a factor of 2); else kz = -1 and the lanes are
- * tested one by one. Sz is the lane's 1/d[kz] of the slab test and Sx = d[kx] * Sz (the paper
- * divides; any shear that maps the ray onto the z axis serves). The winding swap of the paper is not
+ * tested one by one. Sx = d[kx] * (1/d[kz]) with the lane's 1/d of the slab test (the paper divides;
+ * any shear that maps the ray onto the z axis serves; Sz is not needed, t comes from the plane). The winding swap of the paper is not
  * needed: the test is two-sided. */
 static void packet_shear(packet *pk)
 {
@@ -49,9 +49,8 @@ static void packet_shear(packet *pk)
     pk->kx = kz + 1 == 3 ? 0 : kz + 1;
     pk->ky = pk->kx + 1 == 3 ? 0 : pk->kx + 1;
     for (int l = 0; l < LANES; l++) {
-        pk->sz[l] = pk->inv[kz][l];
-        pk->sx[l] = pk->d[pk->kx][l] * pk->sz[l];
-        pk->sy[l] = pk->d[pk->ky][l] * pk->sz[l];
+        pk->sx[l] = pk->d[pk->kx][l] * pk->inv[kz][l];
+        pk->sy[l] = pk->d[pk->ky][l] * pk->inv[kz][l];
     }
 }
 
@@ -86,11 +85,12 @@ static int packet_enters(const packet *pk, const ms_bvh_node *n)
 }
 
 /* The watertight test (ray_triangle.h) against every live lane; clears the lanes the triangle blocks.
- * The vertices relative to the common origin are computed and permuted once; the lane loop is
- * branch-free so that it vectorises. As in the paper, the t range is tested on T against tmin and
- * tmax scaled by det (sign adjusted), without a division: only the any-hit answer is needed here.
- * A lane with an edge function exactly 0 is left to a scalar pass that redoes it in double (as
- * ms_wt_evaluate does); it is rarely taken. */
+ * The vertices relative to the common origin are computed and permuted once, and so are the
+ * triangle's normal N and the origin's offset (v0 - o) . N; the lane loop is branch-free so that it
+ * vectorises. The t range is tested on the plane distance, offset against tmin and tmax scaled by
+ * d . N (sign adjusted), without a division: only the any-hit answer is needed here. A lane with an
+ * edge function exactly 0 is left to a scalar pass that redoes it in double (as ms_wt_evaluate
+ * does); it is rarely taken. */
 static void packet_triangle(packet *pk, const float *tri)
 {
     if (pk->kz < 0) {
@@ -105,29 +105,30 @@ static void packet_triangle(packet *pk, const float *tri)
         return;
     }
     const int kx = pk->kx, ky = pk->ky, kz = pk->kz;
-    float A[3], B[3], C[3];
+    float A[3], B[3], C[3], N[3];
     for (int a = 0; a < 3; a++) { A[a] = tri[a] - pk->o[a]; B[a] = tri[3 + a] - pk->o[a]; C[a] = tri[6 + a] - pk->o[a]; }
     const float Ax = A[kx], Ay = A[ky], Az = A[kz], Bx = B[kx], By = B[ky], Bz = B[kz];
     const float Cx = C[kx], Cy = C[ky], Cz = C[kz];
+    const float num = ms_wt_plane(pk->o, tri, N);
     const float tmin = pk->tmin, tmax = pk->tmax;
     int zero = 0;
     for (int l = 0; l < LANES; l++) {
-        const float sx = pk->sx[l], sy = pk->sy[l], sz = pk->sz[l];
+        const float sx = pk->sx[l], sy = pk->sy[l];
         const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
         const float cx = Cx - sx * Cz, cy = Cy - sy * Cz;
         const float u = ms_wt_edge(cx, cy, bx, by), v = ms_wt_edge(ax, ay, cx, cy), w = ms_wt_edge(bx, by, ax, ay);
         const int z = (u == 0.0f) | (v == 0.0f) | (w == 0.0f);
         const int mixed = ((u < 0.0f) | (v < 0.0f) | (w < 0.0f)) & ((u > 0.0f) | (v > 0.0f) | (w > 0.0f));
         const float det = u + v + w;
-        const float T = u * (sz * Az) + v * (sz * Bz) + w * (sz * Cz);
-        const float Ts = det < 0.0f ? -T : T, adet = fabsf(det);
-        const int hit = !z & !mixed & (det != 0.0f) & (Ts >= tmin * adet) & (Ts <= tmax * adet);
+        const float den = pk->d[0][l] * N[0] + pk->d[1][l] * N[1] + pk->d[2][l] * N[2];
+        const float ns = den < 0.0f ? -num : num, aden = fabsf(den);
+        const int hit = !z & !mixed & (det != 0.0f) & (aden > 0.0f) & (ns >= tmin * aden) & (ns <= tmax * aden);
         zero |= z & pk->live[l];
         pk->live[l] &= !hit;
     }
     if (zero)
         for (int l = 0; l < LANES; l++) {
-            const float sx = pk->sx[l], sy = pk->sy[l], sz = pk->sz[l];
+            const float sx = pk->sx[l], sy = pk->sy[l];
             const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
             const float cx = Cx - sx * Cz, cy = Cy - sy * Cz;
             if (!pk->live[l] || (ms_wt_edge(cx, cy, bx, by) != 0.0f && ms_wt_edge(ax, ay, cx, cy) != 0.0f &&
@@ -136,9 +137,9 @@ static void packet_triangle(packet *pk, const float *tri)
             const float u = ms_wt_edge_d(cx, cy, bx, by), v = ms_wt_edge_d(ax, ay, cx, cy), w = ms_wt_edge_d(bx, by, ax, ay);
             if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) continue;
             const float det = u + v + w;
-            const float T = u * (sz * Az) + v * (sz * Bz) + w * (sz * Cz);
-            const float Ts = det < 0.0f ? -T : T, adet = fabsf(det);
-            if (det != 0.0f && Ts >= tmin * adet && Ts <= tmax * adet) pk->live[l] = 0;
+            const float den = pk->d[0][l] * N[0] + pk->d[1][l] * N[1] + pk->d[2][l] * N[2];
+            const float ns = den < 0.0f ? -num : num, aden = fabsf(den);
+            if (det != 0.0f && aden > 0.0f && ns >= tmin * aden && ns <= tmax * aden) pk->live[l] = 0;
         }
 }
 
