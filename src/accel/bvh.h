@@ -18,6 +18,7 @@ typedef struct ms_bvh {
     uint32_t n_nodes;
     float *tri;           /* 9 floats per triangle, leaf order */
     uint32_t *tri_source; /* leaf-order index -> index in the soup given to the build */
+    float *tri_n;         /* 3 floats per triangle, leaf order: its plane normal (ms_wt_normal) */
     uint32_t n_tris;
     int depth;
     double build_s;

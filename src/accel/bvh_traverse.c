@@ -9,8 +9,10 @@ int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3]
                           float *t, float *u, float *v)
 {
     ms_wt_ray w;
+    float n[3];
     ms_wt_prepare(&w, o, d);
-    return ms_wt_intersect(&w, tri, tmin, tmax, t, u, v);
+    ms_wt_normal(tri, n);
+    return ms_wt_intersect(&w, tri, n, tmin, tmax, t, u, v);
 }
 
 typedef struct ray_pre { float o_lo[3], o_hi[3], inv[3]; ms_wt_ray wt; } ray_pre;
@@ -56,7 +58,7 @@ int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
         if (n->count) {
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 float t, u, v;
-                if (ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, r->tmin, best, &t, &u, &v)) {
+                if (ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i, r->tmin, best, &t, &u, &v)) {
                     best = t; hit->t = t; hit->u = u; hit->v = v; hit->prim = i;
                 }
             }
@@ -96,7 +98,7 @@ int ms_bvh_occluded(const ms_bvh *b, const ms_ray *r, uint32_t skip_prim)
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 float t, u, v;
                 if (i != skip_prim &&
-                    ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, r->tmin, r->tmax, &t, &u, &v))
+                    ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i, r->tmin, r->tmax, &t, &u, &v))
                     return 1;
             }
         } else {

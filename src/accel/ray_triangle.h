@@ -15,8 +15,9 @@
  * Departures from the paper, all deliberate:
  *  - two-sided (its non-culling variant): accept U, V, W all >= 0 or all <= 0;
  *  - t is not the paper's T / det but the distance to the triangle's plane, ((v - o) . N) / (d . N)
- *    (as Moller-Trumbore and Embree compute it) with N from the two shortest edges and v the vertex
- *    nearest the origin (ms_wt_plane), clamped into the range of the vertices' depths
+ *    (as Moller-Trumbore and Embree compute it) with N from the two shortest edges (ms_wt_normal,
+ *    kept per triangle by the BVH) and v the vertex nearest the origin (ms_wt_offset), clamped into
+ *    the range of the vertices' depths
  *    Sz * (v - o)[kz] (where the hit lies; it bounds t for zero-area triangles, whose N is noise).
  *    T / det interpolates the vertices' depths with barycentrics rounded to ulps of the vertices'
  *    distance over the projected triangle's width, which a ray grazing a long triangle amplifies: in
@@ -99,50 +100,57 @@ static inline void ms_wt_evaluate(const ms_wt_ray *r, const float tri[9], ms_wt_
     e->za = r->sz * A[kz]; e->zb = r->sz * B[kz]; e->zc = r->sz * C[kz];
 }
 
-/* The plane's normal N and the origin's offset (v - o) . N, so that t = offset / (d . N). N is the
- * cross product of the two shortest edges (E_a x E_b = E_b x E_c = E_c x E_a for the cyclic edges
- * E_a = v1 - v0, E_b = v2 - v1, E_c = v0 - v2): a sliver's two long edges are nearly parallel and
- * their cross product loses its direction (a 10 x 0.02 triangle: 1e-4 of its vertices' distance in
- * the offset). The offset is taken from the vertex nearest the origin, which rounds least. */
-static inline float ms_wt_plane(const float o[3], const float tri[9], float n[3])
+/* The plane's normal N, the cross product of the two shortest edges (E_a x E_b = E_b x E_c = E_c x E_a
+ * for the cyclic edges E_a = v1 - v0, E_b = v2 - v1, E_c = v0 - v2): a sliver's two long edges are
+ * nearly parallel and their cross product loses its direction (a 10 x 0.02 triangle: 1e-4 of its
+ * vertices' distance in the plane offset). The BVH keeps it per triangle (ms_bvh.tri_n). */
+static inline void ms_wt_normal(const float tri[9], float n[3])
 {
-    float E[3][3], V[3][3], le[3], lv[3];
+    float E[3][3], le[3];
     for (int i = 0; i < 3; i++) {
         const int j = i + 1 == 3 ? 0 : i + 1;
-        for (int a = 0; a < 3; a++) { E[i][a] = tri[3 * j + a] - tri[3 * i + a]; V[i][a] = tri[3 * i + a] - o[a]; }
+        for (int a = 0; a < 3; a++) E[i][a] = tri[3 * j + a] - tri[3 * i + a];
         le[i] = E[i][0] * E[i][0] + E[i][1] * E[i][1] + E[i][2] * E[i][2];
-        lv[i] = V[i][0] * V[i][0] + V[i][1] * V[i][1] + V[i][2] * V[i][2];
     }
     const int lng = le[0] >= le[1] ? (le[0] >= le[2] ? 0 : 2) : (le[1] >= le[2] ? 1 : 2);
     const float *x = E[lng + 1 == 3 ? 0 : lng + 1], *y = E[lng + 2 >= 3 ? lng - 1 : lng + 2];
     n[0] = x[1] * y[2] - x[2] * y[1];
     n[1] = x[2] * y[0] - x[0] * y[2];
     n[2] = x[0] * y[1] - x[1] * y[0];
+}
+
+/* The origin's offset from the plane, (v - o) . N, from the vertex v nearest the origin, which rounds
+ * least: t = offset / (d . N). */
+static inline float ms_wt_offset(const float o[3], const float tri[9], const float n[3])
+{
+    float V[3][3], lv[3];
+    for (int i = 0; i < 3; i++) {
+        for (int a = 0; a < 3; a++) V[i][a] = tri[3 * i + a] - o[a];
+        lv[i] = V[i][0] * V[i][0] + V[i][1] * V[i][1] + V[i][2] * V[i][2];
+    }
     const int nr = lv[0] <= lv[1] ? (lv[0] <= lv[2] ? 0 : 2) : (lv[1] <= lv[2] ? 1 : 2);
     return V[nr][0] * n[0] + V[nr][1] * n[1] + V[nr][2] * n[2];
 }
 
-/* The hit distance for a ray that passed the edge tests: the plane distance, clamped into the
- * vertices' depth range (NaN, from d . N = 0, becomes its low end). */
-static inline float ms_wt_hit_t(const ms_wt_ray *r, const float tri[9], const ms_wt_eval *e)
+/* The hit distance for a ray that passed the edge tests, n the triangle's ms_wt_normal: the plane
+ * distance, clamped into the vertices' depth range (NaN, from d . N = 0, becomes its low end). */
+static inline float ms_wt_hit_t(const ms_wt_ray *r, const float tri[9], const float n[3], const ms_wt_eval *e)
 {
-    float n[3];
-    const float num = ms_wt_plane(r->o, tri, n);
-    const float t = num / (r->d[0] * n[0] + r->d[1] * n[1] + r->d[2] * n[2]);
+    const float t = ms_wt_offset(r->o, tri, n) / (r->d[0] * n[0] + r->d[1] * n[1] + r->d[2] * n[2]);
     const float lo = e->za < e->zb ? (e->za < e->zc ? e->za : e->zc) : (e->zb < e->zc ? e->zb : e->zc);
     const float hi = e->za > e->zb ? (e->za > e->zc ? e->za : e->zc) : (e->zb > e->zc ? e->zb : e->zc);
     return !(t >= lo) ? lo : t > hi ? hi : t;
 }
 
-/* 1 and t, u, v when the ray hits the triangle (two-sided) with t in [tmin, tmax]. */
-static inline int ms_wt_intersect(const ms_wt_ray *r, const float tri[9], float tmin, float tmax, float *t,
-                                  float *u, float *v)
+/* 1 and t, u, v when the ray hits the triangle (two-sided) with t in [tmin, tmax]; n: its ms_wt_normal. */
+static inline int ms_wt_intersect(const ms_wt_ray *r, const float tri[9], const float n[3], float tmin, float tmax,
+                                  float *t, float *u, float *v)
 {
     ms_wt_eval e;
     ms_wt_evaluate(r, tri, &e);
     if ((e.u < 0.0f || e.v < 0.0f || e.w < 0.0f) && (e.u > 0.0f || e.v > 0.0f || e.w > 0.0f)) return 0;
     if (e.det == 0.0f) return 0;
-    const float tt = ms_wt_hit_t(r, tri, &e);
+    const float tt = ms_wt_hit_t(r, tri, n, &e);
     if (!(tt >= tmin && tt <= tmax)) return 0;   /* also rejects NaN (a zero direction) */
     *t = tt;
     *u = e.v / e.det;

@@ -441,14 +441,14 @@ const ms_shadow_method ms_shadow_embree = {
  * (ms_wt_hit_t: so bit for bit the t the BVH primary finds on that triangle), without its inside
  * test: Embree may report a triangle at an edge that our test would just miss. Embree's own t if the
  * triangle is edge-on. */
-static float eb_plane_t(const float tri[9], const float o[3], const float d[3], float t_embree)
+static float eb_plane_t(const float tri[9], const float n[3], const float o[3], const float d[3], float t_embree)
 {
     ms_wt_ray w;
     ms_wt_eval e;
     ms_wt_prepare(&w, o, d);
     ms_wt_evaluate(&w, tri, &e);
     if (e.det == 0.0f) return t_embree;
-    float t = ms_wt_hit_t(&w, tri, &e);
+    float t = ms_wt_hit_t(&w, tri, n, &e);
     return isfinite(t) && t > 0.0f ? t : t_embree;
 }
 
@@ -492,7 +492,7 @@ static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int 
                 /* Embree decides which triangle is seen; the hit parameter on it is recomputed by the
                  * shared triangle test, so that a pixel that sees the same triangle gets the very same
                  * point C as with the BVH primary (Embree's t differs by up to tens of ulps). */
-                ms_hit_finish(ctx, o, d, eb_plane_t(ctx->bvh->tri + 9 * (size_t)prim, o, d, rh.ray.tfar[l]), prim, h);
+                ms_hit_finish(ctx, o, d, eb_plane_t(ctx->bvh->tri + 9 * (size_t)prim, ctx->bvh->tri_n + 3 * (size_t)prim, o, d, rh.ray.tfar[l]), prim, h);
             }
         }
     eb_leave(mx);

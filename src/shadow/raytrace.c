@@ -85,13 +85,13 @@ static int packet_enters(const packet *pk, const ms_bvh_node *n)
 }
 
 /* The watertight test (ray_triangle.h) against every live lane; clears the lanes the triangle blocks.
- * The vertices relative to the common origin are computed and permuted once, and so are the
- * triangle's normal N and the origin's offset (v0 - o) . N; the lane loop is branch-free so that it
+ * The vertices relative to the common origin are computed and permuted once, and so is the
+ * origin's offset (v - o) . N from the triangle's plane (N = ms_wt_normal, kept by the BVH); the lane loop is branch-free so that it
  * vectorises. The t range is tested on the plane distance, offset against tmin and tmax scaled by
  * d . N (sign adjusted), without a division: only the any-hit answer is needed here. A lane with an
  * edge function exactly 0 is left to a scalar pass that redoes it in double (as ms_wt_evaluate
  * does); it is rarely taken. */
-static void packet_triangle(packet *pk, const float *tri)
+static void packet_triangle(packet *pk, const float *tri, const float N[3])
 {
     if (pk->kz < 0) {
         for (int l = 0; l < LANES; l++) {
@@ -100,16 +100,16 @@ static void packet_triangle(packet *pk, const float *tri)
             ms_wt_ray w;
             float t, u, v;
             ms_wt_prepare(&w, pk->o, d);
-            pk->live[l] = !ms_wt_intersect(&w, tri, pk->tmin, pk->tmax, &t, &u, &v);
+            pk->live[l] = !ms_wt_intersect(&w, tri, N, pk->tmin, pk->tmax, &t, &u, &v);
         }
         return;
     }
     const int kx = pk->kx, ky = pk->ky, kz = pk->kz;
-    float A[3], B[3], C[3], N[3];
+    float A[3], B[3], C[3];
     for (int a = 0; a < 3; a++) { A[a] = tri[a] - pk->o[a]; B[a] = tri[3 + a] - pk->o[a]; C[a] = tri[6 + a] - pk->o[a]; }
     const float Ax = A[kx], Ay = A[ky], Az = A[kz], Bx = B[kx], By = B[ky], Bz = B[kz];
     const float Cx = C[kx], Cy = C[ky], Cz = C[kz];
-    const float num = ms_wt_plane(pk->o, tri, N);
+    const float num = ms_wt_offset(pk->o, tri, N);
     const float tmin = pk->tmin, tmax = pk->tmax;
     int zero = 0;
     for (int l = 0; l < LANES; l++) {
@@ -158,7 +158,7 @@ static void trace_packet(const ms_bvh *b, packet *pk, uint32_t skip, uint64_t *c
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 if (i == skip) continue;
                 cnt[C_TRI_TESTS]++;
-                packet_triangle(pk, b->tri + 9 * (size_t)i);
+                packet_triangle(pk, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i);
             }
             if (!any_live(pk->live)) return;
         } else {
