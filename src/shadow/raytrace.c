@@ -86,11 +86,11 @@ static int packet_enters(const packet *pk, const ms_bvh_node *n)
 
 /* The watertight test (ray_triangle.h) against every live lane; clears the lanes the triangle blocks.
  * The vertices relative to the common origin are computed and permuted once, and so is the
- * origin's offset (v - o) . N from the triangle's plane (N = ms_wt_normal, kept by the BVH); the lane loop is branch-free so that it
- * vectorises. The t range is tested on the plane distance, offset against tmin and tmax scaled by
- * d . N (sign adjusted), without a division: only the any-hit answer is needed here. A lane with an
- * edge function exactly 0 is left to a scalar pass that redoes it in double (as ms_wt_evaluate
- * does); it is rarely taken. */
+ * origin's offset (v - o) . N from the triangle's plane (N = ms_wt_normal, kept by the BVH); the
+ * lane loop is branch-free so that it vectorises. The t range is tested on that offset against tmin
+ * and tmax scaled by d . N (sign adjusted), without a division: only the any-hit answer is needed
+ * here. A lane with an edge function exactly 0 is left to a scalar pass that redoes it in double
+ * (as ms_wt_evaluate does); it is rarely taken. */
 static void packet_triangle(packet *pk, const float *tri, const float N[3])
 {
     if (pk->kz < 0) {
