@@ -72,7 +72,7 @@ static void check_scene(const ms_scene *sc, const char *name, ms_pattern pat, in
     assert_true(g.differ * 1000 <= g.pixels);     /* at most 0.1% of the pixels */
     /* the counters add up: every shadow ray traced once, 16 per packet (default mode) */
     assert_int_equal(eb.stats.visible_pixels, rt.stats.visible_pixels);
-    assert_int_equal(eb.stats.n_counters, 6);
+    assert_int_equal(eb.stats.n_counters, 5);
     assert_string_equal(eb.stats.counter_name[0], "rays");
     assert_true(eb.stats.counter[0] == eb.stats.shadow_rays);
     /* packets of 16 samples with none in front are skipped */

@@ -18,6 +18,7 @@ typedef struct ms_bvh {
     uint32_t n_nodes;
     float *tri;           /* 9 floats per triangle, leaf order */
     uint32_t *tri_source; /* leaf-order index -> index in the soup given to the build */
+    float *tri_n;         /* 3 floats per triangle, leaf order: its plane normal (ms_wt_normal) */
     uint32_t n_tris;
     int depth;
     double build_s;
@@ -43,20 +44,11 @@ int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit);
 /* 1 if any triangle other than skip_prim is hit with t in [tmin, tmax]. */
 int ms_bvh_occluded(const ms_bvh *b, const ms_ray *r, uint32_t skip_prim);
 
-/* Two-sided Moller-Trumbore; 1 and t,u,v when the ray hits with t in [tmin, tmax]. Shared by the
- * traversals and by tests as the per-triangle oracle. */
+/* Two-sided watertight ray/triangle test (ray_triangle.h: Woop, Benthin & Wald 2013); 1 and t,u,v when
+ * the ray hits with t in [tmin, tmax]. Shared by tests as the per-triangle oracle of the traversals
+ * (which prepare the ray once and call ms_wt_intersect, the same arithmetic). */
 int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3], float tmin, float tmax,
                           float *t, float *u, float *v);
-
-/* A triangle thinner than float can represent (the sine of its angle between e1 and e2 below 1e-6:
- * a repeated vertex, collinear vertices) has no interior, but Moller-Trumbore's rounding can report
- * hits far off it; every ray test rejects such triangles up front. */
-static inline int ms_triangle_degenerate(const float e1[3], const float e2[3])
-{
-    float nx = e1[1] * e2[2] - e1[2] * e2[1], ny = e1[2] * e2[0] - e1[0] * e2[2], nz = e1[0] * e2[1] - e1[1] * e2[0];
-    float l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2], l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
-    return !(nx * nx + ny * ny + nz * nz > 1e-12f * l1 * l2);
-}
 
 #define MS_BVH_STACK 64
 

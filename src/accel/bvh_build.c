@@ -2,6 +2,7 @@
  * and the split with the lowest surface-area cost is taken; small or unprofitable nodes become
  * leaves. Top levels run as OpenMP tasks so large scenes build on all cores. */
 #include "bvh.h"
+#include "ray_triangle.h"
 #include "../core/vec.h"
 #include <float.h>
 #include <math.h>
@@ -162,7 +163,8 @@ int ms_bvh_build(ms_bvh *b, const float *tri, size_t n, int threads)
     c.nodes = malloc((size_t)c.cap * sizeof(ms_bvh_node));
     b->tri = malloc(n * 9 * sizeof(float));
     b->tri_source = malloc(n * sizeof(uint32_t));
-    if (!c.centroid || !c.tbox || !c.idx || !c.nodes || !b->tri || !b->tri_source) {
+    b->tri_n = malloc(n * 3 * sizeof(float));
+    if (!c.centroid || !c.tbox || !c.idx || !c.nodes || !b->tri || !b->tri_source || !b->tri_n) {
         free(c.centroid); free(c.tbox); free(c.idx); free(c.nodes);
         ms_bvh_free(b);
         return -1;
@@ -183,6 +185,7 @@ int ms_bvh_build(ms_bvh *b, const float *tri, size_t n, int threads)
     for (size_t i = 0; i < n; i++) {
         memcpy(b->tri + 9 * i, tri + 9 * (size_t)c.idx[i], 9 * sizeof(float));
         b->tri_source[i] = c.idx[i];
+        ms_wt_normal(b->tri + 9 * i, b->tri_n + 3 * i);
     }
     b->nodes = realloc(c.nodes, (size_t)c.next * sizeof(ms_bvh_node));
     if (!b->nodes) b->nodes = c.nodes;
@@ -196,6 +199,6 @@ int ms_bvh_build(ms_bvh *b, const float *tri, size_t n, int threads)
 
 void ms_bvh_free(ms_bvh *b)
 {
-    free(b->nodes); free(b->tri); free(b->tri_source);
+    free(b->nodes); free(b->tri); free(b->tri_source); free(b->tri_n);
     memset(b, 0, sizeof *b);
 }

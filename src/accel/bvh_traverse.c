@@ -1,63 +1,51 @@
-/* Single-ray traversal of the BVH: closest hit (nearer child first) and any hit (stops at the first). */
+/* Single-ray traversal of the BVH: closest hit (nearer child first) and any hit (stops at the first),
+ * with the watertight triangle test and the box test widened to match it (ray_triangle.h). */
 #include "bvh.h"
+#include "ray_triangle.h"
 #include "../core/vec.h"
 #include <math.h>
 
 int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3], float tmin, float tmax,
                           float *t, float *u, float *v)
 {
-    float e1[3], e2[3], p[3], s[3], q[3];
-    v3_sub(e1, tri + 3, tri);
-    v3_sub(e2, tri + 6, tri);
-    if (ms_triangle_degenerate(e1, e2)) return 0;
-    v3_cross(p, d, e2);
-    float det = v3_dot(e1, p);
-    if (det == 0.0f) return 0;            /* ray parallel to the plane: two-sided, no culling */
-    float inv = 1.0f / det;
-    v3_sub(s, o, tri);
-    float uu = v3_dot(s, p) * inv;
-    if (!(uu >= 0.0f && uu <= 1.0f)) return 0;
-    v3_cross(q, s, e1);
-    float vv = v3_dot(d, q) * inv;
-    if (!(vv >= 0.0f && uu + vv <= 1.0f)) return 0;
-    float tt = v3_dot(e2, q) * inv;
-    if (!(tt >= tmin && tt <= tmax)) return 0;
-    *t = tt; *u = uu; *v = vv;
-    return 1;
+    ms_wt_ray w;
+    float n[3];
+    ms_wt_prepare(&w, o, d);
+    ms_wt_normal(tri, n);
+    return ms_wt_intersect(&w, tri, n, tmin, tmax, t, u, v);
 }
 
-typedef struct ray_pre { float o[3], inv[3]; } ray_pre;
+typedef struct ray_pre { float o_lo[3], o_hi[3], inv[3]; ms_wt_ray wt; } ray_pre;
 
-static void ray_prepare(ray_pre *rp, const ms_ray *r)
+static void ray_prepare(ray_pre *rp, const ms_bvh *b, const ms_ray *r)
 {
-    for (int a = 0; a < 3; a++) {
-        rp->o[a] = r->o[a];
-        rp->inv[a] = 1.0f / r->d[a];     /* +-inf for axis-parallel rays; the slab test copes */
-    }
+    for (int a = 0; a < 3; a++) rp->inv[a] = 1.0f / r->d[a];   /* +-inf for axis-parallel rays; the slab test copes */
+    ms_wt_prepare(&rp->wt, r->o, r->d);
+    ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, r->o, rp->o_lo, rp->o_hi);
 }
 
-/* Slab test; returns the entry distance or +inf when the box is missed within [tmin, tmax]. */
+/* Slab test on the box widened to match the watertight triangle test (ms_wt_box_origins); returns
+ * the entry distance or +inf when the box is missed within [tmin, tmax]. */
 static inline float box_enter(const ms_bvh_node *n, const ray_pre *rp, float tmin, float tmax)
 {
+    float lo[3], hi[3];
+    for (int a = 0; a < 3; a++) { lo[a] = n->bmin[a] - rp->o_lo[a]; hi[a] = n->bmax[a] - rp->o_hi[a]; }
     float t0 = tmin, t1 = tmax;
     for (int a = 0; a < 3; a++) {
-        float lo = (n->bmin[a] - rp->o[a]) * rp->inv[a];
-        float hi = (n->bmax[a] - rp->o[a]) * rp->inv[a];
+        float x = lo[a] * rp->inv[a], y = hi[a] * rp->inv[a];
         /* NaN (0 * inf: origin on the slab plane of an axis-parallel ray) must not cull: treat as inside. */
-        if (lo > hi) { float x = lo; lo = hi; hi = x; }
-        t0 = lo > t0 ? lo : t0;
-        t1 = hi < t1 ? hi : t1;
+        if (x > y) { float s = x; x = y; y = s; }
+        t0 = x > t0 ? x : t0;
+        t1 = y < t1 ? y : t1;
     }
-    /* Conservative: the exit distance is widened by 2*gamma(3) (Ize, "Robust BVH ray traversal", 2013)
-     * so that rounding in the slabs never culls a box that a ray through a vertex or along an edge of
-     * one of its triangles really touches, where ms_intersect_triangle reports a hit. */
-    return t0 <= t1 * (1.0f + 2.0f * 3.5762786e-07f) ? t0 : INFINITY;
+    /* Exit widened by Ize's bound (ray_triangle.h) for the rounding of the slabs themselves. */
+    return t0 <= t1 * MS_WT_FAR_SCALE ? t0 : INFINITY;
 }
 
 int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
 {
     ray_pre rp;
-    ray_prepare(&rp, r);
+    ray_prepare(&rp, b, r);
     float best = r->tmax;
     hit->prim = UINT32_MAX;
     hit->t = INFINITY;
@@ -70,7 +58,7 @@ int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
         if (n->count) {
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 float t, u, v;
-                if (ms_intersect_triangle(b->tri + 9 * (size_t)i, r->o, r->d, r->tmin, best, &t, &u, &v)) {
+                if (ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i, r->tmin, best, &t, &u, &v)) {
                     best = t; hit->t = t; hit->u = u; hit->v = v; hit->prim = i;
                 }
             }
@@ -99,7 +87,7 @@ int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
 int ms_bvh_occluded(const ms_bvh *b, const ms_ray *r, uint32_t skip_prim)
 {
     ray_pre rp;
-    ray_prepare(&rp, r);
+    ray_prepare(&rp, b, r);
     uint32_t stack[MS_BVH_STACK];
     int sp = 0;
     stack[sp++] = 0;
@@ -110,7 +98,7 @@ int ms_bvh_occluded(const ms_bvh *b, const ms_ray *r, uint32_t skip_prim)
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 float t, u, v;
                 if (i != skip_prim &&
-                    ms_intersect_triangle(b->tri + 9 * (size_t)i, r->o, r->d, r->tmin, r->tmax, &t, &u, &v))
+                    ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i, r->tmin, r->tmax, &t, &u, &v))
                     return 1;
             }
         } else {

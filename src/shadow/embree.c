@@ -30,15 +30,18 @@
  * Embree sets them in MXCSR for the calling thread and restores the caller's MXCSR on return, so that
  * other methods run on the same OpenMP threads are not affected.
  *
- * Degenerate triangles (ms_triangle_degenerate), which every ray test of ours rejects, are given to
- * Embree with zero area so that it never hits them either.
+ * Robust mode (RTC_SCENE_FLAG_ROBUST) for the one scene, so for shadow and primary rays alike: Embree's
+ * watertight triangle test and conservative traversal, as ours (src/accel/ray_triangle.h): no ray
+ * slips between two triangles that share an edge. Every triangle is given as it is, slivers and
+ * zero-area ones included, as our ray tests take them all.
  *
  * Timing: the Embree build happens in create(), which ms_render does not time; it is reported once per
- * frame as the counter "embree_build_us" (and the degenerate triangles as "degenerate_triangles"). */
+ * frame as the counter "embree_build_us". */
 #include "method.h"
 #include "receiver.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
+#include "../accel/ray_triangle.h"
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <pthread.h>
@@ -49,7 +52,7 @@
 #include <xmmintrin.h>
 #include <pmmintrin.h>
 
-enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US, C_DEGENERATE };
+enum { C_RAYS, C_CALLS, C_FILTERED_PIXELS, C_FILTER_REJECTS, C_BUILD_US };
 
 /* One Embree scene for one frame, shared by the primary and the shadow method. */
 typedef struct eb_shared {
@@ -62,8 +65,8 @@ typedef struct eb_shared {
     RTCScene scene;
     ms_embree_mode mode;
     ms_embree_filter filter;
-    uint64_t build_us, n_degenerate;
-    int build_reported;        /* set once by the visibility call that reports build_us, n_degenerate */
+    uint64_t build_us;
+    int build_reported;        /* set once by the visibility call that reports build_us */
     char msg[256];             /* Embree's last error message (error callback) */
 } eb_shared;
 
@@ -169,8 +172,10 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
     int rc = -1;
     s->scene = rtcNewScene(s->dev);
     if (eb_check(s, "scene creation", err, errlen)) goto out;
-    /* The context filter must be enabled on the scene to be called at all ("none": plain Embree). */
-    if (s->filter != MS_EMBREE_FILTER_NONE) rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    /* Robust: watertight, like our ray tests. The context filter must be enabled on the scene to be
+     * called at all ("none": no filter). */
+    rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_ROBUST |
+                               (s->filter != MS_EMBREE_FILTER_NONE ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION : RTC_SCENE_FLAG_NONE));
     rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (eb_check(s, "geometry creation", err, errlen)) goto out;
@@ -186,17 +191,7 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
         goto out;
     }
     memcpy(v, b->tri, 9 * sizeof(float) * (size_t)b->n_tris);
-    /* Triangles our ray tests reject as thinner than float can represent (ms_triangle_degenerate) get
-     * all three indices on one vertex: zero area, which Embree never hits, and primIDs stay ours. */
-    for (uint32_t i = 0; i < b->n_tris; i++) {
-        const float *t = b->tri + 9 * (size_t)i;
-        float e1[3], e2[3];
-        v3_sub(e1, t + 3, t);
-        v3_sub(e2, t + 6, t);
-        int degenerate = ms_triangle_degenerate(e1, e2);
-        s->n_degenerate += (uint64_t)degenerate;
-        for (int c = 0; c < 3; c++) ix[3 * i + c] = 3 * i + (degenerate ? 0 : (unsigned)c);
-    }
+    for (uint32_t i = 0; i < 3 * b->n_tris; i++) ix[i] = i;
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(s->scene, g);
     rtcReleaseGeometry(g);
@@ -376,10 +371,7 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
     eb_shared *s = state;
     const int ns = ctx->samples;
     const size_t mw = (size_t)ctx->mask_words;
-    if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) {
-        cnt[C_BUILD_US] += s->build_us;
-        cnt[C_DEGENERATE] += s->n_degenerate;
-    }
+    if (!__atomic_exchange_n(&s->build_reported, 1, __ATOMIC_RELAXED)) cnt[C_BUILD_US] += s->build_us;
 
     eb_scratch w = { 0 };
     w.pts = malloc((size_t)ns * 3 * sizeof(float));
@@ -416,9 +408,8 @@ const ms_shadow_method ms_shadow_embree = {
     .name = "embree",
     .primary = "embree",
     .needs_grid = 0,
-    .n_counters = 6,
-    .counter_names = { "rays", "embree_calls", "filtered_pixels", "filter_rejects", "embree_build_us",
-                       "degenerate_triangles" },
+    .n_counters = 5,
+    .counter_names = { "rays", "embree_calls", "filtered_pixels", "filter_rejects", "embree_build_us" },
     .create = eb_acquire,
     .visibility = eb_visibility,
     .destroy = eb_release,
@@ -426,21 +417,18 @@ const ms_shadow_method ms_shadow_embree = {
 
 /* ---- primary visibility: camera rays as 16-ray packets over 4x4 pixel blocks ---- */
 
-/* The hit parameter of ray (o, d) on the plane of tri, by the very operations of ms_intersect_triangle
- * (so bit for bit the t the BVH primary finds on that triangle), without its inside test: Embree may
- * report a triangle at an edge that our test would just miss. Embree's own t if the ray is parallel. */
-static float eb_plane_t(const float tri[9], const float o[3], const float d[3], float t_embree)
+/* The hit parameter of ray (o, d) on the plane of tri, by the very operations of the watertight test
+ * (ms_wt_hit_t: so bit for bit the t the BVH primary finds on that triangle), without its inside
+ * test: Embree may report a triangle at an edge that our test would just miss. Embree's own t if the
+ * triangle is edge-on. */
+static float eb_plane_t(const float tri[9], const float n[3], const float o[3], const float d[3], float t_embree)
 {
-    float e1[3], e2[3], p[3], s[3], q[3];
-    v3_sub(e1, tri + 3, tri);
-    v3_sub(e2, tri + 6, tri);
-    v3_cross(p, d, e2);
-    float det = v3_dot(e1, p);
-    if (det == 0.0f) return t_embree;
-    float inv = 1.0f / det;
-    v3_sub(s, o, tri);
-    v3_cross(q, s, e1);
-    float t = v3_dot(e2, q) * inv;
+    ms_wt_ray w;
+    ms_wt_eval e;
+    ms_wt_prepare(&w, o, d);
+    ms_wt_evaluate(&w, tri, &e);
+    if (e.det == 0.0f) return t_embree;
+    float t = ms_wt_hit_t(&w, tri, n, &e);
     return isfinite(t) && t > 0.0f ? t : t_embree;
 }
 
@@ -484,7 +472,7 @@ static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int 
                 /* Embree decides which triangle is seen; the hit parameter on it is recomputed by the
                  * shared triangle test, so that a pixel that sees the same triangle gets the very same
                  * point C as with the BVH primary (Embree's t differs by up to tens of ulps). */
-                ms_hit_finish(ctx, o, d, eb_plane_t(ctx->bvh->tri + 9 * (size_t)prim, o, d, rh.ray.tfar[l]), prim, h);
+                ms_hit_finish(ctx, o, d, eb_plane_t(ctx->bvh->tri + 9 * (size_t)prim, ctx->bvh->tri_n + 3 * (size_t)prim, o, d, rh.ray.tfar[l]), prim, h);
             }
         }
     eb_leave(mx);
