@@ -170,8 +170,7 @@ static void test_open_quad_both_sides(void **state)
 
 /* The visible masks (ctx->mask_words words per point) of the points of a size x size view of sc, through
  * the shadow method's interface with the render context's ISA cap; *kernel and *trav: the ISAs the
- * method reports. Caller frees. (Through the method rather than ms_render, whose options carry no cap
- * yet.) */
+ * method reports. Caller frees. (Through the method rather than ms_render, to compare masks.) */
 static uint64_t *method_masks(const ms_scene *sc, const char *method, int k, int size, ms_isa cap, ms_isa *kernel,
                               ms_isa *trav, int *n_out)
 {
@@ -223,7 +222,7 @@ static uint64_t *method_masks(const ms_scene *sc, const char *method, int k, int
 }
 
 /* The portable scalar paths (kernels and traversal, forced by the context's ISA cap, and reported as
- * scalar) give the same V as the SIMD ones. */
+ * scalar) give the same V as the SIMD ones; the raytrace instances the same masks. */
 static void test_scalar_paths_match(void **state)
 {
     (void)state;
@@ -257,6 +256,21 @@ static void test_scalar_paths_match(void **state)
         free(simd);
         free(scalar);
     }
+    /* The reference tracer's packets, one source compiled per ISA: the very same masks. */
+    for (int cap = MS_ISA_SCALAR; cap <= MS_ISA_AVX512; cap++) {
+        if (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa()) continue;
+        ms_isa kern, trav, kern0, trav0;
+        int n, n0;
+        uint64_t *ref = method_masks(&sc, "raytrace", 32, 48, MS_ISA_SCALAR, &kern0, &trav0, &n0);
+        uint64_t *got = method_masks(&sc, "raytrace", 32, 48, (ms_isa)cap, &kern, &trav, &n);
+        assert_int_equal(kern0, MS_ISA_SCALAR);
+        assert_int_equal(kern, cap);
+        assert_int_equal(n, n0);
+        assert_memory_equal(ref, got, (size_t)n * 16 * sizeof *ref);
+        printf("raytrace %s packets: masks identical to the portable ones on %d points\n", ms_isa_name(kern), n);
+        free(ref);
+        free(got);
+    }
     ms_scene_free(&sc);
 }
 
@@ -285,9 +299,15 @@ static void test_options_isa_and_defaults(void **state)
     assert_int_equal(g.beyond_one, 0);
     ms_frame_free(&a);
     ms_frame_free(&b);
-    o.method = "raytrace";
+    o.method = "raytrace";   /* its packets are compiled per ISA too, under the same cap */
     assert_int_equal(ms_render(&sc, &o, &a, err, sizeof err), 0);
-    assert_string_equal(a.stats.kernel_isa, "none");
+    assert_string_equal(a.stats.kernel_isa, "scalar");
+    if (ms_method_available("embree") == 1) {
+        ms_frame_free(&a);
+        o.method = "embree";   /* Embree dispatches for itself */
+        assert_int_equal(ms_render(&sc, &o, &a, err, sizeof err), 0);
+        assert_string_equal(a.stats.kernel_isa, "none");
+    }
     ms_frame_free(&a);
     ms_scene_free(&sc);
 }

@@ -42,8 +42,18 @@ static ms_isa probe(void)
 static ms_isa probe(void) { return MS_ISA_SCALAR; }
 #endif
 
-/* Not cached: a few cpuid instructions per call, and callers choose once per frame. */
-ms_isa ms_cpu_isa(void) { return probe(); }
+/* Probed once: cpuid traps to the hypervisor in a VM, and the per-sample tracer's fallback asks per pixel.
+ * Racing first calls store the same value. */
+ms_isa ms_cpu_isa(void)
+{
+    static int cached;   /* 0: not probed yet (MS_ISA_AUTO is never a probe's answer) */
+    int c = __atomic_load_n(&cached, __ATOMIC_RELAXED);
+    if (!c) {
+        c = (int)probe();
+        __atomic_store_n(&cached, c, __ATOMIC_RELAXED);
+    }
+    return (ms_isa)c;
+}
 
 ms_isa ms_isa_capped(ms_isa cap)
 {

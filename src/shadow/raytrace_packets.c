@@ -1,0 +1,2 @@
+/* The portable instance of the raytrace packet tracer (raytrace_impl.h). */
+#include "raytrace_impl.h"

@@ -1,0 +1,2 @@
+/* The AVX-512 instance of the raytrace packet tracer (raytrace_impl.h). */
+#include "raytrace_impl.h"
