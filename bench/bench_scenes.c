@@ -141,7 +141,7 @@ int main(int argc, char **argv)
                     double sum = 0.0;
                     size_t n = 0, big = 0;
                     for (size_t i = 0; i < (size_t)size * size; i++) {
-                        if (f.vis[i] < 0.0f && vis[m][i] < 0.0f) continue;
+                        if (vis[m][i] < 0.0f) continue;   /* f.vis moved to vis[m] above */
                         double d = fabs((double)f.shadow[i] - (double)vis[m][i]);
                         sum += d;
                         big += d > 0.1;
