@@ -20,6 +20,13 @@ static ms_raster_fn scalar_fn(ms_kernel_id id, int k)
 ms_raster_fn ms_raster_kernel_scalar(ms_kernel_id id, int k) { return scalar_fn(id, k); }
 
 #if defined(__x86_64__) || defined(__i386__)
+#include <cpuid.h>
+/* LZCNT (CPUID 0x80000001 ECX bit 5, "ABM"): clang 14 does not know __builtin_cpu_supports("lzcnt"). */
+static int have_lzcnt(void)
+{
+    unsigned a, b, c, d;
+    return __get_cpuid(0x80000001u, &a, &b, &c, &d) && (c & (1u << 5));
+}
 static int have_avx512(void)
 {
     __builtin_cpu_init();
@@ -31,7 +38,7 @@ static int have_avx2(void)
 {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-           __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("popcnt") && __builtin_cpu_supports("lzcnt");
+           __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("popcnt") && have_lzcnt();
 }
 #else
 static int have_avx512(void) { return 0; }
