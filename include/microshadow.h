@@ -60,7 +60,14 @@ typedef struct ms_scene {
     double load_s;       /* seconds spent loading meshes */
 } ms_scene;
 
-/* Loads a JSON scene file (meshes through assimp, paths relative to the JSON file). */
+/* Warnings (an unknown key in a scene file) go to this handler, one line each without a newline; by
+ * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */
+typedef void (*ms_warning_fn)(void *user, const char *message);
+void ms_set_warning_handler(ms_warning_fn fn, void *user);
+
+/* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL through assimp, glTF 2.0 through cgltf; paths
+ * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
+ * unknown keys warnings. */
 int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light. */
 int ms_scene_default(ms_scene *out);
