@@ -85,6 +85,12 @@ static int accessor_ok(const cgltf_accessor *a, char *why, size_t n)
     size_t elem = cgltf_calc_size(a->type, a->component_type);
     if (elem == 0 || (a->stride < elem && a->count > 1)) { snprintf(why, n, "an accessor has an invalid stride"); return 0; }
     if (!fits(v->offset, v->size, v->buffer->size)) { snprintf(why, n, "a buffer view exceeds its buffer"); return 0; }
+    /* cgltf reads components through typed pointers: they must be aligned (glTF requires it too). */
+    size_t comp = cgltf_component_size(a->component_type);
+    if (comp == 0 || ((uintptr_t)v->buffer->data + v->offset + a->offset) % comp || a->stride % comp) {
+        snprintf(why, n, "an accessor is not aligned to its component size");
+        return 0;
+    }
     if (a->count - 1 > (SIZE_MAX - elem) / (a->stride ? a->stride : 1) ||
         !fits(a->offset, (a->count - 1) * a->stride + elem, v->size)) {
         snprintf(why, n, "an accessor exceeds its buffer view");

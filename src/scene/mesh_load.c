@@ -34,11 +34,12 @@ static const char *extension(const char *path, char *ext, size_t n)
     return ext;
 }
 
-int ms_mesh_load_memory(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
-                        char *err, size_t errlen)
+static int load_memory(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
+                       char *err, size_t errlen)
 {
     size_t added = 0, before = soup->n;
     int rc;
+    if (len == 0) { snprintf(err, errlen, "%s: the mesh file is empty", path); return -1; }   /* assimp asserts on it */
     if (!strcmp(ext, "gltf") || !strcmp(ext, "glb")) {
         rc = ms_mesh_gltf(buf, len, path, soup, &added, err, errlen);
     } else {
@@ -64,13 +65,21 @@ int ms_mesh_load_memory(const char *buf, size_t len, const char *ext, const char
     return 0;
 }
 
+int ms_mesh_load_memory(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
+                        char *err, size_t errlen)
+{
+    int rc = load_memory(buf, len, ext, path, soup, err, errlen);
+    if (rc) ms_one_line(err);
+    return rc;
+}
+
 int ms_mesh_load(const char *path, ms_tri_soup *soup, char *err, size_t errlen)
 {
     char ext[8];
     extension(path, ext, sizeof ext);
     char *buf;
     size_t len;
-    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, err, errlen)) return -1;
+    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, err, errlen)) { ms_one_line(err); return -1; }
     int rc = ms_mesh_load_memory(buf, len, ext, path, soup, err, errlen);
     free(buf);
     return rc;

@@ -333,6 +333,10 @@ int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, s
         if (el[i].count > body)
             FAIL("%s: element '%s' declares %llu instances but only %zu bytes follow the header", path, el[i].name,
                  (unsigned long long)el[i].count, body);
+    /* assimp's header reader consumes line ends after end_header even in binary files, so a body
+     * starting with one would be read shifted by a byte from what is checked here. */
+    if (fmt != PLY_ASCII && c.p < buf + len && (*c.p == '\n' || *c.p == '\r'))
+        FAIL("%s: the binary PLY body starts with a line-end byte (ambiguous after end_header)", path);
     ply_body r = { (const unsigned char *)c.p, (const unsigned char *)buf + len, fmt, c, NULL, NULL };
     for (int i = 0; i < ne; i++) {
         for (uint64_t k = 0; k < el[i].count; k++) {
@@ -453,7 +457,10 @@ int ms_preflight_stl(const char *buf, size_t len, const char *path, char *err, s
 #define STL_TOK() do { while (p < end && (*p == ' ' || *p == '\t' || is_eol(*p))) { line += *p == '\n'; p++; } \
                        tb = p; while (p < end && !(*p == ' ' || *p == '\t' || is_eol(*p))) p++; tn = (size_t)(p - tb); } while (0)
 #define STL_EXPECT(w) do { STL_TOK(); if (!tok_is(tb, tn, w)) FAIL("%s: line %zu: expected '%s'", path, line, w); } while (0)
-#define STL_NUM() do { STL_TOK(); if (!number_token(tb, tn)) FAIL("%s: line %zu: expected a number", path, line); } while (0)
+/* assimp reads "normal" and the numbers after "facet" and "vertex" on the same line. */
+#define STL_SAME_LINE_TOK() do { while (p < end && (*p == ' ' || *p == '\t')) p++; \
+                       tb = p; while (p < end && !(*p == ' ' || *p == '\t' || is_eol(*p))) p++; tn = (size_t)(p - tb); } while (0)
+#define STL_NUM() do { STL_SAME_LINE_TOK(); if (!number_token(tb, tn)) FAIL("%s: line %zu: expected a number on the same line", path, line); } while (0)
     const char *tb;
     size_t tn;
     for (;;) {
@@ -476,7 +483,8 @@ int ms_preflight_stl(const char *buf, size_t len, const char *path, char *err, s
                 break;
             }
             if (!tok_is(tb, tn, "facet")) FAIL("%s: line %zu: expected 'facet' or 'endsolid'", path, line);
-            STL_EXPECT("normal");
+            STL_SAME_LINE_TOK();
+            if (!tok_is(tb, tn, "normal")) FAIL("%s: line %zu: expected 'normal' after 'facet'", path, line);
             STL_NUM(); STL_NUM(); STL_NUM();
             STL_EXPECT("outer");
             STL_EXPECT("loop");

@@ -47,6 +47,8 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
 /* The scene JSON from memory (text[len] == 0); json_path names it and locates the meshes. */
 int ms_scene_parse(const char *text, size_t len, const char *json_path, struct ms_scene *out, char *err,
                    size_t errlen);
+/* Makes err one printable line: names taken from files may hold newlines or control characters. */
+void ms_one_line(char *err);
 /* Reports a warning through the handler set with ms_set_warning_handler. */
 void ms_warn(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 

@@ -179,13 +179,22 @@ int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen
     memset(out, 0, sizeof *out);
     char *text;
     size_t len;
-    if (ms_read_input(json_path, MS_MAX_SCENE_BYTES, MS_INPUT_SCENE, &text, &len, err, errlen)) return -1;
+    if (ms_read_input(json_path, MS_MAX_SCENE_BYTES, MS_INPUT_SCENE, &text, &len, err, errlen)) { ms_one_line(err); return -1; }
     int rc = ms_scene_parse(text, len, json_path, out, err, errlen);
     free(text);
     return rc;
 }
 
+static int scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen);
+
 int ms_scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen)
+{
+    int rc = scene_parse(text, len, json_path, out, err, errlen);
+    if (rc) ms_one_line(err);
+    return rc;
+}
+
+static int scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     struct timespec t0, t1;

@@ -19,6 +19,13 @@ void ms_warn(const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    ms_one_line(msg);
     if (g_warn) g_warn(g_warn_user, msg);
     else fprintf(stderr, "microshadow: warning: %s\n", msg);
+}
+
+void ms_one_line(char *err)
+{
+    for (unsigned char *p = (unsigned char *)err; *p; p++)
+        if (*p < 0x20 || *p == 0x7f) *p = '?';
 }
