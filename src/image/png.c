@@ -1,6 +1,7 @@
 /* Tone-mapped sRGB PNG through libpng's simplified API. */
 #include "microshadow.h"
 #include "output.h"
+#include <errno.h>
 #include <math.h>
 #include <png.h>
 #include <stdlib.h>
@@ -31,9 +32,11 @@ int ms_png_write_stream(const ms_frame *f, FILE *out, const char *path, char *er
     img.width = (png_uint_32)f->width;
     img.height = (png_uint_32)f->height;
     img.format = PNG_FORMAT_RGB;
+    errno = 0;
     int ok = png_image_write_to_stdio(&img, out, 0, px, 0, NULL);
     free(px);
-    if (!ok) snprintf(err, errlen, "%s: PNG write failed: %s", path, img.message);
+    if (!ok && ferror(out)) snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno ? errno : EIO));
+    else if (!ok) snprintf(err, errlen, "%s: PNG write failed: %s", path, img.message);
     png_image_free(&img);
     return ok ? 0 : -1;
 }

@@ -61,7 +61,7 @@ static const char *result_text(cgltf_result r)
     case cgltf_result_data_too_short: return "the data is shorter than it declares";
     case cgltf_result_unknown_format: return "not a glTF 2.0 file";
     case cgltf_result_invalid_json: return "malformed JSON";
-    case cgltf_result_invalid_gltf: return "invalid glTF";
+    case cgltf_result_invalid_gltf: return "invalid glTF (a reference out of range, a node with two parents or a cycle, or a missing required property)";
     case cgltf_result_file_not_found: return "a buffer file cannot be read";
     case cgltf_result_io_error: return "a buffer cannot be read";
     case cgltf_result_out_of_memory: return "it needs more memory than its size allows";

@@ -46,6 +46,56 @@ static size_t edit_distance(const char *a, const char *b)
     return row[n];
 }
 
+/* Warnings wait until the scene loaded: a failed load prints its one error line only. */
+#define MAX_WARNINGS 16
+typedef struct warn_list { int n; char line[MAX_WARNINGS][320]; } warn_list;
+static _Thread_local warn_list *g_warnings;
+
+/* The known key nearest to name (by edit distance). */
+static const char *nearest_key(const char *name, const char *const *known, size_t *dist)
+{
+    const char *best = known[0];
+    size_t bd = (size_t)-1;
+    for (int k = 0; known[k]; k++) {
+        size_t d = edit_distance(name, known[k]);
+        if (d < bd) { bd = d; best = known[k]; }
+    }
+    if (dist) *dist = bd;
+    return best;
+}
+
+static int is_known(const char *name, const char *const *known)
+{
+    for (int k = 0; known[k]; k++)
+        if (!strcmp(name, known[k])) return 1;
+    return 0;
+}
+
+/* For "X is missing": the unknown key of obj that was probably meant (its nearest known key is X). */
+static const char *meant_for(const cJSON *obj, const char *key, const char *const *known)
+{
+    const cJSON *it;
+    cJSON_ArrayForEach(it, obj)
+        if (!is_known(it->string, known) && !strcmp(nearest_key(it->string, known, NULL), key)) return it->string;
+    return NULL;
+}
+
+static const char *const *known_for(const char *objname)
+{
+    return !strcmp(objname, "camera") ? camera_keys : !strcmp(objname, "light") ? light_keys
+         : !strcmp(objname, "render") ? render_keys : top_keys;
+}
+
+/* "X is missing", with the unknown key that was probably meant. */
+static void missing(const cJSON *obj, const char *objname, const char *key, const char *path, char *err, size_t errlen)
+{
+    const char *typo = meant_for(obj, key, known_for(objname));
+    char hint[128] = "";
+    if (typo) snprintf(hint, sizeof hint, " (\"%.40s\" is not a known key: a typo?)", typo);
+    if (objname[0]) snprintf(err, errlen, "%s: %s.%s is missing%s", path, objname, key, hint);
+    else snprintf(err, errlen, "%s: \"%s\" is missing%s", path, key, hint);
+}
+
 /* Warns about each key of obj not in known, naming the nearest known key. */
 static void warn_unknown(const cJSON *obj, const char *objname, const char *const *known, const char *path)
 {
@@ -59,9 +109,10 @@ static void warn_unknown(const cJSON *obj, const char *objname, const char *cons
             size_t d = edit_distance(it->string, known[k]);
             if (d < bd) { bd = d; best = known[k]; }
         }
-        if (!found)
-            ms_warn("%s: unknown key \"%s%s%.64s\" ignored (the nearest known key is \"%s\")", path, objname,
-                    objname[0] ? "." : "", it->string, best);
+        if (!found && g_warnings && g_warnings->n < MAX_WARNINGS)
+            snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
+                     "%.200s: unknown key \"%s%s%.40s\" ignored (the nearest known key is \"%s\")", path, objname,
+                     objname[0] ? "." : "", it->string, best);
     }
 }
 
@@ -115,7 +166,7 @@ static int get_vec3(const cJSON *obj, const char *objname, const char *key, int 
     const cJSON *a = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!a) {
         if (!required) return 0;
-        snprintf(err, errlen, "%s: %s.%s is missing", path, objname, key);
+        missing(obj, objname, key, path, err, errlen);
         return -1;
     }
     if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != 3) {
@@ -142,7 +193,7 @@ static int get_number(const cJSON *obj, const char *objname, const char *key, in
     const cJSON *x = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!x) {
         if (!required) return 0;
-        snprintf(err, errlen, "%s: %s.%s is missing", path, objname, key);
+        missing(obj, objname, key, path, err, errlen);
         return -1;
     }
     if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) {
@@ -169,7 +220,7 @@ static int get_int(const cJSON *obj, const char *objname, const char *key, int r
 static const cJSON *get_object(const cJSON *root, const char *key, const char *path, char *err, size_t errlen)
 {
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, key);
-    if (!o) { snprintf(err, errlen, "%s: \"%s\" is missing", path, key); return NULL; }
+    if (!o) { missing(root, "", key, path, err, errlen); return NULL; }
     if (!cJSON_IsObject(o)) { snprintf(err, errlen, "%s: \"%s\" must be an object", path, key); return NULL; }
     return o;
 }
@@ -189,8 +240,14 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
 
 int ms_scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen)
 {
+    warn_list w;
+    w.n = 0;
+    g_warnings = &w;
     int rc = scene_parse(text, len, json_path, out, err, errlen);
+    g_warnings = NULL;
     if (rc) ms_one_line(err);
+    else
+        for (int i = 0; i < w.n; i++) ms_warn("%s", w.line[i]);
     return rc;
 }
 
@@ -266,7 +323,7 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     }
 
     const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(root, "meshes");
-    if (!meshes) { snprintf(err, errlen, "%s: \"meshes\" is missing", json_path); goto done; }
+    if (!meshes) { missing(root, "", "meshes", json_path, err, errlen); goto done; }
     if (!cJSON_IsArray(meshes) || cJSON_GetArraySize(meshes) == 0) {
         snprintf(err, errlen, "%s: \"meshes\" must be a non-empty array of {\"file\": ...}", json_path);
         goto done;
