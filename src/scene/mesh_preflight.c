@@ -261,6 +261,8 @@ int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, s
             if (next_token(&p, e, &tb, &tn)) FAIL("%s: line %zu: text after end_header", path, c.line);
             break;
         }
+        if ((c.line == 2) != tok_is(tb, tn, "format"))
+            FAIL("%s: line %zu: the format line must be the second line of a PLY file", path, c.line);
         if (tok_is(tb, tn, "format")) {
             if (fmt >= 0 || !next_token(&p, e, &tb, &tn)) FAIL("%s: line %zu: malformed format line", path, c.line);
             fmt = tok_is(tb, tn, "ascii") ? PLY_ASCII : tok_is(tb, tn, "binary_little_endian") ? PLY_LE
@@ -281,9 +283,11 @@ int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, s
                 FAIL("%s: line %zu: malformed element count", path, c.line);
             cur->is_vertex = !strcmp(cur->name, "vertex");
             cur->is_face = !strcmp(cur->name, "face");
-            /* assimp gives these meaning we do not check (strip restarts, material references). */
-            if (!strcmp(cur->name, "tristrips") || !strcmp(cur->name, "material"))
-                FAIL("%s: line %zu: PLY element '%s' is not supported", path, c.line, cur->name);
+            /* assimp reads the count of an element it does not know from the element's name ("element
+             * 77facE 2" declares 77 instances there), and gives tristrips and materials meaning we do not
+             * check: only these three are read alike by both. */
+            if (!cur->is_vertex && !cur->is_face && strcmp(cur->name, "edge"))
+                FAIL("%s: line %zu: PLY element '%.31s' is not supported (only vertex, face, edge)", path, c.line, cur->name);
             for (int i = 0; i < ne - 1; i++)
                 if (!strcmp(el[i].name, cur->name)) FAIL("%s: line %zu: element '%s' declared twice", path, c.line, cur->name);
             continue;
@@ -341,10 +345,9 @@ int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, s
     for (int i = 0; i < ne; i++) {
         for (uint64_t k = 0; k < el[i].count; k++) {
             if (fmt == PLY_ASCII) {
-                do {
-                    if (!next_line(&r.tc, &r.lb, &r.le))
-                        FAIL("%s: the file ends in %s %llu of %llu", path, el[i].name, (unsigned long long)k, (unsigned long long)el[i].count);
-                } while (r.lb == r.le);
+                if (!next_line(&r.tc, &r.lb, &r.le))
+                    FAIL("%s: the file ends in %s %llu of %llu", path, el[i].name, (unsigned long long)k, (unsigned long long)el[i].count);
+                if (r.lb == r.le) FAIL("%s: line %zu: an empty line in the PLY body", path, r.tc.line);
             }
             for (int j = 0; j < el[i].np; j++) {
                 const ply_prop *pr = &el[i].p[j];
