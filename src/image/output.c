@@ -222,11 +222,15 @@ int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err,
         }
         if (fclose(fp) != 0 && !rc) { snprintf(err, errlen, "%s: write failed: %s", outs[k].path, strerror(errno)); rc = -1; }
     }
-    /* Every target is still a regular file or absent before anything is renamed. */
+    /* Every target is still a regular file or absent before anything is renamed; the renames happen
+     * with the signals blocked, so a signal arriving meanwhile finds all of them done. */
+    sigset_t old;
+    block(&old);
     for (k = 0; k < n && !rc; k++)
         if (outs[k].path) rc = target_kind_ok(outs[k].path, err, errlen);
     for (k = 0; k < n && !rc; k++)
         if (slot[k] >= 0) rc = stage_commit(slot[k], outs[k].path, err, errlen);
+    unblock(&old);
     for (k = 0; k < n; k++)
         if (slot[k] >= 0) stage_remove(slot[k]);   /* nothing left for those renamed */
     return rc;
