@@ -98,16 +98,13 @@ static int has_nul(const char *buf, size_t len) { return memchr(buf, 0, len) != 
 /* One index of an f/l/p token: -?[1-9][0-9]{0,8}, resolved against count (negative: relative). */
 static int obj_index(const char *s, size_t n, uint64_t count)
 {
-    size_t i = 0;
-    int neg = 0;
-    if (n && s[0] == '-') { neg = 1; i = 1; }
+    size_t i = n && s[0] == '-';   /* -k is the k-th last: the same range */
     if (i >= n || n - i > 9 || s[i] == '0') return 0;
     uint64_t v = 0;
     for (; i < n; i++) {
         if (!is_digit(s[i])) return 0;
         v = 10 * v + (uint64_t)(s[i] - '0');
     }
-    (void)neg;
     return v <= count;   /* 1..count, or -1..-count */
 }
 
@@ -210,7 +207,7 @@ typedef struct ply_elem { char name[32]; uint64_t count; int np, is_vertex, is_f
 typedef struct ply_body { const unsigned char *p, *end; int fmt; text_cursor tc; const char *lb, *le; } ply_body;
 enum { PLY_ASCII, PLY_LE, PLY_BE };
 
-static int ply_read(ply_body *r, ply_type t, int64_t *iv, int want_int)
+static int ply_read(ply_body *r, ply_type t, int64_t *iv)
 {
     if (r->fmt == PLY_ASCII) {
         const char *tb;
@@ -221,7 +218,6 @@ static int ply_read(ply_body *r, ply_type t, int64_t *iv, int want_int)
         uint64_t v;
         if (!uint_token(tb + i, tn - i, &v)) return -1;
         *iv = i ? -(int64_t)v : (int64_t)v;
-        (void)want_int;
         return 0;
     }
     size_t n = (size_t)ply_size[t];
@@ -353,7 +349,7 @@ int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, s
                 const ply_prop *pr = &el[i].p[j];
                 int64_t n = 1, v = 0;
                 if (pr->is_list) {
-                    if (ply_read(&r, pr->count_t, &n, 1))
+                    if (ply_read(&r, pr->count_t, &n))
                         FAIL("%s: %s %llu: truncated or malformed list count", path, el[i].name, (unsigned long long)k);
                     if (n < 0 || n > MS_MAX_POLYGON)
                         FAIL("%s: %s %llu: a list of %lld entries (at most %d)", path, el[i].name, (unsigned long long)k, (long long)n, MS_MAX_POLYGON);
@@ -361,7 +357,7 @@ int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, s
                         FAIL("%s: %s %llu: a face needs at least 3 vertices, not %lld", path, el[i].name, (unsigned long long)k, (long long)n);
                 }
                 for (int64_t m = 0; m < n; m++) {
-                    if (ply_read(&r, pr->t, &v, 0))
+                    if (ply_read(&r, pr->t, &v))
                         FAIL("%s: %s %llu: truncated or malformed value", path, el[i].name, (unsigned long long)k);
                     if (pr->is_index && (v < 0 || (uint64_t)v >= vert->count))
                         FAIL("%s: %s %llu: vertex index %lld is not in 0..%llu", path, el[i].name, (unsigned long long)k,
