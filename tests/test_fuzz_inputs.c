@@ -36,7 +36,7 @@ static int replay(const char *kind, int want_ok)
             if (e->d_name[0] == '.') continue;
             char p[4096 + 256];
             snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-            size_t n;
+            size_t n = 0;
             uint8_t *b = slurp(p, &n);
             assert_non_null(b);
             int rc = strcmp(targets[t], "scene") ? ms_fuzz_mesh(targets[t], b, n) : ms_fuzz_scene(ms_fuzz_scene_dir(), b, n);

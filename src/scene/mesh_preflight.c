@@ -118,8 +118,8 @@ int ms_preflight_obj(const char *buf, size_t len, const char *path, char *err, s
     while (next_line(&c, &b, &e)) {
         if (b == e) continue;
         if (e[-1] == '\\') FAIL("%s: line %zu: line continuations ('\\' at the end) are not supported", path, c.line);
-        const char *p = b, *tb;
-        size_t tn;
+        const char *p = b, *tb = b;
+        size_t tn = 0;
         switch (*b) {
         case 'v': {
             if (!next_token(&p, e, &tb, &tn)) break;
@@ -210,8 +210,8 @@ enum { PLY_ASCII, PLY_LE, PLY_BE };
 static int ply_read(ply_body *r, ply_type t, int64_t *iv)
 {
     if (r->fmt == PLY_ASCII) {
-        const char *tb;
-        size_t tn;
+        const char *tb = NULL;
+        size_t tn = 0;
         if (!next_token(&r->lb, r->le, &tb, &tn)) return -1;
         if (t == T_F32 || t == T_F64) return number_token(tb, tn) ? 0 : -1;
         size_t i = tb[0] == '-';
@@ -241,8 +241,8 @@ static int ply_read(ply_body *r, ply_type t, int64_t *iv)
 int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, size_t errlen)
 {
     text_cursor c = { buf, buf + len, 0 };
-    const char *b, *e, *p, *tb;
-    size_t tn;
+    const char *b, *e, *p, *tb = NULL;
+    size_t tn = 0;
     if (len < 4 || memcmp(buf, "ply", 3) || (buf[3] != '\n' && buf[3] != '\r')) FAIL("%s: not a PLY file (no 'ply' line)", path);
     next_line(&c, &b, &e);
     int fmt = -1, ne = 0, crlf = buf[3] == '\r';
@@ -388,8 +388,8 @@ int ms_preflight_off(const char *buf, size_t len, const char *path, char *err, s
 {
     if (has_nul(buf, len)) FAIL("%s: not an OFF text file (it contains a NUL byte)", path);
     text_cursor c = { buf, buf + len, 0 };
-    const char *b, *e, *p, *tb;
-    size_t tn;
+    const char *b, *e, *p, *tb = NULL;
+    size_t tn = 0;
     if (!off_line(&c, &b, &e) || e - b != 3 || memcmp(b, "OFF", 3))
         FAIL("%s: not a plain OFF file (the first line must be 'OFF')", path);
     uint64_t n[3];
@@ -460,8 +460,8 @@ int ms_preflight_stl(const char *buf, size_t len, const char *path, char *err, s
 #define STL_SAME_LINE_TOK() do { while (p < end && (*p == ' ' || *p == '\t')) p++; \
                        tb = p; while (p < end && !(*p == ' ' || *p == '\t' || is_eol(*p))) p++; tn = (size_t)(p - tb); } while (0)
 #define STL_NUM() do { STL_SAME_LINE_TOK(); if (!number_token(tb, tn)) FAIL("%s: line %zu: expected a number on the same line", path, line); } while (0)
-    const char *tb;
-    size_t tn;
+    const char *tb = NULL;
+    size_t tn = 0;
     for (;;) {
         STL_TOK();
         if (tn == 0) break;
