@@ -41,7 +41,10 @@ static int replay(const char *kind, int want_ok)
             assert_non_null(b);
             int rc = strcmp(targets[t], "scene") ? ms_fuzz_mesh(targets[t], b, n) : ms_fuzz_scene(ms_fuzz_scene_dir(), b, n);
             free(b);
-            if ((rc == 0) != want_ok) fail_msg("%s: %s, expected %s", p, rc ? "refused" : "loaded", want_ok ? "to load" : "to be refused");
+            if ((rc == 0) != want_ok) {
+                closedir(d);
+                fail_msg("%s: %s, expected %s", p, rc ? "refused" : "loaded", want_ok ? "to load" : "to be refused");
+            }
             total++;
         }
         closedir(d);
