@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define MS_FUZZ_MESH_PATH "/nonexistent-microshadow-fuzz/input."
 
@@ -62,13 +63,24 @@ static inline int ms_fuzz_scene(const char *dir, const uint8_t *data, size_t siz
     return rc;
 }
 
-/* The directory for ms_fuzz_scene, created once. */
+static char ms_fuzz_dir[64];
+
+static inline void ms_fuzz_remove_dir(void)
+{
+    char p[128];
+    snprintf(p, sizeof p, "%s/a.obj", ms_fuzz_dir);
+    unlink(p);
+    rmdir(ms_fuzz_dir);
+}
+
+/* The directory for ms_fuzz_scene, created once and removed at exit. */
 static inline const char *ms_fuzz_scene_dir(void)
 {
-    static char dir[64];
+    char *dir = ms_fuzz_dir;
     if (dir[0]) return dir;
-    snprintf(dir, sizeof dir, "/tmp/microshadow-fuzz-XXXXXX");
+    snprintf(dir, sizeof ms_fuzz_dir, "/tmp/microshadow-fuzz-XXXXXX");
     if (!mkdtemp(dir)) abort();
+    atexit(ms_fuzz_remove_dir);
     char p[128];
     snprintf(p, sizeof p, "%s/a.obj", dir);
     FILE *f = fopen(p, "wb");
