@@ -449,6 +449,13 @@ int ms_preflight_stl(const char *buf, size_t len, const char *path, char *err, s
     if (has_nul(buf, len)) FAIL("%s: not an STL file (binary size does not match its triangle count, and not text)", path);
     for (size_t i = 0; i < len; i++)
         if ((unsigned char)buf[i] > 127) FAIL("%s: not an STL file (binary size does not match its triangle count, and not text)", path);
+    /* assimp's STL reader separates tokens by space, tab, CR and LF only (a form feed before "vertex"
+     * hides it there and leaks): no other control characters. */
+    for (size_t i = 0; i < len; i++) {
+        unsigned char ch = (unsigned char)buf[i];
+        if (ch < 0x20 && ch != '\t' && ch != '\r' && ch != '\n')
+            FAIL("%s: control character 0x%02x in an ASCII STL file", path, ch);
+    }
     /* ASCII: solid NAME, then facets of exactly three vertices, endsolid; tokens separated by any space. */
     const char *p = buf, *end = buf + len;
     size_t line = 1;
