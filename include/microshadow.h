@@ -38,6 +38,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -80,7 +81,14 @@ typedef struct ms_scene {
     double load_s;       /* seconds spent loading meshes */
 } ms_scene;
 
-/* Loads a JSON scene file (meshes through assimp, paths relative to the JSON file). */
+/* Warnings (an unknown key in a scene file) go to this handler, one line each without a newline; by
+ * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */
+typedef void (*ms_warning_fn)(void *user, const char *message);
+void ms_set_warning_handler(ms_warning_fn fn, void *user);
+
+/* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL through assimp, glTF 2.0 through cgltf; paths
+ * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
+ * unknown keys warnings. */
 int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light. */
 int ms_scene_default(ms_scene *out);
@@ -186,7 +194,32 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
               char *err, size_t errlen);
 void ms_frame_free(ms_frame *f);
 
-/* Outputs. Each is written to a temporary file beside the target and renamed at the end. */
+/* Outputs, all or nothing. A caller that writes several outputs of one frame lists them in an ms_output
+ * table: ms_outputs_check before the render refuses bad targets (two outputs to one file, a target that
+ * exists and is not a regular file, an unwritable directory, a name past the filesystem's limit, a wrong
+ * ending); ms_outputs_write after it writes each to a staging file beside its target and renames them
+ * into place only when all were written; any failure removes the staging files, and so do SIGINT,
+ * SIGTERM, SIGHUP and SIGQUIT once ms_outputs_cleanup_on_signals was called (for programs: a library
+ * caller with its own signal handling need not call it). New files get 0666 less the umask. */
+typedef int (*ms_output_write_fn)(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+typedef struct ms_output {
+    const char *flag;             /* how the caller named it, for messages ("-o", "--vis") */
+    const char *path;             /* NULL: not requested */
+    ms_output_write_fn write;     /* one of the writers below, or the caller's own */
+    const char *const *suffixes;  /* NULL-terminated accepted endings (case-insensitive), or NULL: any */
+} ms_output;
+#define MS_MAX_OUTPUTS 8
+int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
+int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
+void ms_outputs_cleanup_on_signals(void);
+/* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name); the stats as JSON. */
+int ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+extern const char *const ms_float_image_suffixes[];   /* ".pfm", ".exr" */
+
+/* One output alone, all or nothing (checked, staged and renamed). */
 int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */
 int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .pfm or .exr, float V */
 int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages microshadow needs that are missing (root, or sudo when available).
 set -euo pipefail
+# clang, libclang-rt-dev (sanitizer and libFuzzer runtimes) and libomp-dev (OpenMP for clang): the clang
+# build and the fuzzers of .ci/run.
 pkgs=(build-essential cmake pkg-config libassimp-dev libcjson-dev libpng-dev libopenexr-dev libembree-dev
-      libcmocka-dev gnuplot-nox)
+      libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

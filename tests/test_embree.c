@@ -275,7 +275,11 @@ static void test_primary_points(void **st)
         n++;
     }
     uint64_t cnt_rt[MS_MAX_COUNTERS] = { 0 }, cnt_eb[MS_MAX_COUNTERS] = { 0 };
-    assert_int_equal(tu_shadow_vs(ms_find_shadow_method("raytrace"), NULL, &ctx, q, n, va, sa, cnt_rt), 0);
+    const ms_shadow_method *rt = ms_find_shadow_method("raytrace");
+    void *rts = NULL;
+    assert_int_equal(rt->create(&ctx, &rts, err, sizeof err), 0);
+    assert_int_equal(tu_shadow_vs(rt, rts, &ctx, q, n, va, sa, cnt_rt), 0);
+    rt->destroy(rts);
     assert_int_equal(tu_shadow_vs(ms_find_shadow_method("embree"), se2, &ctx, q, n, vb, sb2, cnt_eb), 0);
     long differ = 0, beyond = 0, s_differ = 0;
     for (int i = 0; i < n; i++) {

@@ -1,6 +1,5 @@
 /* The microshadow command line: render a scene file (or the built-in scene) with one shadow method. */
 #include "microshadow.h"
-#include "image/atomic_file.h"
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
@@ -28,8 +27,10 @@ static void usage(FILE *f)
         "  --threads T         threads (default: all cores)\n"
         "  --seed S            seed of the per-pixel sample patterns (default 0)\n"
         "  -o OUT.png          shaded image (default microshadow.png)\n"
-        "  --vis OUT.pfm|.exr  float visibility image, -1 where the primary ray missed\n"
+        "  --vis OUT.pfm|.exr  float visibility V, -1 where the primary ray missed\n"
+        "  --shadow OUT.pfm|.exr  float shadow factor S, -1 where the primary ray missed\n"
         "  --stats OUT.json    timings and counters\n"
+        "  --isa I             cap on the SIMD instruction set: auto (default), avx512, avx2, scalar\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --help, --version\n");
 }
@@ -62,59 +63,42 @@ static int parse_int(const char *opt, const char *s, long lo, long hi, long *out
     return 0;
 }
 
-/* All outputs or none: each is first written (atomically) under a staging name beside its target, and
- * only when every one succeeded are they renamed into place; a failure removes the staged files. */
-static int write_outputs(const ms_frame *f, const char *png, const char *vis, const char *stats, char *err,
-                         size_t errlen)
-{
-    const char *path[3] = { png, vis, stats };
-    char staged[3][4200];
-    int written = 0, rc = 0;
-    for (int i = 0; i < 3 && !rc; i++) {
-        if (!path[i]) continue;
-        /* The staging name keeps the extension, which selects the visibility format. */
-        const char *slash = strrchr(path[i], '/');
-        int dir = slash ? (int)(slash - path[i] + 1) : 0;
-        snprintf(staged[i], sizeof staged[i], "%.*s.ms-stage-%ld-%s", dir, path[i], (long)getpid(), path[i] + dir);
-        rc = i == 0 ? ms_write_png(f, staged[i], err, errlen)
-           : i == 1 ? ms_write_vis(f, staged[i], err, errlen)
-                    : ms_write_stats_json(f, staged[i], err, errlen);
-        if (rc) {
-            /* Name the user's file in the message, not the staging one. */
-            char *at = strstr(err, staged[i]);
-            if (at) {
-                char rest[1024];
-                snprintf(rest, sizeof rest, "%s%s", path[i], at + strlen(staged[i]));
-                snprintf(at, errlen - (size_t)(at - err), "%s", rest);
-            }
-        } else {
-            written |= 1 << i;
-        }
-    }
-    for (int i = 0; i < 3 && !rc; i++)
-        if ((written >> i & 1) && rename(staged[i], path[i]) != 0) {
-            snprintf(err, errlen, "%s: cannot rename into place: %s", path[i], strerror(errno));
-            rc = -1;
-        }
-    for (int i = 0; i < 3; i++)
-        if (written >> i & 1) unlink(staged[i]);   /* a no-op for those renamed */
-    return rc ? EXIT_BAD_INPUT : 0;
-}
-
 int main(int argc, char **argv)
 {
-    enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_STATS,
-           O_QUIET, O_HELP, O_VERSION };
+    enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
+           O_STATS, O_ISA, O_QUIET, O_HELP, O_VERSION };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
         { "height", required_argument, 0, O_HEIGHT }, { "threads", required_argument, 0, O_THREADS },
         { "seed", required_argument, 0, O_SEED }, { "vis", required_argument, 0, O_VIS },
+        { "shadow", required_argument, 0, O_SHADOW }, { "isa", required_argument, 0, O_ISA },
         { "stats", required_argument, 0, O_STATS }, { "quiet", no_argument, 0, O_QUIET },
         { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION }, { 0, 0, 0, 0 } };
     ms_render_options opt;
     ms_render_options_default(&opt);
-    const char *out_png = "microshadow.png", *out_vis = NULL, *out_stats = NULL;
+    /* The library reads no environment; for measuring (docs/embree.md) the CLI maps these onto options. */
+    const char *em = getenv("MS_EMBREE_MODE"), *ef = getenv("MS_EMBREE_FILTER");
+    if (em && *em) {
+        if (!strcmp(em, "packet16")) opt.embree_mode = MS_EMBREE_PACKET16;
+        else if (!strcmp(em, "stream")) opt.embree_mode = MS_EMBREE_STREAM;
+        else { fprintf(stderr, "microshadow: MS_EMBREE_MODE: '%s' is not packet16 or stream\n", em); return EXIT_BAD_INPUT; }
+    }
+    if (ef && *ef) {
+        if (!strcmp(ef, "plane")) opt.embree_filter = MS_EMBREE_FILTER_PLANE;
+        else if (!strcmp(ef, "always")) opt.embree_filter = MS_EMBREE_FILTER_ALWAYS;
+        else if (!strcmp(ef, "none")) opt.embree_filter = MS_EMBREE_FILTER_NONE;
+        else { fprintf(stderr, "microshadow: MS_EMBREE_FILTER: '%s' is not plane, always or none\n", ef); return EXIT_BAD_INPUT; }
+    }
+    /* Every output the command line can ask for: one row each, checked before the render and written
+     * all or nothing after it (ms_outputs_check, ms_outputs_write). */
+    ms_output outs[] = {
+        { "-o", "microshadow.png", ms_png_write_stream, NULL },
+        { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
+        { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
+        { "--stats", NULL, ms_stats_write_stream, NULL },
+    };
+    enum { OUT_PNG, OUT_VIS, OUT_SHADOW, OUT_STATS, N_OUTS = sizeof outs / sizeof outs[0] };
     int quiet = 0, c;
     long v;
     opterr = 0;
@@ -134,13 +118,20 @@ int main(int argc, char **argv)
             }
             opt.samples = (int)v;
             break;
-        case O_WIDTH: if (parse_int("--width", optarg, 1, 16384, &v)) return EXIT_BAD_INPUT; opt.width = (int)v; break;
-        case O_HEIGHT: if (parse_int("--height", optarg, 1, 16384, &v)) return EXIT_BAD_INPUT; opt.height = (int)v; break;
+        case O_WIDTH: if (parse_int("--width", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; opt.width = (int)v; break;
+        case O_HEIGHT: if (parse_int("--height", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; opt.height = (int)v; break;
         case O_THREADS: if (parse_int("--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; opt.threads = (int)v; break;
         case O_SEED: if (parse_int("--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; opt.seed = (uint32_t)v; break;
-        case 'o': out_png = optarg; break;
-        case O_VIS: out_vis = optarg; break;
-        case O_STATS: out_stats = optarg; break;
+        case 'o': outs[OUT_PNG].path = optarg; break;
+        case O_VIS: outs[OUT_VIS].path = optarg; break;
+        case O_SHADOW: outs[OUT_SHADOW].path = optarg; break;
+        case O_ISA:
+            if (ms_isa_from_name(optarg, &opt.isa)) {
+                fprintf(stderr, "microshadow: --isa: '%s' is not auto, avx512, avx2 or scalar\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case O_STATS: outs[OUT_STATS].path = optarg; break;
         case O_QUIET: quiet = 1; break;
         case 'h': case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("microshadow %s\n", MS_VERSION_STRING); return 0;
@@ -162,20 +153,12 @@ int main(int argc, char **argv)
         return EXIT_BAD_INPUT;
     }
     char err[1024];
-    /* Refuse unwritable outputs before a long render, and a visibility path of the wrong type. */
-    if (out_vis) {
-        size_t n = strlen(out_vis);
-        if (n < 4 || (strcasecmp(out_vis + n - 4, ".pfm") && strcasecmp(out_vis + n - 4, ".exr"))) {
-            fprintf(stderr, "microshadow: %s: the visibility image must end in .pfm or .exr\n", out_vis);
-            return EXIT_BAD_INPUT;
-        }
+    /* Refuse bad outputs before a long render; from here on a signal removes any staging file. */
+    ms_outputs_cleanup_on_signals();
+    if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) {
+        fprintf(stderr, "microshadow: %s\n", err);
+        return EXIT_BAD_INPUT;
     }
-    const char *outs[3] = { out_png, out_vis, out_stats };
-    for (int i = 0; i < 3; i++)
-        if (outs[i] && ms_check_writable(outs[i], err, sizeof err)) {
-            fprintf(stderr, "microshadow: %s\n", err);
-            return EXIT_BAD_INPUT;
-        }
 
     ms_scene scene;
     if (scene_path) {
@@ -195,7 +178,7 @@ int main(int argc, char **argv)
         ms_scene_free(&scene);
         return EXIT_BAD_INPUT;
     }
-    int rc = write_outputs(&frame, out_png, out_vis, out_stats, err, sizeof err);
+    int rc = ms_outputs_write(&frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
     if (rc) fprintf(stderr, "microshadow: %s\n", err);
     if (!quiet && rc == 0) {
         const ms_stats *s = &frame.stats;
@@ -203,7 +186,7 @@ int main(int argc, char **argv)
                 "shadow %.3fs (%.1f M shadow rays/s), total %.3fs -> %s\n",
                 scene_path ? scene_path : "built-in scene", s->triangles, s->width, s->height, s->samples, s->method,
                 s->threads, s->build_s, s->setup_s, s->primary_s, s->shadow_s,
-                s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s * 1e-6 : 0.0, s->total_s, out_png);
+                s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s * 1e-6 : 0.0, s->total_s, outs[OUT_PNG].path);
     }
     ms_frame_free(&frame);
     ms_scene_free(&scene);

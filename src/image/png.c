@@ -1,6 +1,7 @@
 /* Tone-mapped sRGB PNG through libpng's simplified API. */
 #include "microshadow.h"
-#include "atomic_file.h"
+#include "microshadow.h"
+#include <errno.h>
 #include <math.h>
 #include <png.h>
 #include <stdlib.h>
@@ -14,7 +15,7 @@ static unsigned char to_srgb8(float x)
     return (unsigned char)lrintf(s * 255.0f);
 }
 
-int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen)
+int ms_png_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
     size_t n = (size_t)f->width * f->height;
     unsigned char *px = malloc(3 * n);
@@ -31,16 +32,11 @@ int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen)
     img.width = (png_uint_32)f->width;
     img.height = (png_uint_32)f->height;
     img.format = PNG_FORMAT_RGB;
-    ms_atomic_file a;
-    if (ms_atomic_open(&a, path, err, errlen)) { free(px); return -1; }
-    int ok = png_image_write_to_stdio(&img, a.f, 0, px, 0, NULL);
+    errno = 0;
+    int ok = png_image_write_to_stdio(&img, out, 0, px, 0, NULL);
     free(px);
-    if (!ok) {
-        snprintf(err, errlen, "%s: PNG write failed: %s", path, img.message);
-        ms_atomic_abort(&a);
-        png_image_free(&img);
-        return -1;
-    }
+    if (!ok && ferror(out)) snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno ? errno : EIO));
+    else if (!ok) snprintf(err, errlen, "%s: PNG write failed: %s", path, img.message);
     png_image_free(&img);
-    return ms_atomic_commit(&a, err, errlen);
+    return ok ? 0 : -1;
 }

@@ -1,11 +1,15 @@
 /* The float images of V and S: PFM (written here: a header and raw floats, rows bottom to top as the
  * format requires) or OpenEXR (through OpenEXRCore, one FLOAT channel "V" resp. "S", ZIP compressed). */
 #include "microshadow.h"
-#include "atomic_file.h"
+#include "microshadow.h"
+#include <errno.h>
 #include <openexr.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
+
+const char *const ms_float_image_suffixes[] = { ".pfm", ".exr", NULL };
 
 static int ends_with(const char *s, const char *suffix)
 {
@@ -13,12 +17,10 @@ static int ends_with(const char *s, const char *suffix)
     return n >= m && strcasecmp(s + n - m, suffix) == 0;
 }
 
-static int write_pfm(const ms_frame *f, const float *data, const char *path, char *err, size_t errlen)
+static int write_pfm(const ms_frame *f, const float *data, FILE *out)
 {
-    ms_atomic_file a;
-    if (ms_atomic_open(&a, path, err, errlen)) return -1;
     /* Negative scale: little-endian floats. */
-    fprintf(a.f, "Pf\n%d %d\n-1.0\n", f->width, f->height);
+    fprintf(out, "Pf\n%d %d\n-1.0\n", f->width, f->height);
     for (int y = f->height - 1; y >= 0; y--) {
         const float *row = data + (size_t)y * f->width;
         for (int x = 0; x < f->width; x++) {
@@ -27,27 +29,48 @@ static int write_pfm(const ms_frame *f, const float *data, const char *path, cha
             uint32_t u;
             memcpy(&u, &v, 4);
             b[0] = (unsigned char)u; b[1] = (unsigned char)(u >> 8); b[2] = (unsigned char)(u >> 16); b[3] = (unsigned char)(u >> 24);
-            fwrite(b, 1, 4, a.f);
+            fwrite(b, 1, 4, out);
         }
     }
-    return ms_atomic_commit(&a, err, errlen);
+    return 0;   /* write errors surface at the flush */
 }
 
-static int write_exr(const ms_frame *f, const float *data, const char *channel, const char *path, char *err,
-                     size_t errlen)
+/* OpenEXRCore writes through our callback into the staging file's descriptor, and its errors come
+ * back to us instead of being printed (they would name the staging file). */
+typedef struct exr_sink { int fd; int saved_errno; } exr_sink;
+
+static int64_t exr_sink_write(exr_const_context_t ctx, void *user, const void *buf, uint64_t sz, uint64_t offset,
+                              exr_stream_error_func_ptr_t error_cb)
 {
-    ms_atomic_file a;
-    if (ms_atomic_open(&a, path, err, errlen)) return -1;
-    /* OpenEXRCore writes by file name: write over the temporary we own, then rename it. */
-    fclose(a.f);
-    a.f = NULL;
+    (void)ctx; (void)error_cb;
+    exr_sink *s = user;
+    const char *p = buf;
+    uint64_t done = 0;
+    while (done < sz) {
+        ssize_t w = pwrite(s->fd, p + done, (size_t)(sz - done), (off_t)(offset + done));
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) { s->saved_errno = w < 0 ? errno : EIO; return -1; }
+        done += (uint64_t)w;
+    }
+    return (int64_t)done;
+}
+
+static void exr_quiet(exr_const_context_t ctx, exr_result_t code, const char *msg) { (void)ctx; (void)code; (void)msg; }
+
+static int write_exr(const ms_frame *f, const float *data, const char *channel, FILE *out, const char *path,
+                     char *err, size_t errlen)
+{
+    exr_sink sink = { fileno(out), 0 };
     exr_context_t ctx = NULL;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    exr_result_t r = exr_start_write(&ctx, a.tmp, EXR_WRITE_FILE_DIRECTLY, &init);
+    init.user_data = &sink;
+    init.write_fn = exr_sink_write;
+    init.error_handler_fn = exr_quiet;
+    exr_result_t r = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
     int part = 0;
     exr_encode_pipeline_t enc;
     int enc_init = 0;
-    if (r == EXR_ERR_SUCCESS) r = exr_add_part(ctx, "vis", EXR_STORAGE_SCANLINE, &part);
+    if (r == EXR_ERR_SUCCESS) r = exr_add_part(ctx, channel, EXR_STORAGE_SCANLINE, &part);
     if (r == EXR_ERR_SUCCESS) r = exr_initialize_required_attr_simple(ctx, part, f->width, f->height, EXR_COMPRESSION_ZIP);
     if (r == EXR_ERR_SUCCESS) r = exr_add_channel(ctx, part, channel, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
     if (r == EXR_ERR_SUCCESS) r = exr_write_header(ctx);
@@ -73,33 +96,28 @@ static int write_exr(const ms_frame *f, const float *data, const char *channel, 
     exr_result_t fin = ctx ? exr_finish(&ctx) : EXR_ERR_SUCCESS;
     if (r == EXR_ERR_SUCCESS) r = fin;
     if (r != EXR_ERR_SUCCESS) {
-        snprintf(err, errlen, "%s: EXR write failed: %s", path, exr_get_default_error_message(r));
-        ms_atomic_abort(&a);
-        return -1;
-    }
-    if (rename(a.tmp, path) != 0) {
-        snprintf(err, errlen, "%s: cannot rename into place", path);
-        ms_atomic_abort(&a);
+        if (sink.saved_errno) snprintf(err, errlen, "%s: write failed: %s", path, strerror(sink.saved_errno));
+        else snprintf(err, errlen, "%s: EXR write failed: %s", path, exr_get_default_error_message(r));
         return -1;
     }
     return 0;
 }
 
-static int write_float_image(const ms_frame *f, const float *data, const char *channel, const char *what,
+static int write_float_image(const ms_frame *f, const float *data, const char *channel, const char *what, FILE *out,
                              const char *path, char *err, size_t errlen)
 {
-    if (ends_with(path, ".pfm")) return write_pfm(f, data, path, err, errlen);
-    if (ends_with(path, ".exr")) return write_exr(f, data, channel, path, err, errlen);
+    if (ends_with(path, ".pfm")) return write_pfm(f, data, out);
+    if (ends_with(path, ".exr")) return write_exr(f, data, channel, out, path, err, errlen);
     snprintf(err, errlen, "%s: the %s image must end in .pfm or .exr", path, what);
     return -1;
 }
 
-int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen)
+int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
-    return write_float_image(f, f->vis, "V", "visibility", path, err, errlen);
+    return write_float_image(f, f->vis, "V", "visibility", out, path, err, errlen);
 }
 
-int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen)
+int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
-    return write_float_image(f, f->shadow, "S", "shadow factor", path, err, errlen);
+    return write_float_image(f, f->shadow, "S", "shadow factor", out, path, err, errlen);
 }

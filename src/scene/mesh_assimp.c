@@ -1,27 +1,13 @@
-/* Meshes through assimp: every triangle of every mesh instance, in world space. */
+/* OBJ, PLY, OFF and STL through assimp, from memory, after ms_preflight_* accepted the bytes: every
+ * triangle of every mesh instance, in world space. */
 #include "scene_internal.h"
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
-#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-
-int ms_soup_push(ms_tri_soup *soup, const float v[9])
-{
-    if (soup->n == soup->cap) {
-        size_t cap = soup->cap ? 2 * soup->cap : 1024;
-        float *t = realloc(soup->tri, cap * 9 * sizeof(float));
-        if (!t) return -1;
-        soup->tri = t;
-        soup->cap = cap;
-    }
-    memcpy(soup->tri + 9 * soup->n, v, 9 * sizeof(float));
-    soup->n++;
-    return 0;
-}
 
 static void xform(const struct aiMatrix4x4 *m, const struct aiVector3D *p, float out[3])
 {
@@ -43,15 +29,16 @@ static void mat_mul(struct aiMatrix4x4 *r, const struct aiMatrix4x4 *a, const st
     memcpy(&r->a1, R, sizeof R);
 }
 
-static int walk(const struct aiScene *sc, const struct aiNode *node, const struct aiMatrix4x4 *parent,
-                ms_tri_soup *soup, size_t *added, int depth)
+typedef struct walk_ctx { const struct aiScene *sc; ms_tri_soup *soup; size_t added, max_tris; int full; } walk_ctx;
+
+static int walk(walk_ctx *w, const struct aiNode *node, const struct aiMatrix4x4 *parent, int depth)
 {
     if (depth > 256) return 0;   /* a cycle in a malformed file: stop rather than recurse forever */
     struct aiMatrix4x4 m;
     mat_mul(&m, parent, &node->mTransformation);
     for (unsigned i = 0; i < node->mNumMeshes; i++) {
-        if (node->mMeshes[i] >= sc->mNumMeshes) continue;
-        const struct aiMesh *mesh = sc->mMeshes[node->mMeshes[i]];
+        if (node->mMeshes[i] >= w->sc->mNumMeshes) continue;
+        const struct aiMesh *mesh = w->sc->mMeshes[node->mMeshes[i]];
         for (unsigned f = 0; f < mesh->mNumFaces; f++) {
             const struct aiFace *face = &mesh->mFaces[f];
             if (face->mNumIndices != 3) continue;   /* points and lines cast no shadow */
@@ -63,24 +50,38 @@ static int walk(const struct aiScene *sc, const struct aiNode *node, const struc
                 xform(&m, &mesh->mVertices[idx], v + 3 * k);
             }
             if (!ok) continue;
-            if (ms_soup_push(soup, v)) return -1;
-            (*added)++;
+            if (w->added == w->max_tris) { w->full = 1; return -1; }
+            if (ms_soup_push(w->soup, v)) return -1;
+            w->added++;
         }
     }
     for (unsigned c = 0; c < node->mNumChildren; c++)
-        if (walk(sc, node->mChildren[c], &m, soup, added, depth + 1)) return -1;
+        if (walk(w, node->mChildren[c], &m, depth + 1)) return -1;
     return 0;
 }
 
-int ms_mesh_load(const char *path, ms_tri_soup *soup, char *err, size_t errlen)
+int ms_mesh_assimp(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
+                   size_t *added, char *err, size_t errlen)
 {
-    struct stat st;
-    if (stat(path, &st) != 0) { snprintf(err, errlen, "%s: mesh file not found", path); return -1; }
-    if (!S_ISREG(st.st_mode)) { snprintf(err, errlen, "%s: mesh is not a regular file", path); return -1; }
-    FILE *probe = fopen(path, "rb");
-    if (!probe) { snprintf(err, errlen, "%s: mesh file is not readable", path); return -1; }
-    fclose(probe);
-    const struct aiScene *sc = aiImportFile(path, aiProcess_Triangulate | aiProcess_SortByPType);
+    *added = 0;
+    if (len > UINT32_MAX) { snprintf(err, errlen, "%s: mesh file too large for assimp", path); return -1; }
+    /* An OBJ's "mtllib" would make assimp open that path itself (a FIFO there hangs it), and materials
+     * cast no shadow: comment those lines out in a copy. */
+    char *copy = NULL;
+    if (!strcmp(ext, "obj")) {
+        copy = malloc(len + 1);
+        if (!copy) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+        memcpy(copy, buf, len + 1);
+        for (size_t i = 0; i + 6 <= len; i++)
+            if ((i == 0 || copy[i - 1] == '\n' || copy[i - 1] == '\r') && !memcmp(copy + i, "mtllib", 6)) copy[i] = '#';
+        buf = copy;
+    }
+    /* From memory, so that assimp reads exactly the bytes that were checked; the hint picks the one
+     * importer for the extension (no probing of the others). ValidateDataStructure rejects what the
+     * importer built inconsistently instead of handing it on. */
+    const struct aiScene *sc = aiImportFileFromMemory(buf, (unsigned)len,
+        aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure, ext);
+    free(copy);
     if (!sc || !sc->mRootNode) {
         const char *why = aiGetErrorString();
         /* assimp's messages can span lines; keep the first line only. */
@@ -94,16 +95,15 @@ int ms_mesh_load(const char *path, ms_tri_soup *soup, char *err, size_t errlen)
     struct aiMatrix4x4 id;
     memset(&id, 0, sizeof id);
     id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
-    size_t added = 0;
-    int rc = walk(sc, sc->mRootNode, &id, soup, &added, 0);
+    walk_ctx w = { sc, soup, 0, (len + 64) * MS_MAX_TRIS_PER_BYTE, 0 };
+    int rc = walk(&w, sc->mRootNode, &id, 0);
     aiReleaseImport(sc);
+    *added = w.added;
+    if (rc && w.full) {
+        snprintf(err, errlen, "%s: the mesh expands to more than %zu triangles (%d per byte of file)", path,
+                 w.max_tris, MS_MAX_TRIS_PER_BYTE);
+        return -1;
+    }
     if (rc) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
-    if (added == 0) { snprintf(err, errlen, "%s: the mesh has no triangles", path); return -1; }
-    for (size_t i = (soup->n - added) * 9; i < soup->n * 9; i++)
-        if (!isfinite(soup->tri[i])) {
-            snprintf(err, errlen, "%s: triangle %zu has a NaN or infinite coordinate", path,
-                     i / 9 - (soup->n - added));
-            return -1;
-        }
     return 0;
 }

@@ -4,11 +4,51 @@
 
 #define MS_DEFAULT_EMISSION 1.0f
 
+/* Input limits (docs/design.md, "Hostile input"): every loader's memory and work is a fixed multiple
+ * of the bytes it was given. */
+#define MS_MAX_SCENE_BYTES ((size_t)16 << 20)     /* a scene file is a few hundred bytes of JSON */
+#define MS_MAX_MESH_BYTES ((size_t)2 << 30)       /* per mesh file, and per glTF buffer */
+#define MS_MAX_POLYGON 256                        /* vertices per face: triangulation is quadratic */
+#define MS_MAX_TRIS_PER_BYTE 4                    /* triangles emitted per input byte (glTF instancing) */
+#define MS_MAX_COORD 1e18f                        /* |coordinate|: squares and cross products stay finite in float */
+
+struct ms_scene;
 typedef struct ms_tri_soup { float *tri; size_t n, cap; } ms_tri_soup;
 
-/* Appends the triangles of a mesh file (any format assimp reads, triangulated, node transforms
- * applied). Fails with a message naming the file if assimp cannot read it or it has no triangles. */
+typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH } ms_input_kind;
+/* Reads a whole regular file of at most max_bytes (a FIFO, device or directory is refused without
+ * blocking) into a malloc'ed, NUL-terminated buffer. */
+int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char **out, size_t *len, char *err,
+                  size_t errlen);
+
+/* Appends the triangles of a mesh file (OBJ, PLY, OFF, STL through assimp after a structural check;
+ * glTF 2.0 through cgltf), triangulated, node transforms applied. Fails with one line naming the file. */
 int ms_mesh_load(const char *path, ms_tri_soup *soup, char *err, size_t errlen);
+/* The same from bytes already in memory (the fuzzers' entry point). `ext` is the lower-case extension
+ * without the dot; `path` names the file in messages and locates a glTF's external buffers. */
+int ms_mesh_load_memory(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
+                        char *err, size_t errlen);
 int ms_soup_push(ms_tri_soup *soup, const float v[9]);
+
+/* Structural checks before assimp sees a file: declared counts against the bytes present, indices in
+ * range, polygon sizes; 0 if the file is well-formed. buf is NUL-terminated at buf[len]. */
+int ms_preflight_obj(const char *buf, size_t len, const char *path, char *err, size_t errlen);
+int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, size_t errlen);
+int ms_preflight_off(const char *buf, size_t len, const char *path, char *err, size_t errlen);
+int ms_preflight_stl(const char *buf, size_t len, const char *path, char *err, size_t errlen);
+
+/* Importers behind the checks; each appends to soup and sets *added. */
+int ms_mesh_assimp(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
+                   size_t *added, char *err, size_t errlen);
+int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *soup, size_t *added, char *err,
+                 size_t errlen);
+
+/* The scene JSON from memory (text[len] == 0); json_path names it and locates the meshes. */
+int ms_scene_parse(const char *text, size_t len, const char *json_path, struct ms_scene *out, char *err,
+                   size_t errlen);
+/* Makes err one printable line: names taken from files may hold newlines or control characters. */
+void ms_one_line(char *err);
+/* Reports a warning through the handler set with ms_set_warning_handler. */
+void ms_warn(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
 #endif

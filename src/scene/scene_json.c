@@ -2,7 +2,9 @@
 #include "microshadow.h"
 #include "scene_internal.h"
 #include <cjson/cJSON.h>
+#include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <libgen.h>
 #include <math.h>
 #include <stdio.h>
@@ -10,28 +12,151 @@
 #include <string.h>
 #include <time.h>
 
-static char *read_file(const char *path, char *err, size_t errlen)
+/* Line number of offset off in text. */
+static int line_of(const char *text, size_t off)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) { snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno)); return NULL; }
-    char *buf = NULL;
-    size_t len = 0, cap = 0;
-    for (;;) {
-        if (len + 4096 + 1 > cap) {
-            cap = cap ? 2 * cap : 65536;
-            char *nb = realloc(buf, cap);
-            if (!nb) { free(buf); fclose(f); snprintf(err, errlen, "%s: out of memory", path); return NULL; }
-            buf = nb;
+    int line = 1;
+    for (size_t i = 0; i < off && text[i]; i++) line += text[i] == '\n';
+    return line;
+}
+
+/* Known keys, per object, for the unknown-key warnings. */
+static const char *const top_keys[] = { "meshes", "camera", "light", "render", NULL };
+static const char *const camera_keys[] = { "eye", "target", "up", "fov_y", "width", "height", NULL };
+static const char *const light_keys[] = { "corner", "edge_s", "edge_t", "emission", NULL };
+static const char *const render_keys[] = { "samples", NULL };
+static const char *const mesh_keys[] = { "file", NULL };
+
+static size_t edit_distance(const char *a, const char *b)
+{
+    size_t n = strlen(b), row[64];
+    if (n >= 64 || strlen(a) >= 64) return 64;
+    for (size_t j = 0; j <= n; j++) row[j] = j;
+    for (size_t i = 1; a[i - 1]; i++) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= n; j++) {
+            size_t up = row[j];
+            size_t sub = diag + (tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]));
+            row[j] = sub < up + 1 ? sub : up + 1;
+            if (row[j - 1] + 1 < row[j]) row[j] = row[j - 1] + 1;
+            diag = up;
         }
-        size_t n = fread(buf + len, 1, cap - len - 1, f);
-        len += n;
-        if (n == 0) break;
     }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) { free(buf); snprintf(err, errlen, "%s: cannot read: %s", path, strerror(errno)); return NULL; }
-    buf[len] = 0;
-    return buf;
+    return row[n];
+}
+
+/* Warnings wait until the scene loaded: a failed load prints its one error line only. */
+#define MAX_WARNINGS 16
+typedef struct warn_list { int n; char line[MAX_WARNINGS][320]; } warn_list;
+static _Thread_local warn_list *g_warnings;
+
+/* The known key nearest to name (by edit distance). */
+static const char *nearest_key(const char *name, const char *const *known, size_t *dist)
+{
+    const char *best = known[0];
+    size_t bd = (size_t)-1;
+    for (int k = 0; known[k]; k++) {
+        size_t d = edit_distance(name, known[k]);
+        if (d < bd) { bd = d; best = known[k]; }
+    }
+    if (dist) *dist = bd;
+    return best;
+}
+
+static int is_known(const char *name, const char *const *known)
+{
+    for (int k = 0; known[k]; k++)
+        if (!strcmp(name, known[k])) return 1;
+    return 0;
+}
+
+/* For "X is missing": the unknown key of obj that was probably meant (its nearest known key is X). */
+static const char *meant_for(const cJSON *obj, const char *key, const char *const *known)
+{
+    const cJSON *it;
+    cJSON_ArrayForEach(it, obj)
+        if (!is_known(it->string, known) && !strcmp(nearest_key(it->string, known, NULL), key)) return it->string;
+    return NULL;
+}
+
+static const char *const *known_for(const char *objname)
+{
+    return !strcmp(objname, "camera") ? camera_keys : !strcmp(objname, "light") ? light_keys
+         : !strcmp(objname, "render") ? render_keys : top_keys;
+}
+
+/* "X is missing", with the unknown key that was probably meant. */
+static void missing(const cJSON *obj, const char *objname, const char *key, const char *path, char *err, size_t errlen)
+{
+    const char *typo = meant_for(obj, key, known_for(objname));
+    char hint[128] = "";
+    if (typo) snprintf(hint, sizeof hint, " (\"%.40s\" is not a known key: a typo?)", typo);
+    if (objname[0]) snprintf(err, errlen, "%s: %s.%s is missing%s", path, objname, key, hint);
+    else snprintf(err, errlen, "%s: \"%s\" is missing%s", path, key, hint);
+}
+
+/* Warns about each key of obj not in known, naming the nearest known key. */
+static void warn_unknown(const cJSON *obj, const char *objname, const char *const *known, const char *path)
+{
+    const cJSON *it;
+    cJSON_ArrayForEach(it, obj) {
+        int found = 0;
+        const char *best = known[0];
+        size_t bd = (size_t)-1;
+        for (int k = 0; known[k]; k++) {
+            if (!strcmp(it->string, known[k])) { found = 1; break; }
+            size_t d = edit_distance(it->string, known[k]);
+            if (d < bd) { bd = d; best = known[k]; }
+        }
+        if (!found && g_warnings && g_warnings->n < MAX_WARNINGS)
+            snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
+                     "%.200s: unknown key \"%s%s%.40s\" ignored (the nearest known key is \"%s\")", path, objname,
+                     objname[0] ? "." : "", it->string, best);
+    }
+}
+
+static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
+
+/* Duplicate keys anywhere: cJSON keeps both and returns the first, which silently drops the second. */
+static int check_duplicates(const cJSON *node, const char *where, const char *path, char *err, size_t errlen)
+{
+    if (!cJSON_IsObject(node) && !cJSON_IsArray(node)) return 0;
+    size_t n = 0;
+    const cJSON *it;
+    cJSON_ArrayForEach(it, node) n++;
+    if (cJSON_IsObject(node) && n > 1) {
+        const char **names = malloc(n * sizeof *names);
+        if (!names) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+        size_t i = 0;
+        cJSON_ArrayForEach(it, node) names[i++] = it->string;
+        qsort(names, n, sizeof *names, cmp_str);
+        for (i = 1; i < n; i++)
+            if (!strcmp(names[i - 1], names[i])) {
+                snprintf(err, errlen, "%s: duplicate key \"%s%s%.64s\"", path, where, where[0] ? "." : "", names[i]);
+                free(names);
+                return -1;
+            }
+        free(names);
+    }
+    size_t i = 0;
+    cJSON_ArrayForEach(it, node) {
+        char sub[256];
+        if (cJSON_IsObject(node)) snprintf(sub, sizeof sub, "%s%s%.64s", where, where[0] ? "." : "", it->string);
+        else snprintf(sub, sizeof sub, "%s[%zu]", where, i);
+        if (check_duplicates(it, sub, path, err, errlen)) return -1;
+        i++;
+    }
+    return 0;
+}
+
+/* A number read into a float: finite, and within float range (1e39 would become infinity). */
+static int float_ok(double d, const char *objname, const char *key, int index, const char *path, char *err, size_t errlen)
+{
+    if (fabs(d) <= FLT_MAX) return 0;
+    if (index >= 0) snprintf(err, errlen, "%s: %s.%s[%d] = %g overflows a float (largest magnitude %g)", path, objname, key, index, d, (double)FLT_MAX);
+    else snprintf(err, errlen, "%s: %s.%s = %g overflows a float (largest magnitude %g)", path, objname, key, d, (double)FLT_MAX);
+    return -1;
 }
 
 /* Reads key as an array of three finite numbers. */
@@ -41,7 +166,7 @@ static int get_vec3(const cJSON *obj, const char *objname, const char *key, int 
     const cJSON *a = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!a) {
         if (!required) return 0;
-        snprintf(err, errlen, "%s: %s.%s is missing", path, objname, key);
+        missing(obj, objname, key, path, err, errlen);
         return -1;
     }
     if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != 3) {
@@ -55,6 +180,7 @@ static int get_vec3(const cJSON *obj, const char *objname, const char *key, int 
             snprintf(err, errlen, "%s: %s.%s must be an array of 3 finite numbers", path, objname, key);
             return -1;
         }
+        if (float_ok(x->valuedouble, objname, key, i, path, err, errlen)) return -1;
         v[i] = (float)x->valuedouble;
     }
     out->x = v[0]; out->y = v[1]; out->z = v[2];
@@ -67,7 +193,7 @@ static int get_number(const cJSON *obj, const char *objname, const char *key, in
     const cJSON *x = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!x) {
         if (!required) return 0;
-        snprintf(err, errlen, "%s: %s.%s is missing", path, objname, key);
+        missing(obj, objname, key, path, err, errlen);
         return -1;
     }
     if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) {
@@ -94,7 +220,7 @@ static int get_int(const cJSON *obj, const char *objname, const char *key, int r
 static const cJSON *get_object(const cJSON *root, const char *key, const char *path, char *err, size_t errlen)
 {
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, key);
-    if (!o) { snprintf(err, errlen, "%s: \"%s\" is missing", path, key); return NULL; }
+    if (!o) { missing(root, "", key, path, err, errlen); return NULL; }
     if (!cJSON_IsObject(o)) { snprintf(err, errlen, "%s: \"%s\" must be an object", path, key); return NULL; }
     return o;
 }
@@ -102,26 +228,64 @@ static const cJSON *get_object(const cJSON *root, const char *key, const char *p
 int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
+    char *text;
+    size_t len;
+    if (ms_read_input(json_path, MS_MAX_SCENE_BYTES, MS_INPUT_SCENE, &text, &len, err, errlen)) { ms_one_line(err); return -1; }
+    int rc = ms_scene_parse(text, len, json_path, out, err, errlen);
+    free(text);
+    return rc;
+}
+
+static int scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen);
+
+int ms_scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen)
+{
+    warn_list w;
+    w.n = 0;
+    g_warnings = &w;
+    int rc = scene_parse(text, len, json_path, out, err, errlen);
+    g_warnings = NULL;
+    if (rc) ms_one_line(err);
+    else
+        for (int i = 0; i < w.n; i++) ms_warn("%s", w.line[i]);
+    return rc;
+}
+
+static int scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    char *text = read_file(json_path, err, errlen);
-    if (!text) return -1;
+    const char *nul = memchr(text, 0, len);
+    if (nul) {
+        snprintf(err, errlen, "%s: line %d: a NUL byte (not a JSON text file)", json_path, line_of(text, (size_t)(nul - text)));
+        return -1;
+    }
+    /* cJSON decodes \u0000 into a NUL inside the string, which then silently ends it (a mesh path
+     * would be cut): refuse it. Backslashes only occur inside strings in valid JSON. */
+    for (size_t i = 0; i + 1 < len; i++)
+        if (text[i] == '\\') {
+            if (text[i + 1] == 'u' && i + 6 <= len && !memcmp(text + i + 2, "0000", 4)) {
+                snprintf(err, errlen, "%s: line %d: a string contains \\u0000 (NUL is not allowed)", json_path, line_of(text, i));
+                return -1;
+            }
+            i++;
+        }
     const char *where = NULL;
     cJSON *root = cJSON_ParseWithOpts(text, &where, 1);
     if (!root) {
-        long off = where ? (long)(where - text) : -1;
-        int line = 1;
-        for (long i = 0; i < off && text[i]; i++) line += text[i] == '\n';
-        snprintf(err, errlen, "%s: malformed JSON near line %d", json_path, line);
-        free(text);
+        size_t off = where ? (size_t)(where - text) : 0;
+        snprintf(err, errlen, "%s: malformed JSON near line %d", json_path, line_of(text, off));
         return -1;
     }
-    free(text);
     int rc = -1;
     if (!cJSON_IsObject(root)) { snprintf(err, errlen, "%s: the top level must be an object", json_path); goto done; }
+    if (check_duplicates(root, "", json_path, err, errlen)) goto done;
+    warn_unknown(root, "", top_keys, json_path);
 
     const cJSON *cam = get_object(root, "camera", json_path, err, errlen);
     if (!cam) goto done;
+    warn_unknown(cam, "camera", camera_keys, json_path);
     ms_camera *c = &out->camera;
     double fov = 60.0;
     c->width = 1024; c->height = 1024;
@@ -132,10 +296,12 @@ int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen
         get_int(cam, "camera", "width", 0, 1, MS_MAX_IMAGE_SIZE, &c->width, json_path, err, errlen) ||
         get_int(cam, "camera", "height", 0, 1, MS_MAX_IMAGE_SIZE, &c->height, json_path, err, errlen))
         goto done;
+    if (float_ok(fov, "camera", "fov_y", -1, json_path, err, errlen)) goto done;
     c->fov_y = (float)fov;
 
     const cJSON *light = get_object(root, "light", json_path, err, errlen);
     if (!light) goto done;
+    warn_unknown(light, "light", light_keys, json_path);
     ms_light *l = &out->light;
     l->emission = (ms_vec3){ MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION };
     if (get_vec3(light, "light", "corner", 1, &l->corner, json_path, err, errlen) ||
@@ -152,11 +318,12 @@ int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen
     const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
     if (render) {
         if (!cJSON_IsObject(render)) { snprintf(err, errlen, "%s: \"render\" must be an object", json_path); goto done; }
+        warn_unknown(render, "render", render_keys, json_path);
         if (get_int(render, "render", "samples", 0, 1, 1 << 20, &out->samples, json_path, err, errlen)) goto done;
     }
 
     const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(root, "meshes");
-    if (!meshes) { snprintf(err, errlen, "%s: \"meshes\" is missing", json_path); goto done; }
+    if (!meshes) { missing(root, "", "meshes", json_path, err, errlen); goto done; }
     if (!cJSON_IsArray(meshes) || cJSON_GetArraySize(meshes) == 0) {
         snprintf(err, errlen, "%s: \"meshes\" must be a non-empty array of {\"file\": ...}", json_path);
         goto done;
@@ -173,9 +340,16 @@ int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen
             snprintf(err, errlen, "%s: meshes[%d].file must be a non-empty string", json_path, i);
             goto mesh_fail;
         }
+        char objname[32];
+        snprintf(objname, sizeof objname, "meshes[%d]", i);
+        warn_unknown(m, objname, mesh_keys, json_path);
         char mesh_path[4096];
-        if (file->valuestring[0] == '/') snprintf(mesh_path, sizeof mesh_path, "%s", file->valuestring);
-        else snprintf(mesh_path, sizeof mesh_path, "%s/%s", dir, file->valuestring);
+        int n = file->valuestring[0] == '/' ? snprintf(mesh_path, sizeof mesh_path, "%s", file->valuestring)
+                                            : snprintf(mesh_path, sizeof mesh_path, "%s/%s", dir, file->valuestring);
+        if (n < 0 || (size_t)n >= sizeof mesh_path) {
+            snprintf(err, errlen, "%s: meshes[%d].file: the path is longer than %zu bytes", json_path, i, sizeof mesh_path - 1);
+            goto mesh_fail;
+        }
         if (ms_mesh_load(mesh_path, &soup, err, errlen)) goto mesh_fail;
         i++;
     }

@@ -6,6 +6,7 @@
 #include <stdio.h>
 
 static int vec_ok(ms_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+static int in_range(ms_vec3 v) { return fabsf(v.x) <= MS_MAX_COORD && fabsf(v.y) <= MS_MAX_COORD && fabsf(v.z) <= MS_MAX_COORD; }
 
 int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen)
 {
@@ -19,6 +20,17 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         snprintf(err, errlen, "%s: light has a NaN or infinite value", what);
         return -1;
     }
+    /* Beyond 1e18, squared lengths and cross products overflow single precision: the camera basis or
+     * the light's area would come out infinite and be misreported as degenerate. */
+    const struct { const char *name; ms_vec3 v; } coords[] = {
+        { "camera.eye", c->eye }, { "camera.target", c->target }, { "camera.up", c->up },
+        { "light.corner", l->corner }, { "light.edge_s", l->edge_s }, { "light.edge_t", l->edge_t } };
+    for (size_t i = 0; i < sizeof coords / sizeof coords[0]; i++)
+        if (!in_range(coords[i].v)) {
+            snprintf(err, errlen, "%s: %s has a coordinate beyond +-%g (too large for single precision)", what,
+                     coords[i].name, (double)MS_MAX_COORD);
+            return -1;
+        }
     if (!(c->fov_y > 0.0f && c->fov_y < 180.0f)) {
         snprintf(err, errlen, "%s: camera.fov_y must be in (0, 180) degrees", what);
         return -1;
@@ -46,10 +58,16 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         snprintf(err, errlen, "%s: the scene has no triangles", what);
         return -1;
     }
-    for (size_t i = 0; i < 9 * s->n_tris; i++)
+    for (size_t i = 0; i < 9 * s->n_tris; i++) {
         if (!isfinite(s->tri[i])) {
             snprintf(err, errlen, "%s: triangle %zu has a NaN or infinite coordinate", what, i / 9);
             return -1;
         }
+        if (fabsf(s->tri[i]) > MS_MAX_COORD) {
+            snprintf(err, errlen, "%s: triangle %zu has a coordinate beyond +-%g (too large for single precision)", what,
+                     i / 9, (double)MS_MAX_COORD);
+            return -1;
+        }
+    }
     return 0;
 }

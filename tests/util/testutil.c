@@ -8,7 +8,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/time.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 static void rm_tree(const char *dir)
@@ -75,6 +79,7 @@ int tu_run_cli(const char *const *args, char *err_line, size_t n)
         int nul = open("/dev/null", O_WRONLY);
         if (fd >= 0) dup2(fd, 2);
         if (nul >= 0) dup2(nul, 1);
+        alarm(600);   /* a hang fails the test instead of blocking ctest */
         const char *argv[64];
         int a = 0;
         argv[a++] = MS_CLI_PATH;
@@ -214,4 +219,58 @@ int tu_isa_allowed(ms_isa isa)
 {
     const ms_isa cap = tu_isa_cap();
     return cap == MS_ISA_AUTO || isa <= cap;
+}
+
+int tu_run_cli_ex(const char *const *args, const tu_run_opts *opts, char *err_all, size_t n, tu_run_result *res)
+{
+    char errpath[4096];
+    snprintf(errpath, sizeof errpath, "%s/cli-stderr-ex-%d.txt", MS_TEST_TMPDIR, (int)getpid());
+    mkdir(MS_TEST_TMPDIR, 0755);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        int nul = open("/dev/null", O_WRONLY);
+        if (fd >= 0) dup2(fd, 2);
+        if (nul >= 0) dup2(nul, 1);
+        if (opts && opts->fsize_limit > 0) {
+            signal(SIGXFSZ, SIG_IGN);
+            struct rlimit rl = { (rlim_t)opts->fsize_limit, (rlim_t)opts->fsize_limit };
+            setrlimit(RLIMIT_FSIZE, &rl);
+        }
+        if (opts && opts->umask >= 0) umask((mode_t)opts->umask);
+        alarm(opts && opts->timeout_s > 0 ? (unsigned)opts->timeout_s : 120);
+        const char *argv[64];
+        int a = 0;
+        argv[a++] = MS_CLI_PATH;
+        for (int i = 0; args[i] && a < 63; i++) argv[a++] = args[i];
+        argv[a] = NULL;
+        execv(MS_CLI_PATH, (char *const *)argv);
+        _exit(127);
+    }
+    int status = 0;
+    struct rusage ru;
+    memset(&ru, 0, sizeof ru);
+    wait4(pid, &status, 0, &ru);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (res) {
+        res->max_rss_mb = (double)ru.ru_maxrss / 1024.0;
+        res->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        res->lines = 0;
+    }
+    if (err_all && n) {
+        err_all[0] = 0;
+        FILE *f = fopen(errpath, "rb");
+        if (f) {
+            size_t k = fread(err_all, 1, n - 1, f);
+            err_all[k] = 0;
+            fclose(f);
+        }
+        if (res)
+            for (const char *p = err_all; *p; p++) res->lines += *p == '\n';
+    }
+    unlink(errpath);
+    if (WIFEXITED(status)) return WEXITSTATUS(status);
+    return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }

@@ -19,6 +19,13 @@ int tu_count_entries(const char *dir);
 /* Runs the CLI with argv (NULL-terminated, without argv[0]); returns its exit status and the first
  * line of its stderr in err_line. */
 int tu_run_cli(const char *const *args, char *err_line, size_t n);
+/* tu_run_cli with limits: the child's file size limit (0: none; SIGXFSZ is ignored so writes fail with
+ * EFBIG, as on a full disk), umask (-1: inherited) and a time limit (seconds, 0: 120). Returns the exit
+ * status (128 + signal if killed), all of stderr, its number of lines, the child's peak RSS in MB and
+ * its wall time in seconds. */
+typedef struct tu_run_opts { long fsize_limit; int umask; int timeout_s; } tu_run_opts;
+typedef struct tu_run_result { int lines; double max_rss_mb, seconds; } tu_run_result;
+int tu_run_cli_ex(const char *const *args, const tu_run_opts *opts, char *err_all, size_t n, tu_run_result *res);
 /* 1 if ../shared/scenes is present; prints a skip message otherwise. */
 int tu_have_shared_scenes(void);
 const char *tu_shared_scene(char *buf, size_t n, const char *rel);

@@ -1,0 +1,266 @@
+#include "microshadow.h"
+#include <errno.h>
+#include <fcntl.h>
+#include <libgen.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+/* Staging files that exist right now, for the signal handler: it may only read these. */
+static char g_stage[MS_MAX_OUTPUTS][PATH_MAX];
+static volatile sig_atomic_t g_live[MS_MAX_OUTPUTS];
+
+static void on_signal(int sig)
+{
+    for (int i = 0; i < MS_MAX_OUTPUTS; i++)
+        if (g_live[i]) unlink(g_stage[i]);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+static const int g_signals[] = { SIGINT, SIGTERM, SIGHUP, SIGQUIT };
+
+void ms_outputs_cleanup_on_signals(void)
+{
+    for (size_t i = 0; i < sizeof g_signals / sizeof g_signals[0]; i++) {
+        struct sigaction old, sa;
+        if (sigaction(g_signals[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_signal;
+        sigemptyset(&sa.sa_mask);
+        sigaction(g_signals[i], &sa, NULL);
+    }
+}
+
+/* Creating or renaming a staging file and recording it happen with the signals blocked, so the
+ * handler never misses a file nor removes a renamed one. */
+static void block(sigset_t *old)
+{
+    sigset_t s;
+    sigemptyset(&s);
+    for (size_t i = 0; i < sizeof g_signals / sizeof g_signals[0]; i++) sigaddset(&s, g_signals[i]);
+    sigprocmask(SIG_BLOCK, &s, old);
+}
+static void unblock(const sigset_t *old) { sigprocmask(SIG_SETMASK, old, NULL); }
+
+static int free_slot(void)
+{
+    for (int i = 0; i < MS_MAX_OUTPUTS; i++)
+        if (!g_live[i]) return i;
+    return -1;
+}
+
+/* dir of path (".", when it has no slash) into d. */
+static void dir_of(const char *path, char *d, size_t n)
+{
+    snprintf(d, n, "%s", path);
+    char *s = strrchr(d, '/');
+    if (!s) snprintf(d, n, ".");
+    else if (s == d) d[1] = 0;
+    else *s = 0;
+}
+
+static const char *base_of(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    return s ? s + 1 : path;
+}
+
+/* Creates a staging file in the target's directory: a short fixed-length name, so that any target
+ * name the filesystem accepts can be staged; mode 0666 less the umask, as any new file. Returns the
+ * slot (path in g_stage) or -1. */
+static int stage_create(const char *target, int *fd_out, char *err, size_t errlen)
+{
+    char dir[PATH_MAX];
+    dir_of(target, dir, sizeof dir);
+    static unsigned counter;
+    for (int attempt = 0; attempt < 100; attempt++) {
+        sigset_t old;
+        block(&old);
+        int slot = free_slot();
+        if (slot < 0) { unblock(&old); snprintf(err, errlen, "%s: too many outputs", target); return -1; }
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        unsigned r = (unsigned)ts.tv_nsec ^ (unsigned)getpid() * 2654435761u ^ ++counter * 40503u;
+        int n = snprintf(g_stage[slot], sizeof g_stage[slot], "%s/.ms-stage-%08x", dir, r);
+        if (n < 0 || (size_t)n >= sizeof g_stage[slot]) {
+            unblock(&old);
+            snprintf(err, errlen, "%s: cannot write: the directory's path is too long", target);
+            return -1;
+        }
+        int fd = open(g_stage[slot], O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd >= 0) g_live[slot] = 1;
+        int e = errno;
+        unblock(&old);
+        if (fd >= 0) { *fd_out = fd; return slot; }
+        if (e != EEXIST) { snprintf(err, errlen, "%s: cannot write: %s", target, strerror(e)); return -1; }
+    }
+    snprintf(err, errlen, "%s: cannot write: no free staging name", target);
+    return -1;
+}
+
+static void stage_remove(int slot)
+{
+    sigset_t old;
+    block(&old);
+    if (g_live[slot]) unlink(g_stage[slot]);
+    g_live[slot] = 0;
+    unblock(&old);
+}
+
+static int stage_commit(int slot, const char *target, char *err, size_t errlen)
+{
+    sigset_t old;
+    block(&old);
+    int rc = rename(g_stage[slot], target);
+    int e = errno;
+    if (rc == 0) g_live[slot] = 0;
+    unblock(&old);
+    if (rc) { snprintf(err, errlen, "%s: cannot rename into place: %s", target, strerror(e)); return -1; }
+    return 0;
+}
+
+static int has_suffix(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcasecmp(s + n - m, suffix) == 0;
+}
+
+/* The target exists as a regular file, or not at all. */
+static int target_kind_ok(const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return 0;
+    if (S_ISREG(st.st_mode)) return 0;
+    if (S_ISDIR(st.st_mode)) snprintf(err, errlen, "%s: cannot write: is a directory", path);
+    else snprintf(err, errlen, "%s: cannot write: not a regular file (a %s is never replaced)", path,
+                  S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "device" : S_ISFIFO(st.st_mode) ? "FIFO" : "special file");
+    return -1;
+}
+
+/* Same file: the same inode when both exist, else the same name in the same (resolved) directory. */
+static int same_target(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    int ea = stat(a, &sa) == 0, eb = stat(b, &sb) == 0;
+    if (ea && eb) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    if (ea != eb) return 0;
+    if (strcmp(base_of(a), base_of(b))) return 0;
+    char da[PATH_MAX], db[PATH_MAX], ra[PATH_MAX], rb[PATH_MAX];
+    dir_of(a, da, sizeof da);
+    dir_of(b, db, sizeof db);
+    if (!realpath(da, ra) || !realpath(db, rb)) return strcmp(da, db) == 0;
+    return strcmp(ra, rb) == 0;
+}
+
+int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
+{
+    for (int i = 0; i < n; i++) {
+        const char *p = outs[i].path;
+        if (!p) continue;
+        if (!p[0]) { snprintf(err, errlen, "empty output path (%s)", outs[i].flag); return -1; }
+        if (outs[i].suffixes) {
+            int ok = 0;
+            char list[128] = "";
+            for (int k = 0; outs[i].suffixes[k]; k++) {
+                ok |= has_suffix(p, outs[i].suffixes[k]);
+                snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? " or " : "", outs[i].suffixes[k]);
+            }
+            if (!ok) { snprintf(err, errlen, "%s: %s needs a file ending in %s", p, outs[i].flag, list); return -1; }
+        }
+        for (int j = 0; j < i; j++)
+            if (outs[j].path && same_target(outs[j].path, p)) {
+                snprintf(err, errlen, "%s: given to both %s and %s (each output needs its own file)", p, outs[j].flag, outs[i].flag);
+                return -1;
+            }
+        if (target_kind_ok(p, err, errlen)) return -1;
+        char dir[PATH_MAX];
+        dir_of(p, dir, sizeof dir);
+        long name_max = pathconf(dir, _PC_NAME_MAX);
+        size_t blen = strlen(base_of(p));
+        if (blen == 0) { snprintf(err, errlen, "%s: cannot write: no file name", p); return -1; }
+        if (name_max > 0 && blen > (size_t)name_max) {
+            snprintf(err, errlen, "%s: cannot write: the file name is %zu bytes, more than this filesystem's %ld", p, blen, name_max);
+            return -1;
+        }
+        if (strlen(p) >= PATH_MAX) { snprintf(err, errlen, "%s: cannot write: the path is too long", p); return -1; }
+        /* The directory accepts a new file (creating and removing a staging file proves it). */
+        int fd;
+        int slot = stage_create(p, &fd, err, errlen);
+        if (slot < 0) return -1;
+        close(fd);
+        stage_remove(slot);
+    }
+    return 0;
+}
+
+int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen)
+{
+    int slot[MS_MAX_OUTPUTS];
+    int rc = 0, k;
+    if (n > MS_MAX_OUTPUTS) { snprintf(err, errlen, "too many outputs"); return -1; }
+    for (k = 0; k < n; k++) slot[k] = -1;
+    for (k = 0; k < n && !rc; k++) {
+        if (!outs[k].path) continue;
+        int fd;
+        slot[k] = stage_create(outs[k].path, &fd, err, errlen);
+        if (slot[k] < 0) { rc = -1; break; }
+        FILE *fp = fdopen(fd, "wb");
+        if (!fp) { snprintf(err, errlen, "%s: cannot write: %s", outs[k].path, strerror(errno)); close(fd); rc = -1; break; }
+        rc = outs[k].write(f, fp, outs[k].path, err, errlen);
+        if (!rc) {
+            errno = 0;
+            if (fflush(fp) != 0 || ferror(fp) || fsync(fileno(fp)) != 0) {
+                snprintf(err, errlen, "%s: write failed: %s", outs[k].path, strerror(errno ? errno : EIO));
+                rc = -1;
+            }
+        }
+        if (fclose(fp) != 0 && !rc) { snprintf(err, errlen, "%s: write failed: %s", outs[k].path, strerror(errno)); rc = -1; }
+    }
+    /* Every target is still a regular file or absent before anything is renamed; the renames happen
+     * with the signals blocked, so a signal arriving meanwhile finds all of them done. */
+    sigset_t old;
+    block(&old);
+    for (k = 0; k < n && !rc; k++)
+        if (outs[k].path) rc = target_kind_ok(outs[k].path, err, errlen);
+    for (k = 0; k < n && !rc; k++)
+        if (slot[k] >= 0) rc = stage_commit(slot[k], outs[k].path, err, errlen);
+    unblock(&old);
+    for (k = 0; k < n; k++)
+        if (slot[k] >= 0) stage_remove(slot[k]);   /* nothing left for those renamed */
+    return rc;
+}
+
+/* The single-output entry points of the public API. */
+static int write_one(const ms_frame *f, const char *path, const char *flag, ms_output_write_fn fn,
+                     const char *const *suffixes, char *err, size_t errlen)
+{
+    ms_output o = { flag, path ? path : "", fn, suffixes };
+    if (ms_outputs_check(&o, 1, err, errlen)) return -1;
+    return ms_outputs_write(f, &o, 1, err, errlen);
+}
+
+int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen)
+{
+    return write_one(f, path, "PNG", ms_png_write_stream, NULL, err, errlen);
+}
+
+int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen)
+{
+    return write_one(f, path, "the visibility image", ms_vis_write_stream, ms_float_image_suffixes, err, errlen);
+}
+
+int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen)
+{
+    return write_one(f, path, "the shadow factor image", ms_shadow_write_stream, ms_float_image_suffixes, err, errlen);
+}
+
+int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen)
+{
+    return write_one(f, path, "stats", ms_stats_write_stream, NULL, err, errlen);
+}

@@ -1,0 +1,267 @@
+/* glTF 2.0 (.gltf, .glb) through cgltf rather than assimp: cgltf is small, fuzzed upstream and here,
+ * and lets us bound its memory (an allocator with a budget), read external buffers ourselves
+ * (regular files only) and check every accessor we read against the bytes behind it. */
+#include "scene_internal.h"
+#include "cgltf.h"
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct gltf_ctx {
+    size_t used, limit;        /* bytes cgltf allocated, and its budget (a multiple of the input) */
+    size_t input;              /* bytes of input: the file and the external buffers read so far */
+    char why[512];             /* the reason an external buffer could not be read */
+} gltf_ctx;
+
+/* cgltf's parse structures are up to ~200 times the JSON they come from ("{}" is a whole node). */
+#define GLTF_BUDGET_PER_BYTE 256
+#define GLTF_BUDGET_BASE ((size_t)16 << 20)
+
+static void *budget_alloc(void *user, cgltf_size size)
+{
+    gltf_ctx *g = user;
+    if (size > g->limit - g->used) return NULL;
+    void *p = malloc(size ? size : 1);
+    if (p) g->used += size;
+    return p;
+}
+
+static void budget_free(void *user, void *ptr) { (void)user; free(ptr); }
+
+static cgltf_result read_buffer_file(const struct cgltf_memory_options *mo, const struct cgltf_file_options *fo,
+                                     const char *path, cgltf_size *size, void **data)
+{
+    (void)mo;
+    gltf_ctx *g = fo->user_data;
+    char *buf;
+    size_t len;
+    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, g->why, sizeof g->why))
+        return cgltf_result_file_not_found;
+    if (len < *size) {
+        snprintf(g->why, sizeof g->why, "%s: holds %zu bytes, fewer than the %zu the glTF declares", path, len, (size_t)*size);
+        free(buf);
+        return cgltf_result_data_too_short;
+    }
+    g->input += len;
+    g->limit += len;
+    *data = buf;
+    return cgltf_result_success;
+}
+
+static void release_buffer_file(const struct cgltf_memory_options *mo, const struct cgltf_file_options *fo, void *data)
+{
+    (void)mo; (void)fo;
+    free(data);
+}
+
+static const char *result_text(cgltf_result r)
+{
+    switch (r) {
+    case cgltf_result_data_too_short: return "the data is shorter than it declares";
+    case cgltf_result_unknown_format: return "not a glTF 2.0 file";
+    case cgltf_result_invalid_json: return "malformed JSON";
+    case cgltf_result_invalid_gltf: return "invalid glTF (a reference out of range, a node with two parents or a cycle, or a missing required property)";
+    case cgltf_result_file_not_found: return "a buffer file cannot be read";
+    case cgltf_result_io_error: return "a buffer cannot be read";
+    case cgltf_result_out_of_memory: return "it needs more memory than its size allows";
+    case cgltf_result_legacy_gltf: return "glTF 1.0 is not supported";
+    default: return "cannot be read";
+    }
+}
+
+/* a + b <= lim without overflow. */
+static int fits(size_t a, size_t b, size_t lim) { return a <= lim && b <= lim - a; }
+
+/* The accessor can be read element by element without leaving its buffer's data. */
+static int accessor_ok(const cgltf_accessor *a, char *why, size_t n)
+{
+    if (a->is_sparse) { snprintf(why, n, "sparse accessors are not supported"); return 0; }
+    if (a->count == 0) { snprintf(why, n, "an accessor has no elements"); return 0; }
+    const cgltf_buffer_view *v = a->buffer_view;
+    if (!v) return 1;   /* no view: all zeros, read without touching memory */
+    if (v->has_meshopt_compression) { snprintf(why, n, "meshopt-compressed buffers are not supported"); return 0; }
+    if (!v->buffer || !v->buffer->data) { snprintf(why, n, "an accessor's buffer has no data"); return 0; }
+    size_t elem = cgltf_calc_size(a->type, a->component_type);
+    if (elem == 0 || (a->stride < elem && a->count > 1)) { snprintf(why, n, "an accessor has an invalid stride"); return 0; }
+    if (!fits(v->offset, v->size, v->buffer->size)) { snprintf(why, n, "a buffer view exceeds its buffer"); return 0; }
+    /* cgltf reads components through typed pointers: they must be aligned (glTF requires it too). */
+    size_t comp = cgltf_component_size(a->component_type);
+    if (comp == 0 || ((uintptr_t)v->buffer->data + v->offset + a->offset) % comp || a->stride % comp) {
+        snprintf(why, n, "an accessor is not aligned to its component size");
+        return 0;
+    }
+    if (a->count - 1 > (SIZE_MAX - elem) / (a->stride ? a->stride : 1) ||
+        !fits(a->offset, (a->count - 1) * a->stride + elem, v->size)) {
+        snprintf(why, n, "an accessor exceeds its buffer view");
+        return 0;
+    }
+    return 1;
+}
+
+static void mat4_mul(float r[16], const float a[16], const float b[16])   /* column-major, r = a b */
+{
+    float t[16];
+    for (int c = 0; c < 4; c++)
+        for (int i = 0; i < 4; i++) {
+            float s = 0;
+            for (int k = 0; k < 4; k++) s += a[k * 4 + i] * b[c * 4 + k];
+            t[c * 4 + i] = s;
+        }
+    memcpy(r, t, sizeof t);
+}
+
+static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_soup *soup, size_t *added,
+                          size_t max_tris, const char *path, char *err, size_t errlen)
+{
+    if (pr->type != cgltf_primitive_type_triangles && pr->type != cgltf_primitive_type_triangle_strip &&
+        pr->type != cgltf_primitive_type_triangle_fan)
+        return 0;   /* points and lines cast no shadow */
+    char why[128];
+    if (pr->has_draco_mesh_compression) { snprintf(err, errlen, "%s: Draco-compressed meshes are not supported", path); return -1; }
+    const cgltf_accessor *pos = NULL;
+    for (size_t i = 0; i < pr->attributes_count; i++)
+        if (pr->attributes[i].type == cgltf_attribute_type_position && pr->attributes[i].index == 0) pos = pr->attributes[i].data;
+    if (!pos) { snprintf(err, errlen, "%s: a triangle primitive has no POSITION", path); return -1; }
+    if (pos->type != cgltf_type_vec3) { snprintf(err, errlen, "%s: POSITION is not a VEC3 accessor", path); return -1; }
+    if (!accessor_ok(pos, why, sizeof why)) { snprintf(err, errlen, "%s: %s", path, why); return -1; }
+    const cgltf_accessor *ix = pr->indices;
+    if (ix) {
+        if (ix->type != cgltf_type_scalar || (ix->component_type != cgltf_component_type_r_8u &&
+            ix->component_type != cgltf_component_type_r_16u && ix->component_type != cgltf_component_type_r_32u)) {
+            snprintf(err, errlen, "%s: indices must be unsigned integer scalars", path);
+            return -1;
+        }
+        if (!accessor_ok(ix, why, sizeof why)) { snprintf(err, errlen, "%s: %s", path, why); return -1; }
+    }
+    size_t n = ix ? ix->count : pos->count;
+    size_t tris = pr->type == cgltf_primitive_type_triangles ? n / 3 : n >= 3 ? n - 2 : 0;
+    if (tris > max_tris - *added) {
+        snprintf(err, errlen, "%s: the scene expands to more than %zu triangles (%d per byte of input)", path, max_tris,
+                 MS_MAX_TRIS_PER_BYTE);
+        return -1;
+    }
+    for (size_t t = 0; t < tris; t++) {
+        size_t corner[3];
+        if (pr->type == cgltf_primitive_type_triangles) { corner[0] = 3 * t; corner[1] = 3 * t + 1; corner[2] = 3 * t + 2; }
+        else if (pr->type == cgltf_primitive_type_triangle_strip) { corner[0] = t; corner[1] = t + 1 + (t & 1); corner[2] = t + 2 - (t & 1); }
+        else { corner[0] = t + 1; corner[1] = t + 2; corner[2] = 0; }
+        float v[9];
+        for (int k = 0; k < 3; k++) {
+            size_t idx = ix ? cgltf_accessor_read_index(ix, corner[k]) : corner[k];
+            if (idx >= pos->count) {
+                snprintf(err, errlen, "%s: index %zu is beyond the %zu vertices", path, idx, (size_t)pos->count);
+                return -1;
+            }
+            float p[3] = { 0, 0, 0 };
+            cgltf_accessor_read_float(pos, idx, p, 3);
+            for (int r = 0; r < 3; r++) v[3 * k + r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+        }
+        if (ms_soup_push(soup, v)) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+        (*added)++;
+    }
+    return 0;
+}
+
+typedef struct node_item { const cgltf_node *node; float parent[16]; } node_item;
+
+/* Depth-first over the node trees without recursion; every node at most once (glTF requires trees,
+ * and a node listed twice would expand exponentially: 41 such nodes are 2^40 instances). */
+static int walk_nodes(const cgltf_data *d, ms_tri_soup *soup, size_t *added, size_t max_tris, const char *path,
+                      char *err, size_t errlen)
+{
+    const cgltf_scene *sc = d->scene ? d->scene : d->scenes_count ? &d->scenes[0] : NULL;
+    size_t nn = d->nodes_count;
+    unsigned char *seen = calloc(nn ? nn : 1, 1);
+    node_item *stack = malloc((nn ? nn : 1) * sizeof *stack);
+    int rc = 0;
+    if (!seen || !stack) { snprintf(err, errlen, "%s: out of memory", path); rc = -1; goto out; }
+    size_t top = 0;
+    static const float id[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+    size_t nroots = sc ? sc->nodes_count : nn;
+    for (size_t r = 0; r < nroots && !rc; r++) {
+        const cgltf_node *root = sc ? sc->nodes[r] : &d->nodes[r];
+        if (!sc && root->parent) continue;
+        top = 0;
+        size_t ri = (size_t)(root - d->nodes);
+        if (seen[ri]) { snprintf(err, errlen, "%s: node %zu is reached more than once (glTF nodes form trees)", path, ri); rc = -1; break; }
+        seen[ri] = 1;
+        stack[top].node = root;
+        memcpy(stack[top++].parent, id, sizeof id);
+        while (top && !rc) {
+            node_item it = stack[--top];
+            float local[16], world[16];
+            cgltf_node_transform_local(it.node, local);
+            mat4_mul(world, it.parent, local);
+            if (it.node->mesh)
+                for (size_t p = 0; p < it.node->mesh->primitives_count && !rc; p++)
+                    rc = emit_primitive(&it.node->mesh->primitives[p], world, soup, added, max_tris, path, err, errlen);
+            for (size_t c = 0; c < it.node->children_count && !rc; c++) {
+                size_t ci = (size_t)(it.node->children[c] - d->nodes);
+                if (seen[ci]) {
+                    snprintf(err, errlen, "%s: node %zu is reached more than once (glTF nodes form trees)", path, ci);
+                    rc = -1;
+                    break;
+                }
+                seen[ci] = 1;
+                stack[top].node = it.node->children[c];   /* top < nn: each node is pushed once */
+                memcpy(stack[top++].parent, world, sizeof world);
+            }
+        }
+    }
+out:
+    free(seen);
+    free(stack);
+    return rc;
+}
+
+int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *soup, size_t *added, char *err,
+                 size_t errlen)
+{
+    *added = 0;
+    gltf_ctx g = { 0, GLTF_BUDGET_BASE + GLTF_BUDGET_PER_BYTE * len, len, "" };
+    cgltf_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.memory.alloc_func = budget_alloc;
+    opt.memory.free_func = budget_free;
+    opt.memory.user_data = &g;
+    opt.file.read = read_buffer_file;
+    opt.file.release = release_buffer_file;
+    opt.file.user_data = &g;
+    cgltf_data *d = NULL;
+    cgltf_result r = cgltf_parse(&opt, buf, len, &d);
+    if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); return -1; }
+    int rc = -1;
+    /* A data: URI's declared length must fit in its text before cgltf allocates it. */
+    for (size_t i = 0; i < d->buffers_count; i++) {
+        const char *uri = d->buffers[i].uri;
+        const char *comma = uri && !strncmp(uri, "data:", 5) ? strchr(uri, ',') : NULL;
+        if (comma && d->buffers[i].size / 3 > strlen(comma + 1) / 4 + 1) {
+            snprintf(err, errlen, "%s: buffer %zu declares %zu bytes, more than its data URI holds", path, i, (size_t)d->buffers[i].size);
+            goto out;
+        }
+    }
+    r = cgltf_load_buffers(&opt, d, path);
+    if (r != cgltf_result_success) {
+        if (g.why[0]) snprintf(err, errlen, "%s: buffer %s", path, g.why);
+        else snprintf(err, errlen, "%s: %s", path, result_text(r));
+        goto out;
+    }
+    /* cgltf_validate reads index data through accessor bounds it computes with wrapping arithmetic:
+     * check every accessor with data here first. */
+    for (size_t i = 0; i < d->accessors_count; i++) {
+        const cgltf_accessor *a = &d->accessors[i];
+        char why[128];
+        if (a->is_sparse || (a->count && a->buffer_view && a->buffer_view->buffer && a->buffer_view->buffer->data &&
+                             !accessor_ok(a, why, sizeof why))) {
+            snprintf(err, errlen, "%s: accessor %zu: %s", path, i, a->is_sparse ? "sparse accessors are not supported" : why);
+            goto out;
+        }
+    }
+    r = cgltf_validate(d);
+    if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); goto out; }
+    rc = walk_nodes(d, soup, added, (g.input + 64) * MS_MAX_TRIS_PER_BYTE, path, err, errlen);
+out:
+    cgltf_free(d);
+    return rc;
+}

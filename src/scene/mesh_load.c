@@ -1,0 +1,86 @@
+/* Mesh files: chosen by extension, checked for structure and size, then imported (assimp or cgltf).
+ * Only formats microshadow checks itself reach an importer: assimp's own format probing is where a
+ * few bytes of garbage crash it. */
+#include "scene_internal.h"
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int ms_soup_push(ms_tri_soup *soup, const float v[9])
+{
+    if (soup->n == soup->cap) {
+        size_t cap = soup->cap ? 2 * soup->cap : 1024;
+        float *t = realloc(soup->tri, cap * 9 * sizeof(float));
+        if (!t) return -1;
+        soup->tri = t;
+        soup->cap = cap;
+    }
+    memcpy(soup->tri + 9 * soup->n, v, 9 * sizeof(float));
+    soup->n++;
+    return 0;
+}
+
+static const char *extension(const char *path, char *ext, size_t n)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    ext[0] = 0;
+    if (!dot || (slash && dot < slash)) return ext;
+    size_t i = 0;
+    for (dot++; *dot && i + 1 < n; dot++) ext[i++] = (char)tolower((unsigned char)*dot);
+    ext[i] = 0;
+    if (*dot) ext[0] = 0;   /* longer than any we know */
+    return ext;
+}
+
+static int load_memory(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
+                       char *err, size_t errlen)
+{
+    size_t added = 0, before = soup->n;
+    int rc;
+    if (len == 0) { snprintf(err, errlen, "%s: the mesh file is empty", path); return -1; }   /* assimp asserts on it */
+    if (!strcmp(ext, "gltf") || !strcmp(ext, "glb")) {
+        rc = ms_mesh_gltf(buf, len, path, soup, &added, err, errlen);
+    } else {
+        int (*check)(const char *, size_t, const char *, char *, size_t) =
+            !strcmp(ext, "obj") ? ms_preflight_obj : !strcmp(ext, "ply") ? ms_preflight_ply
+          : !strcmp(ext, "off") ? ms_preflight_off : !strcmp(ext, "stl") ? ms_preflight_stl : NULL;
+        if (!check) {
+            snprintf(err, errlen, "%s: unsupported mesh format '.%s' (microshadow reads .obj, .ply, .off, .stl, "
+                     ".gltf, .glb)", path, ext);
+            return -1;
+        }
+        rc = check(buf, len, path, err, errlen);
+        if (!rc) rc = ms_mesh_assimp(buf, len, ext, path, soup, &added, err, errlen);
+    }
+    if (rc) { soup->n = before; return -1; }
+    if (added == 0) { snprintf(err, errlen, "%s: the mesh has no triangles", path); return -1; }
+    for (size_t i = before * 9; i < soup->n * 9; i++)
+        if (!isfinite(soup->tri[i])) {
+            snprintf(err, errlen, "%s: triangle %zu has a NaN or infinite coordinate", path, i / 9 - before);
+            soup->n = before;
+            return -1;
+        }
+    return 0;
+}
+
+int ms_mesh_load_memory(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
+                        char *err, size_t errlen)
+{
+    int rc = load_memory(buf, len, ext, path, soup, err, errlen);
+    if (rc) ms_one_line(err);
+    return rc;
+}
+
+int ms_mesh_load(const char *path, ms_tri_soup *soup, char *err, size_t errlen)
+{
+    char ext[8];
+    extension(path, ext, sizeof ext);
+    char *buf;
+    size_t len;
+    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, err, errlen)) { ms_one_line(err); return -1; }
+    int rc = ms_mesh_load_memory(buf, len, ext, path, soup, err, errlen);
+    free(buf);
+    return rc;
+}

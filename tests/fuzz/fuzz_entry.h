@@ -1,0 +1,93 @@
+/* The fuzz targets' bodies, shared by the libFuzzer harnesses (fuzz_*.c, clang only) and by the ctest
+ * program test_fuzz_inputs, which replays every committed seed and kept crash input with any compiler.
+ * Each body checks the loaders' contract: no crash (the sanitizers), and on failure exactly one line of
+ * message naming the file. */
+#ifndef MS_FUZZ_ENTRY_H
+#define MS_FUZZ_ENTRY_H
+#include "microshadow.h"
+#include "scene/scene_internal.h"
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define MS_FUZZ_MESH_PATH "/nonexistent-microshadow-fuzz/input."
+
+/* One line, "FILE: problem"; name, when given, must be the file. */
+static inline void ms_fuzz_check_message(const char *err, const char *name)
+{
+    const char *colon = strstr(err, ": ");
+    if (!colon || colon == err || strchr(err, '\n') || (name && strncmp(err, name, strlen(name)))) {
+        fprintf(stderr, "bad error message: '%s' (must be one line 'FILE: problem'%s%s)\n", err, name ? " naming " : "",
+                name ? name : "");
+        abort();
+    }
+}
+
+/* One mesh file of format ext (obj, ply, off, stl, gltf), from bytes; 0 if it loaded. */
+static inline int ms_fuzz_mesh(const char *ext, const uint8_t *data, size_t size)
+{
+    char *buf = malloc(size + 1);
+    if (!buf) return 0;
+    memcpy(buf, data, size);
+    buf[size] = 0;
+    char path[64], err[1024] = "";
+    snprintf(path, sizeof path, "%s%s", MS_FUZZ_MESH_PATH, ext);
+    ms_tri_soup soup = { 0 };
+    int rc = ms_mesh_load_memory(buf, size, ext, path, &soup, err, sizeof err);
+    if (rc) ms_fuzz_check_message(err, path);
+    else if (soup.n == 0) abort();   /* success means triangles */
+    free(soup.tri);
+    free(buf);
+    return rc;
+}
+
+static inline void ms_fuzz_ignore_warning(void *user, const char *msg) { (void)user; (void)msg; }
+
+/* A scene file, from bytes, beside a directory holding one small valid mesh (a.obj); 0 if it loaded. */
+static inline int ms_fuzz_scene(const char *dir, const uint8_t *data, size_t size)
+{
+    ms_set_warning_handler(ms_fuzz_ignore_warning, NULL);
+    char *buf = malloc(size + 1);
+    if (!buf) return 0;
+    memcpy(buf, data, size);
+    buf[size] = 0;
+    char path[4096], err[1024] = "";
+    snprintf(path, sizeof path, "%s/scene.json", dir);
+    ms_scene s;
+    int rc = ms_scene_parse(buf, size, path, &s, err, sizeof err);
+    if (rc) ms_fuzz_check_message(err, NULL);   /* the scene file or a mesh file it names */
+    else ms_scene_free(&s);
+    free(buf);
+    return rc;
+}
+
+static char ms_fuzz_dir[64];
+
+static inline void ms_fuzz_remove_dir(void)
+{
+    char p[128];
+    snprintf(p, sizeof p, "%s/a.obj", ms_fuzz_dir);
+    unlink(p);
+    rmdir(ms_fuzz_dir);
+}
+
+/* The directory for ms_fuzz_scene, created once and removed at exit. */
+static inline const char *ms_fuzz_scene_dir(void)
+{
+    char *dir = ms_fuzz_dir;
+    if (dir[0]) return dir;
+    snprintf(dir, sizeof ms_fuzz_dir, "/tmp/microshadow-fuzz-XXXXXX");
+    if (!mkdtemp(dir)) abort();
+    atexit(ms_fuzz_remove_dir);
+    char p[128];
+    snprintf(p, sizeof p, "%s/a.obj", dir);
+    FILE *f = fopen(p, "wb");
+    if (!f) abort();
+    fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n", f);
+    fclose(f);
+    return dir;
+}
+
+#endif
