@@ -2,14 +2,19 @@
 #include "receiver.h"
 #include "../core/vec.h"
 #include "../raster/raster.h"
+#include "../core/cpu.h"
 #include <math.h>
 #include <string.h>
 
 int ms_mask_count(const uint64_t *m, int n)
 {
-    int c = 0;
-    for (int i = 0; i < n; i++) c += __builtin_popcountll(m[i]);
-    return c;
+    /* Exact on every instance, so no cap applies: the best the CPU has (a portable popcount is a libgcc
+     * call per word, which made counting the masks cost more than the weights). */
+    switch (ms_cpu_isa()) {
+    case MS_ISA_AVX512: return ms_mask_count_avx512(m, n);
+    case MS_ISA_AVX2: return ms_mask_count_avx2(m, n);
+    default: return ms_mask_count_scalar(m, n);
+    }
 }
 
 void ms_horizon_edge(const ms_grid *g, const float p[3], const float n[3], float h[3])
@@ -56,42 +61,8 @@ int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
     return ms_mask_count(front, nw);
 }
 
-/* Adds the weights of row j's front samples to wf[] and of its visible ones to wv[] (16 lane sums). With
- * d = L - P, cos theta_r = d . n / r = (h . (i, j, 1)) / r (n is unit) and cos theta_l = b / r with
- * b = -d . n_l, so w = a b / r^4. On the grid every sample lies on the light's plane, b is the same for all
- * of them and cancels in S: the rows sum a / r^4. Written as 16 independent lanes (no reduction inside
- * the loop) so that it vectorises without reassociating float sums, and sums in the same order on every
- * ISA. */
-#define WLANES 16
-static void grid_row_weights(const ms_grid *g, const float rel0[3], const float h[3], int k, int j,
-                             uint64_t fbits, uint64_t vbits, float wf[WLANES], float wv[WLANES])
-{
-    static const uint32_t bit[WLANES] = { 1u << 0, 1u << 1, 1u << 2, 1u << 3, 1u << 4, 1u << 5, 1u << 6, 1u << 7,
-                                          1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14, 1u << 15 };
-    const float fj = (float)j;
-    const float bx = rel0[0] + fj * g->dt[0], by = rel0[1] + fj * g->dt[1], bz = rel0[2] + fj * g->dt[2];
-    const float hb = h[2] + fj * h[1];
-    for (int i0 = 0; i0 < k; i0 += WLANES) {
-        const uint32_t fb = (uint32_t)(fbits >> i0) & 0xFFFFu, vb = (uint32_t)(vbits >> i0) & 0xFFFFu;
-        if (!fb) continue;
-        for (int l = 0; l < WLANES; l++) {
-            const float fi = (float)(i0 + l);
-            const float dx = bx + fi * g->ds[0], dy = by + fi * g->ds[1], dz = bz + fi * g->ds[2];
-            const float r2 = dx * dx + dy * dy + dz * dz;
-            const float a = ms_maxf(hb + fi * h[0], 0.0f);
-            const float w = a / (r2 * r2);
-            wf[l] += (fb & bit[l]) ? w : 0.0f;
-            wv[l] += (vb & bit[l]) ? w : 0.0f;
-        }
-    }
-}
-
-static uint64_t mask_row(const uint64_t *m, int k, int j)
-{
-    const int bit = j * k;
-    const uint64_t w = m[bit >> 6] >> (bit & 63);
-    return k == 64 ? w : w & ((UINT64_C(1) << k) - 1);
-}
+typedef void (*grid_weights_fn)(const ms_grid *g, const float rel0[3], const float h[3], int k, const uint64_t *front,
+                                const uint64_t *vis, float *wf, float *wv);
 
 int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, const uint64_t *front,
                   const uint64_t *vis, float *v, float *s)
@@ -127,13 +98,14 @@ int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
         ms_grid_for_pixel(L, k, q->px, q->py, ctx->seed, &g);
         ms_horizon_edge(&g, q->p, q->n, h);
         v3_sub(rel0, g.p0, q->p);
-        float lf[WLANES] = { 0 }, lv[WLANES] = { 0 };
+        /* The instance of the capped ISA (the probe is cached: a load and a compare per call). */
+        static const grid_weights_fn by_isa[] = {
+            [MS_ISA_SCALAR] = ms_grid_weights_scalar,
+            [MS_ISA_AVX2] = ms_grid_weights_avx2,
+            [MS_ISA_AVX512] = ms_grid_weights_avx512,
+        };
         if (-v3_dot(rel0, nl) > 0.0f)   /* else every cos theta_l <= 0: all weights 0 */
-            for (int j = 0; j < k; j++) {
-                const uint64_t fb = mask_row(front, k, j);
-                if (fb) grid_row_weights(&g, rel0, h, k, j, fb, mask_row(vis, k, j), lf, lv);
-            }
-        for (int l = 0; l < WLANES; l++) { wf += lf[l]; wv += lv[l]; }
+            by_isa[ms_isa_capped(ctx->isa_cap)](&g, rel0, h, k, front, vis, &wf, &wv);
     }
     *s = wf > 0.0f ? wv / wf : *v;
     return 1;

@@ -34,6 +34,18 @@ int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
 int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, const uint64_t *front,
                    const uint64_t *vis, float *v, float *s);
 
+/* The grid's weight sums over the front (wf) and visible (wv) samples, per ISA (receiver_weights_impl.h). */
+void ms_grid_weights_scalar(const ms_grid *g, const float rel0[3], const float h[3], int k, const uint64_t *front,
+                            const uint64_t *vis, float *wf, float *wv);
+void ms_grid_weights_avx2(const ms_grid *g, const float rel0[3], const float h[3], int k, const uint64_t *front,
+                          const uint64_t *vis, float *wf, float *wv);
+void ms_grid_weights_avx512(const ms_grid *g, const float rel0[3], const float h[3], int k, const uint64_t *front,
+                            const uint64_t *vis, float *wf, float *wv);
+
+int ms_mask_count_scalar(const uint64_t *m, int n);
+int ms_mask_count_avx2(const uint64_t *m, int n);
+int ms_mask_count_avx512(const uint64_t *m, int n);
+
 /* Number of set bits in n words. */
 int ms_mask_count(const uint64_t *m, int n);
 

@@ -1,0 +1,2 @@
+/* The portable instance of the grid weights of S (receiver_weights_impl.h). */
+#include "receiver_weights_impl.h"
