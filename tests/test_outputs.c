@@ -18,11 +18,13 @@ static void make_frame(ms_frame *f)
     f->width = FW;
     f->height = FH;
     f->vis = malloc(sizeof(float) * FW * FH);
+    f->shadow = malloc(sizeof(float) * FW * FH);
     f->rgb = malloc(3 * sizeof(float) * FW * FH);
     for (int y = 0; y < FH; y++)
         for (int x = 0; x < FW; x++) {
             int i = y * FW + x;
             f->vis[i] = (x + y) % 7 == 0 ? -1.0f : (float)((x * 31 + y * 17) % 1025) / 1024.0f;
+            f->shadow[i] = f->vis[i] < 0.0f ? -1.0f : (float)((x * 13 + y * 29) % 997) / 996.0f;   /* not V */
             for (int c = 0; c < 3; c++) f->rgb[3 * i + c] = 0.01f * (float)(x + c) * (float)y;
         }
     f->exposure = 1.0f;
@@ -56,17 +58,25 @@ static void test_pfm(void **st)
             memcpy(&v, &u, 4);
             assert_true(v == f.vis[(FH - 1 - r) * FW + x]);   /* rows bottom to top */
         }
+    /* S through the same writer: its own data, read back top row first */
+    assert_int_equal(ms_write_shadow(&f, tu_path(path, sizeof path, dir, "s.pfm"), err, sizeof err), 0);
+    int w = 0, h = 0;
+    float *sv = tu_read_pfm(path, &w, &h);
+    assert_non_null(sv);
+    assert_int_equal(w, FW);
+    assert_int_equal(h, FH);
+    assert_memory_equal(sv, f.shadow, sizeof(float) * FW * FH);
+    free(sv);
     ms_frame_free(&f);
 }
 
-static void test_exr(void **st)
+static void check_exr(const ms_frame *fr, int shadow)
 {
-    (void)st;
-    const char *dir = tu_tmpdir("outputs_exr");
+    const char *dir = tu_tmpdir(shadow ? "outputs_exr_s" : "outputs_exr");
     char path[4096], err[512];
-    ms_frame f;
-    make_frame(&f);
-    assert_int_equal(ms_write_vis(&f, tu_path(path, sizeof path, dir, "v.exr"), err, sizeof err), 0);
+    const ms_frame f = *fr;
+    if (shadow) assert_int_equal(ms_write_shadow(&f, tu_path(path, sizeof path, dir, "s.exr"), err, sizeof err), 0);
+    else assert_int_equal(ms_write_vis(&f, tu_path(path, sizeof path, dir, "v.exr"), err, sizeof err), 0);
     assert_int_equal(tu_count_entries(dir), 1);
 
     exr_context_t ctx = NULL;
@@ -82,7 +92,7 @@ static void test_exr(void **st)
     const exr_attr_chlist_t *chl = NULL;
     assert_int_equal(exr_get_channels(ctx, 0, &chl), EXR_ERR_SUCCESS);
     assert_int_equal(chl->num_channels, 1);
-    assert_string_equal(chl->entries[0].name.str, "V");
+    assert_string_equal(chl->entries[0].name.str, shadow ? "S" : "V");
     assert_int_equal(chl->entries[0].pixel_type, EXR_PIXEL_FLOAT);
     int lines = 0;
     assert_int_equal(exr_get_scanlines_per_chunk(ctx, 0, &lines), EXR_ERR_SUCCESS);
@@ -105,8 +115,17 @@ static void test_exr(void **st)
     exr_decoding_destroy(ctx, &dec);
     exr_finish(&ctx);
     /* EXR rows are top to bottom, as in the frame. */
-    assert_memory_equal(img, f.vis, sizeof(float) * FW * FH);
+    assert_memory_equal(img, shadow ? f.shadow : f.vis, sizeof(float) * FW * FH);
     free(img);
+}
+
+static void test_exr(void **st)
+{
+    (void)st;
+    ms_frame f;
+    make_frame(&f);
+    check_exr(&f, 0);
+    check_exr(&f, 1);
     ms_frame_free(&f);
 }
 
@@ -199,15 +218,30 @@ static void test_stats(void **st)
     assert_int_equal(fr.stats.threads, 2);
     assert_int_equal(ms_write_stats_json(&fr, tu_path(path, sizeof path, dir, "s.json"), err, sizeof err), 0);
     check_stats(path, &fr, s.n_tris);
-    /* Through the CLI (built-in scene), with all three outputs: exactly three files, no temporaries. */
-    char png[4096], exr[4096], js[4096];
+    /* Through the CLI (built-in scene), with all four outputs: exactly four files, no temporaries; the S
+     * image is the frame's S (the same render through the library). */
+    char png[4096], exr[4096], js[4096], spfm[4096];
     const char *args[] = { "--method", "raytrace", "--samples", "256", "--width", "24", "--height", "16", "--quiet",
-                           "-o", tu_path(png, sizeof png, dir, "c.png"), "--vis", tu_path(exr, sizeof exr, dir, "c.exr"),
+                           "--threads", "2", "-o", tu_path(png, sizeof png, dir, "c.png"), "--vis",
+                           tu_path(exr, sizeof exr, dir, "c.exr"), "--shadow", tu_path(spfm, sizeof spfm, dir, "c.pfm"),
                            "--stats", tu_path(js, sizeof js, dir, "c.json"), NULL };
     int rc = tu_run_cli(args, err, sizeof err);
     if (rc) fail_msg("CLI exit %d: %s", rc, err);
-    assert_int_equal(tu_count_entries(dir), 4);
+    assert_int_equal(tu_count_entries(dir), 5);
     check_stats(js, NULL, s.n_tris);
+    int w = 0, h = 0;
+    float *sv = tu_read_pfm(spfm, &w, &h);
+    assert_non_null(sv);
+    assert_int_equal(w * h, 24 * 16);
+    assert_memory_equal(sv, fr.shadow, sizeof(float) * 24 * 16);
+    free(sv);
+    /* a bad --isa or --shadow ending: exit 2 before rendering */
+    const char *bad_isa[] = { "--isa", "sse9", "--quiet", NULL };
+    assert_int_equal(tu_run_cli(bad_isa, err, sizeof err), 2);
+    assert_non_null(strstr(err, "--isa"));
+    const char *bad_s[] = { "--shadow", tu_path(spfm, sizeof spfm, dir, "s.tiff"), "--quiet", NULL };
+    assert_int_equal(tu_run_cli(bad_s, err, sizeof err), 2);
+    assert_non_null(strstr(err, "s.tiff"));
     ms_frame_free(&fr);
     ms_scene_free(&s);
 }
