@@ -267,12 +267,7 @@ static void test_primary_points(void **st)
     int n = 0;
     for (int i = 0; i < W * H; i++) {
         if (hb[i].prim == UINT32_MAX || (i % W + i / W) % 3) continue;   /* a third of the pixels: raytrace is slow under ASan */
-        memcpy(q[n].p, hb[i].p, sizeof q[n].p);
-        memcpy(q[n].n, hb[i].n, sizeof q[n].n);
-        q[n].prim = hb[i].prim;
-        q[n].px = (uint32_t)(i % W);
-        q[n].py = (uint32_t)(i / W);
-        n++;
+        tu_query_from_hit(&q[n++], &hb[i], i % W, i / W);
     }
     uint64_t cnt_rt[MS_MAX_COUNTERS] = { 0 }, cnt_eb[MS_MAX_COUNTERS] = { 0 };
     const ms_shadow_method *rt = ms_find_shadow_method("raytrace");

@@ -195,13 +195,7 @@ static uint64_t *method_masks(const ms_scene *sc, const char *method, int k, int
     pm->destroy(ps);
     int nq = 0;
     for (int i = 0; i < size * size; i++) {
-        if (hits[i].prim == UINT32_MAX) continue;
-        memcpy(q[nq].p, hits[i].p, sizeof q[nq].p);
-        memcpy(q[nq].n, hits[i].n, sizeof q[nq].n);
-        q[nq].prim = hits[i].prim;
-        q[nq].px = (uint32_t)(i % size);
-        q[nq].py = (uint32_t)(i / size);
-        nq++;
+        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[nq++], &hits[i], i % size, i / size);
     }
     const size_t mw = (size_t)ctx.mask_words;
     uint64_t *front = calloc((size_t)nq * mw + 1, sizeof *front), *vis = calloc((size_t)nq * mw + 1, sizeof *vis);

@@ -302,11 +302,7 @@ static void test_two_lifts(void **st)
     int n = 0, cut = 0;
     for (int i = 0; i < W * H; i++) {
         if (hits[i].prim == UINT32_MAX) continue;
-        memcpy(q0[n].p, hits[i].p, sizeof q0[n].p);
-        memcpy(q0[n].n, hits[i].n, sizeof q0[n].n);
-        q0[n].prim = hits[i].prim;
-        q0[n].px = (uint32_t)(i % W);
-        q0[n].py = (uint32_t)(i / W);
+        tu_query_from_hit(&q0[n], &hits[i], i % W, i / W);
         uint64_t fm[16];
         int nf = ms_front_mask(&ctx, &q0[n], NULL, fm);
         cut += nf > 0 && nf < ctx.samples;

@@ -49,6 +49,9 @@ struct ms_render_ctx;
 struct ms_shadow_query;
 struct ms_shadow_method;
 struct ms_bvh;
+struct ms_hit;
+/* The shadow query of a primary hit at pixel (x, y), as ms_render makes it. */
+void tu_query_from_hit(struct ms_shadow_query *q, const struct ms_hit *h, int x, int y);
 /* A frame context as ms_render sets it up: grid pattern, k x k samples, the scene's camera at W x H. */
 void tu_ctx_init(struct ms_render_ctx *ctx, const ms_scene *sc, const struct ms_bvh *bvh, int W, int H, int k);
 /* V and S of n points by a shadow method (state from its create), through front masks and ms_resolve_vs
