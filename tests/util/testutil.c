@@ -70,38 +70,15 @@ int tu_count_entries(const char *dir)
 
 int tu_run_cli(const char *const *args, char *err_line, size_t n)
 {
-    char errpath[4096];
-    snprintf(errpath, sizeof errpath, "%s/cli-stderr-%d.txt", MS_TEST_TMPDIR, (int)getpid());
-    mkdir(MS_TEST_TMPDIR, 0755);
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fd = open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int nul = open("/dev/null", O_WRONLY);
-        if (fd >= 0) dup2(fd, 2);
-        if (nul >= 0) dup2(nul, 1);
-        alarm(600);   /* a hang fails the test instead of blocking ctest */
-        const char *argv[64];
-        int a = 0;
-        argv[a++] = MS_CLI_PATH;
-        for (int i = 0; args[i] && a < 63; i++) argv[a++] = args[i];
-        argv[a] = NULL;
-        execv(MS_CLI_PATH, (char *const *)argv);
-        _exit(127);
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
+    /* a hang fails the test (after 600 s) instead of blocking ctest */
+    const tu_run_opts opts = { .fsize_limit = 0, .umask = -1, .timeout_s = 600 };
+    static char all[65536];
+    const int rc = tu_run_cli_ex(args, &opts, all, sizeof all, NULL);
     if (err_line && n) {
-        err_line[0] = 0;
-        FILE *f = fopen(errpath, "rb");
-        if (f) {
-            if (!fgets(err_line, (int)n, f)) err_line[0] = 0;
-            err_line[strcspn(err_line, "\n")] = 0;
-            fclose(f);
-        }
+        all[strcspn(all, "\n")] = 0;   /* the first line */
+        snprintf(err_line, n, "%s", all);
     }
-    unlink(errpath);
-    if (WIFEXITED(status)) return WEXITSTATUS(status);
-    return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    return rc;
 }
 
 int tu_have_shared_scenes(void)
