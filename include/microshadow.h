@@ -132,6 +132,13 @@ typedef enum ms_embree_filter {
     MS_EMBREE_FILTER_NONE = 2    /* never: for measuring only, the receiver then occludes itself */
 } ms_embree_filter;
 
+/* How the micro-rasterization methods find the triangles between a point and the light. */
+typedef enum ms_traversal {
+    MS_TRAVERSAL_AUTO = 0,   /* the default: MS_TRAVERSAL_BLOCK */
+    MS_TRAVERSAL_BLOCK = 1,  /* the frusta of a 4x4 pixel block together through a shallow BVH (Benthin & Wald 2009) */
+    MS_TRAVERSAL_PIXEL = 2   /* each pixel's frustum alone through the deep BVH (Woop 2010) */
+} ms_traversal;
+
 /* Every field's zero means its default, so a zeroed struct renders with the defaults. */
 typedef struct ms_render_options {
     const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
@@ -148,6 +155,9 @@ typedef struct ms_render_options {
     int no_child_order;     /* micro-raster methods: no near-first order of BVH children */
     ms_embree_mode embree_mode;
     ms_embree_filter embree_filter;
+    ms_traversal traversal; /* micro-raster methods: block (default) or per-pixel traversal */
+    int frustum_shrink;     /* block traversal: also narrow a pixel's traversal frustum as its samples are
+                             * occluded (the paper's "FS"; off: only its leaf rectangle shrinks, "CR") */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */

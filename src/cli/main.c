@@ -31,6 +31,8 @@ static void usage(FILE *f)
         "  --shadow OUT.pfm|.exr  float shadow factor S, -1 where the primary ray missed\n"
         "  --stats OUT.json    timings and counters\n"
         "  --isa I             cap on the SIMD instruction set: auto (default), avx512, avx2, scalar\n"
+        "  --traversal T       micro-raster methods: block (default: 4x4 pixels' frusta together) or pixel\n"
+        "  --frustum-shrink    block traversal: narrow each frustum as its samples are occluded\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --help, --version\n");
 }
@@ -66,7 +68,7 @@ static int parse_int(const char *opt, const char *s, long lo, long hi, long *out
 int main(int argc, char **argv)
 {
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
-           O_STATS, O_ISA, O_QUIET, O_HELP, O_VERSION };
+           O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -74,6 +76,7 @@ int main(int argc, char **argv)
         { "seed", required_argument, 0, O_SEED }, { "vis", required_argument, 0, O_VIS },
         { "shadow", required_argument, 0, O_SHADOW }, { "isa", required_argument, 0, O_ISA },
         { "stats", required_argument, 0, O_STATS }, { "quiet", no_argument, 0, O_QUIET },
+        { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
         { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION }, { 0, 0, 0, 0 } };
     ms_render_options opt;
     ms_render_options_default(&opt);
@@ -131,6 +134,12 @@ int main(int argc, char **argv)
                 return EXIT_BAD_INPUT;
             }
             break;
+        case O_TRAVERSAL:
+            if (strcmp(optarg, "block") == 0) opt.traversal = MS_TRAVERSAL_BLOCK;
+            else if (strcmp(optarg, "pixel") == 0) opt.traversal = MS_TRAVERSAL_PIXEL;
+            else { fprintf(stderr, "microshadow: --traversal: '%s' is not block or pixel\n", optarg); return EXIT_BAD_INPUT; }
+            break;
+        case O_FRUSTUM_SHRINK: opt.frustum_shrink = 1; break;
         case O_STATS: outs[OUT_STATS].path = optarg; break;
         case O_QUIET: quiet = 1; break;
         case 'h': case O_HELP: usage(stdout); return 0;

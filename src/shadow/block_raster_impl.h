@@ -1,0 +1,241 @@
+/* The micro-rasterization methods' multi-frusta traversal (block_raster.h), instantiated per k through
+ * core/perk_each.h (MS_K, MS_WORD) for each ISA (block_raster_{scalar,avx2,avx512}.c); the loop is
+ * block_traverse_loop.h, the lanes lanes16.h.
+ *
+ * Exactness: the per-pixel traversal hands every triangle of a surviving leaf to the kernel; here a
+ * triangle is dropped for a pixel only where the kernel would change nothing in its buffer:
+ *   - depth: the kernel's own test, recomputed with its arithmetic operation for operation
+ *     (raster_internal.h, ms_tri_setup_run: light-index vertices m (P - C) summed left to right, the same
+ *     error bound MS_Z_REL), so the decision is the kernel's;
+ *   - rectangle: when the kernel would bound the triangle by its projected box (its zmin > 0), that box,
+ *     again recomputed as the kernel computes it (x * (1/z), the same slack), against the rectangle of
+ *     the buffer's visible samples: the kernel clears only samples inside its box, and outside the
+ *     rectangle there is nothing left to clear;
+ *   - coverage: the same box against the visible samples of the rows it spans;
+ *   - horizon: every vertex behind the receiver's plane by more than 1e-5 of its distance: the
+ *     segments to front samples lie strictly in front of that plane, so such a triangle blocks none
+ *     (the margin leaves the kernel's rounding near the horizon to the kernel).
+ * What the paper's leaf does per triangle with corner rays (cull frusta that miss it, from their four
+ * corner rays), the rectangle does here in the pixel's light-index space, where the corner rays are the
+ * rectangle's corners; the shrinking (CR) is the rectangle recomputed after a leaf that rasterized. */
+#include <string.h>
+#include "block_raster.h"
+#include "lanes16.h"
+#include "../raster/raster_internal.h"
+
+#ifndef MS_BR_COMMON
+#define MS_BR_COMMON
+/* A leaf's triangles that are some pixel's own (never occluding): few, usually none. */
+#define BR_MAX_SKIP MS_BLOCK_LANES
+typedef struct br_state {
+    ms_block_frusta *fr;
+    uint64_t *bt_cnt;
+    const ms_bvh *b;
+    const ms_block_input *in;
+    ms_raster_fn raster;
+    int flags;
+    float m[3][3][MS_BLOCK_LANES];   /* lane frames' m[r][a] */
+    float mabs2[3][MS_BLOCK_LANES];  /* |m[2][a]| */
+    float hn[3][MS_BLOCK_LANES];     /* receiver normals */
+    float rx0[MS_BLOCK_LANES], rx1[MS_BLOCK_LANES], ry0[MS_BLOCK_LANES], ry1[MS_BLOCK_LANES];
+    int rect[MS_BLOCK_LANES][4];
+} br_state;
+
+/* The four corner directions of lane rectangle r (columns r[0]..r[1], rows r[2]..r[3]) from C: sample
+ * (i, j) is C + mt[2] + i mt[0] + j mt[1] (raster.h). */
+static inline void br_corner_dirs(const ms_raster_frame *f, const int r[4], float d[4][3])
+{
+    for (int c = 0; c < 4; c++) {
+        const float i = (float)r[c & 1], j = (float)r[2 + (c >> 1)];
+        for (int a = 0; a < 3; a++) d[c][a] = f->mt[2][a] + i * f->mt[0][a] + j * f->mt[1][a];
+    }
+}
+#endif
+
+/* The rectangle of the visible samples of a buffer: columns r[0]..r[1], rows r[2]..r[3]; 0 if none. */
+static inline int MS_KFN(br_live_rect)(const MS_WORD *buf, int r[4])
+{
+    MS_WORD any = 0;
+    int j0 = -1, j1 = -1;
+    for (int j = 0; j < MS_K; j++)
+        if (buf[j]) { if (j0 < 0) j0 = j; j1 = j; any |= buf[j]; }
+    if (!any) return 0;
+    const uint64_t a = (uint64_t)any;
+    r[0] = __builtin_ctzll(a);
+    r[1] = 63 - __builtin_clzll(a);
+    r[2] = j0;
+    r[3] = j1;
+    return 1;
+}
+
+/* Lane l's rectangle from its buffer (0: the buffer is empty), and its traversal frustum from the
+ * rectangle when `frustum` is set. */
+static inline int MS_KFN(br_update_lane)(br_state *s, int l, int frustum)
+{
+    int r[4];
+    if (!MS_KFN(br_live_rect)((const MS_WORD *)s->in->buf[l], r)) return 0;
+    memcpy(s->rect[l], r, sizeof r);
+    s->rx0[l] = (float)r[0]; s->rx1[l] = (float)r[1];
+    s->ry0[l] = (float)r[2]; s->ry1[l] = (float)r[3];
+    if (frustum) {
+        float d[4][3];
+        br_corner_dirs(s->in->frame[l], r, d);
+        ms_block_frusta_set_lane(s->fr, l, s->in->frame[l]->c, d, 1e-5f);
+    }
+    return 1;
+}
+
+/* 1 if a visible sample lies in columns x0..x1 of rows y0..y1. */
+static inline int MS_KFN(br_covers)(const MS_WORD *buf, int x0, int x1, int y0, int y1)
+{
+    const MS_WORD ones = (MS_WORD)~(MS_WORD)0;   /* cast after ~: uint16_t promotes to int */
+    const MS_WORD mask = (MS_WORD)((MS_WORD)(ones >> (MS_K - 1 - (x1 - x0))) << x0);
+    MS_WORD any = 0;
+    for (int j = y0; j <= y1; j++) any |= buf[j];
+    return (any & mask) != 0;
+}
+
+static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
+{
+    ms_block_frusta *fr = s->fr;
+    uint64_t *cnt = s->bt_cnt;
+    const ms_block_input *in = s->in;
+    /* The pixels whose own triangle is in this leaf. */
+    uint32_t skip_tri[BR_MAX_SKIP];
+    unsigned skip_lane[BR_MAX_SKIP];
+    int nskip = 0;
+    for (unsigned m = mask; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        if (in->skip[l] - n->first < n->count) { skip_tri[nskip] = in->skip[l]; skip_lane[nskip++] = 1u << l; }
+    }
+    const l16 near = l16_set1(fr->near), far = l16_set1(fr->far), zero = l16_set1(0.0f);
+    const l16 zrel = l16_set1(MS_Z_REL), slack = l16_set1(MS_BOX_SLACK), hrel = l16_set1(1e-5f);
+    l16 m[3][3], ma[3], hn[3], c[3];
+    for (int a = 0; a < 3; a++) {
+        c[a] = l16_load(fr->c[a]);
+        ma[a] = l16_load(s->mabs2[a]);
+        hn[a] = l16_load(s->hn[a]);
+        for (int r = 0; r < 3; r++) m[r][a] = l16_load(s->m[r][a]);
+    }
+    const l16 rx0 = l16_load(s->rx0), rx1 = l16_load(s->rx1), ry0 = l16_load(s->ry0), ry1 = l16_load(s->ry1);
+    unsigned rasterized = 0;
+    uint64_t tri_lanes = 0, c_depth = 0, c_horizon = 0, c_rect = 0, c_cov = 0, c_rast = 0;
+    for (uint32_t t = n->first; t < n->first + n->count; t++) {
+        unsigned lanes = mask & fr->live;
+        if (!lanes) break;
+        for (int q = 0; q < nskip; q++)
+            if (skip_tri[q] == t) lanes &= ~skip_lane[q];
+        if (!lanes) continue;
+        tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
+        const float *tri = s->b->tri + 9 * (size_t)t;
+        l16 x[3], y[3], z[3], zlo[3], zhi[3];
+        unsigned behind = 0xFFFF;
+        for (int v = 0; v < 3; v++) {
+            l16 a[3], aa[3];
+            for (int k = 0; k < 3; k++) { a[k] = l16_sub(l16_set1(tri[3 * v + k]), c[k]); aa[k] = l16_abs(a[k]); }
+            x[v] = l16_add(l16_add(l16_mul(m[0][0], a[0]), l16_mul(m[0][1], a[1])), l16_mul(m[0][2], a[2]));
+            y[v] = l16_add(l16_add(l16_mul(m[1][0], a[0]), l16_mul(m[1][1], a[1])), l16_mul(m[1][2], a[2]));
+            z[v] = l16_add(l16_add(l16_mul(m[2][0], a[0]), l16_mul(m[2][1], a[1])), l16_mul(m[2][2], a[2]));
+            const l16 zerr = l16_mul(l16_add(l16_add(l16_mul(ma[0], aa[0]), l16_mul(ma[1], aa[1])), l16_mul(ma[2], aa[2])), zrel);
+            zlo[v] = l16_sub(z[v], zerr);
+            zhi[v] = l16_add(z[v], zerr);
+            const l16 h = l16_add(l16_add(l16_mul(hn[0], a[0]), l16_mul(hn[1], a[1])), l16_mul(hn[2], a[2]));
+            const l16 tol = l16_mul(l16_add(l16_add(aa[0], aa[1]), aa[2]), hrel);
+            behind &= l16_lt(h, l16_sub(zero, tol));
+        }
+        const l16 zmin = l16_min(l16_min(zlo[0], zlo[1]), zlo[2]);
+        const l16 zmax = l16_max(l16_max(zhi[0], zhi[1]), zhi[2]);
+        const unsigned depth_ok = l16_le(near, zmax) & l16_le(zmin, far);
+        const unsigned front = l16_gt(zmin, zero);
+        l16 xs[3], ys[3];
+        for (int v = 0; v < 3; v++) {
+            const l16 inv = l16_div(l16_set1(1.0f), z[v]);
+            xs[v] = l16_mul(x[v], inv);
+            ys[v] = l16_mul(y[v], inv);
+        }
+        const l16 xlo = l16_sub(l16_min(l16_min(xs[0], xs[1]), xs[2]), slack);
+        const l16 xhi = l16_add(l16_max(l16_max(xs[0], xs[1]), xs[2]), slack);
+        const l16 ylo = l16_sub(l16_min(l16_min(ys[0], ys[1]), ys[2]), slack);
+        const l16 yhi = l16_add(l16_max(l16_max(ys[0], ys[1]), ys[2]), slack);
+        const unsigned miss = front & (l16_lt(xhi, rx0) | l16_gt(xlo, rx1) | l16_lt(yhi, ry0) | l16_gt(ylo, ry1));
+        const unsigned l_depth = lanes & ~depth_ok, l_horizon = lanes & depth_ok & behind;
+        const unsigned l_rect = lanes & depth_ok & ~behind & miss;
+        c_depth += (uint64_t)ms_bt_popcount16(l_depth);
+        c_horizon += (uint64_t)ms_bt_popcount16(l_horizon);
+        c_rect += (uint64_t)ms_bt_popcount16(l_rect);
+        unsigned pass = lanes & depth_ok & ~behind & ~miss;
+        if (!pass) continue;
+        float bx0[MS_BLOCK_LANES], bx1[MS_BLOCK_LANES], by0[MS_BLOCK_LANES], by1[MS_BLOCK_LANES];
+        l16_store(bx0, xlo); l16_store(bx1, xhi); l16_store(by0, ylo); l16_store(by1, yhi);
+        const float kmax = (float)(MS_K - 1);
+        for (; pass; pass &= pass - 1) {
+            const int l = __builtin_ctz(pass);
+            const int *r = s->rect[l];
+            int x0 = r[0], x1 = r[1], y0 = r[2], y1 = r[3];
+            if (front >> l & 1) {
+                /* The kernel's box (ms_tri_setup_run), within the rectangle. */
+                const int bx = ms_ceil_i(ms_clampf(bx0[l], -1.0f, kmax + 1.0f)), ex = ms_floor_i(ms_clampf(bx1[l], -1.0f, kmax + 1.0f));
+                const int by = ms_ceil_i(ms_clampf(by0[l], -1.0f, kmax + 1.0f)), ey = ms_floor_i(ms_clampf(by1[l], -1.0f, kmax + 1.0f));
+                x0 = bx > x0 ? bx : x0; x1 = ex < x1 ? ex : x1;
+                y0 = by > y0 ? by : y0; y1 = ey < y1 ? ey : y1;
+                if (x0 > x1 || y0 > y1 || !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], x0, x1, y0, y1)) { c_cov++; continue; }
+            }
+            s->raster(in->frame[l], tri, in->buf[l]);
+            rasterized |= 1u << l;
+            c_rast++;
+        }
+    }
+    cnt[MS_BR_TRI_LANES] += tri_lanes;
+    cnt[MS_BR_CULLED_DEPTH] += c_depth;
+    cnt[MS_BR_CULLED_HORIZON] += c_horizon;
+    cnt[MS_BR_CULLED_RECT] += c_rect;
+    cnt[MS_BR_CULLED_COVERAGE] += c_cov;
+    cnt[MS_BR_RASTERIZED] += c_rast;
+    /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */
+    const int fs = s->flags & MS_BR_FRUSTUM_SHRINK;
+    for (; rasterized; rasterized &= rasterized - 1) {
+        const int l = __builtin_ctz(rasterized);
+        int old[4];
+        memcpy(old, s->rect[l], sizeof old);
+        if (!MS_KFN(br_update_lane)(s, l, fs)) { fr->live &= ~(1u << l); cnt[MS_BR_PIXELS_EARLY_OUT]++; continue; }
+        cnt[MS_BR_RECT_SHRINKS] += memcmp(old, s->rect[l], sizeof old) != 0;
+    }
+}
+
+#define BT_STATE br_state
+#define BT_LEAF(s, n, mask) MS_KFN(br_leaf)(s, n, mask)
+#define BT_FN MS_KFN(br_traverse)
+#include "block_traverse_loop.h"
+#undef BT_STATE
+#undef BT_LEAF
+#undef BT_FN
+
+void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh, ms_raster_fn raster,
+                             float near, float far, uint64_t *cnt, int flags)
+{
+    ms_block_frusta fr;
+    br_state s;
+    ms_block_frusta_init(&fr, &sh->nodes[0], near, far);
+    s.fr = &fr;
+    s.bt_cnt = cnt;
+    s.b = b;
+    s.in = in;
+    s.raster = raster;
+    s.flags = flags;
+    memset(s.m, 0, sizeof s.m);
+    memset(s.mabs2, 0, sizeof s.mabs2);
+    memset(s.hn, 0, sizeof s.hn);
+    for (int l = 0; l < MS_BLOCK_LANES; l++) {
+        s.rx0[l] = s.ry0[l] = 1.0f;
+        s.rx1[l] = s.ry1[l] = 0.0f;
+    }
+    for (int l = 0; l < in->n; l++) {
+        const ms_raster_frame *f = in->frame[l];
+        for (int r = 0; r < 3; r++)
+            for (int a = 0; a < 3; a++) s.m[r][a][l] = f->m[r][a];
+        for (int a = 0; a < 3; a++) { s.mabs2[a][l] = fabsf(f->m[2][a]); s.hn[a][l] = in->normal[l][a]; }
+        /* The starting frustum bounds the front samples (the horizon already cleared the rest). */
+        MS_KFN(br_update_lane)(&s, l, 1);
+    }
+    MS_KFN(br_traverse)(&s, sh, flags & MS_BR_ORDER);
+}
