@@ -22,6 +22,7 @@
 #include "block_raster.h"
 #include "lanes16.h"
 #include "../raster/raster_internal.h"
+#include "frustum_traverse.h"   /* MS_TRAV_SIDE_SLACK */
 
 #ifndef MS_BR_COMMON
 #define MS_BR_COMMON
@@ -85,6 +86,7 @@ static inline int MS_KFN(br_update_lane)(br_state *s, int l, int frustum)
     return 1;
 }
 
+
 /* 1 if a visible sample lies in columns x0..x1 of rows y0..y1. */
 static inline int MS_KFN(br_covers)(const MS_WORD *buf, int x0, int x1, int y0, int y1)
 {
@@ -93,6 +95,75 @@ static inline int MS_KFN(br_covers)(const MS_WORD *buf, int x0, int x1, int y0, 
     MS_WORD any = 0;
     for (int j = y0; j <= y1; j++) any |= buf[j];
     return (any & mask) != 0;
+}
+
+/* The lanes of mask whose rectangle frustum (light-index space: i in [rx0, rx1], j in [ry0, ry1] on the
+ * plane z = 1, segment parameter in [near, far]) may meet the box of leaf n: the per-pixel traversal's
+ * node test (frustum_traverse_impl.h, the same slack) for all sixteen pixels at once, against each
+ * pixel's rectangle rather than the whole buffer. All eight corners outside one plane through C (or
+ * beyond near or far) cull: the box, hence every triangle in it, then lies wholly outside the frustum
+ * of the visible samples. */
+static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_node *n, unsigned mask,
+                                             const l16 m[3][3], const l16 c[3])
+{
+    l16 base[3], col[3][3];
+    l16 rel[3];
+    for (int a = 0; a < 3; a++) rel[a] = l16_sub(l16_set1(n->bmin[a]), c[a]);
+    for (int r = 0; r < 3; r++) {
+        base[r] = l16_add(l16_add(l16_mul(m[r][0], rel[0]), l16_mul(m[r][1], rel[1])), l16_mul(m[r][2], rel[2]));
+        for (int a = 0; a < 3; a++) col[a][r] = l16_mul(m[r][a], l16_set1(n->bmax[a] - n->bmin[a]));
+    }
+    const l16 sl = l16_set1(MS_TRAV_SIDE_SLACK);
+    const l16 x0 = l16_sub(l16_load(s->rx0), sl), x1 = l16_add(l16_load(s->rx1), sl);
+    const l16 y0 = l16_sub(l16_load(s->ry0), sl), y1 = l16_add(l16_load(s->ry1), sl);
+    const l16 near = l16_set1(s->fr->near), far = l16_set1(s->fr->far);
+    unsigned out_xl = 0xFFFF, out_xh = 0xFFFF, out_yl = 0xFFFF, out_yh = 0xFFFF, out_n = 0xFFFF, out_f = 0xFFFF;
+    unsigned front = 0xFFFF;
+    const l16 inf = l16_set1(INFINITY), zero = l16_set1(0.0f), one = l16_set1(1.0f);
+    l16 px0 = inf, py0 = inf, px1 = l16_sub(zero, inf), py1 = l16_sub(zero, inf);
+    for (int corner = 0; corner < 8; corner++) {
+        l16 p[3];
+        for (int r = 0; r < 3; r++) {
+            p[r] = base[r];
+            if (corner & 1) p[r] = l16_add(p[r], col[0][r]);
+            if (corner & 2) p[r] = l16_add(p[r], col[1][r]);
+            if (corner & 4) p[r] = l16_add(p[r], col[2][r]);
+        }
+        /* Side planes x = x0 z etc.: through C, so the tests hold whatever the sign of z. */
+        out_xl &= l16_lt(p[0], l16_mul(x0, p[2]));
+        out_xh &= l16_gt(p[0], l16_mul(x1, p[2]));
+        out_yl &= l16_lt(p[1], l16_mul(y0, p[2]));
+        out_yh &= l16_gt(p[1], l16_mul(y1, p[2]));
+        out_n &= l16_lt(p[2], near);
+        out_f &= l16_gt(p[2], far);
+        front &= l16_gt(p[2], zero);
+        const l16 iz = l16_div(one, p[2]);
+        const l16 qx = l16_mul(p[0], iz), qy = l16_mul(p[1], iz);
+        px0 = l16_min(px0, qx); px1 = l16_max(px1, qx);
+        py0 = l16_min(py0, qy); py1 = l16_max(py1, qy);
+    }
+    unsigned keep = mask & ~(out_xl | out_xh | out_yl | out_yh | out_n | out_f);
+    /* Coverage (the per-pixel traversal's occlusion cull): in front of C the box projects inside the hull
+     * of its corners' projections; if that holds no visible sample, nothing in the leaf changes the
+     * buffer. */
+    unsigned cand = keep & front;
+    if (cand) {
+        float bx0[MS_BLOCK_LANES], bx1[MS_BLOCK_LANES], by0[MS_BLOCK_LANES], by1[MS_BLOCK_LANES];
+        l16_store(bx0, px0); l16_store(bx1, px1); l16_store(by0, py0); l16_store(by1, py1);
+        for (; cand; cand &= cand - 1) {
+            const int l = __builtin_ctz(cand);
+            const int *r = s->rect[l];
+            const float kmax = (float)(MS_K - 1);
+            const int ix0 = ms_ceil_i(ms_clampf(bx0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int ix1 = ms_floor_i(ms_clampf(bx1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int iy0 = ms_ceil_i(ms_clampf(by0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int iy1 = ms_floor_i(ms_clampf(by1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int xa = ix0 > r[0] ? ix0 : r[0], xb = ix1 < r[1] ? ix1 : r[1];
+            const int ya = iy0 > r[2] ? iy0 : r[2], yb = iy1 < r[3] ? iy1 : r[3];
+            if (xa > xb || ya > yb || !MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa, xb, ya, yb)) keep &= ~(1u << l);
+        }
+    }
+    return keep;
 }
 
 static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
@@ -118,6 +189,10 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
         for (int r = 0; r < 3; r++) m[r][a] = l16_load(s->m[r][a]);
     }
     const l16 rx0 = l16_load(s->rx0), rx1 = l16_load(s->rx1), ry0 = l16_load(s->ry0), ry1 = l16_load(s->ry1);
+    const unsigned before = mask & fr->live;
+    mask = MS_KFN(br_leaf_lanes)(s, n, before, m, c);
+    cnt[MS_BR_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
+    if (!mask) return;
     unsigned rasterized = 0;
     uint64_t tri_lanes = 0, c_depth = 0, c_horizon = 0, c_rect = 0, c_cov = 0, c_rast = 0;
     for (uint32_t t = n->first; t < n->first + n->count; t++) {

@@ -40,7 +40,7 @@ typedef struct mr_state {
 } mr_state;
 
 static const char *const block_counter_names[] = {
-    "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "tri_pixel_tests",
+    "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "leaf_pixels_culled", "tri_pixel_tests",
     "culled_depth", "culled_horizon", "culled_rect", "culled_coverage", "triangles_rasterized",
     "pixels_early_out", "rect_shrinks", "pixels_traced_edge_on"
 };
