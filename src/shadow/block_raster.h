@@ -15,19 +15,18 @@
 #include "../core/perk.h"
 
 /* The block as the caller hands it over: up to 16 pixels, each with its frame, its buffer (the front
- * mask on entry, the visible mask on return), its hit triangle and receiver normal. */
+ * mask on entry, the visible mask on return) and its hit triangle. */
 typedef struct ms_block_input {
     int n;
     const ms_raster_frame *frame[MS_BLOCK_LANES];
     void *buf[MS_BLOCK_LANES];
     uint32_t skip[MS_BLOCK_LANES];
-    float normal[MS_BLOCK_LANES][3];
 } ms_block_input;
 
 enum {
     MS_BR_LEAF_LANES_CULLED = MS_BT_COUNTERS, /* pixels dropped at a leaf by their own frustum */
     MS_BR_TRI_LANES,                   /* (triangle, pixel) pairs reaching the leaf tests */
-    MS_BR_CULLED_DEPTH, MS_BR_CULLED_HORIZON, MS_BR_CULLED_RECT, MS_BR_CULLED_COVERAGE,
+    MS_BR_CULLED_DEPTH, MS_BR_CULLED_RECT, MS_BR_CULLED_COVERAGE,
     MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS, MS_BR_COUNTERS
 };
 

@@ -24,6 +24,9 @@ L16_INLINE l16 l16_div(l16 a, l16 b) { return _mm512_div_ps(a, b); }
 L16_INLINE l16 l16_min(l16 a, l16 b) { return _mm512_min_ps(a, b); }
 L16_INLINE l16 l16_max(l16 a, l16 b) { return _mm512_max_ps(a, b); }
 L16_INLINE l16 l16_abs(l16 a) { return _mm512_abs_ps(a); }
+L16_INLINE l16 l16_ceil(l16 a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC); }
+L16_INLINE l16 l16_floor(l16 a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
+L16_INLINE void l16_store_int(int32_t *p, l16 a) { _mm512_storeu_si512((void *)p, _mm512_cvttps_epi32(a)); }
 L16_INLINE unsigned l16_lt(l16 a, l16 b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
 L16_INLINE unsigned l16_le(l16 a, l16 b) { return _mm512_cmp_ps_mask(a, b, _CMP_LE_OQ); }
 L16_INLINE unsigned l16_gt(l16 a, l16 b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
@@ -48,6 +51,13 @@ L16_INLINE l16 l16_abs(l16 a)
 {
     const __m256 s = _mm256_set1_ps(-0.0f);
     return (l16){ _mm256_andnot_ps(s, a.lo), _mm256_andnot_ps(s, a.hi) };
+}
+L16_INLINE l16 l16_ceil(l16 a) { return (l16){ _mm256_ceil_ps(a.lo), _mm256_ceil_ps(a.hi) }; }
+L16_INLINE l16 l16_floor(l16 a) { return (l16){ _mm256_floor_ps(a.lo), _mm256_floor_ps(a.hi) }; }
+L16_INLINE void l16_store_int(int32_t *p, l16 a)
+{
+    _mm256_storeu_si256((__m256i *)p, _mm256_cvttps_epi32(a.lo));
+    _mm256_storeu_si256((__m256i *)(p + 8), _mm256_cvttps_epi32(a.hi));
 }
 #define L16_CMP(name, pred)                                                                   \
     L16_INLINE unsigned name(l16 a, l16 b)                                                    \
@@ -89,6 +99,21 @@ L16_OP(l16_div, x / y)
 L16_OP(l16_min, x < y ? x : y)
 L16_OP(l16_max, x > y ? x : y)
 L16_INLINE l16 l16_abs(l16 a) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = a.v[i] < 0.0f ? -a.v[i] : a.v[i] + 0.0f; return r; }
+/* Ceiling and floor of values within int range (the callers clamp first): exact by truncation and one
+ * step, as ms_ceil_i (ceilf/floorf are library calls without SSE4.1). */
+L16_INLINE l16 l16_ceil(l16 a)
+{
+    l16 r;
+    for (int i = 0; i < 16; i++) { const int t = (int)a.v[i]; r.v[i] = (float)(t + ((float)t < a.v[i])); }
+    return r;
+}
+L16_INLINE l16 l16_floor(l16 a)
+{
+    l16 r;
+    for (int i = 0; i < 16; i++) { const int t = (int)a.v[i]; r.v[i] = (float)(t - ((float)t > a.v[i])); }
+    return r;
+}
+L16_INLINE void l16_store_int(int32_t *p, l16 a) { for (int i = 0; i < 16; i++) p[i] = (int32_t)a.v[i]; }
 #define L16_CMP(name, op)                                                          \
     L16_INLINE unsigned name(l16 a, l16 b)                                         \
     {                                                                              \

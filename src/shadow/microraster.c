@@ -41,7 +41,7 @@ typedef struct mr_state {
 
 static const char *const block_counter_names[] = {
     "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "leaf_pixels_culled", "tri_pixel_tests",
-    "culled_depth", "culled_horizon", "culled_rect", "culled_coverage", "triangles_rasterized",
+    "culled_depth", "culled_rect", "culled_coverage", "triangles_rasterized",
     "pixels_early_out", "rect_shrinks", "pixels_traced_edge_on"
 };
 enum { MR_BLOCK_EDGE_ON = MS_BR_COUNTERS, MR_BLOCK_COUNTERS };
@@ -153,7 +153,6 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
             in.frame[in.n] = &frames[in.n];
             in.buf[in.n] = buf;
             in.skip[in.n] = q[i].prim;
-            memcpy(in.normal[in.n], q[i].n, sizeof q[i].n);
             in.n++;
         }
         if (!rc && in.n) s->block(&in, ctx->bvh, &s->shallow, s->raster, ctx->near, ctx->far, cnt, s->block_flags);
