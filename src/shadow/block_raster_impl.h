@@ -59,16 +59,16 @@ static inline void br_corner_dirs(const ms_raster_frame *f, const int r[4], floa
 /* The rectangle of the visible samples of a buffer: columns r[0]..r[1], rows r[2]..r[3]; 0 if none. */
 static inline int MS_KFN(br_live_rect)(const MS_WORD *buf, int r[4])
 {
+    /* Branch-free (the rows' emptiness is data, and mispredicted here it cost 10% of the traversal). */
     MS_WORD any = 0;
-    int j0 = -1, j1 = -1;
-    for (int j = 0; j < MS_K; j++)
-        if (buf[j]) { if (j0 < 0) j0 = j; j1 = j; any |= buf[j]; }
+    uint64_t rows = 0;
+    for (int j = 0; j < MS_K; j++) { any |= buf[j]; rows |= (uint64_t)(buf[j] != 0) << j; }
     if (!any) return 0;
     const uint64_t a = (uint64_t)any;
     r[0] = __builtin_ctzll(a);
     r[1] = 63 - __builtin_clzll(a);
-    r[2] = j0;
-    r[3] = j1;
+    r[2] = __builtin_ctzll(rows);
+    r[3] = 63 - __builtin_clzll(rows);
     return 1;
 }
 
