@@ -26,7 +26,7 @@ typedef struct ms_block_input {
 enum {
     MS_BR_LEAF_LANES_CULLED = MS_BT_COUNTERS, /* pixels dropped at a leaf by their own frustum */
     MS_BR_TRI_LANES,                   /* (triangle, pixel) pairs reaching the leaf tests */
-    MS_BR_CULLED_DEPTH, MS_BR_CULLED_RECT, MS_BR_CULLED_COVERAGE,
+    MS_BR_CULLED_DEPTH, MS_BR_CULLED_RECT, MS_BR_CULLED_CORNER, MS_BR_CULLED_COVERAGE,
     MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS, MS_BR_COUNTERS
 };
 

@@ -32,6 +32,8 @@
 #define MS_BR_COMMON
 /* A leaf's triangles that are some pixel's own (never occluding): few, usually none. */
 #define BR_MAX_SKIP MS_BLOCK_LANES
+/* Smallest rectangle (in samples) for which the corner-ray test runs. */
+#define BR_CORNER_AREA 16.0f
 typedef struct br_state {
     ms_block_frusta *fr;
     uint64_t *bt_cnt;
@@ -197,7 +199,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
     if (!mask) return;
     unsigned rasterized = 0;
-    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_cov = 0, c_rast = 0;
+    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_corner = 0, c_cov = 0, c_rast = 0;
     for (uint32_t t = n->first; t < n->first + n->count; t++) {
         unsigned lanes = mask & fr->live;
         if (!lanes) break;
@@ -243,6 +245,44 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
         c_rect += (uint64_t)ms_bt_popcount16(l_rect);
         unsigned pass = lanes & depth_ok & ~miss;
         if (!pass) continue;
+        /* Corner rays (the paper's corner-ray culling, in light-index space): a triangle whose box holds
+         * visible samples may still miss the whole rectangle box x rows (a long thin triangle across
+         * it). Its three edge planes through C, oriented towards the opposite vertex: if the four
+         * corners of the rectangle lie outside one of them, no sample inside does (convexity). Worth
+         * its cost only for large rectangles, where the kernel call it saves is dear and the miss likely;
+         * a margin of 1e-5 of the terms' magnitudes leaves any doubt to the kernel. */
+        const l16 cx0 = l16_select(front, bx0, rx0), cx1 = l16_select(front, bx1, rx1);
+        const l16 cy0 = l16_select(front, by0, ry0), cy1 = l16_select(front, by1, ry1);
+        const l16 area = l16_mul(l16_add(l16_sub(cx1, cx0), one), l16_add(l16_sub(cy1, cy0), one));
+        if (pass & l16_gt(area, l16_set1(BR_CORNER_AREA))) {
+            l16 n1[3];
+            for (int v = 0; v < 3; v++) n1[v] = l16_add(l16_add(l16_abs(x[v]), l16_abs(y[v])), l16_abs(z[v]));
+            const l16 pmax = l16_add(l16_add(cx1, cy1), one);   /* |i| + |j| + 1 at any corner */
+            unsigned out = 0;
+            for (int e = 0; e < 3; e++) {
+                const int va = (e + 1) % 3, vb = (e + 2) % 3;
+                const l16 ex = l16_sub(l16_mul(y[va], z[vb]), l16_mul(z[va], y[vb]));
+                const l16 ey = l16_sub(l16_mul(z[va], x[vb]), l16_mul(x[va], z[vb]));
+                const l16 ez = l16_sub(l16_mul(x[va], y[vb]), l16_mul(y[va], x[vb]));
+                const l16 tol = l16_mul(l16_mul(n1[va], n1[vb]), l16_set1(1e-5f));
+                const l16 side = l16_add(l16_add(l16_mul(ex, x[e]), l16_mul(ey, y[e])), l16_mul(ez, z[e]));
+                const l16 tc = l16_mul(tol, n1[e]);
+                const unsigned pos = l16_gt(side, tc), neg = l16_lt(side, l16_sub(zero, tc));
+                const l16 tp = l16_mul(tol, pmax), ntp = l16_sub(zero, tp);
+                unsigned pos_out = pos, neg_out = neg;
+                for (int corner = 0; corner < 4; corner++) {
+                    const l16 pi = (corner & 1) ? cx1 : cx0, pj = (corner & 2) ? cy1 : cy0;
+                    const l16 val = l16_add(l16_add(l16_mul(ex, pi), l16_mul(ey, pj)), ez);
+                    pos_out &= l16_lt(val, ntp);   /* inside is positive: the corner is outside */
+                    neg_out &= l16_gt(val, tp);
+                }
+                out |= pos_out | neg_out;
+            }
+            out &= pass;
+            c_corner += (uint64_t)ms_bt_popcount16(out);
+            pass &= ~out;
+            if (!pass) continue;
+        }
         int32_t ix0[MS_BLOCK_LANES], ix1[MS_BLOCK_LANES], iy0[MS_BLOCK_LANES], iy1[MS_BLOCK_LANES];
         l16_store_int(ix0, bx0); l16_store_int(ix1, bx1); l16_store_int(iy0, by0); l16_store_int(iy1, by1);
         for (; pass; pass &= pass - 1) {
@@ -258,6 +298,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_TRI_LANES] += tri_lanes;
     cnt[MS_BR_CULLED_DEPTH] += c_depth;
     cnt[MS_BR_CULLED_RECT] += c_rect;
+    cnt[MS_BR_CULLED_CORNER] += c_corner;
     cnt[MS_BR_CULLED_COVERAGE] += c_cov;
     cnt[MS_BR_RASTERIZED] += c_rast;
     /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */

@@ -41,7 +41,7 @@ typedef struct mr_state {
 
 static const char *const block_counter_names[] = {
     "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "leaf_pixels_culled", "tri_pixel_tests",
-    "culled_depth", "culled_rect", "culled_coverage", "triangles_rasterized",
+    "culled_depth", "culled_rect", "culled_corner_rays", "culled_coverage", "triangles_rasterized",
     "pixels_early_out", "rect_shrinks", "pixels_traced_edge_on"
 };
 enum { MR_BLOCK_EDGE_ON = MS_BR_COUNTERS, MR_BLOCK_COUNTERS };
