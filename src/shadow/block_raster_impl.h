@@ -58,13 +58,14 @@ static inline void br_corner_dirs(const ms_raster_frame *f, const int r[4], floa
 }
 #endif
 
-/* The rectangle of the visible samples of a buffer: columns r[0]..r[1], rows r[2]..r[3]; 0 if none. */
-static inline int MS_KFN(br_live_rect)(const MS_WORD *buf, int r[4])
+/* The rectangle of the visible samples of a buffer within rows j0..j1 (the others known empty):
+ * columns r[0]..r[1], rows r[2]..r[3]; 0 if none. */
+static inline int MS_KFN(br_live_rect)(const MS_WORD *buf, int j0, int j1, int r[4])
 {
     /* Branch-free (the rows' emptiness is data, and mispredicted here it cost 10% of the traversal). */
     MS_WORD any = 0;
     uint64_t rows = 0;
-    for (int j = 0; j < MS_K; j++) { any |= buf[j]; rows |= (uint64_t)(buf[j] != 0) << j; }
+    for (int j = j0; j <= j1; j++) { any |= buf[j]; rows |= (uint64_t)(buf[j] != 0) << j; }
     if (!any) return 0;
     const uint64_t a = (uint64_t)any;
     r[0] = __builtin_ctzll(a);
@@ -75,11 +76,13 @@ static inline int MS_KFN(br_live_rect)(const MS_WORD *buf, int r[4])
 }
 
 /* Lane l's rectangle from its buffer (0: the buffer is empty), and its traversal frustum from the
- * rectangle when `frustum` is set. */
-static inline int MS_KFN(br_update_lane)(br_state *s, int l, int frustum)
+ * rectangle when `frustum` is set. Rectangles only shrink: rows outside the current one are not read
+ * (`first`: there is none yet). */
+static inline int MS_KFN(br_update_lane)(br_state *s, int l, int frustum, int first)
 {
     int r[4];
-    if (!MS_KFN(br_live_rect)((const MS_WORD *)s->in->buf[l], r)) return 0;
+    const int j0 = first ? 0 : s->rect[l][2], j1 = first ? MS_K - 1 : s->rect[l][3];
+    if (!MS_KFN(br_live_rect)((const MS_WORD *)s->in->buf[l], j0, j1, r)) return 0;
     memcpy(s->rect[l], r, sizeof r);
     s->rx0[l] = (float)r[0]; s->rx1[l] = (float)r[1];
     s->ry0[l] = (float)r[2]; s->ry1[l] = (float)r[3];
@@ -307,7 +310,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
         const int l = __builtin_ctz(rasterized);
         int old[4];
         memcpy(old, s->rect[l], sizeof old);
-        if (!MS_KFN(br_update_lane)(s, l, fs)) { fr->live &= ~(1u << l); cnt[MS_BR_PIXELS_EARLY_OUT]++; continue; }
+        if (!MS_KFN(br_update_lane)(s, l, fs, 0)) { fr->live &= ~(1u << l); cnt[MS_BR_PIXELS_EARLY_OUT]++; continue; }
         cnt[MS_BR_RECT_SHRINKS] += memcmp(old, s->rect[l], sizeof old) != 0;
     }
 }
@@ -344,7 +347,7 @@ void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms
             for (int a = 0; a < 3; a++) s.m[r][a][l] = f->m[r][a];
         for (int a = 0; a < 3; a++) s.mabs2[a][l] = fabsf(f->m[2][a]);
         /* The starting frustum bounds the front samples (the horizon already cleared the rest). */
-        MS_KFN(br_update_lane)(&s, l, 1);
+        MS_KFN(br_update_lane)(&s, l, 1, 1);
     }
     MS_KFN(br_traverse)(&s, sh, flags & MS_BR_ORDER);
 }
