@@ -229,6 +229,76 @@ int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t e
  * light clipped to the receiver's hemisphere), per unit emitted radiance. */
 float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
 
+/* ---- Visibility at any points: the library for bakers (docs/baking.md) ----
+ *
+ * A baker needs V and S at its own receivers (texels, vertices, probes), not at pixels. The scene's
+ * acceleration structure is built once (ms_accel_build) and reused by any number of calls, from any
+ * number of threads at once (the handle is read-only after the build). Each call answers V and S under
+ * the definition above, with the receiver's plane given by its normal and the triangle it lies on (if
+ * given) never occluding it, on the same sample patterns as frames: point i's pattern is that of
+ * pixel (key[2i], key[2i+1]) of a frame with the same seed, or of pixel (i, 0) without keys, so results
+ * do not depend on the order in which points are processed or on the number of threads. Internally
+ * points are grouped by proximity (Morton order of their positions) so that coherent methods stay
+ * coherent; results come back in the caller's order. */
+
+/* Status codes of the points API (and ms_bake); a one-line message goes into err as elsewhere. */
+typedef enum ms_status {
+    MS_OK = 0,
+    MS_ERR_INVALID = 1,     /* a bad argument (the message names it) */
+    MS_ERR_NO_MEMORY = 2,
+    MS_ERR_CANCELLED = 3,   /* the progress callback returned non-zero */
+    MS_ERR_METHOD = 4,      /* unknown method, not compiled in, or its set-up failed */
+    MS_ERR_IO = 5           /* reading or writing a file failed */
+} ms_status;
+/* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o". */
+const char *ms_status_name(ms_status s);
+
+/* Progress with cancellation (like Embree's progress monitor): called with the fraction done, from one
+ * thread at a time (never concurrently for one call); return 0 to go on, non-zero to cancel the call,
+ * which then returns MS_ERR_CANCELLED soon after without results. */
+typedef int (*ms_progress_cancel_fn)(void *user, double fraction_done);
+
+typedef struct ms_accel ms_accel;
+/* Builds the acceleration structure of the scene's triangles (copied: the scene may be freed after).
+ * threads: 0 for all cores. MS_OK and *out, or an error with *out = NULL. */
+ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
+void ms_accel_free(ms_accel *a);
+size_t ms_accel_triangles(const ms_accel *a);
+
+#define MS_NO_TRIANGLE UINT32_MAX
+
+typedef struct ms_points {
+    size_t n;
+    const float *position;   /* 3n floats */
+    const float *normal;     /* 3n floats: the side of each receiver (need not be unit length, not zero) */
+    const uint32_t *triangle;/* n or NULL: index of the scene triangle (ms_scene.tri) each point lies on,
+                              * which never occludes it, or MS_NO_TRIANGLE; NULL: none. Without it a point
+                              * on a surface is still not occluded by that surface's plane (the near
+                              * range), but may be by a triangle meeting it at a crease. */
+    const uint32_t *key;     /* 2n or NULL: the pixel whose sample pattern point i uses (see above) */
+} ms_points;
+
+/* Every field's zero means its default (as ms_render_options). */
+typedef struct ms_points_options {
+    const char *method;     /* NULL: MS_DEFAULT_METHOD */
+    ms_pattern pattern;
+    int samples;            /* 256, 1024 or 4096; 0: MS_SAMPLES_DEFAULT */
+    int threads;            /* 0: all cores */
+    uint32_t seed;
+    ms_isa isa;
+    ms_progress_cancel_fn progress;   /* may be NULL */
+    void *progress_user;
+    ms_embree_mode embree_mode;
+    ms_embree_filter embree_filter;
+} ms_points_options;
+
+/* V, S and the front count of each point (any output may be NULL; each has n entries). light: NULL for
+ * the light of the scene the accel was built from. Stats (timing, counters, no image fields) into
+ * stats when non-NULL. */
+ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
+                               const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
+                               ms_stats *stats, char *err, size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif
