@@ -32,3 +32,7 @@ configure_file(cmake/microshadow.pc.in ${CMAKE_CURRENT_BINARY_DIR}/microshadow.p
 configure_file(cmake/microshadow-static.pc.in ${CMAKE_CURRENT_BINARY_DIR}/microshadow-static.pc @ONLY)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/microshadow.pc ${CMAKE_CURRENT_BINARY_DIR}/microshadow-static.pc
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# The Python module, beside the library it loads (python/microshadow finds ../../../libmicroshadow.so).
+install(DIRECTORY python/microshadow DESTINATION ${CMAKE_INSTALL_LIBDIR}/python3/dist-packages
+  PATTERN __pycache__ EXCLUDE)

@@ -44,4 +44,18 @@ $cc $flags -o "$work/pc_static" "$src/consumer/consumer.c" $(pkg-config --static
 echo "--- the installed CLI"
 "$prefix/bin/microshadow" --quiet --width 32 --height 24 --samples 256 -o "$work/cli.png"
 [ -s "$work/cli.png" ] || { echo "test_install: the installed CLI wrote no image"; exit 1; }
+echo "--- the installed Python module"
+if [ -n "$flags" ]; then
+    echo "skipped in a sanitized build (python is not instrumented; test_python covers the module there)"
+elif ! /usr/bin/python3 -c "import numpy" 2>/dev/null; then
+    echo "skipped: /usr/bin/python3 with numpy not found"
+else
+    (cd "$work" && env -u MICROSHADOW_LIBRARY PYTHONPATH="$libdir/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 \
+        /usr/bin/python3 -c "
+import microshadow as ms, numpy as np
+assert ms._lib._name.startswith('$libdir/'), ms._lib._name
+V, S = ms.visibility_points(ms.default_scene(), [[5, 0, 5], [2.25, 0.5, -0.75]], [[0, 1, 0], [0, 1, 0]])
+assert V[0] == 1.0 and V[1] == 0.0, V
+print('python: V', V, 'from', ms._lib._name)")
+fi
 echo "test_install: all passed"
