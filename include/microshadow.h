@@ -326,7 +326,7 @@ typedef struct ms_bake_options {
                                 * lacks it are unwrapped by xatlas into the free space of one atlas with
                                 * them (all of them if no mesh has the set); -1: xatlas for every triangle */
     int dilate;                /* texels of dilation; 0: 4; -1: none */
-    int padding;               /* texels between xatlas charts; 0: 4 */
+    int padding;               /* texels between xatlas charts; 0: 2 */
 } ms_bake_options;
 
 typedef struct ms_lightmap {

@@ -325,7 +325,7 @@ _lightmap_free = _sig("ms_lightmap_free", None, ctypes.POINTER(_Lightmap))
 
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
-         dilate=4, padding=4, accel=None, progress=None):
+         dilate=4, padding=2, accel=None, progress=None):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3), vis and shadow (size, size; -1 where
     nothing reached), front, position and normal (size, size, 3; NaN off the triangles), triangle
     (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked into, and counts and

@@ -25,7 +25,7 @@ static void usage(FILE *f)
         "  --png OUT.png       tone-mapped preview\n"
         "  --stats OUT.json    timings and counters\n"
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
-        "  --padding N         texels between xatlas charts (default 4)\n"
+        "  --padding N         texels between xatlas charts (default 2)\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --help\n", MS_MAX_UV_SETS - 1);

@@ -228,7 +228,7 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
         return MS_ERR_INVALID;
     }
     const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
-    const int padding = o->padding > 0 ? o->padding : 4;
+    const int padding = o->padding > 0 ? o->padding : 2;
     ms_accel *own = NULL;
     ms_status st;
     if (!accel) {
