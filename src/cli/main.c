@@ -1,5 +1,6 @@
 /* The microshadow command line: render a scene file (or the built-in scene) with one shadow method. */
 #include "microshadow.h"
+#include "bake.h"
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
@@ -15,6 +16,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
         "usage: microshadow [SCENE.json] [options]\n"
+        "       microshadow bake [SCENE.json] [options]   (a lightmap: microshadow bake --help)\n"
         "Renders soft shadows from the scene's parallelogram light (the built-in scene without SCENE).\n"
         "\n"
         "  --method M          shadow method:");
@@ -67,6 +69,7 @@ static int parse_int(const char *opt, const char *s, long lo, long hi, long *out
 
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION };
     static const struct option longopts[] = {

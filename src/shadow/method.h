@@ -34,7 +34,8 @@ typedef struct ms_render_ctx {
 } ms_render_ctx;
 
 /* One visible point: the pixel, its hit point, the unit geometric normal facing the camera (its plane is
- * the receiver's horizon), and the hit triangle, which never occludes. */
+ * the receiver's horizon), and the hit triangle, which never occludes (UINT32_MAX: none, for points of
+ * the points API that lie on no triangle). */
 typedef struct ms_shadow_query {
     float p[3];
     float n[3];
