@@ -191,6 +191,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     ctx.isa_cap = opt->isa;
     ctx.embree_mode = opt->embree_mode;
     ctx.embree_filter = opt->embree_filter;
+    ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
 
     const size_t n = pts->n;
     /* Proximity order: Morton codes in the points' bounding box, ties by index (a total order). */

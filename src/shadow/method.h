@@ -28,6 +28,8 @@ typedef struct ms_render_ctx {
     ms_isa isa_cap;
     int no_occlusion_cull, no_child_order;
     ms_traversal traversal;            /* micro-raster methods: block or per-pixel traversal */
+    int queries_in_order;              /* 1: queries come in proximity order (the points API), so block
+                                        * methods group consecutive ones; 0: by 4x4 pixel block (frames) */
     int frustum_shrink;
     ms_embree_mode embree_mode;        /* embree: how rays are handed over, and when the receiver is filtered */
     ms_embree_filter embree_filter;

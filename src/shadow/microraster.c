@@ -127,7 +127,8 @@ static int cmp_by_block(const void *a, const void *b, void *arg)
     return ka < kb ? -1 : ka > kb;
 }
 
-/* The queries grouped by 4x4 pixel block (at most 16 to a group), each group traversed together. */
+/* The queries grouped by 4x4 pixel block (at most 16 to a group), or 16 consecutive ones when they come
+ * in proximity order (the points API), each group traversed together. */
 static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
                                const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
@@ -136,7 +137,7 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
     int *order = malloc((size_t)nq * sizeof *order);
     if (!order) return -1;
     for (int i = 0; i < nq; i++) order[i] = i;
-    qsort_r(order, (size_t)nq, sizeof *order, cmp_by_block, (void *)q);
+    if (!ctx->queries_in_order) qsort_r(order, (size_t)nq, sizeof *order, cmp_by_block, (void *)q);
     int rc = 0;
     for (int g = 0; g < nq && !rc;) {
         ms_block_input in;
@@ -144,7 +145,7 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
         in.n = 0;
         const uint64_t key = block_key(&q[order[g]]);
         int e = g;
-        for (; e < nq && e - g < MS_BLOCK_LANES && block_key(&q[order[e]]) == key; e++) {
+        for (; e < nq && e - g < MS_BLOCK_LANES && (ctx->queries_in_order || block_key(&q[order[e]]) == key); e++) {
             const int i = order[e];
             uint64_t *buf = vis + (size_t)i * mw;
             const int go = mr_start(ctx, &q[i], front + (size_t)i * mw, buf, &frames[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
