@@ -19,9 +19,11 @@
  * Before the triangles, a leaf's box is tested the same way for all sixteen pixels (br_leaf_lanes):
  * against each pixel's rectangle frustum and, projected, against its visible samples (the per-pixel
  * traversal's node tests, frustum_traverse_impl.h), so that a pixel skips a leaf it cannot change.
- * What the paper's leaf does per triangle with corner rays (cull frusta that miss it, from their four
- * corner rays), the rectangle does here in the pixel's light-index space, where the corner rays are the
- * rectangle's corners; the shrinking (CR) is the rectangle recomputed after a leaf that rasterized. */
+ * The paper's corner rays are here the rays through the rectangle's corners (the pixel's light-index
+ * space makes them the corners of a box of sample indices): the rectangle test is the frustum's side
+ * planes against the triangle, the corner-ray test (large rectangles only) the triangle's edge planes
+ * against the corner rays, and the paper's shrinking (CR) is the rectangle recomputed after a leaf in
+ * which the pixel rasterized. */
 #include <string.h>
 #include "block_raster.h"
 #include "lanes16.h"
