@@ -4,6 +4,7 @@
 #include "../core/pattern.h"
 #include "../shadow/method.h"
 #include "../shadow/receiver.h"
+#include "shadow_frame.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -140,6 +141,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     int failed = 0;
     const size_t mw = (size_t)ctx.mask_words;
     const int stratified = ctx.pattern != MS_PATTERN_GRID;
+    const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
 #pragma omp parallel num_threads(threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
@@ -151,7 +153,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
         int ok = front && vmask && (pts || !stratified);
 #pragma omp for schedule(dynamic, 1)
-        for (int t = 0; t < ntiles; t++) {
+        for (int t = 0; t < shadow_tiles; t++) {
             int x0 = (t % tx) * TILE, y0 = (t / tx) * TILE;
             int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
             ms_shadow_query q[TILE * TILE];
@@ -198,6 +200,9 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
             failed |= !ok;
         }
     }
+    if (sm->visibility_all && !failed)
+        failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, W, H, out, counters, &visible, &penumbra, &segments,
+                                       &resolve_thread_s) != 0;
     double t2 = omp_get_wtime();
     if (failed) {
         snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);

@@ -55,6 +55,13 @@ typedef struct ms_shadow_method {
     int (*visibility)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n,
                       const uint64_t *front, uint64_t *vis, uint64_t *counters);
     void (*destroy)(void *state);
+    /* Optional whole-frame entry (NULL: per tile through visibility). For methods that need every receiver of
+     * the frame at once (hpc: triangle order over a hierarchy of all hit points): n queries, their front and
+     * visible masks as for visibility; called once per frame from one thread (the method threads itself,
+     * ctx->threads), counters summed over its threads. The renderer resolves V and S from the masks as for
+     * every method (ms_resolve_vs). 0, or -1 when out of memory. */
+    int (*visibility_all)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, size_t n,
+                          const uint64_t *front, uint64_t *vis, uint64_t *counters);
     /* Optional (NULL: the method has no ISA-dispatched code): the instruction sets its kernel and its
      * traversal run, as chosen by create under ctx->isa_cap, for ms_stats. */
     void (*isa_used)(const void *state, ms_isa *kernel, ms_isa *traversal);
