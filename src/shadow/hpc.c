@@ -37,8 +37,8 @@
  *    per-point part of "constructing V_li" (the packet shear axes) is made lazily with the point's mask.
  *  - the penumbra volumes cull with a margin (hpc_volume.h) that covers the rounding of that exact test:
  *    the error of a float test is magnified behind the triangle by (distance to the light) / (triangle's
- *    distance from the light's plane), so the margin grows with it (tri_margin); a triangle touching the
- *    light's plane gets no volume (nothing culled, every relation tested).
+ *    distance from the light), so the margin grows with it (tri_margin); a triangle touching the light's
+ *    bounding box gets no volume (nothing culled, every relation tested).
  *  - below 1K points the split is a 16-bin SAH (count-weighted, the paper's "total surface area of the
  *    children" unweighted would split off single points), and leaves hold up to 8 points.
  *  - the light samples behind a receiver's plane (the horizon) count as blocked from the start, so umbra
@@ -105,7 +105,7 @@ typedef struct shared {
     uint64_t *gmask;                 /* G x mw: the samples of each group */
     double light_poly[12];
     double group_poly[64][12];
-    float light_n[3], light_d, scale;
+    float light_lo[3], light_hi[3], scale;
     size_t n;
     const ms_shadow_query *q;
     const uint64_t *front;
@@ -352,18 +352,21 @@ static void slot_put(chunk *c, int32_t s)
 /* ---- per triangle ---- */
 
 /* The culling margin for a triangle (see the departures above): 256 ulps of the frame's coordinates,
- * magnified by the largest ratio of receiver-to-light over triangle-to-light-plane distances. A triangle
- * touching the light's plane: infinite (no culling). */
+ * magnified by the largest ratio of a receiver's distance to the light over the distance between the
+ * triangle and the light: a ray from a sample through the triangle passes it at least that far from the
+ * sample, and rounding at the triangle moves the shadow at the receiver by that ratio. The distance is
+ * bounded below by the gap between the bounding boxes of the triangle and the light. A triangle touching
+ * the light's box: infinite (no culling). */
 static float tri_margin(const shared *sh, const float v[9])
 {
-    float dmin = INFINITY, dmax = -INFINITY, sc = sh->scale;
-    for (int i = 0; i < 3; i++) {
-        const float d = v3_dot(sh->light_n, v + 3 * i) + sh->light_d;
-        dmin = ms_minf(dmin, d);
-        dmax = ms_maxf(dmax, d);
-        for (int a = 0; a < 3; a++) sc = ms_maxf(sc, fabsf(v[3 * i + a]));
+    float sc = sh->scale, gap2 = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        const float lo = ms_minf(v[a], ms_minf(v[3 + a], v[6 + a])), hi = ms_maxf(v[a], ms_maxf(v[3 + a], v[6 + a]));
+        const float g = ms_maxf(sh->light_lo[a] - hi, lo - sh->light_hi[a]);
+        if (g > 0.0f) gap2 += g * g;
+        sc = ms_maxf(sc, ms_maxf(fabsf(lo), fabsf(hi)));
     }
-    const float D = dmin > 0.0f ? dmin : dmax < 0.0f ? -dmax : 0.0f;
+    const float D = sqrtf(gap2);
     const float u = 256.0f * 1.1920929e-07f * sc;
     if (!(D > 1e-6f * sc)) return INFINITY;
     return u * (1.0f + 4.0f * sc / D);
@@ -609,11 +612,14 @@ static void setup_light(shared *sh)
             for (int a = 0; a < 3; a++) sh->group_poly[g][3 * v + a] = P[a] + s * S[a] + t * T[a];
         }
     }
-    float es[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, et[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
-    const float c[3] = { L->corner.x, L->corner.y, L->corner.z };
-    v3_cross(sh->light_n, es, et);
-    v3_normalize(sh->light_n, sh->light_n);
-    sh->light_d = -v3_dot(sh->light_n, c);
+    for (int a = 0; a < 3; a++) {
+        sh->light_lo[a] = INFINITY;
+        sh->light_hi[a] = -INFINITY;
+        for (int v = 0; v < 4; v++) {
+            sh->light_lo[a] = ms_minf(sh->light_lo[a], (float)sh->light_poly[3 * v + a]);
+            sh->light_hi[a] = ms_maxf(sh->light_hi[a], (float)sh->light_poly[3 * v + a]);
+        }
+    }
     float sc = 0.0f;
     for (int i = 0; i < 12; i++) sc = ms_maxf(sc, (float)fabs(sh->light_poly[i]));
     sh->scale = sc;
