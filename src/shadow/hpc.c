@@ -106,6 +106,7 @@ typedef struct shared {
     double light_poly[12];
     double group_poly[64][12];
     float light_lo[3], light_hi[3], scale;
+    float reach;                     /* farthest distance from the light's box to the receivers' box */
     size_t n;
     const ms_shadow_query *q;
     const uint64_t *front;
@@ -351,12 +352,13 @@ static void slot_put(chunk *c, int32_t s)
 
 /* ---- per triangle ---- */
 
-/* The culling margin for a triangle (see the departures above): 256 ulps of the frame's coordinates,
- * magnified by the largest ratio of a receiver's distance to the light over the distance between the
- * triangle and the light: a ray from a sample through the triangle passes it at least that far from the
- * sample, and rounding at the triangle moves the shadow at the receiver by that ratio. The distance is
- * bounded below by the gap between the bounding boxes of the triangle and the light. A triangle touching
- * the light's box: infinite (no culling). */
+/* The culling margin for a triangle (see the departures above). The exact test rounds the vertices and the
+ * sample relative to the receiver, by ulps of their distance to it (at most sh->reach, the farthest
+ * distance from the light's box to the receivers' box); a ray from a sample through the triangle passes it
+ * at least D from the sample (D: the gap between the triangle's and the light's bounding boxes), so an
+ * error at the triangle moves the shadow at the receiver by up to reach / D. The samples' own rounding is
+ * absorbed by the polygons (setup_light), the plane evaluation's by ulps of the coordinates. 256 ulps of
+ * each for safety; a triangle touching the light's box: infinite (no culling). */
 static float tri_margin(const shared *sh, const float v[9])
 {
     float sc = sh->scale, gap2 = 0.0f;
@@ -367,9 +369,8 @@ static float tri_margin(const shared *sh, const float v[9])
         sc = ms_maxf(sc, ms_maxf(fabsf(lo), fabsf(hi)));
     }
     const float D = sqrtf(gap2);
-    const float u = 256.0f * 1.1920929e-07f * sc;
     if (!(D > 1e-6f * sc)) return INFINITY;
-    return u * (1.0f + 4.0f * sc / D);
+    return 256.0f * 1.1920929e-07f * (sc + sh->reach * (1.0f + 4.0f * sh->reach / D));
 }
 
 static void build_group_volumes(const shared *sh, chunk *c, const tri_job *t)
@@ -598,8 +599,11 @@ static void setup_light(shared *sh)
     const double P[3] = { L->corner.x, L->corner.y, L->corner.z };
     const double S[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, T[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
     const int k = sh->k, gpr = k / sh->gs;
-    /* Widened by 1e-3 of a cell: the float samples round off their cells by ulps. */
-    const double w = 1e-3 / k;
+    /* Widened by 1e-3 of a cell and by 16 ulps of the frame's coordinates (sh->scale, set by the caller):
+     * the float samples round off their cells by ulps of their coordinates, which the polygons absorb so
+     * that the culling margin need not magnify them. */
+    const double ls = fmin(sqrt(S[0] * S[0] + S[1] * S[1] + S[2] * S[2]), sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2]));
+    const double w = 1e-3 / k + (ls > 0.0 ? 16.0 * 1.1920929e-07 * sh->scale / ls : 0.0);
     const double corners[4][2] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } };
     for (int v = 0; v < 4; v++) {
         const double s = corners[v][0] * (1 + 2 * w) - w, t = corners[v][1] * (1 + 2 * w) - w;
@@ -620,9 +624,6 @@ static void setup_light(shared *sh)
             sh->light_hi[a] = ms_maxf(sh->light_hi[a], (float)sh->light_poly[3 * v + a]);
         }
     }
-    float sc = 0.0f;
-    for (int i = 0; i < 12; i++) sc = ms_maxf(sc, (float)fabs(sh->light_poly[i]));
-    sh->scale = sc;
 }
 
 int ms_hpc_cast(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster, const ms_shadow_query *q, size_t n,
@@ -646,9 +647,30 @@ int ms_hpc_cast(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster, con
     sh.frame_off = (size_t)mw * sizeof(uint64_t);
     sh.kz_off = sh.frame_off + (scanline ? sizeof(ms_raster_frame) : 0);
     sh.slot_bytes = (sh.kz_off + (size_t)sh.npk + 63) / 64 * 64;
-    setup_light(&sh);
+    {
+        const ms_light *L = &ctx->light;
+        const float c[4][3] = { { L->corner.x, L->corner.y, L->corner.z },
+                                { L->corner.x + L->edge_s.x, L->corner.y + L->edge_s.y, L->corner.z + L->edge_s.z },
+                                { L->corner.x + L->edge_t.x, L->corner.y + L->edge_t.y, L->corner.z + L->edge_t.z },
+                                { L->corner.x + L->edge_s.x + L->edge_t.x, L->corner.y + L->edge_s.y + L->edge_t.y,
+                                  L->corner.z + L->edge_s.z + L->edge_t.z } };
+        for (int v = 0; v < 4; v++)
+            for (int a = 0; a < 3; a++) sh.scale = ms_maxf(sh.scale, 2.0f * fabsf(c[v][a]));
+    }
     for (size_t i = 0; i < n; i++)
         for (int a = 0; a < 3; a++) sh.scale = ms_maxf(sh.scale, fabsf(q[i].p[a]));
+    setup_light(&sh);
+    float rlo[3] = { INFINITY, INFINITY, INFINITY }, rhi[3] = { -INFINITY, -INFINITY, -INFINITY }, reach2 = 0.0f;
+    for (size_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) {
+            rlo[a] = ms_minf(rlo[a], q[i].p[a]);
+            rhi[a] = ms_maxf(rhi[a], q[i].p[a]);
+        }
+    for (int a = 0; a < 3 && n; a++) {
+        const float e = ms_maxf(fabsf(rhi[a] - sh.light_lo[a]), fabsf(sh.light_hi[a] - rlo[a]));
+        reach2 += e * e;
+    }
+    sh.reach = sqrtf(reach2);
 
     int rc = -1, nchunks = 0;
     const int threads = ctx->threads > 0 ? ctx->threads : 1;
