@@ -5,6 +5,7 @@
 #include "../shadow/method.h"
 #include "../shadow/receiver.h"
 #include "shadow_frame.h"
+#include "render_materialise.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -63,7 +64,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         else snprintf(err, errlen, "unknown method '%s'", method);
         return -1;
     }
-    const ms_primary_method *pm = ms_find_primary_method(sm->primary);
+    /* A procedural scene: streamed by the methods that can (primary by a depth pass, no BVH), else
+     * materialised (render_materialise.c). */
+    const int streamed = scene->procedural.type != MS_PROCEDURAL_NONE;
+    if (streamed && !sm->streams) return ms_render_materialised(scene, opt, out, err, errlen);
+    const ms_primary_method *pm = ms_find_primary_method(streamed ? "depth" : sm->primary);
     if (!pm) { snprintf(err, errlen, "primary method '%s' is not compiled into this build", sm->primary); return -1; }
     int samples = opt->samples > 0 ? opt->samples : scene->samples;
     int k = ms_samples_to_k(samples);
@@ -87,9 +92,10 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         return -1;
     }
     ms_bvh bvh;
-    if (ms_bvh_build(&bvh, scene->tri, scene->n_tris, threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
+    memset(&bvh, 0, sizeof bvh);
+    if (!streamed && ms_bvh_build(&bvh, scene->tri, scene->n_tris, threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
     ctx.scene = scene;
-    ctx.bvh = &bvh;
+    ctx.bvh = streamed ? NULL : &bvh;
     ctx.light = scene->light;
     ctx.pattern = opt->pattern;
     ctx.k = k;

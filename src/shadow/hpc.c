@@ -637,7 +637,8 @@ int ms_hpc_cast(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster, con
     sh.raster = raster;
     sh.k = k;
     sh.mw = mw;
-    sh.gs = k >= 64 ? 8 : 4;     /* 16, 64, 64 groups for k = 16, 32, 64 (a group-umbra word) */
+    sh.gs = k >= 64 ? 8 : 4;     /* 16, 64, 64 groups for k = 16, 32, 64 (a group-umbra word; 2x2 groups at
+                                  * k = 16 tripled the box-plane tests and the time on a flowers scene) */
     sh.G = (k / sh.gs) * (k / sh.gs);
     sh.all_groups = sh.G == 64 ? UINT64_MAX : (UINT64_C(1) << sh.G) - 1u;
     sh.npk = k * k / LANES;

@@ -1,7 +1,9 @@
 /* Methods "hpc" and "hpc-scanline" (hpc.c): hierarchical penumbra casting over the whole frame at once,
  * through the method interface's frame-level entry (visibility_all, method.h). The triangles are the
  * scene's, read in coarse area order (hpc_sort.c) from the soup; the BVH the renderer builds for primary
- * visibility is not used for shadows (its triangle copy only gives each triangle its prim id). The
+ * visibility is not used for shadows (only its leaf order gives each triangle its prim id). A procedural
+ * scene is streamed: generated batch by batch, its primary hits from the depth pass (primary_depth.c), no
+ * BVH at all. The
  * per-tile entry runs the same algorithm over the tile's points, for callers that drive methods per tile. */
 #include "hpc.h"
 #include "receiver.h"
@@ -24,6 +26,32 @@ typedef struct soup_source {
 } soup_source;
 
 static int soup_rewind(void *user) { ((soup_source *)user)->pos = 0; return 0; }
+
+/* A procedural scene, generated batch by batch (in parallel) and bucketed by area within each batch: the
+ * paper buckets the whole stream out of core into files; a batch is all we hold. ids: the triangle index,
+ * as the depth pass names hits. */
+static size_t procedural_next(void *user, float *tri, uint32_t *ids, size_t max)
+{
+    soup_source *src = user;
+    const ms_scene *sc = src->ctx->scene;
+    const size_t n = sc->n_tris - src->pos < max ? sc->n_tris - src->pos : max;
+    if (!n) return 0;
+    float *raw = malloc(n * 9 * sizeof *raw);
+    if (!raw) return (size_t)-1;
+    const int threads = src->ctx->threads > 0 ? src->ctx->threads : 1;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (size_t c = 0; c < n; c += 1024) ms_procedural_triangles(sc, src->pos + c, n - c < 1024 ? n - c : 1024, raw + 9 * c);
+    uint32_t *order = ms_hpc_area_order(raw, n);
+    if (!order) { free(raw); return (size_t)-1; }
+    for (size_t i = 0; i < n; i++) {
+        memcpy(tri + 9 * i, raw + 9 * (size_t)order[i], 9 * sizeof *tri);
+        ids[i] = (uint32_t)(src->pos + order[i]);
+    }
+    free(order);
+    free(raw);
+    src->pos += n;
+    return n;
+}
 
 static size_t soup_next(void *user, float *tri, uint32_t *ids, size_t max)
 {
@@ -48,6 +76,7 @@ static int hpc_create_common(const ms_render_ctx *ctx, void **state, char *err, 
         snprintf(err, errlen, "no Scanline kernel for %d samples", ctx->samples);
         return -1;
     }
+    if (ctx->scene->procedural.type != MS_PROCEDURAL_NONE) { *state = s; return 0; }   /* streamed */
     const size_t n = ctx->scene->n_tris;
     s->order = ms_hpc_area_order(ctx->scene->tri, n);
     s->leaf_of = malloc((n ? n : 1) * sizeof *s->leaf_of);
@@ -69,7 +98,7 @@ static int hpc_all(void *state, const ms_render_ctx *ctx, const ms_shadow_query 
 {
     const hpc_state *s = state;
     soup_source ss = { ctx, s, 0 };
-    const hpc_source src = { &ss, soup_rewind, soup_next };
+    const hpc_source src = { &ss, soup_rewind, ctx->scene->procedural.type != MS_PROCEDURAL_NONE ? procedural_next : soup_next };
     return ms_hpc_cast(ctx, s->scanline, s->raster, q, n, front, vis, &src, counters);
 }
 
@@ -104,14 +133,14 @@ static void hpc_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
       "full_umbra_points", "raster_calls" }
 
 const ms_shadow_method ms_shadow_hpc = {
-    .name = "hpc", .primary = "bvh", .needs_grid = 1, .n_counters = HPC_N_COUNTERS,
+    .name = "hpc", .primary = "bvh", .needs_grid = 1, .streams = 1, .n_counters = HPC_N_COUNTERS,
     .counter_names = HPC_COUNTER_NAMES,
     .create = hpc_create, .visibility = hpc_tile, .visibility_all = hpc_all, .destroy = hpc_destroy,
     .isa_used = hpc_isa_used,
 };
 
 const ms_shadow_method ms_shadow_hpc_scanline = {
-    .name = "hpc-scanline", .primary = "bvh", .needs_grid = 1, .n_counters = HPC_N_COUNTERS,
+    .name = "hpc-scanline", .primary = "bvh", .needs_grid = 1, .streams = 1, .n_counters = HPC_N_COUNTERS,
     .counter_names = HPC_COUNTER_NAMES,
     .create = hpcs_create, .visibility = hpc_tile, .visibility_all = hpc_all, .destroy = hpc_destroy,
     .isa_used = hpc_isa_used,

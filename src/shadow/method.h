@@ -44,6 +44,8 @@ typedef struct ms_shadow_method {
     const char *name;
     const char *primary;          /* primary-visibility method it pairs with ("bvh", "embree") */
     int needs_grid;               /* 1: only the grid pattern fits (micro-rasterization) */
+    int streams;                  /* 1: reads the triangles once in batches, never all at once: a procedural
+                                   * scene is streamed (primary "depth", no BVH), not materialised */
     int n_counters;
     const char *counter_names[MS_MAX_COUNTERS];
     /* Per-frame set-up (shared, read-only afterwards); 0 or -1 with a message in err. */
