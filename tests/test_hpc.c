@@ -8,7 +8,10 @@
  *   - the answer does not depend on the triangle order or the thread count: the engine driven directly
  *     with the triangles in area order, reversed and shuffled, on 1 and 2 threads, gives the same masks
  *     bit for bit, equal to raytrace's; and a scene whose triangle array is shuffled renders to raytrace's
- *     answer on that scene. */
+ *     answer on that scene;
+ *   - streaming: a procedural flowers scene rendered by hpc (no BVH, depth-pass primary, triangles
+ *     generated in batches) equals raytrace on the same scene materialised; bad procedural sources fail
+ *     with one line naming the file (exit 2 through the CLI). */
 #include "testutil.h"
 #include "shadow/method.h"
 #include "shadow/receiver.h"
@@ -215,6 +218,94 @@ static void test_shuffled_scene(void **st)
     ms_scene_free(&sc);
 }
 
+/* ---- streaming ---- */
+
+static const char *flowers_json(const char *dir, const char *name, const char *proc)
+{
+    static char path[4096];
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"procedural\": %s,\n \"camera\": {\"eye\": [0, 14, 18], \"target\": [0, 0, 0], \"up\": [0, 1, 0], "
+             "\"fov_y\": 60},\n \"light\": {\"corner\": [-2, 12, -2], \"edge_s\": [4, 0, 0], \"edge_t\": [0, 0, 4]}}\n", proc);
+    tu_path(path, sizeof path, dir, name);
+    assert_int_equal(tu_write_file(path, text), 0);
+    return path;
+}
+
+/* A streamed procedural scene: hpc and hpc-scanline (no BVH, primary hits from the depth pass, triangles
+ * generated batch by batch) against raytrace on the same scene materialised (BVH primary): V and S bit
+ * for bit for hpc, within ties for hpc-scanline. More than one batch of triangles (16K in hpc.c, 64K in
+ * the depth pass). */
+static void test_streamed_flowers(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("test_hpc");
+    char err[1024];
+    ms_scene sc;
+    if (ms_scene_load(flowers_json(dir, "flowers.json", "{\"type\": \"flowers\", \"triangles\": 70000, \"seed\": 3}"),
+                      &sc, err, sizeof err))
+        fail_msg("%s", err);
+    assert_null(sc.tri);
+    assert_int_equal(sc.n_tris, 70000);
+    ms_frame ref, f;
+    render_ok(&sc, "raytrace", 256, 48, 0, &ref);   /* materialised */
+    render_ok(&sc, "hpc", 256, 48, 0, &f);          /* streamed */
+    assert_int_equal(f.stats.build_s, 0.0);         /* no BVH */
+    long lit = 0, part = 0;
+    for (int i = 0; i < 48 * 48; i++) { lit += ref.vis[i] > 0.0f; part += ref.vis[i] > 0.0f && ref.vis[i] < 1.0f; }
+    printf("flowers 70000: %ld lit, %ld penumbra pixels of %d\n", lit, part, 48 * 48);
+    assert_true(part > 50);
+    assert_memory_equal(f.vis, ref.vis, 48 * 48 * sizeof(float));
+    assert_memory_equal(f.shadow, ref.shadow, 48 * 48 * sizeof(float));
+    ms_frame_free(&f);
+    render_ok(&sc, "hpc-scanline", 256, 48, 0, &f);
+    tu_agreement a = tu_compare_frames(&f, &ref);
+    assert_int_equal(a.miss_mismatch, 0);
+    assert_int_equal(a.beyond_one, 0);
+    assert_true((double)a.differ <= 0.002 * (double)a.pixels);
+    ms_frame_free(&f);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
+/* Bad procedural sources: one line naming the file and what is wrong. */
+static void test_procedural_bad_input(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("test_hpc_bad");
+    static const struct { const char *proc, *want; } cases[] = {
+        { "{\"type\": \"trees\", \"triangles\": 10}", "procedural.type must be \"flowers\"" },
+        { "{\"type\": \"flowers\", \"triangles\": 0}", "procedural.triangles must be an integer" },
+        { "{\"type\": \"flowers\", \"triangles\": 1.5}", "procedural.triangles must be an integer" },
+        { "{\"type\": \"flowers\", \"triangles\": 1e12}", "procedural.triangles must be an integer" },
+        { "{\"type\": \"flowers\", \"triangles\": 10, \"seed\": -1}", "procedural.seed must be an integer" },
+        { "{\"type\": \"flowers\"}", "triangles" },
+        { "[1, 2]", "\"procedural\" must be an object" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        char err[1024], name[32];
+        snprintf(name, sizeof name, "bad%zu.json", i);
+        const char *path = flowers_json(dir, name, cases[i].proc);
+        ms_scene sc;
+        assert_int_not_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+        if (!strstr(err, cases[i].want) || !strstr(err, name)) fail_msg("case %zu: got \"%s\"", i, err);
+    }
+    /* meshes and procedural together */
+    char path[4096], err[1024];
+    tu_path(path, sizeof path, dir, "both.json");
+    tu_write_file(path, "{\"meshes\": [{\"file\": \"x.obj\"}], \"procedural\": {\"type\": \"flowers\", \"triangles\": 5},"
+                        " \"camera\": {\"eye\": [0, 1, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov_y\": 60},"
+                        " \"light\": {\"corner\": [0, 3, 0], \"edge_s\": [1, 0, 0], \"edge_t\": [0, 0, 1]}}");
+    ms_scene sc;
+    assert_int_not_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    assert_non_null(strstr(err, "either \"meshes\" or \"procedural\""));
+    /* through the CLI: exit 2 and the message */
+    const char *args[] = { flowers_json(dir, "cli.json", "{\"type\": \"tulips\", \"triangles\": 5}"), "--quiet", NULL };
+    char line[1024];
+    assert_int_equal(tu_run_cli(args, line, sizeof line), 2);
+    assert_non_null(strstr(line, "procedural.type"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -224,6 +315,8 @@ int main(void)
         cmocka_unit_test(test_sponza),
         cmocka_unit_test(test_order_and_threads),
         cmocka_unit_test(test_shuffled_scene),
+        cmocka_unit_test(test_streamed_flowers),
+        cmocka_unit_test(test_procedural_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
