@@ -70,6 +70,7 @@
 #define LEAF_POINTS 8
 #define MIDDLE_SPLIT_ABOVE 1024   /* the paper's 1K */
 #define SAH_BINS 16
+#define MEDIAN_BELOW_DEPTH 40     /* median splits from here: depth at most 40 + log2(points) */
 #define BATCH 16384               /* triangles read and prepared together */
 #define EDGE_ON 1e-3f             /* as microraster.c */
 #define LANES 16                  /* the reference tracer's packet width (raytrace_impl.h) */
@@ -167,8 +168,11 @@ static int cmp_key(const void *a, const void *b)
 }
 
 /* Where to split idx[0..n): the middle of the longest axis above MIDDLE_SPLIT_ABOVE points, else a binned
- * SAH; the median when a side would be empty (coincident points). Returns the left count. */
-static uint32_t split_points(const shared *sh, uint32_t *idx, uint32_t n, const float lo[3], const float hi[3])
+ * SAH; the median when a side would be empty (coincident points) or when asked (deep in the tree: points
+ * spaced exponentially would otherwise peel off one per level, and the traversal recurses). Returns the
+ * left count. */
+static uint32_t split_points(const shared *sh, uint32_t *idx, uint32_t n, const float lo[3], const float hi[3],
+                             int median)
 {
     const float ext[3] = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
     int axis = ext[0] >= ext[1] ? (ext[0] >= ext[2] ? 0 : 2) : (ext[1] >= ext[2] ? 1 : 2);
@@ -210,7 +214,7 @@ static uint32_t split_points(const shared *sh, uint32_t *idx, uint32_t n, const 
             }
         }
     }
-    uint32_t m = partition(sh, idx, n, axis, split);
+    uint32_t m = median ? 0 : partition(sh, idx, n, axis, split);
     if (m == 0 || m == n) {
         /* Median by sorting keys (rare: points bunched in one bin or coincident). */
         float *key = malloc((size_t)n * 2 * sizeof *key);
@@ -249,18 +253,20 @@ static int build_tree(const shared *sh, chunk *c)
     c->n_nodes = 0;
     if (!live) return 0;
     c->nodes = malloc((size_t)(2 * live) * sizeof *c->nodes);
-    uint32_t *stack = malloc((size_t)(2 * live + 64) * sizeof *stack);
+    uint32_t *stack = malloc((size_t)(2 * live + 64) * 2 * sizeof *stack);   /* node, depth */
     if (!c->nodes || !stack) { free(stack); return -1; }
     c->n_nodes = 1;
     c->nodes[0].first = 0;
     c->nodes[0].count = live;
     int sp = 0;
     stack[sp++] = 0;
+    stack[sp++] = 0;
     while (sp) {
+        const uint32_t depth = stack[--sp];
         hnode *N = &c->nodes[stack[--sp]];
         bounds_of(sh, c->idx + N->first, N->count, N->lo, N->hi);
         if (N->count <= LEAF_POINTS) continue;
-        const uint32_t m = split_points(sh, c->idx + N->first, N->count, N->lo, N->hi);
+        const uint32_t m = split_points(sh, c->idx + N->first, N->count, N->lo, N->hi, depth >= MEDIAN_BELOW_DEPTH);
         const uint32_t l = c->n_nodes;
         c->n_nodes += 2;
         c->nodes[l].first = N->first;
@@ -270,7 +276,9 @@ static int build_tree(const shared *sh, chunk *c)
         N->first = l;
         N->count = 0;
         stack[sp++] = l + 1;
+        stack[sp++] = depth + 1;
         stack[sp++] = l;
+        stack[sp++] = depth + 1;
     }
     free(stack);
     /* Children follow their parents: umbra bits bottom-up in reverse order. */
