@@ -68,7 +68,8 @@ int main(int argc, char **argv)
             counter(&f[1], "masks_peak_sum_over_chunks", &peak);
             counter(&f[1], "full_umbra_points", &umbra);
             counter(&f[1], "rebuilds", &rebuilds);
-            const double slot = (double)samples / 8.0 + samples / 16.0;   /* mask bytes + packet shear axes (hpc.c) */
+            /* a pool slot (hpc.c): mask bytes + packet shear axes, rounded up to 64 bytes */
+            const double slot = (double)((samples / 8 + samples / 16 + 63) / 64 * 64);
             printf("| %s | %d | %.3f | %.3f | %.3f | %.3f | %.2f | %.2f | %.2f | %ld | %ld | %llu | %llu | %.1f | %llu | %llu |\n",
                    label, sizes[s], f[0].stats.shadow_s, f[1].stats.shadow_s, f[2].stats.shadow_s, f[3].stats.shadow_s,
                    f[0].stats.shadow_s / f[1].stats.shadow_s, f[0].stats.shadow_s / f[2].stats.shadow_s,
