@@ -37,8 +37,9 @@
  *    per-point part of "constructing V_li" (the packet shear axes) is made lazily with the point's mask.
  *  - the penumbra volumes cull with a margin (hpc_volume.h) that covers the rounding of that exact test:
  *    the error of a float test is magnified behind the triangle by (distance to the light) / (triangle's
- *    distance from the light), so the margin grows with it (tri_margin); a triangle touching the light's
- *    bounding box gets no volume (nothing culled, every relation tested).
+ *    distance from the light, bounded below on separating axes), so the margin grows with it
+ *    (tri_margin); a triangle that may touch the light gets no volume (nothing culled, every relation
+ *    tested).
  *  - below 1K points the split is a 16-bin SAH (count-weighted, the paper's "total surface area of the
  *    children" unweighted would split off single points), and leaves hold up to 8 points.
  *  - the light samples behind a receiver's plane (the horizon) count as blocked from the start, so umbra
@@ -360,23 +361,64 @@ static void slot_put(chunk *c, int32_t s)
 
 /* ---- per triangle ---- */
 
+/* A lower bound on the distance between the triangle and the light: the largest gap between their
+ * projections on the separating axes of two convex polygons (the box axes, both normals, and the cross
+ * products of their edges); a projection never lengthens a distance. 0 when they may touch. */
+static double tri_light_gap(const shared *sh, const float v[9])
+{
+    double T[3][3], L[4][3], ax[14][3];
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) T[i][a] = v[3 * i + a];
+    for (int i = 0; i < 4; i++)
+        for (int a = 0; a < 3; a++) L[i][a] = sh->light_poly[3 * i + a];
+    int n = 0;
+    for (int a = 0; a < 3; a++) { ax[n][0] = a == 0; ax[n][1] = a == 1; ax[n][2] = a == 2; n++; }
+    double te[3][3], le[2][3];
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) te[i][a] = T[(i + 1) % 3][a] - T[i][a];
+    for (int a = 0; a < 3; a++) { le[0][a] = L[1][a] - L[0][a]; le[1][a] = L[3][a] - L[0][a]; }
+#define CROSS(r, x, y) (r[0] = x[1] * y[2] - x[2] * y[1], r[1] = x[2] * y[0] - x[0] * y[2], r[2] = x[0] * y[1] - x[1] * y[0])
+    CROSS(ax[n], te[0], te[1]); n++;
+    CROSS(ax[n], le[0], le[1]); n++;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 2; j++) { CROSS(ax[n], te[i], le[j]); n++; }
+#undef CROSS
+    double gap = 0.0;
+    for (int k = 0; k < n; k++) {
+        const double len = sqrt(ax[k][0] * ax[k][0] + ax[k][1] * ax[k][1] + ax[k][2] * ax[k][2]);
+        if (!(len > 0.0)) continue;
+        double tmin = INFINITY, tmax = -INFINITY, lmin = INFINITY, lmax = -INFINITY;
+        for (int i = 0; i < 3; i++) {
+            const double d = (T[i][0] * ax[k][0] + T[i][1] * ax[k][1] + T[i][2] * ax[k][2]) / len;
+            tmin = fmin(tmin, d); tmax = fmax(tmax, d);
+        }
+        for (int i = 0; i < 4; i++) {
+            const double d = (L[i][0] * ax[k][0] + L[i][1] * ax[k][1] + L[i][2] * ax[k][2]) / len;
+            lmin = fmin(lmin, d); lmax = fmax(lmax, d);
+        }
+        gap = fmax(gap, fmax(lmin - tmax, tmin - lmax));
+    }
+    return gap;
+}
+
 /* The culling margin for a triangle (see the departures above). The exact test rounds the vertices and the
  * sample relative to the receiver, by ulps of their distance to it (at most sh->reach, the farthest
  * distance from the light's box to the receivers' box); a ray from a sample through the triangle passes it
- * at least D from the sample (D: the gap between the triangle's and the light's bounding boxes), so an
- * error at the triangle moves the shadow at the receiver by up to reach / D. The samples' own rounding is
- * absorbed by the polygons (setup_light), the plane evaluation's by ulps of the coordinates. 256 ulps of
- * each for safety; a triangle touching the light's box: infinite (no culling). */
+ * at least D from the sample (D: the larger of tri_light_gap and the gap between the bounding boxes, less
+ * a relative 1e-6 for their rounding), so an error at
+ * the triangle moves the shadow at the receiver by up to reach / D. The samples' own rounding is absorbed
+ * by the polygons (setup_light), the plane evaluation's by ulps of the coordinates. 256 ulps of each for
+ * safety; a triangle that may touch the light: infinite (no culling). */
 static float tri_margin(const shared *sh, const float v[9])
 {
-    float sc = sh->scale, gap2 = 0.0f;
-    for (int a = 0; a < 3; a++) {
+    float sc = sh->scale, box2 = 0.0f;
+    for (int a = 0; a < 3; a++) {   /* the gap between the bounding boxes, another lower bound */
         const float lo = ms_minf(v[a], ms_minf(v[3 + a], v[6 + a])), hi = ms_maxf(v[a], ms_maxf(v[3 + a], v[6 + a]));
         const float g = ms_maxf(sh->light_lo[a] - hi, lo - sh->light_hi[a]);
-        if (g > 0.0f) gap2 += g * g;
+        if (g > 0.0f) box2 += g * g;
         sc = ms_maxf(sc, ms_maxf(fabsf(lo), fabsf(hi)));
     }
-    const float D = sqrtf(gap2);
+    const float D = (float)(fmax(tri_light_gap(sh, v), sqrt((double)box2)) - 1e-6 * sc);
     if (!(D > 1e-6f * sc)) return INFINITY;
     return 256.0f * 1.1920929e-07f * (sc + sh->reach * (1.0f + 4.0f * sh->reach / D));
 }
