@@ -73,7 +73,17 @@ typedef struct ms_light {
 
 #define MS_MAX_UV_SETS 4
 
-/* A triangle soup: tri[9*i .. 9*i+8] are the three vertices of triangle i. */
+/* A procedural triangle source (scene file: "procedural": {"type": "flowers", "triangles": N, "seed": S}):
+ * triangle i is a pure function of (type, seed, i), generated in batches when needed, so that methods that
+ * stream their triangles (hpc, hpc-scanline) never hold the scene; the others get it materialised. */
+typedef enum ms_procedural_type { MS_PROCEDURAL_NONE = 0, MS_PROCEDURAL_FLOWERS = 1 } ms_procedural_type;
+typedef struct ms_procedural {
+    ms_procedural_type type;
+    uint32_t seed;
+} ms_procedural;
+
+/* A triangle soup: tri[9*i .. 9*i+8] are the three vertices of triangle i. With a procedural source, tri is
+ * NULL and n_tris counts the triangles it generates. */
 typedef struct ms_scene {
     float *tri;
     size_t n_tris;
@@ -88,7 +98,11 @@ typedef struct ms_scene {
     uint32_t *tri_mesh;
     float *tri_uv[MS_MAX_UV_SETS];
     size_t n_meshes;
+    ms_procedural procedural;
 } ms_scene;
+
+/* Triangles [first, first + count) of a procedural scene (9 floats each) into out. */
+void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, float *out);
 
 /* Warnings (an unknown key in a scene file) go to this handler, one line each without a newline; by
  * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */

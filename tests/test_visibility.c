@@ -94,7 +94,7 @@ static oracle brute_force(const ms_render_ctx *ctx, const float *soup, size_t nt
 
 /* ---- scenes ---- */
 
-static const char *const methods[] = { "raytrace", "scanline", "bounds", "hierarchical", "embree" };
+static const char *const methods[] = { "raytrace", "scanline", "bounds", "hierarchical", "hpc", "hpc-scanline", "embree" };
 #define N_METHODS (sizeof methods / sizeof *methods)
 
 static size_t find_prim(const ms_bvh *bvh, const float *tri)

@@ -220,7 +220,11 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
     ms_bake_options zero;
     memset(&zero, 0, sizeof zero);
     const ms_bake_options *o = opt_in ? opt_in : &zero;
-    if (!scene || (!scene->tri && scene->n_tris)) { snprintf(err, errlen, "ms_bake: no scene"); return MS_ERR_INVALID; }
+    if (!scene) { snprintf(err, errlen, "ms_bake: no scene"); return MS_ERR_INVALID; }
+    if (!scene->tri && scene->n_tris) {
+        snprintf(err, errlen, "ms_bake: a procedural scene has no triangles in memory (only the streaming methods render it)");
+        return MS_ERR_INVALID;
+    }
     const int size = o->size ? o->size : 1024;
     if (size < 1 || size > MS_MAX_IMAGE_SIZE) { snprintf(err, errlen, "lightmap size must be in [1, %d]", MS_MAX_IMAGE_SIZE); return MS_ERR_INVALID; }
     if (o->uv_set < -1 || o->uv_set >= MS_MAX_UV_SETS) {

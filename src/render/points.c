@@ -44,7 +44,11 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
 {
     if (!out) { snprintf(err, errlen, "ms_accel_build: out is NULL"); return MS_ERR_INVALID; }
     *out = NULL;
-    if (!scene || (!scene->tri && scene->n_tris)) { snprintf(err, errlen, "ms_accel_build: no scene"); return MS_ERR_INVALID; }
+    if (!scene) { snprintf(err, errlen, "ms_accel_build: no scene"); return MS_ERR_INVALID; }
+    if (!scene->tri && scene->n_tris) {
+        snprintf(err, errlen, "ms_accel_build: a procedural scene has no triangles in memory (only the streaming methods render it)");
+        return MS_ERR_INVALID;
+    }
     if (scene->n_tris >= UINT32_MAX) { snprintf(err, errlen, "ms_accel_build: more than 2^32-2 triangles"); return MS_ERR_INVALID; }
     ms_accel *a = calloc(1, sizeof *a);
     if (!a) { snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }

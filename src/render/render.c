@@ -4,6 +4,8 @@
 #include "../core/pattern.h"
 #include "../shadow/method.h"
 #include "../shadow/receiver.h"
+#include "shadow_frame.h"
+#include "render_materialise.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -62,7 +64,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         else snprintf(err, errlen, "unknown method '%s'", method);
         return -1;
     }
-    const ms_primary_method *pm = ms_find_primary_method(sm->primary);
+    /* A procedural scene: streamed by the methods that can (primary by a depth pass, no BVH), else
+     * materialised (render_materialise.c). */
+    const int streamed = scene->procedural.type != MS_PROCEDURAL_NONE;
+    if (streamed && !sm->streams) return ms_render_materialised(scene, opt, out, err, errlen);
+    const ms_primary_method *pm = ms_find_primary_method(streamed ? "depth" : sm->primary);
     if (!pm) { snprintf(err, errlen, "primary method '%s' is not compiled into this build", sm->primary); return -1; }
     int samples = opt->samples > 0 ? opt->samples : scene->samples;
     int k = ms_samples_to_k(samples);
@@ -86,9 +92,10 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         return -1;
     }
     ms_bvh bvh;
-    if (ms_bvh_build(&bvh, scene->tri, scene->n_tris, threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
+    memset(&bvh, 0, sizeof bvh);
+    if (!streamed && ms_bvh_build(&bvh, scene->tri, scene->n_tris, threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
     ctx.scene = scene;
-    ctx.bvh = &bvh;
+    ctx.bvh = streamed ? NULL : &bvh;
     ctx.light = scene->light;
     ctx.pattern = opt->pattern;
     ctx.k = k;
@@ -142,6 +149,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     int failed = 0;
     const size_t mw = (size_t)ctx.mask_words;
     const int stratified = ctx.pattern != MS_PATTERN_GRID;
+    const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
 #pragma omp parallel num_threads(threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
@@ -153,7 +161,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
         int ok = front && vmask && (pts || !stratified);
 #pragma omp for schedule(dynamic, 1)
-        for (int t = 0; t < ntiles; t++) {
+        for (int t = 0; t < shadow_tiles; t++) {
             int x0 = (t % tx) * TILE, y0 = (t / tx) * TILE;
             int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
             ms_shadow_query q[TILE * TILE];
@@ -200,6 +208,9 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
             failed |= !ok;
         }
     }
+    if (sm->visibility_all && !failed)
+        failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, W, H, out, counters, &visible, &penumbra, &segments,
+                                       &resolve_thread_s) != 0;
     double t2 = omp_get_wtime();
     if (failed) {
         snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);

@@ -22,7 +22,8 @@ static int line_of(const char *text, size_t off)
 }
 
 /* Known keys, per object, for the unknown-key warnings. */
-static const char *const top_keys[] = { "meshes", "camera", "light", "render", NULL };
+static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "render", NULL };
+static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
 static const char *const camera_keys[] = { "eye", "target", "up", "fov_y", "width", "height", NULL };
 static const char *const light_keys[] = { "corner", "edge_s", "edge_t", "emission", NULL };
 static const char *const render_keys[] = { "samples", NULL };
@@ -84,7 +85,7 @@ static const char *meant_for(const cJSON *obj, const char *key, const char *cons
 static const char *const *known_for(const char *objname)
 {
     return !strcmp(objname, "camera") ? camera_keys : !strcmp(objname, "light") ? light_keys
-         : !strcmp(objname, "render") ? render_keys : top_keys;
+         : !strcmp(objname, "render") ? render_keys : !strcmp(objname, "procedural") ? procedural_keys : top_keys;
 }
 
 /* "X is missing", with the unknown key that was probably meant. */
@@ -324,6 +325,35 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     }
 
     const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(root, "meshes");
+    const cJSON *proc = cJSON_GetObjectItemCaseSensitive(root, "procedural");
+    if (proc) {
+        if (meshes) { snprintf(err, errlen, "%s: give either \"meshes\" or \"procedural\", not both", json_path); goto done; }
+        if (!cJSON_IsObject(proc)) { snprintf(err, errlen, "%s: \"procedural\" must be an object", json_path); goto done; }
+        warn_unknown(proc, "procedural", procedural_keys, json_path);
+        const cJSON *type = cJSON_GetObjectItemCaseSensitive(proc, "type");
+        if (!cJSON_IsString(type) || strcmp(type->valuestring, "flowers") != 0) {
+            snprintf(err, errlen, "%s: procedural.type must be \"flowers\"", json_path);
+            goto done;
+        }
+        double tris = 0, seed = 0;
+        if (get_number(proc, "procedural", "triangles", 1, &tris, json_path, err, errlen) ||
+            get_number(proc, "procedural", "seed", 0, &seed, json_path, err, errlen))
+            goto done;
+        /* prim ids are 32-bit with UINT32_MAX for a miss; 2^31 keeps far from it */
+        if (tris != floor(tris) || tris < 1 || tris > 2147483648.0) {
+            snprintf(err, errlen, "%s: procedural.triangles must be an integer in [1, 2^31]", json_path);
+            goto done;
+        }
+        if (seed != floor(seed) || seed < 0 || seed > 4294967295.0) {
+            snprintf(err, errlen, "%s: procedural.seed must be an integer in [0, 2^32 - 1]", json_path);
+            goto done;
+        }
+        out->procedural.type = MS_PROCEDURAL_FLOWERS;
+        out->procedural.seed = (uint32_t)seed;
+        out->n_tris = (size_t)tris;
+        rc = ms_scene_validate(out, json_path, err, errlen);
+        goto done;
+    }
     if (!meshes) { missing(root, "", "meshes", json_path, err, errlen); goto done; }
     if (!cJSON_IsArray(meshes) || cJSON_GetArraySize(meshes) == 0) {
         snprintf(err, errlen, "%s: \"meshes\" must be a non-empty array of {\"file\": ...}", json_path);

@@ -54,11 +54,15 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         snprintf(err, errlen, "%s: light has zero area (edge_s and edge_t are zero or parallel)", what);
         return -1;
     }
+    if (!s->tri && s->procedural.type == MS_PROCEDURAL_NONE && s->n_tris) {
+        snprintf(err, errlen, "%s: the scene has no triangle array", what);
+        return -1;
+    }
     if (s->n_tris == 0) {
         snprintf(err, errlen, "%s: the scene has no triangles", what);
         return -1;
     }
-    for (size_t i = 0; i < 9 * s->n_tris; i++) {
+    for (size_t i = 0; s->tri && i < 9 * s->n_tris; i++) {
         if (!isfinite(s->tri[i])) {
             snprintf(err, errlen, "%s: triangle %zu has a NaN or infinite coordinate", what, i / 9);
             return -1;

@@ -49,6 +49,8 @@ typedef struct ms_shadow_method {
     const char *name;
     const char *primary;          /* primary-visibility method it pairs with ("bvh", "embree") */
     int needs_grid;               /* 1: only the grid pattern fits (micro-rasterization) */
+    int streams;                  /* 1: reads the triangles once in batches, never all at once: a procedural
+                                   * scene is streamed (primary "depth", no BVH), not materialised */
     int n_counters;
     const char *counter_names[MS_MAX_COUNTERS];
     /* Per-frame set-up (shared, read-only afterwards); 0 or -1 with a message in err. */
@@ -60,6 +62,13 @@ typedef struct ms_shadow_method {
     int (*visibility)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n,
                       const uint64_t *front, uint64_t *vis, uint64_t *counters);
     void (*destroy)(void *state);
+    /* Optional whole-frame entry (NULL: per tile through visibility). For methods that need every receiver of
+     * the frame at once (hpc: triangle order over a hierarchy of all hit points): n queries, their front and
+     * visible masks as for visibility; called once per frame from one thread (the method threads itself,
+     * ctx->threads), counters summed over its threads. The renderer resolves V and S from the masks as for
+     * every method (ms_resolve_vs). 0, or -1 when out of memory. */
+    int (*visibility_all)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, size_t n,
+                          const uint64_t *front, uint64_t *vis, uint64_t *counters);
     /* Optional (NULL: the method has no ISA-dispatched code): the instruction sets its kernel and its
      * traversal run, as chosen by create under ctx->isa_cap, for ms_stats. */
     void (*isa_used)(const void *state, ms_isa *kernel, ms_isa *traversal);

@@ -5,7 +5,8 @@
 
 extern const ms_shadow_method ms_shadow_raytrace;
 extern const ms_shadow_method ms_shadow_scanline, ms_shadow_bounds, ms_shadow_hierarchical;
-extern const ms_primary_method ms_primary_bvh;
+extern const ms_shadow_method ms_shadow_hpc, ms_shadow_hpc_scanline;
+extern const ms_primary_method ms_primary_bvh, ms_primary_depth;
 #ifdef MS_HAVE_EMBREE
 extern const ms_shadow_method ms_shadow_embree;
 extern const ms_primary_method ms_primary_embree;
@@ -13,6 +14,7 @@ extern const ms_primary_method ms_primary_embree;
 
 static const ms_shadow_method *const shadow_methods[] = {
     &ms_shadow_scanline, &ms_shadow_bounds, &ms_shadow_hierarchical, &ms_shadow_raytrace,
+    &ms_shadow_hpc, &ms_shadow_hpc_scanline,
 #ifdef MS_HAVE_EMBREE
     &ms_shadow_embree,
 #endif
@@ -34,6 +36,7 @@ const ms_shadow_method *ms_find_shadow_method(const char *name)
 const ms_primary_method *ms_find_primary_method(const char *name)
 {
     if (strcmp(name, "bvh") == 0) return &ms_primary_bvh;
+    if (strcmp(name, "depth") == 0) return &ms_primary_depth;
 #ifdef MS_HAVE_EMBREE
     if (strcmp(name, "embree") == 0) return &ms_primary_embree;
 #endif

@@ -1,0 +1,79 @@
+/* The whole-frame shadow phase (shadow_frame.h): the same front masks and the same V/S resolution as the
+ * tiled phase of render.c, around one call of the method's frame-level entry. */
+#include "shadow_frame.h"
+#include "../core/pattern.h"
+#include "../shadow/receiver.h"
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, const ms_hit *hits,
+                          int W, int H, ms_frame *out, uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
+                          uint64_t *segments, double *resolve_thread_s)
+{
+    const size_t npix = (size_t)W * H, mw = (size_t)ctx->mask_words;
+    const int stratified = ctx->pattern != MS_PATTERN_GRID;
+    size_t n = 0;
+    for (size_t i = 0; i < npix; i++) n += hits[i].prim != UINT32_MAX;
+    ms_shadow_query *q = malloc((n ? n : 1) * sizeof *q);
+    size_t *where = malloc((n ? n : 1) * sizeof *where);
+    uint64_t *front = malloc((n ? n : 1) * mw * sizeof *front);
+    uint64_t *vis = malloc((n ? n : 1) * mw * sizeof *vis);
+    int rc = -1;
+    if (!q || !where || !front || !vis) goto done;
+    n = 0;
+    for (size_t i = 0; i < npix; i++) {
+        const ms_hit *h = &hits[i];
+        if (h->prim == UINT32_MAX) { out->vis[i] = out->shadow[i] = -1.0f; out->front[i] = 0; continue; }
+        memcpy(q[n].p, h->p, sizeof h->p);
+        memcpy(q[n].n, h->n, sizeof h->n);
+        q[n].prim = h->prim;
+        q[n].px = (uint32_t)(i % (size_t)W);
+        q[n].py = (uint32_t)(i / (size_t)W);
+        where[n++] = i;
+    }
+    int failed = 0;
+    uint64_t seg = 0;
+#pragma omp parallel num_threads(ctx->threads) reduction(+ : seg) reduction(| : failed)
+    {
+        float *pts = stratified ? malloc((size_t)ctx->samples * 3 * sizeof *pts) : NULL;
+        failed |= stratified && !pts;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (failed) continue;
+            if (pts) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
+            const int nf = ms_front_mask(ctx, &q[i], pts, front + i * mw);
+            out->front[where[i]] = (uint16_t)nf;
+            seg += (uint64_t)nf;
+        }
+        free(pts);
+    }
+    if (failed || sm->visibility_all(sstate, ctx, q, n, front, vis, counters)) goto done;
+    const double tr = omp_get_wtime();
+    uint64_t pen = 0;
+#pragma omp parallel num_threads(ctx->threads) reduction(+ : pen) reduction(| : failed)
+    {
+        float *pts = stratified ? malloc((size_t)ctx->samples * 3 * sizeof *pts) : NULL;
+        failed |= stratified && !pts;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (failed) continue;
+            if (pts) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
+            pen += (uint64_t)ms_resolve_vs(ctx, &q[i], pts, front + i * mw, vis + i * mw, &out->vis[where[i]],
+                                           &out->shadow[where[i]]);
+        }
+        free(pts);
+    }
+    if (failed) goto done;
+    *resolve_thread_s += (omp_get_wtime() - tr) * ctx->threads;   /* thread-seconds, as render.c sums them */
+    *visible += n;
+    *penumbra += pen;
+    *segments += seg;
+    rc = 0;
+done:
+    free(q);
+    free(where);
+    free(front);
+    free(vis);
+    return rc;
+}

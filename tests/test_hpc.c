@@ -1,0 +1,322 @@
+/* Hierarchical penumbra casting (methods hpc and hpc-scanline, src/shadow/hpc.c) against the reference ray
+ * tracer on identical samples:
+ *   - hpc equals raytrace sample for sample: V and S bit for bit at every pixel (its per-sample decision is
+ *     raytrace's own ray/triangle test; the volumes only cull, with a margin), on the built-in scene, the
+ *     Quad and two real scenes (shared scenes, skipped when absent), at 256 and 1024 samples;
+ *   - hpc-scanline equals raytrace up to ties (Scanline's rounding at edges), as test_microraster bounds
+ *     the scanline method;
+ *   - the answer does not depend on the triangle order or the thread count: the engine driven directly
+ *     with the triangles in area order, reversed and shuffled, on 1 and 2 threads, gives the same masks
+ *     bit for bit, equal to raytrace's; and a scene whose triangle array is shuffled renders to raytrace's
+ *     answer on that scene;
+ *   - streaming: a procedural flowers scene rendered by hpc (no BVH, depth-pass primary, triangles
+ *     generated in batches) equals raytrace on the same scene materialised; bad procedural sources fail
+ *     with one line naming the file (exit 2 through the CLI). */
+#include "testutil.h"
+#include "shadow/method.h"
+#include "shadow/receiver.h"
+#include "shadow/hpc.h"
+#include "accel/bvh.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void render_ok(const ms_scene *sc, const char *method, int samples, int size, int threads, ms_frame *f)
+{
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.method = method;
+    o.samples = samples;
+    o.width = o.height = size;
+    o.threads = threads;
+    char err[512];
+    int rc = ms_render(sc, &o, f, err, sizeof err);
+    if (rc) fprintf(stderr, "render %s: %s\n", method, err);
+    assert_int_equal(rc, 0);
+}
+
+/* hpc bit for bit, hpc-scanline within ties. */
+static void agree_on_scene(const ms_scene *sc, const char *label, int samples, int size)
+{
+    ms_frame ref, f;
+    render_ok(sc, "raytrace", samples, size, 0, &ref);
+    render_ok(sc, "hpc", samples, size, 0, &f);
+    long dv = 0, ds = 0, npix = (long)size * size, lit = 0, part = 0;
+    for (long i = 0; i < npix; i++) {
+        dv += memcmp(&f.vis[i], &ref.vis[i], sizeof(float)) != 0;
+        ds += memcmp(&f.shadow[i], &ref.shadow[i], sizeof(float)) != 0;
+        lit += ref.vis[i] > 0.0f;
+        part += ref.vis[i] > 0.0f && ref.vis[i] < 1.0f;
+    }
+    printf("%-16s N=%-4d hpc: V differs at %ld, S at %ld of %ld pixels (%ld lit, %ld in penumbra); %llu triangles, "
+           "%llu sample tests, %llu full-umbra points\n", label, samples, dv, ds, npix, lit, part,
+           (unsigned long long)f.stats.counter[0], (unsigned long long)f.stats.counter[9],
+           (unsigned long long)f.stats.counter[14]);
+    assert_int_equal(dv, 0);
+    assert_int_equal(ds, 0);
+    assert_true(lit > 0);
+    assert_string_equal(f.stats.counter_name[9], "sample_tests");
+    ms_frame_free(&f);
+
+    render_ok(sc, "hpc-scanline", samples, size, 0, &f);
+    tu_agreement a = tu_compare_frames(&f, &ref);
+    printf("%-16s N=%-4d hpc-scanline: differ %ld/%ld pixels, max |dV| %.2f samples, max |dS| %.5f\n", label, samples,
+           a.differ, a.pixels, a.max_steps, a.max_ds);
+    assert_int_equal(a.miss_mismatch, 0);
+    assert_int_equal(a.beyond_one, 0);
+    assert_int_equal(a.s_beyond, 0);
+    assert_true((double)a.differ <= 0.001 * (double)a.pixels);
+    ms_frame_free(&f);
+    ms_frame_free(&ref);
+}
+
+static void test_builtin(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    agree_on_scene(&sc, "built-in", 256, 96);
+    agree_on_scene(&sc, "built-in", 1024, 48);
+    ms_scene_free(&sc);
+}
+
+static void shared_scene(const char *rel, const char *label, int samples, int size)
+{
+    if (!tu_have_shared_scenes()) skip();
+    char path[4096], err[1024];
+    tu_shared_scene(path, sizeof path, rel);
+    ms_scene sc;
+    if (ms_scene_load(path, &sc, err, sizeof err)) fail_msg("%s", err);
+    agree_on_scene(&sc, label, samples, size);
+    ms_scene_free(&sc);
+}
+
+static void test_quad(void **st) { (void)st; shared_scene("quad/quad.json", "quad", 1024, 64); }
+static void test_sibenik(void **st) { (void)st; shared_scene("sibenik/sibenik.json", "sibenik", 256, 48); }
+static void test_sponza(void **st) { (void)st; shared_scene("dabrovic-sponza/dabrovic-sponza.json", "dabrovic-sponza", 256, 48); }
+
+/* ---- the engine driven directly: order and threads ---- */
+
+typedef struct perm_source {
+    const ms_bvh *bvh;
+    const uint32_t *order;   /* leaf-order ids */
+    size_t n, pos;
+} perm_source;
+
+static int perm_rewind(void *u) { ((perm_source *)u)->pos = 0; return 0; }
+
+static size_t perm_next(void *u, float *tri, uint32_t *ids, size_t max)
+{
+    perm_source *s = u;
+    size_t n = 0;
+    for (; n < max && s->pos < s->n; n++, s->pos++) {
+        const uint32_t i = s->order[s->pos];
+        memcpy(tri + 9 * n, s->bvh->tri + 9 * (size_t)i, 9 * sizeof *tri);
+        ids[n] = i;
+    }
+    return n;
+}
+
+static void test_order_and_threads(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    const int W = 64, H = 64, k = 16;
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
+    ms_render_ctx ctx;
+    tu_ctx_init(&ctx, &sc, &bvh, W, H, k);
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    void *ps = NULL;
+    char err[256];
+    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
+    ms_hit *hits = malloc((size_t)W * H * sizeof *hits);
+    pm->trace(ps, &ctx, 0, 0, W, H, hits);
+    pm->destroy(ps);
+    ms_shadow_query *q = malloc((size_t)W * H * sizeof *q);
+    size_t n = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            if (hits[y * W + x].prim != UINT32_MAX) tu_query_from_hit(&q[n++], &hits[y * W + x], x, y);
+    assert_true(n > 1000);
+    const size_t mw = (size_t)ctx.mask_words;
+    uint64_t *front = malloc(n * mw * sizeof *front), *ref = malloc(n * mw * sizeof *ref);
+    uint64_t *vis = malloc(n * mw * sizeof *vis), *scan_ref = malloc(n * mw * sizeof *scan_ref);
+    float *pts = malloc((size_t)ctx.samples * 3 * sizeof *pts);
+    uint64_t rc[MS_MAX_COUNTERS] = { 0 };
+    for (size_t i = 0; i < n; i++) {
+        ms_front_mask(&ctx, &q[i], NULL, front + i * mw);
+        ms_raytrace_visible_samples(&ctx, &q[i], pts, front + i * mw, ref + i * mw, rc);
+    }
+    /* Orders: area buckets (what the method uses), reversed, and three shuffles. */
+    const size_t nt = bvh.n_tris;
+    uint32_t *area = ms_hpc_area_order(bvh.tri, nt), *order = malloc(nt * sizeof *order);
+    assert_non_null(area);
+    tu_rng rng = { 0x4850434Cu };
+    long blocked = 0;
+    for (int variant = 0; variant < 5; variant++) {
+        for (size_t i = 0; i < nt; i++) order[i] = variant == 1 ? area[nt - 1 - i] : area[i];
+        if (variant >= 2)
+            for (size_t i = nt - 1; i > 0; i--) {
+                const size_t j = (size_t)(tu_rng_next(&rng) % (i + 1));
+                const uint32_t t = order[i]; order[i] = order[j]; order[j] = t;
+            }
+        for (int threads = 1; threads <= 2; threads++) {
+            perm_source ps2 = { &bvh, order, nt, 0 };
+            const hpc_source src = { &ps2, perm_rewind, perm_next };
+            ctx.threads = threads;
+            uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+            for (int scan = 0; scan <= 1; scan++) {
+                ms_raster_fn raster = scan ? ms_raster_kernel(MS_KERNEL_SCANLINE, k, ctx.isa_cap, NULL) : NULL;
+                assert_int_equal(ms_hpc_cast(&ctx, scan, raster, q, n, front, vis, &src, cnt), 0);
+                long differ = 0;
+                for (size_t i = 0; i < n * mw; i++) differ += vis[i] != ref[i];
+                if (!scan) assert_int_equal(differ, 0);            /* hpc: raytrace's masks exactly */
+                else {
+                    assert_true(differ * 1000 <= (long)(n * mw));  /* hpc-scanline: raytrace's up to ties */
+                    if (variant == 0 && threads == 1) memcpy(scan_ref, vis, n * mw * sizeof *vis);
+                    else assert_memory_equal(vis, scan_ref, n * mw * sizeof *vis);   /* and order-free */
+                }
+                if (variant == 0 && threads == 1 && !scan)
+                    for (size_t i = 0; i < n * mw; i++) blocked += __builtin_popcountll(front[i] & ~vis[i]);
+            }
+        }
+    }
+    printf("order/threads: %zu points, %zu triangles, %ld blocked relations, 5 orders x 2 thread counts equal\n", n, nt,
+           blocked);
+    assert_true(blocked > 1000);
+    free(area); free(order); free(front); free(ref); free(vis); free(scan_ref); free(pts); free(q); free(hits);
+    ms_bvh_free(&bvh);
+    ms_scene_free(&sc);
+}
+
+/* The scene's own triangle array shuffled: the render still equals raytrace on it, on 1 and 2 threads. */
+static void test_shuffled_scene(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    tu_rng rng = { 77 };
+    for (size_t i = sc.n_tris - 1; i > 0; i--) {
+        const size_t j = (size_t)(tu_rng_next(&rng) % (i + 1));
+        float t[9];
+        memcpy(t, sc.tri + 9 * i, sizeof t);
+        memcpy(sc.tri + 9 * i, sc.tri + 9 * j, sizeof t);
+        memcpy(sc.tri + 9 * j, t, sizeof t);
+    }
+    ms_frame ref, a, b;
+    render_ok(&sc, "raytrace", 256, 64, 0, &ref);
+    render_ok(&sc, "hpc", 256, 64, 1, &a);
+    render_ok(&sc, "hpc", 256, 64, 2, &b);
+    assert_memory_equal(a.vis, ref.vis, 64 * 64 * sizeof(float));
+    assert_memory_equal(a.shadow, ref.shadow, 64 * 64 * sizeof(float));
+    assert_memory_equal(b.vis, ref.vis, 64 * 64 * sizeof(float));
+    assert_memory_equal(b.shadow, ref.shadow, 64 * 64 * sizeof(float));
+    ms_frame_free(&ref); ms_frame_free(&a); ms_frame_free(&b);
+    ms_scene_free(&sc);
+}
+
+/* ---- streaming ---- */
+
+static const char *flowers_json(const char *dir, const char *name, const char *proc)
+{
+    static char path[4096];
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"procedural\": %s,\n \"camera\": {\"eye\": [0, 14, 18], \"target\": [0, 0, 0], \"up\": [0, 1, 0], "
+             "\"fov_y\": 60},\n \"light\": {\"corner\": [-2, 12, -2], \"edge_s\": [4, 0, 0], \"edge_t\": [0, 0, 4]}}\n", proc);
+    tu_path(path, sizeof path, dir, name);
+    assert_int_equal(tu_write_file(path, text), 0);
+    return path;
+}
+
+/* A streamed procedural scene: hpc and hpc-scanline (no BVH, primary hits from the depth pass, triangles
+ * generated batch by batch) against raytrace on the same scene materialised (BVH primary): V and S bit
+ * for bit for hpc, within ties for hpc-scanline. More than one batch of triangles (16K in hpc.c, 64K in
+ * the depth pass). */
+static void test_streamed_flowers(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("test_hpc");
+    char err[1024];
+    ms_scene sc;
+    if (ms_scene_load(flowers_json(dir, "flowers.json", "{\"type\": \"flowers\", \"triangles\": 70000, \"seed\": 3}"),
+                      &sc, err, sizeof err))
+        fail_msg("%s", err);
+    assert_null(sc.tri);
+    assert_int_equal(sc.n_tris, 70000);
+    ms_frame ref, f;
+    render_ok(&sc, "raytrace", 256, 48, 0, &ref);   /* materialised */
+    render_ok(&sc, "hpc", 256, 48, 0, &f);          /* streamed */
+    assert_int_equal(f.stats.build_s, 0.0);         /* no BVH */
+    long lit = 0, part = 0;
+    for (int i = 0; i < 48 * 48; i++) { lit += ref.vis[i] > 0.0f; part += ref.vis[i] > 0.0f && ref.vis[i] < 1.0f; }
+    printf("flowers 70000: %ld lit, %ld penumbra pixels of %d\n", lit, part, 48 * 48);
+    assert_true(part > 50);
+    assert_memory_equal(f.vis, ref.vis, 48 * 48 * sizeof(float));
+    assert_memory_equal(f.shadow, ref.shadow, 48 * 48 * sizeof(float));
+    ms_frame_free(&f);
+    render_ok(&sc, "hpc-scanline", 256, 48, 0, &f);
+    tu_agreement a = tu_compare_frames(&f, &ref);
+    assert_int_equal(a.miss_mismatch, 0);
+    assert_int_equal(a.beyond_one, 0);
+    assert_true((double)a.differ <= 0.002 * (double)a.pixels);
+    ms_frame_free(&f);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
+/* Bad procedural sources: one line naming the file and what is wrong. */
+static void test_procedural_bad_input(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("test_hpc_bad");
+    static const struct { const char *proc, *want; } cases[] = {
+        { "{\"type\": \"trees\", \"triangles\": 10}", "procedural.type must be \"flowers\"" },
+        { "{\"type\": \"flowers\", \"triangles\": 0}", "procedural.triangles must be an integer" },
+        { "{\"type\": \"flowers\", \"triangles\": 1.5}", "procedural.triangles must be an integer" },
+        { "{\"type\": \"flowers\", \"triangles\": 1e12}", "procedural.triangles must be an integer" },
+        { "{\"type\": \"flowers\", \"triangles\": 10, \"seed\": -1}", "procedural.seed must be an integer" },
+        { "{\"type\": \"flowers\"}", "triangles" },
+        { "[1, 2]", "\"procedural\" must be an object" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        char err[1024], name[32];
+        snprintf(name, sizeof name, "bad%zu.json", i);
+        const char *path = flowers_json(dir, name, cases[i].proc);
+        ms_scene sc;
+        assert_int_not_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+        if (!strstr(err, cases[i].want) || !strstr(err, name)) fail_msg("case %zu: got \"%s\"", i, err);
+    }
+    /* meshes and procedural together */
+    char path[4096], err[1024];
+    tu_path(path, sizeof path, dir, "both.json");
+    tu_write_file(path, "{\"meshes\": [{\"file\": \"x.obj\"}], \"procedural\": {\"type\": \"flowers\", \"triangles\": 5},"
+                        " \"camera\": {\"eye\": [0, 1, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov_y\": 60},"
+                        " \"light\": {\"corner\": [0, 3, 0], \"edge_s\": [1, 0, 0], \"edge_t\": [0, 0, 1]}}");
+    ms_scene sc;
+    assert_int_not_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    assert_non_null(strstr(err, "either \"meshes\" or \"procedural\""));
+    /* through the CLI: exit 2 and the message */
+    const char *args[] = { flowers_json(dir, "cli.json", "{\"type\": \"tulips\", \"triangles\": 5}"), "--quiet", NULL };
+    char line[1024];
+    assert_int_equal(tu_run_cli(args, line, sizeof line), 2);
+    assert_non_null(strstr(line, "procedural.type"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_builtin),
+        cmocka_unit_test(test_quad),
+        cmocka_unit_test(test_sibenik),
+        cmocka_unit_test(test_sponza),
+        cmocka_unit_test(test_order_and_threads),
+        cmocka_unit_test(test_shuffled_scene),
+        cmocka_unit_test(test_streamed_flowers),
+        cmocka_unit_test(test_procedural_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

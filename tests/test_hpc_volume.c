@@ -1,0 +1,117 @@
+/* Penumbra volumes (src/shadow/hpc_volume.c, Laine & Aila 2005 sec. 3.2) against brute force: for random
+ * light rectangles and triangles, every point that some segment from a point of the rectangle through the
+ * triangle reaches (sampled densely, in double) lies inside the volume, with margin 0; and a box around
+ * such a point is never culled. Also reports how tight the volume is: the share of sampled points inside
+ * it that are shadowed from at least one of 64 light points. */
+#include "testutil.h"
+#include "shadow/hpc_volume.h"
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static double unitd(tu_rng *r) { return (double)(tu_rng_next(r) >> 11) * (1.0 / 9007199254740992.0); }
+
+static void test_contains_every_shadow(void **st)
+{
+    (void)st;
+    tu_rng rng = { 0x5EED };
+    long shadowed = 0, inside = 0, inside_and_shadowed = 0, planes = 0;
+    for (int trial = 0; trial < 300; trial++) {
+        /* light: a rectangle at y = 4 (random size), triangle between y = 0.5 and 3.5 */
+        const double lx = 0.2 + 2.0 * unitd(&rng), lz = 0.2 + 2.0 * unitd(&rng);
+        const double poly[12] = { -lx, 4, -lz, lx, 4, -lz, lx, 4, lz, -lx, 4, lz };
+        float tri[9];
+        for (int v = 0; v < 3; v++) {
+            tri[3 * v] = (float)(3.0 * unitd(&rng) - 1.5);
+            tri[3 * v + 1] = (float)(0.5 + 3.0 * unitd(&rng));
+            tri[3 * v + 2] = (float)(3.0 * unitd(&rng) - 1.5);
+        }
+        hpc_volume vol;
+        planes += hpc_volume_build(&vol, poly, 4, tri, 0.0f);
+        for (int k = 0; k < 200; k++) {
+            /* a shadowed point: light point l, triangle point t (barycentric), x = l + s (t - l), s >= 1 */
+            double a = unitd(&rng), b = unitd(&rng);
+            if (a + b > 1) { a = 1 - a; b = 1 - b; }
+            double l[3] = { -lx + 2 * lx * unitd(&rng), 4, -lz + 2 * lz * unitd(&rng) }, t[3], x[3];
+            for (int c = 0; c < 3; c++) t[c] = tri[c] + a * (tri[3 + c] - tri[c]) + b * (tri[6 + c] - tri[c]);
+            const double s = 1.0 + 5.0 * unitd(&rng);
+            for (int c = 0; c < 3; c++) x[c] = l[c] + s * (t[c] - l[c]);
+            const float p[3] = { (float)x[0], (float)x[1], (float)x[2] };
+            uint64_t tests = 0;
+            /* margin: the float rounding of p and of the planes, far below the geometry */
+            vol.eps = 1e-4f;
+            if (!hpc_volume_point(&vol, HPC_ALL_PLANES, p, &tests))
+                fail_msg("trial %d: shadowed point (%g %g %g) outside the volume", trial, x[0], x[1], x[2]);
+            const float lo[3] = { p[0] - 0.01f, p[1] - 0.01f, p[2] - 0.01f }, hi[3] = { p[0] + 0.01f, p[1] + 0.01f, p[2] + 0.01f };
+            uint32_t out;
+            assert_true(hpc_volume_box(&vol, HPC_ALL_PLANES, lo, hi, &out, &tests));
+            shadowed++;
+        }
+        /* tightness: random points below the light, inside the volume, shadowed from some light point? */
+        for (int k = 0; k < 200; k++) {
+            const float p[3] = { (float)(12 * unitd(&rng) - 6), (float)(-2 + 5.5 * unitd(&rng)), (float)(12 * unitd(&rng) - 6) };
+            uint64_t tests = 0;
+            vol.eps = 0.0f;
+            if (!hpc_volume_point(&vol, HPC_ALL_PLANES, p, &tests)) continue;
+            inside++;
+            int any = 0;
+            for (int i = 0; i < 8 && !any; i++)
+                for (int j = 0; j < 8 && !any; j++) {
+                    const double l[3] = { -lx + 2 * lx * (i + 0.5) / 8, 4, -lz + 2 * lz * (j + 0.5) / 8 };
+                    /* segment l -> p against the triangle (Moller-Trumbore in double) */
+                    double e1[3], e2[3], d[3], pv[3], sv[3], qv[3];
+                    for (int c = 0; c < 3; c++) { e1[c] = tri[3 + c] - tri[c]; e2[c] = tri[6 + c] - tri[c]; d[c] = p[c] - l[c]; sv[c] = l[c] - tri[c]; }
+                    pv[0] = d[1] * e2[2] - d[2] * e2[1]; pv[1] = d[2] * e2[0] - d[0] * e2[2]; pv[2] = d[0] * e2[1] - d[1] * e2[0];
+                    const double det = e1[0] * pv[0] + e1[1] * pv[1] + e1[2] * pv[2];
+                    if (fabs(det) < 1e-12) continue;
+                    const double u = (sv[0] * pv[0] + sv[1] * pv[1] + sv[2] * pv[2]) / det;
+                    qv[0] = sv[1] * e1[2] - sv[2] * e1[1]; qv[1] = sv[2] * e1[0] - sv[0] * e1[2]; qv[2] = sv[0] * e1[1] - sv[1] * e1[0];
+                    const double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) / det;
+                    const double tt = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) / det;
+                    any = u >= 0 && v >= 0 && u + v <= 1 && tt > 0 && tt < 1;
+                }
+            inside_and_shadowed += any;
+        }
+    }
+    printf("%ld shadowed points all inside; %.2f planes per volume; of %ld random points inside a volume, %.1f%% are "
+           "shadowed from one of 64 light points\n", shadowed, (double)planes / 300.0, inside,
+           100.0 * (double)inside_and_shadowed / (double)(inside ? inside : 1));
+    assert_true(inside_and_shadowed * 2 > inside);   /* the volume is not the whole space */
+}
+
+/* Active plane sets: a box wholly inside loses its planes; a child box then needs no plane tests. */
+static void test_active_planes(void **st)
+{
+    (void)st;
+    const double poly[12] = { -1, 4, -1, 1, 4, -1, 1, 4, 1, -1, 4, 1 };
+    const float tri[9] = { -1, 2, -1, 1, 2, -1, 0, 2, 1 };
+    hpc_volume v;
+    const int n = hpc_volume_build(&v, poly, 4, tri, 1e-5f);
+    assert_true(n >= 4);
+    assert_false(v.unbounded);
+    uint64_t tests = 0;
+    uint32_t out;
+    /* a small box right under the triangle's centre, well inside the umbra region */
+    const float lo[3] = { -0.05f, 1.0f, -0.35f }, hi[3] = { 0.05f, 1.1f, -0.25f };
+    assert_true(hpc_volume_box(&v, HPC_ALL_PLANES, lo, hi, &out, &tests));
+    assert_int_equal(out, 0);
+    const uint64_t before = tests;
+    assert_true(hpc_volume_point(&v, out, lo, &tests));
+    assert_int_equal(tests, before);
+    /* a box beside the light, above the triangle's plane: outside */
+    const float lo2[3] = { 5, 3, 5 }, hi2[3] = { 6, 3.5f, 6 };
+    assert_false(hpc_volume_box(&v, HPC_ALL_PLANES, lo2, hi2, &out, &tests));
+    /* a triangle crossing the light: no separating plane, nothing culled */
+    const float cross[9] = { -3, 3, 0, 3, 5, 0, 0, 4, 3 };
+    hpc_volume_build(&v, poly, 4, cross, 1e-5f);
+    assert_true(hpc_volume_box(&v, HPC_ALL_PLANES, lo2, hi2, &out, &tests));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_contains_every_shadow),
+        cmocka_unit_test(test_active_planes),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
