@@ -2,6 +2,10 @@
  *  - the points: the 16 sets of N/16 are disjoint, each is a (0,m,2)-net in base 2 and together they are
  *    a (0,m+4,2)-net (oracle: counting the points in every elementary interval of the right volume); a
  *    pixel's world points are its set's (u,v) on the light, the same in every 4x4 block of the frame;
+ *  - the filter on hand-made frames against a direct double-precision weighted mean: the centred window
+ *    (1/2, 1, 1, 1, 1/2 per axis), weights by front count, neighbours off the pixel's plane, with another
+ *    normal, missed or with no sample in front left out (only the rule for which neighbours lie in a
+ *    pixel's plane is restated here, for the one frame whose normals do not match its points);
  *  - sample for sample: raytrace and embree give the same raw V and S on it (whole frames, filter off);
  *  - quality: filtered at N = 256 (16 rays per pixel) its mean absolute error in V and S against a
  *    4096-sample raytrace render (grid pattern) is smaller than that of plain stratified sampling with
@@ -13,6 +17,7 @@
  * the built-in scene takes ~20 s under ASan); the paper's frames are 1024x1024. */
 #include "testutil.h"
 #include "core/pattern.h"
+#include "render/interleave_filter.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -126,6 +131,63 @@ static void test_pixel_points(void **st)
     assert_int_equal(ms_pattern_samples_per_pixel(MS_PATTERN_GRID, 64), 0);
     assert_int_equal(ms_pattern_samples_per_pixel(MS_PATTERN_GRID, 1024), 1024);
     assert_int_equal(ms_pattern_samples_per_pixel((ms_pattern)7, 1024), 0);
+}
+
+/* Hand-made frames for the filter: pixel (x, y) hits the plane y = 0 at (x, 0, y) with normal +y, unless
+ * `kind` says otherwise for x >= W/2: 1 a parallel plane 0.5 higher (a step), 2 a normal tilted by 30
+ * degrees (points still on y = 0), 3 a miss. */
+enum { FW = 12, FH = 10 };
+static void filter_frame(int kind, ms_hit *h, uint16_t *front, float *v, float *s, tu_rng *rng)
+{
+    for (int y = 0; y < FH; y++)
+        for (int x = 0; x < FW; x++) {
+            const int i = y * FW + x, right = x >= FW / 2;
+            ms_hit *c = &h[i];
+            c->prim = 0;
+            c->p[0] = (float)x; c->p[1] = kind == 1 && right ? 0.5f : 0.0f; c->p[2] = (float)y;
+            c->n[0] = 0.0f; c->n[1] = 1.0f; c->n[2] = 0.0f;
+            if (kind == 2 && right) { c->n[0] = 0.5f; c->n[1] = 0.8660254f; }
+            front[i] = (uint16_t)(1 + tu_rng_next(rng) % 16);
+            v[i] = (float)(tu_rng_next(rng) % 1000) / 999.0f;
+            s[i] = (float)(tu_rng_next(rng) % 1000) / 999.0f;
+            if (kind == 3 && right) { c->prim = UINT32_MAX; front[i] = 0; v[i] = s[i] = -1.0f; }
+        }
+    front[3 * FW + 2] = 0;   /* a pixel with no sample in front: V = S = 0 by definition */
+    v[3 * FW + 2] = s[3 * FW + 2] = 0.0f;
+}
+
+static void test_filter(void **st)
+{
+    (void)st;
+    tu_rng rng = { 99 };
+    for (int kind = 0; kind < 4; kind++) {
+        ms_hit h[FW * FH];
+        uint16_t front[FW * FH];
+        float v[FW * FH], s[FW * FH], v1[FW * FH], s1[FW * FH];
+        filter_frame(kind, h, front, v, s, &rng);
+        memcpy(v1, v, sizeof v);
+        memcpy(s1, s, sizeof s);
+        assert_int_equal(ms_interleave_filter(FW, FH, h, front, v1, s1, 2), 0);
+        for (int y = 0; y < FH; y++)
+            for (int x = 0; x < FW; x++) {
+                const int i = y * FW + x, right = x >= FW / 2;
+                double wv = 0, ws = 0, w = 0;
+                for (int dy = -2; dy <= 2; dy++)
+                    for (int dx = -2; dx <= 2; dx++) {
+                        const int xx = x + dx, yy = y + dy, j = yy * FW + xx;
+                        if (xx < 0 || yy < 0 || xx >= FW || yy >= FH || !front[j]) continue;
+                        if (kind && (xx >= FW / 2) != right) continue;   /* the other surface, or a miss */
+                        /* a tilted normal on the points of y = 0: only the neighbours along z are in its plane */
+                        if (kind == 2 && right && dx != 0) continue;
+                        const double t = (dx == -2 || dx == 2 ? 0.5 : 1.0) * (dy == -2 || dy == 2 ? 0.5 : 1.0) * front[j];
+                        w += t; wv += t * v[j]; ws += t * s[j];
+                    }
+                double ev = w > 0 ? wv / w : v[i], es = w > 0 ? ws / w : s[i];
+                if (!front[i]) ev = es = v[i];           /* misses and pixels with nothing in front stay */
+                if (fabs(v1[i] - ev) > 1e-5 || fabs(s1[i] - es) > 1e-5)
+                    fail_msg("kind %d pixel (%d,%d): filtered V %.6f S %.6f, expected %.6f %.6f", kind, x, y, v1[i], s1[i], ev, es);
+            }
+    }
 }
 
 /* The Quad: 20x20 ground at y=0, 4x4 occluder at y=2, 2x2 light at y=6 (as ../shared/scenes/quad). */
@@ -291,6 +353,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sets_are_nets),
         cmocka_unit_test(test_pixel_points),
+        cmocka_unit_test(test_filter),
         cmocka_unit_test(test_raytrace_embree_agree),
         cmocka_unit_test(test_quality),
     };

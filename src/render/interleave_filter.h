@@ -6,16 +6,16 @@
 #include <stdint.h>
 #include "../shadow/method.h"
 
-/* A neighbour is left out when its hit point lies farther from the pixel's tangent plane than this
- * share of the pixel's distance to the camera ... */
+/* A neighbour is left out when its hit point lies off the pixel's tangent plane by more than this share
+ * of its distance from the pixel (about 0.6 degrees) ... */
 #define MS_FILTER_PLANE_TOL 0.01f
 /* ... or when the cosine between the two normals is below this (about 25 degrees). */
 #define MS_FILTER_NORMAL_COS 0.9f
 
 /* Filters vis and shadow (W*H, row 0 at the top) in place. hits: the frame's primary hits (misses are
- * neither filtered nor used); eye: the camera position; front: each pixel's samples in front of its
- * plane. Returns 0, or -1 when out of memory (the values are then left raw). */
-int ms_interleave_filter(int W, int H, const ms_hit *hits, const float eye[3], const uint16_t *front, float *vis,
-                         float *shadow, int threads);
+ * neither filtered nor used); front: each pixel's samples in front of its plane. Returns 0, or -1 when
+ * out of memory (the values are then left raw). */
+int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front, float *vis, float *shadow,
+                         int threads);
 
 #endif

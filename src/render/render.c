@@ -217,7 +217,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     double filter_s = 0.0;
     if (ctx.pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter) {
         const double tf = omp_get_wtime();
-        if (ms_interleave_filter(W, H, hits, ctx.cam.eye, out->front, out->vis, out->shadow, threads)) {
+        if (ms_interleave_filter(W, H, hits, out->front, out->vis, out->shadow, threads)) {
             snprintf(err, errlen, "out of memory for the interleaved filter of a %dx%d frame", W, H);
             sm->destroy(sstate);
             pm->destroy(pstate);
