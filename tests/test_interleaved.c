@@ -289,6 +289,43 @@ static void test_raytrace_embree_agree(void **st)
     }
 }
 
+/* The CLI: --pattern interleaved gives the library's filtered V, --no-filter the raw one (both read back
+ * from --vis), and the two differ. */
+static void test_cli(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("interleaved_cli");
+    char pf[4096], pr[4096], png[4096], err[1024];
+    tu_path(pf, sizeof pf, dir, "filtered.pfm");
+    tu_path(pr, sizeof pr, dir, "raw.pfm");
+    tu_path(png, sizeof png, dir, "out.png");
+    const char *a1[] = { "--method", "raytrace", "--pattern", "interleaved", "--samples", "256", "--width", "32",
+                         "--height", "32", "--seed", "5", "--vis", pf, "-o", png, "--quiet", NULL };
+    const char *a2[] = { "--method", "raytrace", "--pattern", "interleaved", "--samples", "256", "--width", "32",
+                         "--height", "32", "--seed", "5", "--vis", pr, "-o", png, "--no-filter", "--quiet", NULL };
+    assert_int_equal(tu_run_cli(a1, err, sizeof err), 0);
+    assert_int_equal(tu_run_cli(a2, err, sizeof err), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    const char *paths[2] = { pf, pr };
+    float *got[2];
+    for (int nf = 0; nf < 2; nf++) {
+        int w, h;
+        got[nf] = tu_read_pfm(paths[nf], &w, &h);
+        assert_non_null(got[nf]);
+        assert_int_equal(w, 32);
+        assert_int_equal(h, 32);
+        ms_frame f;
+        render(&sc, "raytrace", MS_PATTERN_INTERLEAVED, 256, 32, nf, &f);
+        assert_memory_equal(got[nf], f.vis, sizeof(float) * 32 * 32);
+        ms_frame_free(&f);
+    }
+    assert_memory_not_equal(got[0], got[1], sizeof(float) * 32 * 32);
+    free(got[0]);
+    free(got[1]);
+    ms_scene_free(&sc);
+}
+
 typedef struct mae { double v, s; long n; } mae;
 
 /* Mean absolute error of V and S against the reference over the pixels the reference sees. */
@@ -357,6 +394,7 @@ int main(void)
         cmocka_unit_test(test_pixel_points),
         cmocka_unit_test(test_filter),
         cmocka_unit_test(test_raytrace_embree_agree),
+        cmocka_unit_test(test_cli),
         cmocka_unit_test(test_quality),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
