@@ -193,8 +193,16 @@ int main(int argc, char **argv)
 {
     const char *dir = "../shared/scenes", *out_md = NULL;
     int samples[4] = { 1024 }, n_samples = 1, size = 1024, threads = 0;
-    const char *methods[MAX_METHODS] = { "raytrace", "embree", "bounds", "hierarchical", "scanline" };
-    int n_methods = 5, quality_only = 0;
+    /* A method may name a variant after a colon: scanline:pixel (the per-pixel traversal), scanline:fs
+     * (block traversal with frustum shrinking). Plain names run the defaults. */
+    const char *methods[MAX_METHODS] = { "raytrace", "embree", "mft", "bounds", "hierarchical", "scanline:pixel", "scanline" };
+    int n_methods = 7, quality_only = 0;
+    /* The command line as given, for the header (strtok below cuts the lists). */
+    char cmdline[1024] = "";
+    for (int i = 1; i < argc; i++) {
+        strncat(cmdline, " ", sizeof cmdline - strlen(cmdline) - 1);
+        strncat(cmdline, argv[i], sizeof cmdline - strlen(cmdline) - 1);
+    }
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--scenes") && i + 1 < argc) dir = argv[++i];
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = atoi(argv[++i]);
@@ -209,14 +217,18 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[++i], ","); t && n_methods < MAX_METHODS; t = strtok(NULL, ",")) methods[n_methods++] = t;
         } else {
             fprintf(stderr, "usage: bench_scenes [--scenes DIR] [--samples 256,1024,4096] [--size S] [--threads T] "
-                            "[--methods raytrace,embree,bounds,hierarchical,scanline] [--quality-only] [--out FILE.md]\n");
+                            "[--methods raytrace,embree,mft,bounds,hierarchical,scanline:pixel,scanline] [--quality-only] "
+                            "[--out FILE.md]\n");
             return 2;
         }
     }
     /* Methods not compiled in are dropped with a note rather than failing the run. */
     int m_ok = 0;
     for (int m = 0; m < n_methods; m++) {
-        if (ms_method_available(methods[m]) == 1) methods[m_ok++] = methods[m];
+        char base[64];
+        snprintf(base, sizeof base, "%s", methods[m]);
+        base[strcspn(base, ":")] = 0;
+        if (ms_method_available(base) == 1) methods[m_ok++] = methods[m];
         else fprintf(stderr, "bench_scenes: method %s is not available in this build, skipped\n", methods[m]);
     }
     n_methods = m_ok;
@@ -227,11 +239,8 @@ int main(int argc, char **argv)
     time_t now = time(NULL);
     char date[64];
     strftime(date, sizeof date, "%Y-%m-%d", gmtime(&now));
-    char cmd[2048] = "build/bench_scenes";
-    for (int i = 1; i < argc; i++) {
-        strncat(cmd, " ", sizeof cmd - strlen(cmd) - 1);
-        strncat(cmd, argv[i], sizeof cmd - strlen(cmd) - 1);
-    }
+    char cmd[1100];
+    snprintf(cmd, sizeof cmd, "build/bench_scenes%s", cmdline);
     /* Built in memory (progress on stderr), then printed and written; with --quality-only the file keeps
      * everything outside the section. */
     char *sec = NULL;
@@ -255,9 +264,11 @@ int main(int argc, char **argv)
         fprintf(outs[o], "Shadow seconds per method (primary visibility, shading and BVH build excluded), %dx%d, "
                 "grid pattern, seed 0, threads %s, measured %s by `build/bench_scenes",
                 size, size, threads ? "as given" : "= all cores", date);
-        for (int i = 1; i < argc; i++) fprintf(outs[o], " %s", argv[i]);
-        fprintf(outs[o], "`.\n\n");
+        fprintf(outs[o], "%s`.\n\n", cmdline);
     }
+    double log_scan[MAX_METHODS] = { 0 }, log_emb[MAX_METHODS] = { 0 };
+    int n_scan[MAX_METHODS] = { 0 }, n_emb[MAX_METHODS] = { 0 }, n_lines = 0;
+    char *counter_lines[MAX_METHODS * MAX_SCENES];
     for (int si = 0; si < n_samples; si++) {
         int N = samples[si];
         for (int o = 0; o < 2; o++) {
@@ -276,13 +287,21 @@ int main(int argc, char **argv)
             char err[1024];
             if (ms_scene_load(scenes[s], &sc, err, sizeof err)) { fprintf(stderr, "%s\n", err); continue; }
             double secs[MAX_METHODS], s_cost = NAN, mean_sv = NAN, big_sv = NAN;
+            ms_stats stats[MAX_METHODS];
+            memset(stats, 0, sizeof stats);
             float *vis[MAX_METHODS] = { 0 };
             uint16_t *front[MAX_METHODS] = { 0 };
             int ref = -1, scan = -1, emb = -1;
             for (int m = 0; m < n_methods; m++) {
                 ms_render_options opt;
                 ms_render_options_default(&opt);
-                opt.method = methods[m];
+                char base[64];
+                snprintf(base, sizeof base, "%s", methods[m]);
+                const char *variant = strchr(methods[m], ':');
+                base[strcspn(base, ":")] = 0;
+                opt.method = base;
+                if (variant && !strcmp(variant + 1, "pixel")) opt.traversal = MS_TRAVERSAL_PIXEL;
+                if (variant && !strcmp(variant + 1, "fs")) opt.frustum_shrink = 1;
                 opt.samples = N;
                 opt.width = opt.height = size;
                 opt.threads = threads;
@@ -290,6 +309,7 @@ int main(int argc, char **argv)
                 secs[m] = NAN;
                 if (ms_render(&sc, &opt, &f, err, sizeof err)) { fprintf(stderr, "%s: %s\n", scenes[s], err); continue; }
                 secs[m] = f.stats.shadow_s;
+                stats[m] = f.stats;
                 fprintf(stderr, "  %s %s %d: shadow %.3f s (%.1f M rays/s)\n", base_name(scenes[s]), methods[m], N,
                         f.stats.shadow_s, (double)f.stats.shadow_rays / f.stats.shadow_s * 1e-6);
                 vis[m] = f.vis;
@@ -340,9 +360,41 @@ int main(int argc, char **argv)
                 fprintf(outs[o], " %s | %.1f%% | %.4f | %.2f%% |\n", agree, 100.0 * s_cost, mean_sv, 100.0 * big_sv);
                 fflush(outs[o]);
             }
+            for (int m = 0; m < n_methods; m++) {
+                if (isnan(secs[m])) continue;
+                if (scan >= 0 && !isnan(secs[scan])) { log_scan[m] += log(secs[m] / secs[scan]); n_scan[m]++; }
+                if (emb >= 0 && !isnan(secs[emb])) { log_emb[m] += log(secs[m] / secs[emb]); n_emb[m]++; }
+                /* the counters, for the table after this sample count */
+                char *line = counter_lines[n_lines] = malloc(4096);
+                if (!line) continue;
+                int len = snprintf(line, 4096, "| %s | %s |", base_name(scenes[s]), methods[m]);
+                for (int c = 0; c < stats[m].n_counters && len < 4000; c++)
+                    len += snprintf(line + len, (size_t)(4096 - len), " %s %.3gM;", stats[m].counter_name[c],
+                                    (double)stats[m].counter[c] * 1e-6);
+                snprintf(line + len, (size_t)(4096 - len), " |\n");
+                n_lines++;
+            }
             for (int m = 0; m < n_methods; m++) { free(vis[m]); free(front[m]); }
             ms_scene_free(&sc);
         }
+        for (int o = 0; o < 2; o++) {
+            if (!outs[o]) continue;
+            fprintf(outs[o], "| geometric mean | |");
+            for (int m = 0; m < n_methods; m++) fprintf(outs[o], " |");
+            for (int m = 0; m < n_methods; m++) fprintf(outs[o], n_scan[m] ? " %.2f |" : " - |", n_scan[m] ? exp(log_scan[m] / n_scan[m]) : 0.0);
+            for (int m = 0; m < n_methods; m++) fprintf(outs[o], n_emb[m] ? " %.2f |" : " - |", n_emb[m] ? exp(log_emb[m] / n_emb[m]) : 0.0);
+            fprintf(outs[o], " | | | |\n");
+            /* Counters per method (the paper's Table 1: for the block traversals aabb_tests are 16-wide
+             * node tests, tris_accessed the triangles of visited leaves, tri_pixel_tests the triangle-frustum
+             * pairs after the leaf's culling, triangles_rasterized / the ray tests what reached the kernel). */
+            fprintf(outs[o], "\nCounters, %d samples (M = millions; per method, see docs/design.md):\n\n| scene | method | counters |\n|---|---|---|\n", N);
+            for (int l = 0; l < n_lines; l++) fputs(counter_lines[l], outs[o]);
+            fflush(outs[o]);
+        }
+        for (int l = 0; l < n_lines; l++) free(counter_lines[l]);
+        n_lines = 0;
+        memset(log_scan, 0, sizeof log_scan); memset(log_emb, 0, sizeof log_emb);
+        memset(n_scan, 0, sizeof n_scan); memset(n_emb, 0, sizeof n_emb);
     }
     FILE *mem = open_memstream(&sec, &sec_len);
     if (mem) {

@@ -72,6 +72,8 @@ typedef struct ms_light {
     ms_vec3 emission;
 } ms_light;
 
+#define MS_MAX_UV_SETS 4
+
 /* A triangle soup: tri[9*i .. 9*i+8] are the three vertices of triangle i. */
 typedef struct ms_scene {
     float *tri;
@@ -80,6 +82,13 @@ typedef struct ms_scene {
     ms_light light;
     int samples;         /* light samples per pixel from the scene file (render.samples) */
     double load_s;       /* seconds spent loading meshes */
+    /* For baking (NULL where not known; ms_scene_free frees them). tri_mesh[i]: the mesh of the scene
+     * file (0-based, in its "meshes" order) triangle i came from. tri_uv[s][6*i .. 6*i+5]: (u, v) of
+     * triangle i's three vertices in UV set s (glTF TEXCOORD_s, assimp channel s), NaN where its mesh has
+     * no such set; tri_uv[s] is NULL when no mesh has it. */
+    uint32_t *tri_mesh;
+    float *tri_uv[MS_MAX_UV_SETS];
+    size_t n_meshes;
 } ms_scene;
 
 /* Warnings (an unknown key in a scene file) go to this handler, one line each without a newline; by
@@ -140,6 +149,13 @@ typedef enum ms_embree_filter {
     MS_EMBREE_FILTER_NONE = 2    /* never: for measuring only, the receiver then occludes itself */
 } ms_embree_filter;
 
+/* How the micro-rasterization methods find the triangles between a point and the light. */
+typedef enum ms_traversal {
+    MS_TRAVERSAL_AUTO = 0,   /* the default: MS_TRAVERSAL_BLOCK */
+    MS_TRAVERSAL_BLOCK = 1,  /* the frusta of a 4x4 pixel block together through a shallow BVH (Benthin & Wald 2009) */
+    MS_TRAVERSAL_PIXEL = 2   /* each pixel's frustum alone through the deep BVH (Woop 2010) */
+} ms_traversal;
+
 /* Every field's zero means its default, so a zeroed struct renders with the defaults. */
 typedef struct ms_render_options {
     const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
@@ -157,6 +173,9 @@ typedef struct ms_render_options {
     int no_child_order;     /* micro-raster methods: no near-first order of BVH children */
     ms_embree_mode embree_mode;
     ms_embree_filter embree_filter;
+    ms_traversal traversal; /* micro-raster methods: block (default) or per-pixel traversal */
+    int frustum_shrink;     /* block traversal: also narrow a pixel's traversal frustum as its samples are
+                             * occluded (the paper's "FS"; off: only its leaf rectangle shrinks, "CR") */
     int no_filter;          /* interleaved pattern: leave out the 4x4 discontinuity-aware filter (raw V, S) */
 } ms_render_options;
 
@@ -243,6 +262,122 @@ int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t e
 /* Exact unshadowed irradiance at point p with unit normal n from the light (polygon form factor,
  * light clipped to the receiver's hemisphere), per unit emitted radiance. */
 float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
+
+/* ---- Visibility at any points: the library for bakers (docs/baking.md) ----
+ *
+ * A baker needs V and S at its own receivers (texels, vertices, probes), not at pixels. The scene's
+ * acceleration structure is built once (ms_accel_build) and reused by any number of calls, from any
+ * number of threads at once (the handle is read-only after the build). Each call answers V and S under
+ * the definition above, with the receiver's plane given by its normal and the triangle it lies on (if
+ * given) never occluding it, on the same sample patterns as frames: point i's pattern is that of
+ * pixel (key[2i], key[2i+1]) of a frame with the same seed, or of pixel (i, 0) without keys, so results
+ * do not depend on the order in which points are processed or on the number of threads. Internally
+ * points are grouped by proximity (Morton order of their positions) so that coherent methods stay
+ * coherent; results come back in the caller's order. */
+
+/* Status codes of the points API (and ms_bake); a one-line message goes into err as elsewhere. */
+typedef enum ms_status {
+    MS_OK = 0,
+    MS_ERR_INVALID = 1,     /* a bad argument (the message names it) */
+    MS_ERR_NO_MEMORY = 2,
+    MS_ERR_CANCELLED = 3,   /* the progress callback returned non-zero */
+    MS_ERR_METHOD = 4,      /* unknown method, not compiled in, or its set-up failed */
+    MS_ERR_IO = 5           /* reading or writing a file failed */
+} ms_status;
+/* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o". */
+const char *ms_status_name(ms_status s);
+
+/* Progress with cancellation (like Embree's progress monitor): called with the fraction done, from one
+ * thread at a time (never concurrently for one call); return 0 to go on, non-zero to cancel the call,
+ * which then returns MS_ERR_CANCELLED soon after without results. */
+typedef int (*ms_progress_cancel_fn)(void *user, double fraction_done);
+
+typedef struct ms_accel ms_accel;
+/* Builds the acceleration structure of the scene's triangles (copied: the scene may be freed after).
+ * threads: 0 for all cores. MS_OK and *out, or an error with *out = NULL. */
+ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
+void ms_accel_free(ms_accel *a);
+size_t ms_accel_triangles(const ms_accel *a);
+
+#define MS_NO_TRIANGLE UINT32_MAX
+
+typedef struct ms_points {
+    size_t n;
+    const float *position;   /* 3n floats */
+    const float *normal;     /* 3n floats: the side of each receiver (need not be unit length, not zero) */
+    const uint32_t *triangle;/* n or NULL: index of the scene triangle (ms_scene.tri) each point lies on,
+                              * which never occludes it, or MS_NO_TRIANGLE; NULL: none. Without it a point
+                              * on a surface is still not occluded by that surface's plane (the near
+                              * range), but may be by a triangle meeting it at a crease. */
+    const uint32_t *key;     /* 2n or NULL: the pixel whose sample pattern point i uses (see above) */
+} ms_points;
+
+/* Every field's zero means its default (as ms_render_options). */
+typedef struct ms_points_options {
+    const char *method;     /* NULL: MS_DEFAULT_METHOD */
+    ms_pattern pattern;
+    int samples;            /* 256, 1024 or 4096; 0: MS_SAMPLES_DEFAULT */
+    int threads;            /* 0: all cores */
+    uint32_t seed;
+    ms_isa isa;
+    ms_progress_cancel_fn progress;   /* may be NULL */
+    void *progress_user;
+    ms_embree_mode embree_mode;
+    ms_embree_filter embree_filter;
+} ms_points_options;
+
+/* V, S and the front count of each point (any output may be NULL; each has n entries). light: NULL for
+ * the light of the scene the accel was built from. Stats (timing, counters, no image fields) into
+ * stats when non-NULL. */
+ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
+                               const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
+                               ms_stats *stats, char *err, size_t errlen);
+
+/* ---- Lightmap baking (docs/baking.md) ----
+ *
+ * Texel (x, y) of a size x size lightmap covers u in [x, x+1)/size and v in [y, y+1)/size of the UV set
+ * baked into (row 0 at v = 0, the top of the image as glTF has it). Every texel a triangle's UV image
+ * touches (conservative rasterization) is carried to the triangle's surface: its centre's barycentric
+ * coordinates, moved to the nearest point of the triangle when the centre lies outside (a texel several
+ * triangles touch takes the one containing its centre, else the nearest), give the world position; the
+ * normal is the triangle's, by its winding (cross(b - a, c - a)). V and S there come from
+ * ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
+ * E_unshadowed * S * emission (ms_light_irradiance). Texels no triangle touches are filled by dilation
+ * from their neighbours (across chart seams) so that bilinear lookups do not bleed black. */
+typedef struct ms_bake_options {
+    ms_points_options points;  /* method, pattern, samples, threads, seed, isa, progress; zero: defaults */
+    int size;                  /* texels per side; 0: 1024 (at most MS_MAX_IMAGE_SIZE) */
+    int uv_set;                /* the scene's UV set baked into (0 .. MS_MAX_UV_SETS-1); triangles whose mesh
+                                * lacks it are unwrapped by xatlas into the free space of one atlas with
+                                * them (all of them if no mesh has the set); -1: xatlas for every triangle */
+    int dilate;                /* texels of dilation; 0: 4; -1: none */
+    int padding;               /* texels between xatlas charts; 0: 2 */
+} ms_bake_options;
+
+typedef struct ms_lightmap {
+    /* width = height = size; rgb: irradiance E (not radiance), vis and shadow V and S (-1 where neither
+     * a triangle nor dilation reached), front: the texel's front samples (0 off the triangles);
+     * exposure and stats as for frames (visible_pixels: texels on triangles). The ms_output writers and
+     * ms_exr_write_stream take &lightmap.frame. */
+    ms_frame frame;
+    float *position, *normal;  /* 3 floats per texel: where it was evaluated; NaN off the triangles */
+    uint32_t *triangle;        /* per texel: the scene triangle, MS_NO_TRIANGLE off the triangles */
+    float *uv;                 /* 6 floats per scene triangle: the UVs baked into, in [0,1]^2; NaN if none */
+    size_t n_tris;
+    size_t texels;             /* texels on triangles */
+    size_t unwrapped_tris;     /* triangles whose UVs xatlas made */
+    double unwrap_s, raster_s; /* seconds in xatlas and in the texel rasterization */
+} ms_lightmap;
+
+/* Bakes the scene's light into a lightmap. accel: the scene's (ms_accel_build), or NULL to build one
+ * here. MS_OK, or an error with out zeroed. */
+ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
+                  char *err, size_t errlen);
+void ms_lightmap_free(ms_lightmap *lm);
+
+/* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
+ * of lightmaps), V and S. An ms_output_write_fn; ends in .exr. */
+int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 
 #ifdef __cplusplus
 }

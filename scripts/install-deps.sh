@@ -2,9 +2,9 @@
 # Installs the Debian packages microshadow needs that are missing (root, or sudo when available).
 set -euo pipefail
 # clang, libclang-rt-dev (sanitizer and libFuzzer runtimes) and libomp-dev (OpenMP for clang): the clang
-# build and the fuzzers of .ci/run.
+# build and the fuzzers of .ci/run. python3-numpy: the Python module's tests (python/, run by ctest).
 pkgs=(build-essential cmake pkg-config libassimp-dev libcjson-dev libpng-dev libopenexr-dev libembree-dev
-      libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev)
+      libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev python3-numpy)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -52,4 +52,20 @@ int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3]
 
 #define MS_BVH_STACK 64
 
+/* A shallower view of a BVH for the multi-frusta traversals (Benthin & Wald 2009, sec. 5: a deep BVH suits
+ * single rays and packets, "a shallower BVH" suits frusta, which cull poorly deep down the tree and test
+ * a leaf's triangles with cheap per-frustum culling first). Every subtree of b holding at most max_leaf
+ * triangles becomes one leaf over the same contiguous triangle range (the build keeps subtrees
+ * contiguous), so triangles, prim ids and normals stay b's: nodes only, no second copy of the scene.
+ * Nodes have b's layout (first = left child of a pair, or first triangle; count = 0 for interior). */
+typedef struct ms_bvh_shallow {
+    ms_bvh_node *nodes;
+    uint32_t n_nodes;
+    int max_leaf, depth;
+} ms_bvh_shallow;
+
+/* Returns 0, or -1 when out of memory. */
+int ms_bvh_shallow_build(ms_bvh_shallow *s, const ms_bvh *b, int max_leaf);
+void ms_bvh_shallow_free(ms_bvh_shallow *s);
+
 #endif

@@ -1,5 +1,6 @@
 /* The microshadow command line: render a scene file (or the built-in scene) with one shadow method. */
 #include "microshadow.h"
+#include "bake.h"
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
@@ -15,6 +16,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
         "usage: microshadow [SCENE.json] [options]\n"
+        "       microshadow bake [SCENE.json] [options]   (a lightmap: microshadow bake --help)\n"
         "Renders soft shadows from the scene's parallelogram light (the built-in scene without SCENE).\n"
         "\n"
         "  --method M          shadow method:");
@@ -33,6 +35,8 @@ static void usage(FILE *f)
         "  --shadow OUT.pfm|.exr  float shadow factor S, -1 where the primary ray missed\n"
         "  --stats OUT.json    timings and counters\n"
         "  --isa I             cap on the SIMD instruction set: auto (default), avx512, avx2, scalar\n"
+        "  --traversal T       micro-raster methods: block (default: 4x4 pixels' frusta together) or pixel\n"
+        "  --frustum-shrink    block traversal: narrow each frustum as its samples are occluded\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --help, --version\n");
 }
@@ -67,8 +71,9 @@ static int parse_int(const char *opt, const char *s, long lo, long hi, long *out
 
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
-           O_STATS, O_ISA, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER };
+           O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -76,7 +81,9 @@ int main(int argc, char **argv)
         { "seed", required_argument, 0, O_SEED }, { "vis", required_argument, 0, O_VIS },
         { "shadow", required_argument, 0, O_SHADOW }, { "isa", required_argument, 0, O_ISA },
         { "stats", required_argument, 0, O_STATS }, { "quiet", no_argument, 0, O_QUIET },
-        { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION }, { 0, 0, 0, 0 } };
+        { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
+        { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
+        { 0, 0, 0, 0 } };
     ms_render_options opt;
     ms_render_options_default(&opt);
     /* The library reads no environment; for measuring (docs/embree.md) the CLI maps these onto options. */
@@ -134,6 +141,12 @@ int main(int argc, char **argv)
                 return EXIT_BAD_INPUT;
             }
             break;
+        case O_TRAVERSAL:
+            if (strcmp(optarg, "block") == 0) opt.traversal = MS_TRAVERSAL_BLOCK;
+            else if (strcmp(optarg, "pixel") == 0) opt.traversal = MS_TRAVERSAL_PIXEL;
+            else { fprintf(stderr, "microshadow: --traversal: '%s' is not block or pixel\n", optarg); return EXIT_BAD_INPUT; }
+            break;
+        case O_FRUSTUM_SHRINK: opt.frustum_shrink = 1; break;
         case O_STATS: outs[OUT_STATS].path = optarg; break;
         case O_QUIET: quiet = 1; break;
         case O_NO_FILTER: opt.no_filter = 1; break;

@@ -1,5 +1,6 @@
 /* The float images of V and S: PFM (written here: a header and raw floats, rows bottom to top as the
- * format requires) or OpenEXR (through OpenEXRCore, one FLOAT channel "V" resp. "S", ZIP compressed). */
+ * format requires) or OpenEXR (through OpenEXRCore, one FLOAT channel "V" resp. "S", ZIP compressed);
+ * and the whole frame or lightmap as one EXR (R, G, B, S, V). */
 #include "microshadow.h"
 #include "microshadow.h"
 #include <errno.h>
@@ -57,7 +58,11 @@ static int64_t exr_sink_write(exr_const_context_t ctx, void *user, const void *b
 
 static void exr_quiet(exr_const_context_t ctx, exr_result_t code, const char *msg) { (void)ctx; (void)code; (void)msg; }
 
-static int write_exr(const ms_frame *f, const float *data, const char *channel, FILE *out, const char *path,
+/* One channel of an EXR: its name, its first pixel and the floats from one pixel to the next. */
+typedef struct exr_channel { const char *name; const float *data; int stride; } exr_channel;
+
+/* Channels must come in the file's order: sorted by name (OpenEXR keeps channel lists sorted). */
+static int write_exr(const ms_frame *f, const exr_channel *ch, int nch, FILE *out, const char *path,
                      char *err, size_t errlen)
 {
     exr_sink sink = { fileno(out), 0 };
@@ -70,9 +75,10 @@ static int write_exr(const ms_frame *f, const float *data, const char *channel, 
     int part = 0;
     exr_encode_pipeline_t enc;
     int enc_init = 0;
-    if (r == EXR_ERR_SUCCESS) r = exr_add_part(ctx, channel, EXR_STORAGE_SCANLINE, &part);
+    if (r == EXR_ERR_SUCCESS) r = exr_add_part(ctx, nch == 1 ? ch[0].name : "rgb", EXR_STORAGE_SCANLINE, &part);
     if (r == EXR_ERR_SUCCESS) r = exr_initialize_required_attr_simple(ctx, part, f->width, f->height, EXR_COMPRESSION_ZIP);
-    if (r == EXR_ERR_SUCCESS) r = exr_add_channel(ctx, part, channel, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+    for (int c = 0; c < nch && r == EXR_ERR_SUCCESS; c++)
+        r = exr_add_channel(ctx, part, ch[c].name, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
     if (r == EXR_ERR_SUCCESS) r = exr_write_header(ctx);
     int lines = 1;
     if (r == EXR_ERR_SUCCESS) r = exr_get_scanlines_per_chunk(ctx, part, &lines);
@@ -82,9 +88,11 @@ static int write_exr(const ms_frame *f, const float *data, const char *channel, 
         if (r != EXR_ERR_SUCCESS) break;
         r = enc_init ? exr_encoding_update(ctx, part, &ci, &enc) : exr_encoding_initialize(ctx, part, &ci, &enc);
         if (r != EXR_ERR_SUCCESS) break;
-        enc.channels[0].encode_from_ptr = (const uint8_t *)(data + (size_t)y * f->width);
-        enc.channels[0].user_pixel_stride = (int32_t)sizeof(float);
-        enc.channels[0].user_line_stride = (int32_t)(sizeof(float) * (size_t)f->width);
+        for (int c = 0; c < nch; c++) {
+            enc.channels[c].encode_from_ptr = (const uint8_t *)(ch[c].data + (size_t)y * f->width * ch[c].stride);
+            enc.channels[c].user_pixel_stride = (int32_t)(sizeof(float) * (size_t)ch[c].stride);
+            enc.channels[c].user_line_stride = (int32_t)(sizeof(float) * (size_t)f->width * ch[c].stride);
+        }
         if (!enc_init) {
             r = exr_encoding_choose_default_routines(ctx, part, &enc);
             enc_init = 1;
@@ -107,7 +115,10 @@ static int write_float_image(const ms_frame *f, const float *data, const char *c
                              const char *path, char *err, size_t errlen)
 {
     if (ends_with(path, ".pfm")) return write_pfm(f, data, out);
-    if (ends_with(path, ".exr")) return write_exr(f, data, channel, out, path, err, errlen);
+    if (ends_with(path, ".exr")) {
+        const exr_channel ch = { channel, data, 1 };
+        return write_exr(f, &ch, 1, out, path, err, errlen);
+    }
     snprintf(err, errlen, "%s: the %s image must end in .pfm or .exr", path, what);
     return -1;
 }
@@ -120,4 +131,12 @@ int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *path, char *er
 int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
     return write_float_image(f, f->shadow, "S", "shadow factor", out, path, err, errlen);
+}
+
+int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
+{
+    if (!ends_with(path, ".exr")) { snprintf(err, errlen, "%s: the RGB image must end in .exr", path); return -1; }
+    const exr_channel ch[5] = { { "B", f->rgb + 2, 3 }, { "G", f->rgb + 1, 3 }, { "R", f->rgb, 3 },
+                                { "S", f->shadow, 1 }, { "V", f->vis, 1 } };
+    return write_exr(f, ch, 5, out, path, err, errlen);
 }

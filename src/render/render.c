@@ -110,6 +110,8 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     ctx.isa_cap = opt->isa;
     ctx.no_occlusion_cull = opt->no_occlusion_cull;
     ctx.no_child_order = opt->no_child_order;
+    ctx.traversal = opt->traversal;
+    ctx.frustum_shrink = opt->frustum_shrink;
     ctx.embree_mode = opt->embree_mode;
     ctx.embree_filter = opt->embree_filter;
 
@@ -274,8 +276,14 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     st->shadow_factor_s = resolve_thread_s / threads;
     st->filter_s = filter_s;
     st->shadow_rays = segments;
+    const char *const *cnames = sm->counter_names;
     st->n_counters = sm->n_counters;
-    for (int c = 0; c < sm->n_counters; c++) { st->counter_name[c] = sm->counter_names[c]; st->counter[c] = counters[c]; }
+    if (sm->counters_used) {
+        const int n = sm->counters_used(sstate, &cnames);
+        if (n >= 0) st->n_counters = n;
+        else cnames = sm->counter_names;
+    }
+    for (int c = 0; c < st->n_counters; c++) { st->counter_name[c] = cnames[c]; st->counter[c] = counters[c]; }
     sm->destroy(sstate);
     pm->destroy(pstate);
     st->total_s = omp_get_wtime() - t_start + scene->load_s;

@@ -42,16 +42,24 @@ static int walk(walk_ctx *w, const struct aiNode *node, const struct aiMatrix4x4
         for (unsigned f = 0; f < mesh->mNumFaces; f++) {
             const struct aiFace *face = &mesh->mFaces[f];
             if (face->mNumIndices != 3) continue;   /* points and lines cast no shadow */
-            float v[9];
+            float v[9], uv[MS_SOUP_UV_SETS][6];
+            const float *uvp[MS_SOUP_UV_SETS] = { NULL };
             int ok = 1;
             for (int k = 0; k < 3; k++) {
                 unsigned idx = face->mIndices[k];
                 if (idx >= mesh->mNumVertices) { ok = 0; break; }
                 xform(&m, &mesh->mVertices[idx], v + 3 * k);
+                /* UV channel s of the mesh is UV set s (baking); a channel may be absent. */
+                for (int s = 0; s < MS_SOUP_UV_SETS && s < AI_MAX_NUMBER_OF_TEXTURECOORDS; s++) {
+                    if (!mesh->mTextureCoords[s]) continue;
+                    uv[s][2 * k] = mesh->mTextureCoords[s][idx].x;
+                    uv[s][2 * k + 1] = mesh->mTextureCoords[s][idx].y;
+                    uvp[s] = uv[s];
+                }
             }
             if (!ok) continue;
             if (w->added == w->max_tris) { w->full = 1; return -1; }
-            if (ms_soup_push(w->soup, v)) return -1;
+            if (ms_soup_push_uv(w->soup, v, uvp)) return -1;
             w->added++;
         }
     }

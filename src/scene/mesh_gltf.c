@@ -123,6 +123,14 @@ static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_s
     for (size_t i = 0; i < pr->attributes_count; i++)
         if (pr->attributes[i].type == cgltf_attribute_type_position && pr->attributes[i].index == 0) pos = pr->attributes[i].data;
     if (!pos) { snprintf(err, errlen, "%s: a triangle primitive has no POSITION", path); return -1; }
+    /* TEXCOORD_s is UV set s (baking); an unusable one is ignored like an absent one. */
+    const cgltf_accessor *tc[MS_SOUP_UV_SETS] = { NULL };
+    for (size_t i = 0; i < pr->attributes_count; i++) {
+        const cgltf_attribute *a = &pr->attributes[i];
+        if (a->type == cgltf_attribute_type_texcoord && a->index >= 0 && a->index < MS_SOUP_UV_SETS && a->data &&
+            a->data->type == cgltf_type_vec2 && a->data->count == pos->count && accessor_ok(a->data, why, sizeof why))
+            tc[a->index] = a->data;
+    }
     if (pos->type != cgltf_type_vec3) { snprintf(err, errlen, "%s: POSITION is not a VEC3 accessor", path); return -1; }
     if (!accessor_ok(pos, why, sizeof why)) { snprintf(err, errlen, "%s: %s", path, why); return -1; }
     const cgltf_accessor *ix = pr->indices;
@@ -146,7 +154,8 @@ static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_s
         if (pr->type == cgltf_primitive_type_triangles) { corner[0] = 3 * t; corner[1] = 3 * t + 1; corner[2] = 3 * t + 2; }
         else if (pr->type == cgltf_primitive_type_triangle_strip) { corner[0] = t; corner[1] = t + 1 + (t & 1); corner[2] = t + 2 - (t & 1); }
         else { corner[0] = t + 1; corner[1] = t + 2; corner[2] = 0; }
-        float v[9];
+        float v[9], uv[MS_SOUP_UV_SETS][6];
+        const float *uvp[MS_SOUP_UV_SETS] = { NULL };
         for (int k = 0; k < 3; k++) {
             size_t idx = ix ? cgltf_accessor_read_index(ix, corner[k]) : corner[k];
             if (idx >= pos->count) {
@@ -156,8 +165,14 @@ static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_s
             float p[3] = { 0, 0, 0 };
             cgltf_accessor_read_float(pos, idx, p, 3);
             for (int r = 0; r < 3; r++) v[3 * k + r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+            for (int st = 0; st < MS_SOUP_UV_SETS; st++) {
+                if (!tc[st]) continue;
+                uv[st][2 * k] = uv[st][2 * k + 1] = 0.0f;
+                cgltf_accessor_read_float(tc[st], idx, uv[st] + 2 * k, 2);
+                uvp[st] = uv[st];
+            }
         }
-        if (ms_soup_push(soup, v)) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+        if (ms_soup_push_uv(soup, v, uvp)) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
         (*added)++;
     }
     return 0;

@@ -8,18 +8,48 @@
 #include <stdlib.h>
 #include <string.h>
 
-int ms_soup_push(ms_tri_soup *soup, const float v[9])
+int ms_soup_push_uv(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS])
 {
     if (soup->n == soup->cap) {
         size_t cap = soup->cap ? 2 * soup->cap : 1024;
         float *t = realloc(soup->tri, cap * 9 * sizeof(float));
         if (!t) return -1;
         soup->tri = t;
+        uint32_t *m = realloc(soup->mesh, cap * sizeof *m);
+        if (!m) return -1;
+        soup->mesh = m;
+        for (int s = 0; s < MS_SOUP_UV_SETS; s++) {
+            if (!soup->uv[s]) continue;
+            float *u = realloc(soup->uv[s], cap * 6 * sizeof(float));
+            if (!u) return -1;
+            soup->uv[s] = u;
+        }
         soup->cap = cap;
     }
+    for (int s = 0; s < MS_SOUP_UV_SETS; s++) {
+        if (uv && uv[s] && !soup->uv[s]) {   /* the set's first triangle: the earlier ones lack it */
+            soup->uv[s] = malloc(soup->cap * 6 * sizeof(float));
+            if (!soup->uv[s]) return -1;
+            for (size_t i = 0; i < 6 * soup->n; i++) soup->uv[s][i] = NAN;
+        }
+        if (!soup->uv[s]) continue;
+        if (uv && uv[s]) memcpy(soup->uv[s] + 6 * soup->n, uv[s], 6 * sizeof(float));
+        else for (int i = 0; i < 6; i++) soup->uv[s][6 * soup->n + i] = NAN;
+    }
     memcpy(soup->tri + 9 * soup->n, v, 9 * sizeof(float));
+    soup->mesh[soup->n] = soup->cur_mesh;
     soup->n++;
     return 0;
+}
+
+int ms_soup_push(ms_tri_soup *soup, const float v[9]) { return ms_soup_push_uv(soup, v, NULL); }
+
+void ms_soup_free(ms_tri_soup *soup)
+{
+    free(soup->tri);
+    free(soup->mesh);
+    for (int s = 0; s < MS_SOUP_UV_SETS; s++) free(soup->uv[s]);
+    memset(soup, 0, sizeof *soup);
 }
 
 static const char *extension(const char *path, char *ext, size_t n)

@@ -61,11 +61,13 @@ int ms_scene_default(ms_scene *out)
         box(&s, 1.5f, 0.0f, -1.5f, 3.0f, 1.5f, 0.0f) ||         /* cube on the ground */
         quad(&s, p0, p1, p2, p3) ||                             /* floating open plate */
         sphere(&s, -0.8f, 0.9f, -2.6f, 0.9f, 24, 48)) {         /* sphere resting on the ground */
-        free(s.tri);
+        ms_soup_free(&s);
         return -1;
     }
     out->tri = s.tri;
     out->n_tris = s.n;
+    out->tri_mesh = s.mesh;
+    out->n_meshes = 1;
     out->camera = (ms_camera){ { 0.0f, 6.5f, 10.0f }, { 0.0f, 0.6f, 0.0f }, { 0.0f, 1.0f, 0.0f }, 50.0f, 1024, 768 };
     out->light = (ms_light){ { -1.25f, 6.0f, -1.25f }, { 2.5f, 0.0f, 0.0f }, { 0.0f, 0.0f, 2.5f },
                              { MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION } };

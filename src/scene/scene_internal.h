@@ -1,6 +1,7 @@
 #ifndef MS_SCENE_INTERNAL_H
 #define MS_SCENE_INTERNAL_H
 #include <stddef.h>
+#include <stdint.h>
 
 #define MS_DEFAULT_EMISSION 1.0f
 
@@ -13,7 +14,18 @@
 #define MS_MAX_COORD 1e18f                        /* |coordinate|: squares and cross products stay finite in float */
 
 struct ms_scene;
-typedef struct ms_tri_soup { float *tri; size_t n, cap; } ms_tri_soup;
+#define MS_SOUP_UV_SETS 4   /* = MS_MAX_UV_SETS */
+/* Triangles as they are loaded, with the mesh each came from (cur_mesh at the push) and, per UV set,
+ * the UVs of its vertices (6 floats; the array appears with the first triangle that has the set, NaN
+ * for those before and for triangles without it). */
+typedef struct ms_tri_soup {
+    float *tri;
+    size_t n, cap;
+    uint32_t *mesh;
+    float *uv[MS_SOUP_UV_SETS];
+    uint32_t cur_mesh;
+} ms_tri_soup;
+void ms_soup_free(ms_tri_soup *soup);
 
 typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH } ms_input_kind;
 /* Reads a whole regular file of at most max_bytes (a FIFO, device or directory is refused without
@@ -29,6 +41,8 @@ int ms_mesh_load(const char *path, ms_tri_soup *soup, char *err, size_t errlen);
 int ms_mesh_load_memory(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
                         char *err, size_t errlen);
 int ms_soup_push(ms_tri_soup *soup, const float v[9]);
+/* The same with UVs: uv[s] is 6 floats (three vertices' u, v) or NULL when the triangle lacks set s. */
+int ms_soup_push_uv(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS]);
 
 /* Structural checks before assimp sees a file: declared counts against the bytes present, indices in
  * range, polygon sizes; 0 if the file is well-formed. buf is NUL-terminated at buf[len]. */

@@ -1,6 +1,7 @@
 /* Scene files: JSON (cJSON) naming meshes (assimp), camera, light and render settings. */
 #include "microshadow.h"
 #include "scene_internal.h"
+_Static_assert(MS_SOUP_UV_SETS == MS_MAX_UV_SETS, "one count of UV sets");
 #include <cjson/cJSON.h>
 #include <ctype.h>
 #include <errno.h>
@@ -350,19 +351,23 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
             snprintf(err, errlen, "%s: meshes[%d].file: the path is longer than %zu bytes", json_path, i, sizeof mesh_path - 1);
             goto mesh_fail;
         }
+        soup.cur_mesh = (uint32_t)i;
         if (ms_mesh_load(mesh_path, &soup, err, errlen)) goto mesh_fail;
         i++;
     }
     free(dircopy);
     out->tri = soup.tri;
     out->n_tris = soup.n;
+    out->tri_mesh = soup.mesh;
+    for (int s = 0; s < MS_MAX_UV_SETS; s++) out->tri_uv[s] = soup.uv[s];
+    out->n_meshes = (size_t)i;
     rc = ms_scene_validate(out, json_path, err, errlen);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     goto done;
 mesh_fail:
     free(dircopy);
-    free(soup.tri);
+    ms_soup_free(&soup);
 done:
     cJSON_Delete(root);
     if (rc) ms_scene_free(out);
@@ -372,5 +377,7 @@ done:
 void ms_scene_free(ms_scene *s)
 {
     free(s->tri);
+    free(s->tri_mesh);
+    for (int i = 0; i < MS_MAX_UV_SETS; i++) free(s->tri_uv[i]);
     memset(s, 0, sizeof *s);
 }

@@ -273,6 +273,7 @@ static void eb_filter_fn(const struct RTCFilterFunctionNArguments *a)
  * occluding range, i.e. if Embree could report the receiver's triangle; see the header comment. */
 static int eb_needs_filter(const ms_render_ctx *ctx, const ms_shadow_query *q)
 {
+    if (q->prim == UINT32_MAX) return 0;   /* a point on no triangle (the points API): nothing to filter */
     const float *tri = ctx->bvh->tri + 9 * (size_t)q->prim;
     float d[3];
     v3_sub(d, q->p, tri);

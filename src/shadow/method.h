@@ -29,12 +29,17 @@ typedef struct ms_render_ctx {
      * what each buys. */
     ms_isa isa_cap;
     int no_occlusion_cull, no_child_order;
+    ms_traversal traversal;            /* micro-raster methods: block or per-pixel traversal */
+    int queries_in_order;              /* 1: queries come in proximity order (the points API), so block
+                                        * methods group consecutive ones; 0: by 4x4 pixel block (frames) */
+    int frustum_shrink;
     ms_embree_mode embree_mode;        /* embree: how rays are handed over, and when the receiver is filtered */
     ms_embree_filter embree_filter;
 } ms_render_ctx;
 
 /* One visible point: the pixel, its hit point, the unit geometric normal facing the camera (its plane is
- * the receiver's horizon), and the hit triangle, which never occludes. */
+ * the receiver's horizon), and the hit triangle, which never occludes (UINT32_MAX: none, for points of
+ * the points API that lie on no triangle). */
 typedef struct ms_shadow_query {
     float p[3];
     float n[3];
@@ -60,6 +65,10 @@ typedef struct ms_shadow_method {
     /* Optional (NULL: the method has no ISA-dispatched code): the instruction sets its kernel and its
      * traversal run, as chosen by create under ctx->isa_cap, for ms_stats. */
     void (*isa_used)(const void *state, ms_isa *kernel, ms_isa *traversal);
+    /* Optional (NULL: n_counters and counter_names): the counters this state fills, when they depend on
+     * the frame's options (e.g. the traversal); returns their number and sets *names, or -1 for the
+     * static ones. */
+    int (*counters_used)(const void *state, const char *const **names);
 } ms_shadow_method;
 
 typedef struct ms_hit {

@@ -38,7 +38,7 @@ static inline int ms_fuzz_mesh(const char *ext, const uint8_t *data, size_t size
     int rc = ms_mesh_load_memory(buf, size, ext, path, &soup, err, sizeof err);
     if (rc) ms_fuzz_check_message(err, path);
     else if (soup.n == 0) abort();   /* success means triangles */
-    free(soup.tri);
+    ms_soup_free(&soup);
     free(buf);
     return rc;
 }

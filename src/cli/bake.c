@@ -1,0 +1,172 @@
+/* `microshadow bake SCENE.json --uv N --size S -o lightmap.exr [--png preview.png]`: a lightmap of the
+ * scene's light through ms_bake, written all or nothing (ms_outputs_*). */
+#include "microshadow.h"
+#include "bake.h"
+#include <errno.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define EXIT_BAD_INPUT 2
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "usage: microshadow bake [SCENE.json] [options]\n"
+        "Bakes the scene's light into a lightmap (the built-in scene without SCENE): V, S and irradiance per\n"
+        "texel of a UV set; triangles without that set get UVs from xatlas.\n"
+        "\n"
+        "  --uv N              UV set to bake into: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1),\n"
+        "                      or 'xatlas' to unwrap every mesh\n"
+        "  --size N            lightmap width and height in texels (default 1024)\n"
+        "  -o OUT.exr          channels R, G, B (irradiance), S and V (default lightmap.exr)\n"
+        "  --png OUT.png       tone-mapped preview\n"
+        "  --stats OUT.json    timings and counters\n"
+        "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
+        "  --padding N         texels between xatlas charts (default 2)\n"
+        "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I   as for frames\n"
+        "  --quiet             no progress or summary on stderr\n"
+        "  --help\n", MS_MAX_UV_SETS - 1);
+}
+
+static int parse_long(const char *opt, const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s || *end || v < lo || v > hi) {
+        fprintf(stderr, "microshadow bake: %s: '%s' is not an integer in [%ld, %ld]\n", opt, s, lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static int progress_bar(void *user, double frac)
+{
+    int *last = user;
+    int pct = (int)(frac * 100.0);
+    if (pct != *last) {
+        *last = pct;
+        fprintf(stderr, "\rbaking %3d%%", pct);
+        if (pct >= 100) fputc('\n', stderr);
+        fflush(stderr);
+    }
+    return 0;
+}
+
+int ms_cli_bake(int argc, char **argv)
+{
+    enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
+           O_THREADS, O_ISA, O_QUIET, O_HELP };
+    static const struct option longopts[] = {
+        { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
+        { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
+        { "dilate", required_argument, 0, O_DILATE }, { "padding", required_argument, 0, O_PADDING },
+        { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
+        { "samples", required_argument, 0, O_SAMPLES }, { "seed", required_argument, 0, O_SEED },
+        { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
+        { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP }, { 0, 0, 0, 0 } };
+    static const char *const exr_suffix[] = { ".exr", NULL };
+    static const char *const png_suffix[] = { ".png", NULL };
+    ms_output outs[] = {
+        { "-o", "lightmap.exr", ms_exr_write_stream, exr_suffix },
+        { "--png", NULL, ms_png_write_stream, png_suffix },
+        { "--stats", NULL, ms_stats_write_stream, NULL },
+    };
+    enum { N_OUTS = sizeof outs / sizeof outs[0] };
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.uv_set = 1;
+    bo.size = 1024;
+    int quiet = 0, c;
+    long v;
+    opterr = 0;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "o:h", longopts, NULL)) != -1) {
+        switch (c) {
+        case O_UV:
+            if (!strcmp(optarg, "xatlas")) bo.uv_set = -1;
+            else if (parse_long("--uv", optarg, 0, MS_MAX_UV_SETS - 1, &v)) return EXIT_BAD_INPUT;
+            else bo.uv_set = (int)v;
+            break;
+        case O_SIZE: if (parse_long("--size", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; bo.size = (int)v; break;
+        case O_DILATE: if (parse_long("--dilate", optarg, 0, 1 << 16, &v)) return EXIT_BAD_INPUT; bo.dilate = v ? (int)v : -1; break;
+        case O_PADDING: if (parse_long("--padding", optarg, 1, 256, &v)) return EXIT_BAD_INPUT; bo.padding = (int)v; break;
+        case O_METHOD: bo.points.method = optarg; break;
+        case O_PATTERN:
+            if (!strcmp(optarg, "grid")) bo.points.pattern = MS_PATTERN_GRID;
+            else if (!strcmp(optarg, "stratified")) bo.points.pattern = MS_PATTERN_STRATIFIED;
+            else { fprintf(stderr, "microshadow bake: --pattern: '%s' is not grid or stratified\n", optarg); return EXIT_BAD_INPUT; }
+            break;
+        case O_SAMPLES:
+            if (parse_long("--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
+            if (v != 256 && v != 1024 && v != 4096) {
+                fprintf(stderr, "microshadow bake: --samples: %ld is not one of 256, 1024, 4096\n", v);
+                return EXIT_BAD_INPUT;
+            }
+            bo.points.samples = (int)v;
+            break;
+        case O_SEED: if (parse_long("--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; bo.points.seed = (uint32_t)v; break;
+        case O_THREADS: if (parse_long("--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; bo.points.threads = (int)v; break;
+        case O_ISA:
+            if (ms_isa_from_name(optarg, &bo.points.isa)) {
+                fprintf(stderr, "microshadow bake: --isa: '%s' is not auto, avx512, avx2 or scalar\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case 'o': outs[0].path = optarg; break;
+        case O_PNG: outs[1].path = optarg; break;
+        case O_STATS: outs[2].path = optarg; break;
+        case O_QUIET: quiet = 1; break;
+        case 'h': case O_HELP: usage(stdout); return 0;
+        default:
+            if (optopt > 0 && optopt < 256) fprintf(stderr, "microshadow bake: option '-%c' is unknown or needs a value (see --help)\n", optopt);
+            else fprintf(stderr, "microshadow bake: option '%s' is unknown or needs a value (see --help)\n", argv[optind - 1]);
+            return EXIT_BAD_INPUT;
+        }
+    }
+    if (argc - optind > 1) { fprintf(stderr, "microshadow bake: more than one scene file given\n"); return EXIT_BAD_INPUT; }
+    const char *scene_path = optind < argc ? argv[optind] : NULL;
+    const char *method = bo.points.method ? bo.points.method : MS_DEFAULT_METHOD;
+    int avail = ms_method_available(method);
+    if (avail <= 0) {
+        fprintf(stderr, "microshadow bake: --method: '%s' %s\n", method,
+                avail < 0 ? "is not compiled into this build" : "is not a known method (see --help)");
+        return EXIT_BAD_INPUT;
+    }
+    char err[1024];
+    ms_outputs_cleanup_on_signals();
+    if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) { fprintf(stderr, "microshadow bake: %s\n", err); return EXIT_BAD_INPUT; }
+    ms_scene scene;
+    if (scene_path) {
+        if (ms_scene_load(scene_path, &scene, err, sizeof err)) { fprintf(stderr, "microshadow bake: %s\n", err); return EXIT_BAD_INPUT; }
+    } else if (ms_scene_default(&scene)) {
+        fprintf(stderr, "microshadow bake: out of memory building the default scene\n");
+        return 1;
+    }
+    int last = -1;
+    if (!quiet && isatty(STDERR_FILENO)) { bo.points.progress = progress_bar; bo.points.progress_user = &last; }
+    ms_lightmap lm;
+    ms_status st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
+    if (st) {
+        fprintf(stderr, "microshadow bake: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
+        ms_scene_free(&scene);
+        return st == MS_ERR_NO_MEMORY ? 1 : EXIT_BAD_INPUT;
+    }
+    int rc = ms_outputs_write(&lm.frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
+    if (rc) fprintf(stderr, "microshadow bake: %s\n", err);
+    if (!quiet && !rc) {
+        const ms_stats *s = &lm.frame.stats;
+        fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
+                "(rasterized in %.3fs), %d samples, method %s, %d threads: shadow %.3fs (%.0f texels/s), total %.3fs -> %s\n",
+                scene_path ? scene_path : "built-in scene", s->triangles, lm.unwrapped_tris, lm.unwrap_s, lm.frame.width,
+                lm.frame.height, lm.texels, lm.raster_s, s->samples, s->method, s->threads, s->shadow_s,
+                s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, outs[0].path);
+    }
+    ms_lightmap_free(&lm);
+    ms_scene_free(&scene);
+    return rc;
+}

@@ -1,0 +1,323 @@
+/* Lightmap baking (microshadow.h, "Lightmap baking"): UVs (the scene's set, xatlas for the rest), texels
+ * rasterized conservatively onto the triangles' UV images and carried to world points, V and S there
+ * through ms_visibility_points (so every method bakes, on the frames' sample patterns keyed by texel),
+ * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
+#include "microshadow.h"
+#include "lightmap_unwrap.h"
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void ms_lightmap_free(ms_lightmap *lm)
+{
+    if (!lm) return;
+    ms_frame_free(&lm->frame);
+    free(lm->position);
+    free(lm->normal);
+    free(lm->triangle);
+    free(lm->uv);
+    memset(lm, 0, sizeof *lm);
+}
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* Closest point to p on triangle abc in 2D (Ericson, Real-Time Collision Detection 5.1.5), as
+ * barycentric weights w (of a, b, c). */
+static void closest_on_triangle(const double p[2], const double a[2], const double b[2], const double c[2], double w[3])
+{
+    const double ab[2] = { b[0] - a[0], b[1] - a[1] }, ac[2] = { c[0] - a[0], c[1] - a[1] };
+    const double ap[2] = { p[0] - a[0], p[1] - a[1] };
+    const double d1 = ab[0] * ap[0] + ab[1] * ap[1], d2 = ac[0] * ap[0] + ac[1] * ap[1];
+    if (d1 <= 0 && d2 <= 0) { w[0] = 1; w[1] = w[2] = 0; return; }
+    const double bp[2] = { p[0] - b[0], p[1] - b[1] };
+    const double d3 = ab[0] * bp[0] + ab[1] * bp[1], d4 = ac[0] * bp[0] + ac[1] * bp[1];
+    if (d3 >= 0 && d4 <= d3) { w[1] = 1; w[0] = w[2] = 0; return; }
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) { const double v = d1 / (d1 - d3); w[0] = 1 - v; w[1] = v; w[2] = 0; return; }
+    const double cp[2] = { p[0] - c[0], p[1] - c[1] };
+    const double d5 = ab[0] * cp[0] + ab[1] * cp[1], d6 = ac[0] * cp[0] + ac[1] * cp[1];
+    if (d6 >= 0 && d5 <= d6) { w[2] = 1; w[0] = w[1] = 0; return; }
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) { const double t = d2 / (d2 - d6); w[0] = 1 - t; w[2] = t; w[1] = 0; return; }
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        w[1] = 1 - t; w[2] = t; w[0] = 0;
+        return;
+    }
+    const double den = 1.0 / (va + vb + vc);
+    w[1] = vb * den;
+    w[2] = vc * den;
+    w[0] = 1.0 - w[1] - w[2];
+}
+
+/* The UVs baked into: the scene's set where a triangle has it, xatlas where not. */
+static ms_status choose_uvs(const ms_scene *sc, const ms_bake_options *o, int size, int padding, ms_lightmap *lm,
+                            char *err, size_t errlen)
+{
+    const size_t n = sc->n_tris;
+    lm->uv = malloc((n ? n : 1) * 6 * sizeof(float));
+    uint8_t *want = calloc(n ? n : 1, 1);
+    if (!lm->uv || !want) { free(want); snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); return MS_ERR_NO_MEMORY; }
+    const float *set = o->uv_set >= 0 ? sc->tri_uv[o->uv_set] : NULL;
+    size_t missing = 0;
+    for (size_t i = 0; i < n; i++) {
+        int ok = set != NULL;
+        for (int k = 0; k < 6 && ok; k++) ok = isfinite(set[6 * i + k]);
+        if (ok) memcpy(lm->uv + 6 * i, set + 6 * i, 6 * sizeof(float));
+        else { want[i] = 1; missing++; }
+    }
+    const double t0 = omp_get_wtime();
+    int rc = 0;
+    if (missing == n) rc = ms_lightmap_unwrap(sc->tri, n, want, size, padding, lm->uv, err, errlen);
+    else if (missing) {
+        /* Some meshes have the set, some not: the file's charts keep the top half of the lightmap
+         * (v halved), xatlas packs the rest into the bottom-left quarter (docs/baking.md). */
+        rc = ms_lightmap_unwrap(sc->tri, n, want, size / 2, padding, lm->uv, err, errlen);
+        for (size_t i = 0; i < n && !rc; i++)
+            for (int k = 0; k < 3; k++) {
+                float *u = lm->uv + 6 * i + 2 * k;
+                if (want[i]) { u[0] *= 0.5f; u[1] = 0.5f + 0.5f * u[1]; }
+                else u[1] *= 0.5f;
+            }
+    }
+    lm->unwrap_s = omp_get_wtime() - t0;
+    lm->unwrapped_tris = missing;
+    free(want);
+    return rc ? MS_ERR_INVALID : MS_OK;
+}
+
+/* Texels of every triangle's UV image (conservative: every texel square the triangle overlaps, tested
+ * with each edge function pushed out by half a texel in L1), each texel kept by the triangle nearest its
+ * centre in UV space (0 inside; ties to the lower index, so the result does not depend on order). */
+static ms_status rasterize(const ms_scene *sc, int size, ms_lightmap *lm, char *err, size_t errlen)
+{
+    const size_t nt = (size_t)size * size;
+    float *dist = malloc(nt * sizeof *dist);
+    lm->triangle = malloc(nt * sizeof *lm->triangle);
+    lm->position = malloc(nt * 3 * sizeof(float));
+    lm->normal = malloc(nt * 3 * sizeof(float));
+    if (!dist || !lm->triangle || !lm->position || !lm->normal) {
+        free(dist);
+        snprintf(err, errlen, "out of memory for a %dx%d lightmap", size, size);
+        return MS_ERR_NO_MEMORY;
+    }
+    for (size_t i = 0; i < nt; i++) { dist[i] = INFINITY; lm->triangle[i] = MS_NO_TRIANGLE; }
+    for (size_t i = 0; i < 3 * nt; i++) lm->position[i] = lm->normal[i] = NAN;
+    for (size_t t = 0; t < sc->n_tris; t++) {
+        const float *uv = lm->uv + 6 * t;
+        double a[2] = { uv[0] * (double)size, uv[1] * (double)size }, b[2] = { uv[2] * (double)size, uv[3] * (double)size },
+               c[2] = { uv[4] * (double)size, uv[5] * (double)size };
+        if (!(isfinite(a[0]) && isfinite(a[1]) && isfinite(b[0]) && isfinite(b[1]) && isfinite(c[0]) && isfinite(c[1]))) continue;
+        double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if (area == 0.0) continue;
+        if (area < 0.0) { const double s[2] = { b[0], b[1] }; b[0] = c[0]; b[1] = c[1]; c[0] = s[0]; c[1] = s[1]; }
+        const double *v[3] = { a, b, c };
+        double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+        for (int k = 0; k < 3; k++)
+            for (int d = 0; d < 2; d++) { lo[d] = fmin(lo[d], v[k][d]); hi[d] = fmax(hi[d], v[k][d]); }
+        const int x0 = (int)fmax(floor(lo[0]), 0.0), x1 = (int)fmin(floor(hi[0]), size - 1.0);
+        const int y0 = (int)fmax(floor(lo[1]), 0.0), y1 = (int)fmin(floor(hi[1]), size - 1.0);
+        const float *w = sc->tri + 9 * t;
+        float e1[3], e2[3], nn[3];
+        for (int d = 0; d < 3; d++) { e1[d] = w[3 + d] - w[d]; e2[d] = w[6 + d] - w[d]; }
+        nn[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        nn[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        nn[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        const float len = sqrtf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+        if (!(len > 0.0f) || !isfinite(len)) continue;   /* no plane, no receiver */
+        for (int d = 0; d < 3; d++) nn[d] /= len;
+        for (int y = y0; y <= y1; y++)
+            for (int x = x0; x <= x1; x++) {
+                const double p[2] = { x + 0.5, y + 0.5 };
+                int in = 1, touches = 1;
+                for (int k = 0; k < 3; k++) {
+                    const double *s0 = v[k], *s1 = v[(k + 1) % 3];
+                    const double ex = s1[0] - s0[0], ey = s1[1] - s0[1];
+                    const double e = ex * (p[1] - s0[1]) - ey * (p[0] - s0[0]);   /* > 0 inside (counter-clockwise) */
+                    in &= e >= 0.0;
+                    touches &= e + 0.5 * (fabs(ex) + fabs(ey)) >= 0.0;
+                }
+                if (!touches) continue;
+                double bw[3];
+                float dd = 0.0f;
+                if (in) {
+                    const double l1 = ((c[0] - b[0]) * (p[1] - b[1]) - (c[1] - b[1]) * (p[0] - b[0])) / fabs(area);
+                    const double l2 = ((a[0] - c[0]) * (p[1] - c[1]) - (a[1] - c[1]) * (p[0] - c[0])) / fabs(area);
+                    bw[0] = l1; bw[1] = l2; bw[2] = 1.0 - l1 - l2;
+                } else {
+                    closest_on_triangle(p, a, b, c, bw);
+                    const double q0 = bw[0] * a[0] + bw[1] * b[0] + bw[2] * c[0], q1 = bw[0] * a[1] + bw[1] * b[1] + bw[2] * c[1];
+                    dd = (float)hypot(q0 - p[0], q1 - p[1]);
+                }
+                const size_t i = (size_t)y * size + x;
+                if (dd > dist[i] || (dd == dist[i] && lm->triangle[i] < t)) continue;
+                dist[i] = dd;
+                lm->triangle[i] = (uint32_t)t;
+                /* bw weighs a, b, c as rasterized; undo the swap of b and c for the world vertices */
+                const double wa = bw[0], wb = area < 0.0 ? bw[2] : bw[1], wc = area < 0.0 ? bw[1] : bw[2];
+                for (int d = 0; d < 3; d++) {
+                    lm->position[3 * i + d] = (float)(wa * w[d] + wb * w[3 + d] + wc * w[6 + d]);
+                    lm->normal[3 * i + d] = nn[d];
+                }
+            }
+    }
+    free(dist);
+    return MS_OK;
+}
+
+/* Fills texels off the triangles from the average of their filled 8-neighbours, `passes` rings deep. */
+static int dilate(ms_frame *f, int passes)
+{
+    const int W = f->width, H = f->height;
+    uint8_t *filled = malloc((size_t)W * H), *next = malloc((size_t)W * H);
+    if (!filled || !next) { free(filled); free(next); return -1; }
+    for (size_t i = 0; i < (size_t)W * H; i++) filled[i] = f->vis[i] >= 0.0f;
+    for (int pass = 0; pass < passes; pass++) {
+        memcpy(next, filled, (size_t)W * H);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const size_t i = (size_t)y * W + x;
+                if (filled[i]) continue;
+                double acc[5] = { 0 };
+                int cnt = 0;
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++) {
+                        const int xx = x + dx, yy = y + dy;
+                        if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+                        const size_t j = (size_t)yy * W + xx;
+                        if (!filled[j]) continue;
+                        for (int c = 0; c < 3; c++) acc[c] += f->rgb[3 * j + c];
+                        acc[3] += f->vis[j];
+                        acc[4] += f->shadow[j];
+                        cnt++;
+                    }
+                if (!cnt) continue;
+                for (int c = 0; c < 3; c++) f->rgb[3 * i + c] = (float)(acc[c] / cnt);
+                f->vis[i] = (float)(acc[3] / cnt);
+                f->shadow[i] = (float)(acc[4] / cnt);
+                next[i] = 1;
+            }
+        uint8_t *t = filled; filled = next; next = t;
+    }
+    free(filled);
+    free(next);
+    return 0;
+}
+
+ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *out,
+                  char *err, size_t errlen)
+{
+    const double t_start = omp_get_wtime();
+    if (!out) { snprintf(err, errlen, "ms_bake: out is NULL"); return MS_ERR_INVALID; }
+    memset(out, 0, sizeof *out);
+    ms_bake_options zero;
+    memset(&zero, 0, sizeof zero);
+    const ms_bake_options *o = opt_in ? opt_in : &zero;
+    if (!scene || (!scene->tri && scene->n_tris)) { snprintf(err, errlen, "ms_bake: no scene"); return MS_ERR_INVALID; }
+    const int size = o->size ? o->size : 1024;
+    if (size < 1 || size > MS_MAX_IMAGE_SIZE) { snprintf(err, errlen, "lightmap size must be in [1, %d]", MS_MAX_IMAGE_SIZE); return MS_ERR_INVALID; }
+    if (o->uv_set < -1 || o->uv_set >= MS_MAX_UV_SETS) {
+        snprintf(err, errlen, "UV set must be in [0, %d], or -1 for xatlas", MS_MAX_UV_SETS - 1);
+        return MS_ERR_INVALID;
+    }
+    const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
+    const int padding = o->padding > 0 ? o->padding : 2;
+    ms_accel *own = NULL;
+    ms_status st;
+    if (!accel) {
+        st = ms_accel_build(scene, o->points.threads, &own, err, errlen);
+        if (st) return st;
+        accel = own;
+    }
+    st = choose_uvs(scene, o, size, padding, out, err, errlen);
+    const double t_raster = omp_get_wtime();
+    if (!st) st = rasterize(scene, size, out, err, errlen);
+    out->raster_s = omp_get_wtime() - t_raster;
+    out->n_tris = scene->n_tris;
+    const size_t nt = (size_t)size * size;
+    ms_frame *f = &out->frame;
+    float *pos = NULL, *nor = NULL;
+    uint32_t *tri = NULL, *key = NULL;
+    size_t *where = NULL, m = 0;
+    if (!st) {
+        f->width = f->height = size;
+        f->vis = malloc(nt * sizeof(float));
+        f->shadow = malloc(nt * sizeof(float));
+        f->front = calloc(nt, sizeof *f->front);
+        f->rgb = calloc(nt * 3, sizeof(float));
+        for (size_t i = 0; i < nt; i++) m += out->triangle && out->triangle[i] != MS_NO_TRIANGLE;
+        pos = malloc((m ? m : 1) * 3 * sizeof *pos);
+        nor = malloc((m ? m : 1) * 3 * sizeof *nor);
+        tri = malloc((m ? m : 1) * sizeof *tri);
+        key = malloc((m ? m : 1) * 2 * sizeof *key);
+        where = malloc((m ? m : 1) * sizeof *where);
+        if (!f->vis || !f->shadow || !f->front || !f->rgb || !pos || !nor || !tri || !key || !where) {
+            snprintf(err, errlen, "out of memory for a %dx%d lightmap", size, size);
+            st = MS_ERR_NO_MEMORY;
+        }
+    }
+    if (!st) {
+        size_t j = 0;
+        for (size_t i = 0; i < nt; i++) {
+            f->vis[i] = f->shadow[i] = -1.0f;
+            if (out->triangle[i] == MS_NO_TRIANGLE) continue;
+            memcpy(pos + 3 * j, out->position + 3 * i, 3 * sizeof(float));
+            memcpy(nor + 3 * j, out->normal + 3 * i, 3 * sizeof(float));
+            tri[j] = out->triangle[i];
+            key[2 * j] = (uint32_t)(i % (size_t)size);
+            key[2 * j + 1] = (uint32_t)(i / (size_t)size);
+            where[j++] = i;
+        }
+        out->texels = m;
+        float *v = malloc((m ? m : 1) * sizeof *v), *s = malloc((m ? m : 1) * sizeof *s);
+        uint16_t *fr = malloc((m ? m : 1) * sizeof *fr);
+        if (!v || !s || !fr) { snprintf(err, errlen, "out of memory for %zu texels", m); st = MS_ERR_NO_MEMORY; }
+        ms_points pts = { m, pos, nor, tri, key };
+        if (!st) st = ms_visibility_points(accel, NULL, &pts, &o->points, v, s, fr, &f->stats, err, errlen);
+        if (!st) {
+            const ms_light L = scene->light;
+            float *lum = malloc((m ? m : 1) * sizeof *lum);
+            for (size_t k = 0; k < m; k++) {
+                const size_t i = where[k];
+                f->vis[i] = v[k];
+                f->shadow[i] = s[k];
+                f->front[i] = fr[k];
+                const float e = ms_light_irradiance(&L, pos + 3 * k, nor + 3 * k);
+                f->rgb[3 * i] = e * L.emission.x * s[k];
+                f->rgb[3 * i + 1] = e * L.emission.y * s[k];
+                f->rgb[3 * i + 2] = e * L.emission.z * s[k];
+                if (lum) lum[k] = e * (0.2126f * L.emission.x + 0.7152f * L.emission.y + 0.0722f * L.emission.z);
+            }
+            f->exposure = 1.0f;
+            if (lum && m) {
+                qsort(lum, m, sizeof *lum, cmp_float);
+                const float p99 = lum[(size_t)(0.99 * (double)(m - 1))];
+                if (p99 > 0.0f) f->exposure = 1.0f / p99;
+            }
+            free(lum);
+            if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); st = MS_ERR_NO_MEMORY; }
+        }
+        free(v);
+        free(s);
+        free(fr);
+    }
+    free(pos);
+    free(nor);
+    free(tri);
+    free(key);
+    free(where);
+    ms_accel_free(own);
+    if (st) { ms_lightmap_free(out); return st; }
+    f->stats.width = f->stats.height = size;
+    f->stats.triangles = scene->n_tris;
+    f->stats.load_s = scene->load_s;
+    f->stats.total_s = omp_get_wtime() - t_start + scene->load_s;
+    return MS_OK;
+}

@@ -1,0 +1,336 @@
+/* Visibility at caller-given points (microshadow.h, "Visibility at any points"): the driver ms_render
+ * is for frames, without the camera. Points are grouped by proximity (30-bit Morton codes of their
+ * positions in the points' bounding box) into batches of BATCH, and each batch goes through the shadow
+ * method interface exactly as a frame tile does in render.c: front masks (receiver.c), the method's
+ * visible masks, V and S from ms_resolve_vs. A point's sample pattern is keyed like a pixel, so the same
+ * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
+#include "microshadow.h"
+#include "../core/pattern.h"
+#include "../shadow/method.h"
+#include "../shadow/receiver.h"
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define BATCH 256              /* points per visibility call: a frame tile's 16 x 16 */
+/* The occluding range of the segment parameter: the same as ms_render's (render.c); test_points
+ * compares points with frames bit for bit, so the two cannot drift apart unnoticed. */
+#define MS_POINTS_NEAR 1e-4f
+#define MS_POINTS_FAR (1.0f - 1e-4f)
+
+struct ms_accel {
+    ms_bvh bvh;
+    uint32_t *leaf_of;         /* scene triangle index -> BVH leaf-order prim id */
+    ms_scene view;             /* the scene's light and counts (tri = NULL: the BVH holds the triangles) */
+    int threads;
+};
+
+const char *ms_status_name(ms_status s)
+{
+    switch (s) {
+    case MS_OK: return "ok";
+    case MS_ERR_INVALID: return "invalid argument";
+    case MS_ERR_NO_MEMORY: return "out of memory";
+    case MS_ERR_CANCELLED: return "cancelled";
+    case MS_ERR_METHOD: return "method";
+    case MS_ERR_IO: return "i/o";
+    }
+    return "unknown status";
+}
+
+ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen)
+{
+    if (!out) { snprintf(err, errlen, "ms_accel_build: out is NULL"); return MS_ERR_INVALID; }
+    *out = NULL;
+    if (!scene || (!scene->tri && scene->n_tris)) { snprintf(err, errlen, "ms_accel_build: no scene"); return MS_ERR_INVALID; }
+    if (scene->n_tris >= UINT32_MAX) { snprintf(err, errlen, "ms_accel_build: more than 2^32-2 triangles"); return MS_ERR_INVALID; }
+    ms_accel *a = calloc(1, sizeof *a);
+    if (!a) { snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
+    a->threads = threads > 0 ? threads : omp_get_num_procs();
+    if (ms_bvh_build(&a->bvh, scene->tri, scene->n_tris, a->threads)) {
+        free(a);
+        snprintf(err, errlen, "BVH build failed: out of memory");
+        return MS_ERR_NO_MEMORY;
+    }
+    a->leaf_of = malloc((scene->n_tris ? scene->n_tris : 1) * sizeof *a->leaf_of);
+    if (!a->leaf_of) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
+    for (uint32_t i = 0; i < a->bvh.n_tris; i++) a->leaf_of[a->bvh.tri_source[i]] = i;
+    a->view = *scene;
+    a->view.tri = NULL;
+    *out = a;
+    return MS_OK;
+}
+
+void ms_accel_free(ms_accel *a)
+{
+    if (!a) return;
+    ms_bvh_free(&a->bvh);
+    free(a->leaf_of);
+    free(a);
+}
+
+size_t ms_accel_triangles(const ms_accel *a) { return a ? a->view.n_tris : 0; }
+
+/* Spreads the low 10 bits of x to every third bit. */
+static uint32_t spread3(uint32_t x)
+{
+    x &= 0x3ff;
+    x = (x | (x << 16)) & 0x030000ff;
+    x = (x | (x << 8)) & 0x0300f00f;
+    x = (x | (x << 4)) & 0x030c30c3;
+    x = (x | (x << 2)) & 0x09249249;
+    return x;
+}
+
+typedef struct morton_item { uint32_t code; size_t index; } morton_item;
+
+static int cmp_morton(const void *a, const void *b)
+{
+    const morton_item *x = a, *y = b;
+    if (x->code != y->code) return x->code < y->code ? -1 : 1;
+    return (x->index > y->index) - (x->index < y->index);
+}
+
+static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+static int light_ok(const ms_light *l)
+{
+    const float v[12] = { l->corner.x, l->corner.y, l->corner.z, l->edge_s.x, l->edge_s.y, l->edge_s.z,
+                          l->edge_t.x, l->edge_t.y, l->edge_t.z, l->emission.x, l->emission.y, l->emission.z };
+    for (int i = 0; i < 12; i++) if (!isfinite(v[i])) return 0;
+    const float nx = l->edge_s.y * l->edge_t.z - l->edge_s.z * l->edge_t.y;
+    const float ny = l->edge_s.z * l->edge_t.x - l->edge_s.x * l->edge_t.z;
+    const float nz = l->edge_s.x * l->edge_t.y - l->edge_s.y * l->edge_t.x;
+    return nx * nx + ny * ny + nz * nz > 0.0f;
+}
+
+/* Checks the arguments that do not need the method; MS_OK or MS_ERR_INVALID with a message. */
+static ms_status check_points(const ms_accel *a, const ms_points *pts, char *err, size_t errlen)
+{
+    if (!pts || (pts->n && (!pts->position || !pts->normal))) {
+        snprintf(err, errlen, "ms_visibility_points: positions and normals are required");
+        return MS_ERR_INVALID;
+    }
+    for (size_t i = 0; i < pts->n; i++) {
+        const float *p = pts->position + 3 * i, *n = pts->normal + 3 * i;
+        if (!finite3(p)) { snprintf(err, errlen, "point %zu: position is NaN or infinite", i); return MS_ERR_INVALID; }
+        if (!finite3(n) || !(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] > 0.0f)) {
+            snprintf(err, errlen, "point %zu: normal is zero, NaN or infinite", i);
+            return MS_ERR_INVALID;
+        }
+        if (pts->triangle && pts->triangle[i] != MS_NO_TRIANGLE && pts->triangle[i] >= a->view.n_tris) {
+            snprintf(err, errlen, "point %zu: triangle %u is not in the scene (%zu triangles)", i,
+                     pts->triangle[i], a->view.n_tris);
+            return MS_ERR_INVALID;
+        }
+    }
+    return MS_OK;
+}
+
+/* The shadow query of point i: unit normal, leaf-order prim, pattern key. */
+static void make_query(const ms_accel *a, const ms_points *pts, size_t i, ms_shadow_query *q)
+{
+    const float *p = pts->position + 3 * i, *n = pts->normal + 3 * i;
+    const float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int c = 0; c < 3; c++) { q->p[c] = p[c]; q->n[c] = n[c] / len; }
+    const uint32_t t = pts->triangle ? pts->triangle[i] : MS_NO_TRIANGLE;
+    q->prim = t == MS_NO_TRIANGLE ? UINT32_MAX : a->leaf_of[t];
+    if (pts->key) { q->px = pts->key[2 * i]; q->py = pts->key[2 * i + 1]; }
+    else { q->px = (uint32_t)i; q->py = (uint32_t)((uint64_t)i >> 32); }
+}
+
+ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
+                               const ms_points_options *opt_in, float *vis, float *shadow, uint16_t *front_out,
+                               ms_stats *stats, char *err, size_t errlen)
+{
+    const double t_start = omp_get_wtime();
+    ms_points_options zero;
+    memset(&zero, 0, sizeof zero);
+    const ms_points_options *opt = opt_in ? opt_in : &zero;
+    if (stats) memset(stats, 0, sizeof *stats);
+    if (!a) { snprintf(err, errlen, "ms_visibility_points: no accel"); return MS_ERR_INVALID; }
+    if (!light) light = &a->view.light;
+    if (!light_ok(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area"); return MS_ERR_INVALID; }
+    ms_status st = check_points(a, pts, err, errlen);
+    if (st) return st;
+    const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;
+    const ms_shadow_method *sm = ms_find_shadow_method(method);
+    if (!sm) {
+        if (ms_method_available(method) < 0) snprintf(err, errlen, "method '%s' is not compiled into this build", method);
+        else snprintf(err, errlen, "unknown method '%s'", method);
+        return MS_ERR_METHOD;
+    }
+    const int samples = opt->samples > 0 ? opt->samples : MS_SAMPLES_DEFAULT;
+    /* 256, 1024 or 4096 for either pattern here (16 and 64 are for frames of stratified ray tracing) */
+    const int k = ms_pattern_samples_per_pixel(MS_PATTERN_GRID, samples) ? ms_samples_to_k(samples) : 0;
+    if (!k) { snprintf(err, errlen, "samples must be 256, 1024 or 4096 (got %d)", samples); return MS_ERR_INVALID; }
+    if (opt->pattern == MS_PATTERN_INTERLEAVED) {
+        snprintf(err, errlen, "the interleaved pattern needs pixels (4x4 blocks): frames only, not points");
+        return MS_ERR_INVALID;
+    }
+    if (opt->pattern != MS_PATTERN_GRID && opt->pattern != MS_PATTERN_STRATIFIED) {
+        snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern);
+        return MS_ERR_INVALID;
+    }
+    if (sm->needs_grid && opt->pattern != MS_PATTERN_GRID) {
+        snprintf(err, errlen, "method '%s' needs the grid pattern", sm->name);
+        return MS_ERR_INVALID;
+    }
+    const int threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
+
+    ms_render_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.scene = &a->view;
+    ctx.bvh = &a->bvh;
+    ctx.light = *light;
+    ctx.pattern = opt->pattern;
+    ctx.k = k;
+    ctx.samples = k * k;
+    ctx.mask_words = k * k / 64;
+    ctx.seed = opt->seed;
+    ctx.near = MS_POINTS_NEAR;
+    ctx.far = MS_POINTS_FAR;
+    ctx.threads = threads;
+    ctx.isa_cap = opt->isa;
+    ctx.embree_mode = opt->embree_mode;
+    ctx.embree_filter = opt->embree_filter;
+    ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
+
+    const size_t n = pts->n;
+    /* Proximity order: Morton codes in the points' bounding box, ties by index (a total order). */
+    morton_item *order = malloc((n ? n : 1) * sizeof *order);
+    if (!order) { snprintf(err, errlen, "out of memory for %zu points", n); return MS_ERR_NO_MEMORY; }
+    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            const float v = pts->position[3 * i + c];
+            lo[c] = v < lo[c] ? v : lo[c];
+            hi[c] = v > hi[c] ? v : hi[c];
+        }
+    for (size_t i = 0; i < n; i++) {
+        uint32_t cell[3];
+        for (int c = 0; c < 3; c++) {
+            const double ext = (double)hi[c] - (double)lo[c];
+            const double u = ext > 0.0 ? ((double)pts->position[3 * i + c] - (double)lo[c]) / ext : 0.0;
+            cell[c] = (uint32_t)fmin(u * 1024.0, 1023.0);
+        }
+        order[i].code = spread3(cell[0]) | spread3(cell[1]) << 1 | spread3(cell[2]) << 2;
+        order[i].index = i;
+    }
+    qsort(order, n, sizeof *order, cmp_morton);
+
+    void *sstate = NULL;
+    const double t_setup = omp_get_wtime();
+    if (sm->create(&ctx, &sstate, err, errlen)) { free(order); return MS_ERR_METHOD; }
+    const double setup_s = omp_get_wtime() - t_setup;
+
+    const long nbatch = (long)((n + BATCH - 1) / BATCH);
+    const size_t mw = (size_t)ctx.mask_words;
+    const int stratified = ctx.pattern != MS_PATTERN_GRID;
+    uint64_t counters[MS_MAX_COUNTERS] = { 0 };
+    uint64_t penumbra = 0, segments = 0;
+    double resolve_thread_s = 0.0;
+    long done = 0;
+    int failed = 0, cancelled = 0;
+    const double t0 = omp_get_wtime();
+#pragma omp parallel num_threads(threads)
+    {
+        uint64_t local[MS_MAX_COUNTERS] = { 0 };
+        uint64_t local_penumbra = 0, local_segments = 0;
+        double local_resolve = 0.0;
+        uint64_t *fm = aligned_alloc(64, BATCH * mw * sizeof *fm);
+        uint64_t *vm = aligned_alloc(64, BATCH * mw * sizeof *vm);
+        float *spts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *spts) : NULL;
+        ms_shadow_query *q = malloc(BATCH * sizeof *q);
+        int ok = fm && vm && q && (spts || !stratified);
+        if (!ok) {
+#pragma omp atomic write
+            failed = 1;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (long b = 0; b < nbatch; b++) {
+            int stop;
+#pragma omp atomic read
+            stop = cancelled;
+            if (!ok || stop) continue;
+            const size_t i0 = (size_t)b * BATCH, i1 = i0 + BATCH < n ? i0 + BATCH : n;
+            const int m = (int)(i1 - i0);
+            for (int j = 0; j < m; j++) {
+                const size_t i = order[i0 + j].index;
+                make_query(a, pts, i, &q[j]);
+                if (spts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
+                const int nf = ms_front_mask(&ctx, &q[j], spts, fm + (size_t)j * mw);
+                if (front_out) front_out[i] = (uint16_t)nf;
+                local_segments += (uint64_t)nf;
+            }
+            if (sm->visibility(sstate, &ctx, q, m, fm, vm, local)) {
+                ok = 0;
+#pragma omp atomic write
+                failed = 1;
+                continue;
+            }
+            const double tr = omp_get_wtime();
+            for (int j = 0; j < m; j++) {
+                const size_t i = order[i0 + j].index;
+                float v, s;
+                if (spts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
+                local_penumbra += (uint64_t)ms_resolve_vs(&ctx, &q[j], spts, fm + (size_t)j * mw, vm + (size_t)j * mw, &v, &s);
+                if (vis) vis[i] = v;
+                if (shadow) shadow[i] = s;
+            }
+            local_resolve += omp_get_wtime() - tr;
+            if (opt->progress) {
+                /* One caller at a time; its answer stops the remaining batches. */
+#pragma omp critical(ms_points_progress)
+                {
+                    done++;
+                    if (!cancelled && opt->progress(opt->progress_user, (double)done / (double)nbatch)) {
+#pragma omp atomic write
+                        cancelled = 1;
+                    }
+                }
+            }
+        }
+        free(fm);
+        free(vm);
+        free(spts);
+        free(q);
+#pragma omp critical(ms_points_counters)
+        {
+            for (int c = 0; c < MS_MAX_COUNTERS; c++) counters[c] += local[c];
+            penumbra += local_penumbra;
+            segments += local_segments;
+            resolve_thread_s += local_resolve;
+        }
+    }
+    const double t1 = omp_get_wtime();
+    free(order);
+    ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
+    if (sm->isa_used) sm->isa_used(sstate, &kisa, &tisa);
+    sm->destroy(sstate);
+    if (failed) { snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
+    if (cancelled) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
+    if (stats) {
+        stats->triangles = a->view.n_tris;
+        stats->build_s = a->bvh.build_s;
+        stats->setup_s = setup_s;
+        stats->shadow_s = t1 - t0;
+        stats->samples = ctx.samples;
+        stats->samples_per_pixel = ctx.samples;   /* every point gets all N (no interleaving here) */
+        stats->threads = threads;
+        stats->method = sm->name;
+        stats->pattern = stratified ? "stratified" : "grid";
+        stats->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
+        stats->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
+        stats->visible_pixels = n;
+        stats->penumbra_pixels = penumbra;
+        stats->shadow_rays = segments;
+        stats->shadow_factor_s = resolve_thread_s / threads;
+        stats->n_counters = sm->n_counters;
+        for (int c = 0; c < sm->n_counters; c++) { stats->counter_name[c] = sm->counter_names[c]; stats->counter[c] = counters[c]; }
+        stats->total_s = omp_get_wtime() - t_start;
+    }
+    return MS_OK;
+}
