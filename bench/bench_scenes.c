@@ -2,7 +2,13 @@
  * binary, in one run; with the ratio of each method to scanline and to embree, a check that each agrees
  * with raytrace (pixels whose V differs at all, and by more than one sample of the pixel's front count),
  * and for scanline the cost of the shadow factor S (shadow_factor_s / shadow_s) and how far S is from V
- * (mean |S - V| over visible pixels, share of pixels with |S - V| > 0.1). Prints Markdown. */
+ * (mean |S - V| over visible pixels, share of pixels with |S - V| > 0.1). Prints Markdown.
+ *
+ * Then the time-to-quality table (issue 12): per scene a 4096-sample reference (grid pattern; embree when
+ * compiled in, else raytrace: the two agree sample for sample), and for each configuration of
+ * quality_cfgs the mean absolute error of V and S against it and its shadow seconds, so that one reads
+ * off who reaches a given error first. --quality-only runs only this table and, with --out, replaces only
+ * its section of the file (between the markers below; appended when absent). */
 #include "microshadow.h"
 #include <dirent.h>
 #include <stdint.h>
@@ -14,6 +20,31 @@
 
 #define MAX_SCENES 32
 #define MAX_METHODS 8
+#define QUALITY_BEGIN "<!-- time-to-quality: begin (bench_scenes --quality-only rewrites this section) -->"
+#define QUALITY_END "<!-- time-to-quality: end -->"
+
+/* The configurations of the time-to-quality table, in the order printed. Methods not compiled in are
+ * skipped with a note. */
+typedef struct quality_cfg {
+    const char *method;
+    ms_pattern pattern;
+    int samples;                  /* N; the interleaved pattern traces N/16 per pixel */
+    int no_filter;                /* interleaved: raw V and S */
+    const char *note;
+} quality_cfg;
+static const quality_cfg quality_cfgs[] = {
+    { "raytrace", MS_PATTERN_INTERLEAVED, 256, 0, "stand-in for mft: the same samples and filter" },
+    /* { "mft", MS_PATTERN_INTERLEAVED, 256, 0, "the paper's mode" }, */
+    { "raytrace", MS_PATTERN_INTERLEAVED, 256, 1, "raw (--no-filter): what the filter buys" },
+    { "scanline", MS_PATTERN_GRID, 256, 0, "" },
+    { "scanline", MS_PATTERN_GRID, 1024, 0, "" },
+    { "embree", MS_PATTERN_GRID, 256, 0, "" },
+    { "embree", MS_PATTERN_GRID, 1024, 0, "" },
+    { "raytrace", MS_PATTERN_STRATIFIED, 16, 0, "as many rays as interleaved 256" },
+    { "raytrace", MS_PATTERN_STRATIFIED, 64, 0, "" },
+    { "raytrace", MS_PATTERN_STRATIFIED, 256, 0, "" },
+};
+#define N_QUALITY (sizeof quality_cfgs / sizeof *quality_cfgs)
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
@@ -51,6 +82,113 @@ static const char *base_name(const char *p)
     return s ? s + 1 : p;
 }
 
+static int render_frame(const ms_scene *sc, const char *method, ms_pattern pat, int samples, int no_filter, int size,
+                        int threads, ms_frame *f, const char *scene_path)
+{
+    ms_render_options opt;
+    ms_render_options_default(&opt);
+    opt.method = method;
+    opt.pattern = pat;
+    opt.samples = samples;
+    opt.no_filter = no_filter;
+    opt.width = opt.height = size;
+    opt.threads = threads;
+    char err[1024];
+    if (ms_render(sc, &opt, f, err, sizeof err)) { fprintf(stderr, "%s: %s\n", scene_path, err); return -1; }
+    return 0;
+}
+
+/* The time-to-quality table for every scene into out (Markdown, between the section markers). */
+static void quality_table(FILE *out, char **scenes, int n_scenes, int size, int threads, const char *date,
+                          const char *cmd)
+{
+    const char *ref_method = ms_method_available("embree") == 1 ? "embree" : "raytrace";
+    fprintf(out, "%s\n\n### Time to quality\n\nMean absolute error of V and S against a 4096-sample `%s` frame "
+            "(grid pattern), and shadow seconds (the interleaved filter included), %dx%d, seed 0, threads %s, "
+            "measured %s by `%s`. Rays per pixel: N, or N/16 for the interleaved "
+            "pattern (then filtered over 4x4 pixels).\n\n"
+            "| scene | method | pattern | N | rays per pixel | MAE V | MAE S | shadow s | note |\n"
+            "|---|---|---|---|---|---|---|---|---|\n",
+            QUALITY_BEGIN, ref_method, size, size, threads ? "as given" : "= all cores", date, cmd);
+    fflush(out);
+    for (int s = 0; s < n_scenes; s++) {
+        ms_scene sc;
+        char err[1024];
+        if (ms_scene_load(scenes[s], &sc, err, sizeof err)) { fprintf(stderr, "%s\n", err); continue; }
+        ms_frame ref;
+        if (render_frame(&sc, ref_method, MS_PATTERN_GRID, 4096, 0, size, threads, &ref, scenes[s])) { ms_scene_free(&sc); continue; }
+        fprintf(stderr, "  %s reference %s 4096: shadow %.3f s\n", base_name(scenes[s]), ref_method, ref.stats.shadow_s);
+        for (size_t c = 0; c < N_QUALITY; c++) {
+            const quality_cfg *q = &quality_cfgs[c];
+            if (ms_method_available(q->method) != 1) {
+                fprintf(stderr, "bench_scenes: method %s is not available in this build, skipped\n", q->method);
+                continue;
+            }
+            ms_frame f;
+            if (render_frame(&sc, q->method, q->pattern, q->samples, q->no_filter, size, threads, &f, scenes[s])) continue;
+            /* over the pixels both frames see (embree's primary rays may pick another triangle at an edge) */
+            double ev = 0.0, es = 0.0;
+            size_t n = 0;
+            for (size_t i = 0; i < (size_t)size * size; i++) {
+                if (ref.vis[i] < 0.0f || f.vis[i] < 0.0f) continue;
+                ev += fabs((double)f.vis[i] - ref.vis[i]);
+                es += fabs((double)f.shadow[i] - ref.shadow[i]);
+                n++;
+            }
+            if (n) { ev /= (double)n; es /= (double)n; }
+            const char *raw = q->no_filter ? " raw" : "";
+            fprintf(stderr, "  %s %s %s%s %d: MAE V %.5f, shadow %.3f s\n", base_name(scenes[s]), q->method,
+                    ms_pattern_name(q->pattern), raw, q->samples, ev, f.stats.shadow_s);
+            fprintf(out, "| %s | %s | %s%s | %d | %d | %.5f | %.5f | %.3f | %s |\n", base_name(scenes[s]), q->method,
+                    ms_pattern_name(q->pattern), raw, q->samples, f.stats.samples_per_pixel, ev, es, f.stats.shadow_s,
+                    q->note);
+            fflush(out);
+            ms_frame_free(&f);
+        }
+        ms_frame_free(&ref);
+        ms_scene_free(&sc);
+    }
+    fprintf(out, "\n%s\n", QUALITY_END);
+}
+
+/* Replaces the time-to-quality section of the file at path by section (appends it when the file has
+ * none), through a temporary file renamed into place. */
+static int splice_section(const char *path, const char *section)
+{
+    char *old = NULL;
+    size_t len = 0;
+    FILE *f = fopen(path, "rb");
+    if (f) {
+        fseek(f, 0, SEEK_END);
+        long n = ftell(f);
+        fseek(f, 0, SEEK_SET);
+        old = calloc((size_t)(n > 0 ? n : 0) + 1, 1);
+        if (!old || (n > 0 && fread(old, 1, (size_t)n, f) != (size_t)n)) { fclose(f); free(old); return -1; }
+        len = (size_t)n;
+        fclose(f);
+    }
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *o = fopen(tmp, "wb");
+    if (!o) { free(old); return -1; }
+    const char *b = old ? strstr(old, QUALITY_BEGIN) : NULL, *e = b ? strstr(b, QUALITY_END) : NULL;
+    if (b && e) {
+        e += strlen(QUALITY_END);
+        if (*e == '\n') e++;
+        fwrite(old, 1, (size_t)(b - old), o);
+        fputs(section, o);
+        fputs(e, o);
+    } else {
+        if (old) fwrite(old, 1, len, o);
+        if (len && old[len - 1] != '\n') fputc('\n', o);
+        fputs("\n", o);
+        fputs(section, o);
+    }
+    free(old);
+    if (fclose(o) || rename(tmp, path)) { remove(tmp); return -1; }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *dir = "../shared/scenes", *out_md = NULL;
@@ -58,7 +196,7 @@ int main(int argc, char **argv)
     /* A method may name a variant after a colon: scanline:pixel (the per-pixel traversal), scanline:fs
      * (block traversal with frustum shrinking). Plain names run the defaults. */
     const char *methods[MAX_METHODS] = { "raytrace", "embree", "mft", "bounds", "hierarchical", "scanline:pixel", "scanline" };
-    int n_methods = 7;
+    int n_methods = 7, quality_only = 0;
     /* The command line as given, for the header (strtok below cuts the lists). */
     char cmdline[1024] = "";
     for (int i = 1; i < argc; i++) {
@@ -70,6 +208,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) out_md = argv[++i];
+        else if (!strcmp(argv[i], "--quality-only")) quality_only = 1;
         else if (!strcmp(argv[i], "--samples") && i + 1 < argc) {
             n_samples = 0;
             for (char *t = strtok(argv[++i], ","); t && n_samples < 4; t = strtok(NULL, ",")) samples[n_samples++] = atoi(t);
@@ -78,7 +217,8 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[++i], ","); t && n_methods < MAX_METHODS; t = strtok(NULL, ",")) methods[n_methods++] = t;
         } else {
             fprintf(stderr, "usage: bench_scenes [--scenes DIR] [--samples 256,1024,4096] [--size S] [--threads T] "
-                            "[--methods raytrace,embree,mft,bounds,hierarchical,scanline:pixel,scanline] [--out FILE.md]\n");
+                            "[--methods raytrace,embree,mft,bounds,hierarchical,scanline:pixel,scanline] [--quality-only] "
+                            "[--out FILE.md]\n");
             return 2;
         }
     }
@@ -96,11 +236,29 @@ int main(int argc, char **argv)
     int n_scenes = find_scenes(dir, scenes);
     if (!n_scenes) { fprintf(stderr, "bench_scenes: no scenes under %s\n", dir); return 2; }
 
-    FILE *md = out_md ? fopen(out_md, "w") : NULL;
-    FILE *outs[2] = { stdout, md };
     time_t now = time(NULL);
     char date[64];
     strftime(date, sizeof date, "%Y-%m-%d", gmtime(&now));
+    char cmd[1100];
+    snprintf(cmd, sizeof cmd, "build/bench_scenes%s", cmdline);
+    /* Built in memory (progress on stderr), then printed and written; with --quality-only the file keeps
+     * everything outside the section. */
+    char *sec = NULL;
+    size_t sec_len = 0;
+    if (quality_only) {
+        FILE *mem = open_memstream(&sec, &sec_len);
+        if (!mem) { fprintf(stderr, "bench_scenes: out of memory\n"); return 1; }
+        quality_table(mem, scenes, n_scenes, size, threads, date, cmd);
+        fclose(mem);
+        fputs(sec, stdout);
+        int rc = 0;
+        if (out_md && splice_section(out_md, sec)) { fprintf(stderr, "bench_scenes: cannot write %s\n", out_md); rc = 1; }
+        free(sec);
+        for (int s = 0; s < n_scenes; s++) free(scenes[s]);
+        return rc;
+    }
+    FILE *md = out_md ? fopen(out_md, "w") : NULL;
+    FILE *outs[2] = { stdout, md };
     for (int o = 0; o < 2; o++) {
         if (!outs[o]) continue;
         fprintf(outs[o], "Shadow seconds per method (primary visibility, shading and BVH build excluded), %dx%d, "
@@ -237,6 +395,14 @@ int main(int argc, char **argv)
         n_lines = 0;
         memset(log_scan, 0, sizeof log_scan); memset(log_emb, 0, sizeof log_emb);
         memset(n_scan, 0, sizeof n_scan); memset(n_emb, 0, sizeof n_emb);
+    }
+    FILE *mem = open_memstream(&sec, &sec_len);
+    if (mem) {
+        quality_table(mem, scenes, n_scenes, size, threads, date, cmd);
+        fclose(mem);
+        for (int o = 0; o < 2; o++)
+            if (outs[o]) fprintf(outs[o], "\n%s", sec);
+        free(sec);
     }
     if (md) fclose(md);
     for (int s = 0; s < n_scenes; s++) free(scenes[s]);

@@ -46,10 +46,11 @@ extern "C" {
 
 #define MS_VERSION_STRING "0.1.0"
 
-/* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a pixel has 256, 1024 or 4096 light
- * samples (a k x k grid, k = 16, 32, 64). */
+/* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a frame has N = 256, 1024 or 4096 light
+ * samples (a k x k grid, k = 16, 32, 64), the stratified pattern also 16 or 64 (k = 4, 8). Every pixel
+ * gets all N, except with the interleaved pattern: N/16 per pixel. */
 #define MS_MAX_IMAGE_SIZE 16384
-#define MS_SAMPLES_MIN 256
+#define MS_SAMPLES_MIN 16
 #define MS_SAMPLES_DEFAULT 1024
 #define MS_SAMPLES_MAX 4096
 #define MS_DEFAULT_METHOD "scanline"
@@ -121,8 +122,15 @@ void ms_scene_free(ms_scene *s);
 
 typedef enum ms_pattern {
     MS_PATTERN_GRID = 0,       /* k x k lattice, slightly rotated and shifted per pixel (Woop, sec. 6) */
-    MS_PATTERN_STRATIFIED = 1  /* k x k jittered strata, jitter hashed from pixel, sample and seed */
+    MS_PATTERN_STRATIFIED = 1, /* k x k jittered strata, jitter hashed from pixel, sample and seed */
+    MS_PATTERN_INTERLEAVED = 2 /* Benthin & Wald 2009: N QMC points in all, each pixel of a 4x4 block a
+                                * different N/16 of them, then a 4x4 discontinuity-aware filter over V, S */
 } ms_pattern;
+
+/* "grid", "stratified", "interleaved" ("unknown" otherwise). */
+const char *ms_pattern_name(ms_pattern p);
+/* Parses one of those names; 0, or -1 for anything else. */
+int ms_pattern_from_name(const char *name, ms_pattern *out);
 
 /* Instruction-set levels of the SIMD kernels and the traversal, in increasing order. As a cap,
  * MS_ISA_AUTO (0) means none: the best level the CPU runs; a cap above the CPU gives the CPU's best. */
@@ -166,7 +174,8 @@ typedef enum ms_traversal {
 typedef struct ms_render_options {
     const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
     ms_pattern pattern;
-    int samples;            /* 256, 1024 or 4096 (k*k with k = 16, 32, 64); 0: the scene's */
+    int samples;            /* N: 256, 1024 or 4096 (k*k with k = 16, 32, 64), stratified also 16, 64;
+                             * 0: the scene's */
     int width, height;      /* 0: the scene camera's */
     int threads;            /* 0: all cores; the host's OpenMP settings are left alone */
     uint32_t seed;
@@ -181,6 +190,7 @@ typedef struct ms_render_options {
     ms_traversal traversal; /* micro-raster methods: block (default) or per-pixel traversal */
     int frustum_shrink;     /* block traversal: also narrow a pixel's traversal frustum as its samples are
                              * occluded (the paper's "FS"; off: only its leaf rectangle shrinks, "CR") */
+    int no_filter;          /* interleaved pattern: leave out the 4x4 discontinuity-aware filter (raw V, S) */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
@@ -198,7 +208,8 @@ typedef struct ms_stats {
     /* Seconds: scene loading, our BVH build, the methods' own set-up (e.g. Embree's scene build), primary
      * visibility, shadows, and all of it (total_s). */
     double load_s, build_s, setup_s, primary_s, shadow_s, total_s;
-    int samples, threads, width, height;
+    int samples, threads, width, height;   /* samples: N, the frame's light samples */
+    int samples_per_pixel;         /* N, or N/16 for the interleaved pattern */
     const char *method;
     const char *pattern;
     const char *kernel_isa;        /* instruction set the method's kernel ran ("none" when it has none) */
@@ -208,6 +219,7 @@ typedef struct ms_stats {
     uint64_t penumbra_pixels;      /* pixels with some but not all front samples visible: S needs weights */
     double shadow_factor_s;        /* part of shadow_s spent resolving V and S from the sample masks
                                     * (thread-seconds / threads) */
+    double filter_s;               /* part of shadow_s spent in the interleaved pattern's filter (0: none) */
     int n_counters;                /* method-specific counters */
     const char *counter_name[MS_MAX_COUNTERS];
     uint64_t counter[MS_MAX_COUNTERS];
@@ -217,7 +229,10 @@ typedef struct ms_frame {
     int width, height;
     float *vis;       /* width*height, row 0 at the top: V; -1 where the primary ray missed */
     float *shadow;    /* width*height: the shadow factor S; -1 where the primary ray missed */
-    uint16_t *front;  /* width*height: the samples in front of the receiver's plane (0..N); 0 on misses */
+    uint16_t *front;  /* width*height: the pixel's samples in front of the receiver's plane (0..samples per
+                       * pixel); 0 on misses */
+    /* With the interleaved pattern (filter on) vis and shadow hold the filtered values: each mixes 16
+     * pixels' sample sets, so they are not comparable sample for sample with another method's. */
     float *rgb;       /* 3*width*height linear radiance: albedo/pi * E_unshadowed * S * emission */
     float exposure;   /* scale that maps the 99th percentile of unshadowed radiance to 1 (for PNG) */
     ms_stats stats;

@@ -222,7 +222,7 @@ static void test_flags(void **st)
     expect_bad(s, FLAGS("--width", "16385"), NEEDLES("--width", "not an integer in [1, 16384]"));
     expect_bad(s, FLAGS("--height", "-3"), NEEDLES("--height", "not an integer"));
     expect_bad(s, FLAGS("--height", "12x"), NEEDLES("--height", "'12x'"));
-    expect_bad(s, FLAGS("--samples", "100"), NEEDLES("--samples", "not one of 256, 1024, 4096"));
+    expect_bad(s, FLAGS("--samples", "100"), NEEDLES("--samples", "not one of 16, 64, 256, 1024, 4096"));
     expect_bad(s, FLAGS("--samples", "0"), NEEDLES("--samples"));
     expect_bad(s, FLAGS("--threads", "0"), NEEDLES("--threads"));
     expect_bad(s, FLAGS("--seed", "-1"), NEEDLES("--seed"));
@@ -232,6 +232,14 @@ static void test_flags(void **st)
 #endif
     expect_bad(s, FLAGS("--pattern", "hex"), NEEDLES("--pattern", "'hex'"));
     expect_bad(s, FLAGS("--method", "scanline", "--pattern", "stratified"), NEEDLES("flags.json", "needs --pattern grid"));
+    expect_bad(s, FLAGS("--method", "scanline", "--pattern", "interleaved"), NEEDLES("flags.json", "needs --pattern grid"));
+    /* 16 and 64 samples only for the stratified pattern: the grid kernels' buffers are 16..64 wide, and an
+     * interleaved pixel gets N/16 samples, which must fill a 16-ray packet */
+    expect_bad(s, FLAGS("--method", "raytrace", "--samples", "16"), NEEDLES("flags.json", "256, 1024 or 4096 with the grid pattern", "got 16"));
+    expect_bad(s, FLAGS("--method", "raytrace", "--pattern", "interleaved", "--samples", "64"),
+               NEEDLES("flags.json", "256, 1024 or 4096 with the interleaved pattern", "got 64"));
+    expect_bad(s, FLAGS("--method", "scanline", "--samples", "64"), NEEDLES("flags.json", "with the grid pattern"));
+    expect_bad(s, FLAGS("--pattern", "Interleaved"), NEEDLES("--pattern", "'Interleaved'", "interleaved"));
     expect_bad(s, FLAGS("--frobnicate"), NEEDLES("--frobnicate", "unknown"));
     expect_bad(s, FLAGS("--width"), NEEDLES("--width", "needs a value"));
     expect_bad(s, FLAGS(s), NEEDLES("more than one scene file"));

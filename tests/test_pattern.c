@@ -77,6 +77,8 @@ static void test_cells(void **st)
         for (int ki = 0; ki < 3; ki++)
             for (uint32_t p = 0; p < 12; p++)
                 check_cells((ms_pattern)pat, ks[ki], p * 97, p * 13 + 5, p % 3 == 0 ? 0 : 12345 + p);
+    for (int k = 4; k <= 8; k *= 2)   /* stratified at 16 and 64 samples */
+        for (uint32_t p = 0; p < 12; p++) check_cells(MS_PATTERN_STRATIFIED, k, p * 31, p + 2, p);
 }
 
 static void test_determinism_and_variation(void **st)
@@ -116,6 +118,8 @@ static void test_samples_to_k(void **st)
     assert_int_equal(ms_samples_to_k(256), 16);
     assert_int_equal(ms_samples_to_k(1024), 32);
     assert_int_equal(ms_samples_to_k(4096), 64);
+    assert_int_equal(ms_samples_to_k(16), 4);    /* stratified only (ms_pattern_samples_per_pixel) */
+    assert_int_equal(ms_samples_to_k(64), 8);
     assert_int_equal(ms_samples_to_k(0), 0);
     assert_int_equal(ms_samples_to_k(512), 0);
     assert_int_equal(ms_samples_to_k(-256), 0);

@@ -1,5 +1,6 @@
 /* The definition of V and S (microshadow.h, docs/design.md) against independent oracles:
- *   - receivers whose plane cuts the light: every method's V and S equal a brute-force double-precision
+ *   - receivers whose plane cuts the light: every method's V and S (grid; the ray tracers also on the
+ *     interleaved pattern and on 16 stratified samples) equal a brute-force double-precision
  *     count and weighted sum over the same samples (front test, segment-triangle tests, weights);
  *   - two lifts: V and S do not depend on how far the hit point is lifted off its surface;
  *   - the underside of a ceiling under a light above it sees nothing of the light (V = S = 0);
@@ -181,9 +182,16 @@ static void test_plane_cuts_light(void **st)
     ms_shadow_query q[5 * PER];
     const float *recv_tri[5 * PER];
     const int n = make_queries(&sc, &bvh, nr, PER, &rng, q, recv_tri);
-    for (int k = 16; k <= 64; k *= 2) {
+    /* the grid at every k; the other patterns for the ray tracers: interleaved (N/16 per pixel) and
+     * stratified at 16 samples (one mask word, partly used) */
+    static const struct { ms_pattern pat; int k; } cfg[] = {
+        { MS_PATTERN_GRID, 16 }, { MS_PATTERN_GRID, 32 }, { MS_PATTERN_GRID, 64 },
+        { MS_PATTERN_INTERLEAVED, 16 }, { MS_PATTERN_INTERLEAVED, 64 }, { MS_PATTERN_STRATIFIED, 4 } };
+    for (size_t c = 0; c < sizeof cfg / sizeof *cfg; c++) {
+        const int k = cfg[c].k;
         ms_render_ctx ctx;
         tu_ctx_init(&ctx, &sc, &bvh, 64, 64, k);
+        tu_ctx_set_pattern(&ctx, cfg[c].pat);
         oracle *o = malloc((size_t)n * sizeof *o);
         assert_non_null(o);
         int cut = 0, none = 0, tied = 0;
@@ -193,14 +201,15 @@ static void test_plane_cuts_light(void **st)
             none += o[i].front == 0 && o[i].ties == 0;
             tied += o[i].ties > 0;
         }
-        printf("k=%d: %d points, %d with the light cut by their plane, %d with none in front, %d with tied samples\n",
-               k, n, cut, none, tied);
+        printf("%s k=%d: %d points, %d with the light cut by their plane, %d with none in front, %d with tied samples\n",
+               ms_pattern_name(cfg[c].pat), k, n, cut, none, tied);
         assert_true(cut >= n / 4);
         assert_true(none >= PER);
         assert_true(tied * 20 <= n);
         for (size_t m = 0; m < N_METHODS; m++) {
             const ms_shadow_method *sm = ms_find_shadow_method(methods[m]);
             if (!sm) { printf("%s not compiled in\n", methods[m]); continue; }
+            if (sm->needs_grid && cfg[c].pat != MS_PATTERN_GRID) continue;
             void *state = NULL;
             char err[256];
             assert_int_equal(sm->create(&ctx, &state, err, sizeof err), 0);

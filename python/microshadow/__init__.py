@@ -78,10 +78,10 @@ class _Scene(ctypes.Structure):
 class _Stats(ctypes.Structure):
     _fields_ = [("triangles", ctypes.c_size_t)] + \
         [(n, ctypes.c_double) for n in ("load_s", "build_s", "setup_s", "primary_s", "shadow_s", "total_s")] + \
-        [(n, ctypes.c_int) for n in ("samples", "threads", "width", "height")] + \
+        [(n, ctypes.c_int) for n in ("samples", "threads", "width", "height", "samples_per_pixel")] + \
         [(n, ctypes.c_char_p) for n in ("method", "pattern", "kernel_isa", "traversal_isa")] + \
         [(n, ctypes.c_uint64) for n in ("visible_pixels", "shadow_rays", "penumbra_pixels")] + \
-        [("shadow_factor_s", ctypes.c_double), ("n_counters", ctypes.c_int),
+        [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
          ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS)]
 
 
@@ -100,7 +100,8 @@ class _RenderOptions(ctypes.Structure):
                 ("width", ctypes.c_int), ("height", ctypes.c_int), ("threads", ctypes.c_int),
                 ("seed", ctypes.c_uint32), ("progress", _PROGRESS), ("progress_user", _p), ("isa", ctypes.c_int),
                 ("no_occlusion_cull", ctypes.c_int), ("no_child_order", ctypes.c_int),
-                ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int)]
+                ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
+                ("traversal", ctypes.c_int), ("frustum_shrink", ctypes.c_int), ("no_filter", ctypes.c_int)]
 
 
 class _Points(ctypes.Structure):
@@ -136,7 +137,7 @@ _frame_free = _sig("ms_frame_free", None, ctypes.POINTER(_Frame))
 _method_names = _sig("ms_method_names", ctypes.POINTER(ctypes.c_char_p))
 _irradiance = _sig("ms_light_irradiance", _f, ctypes.POINTER(_Light), ctypes.POINTER(_f), ctypes.POINTER(_f))
 
-_PATTERNS = {"grid": 0, "stratified": 1}
+_PATTERNS = {"grid": 0, "stratified": 1, "interleaved": 2}
 _ISAS = {"auto": 0, "scalar": 1, "avx2": 2, "avx512": 3}
 
 

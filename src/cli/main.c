@@ -23,8 +23,10 @@ static void usage(FILE *f)
     for (const char *const *m = ms_method_names(); *m; m++) fprintf(f, " %s", *m);
     fprintf(f,
         " (default scanline)\n"
-        "  --pattern P         light samples: grid (default) or stratified\n"
-        "  --samples N         256, 1024 or 4096 light samples per pixel (default: the scene's)\n"
+        "  --pattern P         light samples: grid (default), stratified, or interleaved (N/16 per pixel\n"
+        "                      of a 4x4 block, then a 4x4 depth- and normal-aware filter; ray tracers only)\n"
+        "  --samples N         256, 1024 or 4096 light samples (default: the scene's); stratified also 16, 64\n"
+        "  --no-filter         interleaved: raw per-pixel V and S, without the filter\n"
         "  --width W, --height H   image size (default: the scene camera's)\n"
         "  --threads T         threads (default: all cores)\n"
         "  --seed S            seed of the per-pixel sample patterns (default 0)\n"
@@ -71,7 +73,7 @@ int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
-           O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION };
+           O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -80,7 +82,8 @@ int main(int argc, char **argv)
         { "shadow", required_argument, 0, O_SHADOW }, { "isa", required_argument, 0, O_ISA },
         { "stats", required_argument, 0, O_STATS }, { "quiet", no_argument, 0, O_QUIET },
         { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
-        { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION }, { 0, 0, 0, 0 } };
+        { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
+        { 0, 0, 0, 0 } };
     ms_render_options opt;
     ms_render_options_default(&opt);
     /* The library reads no environment; for measuring (docs/embree.md) the CLI maps these onto options. */
@@ -112,14 +115,15 @@ int main(int argc, char **argv)
         switch (c) {
         case O_METHOD: opt.method = optarg; break;
         case O_PATTERN:
-            if (strcmp(optarg, "grid") == 0) opt.pattern = MS_PATTERN_GRID;
-            else if (strcmp(optarg, "stratified") == 0) opt.pattern = MS_PATTERN_STRATIFIED;
-            else { fprintf(stderr, "microshadow: --pattern: '%s' is not grid or stratified\n", optarg); return EXIT_BAD_INPUT; }
+            if (ms_pattern_from_name(optarg, &opt.pattern)) {
+                fprintf(stderr, "microshadow: --pattern: '%s' is not grid, stratified or interleaved\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
             break;
         case O_SAMPLES:
             if (parse_int("--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
-            if (v != 256 && v != 1024 && v != 4096) {
-                fprintf(stderr, "microshadow: --samples: %ld is not one of 256, 1024, 4096\n", v);
+            if (v != 16 && v != 64 && v != 256 && v != 1024 && v != 4096) {
+                fprintf(stderr, "microshadow: --samples: %ld is not one of 16, 64, 256, 1024, 4096\n", v);
                 return EXIT_BAD_INPUT;
             }
             opt.samples = (int)v;
@@ -145,6 +149,7 @@ int main(int argc, char **argv)
         case O_FRUSTUM_SHRINK: opt.frustum_shrink = 1; break;
         case O_STATS: outs[OUT_STATS].path = optarg; break;
         case O_QUIET: quiet = 1; break;
+        case O_NO_FILTER: opt.no_filter = 1; break;
         case 'h': case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("microshadow %s\n", MS_VERSION_STRING); return 0;
         default:
@@ -194,9 +199,9 @@ int main(int argc, char **argv)
     if (rc) fprintf(stderr, "microshadow: %s\n", err);
     if (!quiet && rc == 0) {
         const ms_stats *s = &frame.stats;
-        fprintf(stderr, "%s: %zu triangles, %dx%d, %d samples, method %s, %d threads: build %.3fs, setup %.3fs, primary %.3fs, "
+        fprintf(stderr, "%s: %zu triangles, %dx%d, %d samples (%s), method %s, %d threads: build %.3fs, setup %.3fs, primary %.3fs, "
                 "shadow %.3fs (%.1f M shadow rays/s), total %.3fs -> %s\n",
-                scene_path ? scene_path : "built-in scene", s->triangles, s->width, s->height, s->samples, s->method,
+                scene_path ? scene_path : "built-in scene", s->triangles, s->width, s->height, s->samples, s->pattern, s->method,
                 s->threads, s->build_s, s->setup_s, s->primary_s, s->shadow_s,
                 s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s * 1e-6 : 0.0, s->total_s, outs[OUT_PNG].path);
     }

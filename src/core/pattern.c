@@ -1,5 +1,6 @@
 #include "pattern.h"
 #include "vec.h"
+#include <string.h>
 
 uint32_t ms_hash3(uint32_t a, uint32_t b, uint32_t c)
 {
@@ -11,13 +12,84 @@ uint32_t ms_hash3(uint32_t a, uint32_t b, uint32_t c)
     return h;
 }
 
+const char *ms_pattern_name(ms_pattern p)
+{
+    switch (p) {
+    case MS_PATTERN_GRID: return "grid";
+    case MS_PATTERN_STRATIFIED: return "stratified";
+    case MS_PATTERN_INTERLEAVED: return "interleaved";
+    }
+    return "unknown";
+}
+
+int ms_pattern_from_name(const char *name, ms_pattern *out)
+{
+    for (int p = MS_PATTERN_GRID; p <= MS_PATTERN_INTERLEAVED; p++)
+        if (strcmp(name, ms_pattern_name((ms_pattern)p)) == 0) { *out = (ms_pattern)p; return 0; }
+    return -1;
+}
+
 int ms_samples_to_k(int samples)
 {
     switch (samples) {
+    case 16: return 4;
+    case 64: return 8;
     case 256: return 16;
     case 1024: return 32;
     case 4096: return 64;
     default: return 0;
+    }
+}
+
+int ms_pattern_spp(ms_pattern p, int k) { return p == MS_PATTERN_INTERLEAVED ? k * k / 16 : k * k; }
+
+int ms_pattern_samples_per_pixel(ms_pattern p, int samples)
+{
+    const int k = ms_samples_to_k(samples);
+    switch (p) {
+    case MS_PATTERN_GRID: return k >= 16 ? k * k : 0;
+    case MS_PATTERN_STRATIFIED: return k * k;
+    case MS_PATTERN_INTERLEAVED: return k >= 16 ? k * k / 16 : 0;
+    }
+    return 0;
+}
+
+/* The interleaved pattern draws from the 2D Sobol' sequence: x is the van der Corput radical inverse in
+ * base 2 (identity generator matrix), y the second Sobol' component (Pascal matrix mod 2). Together they
+ * form a (0,2)-sequence in base 2 (Kollig & Keller, "Efficient Multidimensional Sampling", EG 2002, whose
+ * VanDerCorput/Sobol2 code this follows): every aligned block of 2^m points, [j 2^m, (j+1) 2^m), is a
+ * (0,m,2)-net, i.e. each elementary interval [a 2^-d, (a+1) 2^-d) x [b 2^-(m-d), (b+1) 2^-(m-d)) holds
+ * exactly one of its points. So each pixel's set of n = N/16 points is a (0,m,2)-net (n = 2^m) and the 16
+ * sets of a 4x4 block together are the first N points, a (0,m+4,2)-net. Departure from the paper, which
+ * names Hammersley or Larcher-Pillichshammer points: those are nets but not sequences, so their aligned
+ * sub-blocks are not nets (Hammersley's are stripes of the light 1/16 wide). The XOR with a hash of the
+ * seed (a digital shift, Kollig & Keller's scrambling argument r) maps elementary intervals onto
+ * elementary intervals, so the nets stay nets; the pattern is the same over the whole frame. */
+static uint32_t radical_inverse2(uint32_t i)
+{
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x00FF00FFu) << 8) | ((i & 0xFF00FF00u) >> 8);
+    i = ((i & 0x0F0F0F0Fu) << 4) | ((i & 0xF0F0F0F0u) >> 4);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xCCCCCCCCu) >> 2);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xAAAAAAAAu) >> 1);
+    return i;
+}
+
+static uint32_t sobol2(uint32_t i)
+{
+    uint32_t r = 0;
+    for (uint32_t v = UINT32_C(1) << 31; i; i >>= 1, v ^= v >> 1)
+        if (i & 1u) r ^= v;
+    return r;
+}
+
+void ms_interleaved_uv(int samples, int set, uint32_t seed, uint32_t *u, uint32_t *v)
+{
+    const uint32_t n = (uint32_t)samples / 16u, base = (uint32_t)set * n;
+    const uint32_t su = ms_hash3(seed, 0x1A7E2C3Bu, 0x5EEDu), sv = ms_hash3(seed, 0x0C4F9D21u, 0x5EEDu);
+    for (uint32_t l = 0; l < n; l++) {
+        u[l] = radical_inverse2(base + l) ^ su;
+        v[l] = sobol2(base + l) ^ sv;
     }
 }
 
@@ -50,6 +122,20 @@ void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint
                 float *o = xyz + 3 * (j * k + i);
                 for (int c = 0; c < 3; c++) o[c] = g.p0[c] + (float)i * g.ds[c] + (float)j * g.dt[c];
             }
+        return;
+    }
+    if (p == MS_PATTERN_INTERLEAVED) {
+        const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
+        const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
+        const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
+        const int n = k * k / 16;
+        uint32_t u[256], v[256];   /* n <= 4096 / 16 */
+        ms_interleaved_uv(k * k, ms_interleaved_set(px, py), seed, u, v);
+        for (int i = 0; i < n; i++) {
+            /* 24 bits: exact in a float, and far finer than the 2^-12 of the smallest elementary interval */
+            const float s = (float)(u[i] >> 8) * (1.0f / 16777216.0f), t = (float)(v[i] >> 8) * (1.0f / 16777216.0f);
+            for (int c = 0; c < 3; c++) xyz[3 * i + c] = P[c] + s * S[c] + t * T[c];
+        }
         return;
     }
     const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };

@@ -7,8 +7,12 @@
  *   samples take k^2 distinct values along each light axis. Being affine, the micro-rasterizer sees
  *   the lattice as integer positions on the plane z = 1 of light space.
  * stratified: sample (i,j) jittered uniformly in cell (i,j), jitter hashed from pixel, sample and seed.
+ * interleaved (Benthin & Wald 2009, sec. 4.5, after Keller & Heidrich 2001): N = k*k points in all, the
+ *   same over the frame; pixel (x,y) of every 4x4 block gets set s = (x & 3) + 4 (y & 3), the aligned
+ *   block of points [s N/16, (s+1) N/16) of a (0,2)-sequence (ms_interleaved_uv), so N/16 per pixel.
  *
- * Sample index is j*k + i; in an occlusion buffer that is bit i of scanline j. */
+ * Sample index is j*k + i for grid and stratified; in an occlusion buffer that is bit i of scanline j. For
+ * interleaved it is the point's place in the pixel's set. */
 #ifndef MS_PATTERN_H
 #define MS_PATTERN_H
 #include <stdint.h>
@@ -24,10 +28,21 @@ uint32_t ms_hash3(uint32_t a, uint32_t b, uint32_t c);
 static inline float ms_hash_unit(uint32_t h) { return (float)(h >> 8) * (1.0f / 16777216.0f); }
 
 void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed, ms_grid *g);
-/* Sample positions (3*k*k floats, index j*k+i) of either pattern for one pixel. */
+/* Sample positions of a pattern for one pixel: 3*ms_pattern_spp(p, k) floats (k*k samples in all). */
 void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                        float *xyz);
-/* k for a sample count (256, 1024, 4096), 0 if unsupported. */
+/* k for a sample count N = k*k (16, 64, 256, 1024, 4096), 0 if unsupported. */
 int ms_samples_to_k(int samples);
+/* Samples per pixel of pattern p at N = k*k: k*k, or k*k/16 for interleaved. */
+int ms_pattern_spp(ms_pattern p, int k);
+/* Light samples per pixel of pattern p at N samples, 0 when p does not take N: grid 256, 1024, 4096 (the
+ * micro-rasterizer's buffers); stratified also 16 and 64; interleaved 256, 1024, 4096 (16, 64, 256 per
+ * pixel, so that the ray tracers' 16-ray packets stay full). 0 also for an unknown p. */
+int ms_pattern_samples_per_pixel(ms_pattern p, int samples);
+/* The interleaved pattern's light parameters as 32-bit fixed point (u / 2^32 in [0,1)): the n = N/16
+ * points of set `set` (0..15), point l = sequence point set*n + l, digitally shifted by the seed. */
+void ms_interleaved_uv(int samples, int set, uint32_t seed, uint32_t *u, uint32_t *v);
+/* The set of pixel (px, py): (px & 3) + 4 (py & 3). */
+static inline int ms_interleaved_set(uint32_t px, uint32_t py) { return (int)((px & 3u) + 4u * (py & 3u)); }
 
 #endif

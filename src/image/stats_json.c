@@ -19,6 +19,7 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     cJSON_AddNumberToObject(o, "width", s->width);
     cJSON_AddNumberToObject(o, "height", s->height);
     cJSON_AddNumberToObject(o, "samples", s->samples);
+    cJSON_AddNumberToObject(o, "samples_per_pixel", s->samples_per_pixel);
     cJSON_AddNumberToObject(o, "threads", s->threads);
     cJSON_AddNumberToObject(o, "load_s", s->load_s);
     cJSON_AddNumberToObject(o, "build_s", s->build_s);
@@ -30,6 +31,7 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     cJSON_AddNumberToObject(o, "shadow_rays", (double)s->shadow_rays);
     cJSON_AddNumberToObject(o, "penumbra_pixels", (double)s->penumbra_pixels);
     cJSON_AddNumberToObject(o, "shadow_factor_s", s->shadow_factor_s);
+    cJSON_AddNumberToObject(o, "filter_s", s->filter_s);
     cJSON_AddNumberToObject(o, "shadow_rays_per_s", s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s : 0.0);
     cJSON *c = cJSON_AddObjectToObject(o, "counters");
     for (int i = 0; c && i < s->n_counters; i++) cJSON_AddNumberToObject(c, s->counter_name[i], (double)s->counter[i]);

@@ -167,8 +167,13 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
         return MS_ERR_METHOD;
     }
     const int samples = opt->samples > 0 ? opt->samples : MS_SAMPLES_DEFAULT;
-    const int k = ms_samples_to_k(samples);
+    /* 256, 1024 or 4096 for either pattern here (16 and 64 are for frames of stratified ray tracing) */
+    const int k = ms_pattern_samples_per_pixel(MS_PATTERN_GRID, samples) ? ms_samples_to_k(samples) : 0;
     if (!k) { snprintf(err, errlen, "samples must be 256, 1024 or 4096 (got %d)", samples); return MS_ERR_INVALID; }
+    if (opt->pattern == MS_PATTERN_INTERLEAVED) {
+        snprintf(err, errlen, "the interleaved pattern needs pixels (4x4 blocks): frames only, not points");
+        return MS_ERR_INVALID;
+    }
     if (opt->pattern != MS_PATTERN_GRID && opt->pattern != MS_PATTERN_STRATIFIED) {
         snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern);
         return MS_ERR_INVALID;
@@ -317,6 +322,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
         stats->setup_s = setup_s;
         stats->shadow_s = t1 - t0;
         stats->samples = ctx.samples;
+        stats->samples_per_pixel = ctx.samples;   /* every point gets all N (no interleaving here) */
         stats->threads = threads;
         stats->method = sm->name;
         stats->pattern = stratified ? "stratified" : "grid";

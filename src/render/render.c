@@ -6,6 +6,7 @@
 #include "../shadow/receiver.h"
 #include "shadow_frame.h"
 #include "render_materialise.h"
+#include "interleave_filter.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -71,8 +72,16 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     const ms_primary_method *pm = ms_find_primary_method(streamed ? "depth" : sm->primary);
     if (!pm) { snprintf(err, errlen, "primary method '%s' is not compiled into this build", sm->primary); return -1; }
     int samples = opt->samples > 0 ? opt->samples : scene->samples;
+    if ((unsigned)opt->pattern > MS_PATTERN_INTERLEAVED) { snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern); return -1; }
+    /* Samples per pixel: N, or N/16 for interleaved; always a multiple of 16 (full ray packets). */
+    const int spp = ms_pattern_samples_per_pixel(opt->pattern, samples);
+    if (!spp) {
+        snprintf(err, errlen, "samples must be %s with the %s pattern (got %d)",
+                 opt->pattern == MS_PATTERN_STRATIFIED ? "16, 64, 256, 1024 or 4096" : "256, 1024 or 4096",
+                 ms_pattern_name(opt->pattern), samples);
+        return -1;
+    }
     int k = ms_samples_to_k(samples);
-    if (!k) { snprintf(err, errlen, "samples must be 256, 1024 or 4096 (got %d)", samples); return -1; }
     if (sm->needs_grid && opt->pattern != MS_PATTERN_GRID) {
         snprintf(err, errlen, "method '%s' needs --pattern grid", sm->name);
         return -1;
@@ -99,8 +108,8 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     ctx.light = scene->light;
     ctx.pattern = opt->pattern;
     ctx.k = k;
-    ctx.samples = k * k;
-    ctx.mask_words = k * k / 64;
+    ctx.samples = spp;
+    ctx.mask_words = (spp + 63) / 64;   /* bits past spp stay 0 */
     ctx.seed = opt->seed;
     ctx.near = MS_NEAR;
     ctx.far = MS_FAR;
@@ -148,7 +157,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     double resolve_thread_s = 0.0;
     int failed = 0;
     const size_t mw = (size_t)ctx.mask_words;
-    const int stratified = ctx.pattern != MS_PATTERN_GRID;
+    const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
     const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
 #pragma omp parallel num_threads(threads)
     {
@@ -211,13 +220,25 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     if (sm->visibility_all && !failed)
         failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, W, H, out, counters, &visible, &penumbra, &segments,
                                        &resolve_thread_s) != 0;
-    double t2 = omp_get_wtime();
     if (failed) {
         snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);
         sm->destroy(sstate);
         pm->destroy(pstate);
         goto fail;
     }
+    /* The interleaved pattern's filter belongs to its shadow cost (timed in shadow_s and on its own). */
+    double filter_s = 0.0;
+    if (ctx.pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter) {
+        const double tf = omp_get_wtime();
+        if (ms_interleave_filter(W, H, hits, out->front, out->vis, out->shadow, threads)) {
+            snprintf(err, errlen, "out of memory for the interleaved filter of a %dx%d frame", W, H);
+            sm->destroy(sstate);
+            pm->destroy(pstate);
+            goto fail;
+        }
+        filter_s = omp_get_wtime() - tf;
+    }
+    double t2 = omp_get_wtime();
 
     /* Shading: the exact unshadowed irradiance times the shadow factor S (the ratio estimator: exact where
      * the light is wholly visible or hidden, converging to the shadowed irradiance as k grows). */
@@ -250,7 +271,8 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     st->setup_s = setup_s;
     st->primary_s = t1 - t0;
     st->shadow_s = t2 - t1;
-    st->samples = ctx.samples;
+    st->samples = samples;
+    st->samples_per_pixel = spp;
     st->threads = threads;
     st->width = W;
     st->height = H;
@@ -259,10 +281,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     if (sm->isa_used) sm->isa_used(sstate, &kisa, &tisa);
     st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
     st->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
-    st->pattern = opt->pattern == MS_PATTERN_GRID ? "grid" : "stratified";
+    st->pattern = ms_pattern_name(opt->pattern);
     st->visible_pixels = visible;
     st->penumbra_pixels = penumbra;
     st->shadow_factor_s = resolve_thread_s / threads;
+    st->filter_s = filter_s;
     st->shadow_rays = segments;
     const char *const *cnames = sm->counter_names;
     st->n_counters = sm->n_counters;

@@ -16,8 +16,10 @@ typedef struct ms_render_ctx {
     ms_camera_basis cam;
     ms_light light;
     ms_pattern pattern;
-    int k, samples;                /* samples = k*k */
-    int mask_words;                /* 64-bit words of one sample mask: samples / 64 (receiver.h) */
+    int k, samples;                /* N = k*k samples in all; samples: per pixel, k*k, or k*k/16 for the
+                                    * interleaved pattern (ms_pattern_spp); always a multiple of 16 */
+    int mask_words;                /* 64-bit words of one sample mask: ceil(samples / 64), bits past
+                                    * samples 0 (receiver.h) */
     uint32_t seed;
     float near, far;               /* occluding range of the segment parameter from hit point to sample */
     int threads;

@@ -8,7 +8,9 @@
  *     light is behind the point or edge-on, and E_unshadowed is 0 there anyway).
  *
  * Masks: ctx->mask_words 64-bit words per point; bit s of the little-endian bit stream is sample s = j*k + i,
- * which is bit i of scanline j in the micro-rasterizer's k x k buffers (raster.h), so a buffer is a mask. */
+ * which is bit i of scanline j in the micro-rasterizer's k x k buffers (raster.h), so a buffer is a mask.
+ * With the interleaved pattern bit s is the pixel's s-th sample of ctx->samples = N/16; bits past
+ * ctx->samples are 0. */
 #ifndef MS_RECEIVER_H
 #define MS_RECEIVER_H
 #include <stdint.h>
@@ -24,7 +26,7 @@ static inline int ms_mask_get(const uint64_t *m, int s) { return (int)(m[s >> 6]
 /* The receiver's horizon as an edge in the grid's sample coordinates: h . (i, j, 1) = (S_ij - P) . n. */
 void ms_horizon_edge(const ms_grid *g, const float p[3], const float n[3], float h[3]);
 
-/* Writes q's front mask. pts: the pattern's sample points (3*k*k floats) for the stratified pattern, NULL
+/* Writes q's front mask. pts: the pattern's sample points (3*ctx->samples floats) for the other patterns, NULL
  * for grid, where the horizon is rasterized by the Scanline row loop (ms_raster_clear_halfplane).
  * Returns the number of samples in front. */
 int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, uint64_t *front);

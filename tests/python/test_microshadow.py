@@ -141,6 +141,16 @@ class QuadTest(unittest.TestCase):
         self.assertLessEqual(np.abs(a["vis"] - b["vis"]).max() * 256, 1.0 + 1e-3)
         self.assertEqual(a["stats"]["method"], "scanline")
         self.assertIn("raytrace", ms.method_names())
+        # the interleaved pattern: N/16 samples per pixel, filtered; the stats' layout matches the C struct
+        c = ms.render(self.scene, method="raytrace", samples=256, pattern="interleaved")
+        self.assertEqual(c["stats"]["pattern"], "interleaved")
+        self.assertEqual(c["stats"]["samples"], 256)
+        self.assertEqual(c["stats"]["samples_per_pixel"], 16)
+        self.assertGreater(c["stats"]["filter_s"], 0.0)
+        self.assertLessEqual(int(c["front"].max()), 16)
+        np.testing.assert_array_equal(hit, c["vis"] >= 0)
+        self.assertEqual(b["stats"]["samples_per_pixel"], 256)
+        self.assertEqual(b["stats"]["filter_s"], 0.0)
 
     def test_bake(self):
         lm = ms.bake(self.scene, size=64, uv=None, samples=256)

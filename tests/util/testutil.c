@@ -161,6 +161,13 @@ void tu_ctx_init(ms_render_ctx *ctx, const ms_scene *sc, const ms_bvh *bvh, int 
     ctx->isa_cap = tu_isa_cap();
 }
 
+void tu_ctx_set_pattern(ms_render_ctx *ctx, ms_pattern p)
+{
+    ctx->pattern = p;
+    ctx->samples = ms_pattern_spp(p, ctx->k);
+    ctx->mask_words = (ctx->samples + 63) / 64;
+}
+
 int tu_shadow_vs(const ms_shadow_method *m, void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n,
                  float *v, float *s, uint64_t *counters)
 {

@@ -54,6 +54,9 @@ struct ms_hit;
 void tu_query_from_hit(struct ms_shadow_query *q, const struct ms_hit *h, int x, int y);
 /* A frame context as ms_render sets it up: grid pattern, k x k samples, the scene's camera at W x H. */
 void tu_ctx_init(struct ms_render_ctx *ctx, const ms_scene *sc, const struct ms_bvh *bvh, int W, int H, int k);
+/* Switches ctx to pattern p at its k (k*k samples in all): samples per pixel and mask words as ms_render
+ * sets them. */
+void tu_ctx_set_pattern(struct ms_render_ctx *ctx, ms_pattern p);
 /* V and S of n points by a shadow method (state from its create), through front masks and ms_resolve_vs
  * exactly as ms_render does. Returns the method's visibility result (0 ok). */
 int tu_shadow_vs(const struct ms_shadow_method *m, void *state, const struct ms_render_ctx *ctx,

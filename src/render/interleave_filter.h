@@ -1,0 +1,21 @@
+/* The interleaved pattern's image-space filter (Benthin & Wald 2009, sec. 4.5): each pixel of a 4x4 block
+ * traced a different 1/16 of the light samples; averaging V and S over a 4x4 neighbourhood gives every
+ * pixel the whole set back, except across depth and normal discontinuities. */
+#ifndef MS_INTERLEAVE_FILTER_H
+#define MS_INTERLEAVE_FILTER_H
+#include <stdint.h>
+#include "../shadow/method.h"
+
+/* A neighbour is left out when its hit point lies off the pixel's tangent plane by more than this share
+ * of its distance from the pixel (about 0.6 degrees) ... */
+#define MS_FILTER_PLANE_TOL 0.01f
+/* ... or when the cosine between the two normals is below this (about 25 degrees). */
+#define MS_FILTER_NORMAL_COS 0.9f
+
+/* Filters vis and shadow (W*H, row 0 at the top) in place. hits: the frame's primary hits (misses are
+ * neither filtered nor used); front: each pixel's samples in front of its plane. Returns 0, or -1 when
+ * out of memory (the values are then left raw). */
+int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front, float *vis, float *shadow,
+                         int threads);
+
+#endif
