@@ -1,0 +1,258 @@
+/* Method "mft": multi-frusta tracing (Benthin & Wald 2009, "Efficient Ray Traced Soft Shadows using
+ * Multi-Frusta Tracing", HPG 2009). Pixels are taken in 4x4 blocks; the shadow frusta of a block (hit
+ * point -> the pixel's light samples) traverse a shallow BVH together, one frustum per SIMD lane, and in a
+ * leaf each triangle is culled for all sixteen by the frusta's corner rays before the surviving frusta
+ * test their live rays against it, 16 rays per operation, one bit per ray (mft_impl.h, per ISA).
+ *
+ * This file: the method's frame set-up, the grouping of the driver's queries into blocks, and each
+ * block's rays. The rays are the light samples of the shared patterns (ms_pattern_points: the points
+ * method raytrace traces) and are formed exactly as raytrace forms them (raytrace_impl.h: d = P - C,
+ * the shear of each 16-sample packet), so that mft and raytrace decide every ray alike; see mft_impl.h
+ * for what departs from the paper. */
+#include "method.h"
+#include "mft.h"
+#include "receiver.h"
+#include "../core/pattern.h"
+#include "../core/vec.h"
+#include "../accel/ray_triangle.h"
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Largest leaf of the shallow BVH (accel/bvh.h: subtrees of at most this many triangles collapsed into
+ * one leaf). Measured on the shared scenes at 384x384, 1024 samples (docs/design.md, "mft"): 4 and 8
+ * within a few percent of each other, 16 slower (more triangle-frustum pairs to cull). */
+#ifndef MFT_SHALLOW_LEAF
+#define MFT_SHALLOW_LEAF 4
+#endif
+
+typedef struct mft_method {
+    ms_mft_fn block;
+    ms_isa isa;
+    ms_bvh_shallow sh;
+    ms_mft_frame f;
+} mft_method;
+
+ms_mft_fn ms_mft_isa(ms_isa isa)
+{
+    static const ms_mft_fn table[] = {
+        [MS_ISA_SCALAR] = ms_mft_block_scalar,
+        [MS_ISA_AVX2] = ms_mft_block_avx2,
+        [MS_ISA_AVX512] = ms_mft_block_avx512,
+    };
+    if (isa < MS_ISA_SCALAR || isa > MS_ISA_AVX512 || ms_cpu_isa() < isa) return NULL;
+    return table[isa];
+}
+
+ms_mft_fn ms_mft_select(ms_isa cap, ms_isa *chosen)
+{
+    const ms_isa isa = ms_isa_capped(cap);
+    if (chosen) *chosen = isa;
+    return ms_mft_isa(isa);
+}
+
+void ms_mft_corners(const ms_mft_frame *f, const float c[3], const int r[4], float d[4][3])
+{
+    const double a[2] = { (r[0] - f->margin) / f->k, (r[1] + 1 + f->margin) / f->k };
+    const double b[2] = { (r[2] - f->margin) / f->k, (r[3] + 1 + f->margin) / f->k };
+    for (int q = 0; q < 4; q++)
+        for (int x = 0; x < 3; x++)
+            d[q][x] = (float)(f->lp[x] + a[q & 1] * f->ls[x] + b[q >> 1] * f->lt[x] - c[x]);
+}
+
+static double d3_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double d3_len(const double a[3]) { return sqrt(d3_dot(a, a)); }
+static void d3_cross(double o[3], const double a[3], const double b[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
+{
+    if (ctx->pattern != MS_PATTERN_GRID && ctx->pattern != MS_PATTERN_STRATIFIED) {
+        snprintf(err, errlen, "method 'mft' supports the grid and stratified patterns only");
+        return -1;
+    }
+    mft_method *s = calloc(1, sizeof *s);
+    if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
+    s->block = ms_mft_select(ctx->isa_cap, &s->isa);
+    if (!s->block || ms_bvh_shallow_build(&s->sh, ctx->bvh, MFT_SHALLOW_LEAF)) {
+        free(s);
+        snprintf(err, errlen, "out of memory for the shallow BVH");
+        return -1;
+    }
+    ms_mft_frame *f = &s->f;
+    f->k = ctx->k;
+    f->samples = ctx->samples;
+    f->mask_words = ctx->mask_words;
+    f->near = ctx->near;
+    f->far = ctx->far;
+    const ms_light *l = &ctx->light;
+    const double P[3] = { l->corner.x, l->corner.y, l->corner.z }, S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
+    const double T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
+    memcpy(f->lp, P, sizeof P);
+    memcpy(f->ls, S, sizeof S);
+    memcpy(f->lt, T, sizeof T);
+    /* The stored points are P + s S + t T (or the grid's p0 + i ds + j dt) rounded to float: a few ulps
+     * of |P| + |S| + |T| per coordinate. In cells of the light (height |S x T| / max(|S|, |T|) over k),
+     * 64 ulps of that, plus 1/100 of a cell. */
+    double n[3], mag = 0.0;
+    d3_cross(n, S, T);
+    for (int a = 0; a < 3; a++) mag += fabs(P[a]) + fabs(S[a]) + fabs(T[a]);
+    const double h = d3_len(n) / fmax(d3_len(S), d3_len(T));
+    f->margin = 0.01 + (h > 0.0 ? 64.0 * FLT_EPSILON * mag * f->k / h : 0.0);
+    f->flags = (ctx->no_child_order ? 0 : MS_MFT_ORDER) | (ctx->frustum_shrink ? MS_MFT_FS : 0);
+#ifdef MFT_NO_FOOTPRINT
+    f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
+#endif
+    *state = s;
+    return 0;
+}
+
+/* Per-lane scratch: the rays of one pixel. */
+typedef struct mft_rays {
+    float *d[3], *sx, *sy;
+    signed char *kz;
+} mft_rays;
+
+/* Lane L's rays (pixel q): the pattern's points, d = P - C, and per 16-sample packet raytrace's shear
+ * (raytrace_impl.h, packet_shear: lane 0's largest axis if every lane has |d[kz]| >= max|d| / 2, else -1,
+ * and sx = d[kx] * (1 / d[kz])). Its cell projection for the footprints: the inverse of the columns
+ * S/k, T/k, P - C (in double), and the footprint's slack: the rounding of the stored points (the frame's
+ * margin) and an angle of 1e-4 around each ray, far above the watertight test's few ulps. */
+static void mft_lane_setup(const ms_render_ctx *ctx, const ms_mft_frame *f, const ms_shadow_query *q, float *pts,
+                           mft_rays *r, ms_mft_lane *L)
+{
+    const int ns = ctx->samples;
+    memcpy(L->c, q->p, sizeof L->c);
+    memcpy(L->n, q->n, sizeof L->n);
+    L->skip = q->prim;
+    ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, pts);
+    for (int i = 0; i < ns; i++)
+        for (int a = 0; a < 3; a++) r->d[a][i] = pts[3 * i + a] - q->p[a];
+    for (int base = 0; base < ns; base += 16) {
+        const float d0[3] = { r->d[0][base], r->d[1][base], r->d[2][base] };
+        const int kz = ms_wt_max_axis(d0);
+        int ok = 1;
+        for (int l = base; l < base + 16; l++) {
+            const float m = ms_maxf(fabsf(r->d[0][l]), ms_maxf(fabsf(r->d[1][l]), fabsf(r->d[2][l])));
+            ok &= 2.0f * fabsf(r->d[kz][l]) >= m && m > 0.0f;
+        }
+        r->kz[base >> 4] = (signed char)(ok ? kz : -1);
+        const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+        for (int l = base; l < base + 16; l++) {
+            const float inv = 1.0f / r->d[kz][l];
+            r->sx[l] = r->d[kx][l] * inv;
+            r->sy[l] = r->d[ky][l] * inv;
+        }
+    }
+    for (int a = 0; a < 3; a++) L->d[a] = r->d[a];
+    L->sx = r->sx;
+    L->sy = r->sy;
+    L->kz = r->kz;
+    double u[3], v[3], w[3], vw[3], wu[3], uv[3];
+    for (int a = 0; a < 3; a++) {
+        u[a] = f->ls[a] / f->k;
+        v[a] = f->lt[a] / f->k;
+        w[a] = f->lp[a] - (double)q->p[a];
+    }
+    d3_cross(vw, v, w);
+    d3_cross(wu, w, u);
+    d3_cross(uv, u, v);
+    const double det = d3_dot(u, vw);
+    L->has_m = fabs(det) > 1e-9 * d3_len(u) * d3_len(v) * d3_len(w);
+    if (!L->has_m) return;
+    for (int a = 0; a < 3; a++) {
+        L->m[0][a] = vw[a] / det;
+        L->m[1][a] = wu[a] / det;
+        L->m[2][a] = uv[a] / det;
+    }
+    L->foot_slack = f->margin + 0.02 +
+                    1e-4 * d3_len(w) * (fmax(d3_len(L->m[0]), d3_len(L->m[1])) + f->k * d3_len(L->m[2]));
+}
+
+/* 4x4 block of a query: its key orders queries block by block. */
+static uint64_t mft_block_key(const ms_shadow_query *q) { return (uint64_t)(q->py >> 2) << 32 | (q->px >> 2); }
+
+static int mft_cmp_block(const void *a, const void *b, void *arg)
+{
+    const ms_shadow_query *q = arg;
+    const uint64_t ka = mft_block_key(&q[*(const int *)a]), kb = mft_block_key(&q[*(const int *)b]);
+    return ka < kb ? -1 : ka > kb;
+}
+
+static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                          const uint64_t *front, uint64_t *vis, uint64_t *cnt)
+{
+    const mft_method *s = state;
+    const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
+    int *order = malloc((size_t)nq * sizeof *order);
+    float *pts = malloc(3 * ns * sizeof *pts);
+    float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
+    signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
+    if (!order || !pts || !rayf || !kzs) { free(order); free(pts); free(rayf); free(kzs); return -1; }
+    mft_rays rays[MS_BLOCK_LANES];
+    for (int l = 0; l < MS_BLOCK_LANES; l++) {
+        float *base = rayf + (size_t)l * 5 * ns;
+        for (int a = 0; a < 3; a++) rays[l].d[a] = base + (size_t)a * ns;
+        rays[l].sx = base + 3 * ns;
+        rays[l].sy = base + 4 * ns;
+        rays[l].kz = kzs + (size_t)l * (ns / 16);
+    }
+    for (int i = 0; i < nq; i++) order[i] = i;
+    qsort_r(order, (size_t)nq, sizeof *order, mft_cmp_block, (void *)q);
+    for (int g = 0; g < nq;) {
+        ms_mft_block blk;
+        blk.n = 0;
+        const uint64_t key = mft_block_key(&q[order[g]]);
+        int e = g;
+        for (; e < nq && e - g < MS_BLOCK_LANES && mft_block_key(&q[order[e]]) == key; e++) {
+            const int i = order[e];
+            uint64_t *m = vis + (size_t)i * mw;
+            memcpy(m, front + (size_t)i * mw, mw * sizeof *m);   /* the front mask is the starting set */
+            if (ms_mask_count(m, (int)mw) == 0) continue;
+            ms_mft_lane *L = &blk.lane[blk.n];
+            L->mask = m;
+            mft_lane_setup(ctx, &s->f, &q[i], pts, &rays[blk.n], L);
+            blk.n++;
+        }
+        if (blk.n) s->block(&s->f, &blk, ctx->bvh, &s->sh, cnt);
+        g = e;
+    }
+    free(order);
+    free(pts);
+    free(rayf);
+    free(kzs);
+    return 0;
+}
+
+static void mft_destroy(void *state)
+{
+    mft_method *s = state;
+    ms_bvh_shallow_free(&s->sh);
+    free(s);
+}
+
+static void mft_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
+{
+    const mft_method *s = state;
+    *kernel = *traversal = s->isa;
+}
+
+const ms_shadow_method ms_shadow_mft = {
+    .name = "mft",
+    .primary = "bvh",
+    .needs_grid = 0,
+    .n_counters = MS_MFT_COUNTERS,
+    .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",
+                       "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",
+                       "culled_footprint", "pairs_tested", "isec_tests16", "frusta_early_out", "rect_shrinks" },
+    .create = mft_create,
+    .visibility = mft_visibility,
+    .destroy = mft_destroy,
+    .isa_used = mft_isa_used,
+};
