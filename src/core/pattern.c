@@ -39,17 +39,17 @@ void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint3
     g->k = k;
 }
 
-void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
-                       float *xyz)
+void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                             int first, int count, float *xyz)
 {
     if (p == MS_PATTERN_GRID) {
         ms_grid g;
         ms_grid_for_pixel(l, k, px, py, seed, &g);
-        for (int j = 0; j < k; j++)
-            for (int i = 0; i < k; i++) {
-                float *o = xyz + 3 * (j * k + i);
-                for (int c = 0; c < 3; c++) o[c] = g.p0[c] + (float)i * g.ds[c] + (float)j * g.dt[c];
-            }
+        for (int n = first; n < first + count; n++) {
+            const int i = n % k, j = n / k;
+            float *o = xyz + 3 * (n - first);
+            for (int c = 0; c < 3; c++) o[c] = g.p0[c] + (float)i * g.ds[c] + (float)j * g.dt[c];
+        }
         return;
     }
     const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
@@ -57,12 +57,18 @@ void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint
     const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
     uint32_t hp = ms_hash3(px, py, seed ^ 0xA511E9B3u);
     float inv = 1.0f / (float)k;
-    for (int j = 0; j < k; j++)
-        for (int i = 0; i < k; i++) {
-            uint32_t h = ms_hash3(hp, (uint32_t)(j * k + i), seed);
-            float s = ((float)i + ms_hash_unit(h)) * inv;
-            float t = ((float)j + ms_hash_unit(ms_hash3(h, 0x68E31DA4u, 1u))) * inv;
-            float *o = xyz + 3 * (j * k + i);
-            for (int c = 0; c < 3; c++) o[c] = P[c] + s * S[c] + t * T[c];
-        }
+    for (int n = first; n < first + count; n++) {
+        const int i = n % k, j = n / k;
+        uint32_t h = ms_hash3(hp, (uint32_t)n, seed);
+        float s = ((float)i + ms_hash_unit(h)) * inv;
+        float t = ((float)j + ms_hash_unit(ms_hash3(h, 0x68E31DA4u, 1u))) * inv;
+        float *o = xyz + 3 * (n - first);
+        for (int c = 0; c < 3; c++) o[c] = P[c] + s * S[c] + t * T[c];
+    }
+}
+
+void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                       float *xyz)
+{
+    ms_pattern_points_range(p, l, k, px, py, seed, 0, k * k, xyz);
 }

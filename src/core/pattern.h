@@ -27,6 +27,10 @@ void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint3
 /* Sample positions (3*k*k floats, index j*k+i) of either pattern for one pixel. */
 void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                        float *xyz);
+/* Samples first .. first+count-1 of the same (3*count floats): the same floats, for methods that form
+ * their rays only where they need them (shadow/mft.c). */
+void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                             int first, int count, float *xyz);
 /* k for a sample count (256, 1024, 4096), 0 if unsupported. */
 int ms_samples_to_k(int samples);
 

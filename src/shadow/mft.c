@@ -105,6 +105,9 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     for (int a = 0; a < 3; a++) mag += fabs(P[a]) + fabs(S[a]) + fabs(T[a]);
     const double h = d3_len(n) / fmax(d3_len(S), d3_len(T));
     f->margin = 0.01 + (h > 0.0 ? 64.0 * FLT_EPSILON * mag * f->k / h : 0.0);
+    f->pattern = ctx->pattern;
+    f->light = ctx->light;
+    f->seed = ctx->seed;
     f->flags = (ctx->no_child_order ? 0 : MS_MFT_ORDER) | (ctx->frustum_shrink ? MS_MFT_FS : 0);
 #ifdef MFT_NO_FOOTPRINT
     f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
@@ -113,47 +116,44 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     return 0;
 }
 
-/* Per-lane scratch: the rays of one pixel. */
-typedef struct mft_rays {
-    float *d[3], *sx, *sy;
-    signed char *kz;
-} mft_rays;
-
-/* Lane L's rays (pixel q): the pattern's points, d = P - C, and per 16-sample packet raytrace's shear
- * (raytrace_impl.h, packet_shear: lane 0's largest axis if every lane has |d[kz]| >= max|d| / 2, else -1,
- * and sx = d[kx] * (1 / d[kz])). Its cell projection for the footprints: the inverse of the columns
- * S/k, T/k, P - C (in double), and the footprint's slack: the rounding of the stored points (the frame's
- * margin) and an angle of 1e-4 around each ray, far above the watertight test's few ulps. */
-static void mft_lane_setup(const ms_render_ctx *ctx, const ms_mft_frame *f, const ms_shadow_query *q, float *pts,
-                           mft_rays *r, ms_mft_lane *L)
+void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
 {
-    const int ns = ctx->samples;
+    const int base = ch * 16;
+    float pts[3 * 16];
+    ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, base, 16, pts);
+    for (int l = 0; l < 16; l++)
+        for (int a = 0; a < 3; a++) L->d[a][base + l] = pts[3 * l + a] - L->c[a];
+    /* raytrace_impl.h, packet_shear: lane 0's largest axis if every lane has |d[kz]| >= max|d| / 2, else
+     * -1 (tested one by one); sx = d[kx] * (1 / d[kz]). */
+    const float d0[3] = { L->d[0][base], L->d[1][base], L->d[2][base] };
+    const int kz = ms_wt_max_axis(d0);
+    int ok = 1;
+    for (int l = base; l < base + 16; l++) {
+        const float m = ms_maxf(fabsf(L->d[0][l]), ms_maxf(fabsf(L->d[1][l]), fabsf(L->d[2][l])));
+        ok &= 2.0f * fabsf(L->d[kz][l]) >= m && m > 0.0f;
+    }
+    L->kz[ch] = (signed char)(ok ? kz : -1);
+    const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+    for (int l = base; l < base + 16; l++) {
+        const float inv = 1.0f / L->d[kz][l];
+        L->sx[l] = L->d[kx][l] * inv;
+        L->sy[l] = L->d[ky][l] * inv;
+    }
+    L->ready[ch >> 6] |= UINT64_C(1) << (ch & 63);
+}
+
+/* Lane L for pixel q: its rays are formed when first tested (ms_mft_rays). Its cell projection for the
+ * footprints: the inverse of the columns S/k, T/k, P - C (in double, then rounded), and the footprint's
+ * slack: the rounding of the stored points (the frame's margin) and an angle of 1e-4 around each ray,
+ * far above the watertight test's few ulps. */
+static void mft_lane_setup(const ms_mft_frame *f, const ms_shadow_query *q, ms_mft_lane *L)
+{
     memcpy(L->c, q->p, sizeof L->c);
     memcpy(L->n, q->n, sizeof L->n);
     L->skip = q->prim;
-    ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, pts);
-    for (int i = 0; i < ns; i++)
-        for (int a = 0; a < 3; a++) r->d[a][i] = pts[3 * i + a] - q->p[a];
-    for (int base = 0; base < ns; base += 16) {
-        const float d0[3] = { r->d[0][base], r->d[1][base], r->d[2][base] };
-        const int kz = ms_wt_max_axis(d0);
-        int ok = 1;
-        for (int l = base; l < base + 16; l++) {
-            const float m = ms_maxf(fabsf(r->d[0][l]), ms_maxf(fabsf(r->d[1][l]), fabsf(r->d[2][l])));
-            ok &= 2.0f * fabsf(r->d[kz][l]) >= m && m > 0.0f;
-        }
-        r->kz[base >> 4] = (signed char)(ok ? kz : -1);
-        const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
-        for (int l = base; l < base + 16; l++) {
-            const float inv = 1.0f / r->d[kz][l];
-            r->sx[l] = r->d[kx][l] * inv;
-            r->sy[l] = r->d[ky][l] * inv;
-        }
-    }
-    for (int a = 0; a < 3; a++) L->d[a] = r->d[a];
-    L->sx = r->sx;
-    L->sy = r->sy;
-    L->kz = r->kz;
+    L->px = q->px;
+    L->py = q->py;
+    memset(L->ready, 0, sizeof L->ready);
     double u[3], v[3], w[3], vw[3], wu[3], uv[3];
     for (int a = 0; a < 3; a++) {
         u[a] = f->ls[a] / f->k;
@@ -164,15 +164,19 @@ static void mft_lane_setup(const ms_render_ctx *ctx, const ms_mft_frame *f, cons
     d3_cross(wu, w, u);
     d3_cross(uv, u, v);
     const double det = d3_dot(u, vw);
-    L->has_m = fabs(det) > 1e-9 * d3_len(u) * d3_len(v) * d3_len(w);
+    L->has_m = fabs(det) > 1e-6 * d3_len(u) * d3_len(v) * d3_len(w);
     if (!L->has_m) return;
+    double m[3][3];
     for (int a = 0; a < 3; a++) {
-        L->m[0][a] = vw[a] / det;
-        L->m[1][a] = wu[a] / det;
-        L->m[2][a] = uv[a] / det;
+        m[0][a] = vw[a] / det;
+        m[1][a] = wu[a] / det;
+        m[2][a] = uv[a] / det;
     }
-    L->foot_slack = f->margin + 0.02 +
-                    1e-4 * d3_len(w) * (fmax(d3_len(L->m[0]), d3_len(L->m[1])) + f->k * d3_len(L->m[2]));
+    for (int r = 0; r < 3; r++) {
+        L->m_l1[r] = (float)(fabs(m[r][0]) + fabs(m[r][1]) + fabs(m[r][2]));
+        for (int a = 0; a < 3; a++) L->m[r][a] = (float)m[r][a];
+    }
+    L->foot_slack = (float)(f->margin + 0.02 + 1e-4 * d3_len(w) * (fmax(d3_len(m[0]), d3_len(m[1])) + f->k * d3_len(m[2])));
 }
 
 /* 4x4 block of a query: its key orders queries block by block. */
@@ -191,22 +195,20 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     const mft_method *s = state;
     const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
     int *order = malloc((size_t)nq * sizeof *order);
-    float *pts = malloc(3 * ns * sizeof *pts);
     float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
     signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
-    if (!order || !pts || !rayf || !kzs) { free(order); free(pts); free(rayf); free(kzs); return -1; }
-    mft_rays rays[MS_BLOCK_LANES];
-    for (int l = 0; l < MS_BLOCK_LANES; l++) {
-        float *base = rayf + (size_t)l * 5 * ns;
-        for (int a = 0; a < 3; a++) rays[l].d[a] = base + (size_t)a * ns;
-        rays[l].sx = base + 3 * ns;
-        rays[l].sy = base + 4 * ns;
-        rays[l].kz = kzs + (size_t)l * (ns / 16);
-    }
+    if (!order || !rayf || !kzs) { free(order); free(rayf); free(kzs); return -1; }
     for (int i = 0; i < nq; i++) order[i] = i;
     qsort_r(order, (size_t)nq, sizeof *order, mft_cmp_block, (void *)q);
+    ms_mft_block blk;
+    for (int l = 0; l < MS_BLOCK_LANES; l++) {
+        float *base = rayf + (size_t)l * 5 * ns;
+        for (int a = 0; a < 3; a++) blk.lane[l].d[a] = base + (size_t)a * ns;
+        blk.lane[l].sx = base + 3 * ns;
+        blk.lane[l].sy = base + 4 * ns;
+        blk.lane[l].kz = kzs + (size_t)l * (ns / 16);
+    }
     for (int g = 0; g < nq;) {
-        ms_mft_block blk;
         blk.n = 0;
         const uint64_t key = mft_block_key(&q[order[g]]);
         int e = g;
@@ -215,16 +217,14 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
             uint64_t *m = vis + (size_t)i * mw;
             memcpy(m, front + (size_t)i * mw, mw * sizeof *m);   /* the front mask is the starting set */
             if (ms_mask_count(m, (int)mw) == 0) continue;
-            ms_mft_lane *L = &blk.lane[blk.n];
+            ms_mft_lane *L = &blk.lane[blk.n++];
             L->mask = m;
-            mft_lane_setup(ctx, &s->f, &q[i], pts, &rays[blk.n], L);
-            blk.n++;
+            mft_lane_setup(&s->f, &q[i], L);
         }
         if (blk.n) s->block(&s->f, &blk, ctx->bvh, &s->sh, cnt);
         g = e;
     }
     free(order);
-    free(pts);
     free(rayf);
     free(kzs);
     return 0;
@@ -249,7 +249,7 @@ const ms_shadow_method ms_shadow_mft = {
     .needs_grid = 0,
     .n_counters = MS_MFT_COUNTERS,
     .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",
-                       "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",
+                       "leaf_frusta_culled", "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",
                        "culled_footprint", "pairs_tested", "isec_tests16", "frusta_early_out", "rect_shrinks" },
     .create = mft_create,
     .visibility = mft_visibility,

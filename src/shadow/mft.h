@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include "block_traverse.h"
 #include "../core/cpu.h"
+#include "microshadow.h"
 
 /* Per frame, read-only. A lane's live rectangle is in cells of the light's k x k strata: sample (i, j)
  * of both shared patterns lies in cell [i, i+1) x [j, j+1) of the light (pattern.h), so the corners of
@@ -22,6 +23,9 @@ typedef struct ms_mft_frame {
     double lp[3], ls[3], lt[3];   /* light corner and edges */
     double margin;                /* cells */
     int flags;
+    ms_pattern pattern;           /* the samples: ms_pattern_points_range */
+    ms_light light;
+    uint32_t seed;
 } ms_mft_frame;
 
 /* Flags: near-first child order; frustum shrinking of the traversal's bounds too (the paper's FS; CR,
@@ -32,12 +36,16 @@ enum { MS_MFT_ORDER = 1, MS_MFT_FS = 2, MS_MFT_NO_FOOTPRINT = 4 };
 typedef struct ms_mft_lane {
     float c[3], n[3];             /* receiver point and its normal facing the camera */
     uint32_t skip;                /* its own triangle */
+    uint32_t px, py;              /* its pixel: its samples */
     uint64_t *mask;               /* mask_words words: live rays */
-    const float *d[3], *sx, *sy;  /* per sample */
-    const signed char *kz;        /* per 16-sample packet: the shear axis, -1: lanes tested one by one */
-    double m[3][3];               /* rows: X - C -> (cell a, cell b, c) with X = C + c (P - C) + a S/k + b T/k */
+    /* Its rays, formed per 16-sample packet when first tested (ms_mft_rays; ready: one bit per packet). */
+    float *d[3], *sx, *sy;        /* per sample */
+    signed char *kz;              /* per packet: the shear axis, -1: lanes tested one by one */
+    uint64_t ready[4];
+    float m[3][3];                /* rows: X - C -> (cell a, cell b, c) with X = C + c (P - C) + a S/k + b T/k */
+    float m_l1[3];                /* the rows' L1 norms */
     int has_m;                    /* 0: C in the light's plane, no footprint */
-    double foot_slack;            /* cells */
+    float foot_slack;             /* cells */
 } ms_mft_lane;
 
 typedef struct ms_mft_block {
@@ -47,7 +55,7 @@ typedef struct ms_mft_block {
 
 /* Counters after the traversal's (block_traverse.h), named in mft.c. */
 enum {
-    MS_MFT_FRUSTA = MS_BT_COUNTERS, MS_MFT_PAIRS, MS_MFT_CULLED_HORIZON, MS_MFT_CULLED_PLANE,
+    MS_MFT_FRUSTA = MS_BT_COUNTERS, MS_MFT_LEAF_LANES_CULLED, MS_MFT_PAIRS, MS_MFT_CULLED_HORIZON, MS_MFT_CULLED_PLANE,
     MS_MFT_CULLED_CORNER, MS_MFT_CULLED_FOOTPRINT, MS_MFT_PAIRS_TESTED, MS_MFT_ISEC16, MS_MFT_FRUSTA_EARLY_OUT,
     MS_MFT_RECT_SHRINKS, MS_MFT_COUNTERS
 };
@@ -55,6 +63,9 @@ enum {
 /* The directions from c to the four corners of cell rectangle r (columns r[0]..r[1], rows r[2]..r[3]),
  * widened by the frame's margin: corner order (a0,b0), (a1,b0), (a0,b1), (a1,b1). */
 void ms_mft_corners(const ms_mft_frame *f, const float c[3], const int r[4], float d[4][3]);
+
+/* Forms packet ch (samples 16 ch .. 16 ch + 15) of lane L's rays, as method raytrace forms them. */
+void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch);
 
 typedef void (*ms_mft_fn)(const ms_mft_frame *f, ms_mft_block *blk, const ms_bvh *b, const ms_bvh_shallow *sh,
                           uint64_t *cnt);

@@ -57,7 +57,12 @@ typedef struct mft_state {
     float cl[4][MS_BLOCK_LANES];      /* their L1 norms */
     float hn[3][MS_BLOCK_LANES];      /* receiver normals */
     int rect[MS_BLOCK_LANES][4];      /* live cells: columns r[0]..r[1], rows r[2]..r[3] */
-    int nlive[MS_BLOCK_LANES];        /* live rays */
+    uint64_t livech[MS_BLOCK_LANES][4]; /* packets (16 samples) with a live ray, one bit each */
+    float m[3][3][MS_BLOCK_LANES];    /* cell projections (ms_mft_lane.m) */
+    float ml1[3][MS_BLOCK_LANES];
+    float fslack[MS_BLOCK_LANES];
+    unsigned has_m;                   /* lanes with a cell projection */
+    float sp[4][3][MS_BLOCK_LANES];   /* the frusta's side planes through C (normals facing in) */
 } mft_state;
 
 /* Row j (k bits) of a sample mask. */
@@ -95,7 +100,64 @@ static void mft_lane_frustum(mft_state *s, int l, int traversal)
         for (int a = 0; a < 3; a++) s->cd[c][a][l] = d[c][a];
         s->cl[c][l] = fabsf(d[c][0]) + fabsf(d[c][1]) + fabsf(d[c][2]);
     }
+    /* Side planes through C and consecutive corners (around the rectangle: 0, 1, 3, 2), in double,
+     * each facing the opposite corner. */
+    static const int ring[5] = { 0, 1, 3, 2, 0 };
+    for (int q = 0; q < 4; q++) {
+        const float *x = d[ring[q]], *y = d[ring[q + 1]], *o = d[ring[q + 2 > 4 ? 1 : q + 2]];
+        double nn[3] = { (double)x[1] * y[2] - (double)x[2] * y[1], (double)x[2] * y[0] - (double)x[0] * y[2],
+                         (double)x[0] * y[1] - (double)x[1] * y[0] };
+        const double side = nn[0] * o[0] + nn[1] * o[1] + nn[2] * o[2];
+        for (int a = 0; a < 3; a++) s->sp[q][a][l] = (float)(side < 0.0 ? -nn[a] : nn[a]);
+    }
     if (traversal) ms_block_frusta_set_lane(s->fr, l, L->c, d, 1e-5f);
+}
+
+/* The lanes of mask whose frustum may reach leaf n's box: the box wholly outside one of the frustum's
+ * four side planes, or behind the receiver's plane, or wholly at c < near/2 or beyond the light's plane
+ * (c > 1), reaches none of its rays (what the micro-raster kernels' block traversal does per pixel at a
+ * leaf; the paper's leaf culling by ray-packet AABB tests did not pay off on Larrabee, this one tests
+ * 16 frusta at once). Over the box, a plane's largest value is n . (centre - C) + |n| . half-extent;
+ * the slack is 1e-5 of the magnitudes. */
+static unsigned mft_leaf_lanes(const mft_state *s, const ms_bvh_node *n, unsigned mask)
+{
+    l16 r[3], h[3];
+    float hs = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        const float hh = 0.5f * (n->bmax[a] - n->bmin[a]);
+        r[a] = l16_sub(l16_set1(0.5f * (n->bmin[a] + n->bmax[a])), l16_load(s->fr->c[a]));
+        h[a] = l16_set1(hh);
+        hs += hh;
+    }
+    const l16 zero = l16_set1(0.0f), rel = l16_set1(MFT_REL);
+    const l16 mag = l16_add(l16_add(l16_add(l16_abs(r[0]), l16_abs(r[1])), l16_abs(r[2])), l16_set1(hs));
+    unsigned out = 0;
+#define MFT_PLANE_MAX(nv, mx, nl1)                                                                              \
+    do {                                                                                                       \
+        const l16 a0 = l16_abs(nv[0]), a1 = l16_abs(nv[1]), a2 = l16_abs(nv[2]);                               \
+        mx = l16_add(l16_add(l16_add(l16_mul(nv[0], r[0]), l16_mul(nv[1], r[1])), l16_mul(nv[2], r[2])),        \
+                     l16_add(l16_add(l16_mul(a0, h[0]), l16_mul(a1, h[1])), l16_mul(a2, h[2])));                \
+        nl1 = l16_add(l16_add(a0, a1), a2);                                                                    \
+    } while (0)
+    for (int q = 0; q < 5; q++) {
+        l16 nv[3], mx, nl1;
+        for (int a = 0; a < 3; a++) nv[a] = l16_load(q < 4 ? s->sp[q][a] : s->hn[a]);
+        MFT_PLANE_MAX(nv, mx, nl1);
+        out |= l16_lt(l16_add(mx, l16_mul(l16_mul(nl1, mag), rel)), zero);
+    }
+    if (s->has_m) {
+        /* c over the box: [-(max of -c), max of c]. */
+        l16 nv[3], mx, nl1, mn;
+        for (int a = 0; a < 3; a++) nv[a] = l16_load(s->m[2][a]);
+        MFT_PLANE_MAX(nv, mx, nl1);
+        const l16 tol = l16_mul(l16_mul(nl1, mag), rel);
+        for (int a = 0; a < 3; a++) nv[a] = l16_sub(zero, nv[a]);
+        MFT_PLANE_MAX(nv, mn, nl1);
+        out |= s->has_m & (l16_lt(l16_add(mx, tol), l16_set1(0.5f * s->f->near)) |
+                           l16_gt(l16_sub(l16_sub(zero, mn), tol), l16_set1(1.0f)));
+    }
+#undef MFT_PLANE_MAX
+    return mask & ~out;
 }
 
 /* a == b for non-NaN lanes, as the scalar ==. */
@@ -107,6 +169,9 @@ static inline unsigned mft_eq(l16 a, l16 b) { return l16_le(a, b) & ~l16_lt(a, b
 static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const float *tri, const float N[3],
                            const float V[3][3], float num, float near, float far)
 {
+#ifdef MFT_STUB
+    return 0;
+#endif
     const int kz = L->kz[ch], base = ch * 16;
     unsigned hit = 0;
     if (kz < 0) {
@@ -158,30 +223,77 @@ static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const fl
     return hit;
 }
 
-/* The cells [x0, x1] x [y0, y1] of lane L's light that triangle tri can cover: its vertices projected
- * from C onto the light's plane (in double: the vertices and C are floats, so X - C is exact), their box
- * widened by the lane's slack. 0 (no restriction) when a vertex is not strictly between C's side and
- * beyond: c <= 1e-6 (a point there meets the segments, if at all, at t <= 1e-6 < near, but the
- * triangle's other points may not). */
-static int mft_footprint(const ms_mft_lane *L, const float *tri, int k, int fp[4])
+/* The cells of the light that triangle (a: its vertices relative to C, la: their L1 norms) can cover,
+ * for the lanes of `lanes`: the triangle clipped to c >= near/4 (the segment parameter of a point is its
+ * c, and a hit needs t >= near) and projected from C onto the light's plane, in cells: box[0..1] the
+ * columns' range, box[2..3] the rows', widened by the lane's slack and, per projected point, by the
+ * rounding of its float coordinates (a bound of 8.4 ulps of |m_r|_1 |X|_1 per coordinate, amplified by
+ * the division by c). Returns the lanes with a box; *empty: the lanes where no part of the triangle has
+ * c >= near/4 (it blocks none of their rays). A lane whose c is too uncertain near C (its bound above
+ * near/8) gets no box. */
+static unsigned mft_footprint16(const mft_state *s, const l16 a[3][3], const l16 la[3], unsigned lanes, unsigned *empty,
+                                float box[4][MS_BLOCK_LANES])
 {
-    double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+    l16 m[3][3], ml[3];
+    for (int r = 0; r < 3; r++) {
+        ml[r] = l16_mul(l16_load(s->ml1[r]), l16_set1(1e-6f));
+        for (int x = 0; x < 3; x++) m[r][x] = l16_load(s->m[r][x]);
+    }
+    const float near = s->f->near;
+    const l16 cmin = l16_set1(0.25f * near), ecmax = l16_set1(0.125f * near);
+    const l16 one = l16_set1(1.0f), two = l16_set1(2.0f), tiny = l16_set1(1e-6f);
+    l16 p[3][3], e[3][3];   /* [vertex][a, b, c] */
+    unsigned in[3], valid = lanes;
     for (int v = 0; v < 3; v++) {
-        const double X[3] = { (double)tri[3 * v] - L->c[0], (double)tri[3 * v + 1] - L->c[1], (double)tri[3 * v + 2] - L->c[2] };
-        const double c = L->m[2][0] * X[0] + L->m[2][1] * X[1] + L->m[2][2] * X[2];
-        if (!(c > 1e-6)) return 0;
-        for (int r = 0; r < 2; r++) {
-            const double p = (L->m[r][0] * X[0] + L->m[r][1] * X[1] + L->m[r][2] * X[2]) / c;
-            lo[r] = p < lo[r] ? p : lo[r];
-            hi[r] = p > hi[r] ? p : hi[r];
+        for (int r = 0; r < 3; r++) {
+            p[v][r] = l16_add(l16_add(l16_mul(m[r][0], a[v][0]), l16_mul(m[r][1], a[v][1])), l16_mul(m[r][2], a[v][2]));
+            e[v][r] = l16_mul(ml[r], la[v]);
         }
+        valid &= l16_le(e[v][2], ecmax);
+        in[v] = l16_le(cmin, p[v][2]);
     }
+    l16 lo[2] = { l16_set1(INFINITY), l16_set1(INFINITY) }, hi[2] = { l16_set1(-INFINITY), l16_set1(-INFINITY) };
+#define MFT_PROJECT(q, eq, msk)                                                                            \
+    do {                                                                                                   \
+        const l16 inv = l16_div(one, q[2]);                                                                \
+        for (int r = 0; r < 2; r++) {                                                                      \
+            const l16 x = l16_mul(q[r], inv), ax = l16_abs(x);                                             \
+            const l16 sl = l16_add(l16_mul(l16_mul(l16_add(eq[r], l16_mul(ax, eq[2])), inv), two), l16_mul(ax, tiny)); \
+            lo[r] = l16_select(msk, l16_min(lo[r], l16_sub(x, sl)), lo[r]);                               \
+            hi[r] = l16_select(msk, l16_max(hi[r], l16_add(x, sl)), hi[r]);                               \
+        }                                                                                                  \
+    } while (0)
+    for (int v = 0; v < 3; v++) MFT_PROJECT(p[v], e[v], in[v] & valid);
+    for (int v = 0; v < 3; v++) {
+        const int w = v == 2 ? 0 : v + 1;
+        const unsigned cross = (in[v] ^ in[w]) & valid;
+        if (!cross) continue;
+        /* The edge's point at c = near/4 (a point of the edge for the rounded parameter: its own c is
+         * used to project it). */
+        const l16 t = l16_div(l16_sub(cmin, p[v][2]), l16_sub(p[w][2], p[v][2]));
+        l16 q[3], eq[3];
+        for (int r = 0; r < 3; r++) {
+            q[r] = l16_add(p[v][r], l16_mul(t, l16_sub(p[w][r], p[v][r])));
+            eq[r] = l16_add(e[v][r], e[w][r]);
+        }
+        MFT_PROJECT(q, eq, cross);
+    }
+#undef MFT_PROJECT
+    *empty = valid & ~(in[0] | in[1] | in[2]);
+    valid &= ~*empty;
+    const l16 fs = l16_load(s->fslack), lim0 = l16_set1(-1.0f), lim1 = l16_set1((float)s->f->k);
     for (int r = 0; r < 2; r++) {
-        const double a = floor(fmax(lo[r] - L->foot_slack, -1.0)), b = floor(fmin(hi[r] + L->foot_slack, (double)k));
-        fp[2 * r] = (int)a;
-        fp[2 * r + 1] = (int)b;
+        l16_store(box[2 * r], l16_min(l16_max(l16_sub(lo[r], fs), lim0), lim1));
+        l16_store(box[2 * r + 1], l16_min(l16_max(l16_add(hi[r], fs), lim0), lim1));
     }
-    return 1;
+    return valid;
+}
+
+/* floor of a float in [-1, 64]. */
+static inline int mft_floor(float x)
+{
+    const int i = (int)x;
+    return i - ((float)i > x);
 }
 
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
@@ -191,6 +303,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     ms_mft_block *blk = s->blk;
     uint64_t *cnt = s->bt_cnt;
     const int k = f->k, cpr = k / 16;
+    /* One bit every cpr bits. */
+    const uint64_t rep = cpr == 1 ? ~UINT64_C(0) : cpr == 2 ? UINT64_C(0x5555555555555555) : UINT64_C(0x1111111111111111);
     /* The pixels whose own triangle is in this leaf. */
     uint32_t skip_tri[MFT_MAX_SKIP];
     unsigned skip_lane[MFT_MAX_SKIP];
@@ -199,6 +313,13 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         const int l = __builtin_ctz(m);
         if (blk->lane[l].skip - n->first < n->count) { skip_tri[nskip] = blk->lane[l].skip; skip_lane[nskip++] = 1u << l; }
     }
+#ifdef MFT_STOP_LEAF
+    return;
+#endif
+    const unsigned before = mask & fr->live;
+    mask = mft_leaf_lanes(s, n, before);
+    cnt[MS_MFT_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
+    if (!mask) return;
     l16 c[3], hn[3], cd[4][3], cl[4];
     for (int a = 0; a < 3; a++) { c[a] = l16_load(fr->c[a]); hn[a] = l16_load(s->hn[a]); }
     for (int q = 0; q < 4; q++) {
@@ -255,6 +376,11 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         const l16 slo = l16_select(pos, dlo, l16_sub(zero, dhi)), shi = l16_select(pos, dhi, l16_sub(zero, dlo));
         const unsigned plane_out = l16_le(an, zero) | l16_le(shi, zero) | l16_lt(l16_mul(far, shi), l16_mul(an, one_lo)) |
                                    l16_gt(l16_mul(near, slo), l16_mul(an, one_hi));
+        unsigned pass = lanes & ~behind;
+        c_hor += (uint64_t)ms_bt_popcount16(lanes & behind);
+        c_plane += (uint64_t)ms_bt_popcount16(pass & plane_out);
+        pass &= ~plane_out;
+        if (!pass) continue;
         /* Corner rays against the edge planes through C: a ray hits (t > 0) only inside the cone of
          * the vertices, where every edge function (a_i x a_j) . d has the sign of det = (a0 x a1) . a2.
          * Trusted only where |det| clears its own rounding. */
@@ -280,45 +406,68 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             corner_out |= all;
         }
         corner_out &= det_ok;
-        unsigned pass = lanes & ~behind;
-        c_hor += (uint64_t)ms_bt_popcount16(lanes & behind);
-        c_plane += (uint64_t)ms_bt_popcount16(pass & plane_out);
-        pass &= ~plane_out;
         c_corner += (uint64_t)ms_bt_popcount16(pass & corner_out);
         pass &= ~corner_out;
         if (!pass) continue;
+        float box[4][MS_BLOCK_LANES];
+        unsigned foot = 0, empty = 0;
+        if (!(f->flags & MS_MFT_NO_FOOTPRINT) && (pass & s->has_m)) {
+            foot = mft_footprint16(s, a, la, pass & s->has_m, &empty, box);
+            c_foot += (uint64_t)ms_bt_popcount16(empty);
+            pass &= ~empty;
+        }
+#ifdef MFT_STOP_CULL
+        continue;
+#endif
         float numv[MS_BLOCK_LANES];
         l16_store(numv, num);
         for (; pass; pass &= pass - 1) {
             const int l = __builtin_ctz(pass);
             ms_mft_lane *L = &blk->lane[l];
             int x0 = s->rect[l][0], x1 = s->rect[l][1], y0 = s->rect[l][2], y1 = s->rect[l][3];
-            int fp[4];
-            if (!(f->flags & MS_MFT_NO_FOOTPRINT) && L->has_m && mft_footprint(L, tri, k, fp)) {
-                x0 = fp[0] > x0 ? fp[0] : x0; x1 = fp[1] < x1 ? fp[1] : x1;
-                y0 = fp[2] > y0 ? fp[2] : y0; y1 = fp[3] < y1 ? fp[3] : y1;
+            if (foot >> l & 1) {
+                const int fx0 = mft_floor(box[0][l]), fx1 = mft_floor(box[1][l]);
+                const int fy0 = mft_floor(box[2][l]), fy1 = mft_floor(box[3][l]);
+                x0 = fx0 > x0 ? fx0 : x0; x1 = fx1 < x1 ? fx1 : x1;
+                y0 = fy0 > y0 ? fy0 : y0; y1 = fy1 < y1 ? fy1 : y1;
                 if (x0 > x1 || y0 > y1) { c_foot++; continue; }
             }
             tested++;
             float V[3][3];
             for (int v = 0; v < 3; v++)
                 for (int x = 0; x < 3; x++) V[v][x] = tri[3 * v + x] - L->c[x];
-            unsigned cleared = 0;
-            for (int j = y0; j <= y1; j++)
-                for (int ch = j * cpr + (x0 >> 4); ch <= j * cpr + (x1 >> 4); ch++) {
-                    const int sh = (ch & 3) * 16;
-                    const unsigned bits = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
+            /* The live packets of rows y0..y1 that reach columns x0..x1: a row is cpr packets, so the
+             * packets of the columns repeat every cpr bits. */
+            const uint64_t rowpat = ((UINT64_C(2) << (x1 >> 4)) - 1) & ~((UINT64_C(1) << (x0 >> 4)) - 1);
+            const uint64_t colpat = rowpat * rep;
+            const int c_lo = y0 * cpr, c_hi = (y1 + 1) * cpr;
+            int cleared = 0, done = 0;
+            for (int w = c_lo >> 6; w <= (c_hi - 1) >> 6; w++) {
+                uint64_t m = s->livech[l][w] & colpat;
+                const int lo = c_lo - 64 * w, hi = c_hi - 64 * w;
+                if (lo > 0) m &= ~UINT64_C(0) << lo;
+                if (hi < 64) m &= (UINT64_C(1) << hi) - 1;
+                for (; m; m &= m - 1) {
+                    const int ch = 64 * w + __builtin_ctzll(m), sh = (ch & 3) * 16, col0 = (ch & (cpr - 1)) * 16;
+                    /* The packet's columns within the footprint. */
+                    const int clo = (x0 > col0 ? x0 : col0) - col0, chi = (x1 < col0 + 15 ? x1 : col0 + 15) - col0;
+                    const unsigned cols = (0xFFFFu >> (15 - (chi - clo))) << clo;
+                    const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu, bits = all & cols;
                     if (!bits) continue;
+                    if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
                     isec++;
                     const unsigned hit = mft_packet(L, ch, bits, tri, N, V, numv[l], f->near, f->far);
                     if (!hit) continue;
                     L->mask[ch >> 2] &= ~((uint64_t)hit << sh);
-                    cleared += (unsigned)ms_bt_popcount16(hit);
+                    cleared = 1;
+                    if (all & ~hit) continue;
+                    s->livech[l][w] &= ~(UINT64_C(1) << (ch & 63));
+                    done = !(s->livech[l][0] | s->livech[l][1] | s->livech[l][2] | s->livech[l][3]);
                 }
+            }
             if (!cleared) continue;
             terminated |= 1u << l;
-            s->nlive[l] -= (int)cleared;
-            if (s->nlive[l] == 0) { fr->live &= ~(1u << l); early++; }
+            if (done) { fr->live &= ~(1u << l); early++; }
         }
     }
     cnt[MS_MFT_PAIRS] += pairs;
@@ -362,11 +511,19 @@ void MS_CAT(ms_mft_block_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_block *b
     s.blk = blk;
     s.b = b;
     for (int l = 0; l < blk->n; l++) {
-        const ms_mft_lane *L = &blk->lane[l];
+        ms_mft_lane *L = &blk->lane[l];
         for (int a = 0; a < 3; a++) s.hn[a][l] = L->n[a];
+        if (L->has_m) {
+            s.has_m |= 1u << l;
+            s.fslack[l] = L->foot_slack;
+            for (int r = 0; r < 3; r++) {
+                s.ml1[r][l] = L->m_l1[r];
+                for (int a = 0; a < 3; a++) s.m[r][a][l] = L->m[r][a];
+            }
+        }
         if (!mft_live_rect(L->mask, f->k, s.rect[l])) continue;   /* the caller hands over non-empty masks */
-        s.nlive[l] = 0;
-        for (int w = 0; w < f->mask_words; w++) s.nlive[l] += __builtin_popcountll(L->mask[w]);
+        for (int ch = 0; ch < f->samples / 16; ch++)
+            if (L->mask[ch >> 2] >> (ch & 3) * 16 & 0xFFFFu) s.livech[l][ch >> 6] |= UINT64_C(1) << (ch & 63);
         mft_lane_frustum(&s, l, 1);
         cnt[MS_MFT_FRUSTA]++;
     }
