@@ -63,9 +63,6 @@ typedef struct mft_state {
     float fslack[MS_BLOCK_LANES];
     unsigned has_m;                   /* lanes with a cell projection */
     float sp[4][3][MS_BLOCK_LANES];   /* the frusta's side planes through C (normals facing in) */
-    float w[3][MS_BLOCK_LANES];       /* P - C */
-    float dl1[MS_BLOCK_LANES];        /* |w|_1 + k (|u|_1 + |v|_1): bounds |d|_1 over the light */
-    float u[3], v[3];                 /* S/k, T/k */
 } mft_state;
 
 /* Row j (k bits) of a sample mask. */
@@ -306,7 +303,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     ms_mft_block *blk = s->blk;
     uint64_t *cnt = s->bt_cnt;
     const int k = f->k, cpr = k / 16;
-    const float margin = (float)f->margin;
+    /* One bit every cpr bits. */
+    const uint64_t rep = cpr == 1 ? ~UINT64_C(0) : cpr == 2 ? UINT64_C(0x5555555555555555) : UINT64_C(0x1111111111111111);
     /* The pixels whose own triangle is in this leaf. */
     uint32_t skip_tri[MFT_MAX_SKIP];
     unsigned skip_lane[MFT_MAX_SKIP];
@@ -408,29 +406,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             corner_out |= all;
         }
         corner_out &= det_ok;
-        /* For the rows (above): each edge function along the light, E(a, b) = e . (w + a u + b v) with
-         * w = P - C, u = S/k, v = T/k (cell coordinates a, b), signed by det and raised by its slack
-         * 1e-5 |a_i|_1 |a_j|_1 D, D bounding |d|_1 over the whole light: a ray can hit only where all
-         * three are >= 0. */
-        float sp_e0[3][MS_BLOCK_LANES], sp_ea[3][MS_BLOCK_LANES], sp_eb[3][MS_BLOCK_LANES];
-        const unsigned span_ok = det_ok;
-        {
-            const l16 w[3] = { l16_load(s->w[0]), l16_load(s->w[1]), l16_load(s->w[2]) }, dl = l16_load(s->dl1);
-            for (int q = 0; q < 3; q++) {
-                const l16 sg[3] = { l16_select(det_pos, e[q][0], l16_sub(zero, e[q][0])),
-                                    l16_select(det_pos, e[q][1], l16_sub(zero, e[q][1])),
-                                    l16_select(det_pos, e[q][2], l16_sub(zero, e[q][2])) };
-                const l16 tol = l16_mul(l16_mul(l16_mul(la[q], la[q == 2 ? 0 : q + 1]), rel), dl);
-                const l16 e0 = l16_add(l16_add(l16_add(l16_mul(sg[0], w[0]), l16_mul(sg[1], w[1])), l16_mul(sg[2], w[2])), tol);
-                const l16 ea = l16_add(l16_add(l16_mul(sg[0], l16_set1(s->u[0])), l16_mul(sg[1], l16_set1(s->u[1]))),
-                                       l16_mul(sg[2], l16_set1(s->u[2])));
-                const l16 eb = l16_add(l16_add(l16_mul(sg[0], l16_set1(s->v[0])), l16_mul(sg[1], l16_set1(s->v[1]))),
-                                       l16_mul(sg[2], l16_set1(s->v[2])));
-                l16_store(sp_e0[q], e0);
-                l16_store(sp_ea[q], ea);
-                l16_store(sp_eb[q], eb);
-            }
-        }
         c_corner += (uint64_t)ms_bt_popcount16(pass & corner_out);
         pass &= ~corner_out;
         if (!pass) continue;
@@ -461,45 +436,21 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             float V[3][3];
             for (int v = 0; v < 3; v++)
                 for (int x = 0; x < 3; x++) V[v][x] = tri[3 * v + x] - L->c[x];
-            /* Row by row, the columns the triangle's cone from C can reach (below), then the live
-             * packets of the row that reach them, and their live rays in those columns. */
-            const int span = span_ok >> l & 1;
-            float ea[3], eb[3], e0[3], inva[3];
-            if (span)
-                for (int q = 0; q < 3; q++) {
-                    e0[q] = sp_e0[q][l]; ea[q] = sp_ea[q][l]; eb[q] = sp_eb[q][l];
-                    inva[q] = ea[q] != 0.0f ? -1.0f / ea[q] : 0.0f;
-                }
+            /* The live packets of rows y0..y1 that reach columns x0..x1: a row is cpr packets, so the
+             * packets of the columns repeat every cpr bits. */
+            const uint64_t rowpat = ((UINT64_C(2) << (x1 >> 4)) - 1) & ~((UINT64_C(1) << (x0 >> 4)) - 1);
+            const uint64_t colpat = rowpat * rep;
+            const int c_lo = y0 * cpr, c_hi = (y1 + 1) * cpr;
             int cleared = 0, done = 0;
-            for (int j = y0; j <= y1 && !done; j++) {
-                int i0 = x0, i1 = x1;
-                if (span) {
-                    /* s E(a, b) + tol >= 0 somewhere in the row's band of b: a linear bound on a per edge. */
-                    const float b0 = (float)j - margin, b1 = (float)j + 1.0f + margin;
-                    float lo = -INFINITY, hi = INFINITY;
-                    int empty_row = 0;
-                    for (int q = 0; q < 3; q++) {
-                        const float p0 = eb[q] * b0, p1 = eb[q] * b1;
-                        const float alpha = e0[q] + (p0 > p1 ? p0 : p1);
-                        if (ea[q] > 0.0f) { const float x = alpha * inva[q]; lo = x > lo ? x : lo; }
-                        else if (ea[q] < 0.0f) { const float x = alpha * inva[q]; hi = x < hi ? x : hi; }
-                        else empty_row |= alpha < 0.0f;
-                    }
-                    /* Cell i holds a in [i - margin, i + 1 + margin]. */
-                    const float lim0 = -2.0f, lim1 = (float)k + 1.0f;
-                    const float flo = lo - 1.0f - margin, fhi = hi + margin;
-                    const int c0 = -mft_floor(-(flo < lim0 ? lim0 : flo > lim1 ? lim1 : flo));
-                    const int c1 = mft_floor(fhi < lim0 ? lim0 : fhi > lim1 ? lim1 : fhi);
-                    if (empty_row || !(lo <= hi)) continue;
-                    i0 = c0 > i0 ? c0 : i0;
-                    i1 = c1 < i1 ? c1 : i1;
-                    if (i0 > i1) continue;
-                }
-                for (int cc = i0 >> 4; cc <= i1 >> 4; cc++) {
-                    const int ch = j * cpr + cc, sh = (ch & 3) * 16, col0 = cc * 16;
-                    if (!(s->livech[l][ch >> 6] >> (ch & 63) & 1)) continue;
-                    /* The packet's columns within the row's span. */
-                    const int clo = (i0 > col0 ? i0 : col0) - col0, chi = (i1 < col0 + 15 ? i1 : col0 + 15) - col0;
+            for (int w = c_lo >> 6; w <= (c_hi - 1) >> 6; w++) {
+                uint64_t m = s->livech[l][w] & colpat;
+                const int lo = c_lo - 64 * w, hi = c_hi - 64 * w;
+                if (lo > 0) m &= ~UINT64_C(0) << lo;
+                if (hi < 64) m &= (UINT64_C(1) << hi) - 1;
+                for (; m; m &= m - 1) {
+                    const int ch = 64 * w + __builtin_ctzll(m), sh = (ch & 3) * 16, col0 = (ch & (cpr - 1)) * 16;
+                    /* The packet's columns within the footprint. */
+                    const int clo = (x0 > col0 ? x0 : col0) - col0, chi = (x1 < col0 + 15 ? x1 : col0 + 15) - col0;
                     const unsigned cols = (0xFFFFu >> (15 - (chi - clo))) << clo;
                     const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu, bits = all & cols;
                     if (!bits) continue;
@@ -510,9 +461,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                     L->mask[ch >> 2] &= ~((uint64_t)hit << sh);
                     cleared = 1;
                     if (all & ~hit) continue;
-                    s->livech[l][ch >> 6] &= ~(UINT64_C(1) << (ch & 63));
+                    s->livech[l][w] &= ~(UINT64_C(1) << (ch & 63));
                     done = !(s->livech[l][0] | s->livech[l][1] | s->livech[l][2] | s->livech[l][3]);
-                    if (done) break;
                 }
             }
             if (!cleared) continue;
@@ -560,20 +510,8 @@ void MS_CAT(ms_mft_block_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_block *b
     s.f = f;
     s.blk = blk;
     s.b = b;
-    float ul1 = 0.0f, vl1 = 0.0f;
-    for (int a = 0; a < 3; a++) {
-        s.u[a] = (float)(f->ls[a] / f->k);
-        s.v[a] = (float)(f->lt[a] / f->k);
-        ul1 += fabsf(s.u[a]);
-        vl1 += fabsf(s.v[a]);
-    }
     for (int l = 0; l < blk->n; l++) {
         ms_mft_lane *L = &blk->lane[l];
-        s.dl1[l] = (float)f->k * (ul1 + vl1);
-        for (int a = 0; a < 3; a++) {
-            s.w[a][l] = (float)(f->lp[a] - L->c[a]);
-            s.dl1[l] += fabsf(s.w[a][l]);
-        }
         for (int a = 0; a < 3; a++) s.hn[a][l] = L->n[a];
         if (L->has_m) {
             s.has_m |= 1u << l;
