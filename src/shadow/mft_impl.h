@@ -160,8 +160,6 @@ static unsigned mft_leaf_lanes(const mft_state *s, const ms_bvh_node *n, unsigne
     return mask & ~out;
 }
 
-/* a == b for non-NaN lanes, as the scalar ==. */
-static inline unsigned mft_eq(l16 a, l16 b) { return l16_le(a, b) & ~l16_lt(a, b) & 0xFFFFu; }
 
 /* The rays of 16-sample packet ch of lane L (bits: the live ones) that triangle tri hits: raytrace's
  * packet_triangle (raytrace_impl.h), the same operations in the same order. V: the vertices relative to
@@ -195,15 +193,16 @@ static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const fl
     const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
     const l16 w = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
     const l16 zero = l16_set1(0.0f);
-    const unsigned z = mft_eq(u, zero) | mft_eq(v, zero) | mft_eq(w, zero);
-    const unsigned mixed = (l16_lt(u, zero) | l16_lt(v, zero) | l16_lt(w, zero)) &
-                           (l16_gt(u, zero) | l16_gt(v, zero) | l16_gt(w, zero));
+    /* raytrace's tests, with fewer compares (the same answers for finite edge functions): some edge
+     * exactly 0 iff the least |edge| is 0; mixed signs iff the least is < 0 and the largest > 0. */
+    const unsigned z = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(w)), zero);
+    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), w), zero) & l16_gt(l16_max(l16_max(u, v), w), zero);
     const l16 det = l16_add(l16_add(u, v), w);
     const l16 den = l16_add(l16_add(l16_mul(l16_load(L->d[0] + base), l16_set1(N[0])),
                                     l16_mul(l16_load(L->d[1] + base), l16_set1(N[1]))),
                             l16_mul(l16_load(L->d[2] + base), l16_set1(N[2])));
     const l16 ns = l16_select(l16_lt(den, zero), l16_set1(-num), l16_set1(num)), aden = l16_abs(den);
-    hit = bits & ~z & ~mixed & ~mft_eq(det, zero) & l16_gt(aden, zero) & l16_le(l16_mul(l16_set1(near), aden), ns) &
+    hit = bits & ~z & ~mixed & l16_gt(l16_abs(det), zero) & l16_gt(aden, zero) & l16_le(l16_mul(l16_set1(near), aden), ns) &
           l16_le(ns, l16_mul(l16_set1(far), aden));
     /* An edge function exactly 0: redone in double, as raytrace does (rare). */
     for (unsigned m = bits & z; m; m &= m - 1) {
