@@ -55,8 +55,8 @@ int main(int argc, char **argv)
 {
     const char *dir = "../shared/scenes", *out_md = NULL;
     int samples[4] = { 1024 }, n_samples = 1, size = 1024, threads = 0;
-    const char *methods[MAX_METHODS] = { "raytrace", "embree", "bounds", "hierarchical", "scanline" };
-    int n_methods = 5;
+    const char *methods[MAX_METHODS] = { "raytrace", "embree", "bounds", "hierarchical", "scanline", "mft" };
+    int n_methods = 6;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--scenes") && i + 1 < argc) dir = argv[++i];
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = atoi(argv[++i]);
@@ -70,7 +70,7 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[++i], ","); t && n_methods < MAX_METHODS; t = strtok(NULL, ",")) methods[n_methods++] = t;
         } else {
             fprintf(stderr, "usage: bench_scenes [--scenes DIR] [--samples 256,1024,4096] [--size S] [--threads T] "
-                            "[--methods raytrace,embree,bounds,hierarchical,scanline] [--out FILE.md]\n");
+                            "[--methods raytrace,embree,bounds,hierarchical,scanline,mft] [--out FILE.md]\n");
             return 2;
         }
     }

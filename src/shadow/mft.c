@@ -22,8 +22,8 @@
 #include <string.h>
 
 /* Largest leaf of the shallow BVH (accel/bvh.h: subtrees of at most this many triangles collapsed into
- * one leaf). Measured on the shared scenes at 384x384, 1024 samples (docs/design.md, "mft"): 4 and 8
- * within a few percent of each other, 16 slower (more triangle-frustum pairs to cull). */
+ * one leaf). Measured (docs/design.md, "mft"): 2, 4 and 8 within 3% of each other on the shared scenes
+ * (the leaf culling absorbs the difference), 16 slower on the big light. */
 #ifndef MFT_SHALLOW_LEAF
 #define MFT_SHALLOW_LEAF 4
 #endif

@@ -1,20 +1,22 @@
 /* Method mft's block tracer (Benthin & Wald 2009, sec. 4-5 and Appendix A), one source compiled per ISA
  * (mft_scalar.c, mft_avx2.c, mft_avx512.c) with lanes16.h for the file's target; defines
  * ms_mft_block_<isa>. The 16 shadow frusta of a 4x4 pixel block (one per lane: apex C, the corner rays of
- * the rectangle of its live samples) traverse the shallow BVH together (block_traverse_loop.h); in a leaf,
- * per triangle:
- *   1. culling of all 16 frusta at once (16 lanes): the receiver's horizon (every vertex behind its plane
- *      by more than 1e-5 of its distance), the triangle's plane (the segments' parameter where they cross
- *      it, bounded over the frustum by the corner rays, outside [near, far]), and the paper's corner-ray
- *      culling: all four corner rays outside one of the triangle's three edge planes through C;
- *   2. for each surviving frustum, its rays that are still live, 16 per SIMD operation, restricted to
- *      the triangle's footprint: the triangle projected from C onto the light, in cells of the light's
- *      k x k strata, gives the rows and columns of samples it can cover (both shared patterns keep
- *      sample (i, j) in cell (i, j)); only the 16-sample packets of those rows that reach those columns
- *      and hold a live ray are tested;
- *   3. one bit per ray: a hit clears it; a frustum with no live ray leaves the block (early
- *      termination) and the block stops when none is left;
- *   4. after a leaf in which some ray of a frustum terminated, its corner rays are recomputed from the
+ * the rectangle of its live samples) traverse the shallow BVH together (block_traverse_loop.h: interval
+ * arithmetic node culling of all 16 at once, nearer child first, early termination); in a leaf:
+ *   0. the leaf's box against each frustum's four side planes, the receiver's horizon and the band of
+ *      the segment parameter (16 lanes at once): a frustum that cannot reach the box skips the leaf;
+ *   1. per triangle, culling of all 16 frusta at once: the receiver's horizon (every vertex behind its
+ *      plane by more than 1e-5 of its distance), the triangle's plane (the segment parameter where the
+ *      rays cross it, bounded over the frustum by the corner rays, outside [near, far]), the paper's
+ *      corner-ray culling (all four corner rays outside one of the triangle's three edge planes through
+ *      C), and the footprint: the triangle clipped to c >= near/4 and projected from C onto the light,
+ *      in cells of the light's k x k strata (both shared patterns keep sample (i, j) in cell (i, j)),
+ *      whose box gives the rows and columns of samples it can cover;
+ *   2. for each surviving frustum, its live rays in those rows and columns, 16 per SIMD operation (a
+ *      packet: 16 consecutive samples of a row), only packets that still hold a live ray in the
+ *      footprint's columns; one bit per ray: a hit clears it; a frustum with no live ray leaves the
+ *      block (early termination) and the block stops when none is left;
+ *   3. after a leaf in which some ray of a frustum terminated, its corner rays are recomputed from the
  *      rectangle of its still-live samples (the paper's CR); with MS_MFT_FS its traversal bounds too
  *      (the paper's FS).
  *
@@ -26,17 +28,20 @@
  * float ulps) far above the rounding of its own arithmetic and of the watertight test's decisions.
  *
  * Departures from the paper, and why:
- *  - rays are not generated from delta vectors at every test but precomputed per block, per pixel
- *    (mft.c): the exact agreement with raytrace needs its shear (one division per ray), which the
- *    paper's per-ray on-demand generation would repeat at every triangle; 16 pixels x N x 5 floats
- *    (320 KB at N = 1024) stay in the L2 cache;
+ *  - rays are not generated from delta vectors at every test but formed once per pixel and 16-sample
+ *    packet, when the packet is first tested (mft.c, ms_mft_rays), and kept for the block: the exact
+ *    agreement with raytrace needs its shear (one division per ray), which generating rays at every
+ *    test would repeat; 16 pixels x N x 5 floats (320 KB at N = 1024) stay in the L2 cache;
  *  - the paper tests a frustum's 16 rays (its interleaved set) in one operation; with N up to 4096 rays
- *    per frustum, we test N/16 packets, and only those the triangle's footprint reaches (the paper
- *    has no footprint: 16 rays need none);
+ *    per frustum, we test N/16 packets, only those the triangle's footprint reaches (16 rays need no
+ *    footprint);
  *  - the paper culls back faces; shadows need both sides (two-sided test), so its back-face test is
  *    replaced by the plane-range test, which also drops the receiver's coplanar neighbours (t ~ 0);
- *  - the horizon test is ours (the front mask already excludes rays behind the receiver; triangles
- *    behind it cannot block the others). */
+ *  - the leaf culling (step 0) and the horizon test are ours; the paper's leaf culling (per-packet
+ *    ray-AABB tests, Table 2) did not pay on Larrabee; this one tests the 16 frusta at once and removes
+ *    60% of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
+ *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
+ *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept). */
 #include <math.h>
 #include <string.h>
 #include "mft.h"
