@@ -156,7 +156,7 @@ typedef struct ms_render_options {
     ms_embree_mode embree_mode;
     ms_embree_filter embree_filter;
     ms_traversal traversal; /* micro-raster methods: block (default) or per-pixel traversal */
-    int frustum_shrink;     /* block traversal: also narrow a pixel's traversal frustum as its samples are
+    int frustum_shrink;     /* block traversal and mft: also narrow a pixel's traversal frustum as its samples are
                              * occluded (the paper's "FS"; off: only its leaf rectangle shrinks, "CR") */
 } ms_render_options;
 

@@ -23,7 +23,7 @@
 
 /* Largest leaf of the shallow BVH (accel/bvh.h: subtrees of at most this many triangles collapsed into
  * one leaf). Measured (docs/design.md, "mft"): 2, 4 and 8 within 3% of each other on the shared scenes
- * (the leaf culling absorbs the difference), 16 slower on the big light. */
+ * (the leaf culling absorbs the difference); 16 was the slowest on the big light. */
 #ifndef MFT_SHALLOW_LEAF
 #define MFT_SHALLOW_LEAF 4
 #endif

@@ -39,7 +39,7 @@
  *    replaced by the plane-range test, which also drops the receiver's coplanar neighbours (t ~ 0);
  *  - the leaf culling (step 0) and the horizon test are ours; the paper's leaf culling (per-packet
  *    ray-AABB tests, Table 2) did not pay on Larrabee; this one tests the 16 frusta at once and removes
- *    60% of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
+ *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
  *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept). */
 #include <math.h>
