@@ -172,9 +172,6 @@ static unsigned mft_leaf_lanes(const mft_state *s, const ms_bvh_node *n, unsigne
 static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const float *tri, const float N[3],
                            const float V[3][3], float num, float near, float far)
 {
-#ifdef MFT_STUB
-    return 0;
-#endif
     const int kz = L->kz[ch], base = ch * 16;
     unsigned hit = 0;
     if (kz < 0) {
@@ -317,9 +314,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         const int l = __builtin_ctz(m);
         if (blk->lane[l].skip - n->first < n->count) { skip_tri[nskip] = blk->lane[l].skip; skip_lane[nskip++] = 1u << l; }
     }
-#ifdef MFT_STOP_LEAF
-    return;
-#endif
     const unsigned before = mask & fr->live;
     mask = mft_leaf_lanes(s, n, before);
     cnt[MS_MFT_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
@@ -420,9 +414,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             c_foot += (uint64_t)ms_bt_popcount16(empty);
             pass &= ~empty;
         }
-#ifdef MFT_STOP_CULL
-        continue;
-#endif
         float numv[MS_BLOCK_LANES];
         l16_store(numv, num);
         for (; pass; pass &= pass - 1) {
