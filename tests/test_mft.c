@@ -2,7 +2,8 @@
  * samples: mft decides every ray by raytrace's own watertight test and only culls what cannot be hit,
  * so V and S must equal raytrace's bit for bit (grid and stratified, 256 and 1024 samples) on the Quad,
  * the built-in scene and real scenes; its scalar, AVX2 and AVX-512 instances give the same masks and
- * the same counters; its switches (frustum shrinking, child order) change no mask. */
+ * the same counters; its switches (frustum shrinking, child order) change no mask; its counters
+ * account for every triangle-frustum pair. */
 #include "testutil.h"
 #include "shadow/method.h"
 #include "shadow/receiver.h"
@@ -220,6 +221,41 @@ static void test_switches_keep_masks(void **state)
     ms_scene_free(&sc);
 }
 
+/* The counters reach ms_stats (and --stats) by name, and account for every triangle-frustum pair: each is
+ * culled by exactly one test (horizon, plane, corner rays, footprint) or tested, and tests at most N/16
+ * packets; blocks hold at most 16 frusta, and a frustum ends early at most once. */
+static uint64_t counter(const ms_stats *st, const char *name)
+{
+    for (int i = 0; i < st->n_counters; i++)
+        if (!strcmp(st->counter_name[i], name)) return st->counter[i];
+    fail_msg("no counter %s", name);
+    return 0;
+}
+
+static void test_counters_account(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    ms_frame f;
+    render_ok(&sc, "mft", MS_PATTERN_GRID, 1024, 64, &f);
+    const ms_stats *st = &f.stats;
+    assert_int_equal(st->n_counters, MS_MAX_COUNTERS);
+    const uint64_t pairs = counter(st, "tri_frustum_pairs"), tested = counter(st, "pairs_tested");
+    printf("default scene 64x64: %llu AABB tests, %llu triangles accessed, %llu pairs, %llu tested, %llu 16-ray tests\n",
+           (unsigned long long)counter(st, "aabb_tests"), (unsigned long long)counter(st, "tris_accessed"),
+           (unsigned long long)pairs, (unsigned long long)tested, (unsigned long long)counter(st, "isec_tests16"));
+    assert_true(tested > 0);
+    assert_int_equal(pairs, counter(st, "culled_horizon") + counter(st, "culled_plane") + counter(st, "culled_corner_rays") +
+                                counter(st, "culled_footprint") + tested);
+    assert_true(counter(st, "isec_tests16") <= tested * (1024 / 16));   /* a pair tests at most N/16 packets */
+    assert_true(counter(st, "frusta") <= 16 * counter(st, "blocks"));
+    assert_true(counter(st, "frusta") <= st->visible_pixels);
+    assert_true(counter(st, "frusta_early_out") <= counter(st, "frusta"));
+    ms_frame_free(&f);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -229,6 +265,7 @@ int main(void)
         cmocka_unit_test(test_bunny_equals),
         cmocka_unit_test(test_isa_instances_identical),
         cmocka_unit_test(test_switches_keep_masks),
+        cmocka_unit_test(test_counters_account),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
