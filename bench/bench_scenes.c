@@ -33,8 +33,8 @@ typedef struct quality_cfg {
     const char *note;
 } quality_cfg;
 static const quality_cfg quality_cfgs[] = {
-    { "raytrace", MS_PATTERN_INTERLEAVED, 256, 0, "stand-in for mft: the same samples and filter" },
-    /* { "mft", MS_PATTERN_INTERLEAVED, 256, 0, "the paper's mode" }, */
+    { "mft", MS_PATTERN_INTERLEAVED, 256, 0, "the paper's mode" },
+    { "raytrace", MS_PATTERN_INTERLEAVED, 256, 0, "the same samples and filter as mft" },
     { "raytrace", MS_PATTERN_INTERLEAVED, 256, 1, "raw (--no-filter): what the filter buys" },
     { "scanline", MS_PATTERN_GRID, 256, 0, "" },
     { "scanline", MS_PATTERN_GRID, 1024, 0, "" },

@@ -188,7 +188,7 @@ typedef struct ms_render_options {
     ms_embree_mode embree_mode;
     ms_embree_filter embree_filter;
     ms_traversal traversal; /* micro-raster methods: block (default) or per-pixel traversal */
-    int frustum_shrink;     /* block traversal: also narrow a pixel's traversal frustum as its samples are
+    int frustum_shrink;     /* block traversal and mft: also narrow a pixel's traversal frustum as its samples are
                              * occluded (the paper's "FS"; off: only its leaf rectangle shrinks, "CR") */
     int no_filter;          /* interleaved pattern: leave out the 4x4 discontinuity-aware filter (raw V, S) */
 } ms_render_options;

@@ -36,7 +36,7 @@ static void usage(FILE *f)
         "  --stats OUT.json    timings and counters\n"
         "  --isa I             cap on the SIMD instruction set: auto (default), avx512, avx2, scalar\n"
         "  --traversal T       micro-raster methods: block (default: 4x4 pixels' frusta together) or pixel\n"
-        "  --frustum-shrink    block traversal: narrow each frustum as its samples are occluded\n"
+        "  --frustum-shrink    block traversal and mft: narrow each frustum as its samples are occluded\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --help, --version\n");
 }

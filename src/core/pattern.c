@@ -111,17 +111,17 @@ void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint3
     g->k = k;
 }
 
-void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
-                       float *xyz)
+void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                             int first, int count, float *xyz)
 {
     if (p == MS_PATTERN_GRID) {
         ms_grid g;
         ms_grid_for_pixel(l, k, px, py, seed, &g);
-        for (int j = 0; j < k; j++)
-            for (int i = 0; i < k; i++) {
-                float *o = xyz + 3 * (j * k + i);
-                for (int c = 0; c < 3; c++) o[c] = g.p0[c] + (float)i * g.ds[c] + (float)j * g.dt[c];
-            }
+        for (int n = first; n < first + count; n++) {
+            const int i = n % k, j = n / k;
+            float *o = xyz + 3 * (n - first);
+            for (int c = 0; c < 3; c++) o[c] = g.p0[c] + (float)i * g.ds[c] + (float)j * g.dt[c];
+        }
         return;
     }
     if (p == MS_PATTERN_INTERLEAVED) {
@@ -131,10 +131,12 @@ void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint
         const int n = k * k / 16;
         uint32_t u[256], v[256];   /* n <= 4096 / 16 */
         ms_interleaved_uv(k * k, ms_interleaved_set(px, py), seed, u, v);
-        for (int i = 0; i < n; i++) {
+        /* The pixel's n = N/16 points; of them [first, first + count). */
+        const int end = first + count < n ? first + count : n;
+        for (int i = first; i < end; i++) {
             /* 24 bits: exact in a float, and far finer than the 2^-12 of the smallest elementary interval */
             const float s = (float)(u[i] >> 8) * (1.0f / 16777216.0f), t = (float)(v[i] >> 8) * (1.0f / 16777216.0f);
-            for (int c = 0; c < 3; c++) xyz[3 * i + c] = P[c] + s * S[c] + t * T[c];
+            for (int c = 0; c < 3; c++) xyz[3 * (i - first) + c] = P[c] + s * S[c] + t * T[c];
         }
         return;
     }
@@ -143,12 +145,18 @@ void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint
     const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
     uint32_t hp = ms_hash3(px, py, seed ^ 0xA511E9B3u);
     float inv = 1.0f / (float)k;
-    for (int j = 0; j < k; j++)
-        for (int i = 0; i < k; i++) {
-            uint32_t h = ms_hash3(hp, (uint32_t)(j * k + i), seed);
-            float s = ((float)i + ms_hash_unit(h)) * inv;
-            float t = ((float)j + ms_hash_unit(ms_hash3(h, 0x68E31DA4u, 1u))) * inv;
-            float *o = xyz + 3 * (j * k + i);
-            for (int c = 0; c < 3; c++) o[c] = P[c] + s * S[c] + t * T[c];
-        }
+    for (int n = first; n < first + count; n++) {
+        const int i = n % k, j = n / k;
+        uint32_t h = ms_hash3(hp, (uint32_t)n, seed);
+        float s = ((float)i + ms_hash_unit(h)) * inv;
+        float t = ((float)j + ms_hash_unit(ms_hash3(h, 0x68E31DA4u, 1u))) * inv;
+        float *o = xyz + 3 * (n - first);
+        for (int c = 0; c < 3; c++) o[c] = P[c] + s * S[c] + t * T[c];
+    }
+}
+
+void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                       float *xyz)
+{
+    ms_pattern_points_range(p, l, k, px, py, seed, 0, k * k, xyz);
 }

@@ -31,6 +31,10 @@ void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint3
 /* Sample positions of a pattern for one pixel: 3*ms_pattern_spp(p, k) floats (k*k samples in all). */
 void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                        float *xyz);
+/* Samples first .. first+count-1 of the same (3*count floats): the same floats, for methods that form
+ * their rays only where they need them (shadow/mft.c). */
+void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                             int first, int count, float *xyz);
 /* k for a sample count N = k*k (16, 64, 256, 1024, 4096), 0 if unsupported. */
 int ms_samples_to_k(int samples);
 /* Samples per pixel of pattern p at N = k*k: k*k, or k*k/16 for interleaved. */

@@ -3,7 +3,7 @@
 #include "method.h"
 #include <string.h>
 
-extern const ms_shadow_method ms_shadow_raytrace;
+extern const ms_shadow_method ms_shadow_raytrace, ms_shadow_mft;
 extern const ms_shadow_method ms_shadow_scanline, ms_shadow_bounds, ms_shadow_hierarchical;
 extern const ms_shadow_method ms_shadow_hpc, ms_shadow_hpc_scanline;
 extern const ms_primary_method ms_primary_bvh, ms_primary_depth;
@@ -13,7 +13,7 @@ extern const ms_primary_method ms_primary_embree;
 #endif
 
 static const ms_shadow_method *const shadow_methods[] = {
-    &ms_shadow_scanline, &ms_shadow_bounds, &ms_shadow_hierarchical, &ms_shadow_raytrace,
+    &ms_shadow_scanline, &ms_shadow_bounds, &ms_shadow_hierarchical, &ms_shadow_raytrace, &ms_shadow_mft,
     &ms_shadow_hpc, &ms_shadow_hpc_scanline,
 #ifdef MS_HAVE_EMBREE
     &ms_shadow_embree,

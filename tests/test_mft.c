@@ -1,0 +1,273 @@
+/* Method mft (multi-frusta tracing, Benthin & Wald 2009) against the reference ray tracer on identical
+ * samples: mft decides every ray by raytrace's own watertight test and only culls what cannot be hit,
+ * so V and S must equal raytrace's bit for bit (grid and stratified, 256 and 1024 samples) on the Quad,
+ * the built-in scene and real scenes; its scalar, AVX2 and AVX-512 instances give the same masks and
+ * the same counters; its switches (frustum shrinking, child order) change no mask; its counters
+ * account for every triangle-frustum pair. */
+#include "testutil.h"
+#include "shadow/method.h"
+#include "shadow/receiver.h"
+#include "accel/bvh.h"
+#include "core/pattern.h"
+#include "shadow/block_traverse.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void render_ok(const ms_scene *sc, const char *method, ms_pattern pat, int samples, int size, ms_frame *f)
+{
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.method = method;
+    o.pattern = pat;
+    o.samples = samples;
+    o.width = o.height = size;
+    char err[512];
+    int rc = ms_render(sc, &o, f, err, sizeof err);
+    if (rc) fprintf(stderr, "render %s: %s\n", method, err);
+    assert_int_equal(rc, 0);
+}
+
+/* mft equals raytrace, V and S, at every pixel, for the three patterns (interleaved: filtered, so the
+ * raw per-pixel values equal too) and the given sample counts. */
+static void equal_on_scene(const ms_scene *sc, const char *label, const int *samples, int n_samples, int size)
+{
+    static const ms_pattern pats[] = { MS_PATTERN_GRID, MS_PATTERN_STRATIFIED, MS_PATTERN_INTERLEAVED };
+    for (int p = 0; p < 3; p++)
+        for (int s = 0; s < n_samples; s++) {
+            ms_frame ref, f;
+            render_ok(sc, "raytrace", pats[p], samples[s], size, &ref);
+            render_ok(sc, "mft", pats[p], samples[s], size, &f);
+            const tu_agreement a = tu_compare_frames(&f, &ref);
+            printf("%-26s %-10s N=%-4d mft vs raytrace: %ld of %ld pixels differ (V), %ld (S only); %llu shadow rays\n",
+                   label, pats[p] == MS_PATTERN_GRID ? "grid" : pats[p] == MS_PATTERN_STRATIFIED ? "stratified" : "interleaved",
+                   samples[s], a.differ, a.pixels,
+                   a.s_differ_same_v, (unsigned long long)f.stats.shadow_rays);
+            assert_int_equal(a.miss_mismatch, 0);
+            assert_int_equal(a.differ, 0);
+            const size_t n = (size_t)size * (size_t)size;
+            assert_memory_equal(f.vis, ref.vis, n * sizeof *f.vis);
+            assert_memory_equal(f.shadow, ref.shadow, n * sizeof *f.shadow);
+            assert_string_equal(f.stats.method, "mft");
+            ms_frame_free(&f);
+            ms_frame_free(&ref);
+        }
+}
+
+/* The Quad: 20x20 ground at y=0, 4x4 occluder at y=2, 2x2 light at y=6 (as ../shared/scenes/quad). */
+static void make_quad(ms_scene *sc)
+{
+    static const float tri[4][9] = {
+        { -10, 0, -10, 10, 0, 10, 10, 0, -10 }, { -10, 0, -10, -10, 0, 10, 10, 0, 10 },
+        { -2, 2, -2, 2, 2, 2, 2, 2, -2 }, { -2, 2, -2, -2, 2, 2, 2, 2, 2 } };
+    memset(sc, 0, sizeof *sc);
+    sc->tri = malloc(sizeof tri);
+    memcpy(sc->tri, tri, sizeof tri);
+    sc->n_tris = 4;
+    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96 };
+    sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
+    sc->samples = 1024;
+}
+
+static void test_quad_equals_raytrace(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    make_quad(&sc);
+    const int samples[] = { 256, 1024 };
+    equal_on_scene(&sc, "quad", samples, 2, 64);
+    ms_scene_free(&sc);
+}
+
+static void test_default_scene_equals_raytrace(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    const int samples[] = { 256, 1024 };
+    equal_on_scene(&sc, "default", samples, 2, 64);
+    ms_scene_free(&sc);
+}
+
+static void real_scene(const char *rel, int size)
+{
+    if (!tu_have_shared_scenes()) skip();
+    char path[4096];
+    ms_scene sc;
+    char err[512];
+    int rc = ms_scene_load(tu_shared_scene(path, sizeof path, rel), &sc, err, sizeof err);
+    if (rc) fprintf(stderr, "%s\n", err);
+    assert_int_equal(rc, 0);
+    const int samples[] = { 1024 };
+    equal_on_scene(&sc, rel, samples, 1, size);
+    ms_scene_free(&sc);
+}
+
+/* The big light: wide frusta, large occluders reaching behind the receivers (the footprint's clipping). */
+static void test_sponza_biglight_equals(void **state) { (void)state; real_scene("dabrovic-sponza/dabrovic-sponza-biglight.json", 48); }
+/* Small triangles: many partly occluded frusta (early termination, CR). */
+static void test_bunny_equals(void **state) { (void)state; real_scene("stanford-bunny/stanford-bunny.json", 48); }
+
+/* The masks and counters of mft on a size x size view of sc, through the method's interface, under an
+ * ISA cap and the given switches. Caller frees the masks. */
+static uint64_t *mft_masks(const ms_scene *sc, ms_pattern pat, int k, int size, ms_isa cap, int fs, int no_order,
+                           uint64_t cnt[MS_MAX_COUNTERS], ms_isa *isa, int *n_out)
+{
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc->tri, sc->n_tris, 1), 0);
+    ms_render_ctx ctx;
+    tu_ctx_init(&ctx, sc, &bvh, size, size, k);
+    ctx.isa_cap = cap;
+    ctx.pattern = pat;
+    ctx.frustum_shrink = fs;
+    ctx.no_child_order = no_order;
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    const ms_shadow_method *sm = ms_find_shadow_method("mft");
+    assert_non_null(pm);
+    assert_non_null(sm);
+    assert_int_equal(sm->needs_grid, 0);
+    char err[256];
+    void *ps = NULL, *ss = NULL;
+    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
+    ms_hit *hits = malloc((size_t)size * size * sizeof *hits);
+    ms_shadow_query *q = malloc((size_t)size * size * sizeof *q);
+    assert_non_null(hits);
+    assert_non_null(q);
+    pm->trace(ps, &ctx, 0, 0, size, size, hits);
+    pm->destroy(ps);
+    int nq = 0;
+    for (int i = 0; i < size * size; i++)
+        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[nq++], &hits[i], i % size, i / size);
+    const size_t mw = (size_t)ctx.mask_words;
+    uint64_t *front = calloc((size_t)nq * mw + 1, sizeof *front), *vis = calloc((size_t)nq * mw + 1, sizeof *vis);
+    assert_non_null(front);
+    assert_non_null(vis);
+    float *pts = malloc((size_t)ctx.samples * 3 * sizeof *pts);
+    assert_non_null(pts);
+    for (int i = 0; i < nq; i++) {
+        ms_pattern_points(pat, &ctx.light, k, q[i].px, q[i].py, ctx.seed, pts);
+        ms_front_mask(&ctx, &q[i], pat == MS_PATTERN_GRID ? NULL : pts, front + i * mw);
+    }
+    free(pts);
+    assert_int_equal(sm->create(&ctx, &ss, err, sizeof err), 0);
+    ms_isa trav;
+    sm->isa_used(ss, isa, &trav);
+    memset(cnt, 0, MS_MAX_COUNTERS * sizeof *cnt);
+    assert_int_equal(sm->visibility(ss, &ctx, q, nq, front, vis, cnt), 0);
+    sm->destroy(ss);
+    free(front);
+    free(hits);
+    free(q);
+    ms_bvh_free(&bvh);
+    *n_out = nq;
+    return vis;
+}
+
+/* The portable, AVX2 and AVX-512 instances: the same masks and the same counters (every decision is
+ * the same IEEE operations, lanes16.h); the portable one reports itself as scalar. */
+static void test_isa_instances_identical(void **state)
+{
+    (void)state;
+    ms_scene scenes[2];
+    assert_int_equal(ms_scene_default(&scenes[0]), 0);
+    make_quad(&scenes[1]);
+    for (int si = 0; si < 2; si++)
+        for (int p = 0; p < 2; p++) {
+            const ms_pattern pat = p ? MS_PATTERN_STRATIFIED : MS_PATTERN_GRID;
+            uint64_t c0[MS_MAX_COUNTERS], c1[MS_MAX_COUNTERS];
+            ms_isa isa0, isa1;
+            int n0, n1;
+            uint64_t *ref = mft_masks(&scenes[si], pat, 32, 40, MS_ISA_SCALAR, 0, 0, c0, &isa0, &n0);
+            assert_int_equal(isa0, MS_ISA_SCALAR);
+            assert_true(c0[MS_BT_AABB_TESTS] > 0);
+            for (int cap = MS_ISA_AVX2; cap <= MS_ISA_AVX512; cap++) {
+                if (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa()) continue;
+                uint64_t *got = mft_masks(&scenes[si], pat, 32, 40, (ms_isa)cap, 0, 0, c1, &isa1, &n1);
+                assert_int_equal(isa1, cap);
+                assert_int_equal(n1, n0);
+                assert_memory_equal(ref, got, (size_t)n0 * 16 * sizeof *ref);
+                assert_memory_equal(c0, c1, sizeof c0);
+                printf("%s %s: mft %s masks and counters identical to the portable ones on %d points\n",
+                       si ? "quad" : "default", p ? "stratified" : "grid", ms_isa_name(isa1), n0);
+                free(got);
+            }
+            free(ref);
+        }
+    ms_scene_free(&scenes[0]);
+    ms_scene_free(&scenes[1]);
+}
+
+/* Frustum shrinking of the traversal bounds (FS) and the child order only change the work, not a mask. */
+static void test_switches_keep_masks(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    const ms_isa cap = tu_isa_cap();
+    uint64_t c0[MS_MAX_COUNTERS], c1[MS_MAX_COUNTERS], c2[MS_MAX_COUNTERS];
+    ms_isa isa;
+    int n0, n1, n2;
+    uint64_t *base = mft_masks(&sc, MS_PATTERN_GRID, 32, 48, cap, 0, 0, c0, &isa, &n0);
+    uint64_t *fs = mft_masks(&sc, MS_PATTERN_GRID, 32, 48, cap, 1, 0, c1, &isa, &n1);
+    uint64_t *unordered = mft_masks(&sc, MS_PATTERN_GRID, 32, 48, cap, 0, 1, c2, &isa, &n2);
+    assert_int_equal(n0, n1);
+    assert_int_equal(n0, n2);
+    assert_memory_equal(base, fs, (size_t)n0 * 16 * sizeof *base);
+    assert_memory_equal(base, unordered, (size_t)n0 * 16 * sizeof *base);
+    printf("default scene: AABB tests %llu (CR), %llu (CR+FS), %llu (no child order)\n",
+           (unsigned long long)c0[MS_BT_AABB_TESTS], (unsigned long long)c1[MS_BT_AABB_TESTS],
+           (unsigned long long)c2[MS_BT_AABB_TESTS]);
+    free(base);
+    free(fs);
+    free(unordered);
+    ms_scene_free(&sc);
+}
+
+/* The counters reach ms_stats (and --stats) by name, and account for every triangle-frustum pair: each is
+ * culled by exactly one test (horizon, plane, corner rays, footprint) or tested, and tests at most N/16
+ * packets; blocks hold at most 16 frusta, and a frustum ends early at most once. */
+static uint64_t counter(const ms_stats *st, const char *name)
+{
+    for (int i = 0; i < st->n_counters; i++)
+        if (!strcmp(st->counter_name[i], name)) return st->counter[i];
+    fail_msg("no counter %s", name);
+    return 0;
+}
+
+static void test_counters_account(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    ms_frame f;
+    render_ok(&sc, "mft", MS_PATTERN_GRID, 1024, 64, &f);
+    const ms_stats *st = &f.stats;
+    assert_int_equal(st->n_counters, MS_MAX_COUNTERS);
+    const uint64_t pairs = counter(st, "tri_frustum_pairs"), tested = counter(st, "pairs_tested");
+    printf("default scene 64x64: %llu AABB tests, %llu triangles accessed, %llu pairs, %llu tested, %llu 16-ray tests\n",
+           (unsigned long long)counter(st, "aabb_tests"), (unsigned long long)counter(st, "tris_accessed"),
+           (unsigned long long)pairs, (unsigned long long)tested, (unsigned long long)counter(st, "isec_tests16"));
+    assert_true(tested > 0);
+    assert_int_equal(pairs, counter(st, "culled_horizon") + counter(st, "culled_plane") + counter(st, "culled_corner_rays") +
+                                counter(st, "culled_footprint") + tested);
+    assert_true(counter(st, "isec_tests16") <= tested * (1024 / 16));   /* a pair tests at most N/16 packets */
+    assert_true(counter(st, "frusta") <= 16 * counter(st, "blocks"));
+    assert_true(counter(st, "frusta") <= st->visible_pixels);
+    assert_true(counter(st, "frusta_early_out") <= counter(st, "frusta"));
+    ms_frame_free(&f);
+    ms_scene_free(&sc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_quad_equals_raytrace),
+        cmocka_unit_test(test_default_scene_equals_raytrace),
+        cmocka_unit_test(test_sponza_biglight_equals),
+        cmocka_unit_test(test_bunny_equals),
+        cmocka_unit_test(test_isa_instances_identical),
+        cmocka_unit_test(test_switches_keep_masks),
+        cmocka_unit_test(test_counters_account),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
