@@ -13,6 +13,7 @@
 #include "mft.h"
 #include "receiver.h"
 #include "../core/pattern.h"
+#include "block_group.h"
 #include "../core/vec.h"
 #include "../accel/ray_triangle.h"
 #include <float.h>
@@ -179,16 +180,6 @@ static void mft_lane_setup(const ms_mft_frame *f, const ms_shadow_query *q, ms_m
     L->foot_slack = (float)(f->margin + 0.02 + 1e-4 * d3_len(w) * (fmax(d3_len(m[0]), d3_len(m[1])) + f->k * d3_len(m[2])));
 }
 
-/* 4x4 block of a query: its key orders queries block by block. */
-static uint64_t mft_block_key(const ms_shadow_query *q) { return (uint64_t)(q->py >> 2) << 32 | (q->px >> 2); }
-
-static int mft_cmp_block(const void *a, const void *b, void *arg)
-{
-    const ms_shadow_query *q = arg;
-    const uint64_t ka = mft_block_key(&q[*(const int *)a]), kb = mft_block_key(&q[*(const int *)b]);
-    return ka < kb ? -1 : ka > kb;
-}
-
 static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
                           const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
@@ -198,8 +189,7 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
     signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
     if (!order || !rayf || !kzs) { free(order); free(rayf); free(kzs); return -1; }
-    for (int i = 0; i < nq; i++) order[i] = i;
-    qsort_r(order, (size_t)nq, sizeof *order, mft_cmp_block, (void *)q);
+    ms_block_order(ctx, q, nq, order);
     ms_mft_block blk;
     for (int l = 0; l < MS_BLOCK_LANES; l++) {
         float *base = rayf + (size_t)l * 5 * ns;
@@ -210,9 +200,8 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     }
     for (int g = 0; g < nq;) {
         blk.n = 0;
-        const uint64_t key = mft_block_key(&q[order[g]]);
-        int e = g;
-        for (; e < nq && e - g < MS_BLOCK_LANES && mft_block_key(&q[order[e]]) == key; e++) {
+        const int end = ms_block_group_end(ctx, q, order, nq, g);
+        for (int e = g; e < end; e++) {
             const int i = order[e];
             uint64_t *m = vis + (size_t)i * mw;
             memcpy(m, front + (size_t)i * mw, mw * sizeof *m);   /* the front mask is the starting set */
@@ -222,7 +211,7 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
             mft_lane_setup(&s->f, &q[i], L);
         }
         if (blk.n) s->block(&s->f, &blk, ctx->bvh, &s->sh, cnt);
-        g = e;
+        g = end;
     }
     free(order);
     free(rayf);

@@ -17,6 +17,7 @@
 #include "method.h"
 #include "frustum_traverse.h"
 #include "block_raster.h"
+#include "block_group.h"
 #include "receiver.h"
 #include <math.h>
 #include "../core/vec.h"
@@ -117,16 +118,6 @@ static int mr_visibility_pixel(const mr_state *s, const ms_render_ctx *ctx, cons
     return 0;
 }
 
-/* 4x4 block of a query: its key orders queries block by block. */
-static uint64_t block_key(const ms_shadow_query *q) { return (uint64_t)(q->py >> 2) << 32 | (q->px >> 2); }
-
-static int cmp_by_block(const void *a, const void *b, void *arg)
-{
-    const ms_shadow_query *q = arg;
-    const uint64_t ka = block_key(&q[*(const int *)a]), kb = block_key(&q[*(const int *)b]);
-    return ka < kb ? -1 : ka > kb;
-}
-
 /* The queries grouped by 4x4 pixel block (at most 16 to a group), or 16 consecutive ones when they come
  * in proximity order (the points API), each group traversed together. */
 static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
@@ -136,16 +127,14 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
     float *pts = NULL;
     int *order = malloc((size_t)nq * sizeof *order);
     if (!order) return -1;
-    for (int i = 0; i < nq; i++) order[i] = i;
-    if (!ctx->queries_in_order) qsort_r(order, (size_t)nq, sizeof *order, cmp_by_block, (void *)q);
+    ms_block_order(ctx, q, nq, order);
     int rc = 0;
     for (int g = 0; g < nq && !rc;) {
         ms_block_input in;
         ms_raster_frame frames[MS_BLOCK_LANES];
         in.n = 0;
-        const uint64_t key = block_key(&q[order[g]]);
-        int e = g;
-        for (; e < nq && e - g < MS_BLOCK_LANES && (ctx->queries_in_order || block_key(&q[order[e]]) == key); e++) {
+        const int end = ms_block_group_end(ctx, q, order, nq, g);
+        for (int e = g; e < end; e++) {
             const int i = order[e];
             uint64_t *buf = vis + (size_t)i * mw;
             const int go = mr_start(ctx, &q[i], front + (size_t)i * mw, buf, &frames[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
@@ -157,7 +146,7 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
             in.n++;
         }
         if (!rc && in.n) s->block(&in, ctx->bvh, &s->shallow, s->raster, ctx->near, ctx->far, cnt, s->block_flags);
-        g = e;
+        g = end;
     }
     free(order);
     free(pts);
