@@ -114,21 +114,6 @@ static void block_equals_pixel(const ms_scene *sc, const char *label, const int 
     }
 }
 
-/* The Quad: 20x20 ground at y=0, 4x4 occluder at y=2, 2x2 light at y=6 (as ../shared/scenes/quad). */
-static void make_quad(ms_scene *sc)
-{
-    static const float tri[4][9] = {
-        { -10, 0, -10, 10, 0, 10, 10, 0, -10 }, { -10, 0, -10, -10, 0, 10, 10, 0, 10 },
-        { -2, 2, -2, 2, 2, 2, 2, 2, -2 }, { -2, 2, -2, -2, 2, 2, 2, 2, 2 } };
-    memset(sc, 0, sizeof *sc);
-    sc->tri = malloc(sizeof tri);
-    memcpy(sc->tri, tri, sizeof tri);
-    sc->n_tris = 4;
-    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96 };
-    sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
-    sc->samples = 1024;
-}
-
 static void test_default_scene(void **state)
 {
     (void)state;
@@ -143,7 +128,7 @@ static void test_quad(void **state)
 {
     (void)state;
     ms_scene sc;
-    make_quad(&sc);
+    tu_make_quad(&sc);
     const int ks[] = { 16, 32, 64 };
     block_equals_pixel(&sc, "quad", ks, 3, 48, 1);
     ms_scene_free(&sc);

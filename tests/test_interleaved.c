@@ -192,22 +192,6 @@ static void test_filter(void **st)
     }
 }
 
-/* The Quad: 20x20 ground at y=0, 4x4 occluder at y=2, 2x2 light at y=6 (as ../shared/scenes/quad). */
-static void make_quad(ms_scene *sc)
-{
-    static const float tri[4][9] = {
-        { -10, 0, -10, 10, 0, 10, 10, 0, -10 }, { -10, 0, -10, -10, 0, 10, 10, 0, 10 },
-        { -2, 2, -2, 2, 2, 2, 2, 2, -2 }, { -2, 2, -2, -2, 2, 2, 2, 2, 2 } };
-    memset(sc, 0, sizeof *sc);
-    sc->tri = malloc(sizeof tri);
-    assert_non_null(sc->tri);
-    memcpy(sc->tri, tri, sizeof tri);
-    sc->n_tris = 4;
-    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96 };
-    sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
-    sc->samples = 1024;
-}
-
 static void render(const ms_scene *sc, const char *method, ms_pattern pat, int samples, int size, int no_filter,
                    ms_frame *f)
 {
@@ -273,7 +257,7 @@ static void test_raytrace_embree_agree(void **st)
 {
     (void)st;
     ms_scene sc;
-    make_quad(&sc);
+    tu_make_quad(&sc);
     agree_on(&sc, "quad", 256, 64);
     agree_on(&sc, "quad", 1024, 48);
     ms_scene_free(&sc);
@@ -379,7 +363,7 @@ static void test_quality(void **st)
 {
     (void)st;
     ms_scene sc;
-    make_quad(&sc);
+    tu_make_quad(&sc);
     quality_on(&sc, "quad", 256);
     ms_scene_free(&sc);
     assert_int_equal(ms_scene_default(&sc), 0);

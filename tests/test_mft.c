@@ -54,26 +54,11 @@ static void equal_on_scene(const ms_scene *sc, const char *label, const int *sam
         }
 }
 
-/* The Quad: 20x20 ground at y=0, 4x4 occluder at y=2, 2x2 light at y=6 (as ../shared/scenes/quad). */
-static void make_quad(ms_scene *sc)
-{
-    static const float tri[4][9] = {
-        { -10, 0, -10, 10, 0, 10, 10, 0, -10 }, { -10, 0, -10, -10, 0, 10, 10, 0, 10 },
-        { -2, 2, -2, 2, 2, 2, 2, 2, -2 }, { -2, 2, -2, -2, 2, 2, 2, 2, 2 } };
-    memset(sc, 0, sizeof *sc);
-    sc->tri = malloc(sizeof tri);
-    memcpy(sc->tri, tri, sizeof tri);
-    sc->n_tris = 4;
-    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96 };
-    sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
-    sc->samples = 1024;
-}
-
 static void test_quad_equals_raytrace(void **state)
 {
     (void)state;
     ms_scene sc;
-    make_quad(&sc);
+    tu_make_quad(&sc);
     const int samples[] = { 256, 1024 };
     equal_on_scene(&sc, "quad", samples, 2, 64);
     ms_scene_free(&sc);
@@ -170,7 +155,7 @@ static void test_isa_instances_identical(void **state)
     (void)state;
     ms_scene scenes[2];
     assert_int_equal(ms_scene_default(&scenes[0]), 0);
-    make_quad(&scenes[1]);
+    tu_make_quad(&scenes[1]);
     for (int si = 0; si < 2; si++)
         for (int p = 0; p < 2; p++) {
             const ms_pattern pat = p ? MS_PATTERN_STRATIFIED : MS_PATTERN_GRID;

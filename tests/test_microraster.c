@@ -59,26 +59,11 @@ static void agree_on_scene(const ms_scene *sc, const char *label, const int *sam
     }
 }
 
-/* The Quad: 20x20 ground at y=0, 4x4 occluder at y=2, 2x2 light at y=6 (as ../shared/scenes/quad). */
-static void make_quad(ms_scene *sc)
-{
-    static const float tri[4][9] = {
-        { -10, 0, -10, 10, 0, 10, 10, 0, -10 }, { -10, 0, -10, -10, 0, 10, 10, 0, 10 },
-        { -2, 2, -2, 2, 2, 2, 2, 2, -2 }, { -2, 2, -2, -2, 2, 2, 2, 2, 2 } };
-    memset(sc, 0, sizeof *sc);
-    sc->tri = malloc(sizeof tri);
-    memcpy(sc->tri, tri, sizeof tri);
-    sc->n_tris = 4;
-    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96 };
-    sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
-    sc->samples = 1024;
-}
-
 static void test_quad_agrees_with_raytrace(void **state)
 {
     (void)state;
     ms_scene sc;
-    make_quad(&sc);
+    tu_make_quad(&sc);
     const int samples[] = { 256, 1024, 4096 };
     agree_on_scene(&sc, "quad", samples, 3, 96);
     ms_scene_free(&sc);
@@ -99,7 +84,7 @@ static void test_quad_exact(void **state)
 {
     (void)state;
     ms_scene sc;
-    make_quad(&sc);
+    tu_make_quad(&sc);
     const int W = 96;
     for (int k = 0; k < 3; k++) {
         ms_frame f;
@@ -145,7 +130,7 @@ static void test_open_quad_both_sides(void **state)
     (void)state;
     for (int flip = 0; flip < 2; flip++) {
         ms_scene sc;
-        make_quad(&sc);
+        tu_make_quad(&sc);
         if (flip)
             for (int t = 2; t < 4; t++) {   /* swap two vertices: the other winding */
                 float tmp[3];

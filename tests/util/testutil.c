@@ -267,3 +267,18 @@ int tu_run_cli_ex(const char *const *args, const tu_run_opts *opts, char *err_al
     if (WIFEXITED(status)) return WEXITSTATUS(status);
     return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
+
+void tu_make_quad(ms_scene *sc)
+{
+    static const float tri[4][9] = {
+        { -10, 0, -10, 10, 0, 10, 10, 0, -10 }, { -10, 0, -10, -10, 0, 10, 10, 0, 10 },
+        { -2, 2, -2, 2, 2, 2, 2, 2, -2 }, { -2, 2, -2, -2, 2, 2, 2, 2, 2 } };
+    memset(sc, 0, sizeof *sc);
+    sc->tri = malloc(sizeof tri);
+    assert_non_null(sc->tri);
+    memcpy(sc->tri, tri, sizeof tri);
+    sc->n_tris = 4;
+    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96 };
+    sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
+    sc->samples = 1024;
+}

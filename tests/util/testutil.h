@@ -26,6 +26,9 @@ int tu_run_cli(const char *const *args, char *err_line, size_t n);
 typedef struct tu_run_opts { long fsize_limit; int umask; int timeout_s; } tu_run_opts;
 typedef struct tu_run_result { int lines; double max_rss_mb, seconds; } tu_run_result;
 int tu_run_cli_ex(const char *const *args, const tu_run_opts *opts, char *err_all, size_t n, tu_run_result *res);
+/* The Quad in code (as ../shared/scenes/quad): a 20x20 ground at y = 0 (two triangles), a 4x4 occluder
+ * at y = 2, a 2x2 light at y = 6, a 96x96 camera, 1024 samples. ms_scene_free frees it. */
+void tu_make_quad(ms_scene *sc);
 /* 1 if ../shared/scenes is present; prints a skip message otherwise. */
 int tu_have_shared_scenes(void);
 const char *tu_shared_scene(char *buf, size_t n, const char *rel);
