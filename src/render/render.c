@@ -73,6 +73,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     if (!pm) { snprintf(err, errlen, "primary method '%s' is not compiled into this build", sm->primary); return -1; }
     int samples = opt->samples > 0 ? opt->samples : scene->samples;
     if ((unsigned)opt->pattern > MS_PATTERN_INTERLEAVED) { snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern); return -1; }
+    if ((unsigned)opt->traversal > MS_TRAVERSAL_PIXEL) { snprintf(err, errlen, "unknown traversal %d", (int)opt->traversal); return -1; }
     /* Samples per pixel: N, or N/16 for interleaved; always a multiple of 16 (full ray packets). */
     const int spp = ms_pattern_samples_per_pixel(opt->pattern, samples);
     if (!spp) {
