@@ -28,8 +28,10 @@ cmake --build "$work/consumer" -j 2 >"$work/consumer-build.log" || { cat "$work/
 "$work/consumer/consumer_shared"
 "$work/consumer/consumer_static"
 # the shared program really uses the installed library
-ldd "$work/consumer/consumer_shared" | grep -q "$libdir/libmicroshadow.so" \
-    || { echo "test_install: consumer_shared does not load $libdir/libmicroshadow.so"; ldd "$work/consumer/consumer_shared"; exit 1; }
+# (ldd's output captured first: with pipefail, grep -q closing the pipe early would fail ldd with SIGPIPE)
+deps=$(ldd "$work/consumer/consumer_shared")
+grep -q "$libdir/libmicroshadow.so" <<<"$deps" \
+    || { echo "test_install: consumer_shared does not load $libdir/libmicroshadow.so"; echo "$deps"; exit 1; }
 
 echo "--- pkg-config"
 export PKG_CONFIG_PATH=$libdir/pkgconfig
@@ -39,7 +41,8 @@ $cc $flags -o "$work/pc_shared" "$src/consumer/consumer.c" $(pkg-config --cflags
 $cc $flags -o "$work/pc_static" "$src/consumer/consumer.c" $(pkg-config --static --cflags --libs microshadow-static)
 "$work/pc_shared"
 "$work/pc_static"
-! ldd "$work/pc_static" | grep -q libmicroshadow || { echo "test_install: pc_static loads a shared microshadow"; exit 1; }
+deps=$(ldd "$work/pc_static")
+! grep -q libmicroshadow <<<"$deps" || { echo "test_install: pc_static loads a shared microshadow"; exit 1; }
 
 echo "--- the installed CLI"
 "$prefix/bin/microshadow" --quiet --width 32 --height 24 --samples 256 -o "$work/cli.png"
