@@ -1,9 +1,12 @@
 /* Methods "scanline", "bounds", "hierarchical": soft shadows by micro-rasterization (Woop 2010,
- * sec. 6). For every visible point C the frustum spanned by C and the light is traversed through the
- * BVH (frustum_traverse_impl.h); every triangle of a surviving leaf is rasterized into the pixel's
- * k x k occlusion buffer with the method's kernel (src/raster), which starts as the pixel's front mask
- * (the receiver's horizon rasterized by the Scanline row loop, receiver.c); what is left is the visible
- * mask. The pixel's 3x3 light-space transform is set up once and shared by all its triangles.
+ * sec. 6). For every visible point C the frustum spanned by C and the light finds the triangles between
+ * them, each of which is rasterized into the pixel's k x k occlusion buffer with the method's kernel
+ * (src/raster); the buffer starts as the pixel's front mask (the receiver's horizon rasterized by the
+ * Scanline row loop, receiver.c) and what is left is the visible mask. The pixel's 3x3 light-space
+ * transform is set up once and shared by all its triangles. Two traversals give the same buffers: by
+ * default the frusta of a 4x4 pixel block together through the shallow BVH (Benthin & Wald 2009,
+ * block_raster_impl.h), or each pixel's alone through the deep BVH (Woop's, frustum_traverse_impl.h;
+ * ms_render_options.traversal).
  *
  * Departure from the paper: a point that sees the light nearly edge-on (closer to the light's plane than
  * 1e-3 of its distance to the light) makes the light-space transform near-singular (light-space
