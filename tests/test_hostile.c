@@ -5,7 +5,9 @@
  * umask, staging files removed on errors and signals, one message of ours on a full disk. */
 #include "testutil.h"
 #include <errno.h>
+#include <dirent.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <time.h>
 #include <signal.h>
 #include <stdio.h>
@@ -447,6 +449,84 @@ static void test_outputs_signal_removes_staging(void **st)
     }
 }
 
+/* A signal sent to the process goes to any thread that does not block it: while the writing thread
+ * is in a critical section (signals blocked there), an idle worker thread receives it. The handler
+ * must then still leave every commit whole: a child writes trios of outputs in a loop next to an idle
+ * thread and is killed at random moments; each trio is then all there or absent, and no staging file
+ * is left. (Before the fix, CI saw one file of a trio committed without the others.) */
+static void *idle_thread(void *arg)
+{
+    (void)arg;
+    for (;;) pause();
+    return NULL;
+}
+
+static void test_outputs_signal_on_other_thread(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("hostile_thread_signal");
+    unsigned seed = 12345;
+    int killed_mid = 0;
+    for (int trial = 0; trial < 40; trial++) {
+        DIR *d0 = opendir(dir);
+        struct dirent *e0;
+        while (d0 && (e0 = readdir(d0))) {
+            if (e0->d_name[0] == '.' && (!e0->d_name[1] || !strcmp(e0->d_name, ".."))) continue;
+            char p[4096];
+            tu_path(p, sizeof p, dir, e0->d_name);
+            unlink(p);
+        }
+        if (d0) closedir(d0);
+        pid_t pid = fork();
+        if (pid == 0) {
+            pthread_t th;
+            ms_outputs_cleanup_on_signals();
+            pthread_create(&th, NULL, idle_thread, NULL);
+            for (int i = 0; i < 100000; i++) {
+                char a[4096], b[4096], c[4096], n[64];
+                snprintf(n, sizeof n, "a%05d.txt", i); tu_path(a, sizeof a, dir, n);
+                snprintf(n, sizeof n, "b%05d.txt", i); tu_path(b, sizeof b, dir, n);
+                snprintf(n, sizeof n, "c%05d.txt", i); tu_path(c, sizeof c, dir, n);
+                ms_output outs[3] = { { "-a", a, writer_ok, NULL }, { "-b", b, writer_ok, NULL }, { "-c", c, writer_ok, NULL } };
+                char err[256];
+                ms_frame fr;
+                memset(&fr, 0, sizeof fr);
+                if (ms_outputs_write(&fr, outs, 3, err, sizeof err)) _exit(3);
+            }
+            _exit(0);
+        }
+        seed = seed * 1103515245u + 12345u;
+        usleep(2000 + (seed >> 8) % 30000);
+        kill(pid, SIGTERM);
+        int status;
+        waitpid(pid, &status, 0);
+        assert_true(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM);
+        /* Count each index's files and any staging file. */
+        static unsigned char have[100000];
+        memset(have, 0, sizeof have);
+        int staging = 0, maxi = -1;
+        DIR *d = opendir(dir);
+        assert_non_null(d);
+        struct dirent *e;
+        while ((e = readdir(d))) {
+            int i;
+            char k;
+            if (!strncmp(e->d_name, ".ms-stage", 9)) staging++;
+            else if (sscanf(e->d_name, "%c%05d.txt", &k, &i) == 2 && i >= 0 && i < 100000 && k >= 'a' && k <= 'c') {
+                have[i] |= (unsigned char)(1u << (k - 'a'));
+                if (i > maxi) maxi = i;
+            }
+        }
+        closedir(d);
+        if (staging) fail_msg("trial %d: %d staging files left", trial, staging);
+        for (int i = 0; i <= maxi; i++)
+            if (have[i] != 7) fail_msg("trial %d: trio %d is partial (mask %d)", trial, i, have[i]);
+        killed_mid += maxi >= 0;
+    }
+    print_message("40 kills during trios of writes next to an idle thread: none partial, no staging file\n");
+    assert_true(killed_mid > 0);
+}
+
 /* The CLI killed by SIGTERM at 30 moments spread over a whole run: the output directory then holds all
  * three outputs or none, and never a staging file (before issue 11: left behind in 8 of 30 trials). */
 static void test_outputs_sigterm_trials(void **st)
@@ -516,6 +596,7 @@ int main(void)
         cmocka_unit_test(test_outputs_long_names_and_mode),
         cmocka_unit_test(test_outputs_full_disk),
         cmocka_unit_test(test_outputs_signal_removes_staging),
+        cmocka_unit_test(test_outputs_signal_on_other_thread),
         cmocka_unit_test(test_outputs_sigterm_trials),
     };
     return cmocka_run_group_tests(tests, setup, NULL);

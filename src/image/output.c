@@ -3,7 +3,9 @@
 #include <fcntl.h>
 #include <libgen.h>
 #include <limits.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -15,8 +17,27 @@
 static char g_stage[MS_MAX_OUTPUTS][PATH_MAX];
 static volatile sig_atomic_t g_live[MS_MAX_OUTPUTS];
 
+/* A signal can be delivered to any thread that does not block it, e.g. an idle OpenMP worker, so
+ * blocking signals in the writing thread alone does not keep the handler out of its critical
+ * sections (creating, removing or committing staging files). One atomic state serialises them: the
+ * handler only acts from IDLE; a signal that arrives while the writer is BUSY is recorded and
+ * re-raised when the writer leaves, so it finds every rename done or none. (CI saw one output
+ * committed without the other two when SIGTERM landed on a worker thread in the middle of the
+ * renames.) */
+enum { STATE_IDLE, STATE_BUSY, STATE_DYING };
+static atomic_int g_state = STATE_IDLE;
+static volatile sig_atomic_t g_pending;
+
 static void on_signal(int sig)
 {
+    int expect = STATE_IDLE;
+    if (!atomic_compare_exchange_strong(&g_state, &expect, STATE_DYING) && expect == STATE_BUSY) {
+        g_pending = sig;
+        /* The writer may have left between the failed exchange and the store above; then nobody
+         * would re-raise, so try once more. */
+        expect = STATE_IDLE;
+        if (!atomic_compare_exchange_strong(&g_state, &expect, STATE_DYING)) return;
+    }
     for (int i = 0; i < MS_MAX_OUTPUTS; i++)
         if (g_live[i]) unlink(g_stage[i]);
     signal(sig, SIG_DFL);
@@ -37,16 +58,30 @@ void ms_outputs_cleanup_on_signals(void)
     }
 }
 
-/* Creating or renaming a staging file and recording it happen with the signals blocked, so the
- * handler never misses a file nor removes a renamed one. */
+/* Enters a critical section: the signals blocked in this thread, and the state BUSY so that a
+ * handler running on another thread defers. When the handler already owns the state the process is
+ * being killed: wait for it. */
 static void block(sigset_t *old)
 {
     sigset_t s;
     sigemptyset(&s);
     for (size_t i = 0; i < sizeof g_signals / sizeof g_signals[0]; i++) sigaddset(&s, g_signals[i]);
-    sigprocmask(SIG_BLOCK, &s, old);
+    pthread_sigmask(SIG_BLOCK, &s, old);
+    for (;;) {
+        int expect = STATE_IDLE;
+        if (atomic_compare_exchange_strong(&g_state, &expect, STATE_BUSY)) return;
+        struct timespec ms = { 0, 1000000 };
+        nanosleep(&ms, NULL);
+    }
 }
-static void unblock(const sigset_t *old) { sigprocmask(SIG_SETMASK, old, NULL); }
+
+static void unblock(const sigset_t *old)
+{
+    atomic_store(&g_state, STATE_IDLE);
+    int sig = g_pending;
+    pthread_sigmask(SIG_SETMASK, old, NULL);
+    if (sig) raise(sig);   /* the deferred signal, now with nothing half done */
+}
 
 static int free_slot(void)
 {
@@ -113,14 +148,12 @@ static void stage_remove(int slot)
     unblock(&old);
 }
 
+/* Called inside the caller's critical section (block/unblock), which covers all the renames. */
 static int stage_commit(int slot, const char *target, char *err, size_t errlen)
 {
-    sigset_t old;
-    block(&old);
     int rc = rename(g_stage[slot], target);
     int e = errno;
     if (rc == 0) g_live[slot] = 0;
-    unblock(&old);
     if (rc) { snprintf(err, errlen, "%s: cannot rename into place: %s", target, strerror(e)); return -1; }
     return 0;
 }
@@ -223,7 +256,7 @@ int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err,
         if (fclose(fp) != 0 && !rc) { snprintf(err, errlen, "%s: write failed: %s", outs[k].path, strerror(errno)); rc = -1; }
     }
     /* Every target is still a regular file or absent before anything is renamed; the renames happen
-     * with the signals blocked, so a signal arriving meanwhile finds all of them done. */
+     * in one critical section, so a signal arriving meanwhile finds all of them done. */
     sigset_t old;
     block(&old);
     for (k = 0; k < n && !rc; k++)
