@@ -201,7 +201,7 @@ const char *const *ms_method_names(void);
 /* 1 if `name` is a known method compiled into this build, 0 if unknown, -1 if known but not compiled in. */
 int ms_method_available(const char *name);
 
-#define MS_MAX_COUNTERS 16
+#define MS_MAX_COUNTERS 24
 
 typedef struct ms_stats {
     size_t triangles;
@@ -223,6 +223,9 @@ typedef struct ms_stats {
     int n_counters;                /* method-specific counters */
     const char *counter_name[MS_MAX_COUNTERS];
     uint64_t counter[MS_MAX_COUNTERS];
+    double shadow_cpu_s;           /* frames: the process's CPU seconds (all threads) during shadow_s, the
+                                    * figure to compare methods by on a machine shared with other work;
+                                    * 0 from the points API (other callers may share the process) */
 } ms_stats;
 
 typedef struct ms_frame {

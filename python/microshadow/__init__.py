@@ -20,7 +20,7 @@ __all__ = ["Error", "Scene", "Accel", "load", "default_scene", "visibility_point
            "method_names", "light_irradiance"]
 
 MAX_UV_SETS = 4
-MAX_COUNTERS = 16
+MAX_COUNTERS = 24
 NO_TRIANGLE = 0xFFFFFFFF
 
 
@@ -82,7 +82,8 @@ class _Stats(ctypes.Structure):
         [(n, ctypes.c_char_p) for n in ("method", "pattern", "kernel_isa", "traversal_isa")] + \
         [(n, ctypes.c_uint64) for n in ("visible_pixels", "shadow_rays", "penumbra_pixels")] + \
         [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
-         ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS)]
+         ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS),
+         ("shadow_cpu_s", ctypes.c_double)]
 
 
 class _Frame(ctypes.Structure):

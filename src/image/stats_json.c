@@ -26,6 +26,7 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     cJSON_AddNumberToObject(o, "setup_s", s->setup_s);
     cJSON_AddNumberToObject(o, "primary_s", s->primary_s);
     cJSON_AddNumberToObject(o, "shadow_s", s->shadow_s);
+    cJSON_AddNumberToObject(o, "shadow_cpu_s", s->shadow_cpu_s);
     cJSON_AddNumberToObject(o, "total_s", s->total_s);
     cJSON_AddNumberToObject(o, "visible_pixels", (double)s->visible_pixels);
     cJSON_AddNumberToObject(o, "shadow_rays", (double)s->shadow_rays);

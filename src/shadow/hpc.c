@@ -79,8 +79,14 @@
 enum {
     C_TRIANGLES, C_TRI_CHUNK_PASSES, C_NODE_VISITS, C_NODES_OUTSIDE_VL, C_UMBRA_NODE_SKIPS, C_PLANE_TESTS,
     C_GROUP_VOLUMES_BUILT, C_POINT_TESTS, C_GROUP_POINT_TESTS, C_SAMPLE_TESTS, C_SAMPLES_BLOCKED,
-    C_MASKS_ALLOCATED, C_MASKS_PEAK, C_REBUILDS, C_FULL_UMBRA_POINTS, C_RASTER_CALLS, C_COUNT
+    C_MASKS_ALLOCATED, C_MASKS_PEAK, C_REBUILDS, C_FULL_UMBRA_POINTS, C_RASTER_CALLS,
+    /* The paper's Table 2 breakdown: phase times (microseconds; the sort is the source's, hpc_method.c) and
+     * memory by kind (bytes allocated at the peak). */
+    C_SORT_US, C_BUILD_US, C_REBUILD_THREAD_US, C_CAST_US, C_SAMPLE_BYTES, C_HIERARCHY_BYTES, C_MASK_BYTES,
+    C_COUNT
 };
+_Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
+_Static_assert(C_SORT_US == HPC_COUNTER_SORT_US, "hpc.h names the sort counter");
 
 typedef struct hnode {
     float lo[3], hi[3];
@@ -125,6 +131,7 @@ typedef struct chunk {
     uint32_t umbra_in_tree;
     hnode *nodes;
     uint32_t n_nodes;
+    size_t node_bytes_peak;          /* the largest node array this chunk held (Table 2 memory) */
     uint8_t *pool;
     int32_t n_slots, cap_slots, n_free, live, peak;
     int32_t *free_list;
@@ -254,6 +261,7 @@ static int build_tree(const shared *sh, chunk *c)
     c->n_nodes = 0;
     if (!live) return 0;
     c->nodes = malloc((size_t)(2 * live) * sizeof *c->nodes);
+    if ((size_t)(2 * live) * sizeof *c->nodes > c->node_bytes_peak) c->node_bytes_peak = (size_t)(2 * live) * sizeof *c->nodes;
     uint32_t *stack = malloc((size_t)(2 * live + 64) * 2 * sizeof *stack);   /* node, depth */
     if (!c->nodes || !stack) { free(stack); return -1; }
     c->n_nodes = 1;
@@ -590,7 +598,10 @@ static void cast_triangle(const shared *sh, chunk *c, const tri_job *t)
     if (c->failed || !c->n_nodes) return;
     if (c->umbra_in_tree > 64 && 4 * c->umbra_in_tree > c->n) {
         c->cnt[C_REBUILDS]++;
-        if (build_tree(sh, c)) { c->failed = 1; return; }
+        const double t0 = omp_get_wtime();
+        const int bad = build_tree(sh, c);
+        c->cnt[C_REBUILD_THREAD_US] += (uint64_t)((omp_get_wtime() - t0) * 1e6);
+        if (bad) { c->failed = 1; return; }
         if (!c->n_nodes) return;
     }
     c->cnt[C_TRI_CHUNK_PASSES]++;
@@ -763,9 +774,12 @@ int ms_hpc_cast(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster, con
     nchunks = nlive ? make_chunks(&sh, idx, nlive, target, ch, cap) : 0;
     if (nchunks < 0) goto done;
     int failed = 0;
+    double t0 = omp_get_wtime();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(| : failed)
     for (int i = 0; i < nchunks; i++) failed |= build_tree(&sh, &ch[i]) != 0;
+    counters[C_BUILD_US] += (uint64_t)((omp_get_wtime() - t0) * 1e6);
     if (failed) goto done;
+    t0 = omp_get_wtime();
 
     if (src->rewind && src->rewind(src->user)) goto done;
     for (;;) {
@@ -780,6 +794,7 @@ int ms_hpc_cast(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster, con
         for (int i = 0; i < nchunks; i++)
             if (ch[i].failed) goto done;
     }
+    counters[C_CAST_US] += (uint64_t)((omp_get_wtime() - t0) * 1e6);
     /* The visible masks: front where no triangle came near, nothing in full umbra, else what is open. */
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t r = 0; r < n; r++) {
@@ -801,10 +816,18 @@ done:
         for (int c = 0; c < C_COUNT; c++)
             if (c != C_TRIANGLES && c != C_MASKS_PEAK) counters[c] += ch[i].cnt[c];
         counters[C_MASKS_PEAK] += (uint64_t)ch[i].peak;
+        /* The pool as allocated (it only grows): each slot's mask, and its per-point sample data (the
+         * packets' shear axes, the Scanline frame). */
+        counters[C_MASK_BYTES] += (uint64_t)ch[i].cap_slots * (uint64_t)mw * 8u;
+        counters[C_SAMPLE_BYTES] += (uint64_t)ch[i].cap_slots * (uint64_t)(sh.slot_bytes - (size_t)mw * 8u);
+        counters[C_HIERARCHY_BYTES] += ch[i].node_bytes_peak;
         free(ch[i].nodes);
         free(ch[i].pool);
         free(ch[i].free_list);
     }
+    /* The hierarchy's per-point arrays: indices, umbra bits, full flags, slot numbers; the groups' masks. */
+    counters[C_HIERARCHY_BYTES] += (uint64_t)n * (sizeof *idx + sizeof *sh.gumbra + 1u + sizeof *sh.slot);
+    counters[C_SAMPLE_BYTES] += (uint64_t)sh.G * (uint64_t)mw * 8u;
     free(ch);
     free(idx);
     free(jobs);

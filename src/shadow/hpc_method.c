@@ -7,6 +7,7 @@
  * per-tile entry runs the same algorithm over the tile's points, for callers that drive methods per tile. */
 #include "hpc.h"
 #include "receiver.h"
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,12 +18,14 @@ typedef struct hpc_state {
     ms_isa kernel_isa;
     uint32_t *order;      /* scene triangles in area order */
     uint32_t *leaf_of;    /* scene index -> prim id (BVH leaf order) */
+    double sort_s;        /* the coarse sort of the scene's triangles, done once in create */
 } hpc_state;
 
 typedef struct soup_source {
     const ms_render_ctx *ctx;
     const hpc_state *s;
     size_t pos;
+    double sort_s;        /* procedural: the batches' sorts */
 } soup_source;
 
 static int soup_rewind(void *user) { ((soup_source *)user)->pos = 0; return 0; }
@@ -41,7 +44,9 @@ static size_t procedural_next(void *user, float *tri, uint32_t *ids, size_t max)
     const int threads = src->ctx->threads > 0 ? src->ctx->threads : 1;
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t c = 0; c < n; c += 1024) ms_procedural_triangles(sc, src->pos + c, n - c < 1024 ? n - c : 1024, raw + 9 * c);
+    const double t0 = omp_get_wtime();
     uint32_t *order = ms_hpc_area_order(raw, n);
+    src->sort_s += omp_get_wtime() - t0;
     if (!order) { free(raw); return (size_t)-1; }
     for (size_t i = 0; i < n; i++) {
         memcpy(tri + 9 * i, raw + 9 * (size_t)order[i], 9 * sizeof *tri);
@@ -78,7 +83,9 @@ static int hpc_create_common(const ms_render_ctx *ctx, void **state, char *err, 
     }
     if (ctx->scene->procedural.type != MS_PROCEDURAL_NONE) { *state = s; return 0; }   /* streamed */
     const size_t n = ctx->scene->n_tris;
+    const double t0 = omp_get_wtime();
     s->order = ms_hpc_area_order(ctx->scene->tri, n);
+    s->sort_s = omp_get_wtime() - t0;
     s->leaf_of = malloc((n ? n : 1) * sizeof *s->leaf_of);
     if (!s->order || !s->leaf_of) {
         free(s->order); free(s->leaf_of); free(s);
@@ -93,13 +100,25 @@ static int hpc_create_common(const ms_render_ctx *ctx, void **state, char *err, 
 static int hpc_create(const ms_render_ctx *c, void **s, char *e, size_t n) { return hpc_create_common(c, s, e, n, 0); }
 static int hpcs_create(const ms_render_ctx *c, void **s, char *e, size_t n) { return hpc_create_common(c, s, e, n, 1); }
 
+static int hpc_cast_all(const hpc_state *s, const ms_render_ctx *ctx, const ms_shadow_query *q, size_t n,
+                        const uint64_t *front, uint64_t *vis, uint64_t *counters, double *sort_s)
+{
+    soup_source ss = { ctx, s, 0, 0.0 };
+    const hpc_source src = { &ss, soup_rewind, ctx->scene->procedural.type != MS_PROCEDURAL_NONE ? procedural_next : soup_next };
+    const int rc = ms_hpc_cast(ctx, s->scanline, s->raster, q, n, front, vis, &src, counters);
+    *sort_s = ss.sort_s;
+    return rc;
+}
+
+/* The frame: the sort counter holds create's sort of the scene, or the streamed batches' sorts. */
 static int hpc_all(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, size_t n, const uint64_t *front,
                    uint64_t *vis, uint64_t *counters)
 {
     const hpc_state *s = state;
-    soup_source ss = { ctx, s, 0 };
-    const hpc_source src = { &ss, soup_rewind, ctx->scene->procedural.type != MS_PROCEDURAL_NONE ? procedural_next : soup_next };
-    return ms_hpc_cast(ctx, s->scanline, s->raster, q, n, front, vis, &src, counters);
+    double sort_s;
+    const int rc = hpc_cast_all(s, ctx, q, n, front, vis, counters, &sort_s);
+    counters[HPC_COUNTER_SORT_US] += (uint64_t)((s->sort_s + sort_s) * 1e6);
+    return rc;
 }
 
 static int hpc_tile(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int n, const uint64_t *front,
@@ -107,7 +126,8 @@ static int hpc_tile(void *state, const ms_render_ctx *ctx, const ms_shadow_query
 {
     ms_render_ctx one = *ctx;
     one.threads = 1;      /* called from the renderer's threads */
-    return hpc_all(state, &one, q, (size_t)n, front, vis, counters);
+    double sort_s;
+    return hpc_cast_all(state, &one, q, (size_t)n, front, vis, counters, &sort_s);
 }
 
 static void hpc_destroy(void *state)
@@ -130,7 +150,8 @@ static void hpc_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
     { "triangles", "triangle_chunk_passes", "node_visits", "nodes_outside_vl", "umbra_node_skips",     \
       "plane_tests", "group_volume_sets_built", "point_tests", "group_point_tests", "sample_tests",     \
       "samples_blocked", "masks_allocated", "masks_peak_sum_over_chunks", "rebuilds",                  \
-      "full_umbra_points", "raster_calls" }
+      "full_umbra_points", "raster_calls", "sort_us", "build_us", "rebuild_thread_us", "cast_us",      \
+      "sample_bytes", "hierarchy_bytes", "mask_bytes" }
 
 const ms_shadow_method ms_shadow_hpc = {
     .name = "hpc", .primary = "bvh", .needs_grid = 1, .streams = 1, .n_counters = HPC_N_COUNTERS,
