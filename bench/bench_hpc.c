@@ -3,8 +3,9 @@
  * sample count and resolution, in one run (same binary, samples, threads): the shadow seconds of
  * raytrace and scanline; hpc's phases (coarse sort, receiver hierarchy build, cast; total = shadow
  * seconds + sort, which a scene's triangles pay in the method's set-up) and hpc-scanline's total; the
- * ratios; hpc's memory by kind (per-point sample data, hierarchy, bit masks: bytes allocated at the
- * peak, hpc.c); agreement with raytrace (pixels whose V differs) and hpc's work counters. Prints Markdown.
+ * ratios; hpc's memory by kind as the paper's Table 2 counts it (the receiver points buffer; the
+ * receiver hierarchy at its peak; the bit masks as allocated at the peak, with the per-point sample data
+ * allocated beside each mask, hpc.c); agreement with raytrace (pixels whose V differs) and hpc's work counters. Prints Markdown.
  *
  * usage: bench_hpc [--samples 256,1024] [--sizes 512,1024,2048] [--light-scale 1,2] [--threads T]
  *                  [--no-reference] [--cpu] SCENE.json|builtin ...
@@ -54,6 +55,15 @@ static void scale_light(ms_light *l, float f)
     l->corner.z = c[2] - 0.5f * (l->edge_s.z + l->edge_t.z);
 }
 
+/* The paper's "samples mem", the buffer of receiver points: each visible point's query (position, normal,
+ * triangle, pixel) and its front and visible masks, which the renderer holds for the whole frame. */
+static double points_mb(const ms_frame *f)
+{
+    const double mask = (double)((f->stats.samples_per_pixel + 63) / 64 * 8);
+    /* 36 bytes: ms_shadow_query (src/shadow/method.h) */
+    return (double)f->stats.visible_pixels * (36.0 + 2.0 * mask) / 1048576.0;
+}
+
 static int g_cpu;   /* --cpu: CPU seconds of all threads instead of wall seconds */
 
 static double total_s(const ms_frame *f, int m)
@@ -82,7 +92,7 @@ int main(int argc, char **argv)
         return 2;
     }
     printf("| scene | light | N | size | raytrace s | scanline s | hpc sort s | hpc build s | hpc cast s | hpc total s "
-           "| hpc-scanline total s | raytrace/hpc | raytrace/hpc-scanline | scanline/hpc-scanline | hpc sample MB "
+           "| hpc-scanline total s | raytrace/hpc | raytrace/hpc-scanline | scanline/hpc-scanline | hpc points MB "
            "| hpc hierarchy MB | hpc mask MB | hpc px != raytrace | hpc-scanline px != raytrace | triangles "
            "| sample tests | full-umbra points | rebuilds |\n");
     printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -137,8 +147,8 @@ int main(int argc, char **argv)
                            label, (double)(scales[li] * scales[li]), samples[ni], sizes[s], col[RT], col[SL],
                            (double)counter(h, "sort_us") * 1e-6, (double)counter(h, "build_us") * 1e-6,
                            (double)counter(h, "cast_us") * 1e-6, col[HPC], col[HPCS], ratio[0], ratio[1], ratio[2],
-                           (double)counter(h, "sample_bytes") / 1048576.0, (double)counter(h, "hierarchy_bytes") / 1048576.0,
-                           (double)counter(h, "mask_bytes") / 1048576.0, diff[0], diff[1],
+                           points_mb(h), (double)counter(h, "hierarchy_bytes") / 1048576.0,
+                           (double)(counter(h, "mask_bytes") + counter(h, "sample_bytes")) / 1048576.0, diff[0], diff[1],
                            (unsigned long long)counter(h, "triangles"), (unsigned long long)counter(h, "sample_tests"),
                            (unsigned long long)counter(h, "full_umbra_points"), (unsigned long long)counter(h, "rebuilds"));
                     fflush(stdout);
