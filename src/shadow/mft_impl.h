@@ -409,8 +409,15 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         if (!pass) continue;
         float box[4][MS_BLOCK_LANES];
         unsigned foot = 0, empty = 0;
-        if (!(f->flags & MS_MFT_NO_FOOTPRINT) && (pass & s->has_m)) {
-            foot = mft_footprint16(s, a, la, pass & s->has_m, &empty, box);
+        /* The footprint, like the corner rays, only where |det| clears its rounding: when C lies
+         * nearly in the triangle's plane, the rays graze it and the watertight test's edge functions
+         * (in the plane across the ray, where such a triangle is a sliver) decide its edges with an
+         * error that grows as 1/|det|, beyond the footprint's slack. Measured: Sponza's big light at
+         * 1024^2, a sliver 3e-5 below the receiver, which raytrace finds hit by a ray passing 2.5e-4
+         * outside it (exact rational arithmetic); mft must give raytrace's answer, so it tests it. */
+        const unsigned foot_lanes = pass & s->has_m & det_ok;
+        if (!(f->flags & MS_MFT_NO_FOOTPRINT) && foot_lanes) {
+            foot = mft_footprint16(s, a, la, foot_lanes, &empty, box);
             c_foot += (uint64_t)ms_bt_popcount16(empty);
             pass &= ~empty;
         }
