@@ -24,8 +24,33 @@ typedef struct ms_tri_soup {
     uint32_t *mesh;
     float *uv[MS_SOUP_UV_SETS];
     uint32_t cur_mesh;
+    /* Surfaces (material.c): per-triangle material index (MS_NO_MATERIAL) and vertex normals (9 floats,
+     * NaN), each appearing with the first triangle that has one; the materials and textures loaded. */
+    uint32_t *material;
+    float *normal;
+    struct ms_material *mats;
+    size_t n_mats;
+    struct ms_texture *tex;
+    size_t n_tex;
+    size_t tex_bytes;   /* decoded texture bytes so far (bounded: MS_MAX_TEXTURE_BYTES) */
 } ms_tri_soup;
 void ms_soup_free(ms_tri_soup *soup);
+/* The same push with a material index (MS_NO_MATERIAL: none) and three vertex normals (or NULL). */
+int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
+                      uint32_t material, const float *normal9);
+/* Appends a material; its index, or -1 when out of memory or past MS_MAX_MATERIALS. */
+long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m);
+
+/* Textures (texture.c). At most MS_MAX_TEXTURE_SIDE texels a side, MS_MAX_TEXTURE_BYTES decoded per scene. */
+#define MS_MAX_TEXTURE_SIDE 16384
+#define MS_MAX_TEXTURE_BYTES ((size_t)1 << 30)
+#define MS_MAX_MATERIALS 65536
+/* Decodes a PNG (JPEG is refused with a message) from memory into an RGBA8 texture appended to the soup;
+ * its index, or -1 with one line in err naming `what`. */
+long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
+                                char *err, size_t errlen);
+/* The same from a file (a regular file of at most MS_MAX_MESH_BYTES). */
+long ms_soup_add_texture_file(ms_tri_soup *soup, const char *path, char *err, size_t errlen);
 
 typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH } ms_input_kind;
 /* Reads a whole regular file of at most max_bytes (a FIFO, device or directory is refused without
