@@ -208,16 +208,16 @@ static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, 
     const cgltf_image *im = &d->images[i];
     char what[64];
     snprintf(what, sizeof what, "image %zu", i);
-    char full[4600];
-    snprintf(full, sizeof full, "%s: %s", path, what);
+    char full[600];   /* messages name the glTF (its path cut at 500 bytes) and the image */
+    snprintf(full, sizeof full, "%.500s: %s", path, what);
     if (im->buffer_view) {
         const cgltf_buffer_view *v = im->buffer_view;
         if (!v->buffer || !v->buffer->data || !fits(v->offset, v->size, v->buffer->size)) {
             snprintf(err, errlen, "%s: its buffer view exceeds its buffer", full);
             return -1;
         }
-        return ms_soup_add_texture_memory(soup, (const unsigned char *)v->buffer->data + v->offset, v->size, full, err,
-                                          errlen);
+        return ms_soup_add_texture_memory(soup, (const unsigned char *)v->buffer->data + v->offset, v->size, full, 0,
+                                          err, errlen);
     }
     if (!im->uri) { snprintf(err, errlen, "%s: has neither a uri nor a bufferView", full); return -1; }
     if (!strncmp(im->uri, "data:", 5)) {
@@ -233,7 +233,7 @@ static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, 
             snprintf(err, errlen, "%s: a bad base64 data URI", full);
             return -1;
         }
-        const long r = ms_soup_add_texture_memory(soup, data, size, full, err, errlen);
+        const long r = ms_soup_add_texture_memory(soup, data, size, full, 0, err, errlen);
         opt->memory.free_func(opt->memory.user_data, data);
         return r;
     }
@@ -247,7 +247,7 @@ static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, 
         return -1;
     }
     cgltf_decode_uri(file + dl);
-    return ms_soup_add_texture_file(soup, file, err, errlen);
+    return ms_soup_add_texture_file(soup, file, 0, err, errlen);
 }
 
 static float clamp01(float x) { return x >= 0.0f ? (x <= 1.0f ? x : 1.0f) : 0.0f; }   /* NaN -> 0 */
@@ -270,22 +270,28 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
             m.metallic = clamp01(pb->metallic_factor);
             m.roughness = clamp01(pb->roughness_factor);
             const cgltf_texture_view *tv = &pb->base_color_texture;
+            /* A texture that cannot be used is a warning: the material keeps its factors (geometry and
+             * visibility do not depend on it). */
             if (tv->texture && tv->texture->image) {
-                if (tv->texcoord < 0 || tv->texcoord >= MS_MAX_UV_SETS) {
-                    snprintf(err, errlen, "%s: material %zu: baseColorTexture uses TEXCOORD_%d (at most %d sets)", path, i,
-                             (int)tv->texcoord, MS_MAX_UV_SETS - 1);
-                    rc = -1;
-                    break;
-                }
                 const size_t im = (size_t)(tv->texture->image - d->images);
-                if (tex_of[im] == -2) tex_of[im] = load_image(d, opt, im, path, soup, err, errlen);
-                if (tex_of[im] < 0) { rc = -1; break; }
-                m.base_color_texture = (int32_t)tex_of[im];
-                m.base_color_uv = (int32_t)tv->texcoord;
+                if (tv->texcoord < 0 || tv->texcoord >= MS_MAX_UV_SETS) {
+                    ms_warn("%s: material %zu: baseColorTexture uses TEXCOORD_%d (at most %d sets): texture ignored", path, i,
+                            (int)tv->texcoord, MS_MAX_UV_SETS - 1);
+                } else {
+                    if (tex_of[im] == -2) {
+                        char why[1024];
+                        tex_of[im] = load_image(d, opt, im, path, soup, why, sizeof why);
+                        if (tex_of[im] < 0) ms_warn("%s: texture ignored", why);
+                    }
+                    if (tex_of[im] >= 0) {
+                        m.base_color_texture = (int32_t)tex_of[im];
+                        m.base_color_uv = (int32_t)tv->texcoord;
+                    }
+                }
             }
         }
         mat_of[i] = ms_soup_add_material(soup, &m);
-        if (mat_of[i] < 0) { snprintf(err, errlen, "%s: more than %d materials", path, MS_MAX_MATERIALS); rc = -1; }
+        if (mat_of[i] < 0) { snprintf(err, errlen, "%s: out of memory, or more than %d materials", path, MS_MAX_MATERIALS); rc = -1; }
     }
     free(tex_of);
     return rc;

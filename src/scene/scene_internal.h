@@ -46,11 +46,29 @@ long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m);
 #define MS_MAX_TEXTURE_BYTES ((size_t)1 << 30)
 #define MS_MAX_MATERIALS 65536
 /* Decodes a PNG (JPEG is refused with a message) from memory into an RGBA8 texture appended to the soup;
- * its index, or -1 with one line in err naming `what`. */
+ * its index, or -1 with one line in err naming `what`. flip_rows: store the rows bottom-up (OBJ's v = 0 is
+ * the image's last row; textures follow glTF, v = 0 the first). Loaders treat a texture that fails as a
+ * warning, the material keeping its factors: a scene whose textures are missing or JPEG still loads. */
 long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
-                                char *err, size_t errlen);
+                                int flip_rows, char *err, size_t errlen);
 /* The same from a file (a regular file of at most MS_MAX_MESH_BYTES). */
-long ms_soup_add_texture_file(ms_tri_soup *soup, const char *path, char *err, size_t errlen);
+long ms_soup_add_texture_file(ms_tri_soup *soup, const char *path, int flip_rows, char *err, size_t errlen);
+
+/* OBJ materials (mtl.c): the materials of MTL files, by name, added to the soup as they are read. */
+typedef struct ms_mtl_lib {
+    char **names;
+    uint32_t *index;   /* soup material of names[i] */
+    size_t n;
+    char **tex_path;   /* textures read so far, each once: soup texture tex_id[i] (-1: unusable) */
+    long *tex_id;
+    size_t n_tex;
+} ms_mtl_lib;
+/* Reads one MTL file (newmtl, Kd, d, map_Kd, Pr, Pm, Ns) into lib and the soup. A file that cannot be read
+ * and a texture that cannot be used are warnings; 0, or -1 when out of memory. */
+int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib);
+/* The soup material named `name`, or MS_NO_MATERIAL. The last definition of a name wins. */
+uint32_t ms_mtl_find(const ms_mtl_lib *lib, const char *name);
+void ms_mtl_lib_free(ms_mtl_lib *lib);
 
 typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH } ms_input_kind;
 /* Reads a whole regular file of at most max_bytes (a FIFO, device or directory is refused without

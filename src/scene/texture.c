@@ -9,7 +9,7 @@
 #include <string.h>
 
 long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
-                                char *err, size_t errlen)
+                                int flip_rows, char *err, size_t errlen)
 {
     if (len >= 3 && buf[0] == 0xFF && buf[1] == 0xD8 && buf[2] == 0xFF) {
         snprintf(err, errlen, "%s: JPEG textures are not supported (use PNG)", what);
@@ -44,7 +44,9 @@ long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, siz
         return -1;
     }
     soup->tex = t;
-    if (!png_image_finish_read(&img, NULL, px, 0, NULL)) {
+    /* A negative row stride makes libpng write the rows bottom-up. */
+    const png_int_32 stride = (png_int_32)(4 * img.width);
+    if (!png_image_finish_read(&img, NULL, px, flip_rows ? -stride : stride, NULL)) {
         snprintf(err, errlen, "%s: bad PNG: %s", what, img.message);
         free(px);
         png_image_free(&img);
@@ -57,12 +59,12 @@ long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, siz
     return (long)soup->n_tex++;
 }
 
-long ms_soup_add_texture_file(ms_tri_soup *soup, const char *path, char *err, size_t errlen)
+long ms_soup_add_texture_file(ms_tri_soup *soup, const char *path, int flip_rows, char *err, size_t errlen)
 {
     char *buf;
     size_t len;
     if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, err, errlen)) return -1;
-    const long r = ms_soup_add_texture_memory(soup, (const unsigned char *)buf, len, path, err, errlen);
+    const long r = ms_soup_add_texture_memory(soup, (const unsigned char *)buf, len, path, flip_rows, err, errlen);
     free(buf);
     return r;
 }
