@@ -14,6 +14,7 @@
 #include "core/pattern.h"
 #include "camera/camera.h"
 #include <math.h>
+#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -642,6 +643,61 @@ static void test_obj_mtl_materials(void **st)
     ms_scene_free(&sc);
 }
 
+/* Mean sRGB byte of a PNG (libpng's simplified reader), -1 if it cannot be read. */
+static double png_mean(const char *path)
+{
+    png_image img;
+    memset(&img, 0, sizeof img);
+    img.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&img, path)) return -1;
+    img.format = PNG_FORMAT_RGB;
+    uint8_t *px = malloc(PNG_IMAGE_SIZE(img));
+    if (!px || !png_image_finish_read(&img, NULL, px, 0, NULL)) { free(px); png_image_free(&img); return -1; }
+    double sum = 0;
+    for (size_t i = 0; i < PNG_IMAGE_SIZE(img); i++) sum += px[i];
+    const double mean = sum / PNG_IMAGE_SIZE(img);
+    free(px);
+    return mean;
+}
+
+/* The CLI: -o OUT.exr writes the linear radiance as EXR (channels R, G, B, V, S), -o OUT.png stays
+ * tone-mapped, and --exposure EV brightens it; a bad --exposure is one line and exit 2. */
+static void test_cli_exr_and_exposure(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("shading_cli");
+    write_gltf_scene(dir, 1, 0.0f, NULL, 0);
+    char scene[512], exr[512], a[512], b[512], err[1024];
+    tu_path(scene, sizeof scene, dir, "scene.json");
+    const char *x[] = { scene, "--quiet", "-o", tu_path(exr, sizeof exr, dir, "out.exr"), NULL };
+    assert_int_equal(tu_run_cli(x, err, sizeof err), 0);
+    FILE *f = fopen(exr, "rb");
+    assert_non_null(f);
+    uint8_t head[512];
+    const size_t n = fread(head, 1, sizeof head, f);
+    fclose(f);
+    static const uint8_t magic[4] = { 0x76, 0x2f, 0x31, 0x01 };
+    assert_true(n > 64 && !memcmp(head, magic, 4));
+    /* The channel list: names NUL-terminated, then 16 bytes each (pixel type 2 = FLOAT first). */
+    const char *names[5] = { "B", "G", "R", "S", "V" };
+    for (int c = 0; c < 5; c++) {
+        int found = 0;
+        for (size_t i = 1; i + 6 < n && !found; i++)
+            found = head[i - 1] == 0 && head[i] == (uint8_t)names[c][0] && head[i + 1] == 0 && head[i + 2] == 2;
+        assert_true(found);
+    }
+    const char *pa[] = { scene, "--quiet", "-o", tu_path(a, sizeof a, dir, "a.png"), NULL };
+    const char *pb[] = { scene, "--quiet", "--exposure", "1.5", "-o", tu_path(b, sizeof b, dir, "b.png"), NULL };
+    assert_int_equal(tu_run_cli(pa, err, sizeof err), 0);
+    assert_int_equal(tu_run_cli(pb, err, sizeof err), 0);
+    const double ma = png_mean(a), mb = png_mean(b);
+    printf("PNG mean byte: exposure 0 %.2f, +1.5 EV %.2f\n", ma, mb);
+    assert_true(ma > 0 && mb > ma + 5);
+    const char *bad[] = { scene, "--quiet", "--exposure", "bright", "-o", tu_path(b, sizeof b, dir, "c.png"), NULL };
+    assert_int_equal(tu_run_cli(bad, err, sizeof err), 2);
+    assert_non_null(strstr(err, "--exposure"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -651,6 +707,7 @@ int main(void)
         cmocka_unit_test(test_normals_change_shading_not_visibility),
         cmocka_unit_test(test_bad_textures),
         cmocka_unit_test(test_obj_mtl_materials),
+        cmocka_unit_test(test_cli_exr_and_exposure),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
