@@ -97,7 +97,7 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
 {
     char *buf, err[1024];
     size_t len;
-    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, err, sizeof err)) {
+    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_AUX, &buf, &len, err, sizeof err)) {
         ms_warn("%s: materials ignored", err);
         return 0;
     }

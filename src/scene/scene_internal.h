@@ -70,7 +70,8 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib);
 uint32_t ms_mtl_find(const ms_mtl_lib *lib, const char *name);
 void ms_mtl_lib_free(ms_mtl_lib *lib);
 
-typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH } ms_input_kind;
+/* MS_INPUT_AUX: a file a mesh refers to (an MTL file, a texture), named "file" in messages. */
+typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH, MS_INPUT_AUX } ms_input_kind;
 /* Reads a whole regular file of at most max_bytes (a FIFO, device or directory is refused without
  * blocking) into a malloc'ed, NUL-terminated buffer. */
 int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char **out, size_t *len, char *err,

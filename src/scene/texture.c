@@ -63,7 +63,7 @@ long ms_soup_add_texture_file(ms_tri_soup *soup, const char *path, int flip_rows
 {
     char *buf;
     size_t len;
-    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, err, errlen)) return -1;
+    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_AUX, &buf, &len, err, errlen)) return -1;
     const long r = ms_soup_add_texture_memory(soup, (const unsigned char *)buf, len, path, flip_rows, err, errlen);
     free(buf);
     return r;
