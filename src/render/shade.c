@@ -112,7 +112,12 @@ float ms_resolve_spec(const ms_render_ctx *ctx, const ms_shadow_query *q, const 
     float nl[3];
     v3_cross(nl, es, et);
     v3_normalize(nl, nl);
-    const float alpha = ms_ggx_alpha(sf->roughness);
+    /* The lobe weight of ms_ggx_f_cos with what is constant per pixel taken out: D G2 / (4 n.v) with
+     * n.h^2 = (n.l + n.v)^2 / |v + l|^2 (no normalisation of h) and Lambda(v) once. */
+    const float alpha = ms_ggx_alpha(sf->roughness), a2 = alpha * alpha;
+    const float cv = v3_dot(sf->n, sf->v);
+    if (!(cv > 0.0f)) return v;   /* the eye below the shading normal's plane: no lobe */
+    const float lv = cv >= 1.0f ? 0.0f : 0.5f * (-1.0f + sqrtf(1.0f + a2 * (1.0f - cv * cv) / (cv * cv)));
     ms_grid g;
     if (!pts) ms_grid_for_pixel(L, k, q->px, q->py, ctx->seed, &g);
     double wf = 0.0, wv = 0.0;
@@ -125,13 +130,20 @@ float ms_resolve_spec(const ms_render_ctx *ctx, const ms_shadow_query *q, const 
             for (int c = 0; c < 3; c++) lp[c] = g.p0[c] + (float)i * g.ds[c] + (float)j * g.dt[c];
         }
         v3_sub(d, lp, q->p);
-        const float r = v3_len(d);
-        if (!(r > 0.0f)) continue;
-        const float cl = -v3_dot(d, nl) / r;
-        if (!(cl > 0.0f)) continue;
-        float l[3];
-        v3_scale(l, d, 1.0f / r);
-        const double w = (double)ms_ggx_f_cos(sf->n, sf->v, l, alpha) * (double)cl / ((double)r * (double)r);
+        const float r2 = v3_dot(d, d);
+        if (!(r2 > 0.0f)) continue;
+        const float inv_r = 1.0f / sqrtf(r2);
+        const float cl = -v3_dot(d, nl) * inv_r;
+        const float nl_ = v3_dot(d, sf->n) * inv_r;
+        if (!(cl > 0.0f) || !(nl_ > 0.0f)) continue;
+        const float vl = v3_dot(d, sf->v) * inv_r;
+        const float hh = 2.0f + 2.0f * vl;   /* |v + l|^2 */
+        if (!(hh > 0.0f)) continue;
+        const float nh2 = (nl_ + cv) * (nl_ + cv) / hh;
+        const float d0 = nh2 * (a2 - 1.0f) + 1.0f;
+        const float ll = nl_ >= 1.0f ? 0.0f : 0.5f * (-1.0f + sqrtf(1.0f + a2 * (1.0f - nl_ * nl_) / (nl_ * nl_)));
+        /* D G2 / (4 n.v) * cos_l / r^2, dropping the constants a2 / (4 pi n.v) common to every sample. */
+        const float w = cl / (r2 * d0 * d0 * (1.0f + lv + ll));
         wf += w;
         if (ms_mask_get(vis, s)) wv += w;
     }
