@@ -18,6 +18,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 /* ---- GGX in double, the oracle's own (height-correlated Smith, as the LTC fit) ---- */
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -698,6 +700,53 @@ static void test_cli_exr_and_exposure(void **st)
     assert_non_null(strstr(err, "--exposure"));
 }
 
+/* Hostile MTL input: an mtllib and a map_Kd that are FIFOs (never opened for a blocking read), a
+ * directory, an absolute path, junk numbers; the scene loads with warnings, each one line. */
+static void test_hostile_mtl(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("shading_hostile_mtl");
+    char path[512], fifo1[512], fifo2[512];
+    unlink(tu_path(fifo1, sizeof fifo1, dir, "fifo.mtl"));
+    unlink(tu_path(fifo2, sizeof fifo2, dir, "fifo.png"));
+    assert_int_equal(mkfifo(fifo1, 0600), 0);
+    assert_int_equal(mkfifo(fifo2, 0600), 0);
+    mkdir(tu_path(path, sizeof path, dir, "adir.png"), 0700);
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "ok.mtl"),
+        "Kd 1 1 1\nnewmtl a\nKd nan inf -3\nPm 1e39\nPr -inf\nmap_Kd fifo.png\nnewmtl b\nmap_Kd adir.png\n"
+        "newmtl c\nmap_Kd /etc/passwd\nnewmtl d\nmap_Kd\nNs -5\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "m.obj"),
+        "mtllib fifo.mtl\nmtllib ok.mtl\nmtllib /abs/x.mtl\nmtllib\n"
+        "v 0 0 0\nv 1 0 0\nv 0 0 1\nusemtl a\nf 1 3 2\nusemtl b\nf 1 3 2\nusemtl nosuch\nf 1 3 2\nusemtl d\nf 1 3 2\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "scene.json"),
+        "{\"meshes\":[{\"file\":\"m.obj\"}],"
+        "\"camera\":{\"eye\":[0,4,4],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":16,\"height\":16},"
+        "\"light\":{\"corner\":[-1,3,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2]}}"), 0);
+    ms_set_warning_handler(catch_warning, NULL);
+    g_warnings = 0;
+    ms_scene sc;
+    char err[512];
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "scene.json"), &sc, err, sizeof err), 0);
+    ms_set_warning_handler(NULL, NULL);
+    printf("%d warnings, the last: %s\n", g_warnings, g_warning);
+    assert_true(g_warnings >= 5);   /* fifo.mtl, /abs/x.mtl, fifo.png, adir.png, /etc/passwd */
+    assert_int_equal((int)sc.n_materials, 4);
+    assert_int_equal((int)sc.n_textures, 0);
+    for (size_t i = 0; i < sc.n_materials; i++) {
+        const ms_material *m = &sc.materials[i];
+        for (int c = 0; c < 4; c++) assert_true(m->base_color[c] >= 0 && m->base_color[c] <= 1);
+        assert_true(m->metallic >= 0 && m->metallic <= 1 && m->roughness >= 0 && m->roughness <= 1);
+    }
+    assert_int_equal(sc.tri_material[2], MS_NO_MATERIAL);   /* usemtl nosuch */
+    ms_frame fr;
+    ms_render_options o;
+    tu_render_options_default(&o);
+    assert_int_equal(ms_render(&sc, &o, &fr, err, sizeof err), 0);
+    for (size_t i = 0; i < 3 * (size_t)fr.width * fr.height; i++) assert_true(isfinite(fr.rgb[i]));
+    ms_frame_free(&fr);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -708,6 +757,7 @@ int main(void)
         cmocka_unit_test(test_bad_textures),
         cmocka_unit_test(test_obj_mtl_materials),
         cmocka_unit_test(test_cli_exr_and_exposure),
+        cmocka_unit_test(test_hostile_mtl),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
