@@ -85,9 +85,10 @@ void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const 
         m->base_color_uv < MS_MAX_UV_SETS && s->tri_uv[m->base_color_uv]) {
         const float *uv = s->tri_uv[m->base_color_uv] + 6 * t;
         const float u = b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4], v = b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5];
-        if (isfinite(u) && isfinite(v)) {
+        const ms_texture *tx = &s->textures[m->base_color_texture];
+        if (isfinite(u) && isfinite(v) && tx->rgba && tx->width > 0 && tx->height > 0) {
             float tex[4];
-            texture_rgba(&s->textures[m->base_color_texture], u, v, tex);
+            texture_rgba(tx, u, v, tex);
             for (int c = 0; c < 4; c++) base[c] *= tex[c];
         }
     }
