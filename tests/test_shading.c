@@ -325,6 +325,8 @@ static const float MAT1_METAL = 0.5f, MAT1_ROUGH = 0.5f;
  * quads: x in [-2, 0] material 0, x in [0, 2] material 1 with u = 0.25 + 0.25 x, v = 0.5 (so the base colour
  * runs from texel A's centre at x = 0 to texel B's at x = 2). occluder: a quad at y = 1.2 over the middle.
  * tilt: NORMAL attributes leaning towards +x (0 none). image: the PNG's bytes (NULL: the tiny texture). */
+static int g_image_mode;   /* the glTF's image: 0 the file tex.png, 1 a base64 data: URI, 2 a bufferView */
+
 static void write_gltf_scene(const char *dir, int occluder, float tilt, const uint8_t *image, size_t image_len)
 {
     enum { MAXV = 18 };
@@ -344,13 +346,6 @@ static void write_gltf_scene(const char *dir, int occluder, float tilt, const ui
             for (int c = 0; c < 3; c++) nrm[nv][c] = nn[c] / l;
         }
     }
-    uint8_t buf[MAXV * 8 * 4];
-    size_t bl = 0;
-    memcpy(buf, pos, (size_t)nv * 12); bl += (size_t)nv * 12;
-    memcpy(buf + bl, uv, (size_t)nv * 8); bl += (size_t)nv * 8;
-    memcpy(buf + bl, nrm, (size_t)nv * 12); bl += (size_t)nv * 12;
-    char b64[sizeof buf * 2];
-    base64(buf, bl, b64);
     char path[512];
     uint8_t png[256];
     size_t pl;
@@ -361,6 +356,21 @@ static void write_gltf_scene(const char *dir, int occluder, float tilt, const ui
         memcpy(texels + 4, TEX_B, 4);
         pl = tiny_png(texels, 2, 1, png);
     }
+    uint8_t buf[MAXV * 8 * 4 + 256];
+    size_t bl = 0;
+    memcpy(buf, pos, (size_t)nv * 12); bl += (size_t)nv * 12;
+    memcpy(buf + bl, uv, (size_t)nv * 8); bl += (size_t)nv * 8;
+    memcpy(buf + bl, nrm, (size_t)nv * 12); bl += (size_t)nv * 12;
+    const size_t png_at = bl;
+    memcpy(buf + bl, png, pl);   /* bufferView 3 (used by image mode 2) */
+    bl += pl;
+    char b64[sizeof buf * 2];
+    base64(buf, bl, b64);
+    char images[1024], png64[512];
+    base64(png, pl, png64);
+    if (g_image_mode == 0) snprintf(images, sizeof images, "[{\"uri\":\"tex.png\"}]");
+    else if (g_image_mode == 1) snprintf(images, sizeof images, "[{\"uri\":\"data:image/png;base64,%s\"}]", png64);
+    else snprintf(images, sizeof images, "[{\"bufferView\":3,\"mimeType\":\"image/png\"}]");
     FILE *f = fopen(tu_path(path, sizeof path, dir, "tex.png"), "wb");
     assert_non_null(f);
     assert_int_equal(fwrite(png, 1, pl, f), pl);
@@ -385,13 +395,13 @@ static void write_gltf_scene(const char *dir, int occluder, float tilt, const ui
         "\"meshes\":[{\"primitives\":[%s]}],"
         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[%g,%g,%g,1],\"metallicFactor\":%g,\"roughnessFactor\":%g}},"
         "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"metallicFactor\":%g,\"roughnessFactor\":%g}}],"
-        "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"tex.png\"}],"
+        "\"textures\":[{\"source\":0}],\"images\":%s,"
         "\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
         "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d},"
-        "{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d}],"
+        "{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}],"
         "\"accessors\":[%s]}",
-        prims, MAT0_BASE[0], MAT0_BASE[1], MAT0_BASE[2], MAT0_METAL, MAT0_ROUGH, MAT1_METAL, MAT1_ROUGH, bl, b64,
-        nv * 12, nv * 12, nv * 8, nv * 20, nv * 12, acc);
+        prims, MAT0_BASE[0], MAT0_BASE[1], MAT0_BASE[2], MAT0_METAL, MAT0_ROUGH, MAT1_METAL, MAT1_ROUGH, images, bl, b64,
+        nv * 12, nv * 12, nv * 8, nv * 20, nv * 12, png_at, pl, acc);
     assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "scene.gltf"), gl), 0);
     assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "scene.json"),
         "{\"meshes\":[{\"file\":\"scene.gltf\"}],"
@@ -429,8 +439,13 @@ static int load_and_render(const char *dir, ms_scene *sc, ms_frame *fr, const ch
 static void test_gltf_materials(void **st)
 {
     (void)st;
+  for (g_image_mode = 0; g_image_mode < 3; g_image_mode++) {
     const char *dir = tu_tmpdir("shading_gltf");
     write_gltf_scene(dir, 0, 0.0f, NULL, 0);
+    if (g_image_mode) {   /* the image must come from inside the glTF, not the file */
+        char tp[512];
+        assert_int_equal(unlink(tu_path(tp, sizeof tp, dir, "tex.png")), 0);
+    }
     ms_scene sc;
     ms_frame fr;
     assert_int_equal(load_and_render(dir, &sc, &fr, NULL), 0);
@@ -475,11 +490,14 @@ static void test_gltf_materials(void **st)
             }
             checked[m]++;
         }
-    printf("glTF materials: %d pixels of material 0, %d of material 1 (textured) match, worst relative error %.2g\n",
-           checked[0], checked[1], worst);
+    printf("glTF materials (image from %s): %d pixels of material 0, %d of material 1 (textured) match, worst relative "
+           "error %.2g\n", g_image_mode == 0 ? "a file" : g_image_mode == 1 ? "a data URI" : "a bufferView", checked[0],
+           checked[1], worst);
     assert_true(checked[0] > 50 && checked[1] > 50);
     ms_frame_free(&fr);
     ms_scene_free(&sc);
+  }
+  g_image_mode = 0;
 }
 
 /* Smooth normals: tilted NORMALs change the colours but not V, S (visibility stays geometric), for a
