@@ -155,13 +155,6 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         progress_tick(&prog);
     }
     double t1 = omp_get_wtime();
-    if (!streamed && (scene->tri_material || scene->tri_normal)) {
-        surf = malloc(npix * sizeof *surf);
-        if (!surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); sm->destroy(sstate); pm->destroy(pstate); goto fail; }
-        const float eye[3] = { scene->camera.eye.x, scene->camera.eye.y, scene->camera.eye.z };
-#pragma omp parallel for schedule(static) num_threads(threads)
-        for (size_t i = 0; i < npix; i++) ms_surface_at(scene, &bvh, &hits[i], eye, &surf[i]);
-    }
 
     uint64_t counters[MS_MAX_COUNTERS] = { 0 };
     uint64_t visible = 0, penumbra = 0, segments = 0;
@@ -170,6 +163,15 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     const size_t mw = (size_t)ctx.mask_words;
     const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
     const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
+    /* The surfaces (material, shading normal) of the hits: S_spec needs them with the masks. Timed with
+     * the shadow phase (a lookup per pixel, far below the shadow cost). */
+    if (!streamed && (scene->tri_material || scene->tri_normal)) {
+        surf = malloc(npix * sizeof *surf);
+        if (!surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); sm->destroy(sstate); pm->destroy(pstate); goto fail; }
+        const float eye[3] = { scene->camera.eye.x, scene->camera.eye.y, scene->camera.eye.z };
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (size_t i = 0; i < npix; i++) ms_surface_at(scene, &bvh, &hits[i], eye, &surf[i]);
+    }
 #pragma omp parallel num_threads(threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
