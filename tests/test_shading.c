@@ -557,12 +557,12 @@ static void test_bad_textures(void **st)
     (void)st;
     const char *dir = tu_tmpdir("shading_bad_tex");
     static const uint8_t jpeg[16] = { 0xFF, 0xD8, 0xFF, 0xE0, 0, 16, 'J', 'F', 'I', 'F', 0 };
-    uint8_t big[64];
+    uint8_t big[128];
     const uint8_t one[4] = { 1, 2, 3, 4 };
     size_t bn = tiny_png(one, 1, 1, big);
     put32(big + 16, 20000);   /* IHDR width past the texture limit, with its CRC made right again */
     put32(big + 29, crc32_of(big + 12, 17));
-    uint8_t cut[64];
+    uint8_t cut[128];
     size_t cn = tiny_png(one, 1, 1, cut) - 20;   /* ends inside IDAT */
     const struct { const uint8_t *b; size_t n; const char *needle; } cases[4] = {
         { jpeg, sizeof jpeg, "JPEG textures are not supported" },
