@@ -100,7 +100,34 @@ typedef struct ms_scene {
     float *tri_uv[MS_MAX_UV_SETS];
     size_t n_meshes;
     ms_procedural procedural;
+    /* Surfaces (docs/shading.md; NULL/0 where no mesh has them; ms_scene_free frees them). tri_material[i]:
+     * index into materials of triangle i, or MS_NO_MATERIAL (the default Lambertian grey of albedo 0.8).
+     * tri_normal[9*i .. 9*i+8]: the shading normals of its three vertices, NaN where its mesh has none
+     * (then the geometric normal shades). Visibility (V, S) never uses either. */
+    struct ms_material *materials;
+    size_t n_materials;
+    uint32_t *tri_material;
+    float *tri_normal;
+    struct ms_texture *textures;
+    size_t n_textures;
 } ms_scene;
+
+#define MS_NO_MATERIAL UINT32_MAX
+
+/* An 8-bit RGBA image, sRGB-encoded colour, row 0 at v = 0 (glTF's convention). */
+typedef struct ms_texture {
+    int width, height;
+    uint8_t *rgba;
+} ms_texture;
+
+/* glTF 2.0 metallic-roughness (OBJ/MTL maps Kd/map_Kd, Pr, Pm onto it). base = base_color * texture
+ * (sampled bilinearly with repeat at the triangle's UVs of set base_color_uv). */
+typedef struct ms_material {
+    float base_color[4];       /* linear RGBA factor */
+    float metallic, roughness; /* in [0, 1]; roughness is perceptual: GGX alpha = roughness^2 */
+    int32_t base_color_texture;/* index into ms_scene.textures, -1: none */
+    int32_t base_color_uv;     /* UV set (0 .. MS_MAX_UV_SETS-1) of the texture's coordinates */
+} ms_material;
 
 /* Triangles [first, first + count) of a procedural scene (9 floats each) into out. */
 void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, float *out);
@@ -236,9 +263,13 @@ typedef struct ms_frame {
                        * pixel); 0 on misses */
     /* With the interleaved pattern (filter on) vis and shadow hold the filtered values: each mixes 16
      * pixels' sample sets, so they are not comparable sample for sample with another method's. */
-    float *rgb;       /* 3*width*height linear radiance: albedo/pi * E_unshadowed * S * emission */
+    float *rgb;       /* 3*width*height linear radiance (docs/shading.md): emission * (c_diff/pi *
+                       * E_unshadowed * S + F * LTC_GGX * S_spec); without materials albedo 0.8, no specular */
     float exposure;   /* scale that maps the 99th percentile of unshadowed radiance to 1 (for PNG) */
     ms_stats stats;
+    /* width*height: the specular shadow factor S_spec (docs/shading.md), S where the pixel's material has
+     * no specular lobe; -1 where the primary ray missed. */
+    float *shadow_spec;
 } ms_frame;
 
 int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,

@@ -72,7 +72,10 @@ class _Scene(ctypes.Structure):
     _fields_ = [("tri", ctypes.POINTER(_f)), ("n_tris", ctypes.c_size_t), ("camera", _Camera), ("light", _Light),
                 ("samples", ctypes.c_int), ("load_s", ctypes.c_double),
                 ("tri_mesh", ctypes.POINTER(ctypes.c_uint32)), ("tri_uv", ctypes.POINTER(_f) * MAX_UV_SETS),
-                ("n_meshes", ctypes.c_size_t)]
+                ("n_meshes", ctypes.c_size_t), ("procedural_type", ctypes.c_int), ("procedural_seed", ctypes.c_uint32),
+                # surfaces (materials, shading normals, textures): read by the library only
+                ("materials", _p), ("n_materials", ctypes.c_size_t), ("tri_material", ctypes.POINTER(ctypes.c_uint32)),
+                ("tri_normal", ctypes.POINTER(_f)), ("textures", _p), ("n_textures", ctypes.c_size_t)]
 
 
 class _Stats(ctypes.Structure):
@@ -89,7 +92,8 @@ class _Stats(ctypes.Structure):
 class _Frame(ctypes.Structure):
     _fields_ = [("width", ctypes.c_int), ("height", ctypes.c_int), ("vis", ctypes.POINTER(_f)),
                 ("shadow", ctypes.POINTER(_f)), ("front", ctypes.POINTER(ctypes.c_uint16)),
-                ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats)]
+                ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats),
+                ("shadow_spec", ctypes.POINTER(_f))]
 
 
 _PROGRESS = ctypes.CFUNCTYPE(None, _p, ctypes.c_double)

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,7 +31,10 @@ static void usage(FILE *f)
         "  --width W, --height H   image size (default: the scene camera's)\n"
         "  --threads T         threads (default: all cores)\n"
         "  --seed S            seed of the per-pixel sample patterns (default 0)\n"
-        "  -o OUT.png          shaded image (default microshadow.png)\n"
+        "  -o OUT.png|.exr     shaded image (default microshadow.png): PNG tone-mapped sRGB, EXR linear HDR\n"
+        "                      radiance (channels R, G, B, V, S)\n"
+        "  --exposure EV       PNG: stops added to the automatic exposure (which maps the 99th percentile of\n"
+        "                      unshadowed radiance to 1): the PNG shows radiance * 2^EV * auto (default 0)\n"
         "  --vis OUT.pfm|.exr  float visibility V, -1 where the primary ray missed\n"
         "  --shadow OUT.pfm|.exr  float shadow factor S, -1 where the primary ray missed\n"
         "  --stats OUT.json    timings and counters\n"
@@ -73,7 +77,8 @@ int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
-           O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER };
+           O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
+           O_EXPOSURE };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -83,6 +88,7 @@ int main(int argc, char **argv)
         { "stats", required_argument, 0, O_STATS }, { "quiet", no_argument, 0, O_QUIET },
         { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
         { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
+        { "exposure", required_argument, 0, O_EXPOSURE },
         { 0, 0, 0, 0 } };
     ms_render_options opt;
     ms_render_options_default(&opt);
@@ -110,6 +116,7 @@ int main(int argc, char **argv)
     enum { OUT_PNG, OUT_VIS, OUT_SHADOW, OUT_STATS, N_OUTS = sizeof outs / sizeof outs[0] };
     int quiet = 0, c;
     long v;
+    double exposure_ev = 0.0;   /* --exposure: stops on top of the automatic exposure (PNG only) */
     opterr = 0;
     while ((c = getopt_long(argc, argv, "o:h", longopts, NULL)) != -1) {
         switch (c) {
@@ -150,6 +157,16 @@ int main(int argc, char **argv)
         case O_STATS: outs[OUT_STATS].path = optarg; break;
         case O_QUIET: quiet = 1; break;
         case O_NO_FILTER: opt.no_filter = 1; break;
+        case O_EXPOSURE: {
+            char *end;
+            errno = 0;
+            exposure_ev = strtod(optarg, &end);
+            if (end == optarg || *end || errno || !(exposure_ev >= -64.0 && exposure_ev <= 64.0)) {
+                fprintf(stderr, "microshadow: --exposure: '%s' is not a number of stops in [-64, 64]\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        }
         case 'h': case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("microshadow %s\n", MS_VERSION_STRING); return 0;
         default:
@@ -162,6 +179,9 @@ int main(int argc, char **argv)
     }
     if (argc - optind > 1) { fprintf(stderr, "microshadow: more than one scene file given\n"); return EXIT_BAD_INPUT; }
     const char *scene_path = optind < argc ? argv[optind] : NULL;
+    /* -o OUT.exr: linear HDR radiance (R, G, B, with V and S) instead of the tone-mapped PNG. */
+    const size_t olen = strlen(outs[OUT_PNG].path);
+    if (olen >= 4 && !strcasecmp(outs[OUT_PNG].path + olen - 4, ".exr")) outs[OUT_PNG].write = ms_exr_write_stream;
 
     int avail = ms_method_available(opt.method);
     if (avail <= 0) {
@@ -195,6 +215,7 @@ int main(int argc, char **argv)
         ms_scene_free(&scene);
         return EXIT_BAD_INPUT;
     }
+    frame.exposure *= (float)exp2(exposure_ev);
     int rc = ms_outputs_write(&frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
     if (rc) fprintf(stderr, "microshadow: %s\n", err);
     if (!quiet && rc == 0) {

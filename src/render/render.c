@@ -7,6 +7,7 @@
 #include "shadow_frame.h"
 #include "render_materialise.h"
 #include "interleave_filter.h"
+#include "shade.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -17,7 +18,6 @@
 #define TILE 16
 #define MS_NEAR 1e-4f        /* segment parameter: occluders closer than this to the receiver are ignored */
 #define MS_FAR (1.0f - 1e-4f)/* ... and this close to the light plane (a light set into a ceiling) */
-#define MS_ALBEDO 0.8f
 
 void ms_render_options_default(ms_render_options *o)
 {
@@ -33,6 +33,7 @@ void ms_frame_free(ms_frame *f)
     free(f->shadow);
     free(f->front);
     free(f->rgb);
+    free(f->shadow_spec);
     memset(f, 0, sizeof *f);
 }
 
@@ -139,9 +140,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     out->shadow = malloc(npix * sizeof(float));
     out->front = malloc(npix * sizeof *out->front);
     out->rgb = malloc(npix * 3 * sizeof(float));
+    out->shadow_spec = malloc(npix * sizeof(float));
+    ms_surface *surf = NULL;   /* per pixel, only for scenes with materials or normals (shade.h) */
     void *pstate = NULL, *sstate = NULL;
     int rc = -1;
-    if (!hits || !out->vis || !out->shadow || !out->front || !out->rgb) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); goto fail; }
+    if (!hits || !out->vis || !out->shadow || !out->front || !out->rgb || !out->shadow_spec) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); goto fail; }
     const double t_setup = omp_get_wtime();
     if (pm->create(&ctx, &pstate, err, errlen)) goto fail;
     if (sm->create(&ctx, &sstate, err, errlen)) { pm->destroy(pstate); goto fail; }
@@ -171,6 +174,15 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     const size_t mw = (size_t)ctx.mask_words;
     const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
     const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
+    /* The surfaces (material, shading normal) of the hits: S_spec needs them with the masks. Timed with
+     * the shadow phase (a lookup per pixel, far below the shadow cost). */
+    if (!streamed && (scene->tri_material || scene->tri_normal)) {
+        surf = malloc(npix * sizeof *surf);
+        if (!surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); sm->destroy(sstate); pm->destroy(pstate); goto fail; }
+        const float eye[3] = { scene->camera.eye.x, scene->camera.eye.y, scene->camera.eye.z };
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (size_t i = 0; i < npix; i++) ms_surface_at(scene, &bvh, &hits[i], eye, &surf[i]);
+    }
 #pragma omp parallel num_threads(threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
@@ -192,7 +204,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
                 for (int x = x0; x < x1; x++) {
                     size_t i = (size_t)y * W + x;
                     const ms_hit *h = &hits[i];
-                    if (h->prim == UINT32_MAX) { out->vis[i] = out->shadow[i] = -1.0f; out->front[i] = 0; continue; }
+                    if (h->prim == UINT32_MAX) { out->vis[i] = out->shadow[i] = out->shadow_spec[i] = -1.0f; out->front[i] = 0; continue; }
                     memcpy(q[n].p, h->p, sizeof h->p);
                     memcpy(q[n].n, h->n, sizeof h->n);
                     q[n].prim = h->prim;
@@ -211,6 +223,9 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
                 local_penumbra += (uint64_t)ms_resolve_vs(&ctx, &q[i], pts, front + (size_t)i * mw,
                                                           vmask + (size_t)i * mw, &out->vis[where[i]],
                                                           &out->shadow[where[i]]);
+                out->shadow_spec[where[i]] = surf && surf[where[i]].specular
+                    ? ms_resolve_spec(&ctx, &q[i], pts, front + (size_t)i * mw, vmask + (size_t)i * mw, &surf[where[i]])
+                    : out->shadow[where[i]];
             }
             local_resolve += omp_get_wtime() - tr;
             local_visible += (uint64_t)n;
@@ -230,8 +245,8 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         }
     }
     if (sm->visibility_all && !failed)
-        failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, W, H, out, counters, &visible, &penumbra, &segments,
-                                       &resolve_thread_s) != 0;
+        failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, surf, W, H, out, counters, &visible, &penumbra,
+                                       &segments, &resolve_thread_s) != 0;
     if (failed) {
         snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);
         sm->destroy(sstate);
@@ -242,30 +257,37 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     double filter_s = 0.0;
     if (ctx.pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter) {
         const double tf = omp_get_wtime();
-        if (ms_interleave_filter(W, H, hits, out->front, out->vis, out->shadow, threads)) {
+        /* S_spec through the same filter, with the same raw V deciding the neighbours. */
+        float *raw_vis = surf ? malloc(npix * sizeof *raw_vis) : NULL;
+        if (raw_vis) memcpy(raw_vis, out->vis, npix * sizeof *raw_vis);
+        if ((surf && !raw_vis) || ms_interleave_filter(W, H, hits, out->front, out->vis, out->shadow, threads) ||
+            (raw_vis && ms_interleave_filter(W, H, hits, out->front, raw_vis, out->shadow_spec, threads))) {
+            free(raw_vis);
             snprintf(err, errlen, "out of memory for the interleaved filter of a %dx%d frame", W, H);
             sm->destroy(sstate);
             pm->destroy(pstate);
             goto fail;
         }
+        free(raw_vis);
         filter_s = omp_get_wtime() - tf;
     }
     double t2 = omp_get_wtime();
     const double c2 = process_cpu_s();
 
-    /* Shading: the exact unshadowed irradiance times the shadow factor S (the ratio estimator: exact where
-     * the light is wholly visible or hidden, converging to the shadowed irradiance as k grows). */
+    /* Shading (shade.h): the exact unshadowed irradiance times S, plus the LTC specular times S_spec (ratio
+     * estimators: exact where the light is wholly visible or hidden, converging as k grows). */
     float *lum = malloc(npix * sizeof(float));
     size_t nlum = 0;
     const ms_light *L = &scene->light;
+    const float eye[3] = { scene->camera.eye.x, scene->camera.eye.y, scene->camera.eye.z };
     for (size_t i = 0; i < npix; i++) {
         float *c = out->rgb + 3 * i;
         if (hits[i].prim == UINT32_MAX) { c[0] = c[1] = c[2] = 0.0f; continue; }
-        float e = ms_light_irradiance(L, hits[i].p, hits[i].n) * MS_ALBEDO / (float)M_PI;
-        c[0] = e * L->emission.x * out->shadow[i];
-        c[1] = e * L->emission.y * out->shadow[i];
-        c[2] = e * L->emission.z * out->shadow[i];
-        if (lum) lum[nlum++] = e * (0.2126f * L->emission.x + 0.7152f * L->emission.y + 0.0722f * L->emission.z);
+        ms_surface grey;
+        if (!surf) ms_surface_at(scene, NULL, &hits[i], eye, &grey);
+        float u;
+        ms_shade(L, hits[i].p, surf ? &surf[i] : &grey, out->shadow[i], out->shadow_spec[i], c, &u);
+        if (lum) lum[nlum++] = u;
     }
     out->exposure = 1.0f;
     if (lum && nlum) {
@@ -315,6 +337,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     rc = 0;
 fail:
     free(hits);
+    free(surf);
     ms_bvh_free(&bvh);
     if (rc) ms_frame_free(out);
     return rc;

@@ -1,6 +1,7 @@
 /* OBJ, PLY, OFF and STL through assimp, from memory, after ms_preflight_* accepted the bytes: every
  * triangle of every mesh instance, in world space. */
 #include "scene_internal.h"
+#include "microshadow.h"
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -29,7 +30,23 @@ static void mat_mul(struct aiMatrix4x4 *r, const struct aiMatrix4x4 *a, const st
     memcpy(&r->a1, R, sizeof R);
 }
 
-typedef struct walk_ctx { const struct aiScene *sc; ms_tri_soup *soup; size_t added, max_tris; int full; } walk_ctx;
+typedef struct walk_ctx {
+    const struct aiScene *sc;
+    ms_tri_soup *soup;
+    size_t added, max_tris;
+    int full;
+    const ms_mtl_lib *mtl;   /* OBJ: the materials of its MTL files, by name (NULL: none) */
+} walk_ctx;
+
+/* The soup material of an assimp material: for OBJ by its name (usemtl) in the MTL files. */
+static uint32_t material_of(const walk_ctx *w, const struct aiMesh *mesh)
+{
+    if (!w->mtl || mesh->mMaterialIndex >= w->sc->mNumMaterials) return MS_NO_MATERIAL;
+    struct aiString name;
+    if (aiGetMaterialString(w->sc->mMaterials[mesh->mMaterialIndex], AI_MATKEY_NAME, &name) != aiReturn_SUCCESS)
+        return MS_NO_MATERIAL;
+    return ms_mtl_find(w->mtl, name.data);
+}
 
 static int walk(walk_ctx *w, const struct aiNode *node, const struct aiMatrix4x4 *parent, int depth)
 {
@@ -39,16 +56,29 @@ static int walk(walk_ctx *w, const struct aiNode *node, const struct aiMatrix4x4
     for (unsigned i = 0; i < node->mNumMeshes; i++) {
         if (node->mMeshes[i] >= w->sc->mNumMeshes) continue;
         const struct aiMesh *mesh = w->sc->mMeshes[node->mMeshes[i]];
+        const uint32_t material = material_of(w, mesh);
+        /* Normals to world space by the cofactor matrix of m (the inverse transpose up to scale). */
+        const float *M = &m.a1;
+        float cof[9];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++) {
+                const int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+                cof[3 * r + c] = M[4 * r1 + c1] * M[4 * r2 + c2] - M[4 * r1 + c2] * M[4 * r2 + c1];
+            }
         for (unsigned f = 0; f < mesh->mNumFaces; f++) {
             const struct aiFace *face = &mesh->mFaces[f];
             if (face->mNumIndices != 3) continue;   /* points and lines cast no shadow */
-            float v[9], uv[MS_SOUP_UV_SETS][6];
+            float v[9], uv[MS_SOUP_UV_SETS][6], nv[9];
             const float *uvp[MS_SOUP_UV_SETS] = { NULL };
             int ok = 1;
             for (int k = 0; k < 3; k++) {
                 unsigned idx = face->mIndices[k];
                 if (idx >= mesh->mNumVertices) { ok = 0; break; }
                 xform(&m, &mesh->mVertices[idx], v + 3 * k);
+                if (mesh->mNormals) {
+                    const struct aiVector3D *q = &mesh->mNormals[idx];
+                    for (int r = 0; r < 3; r++) nv[3 * k + r] = cof[3 * r] * q->x + cof[3 * r + 1] * q->y + cof[3 * r + 2] * q->z;
+                }
                 /* UV channel s of the mesh is UV set s (baking); a channel may be absent. */
                 for (int s = 0; s < MS_SOUP_UV_SETS && s < AI_MAX_NUMBER_OF_TEXTURECOORDS; s++) {
                     if (!mesh->mTextureCoords[s]) continue;
@@ -59,7 +89,7 @@ static int walk(walk_ctx *w, const struct aiNode *node, const struct aiMatrix4x4
             }
             if (!ok) continue;
             if (w->added == w->max_tris) { w->full = 1; return -1; }
-            if (ms_soup_push_uv(w->soup, v, uvp)) return -1;
+            if (ms_soup_push_full(w->soup, v, uvp, material, mesh->mNormals ? nv : NULL)) return -1;
             w->added++;
         }
     }
@@ -76,12 +106,36 @@ int ms_mesh_assimp(const char *buf, size_t len, const char *ext, const char *pat
     /* An OBJ's "mtllib" would make assimp open that path itself (a FIFO there hangs it), and materials
      * cast no shadow: comment those lines out in a copy. */
     char *copy = NULL;
+    ms_mtl_lib mtl;
+    memset(&mtl, 0, sizeof mtl);
     if (!strcmp(ext, "obj")) {
         copy = malloc(len + 1);
         if (!copy) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
         memcpy(copy, buf, len + 1);
+        /* ... and the MTL files are read here instead (mtl.c), relative to the OBJ. */
+        const char *slash = strrchr(path, '/');
+        const int dl = slash ? (int)(slash - path + 1) : 0;
         for (size_t i = 0; i + 6 <= len; i++)
-            if ((i == 0 || copy[i - 1] == '\n' || copy[i - 1] == '\r') && !memcmp(copy + i, "mtllib", 6)) copy[i] = '#';
+            if ((i == 0 || copy[i - 1] == '\n' || copy[i - 1] == '\r') && !memcmp(copy + i, "mtllib", 6) &&
+                (copy[i + 6] == ' ' || copy[i + 6] == '\t')) {
+                copy[i] = '#';
+                size_t a = i + 7, e = a;
+                while (a < len && (copy[a] == ' ' || copy[a] == '\t')) a++;
+                for (e = a; e < len && copy[e] != '\n' && copy[e] != '\r'; e++) {}
+                while (e > a && (copy[e - 1] == ' ' || copy[e - 1] == '\t')) e--;
+                char mpath[4096];
+                if (e == a) continue;
+                if (copy[a] == '/' || snprintf(mpath, sizeof mpath, "%.*s%.*s", dl, path, (int)(e - a), copy + a) >= (int)sizeof mpath) {
+                    ms_warn("%s: mtllib '%.*s': only relative paths are read: materials ignored", path, (int)(e - a > 200 ? 200 : e - a), copy + a);
+                    continue;
+                }
+                if (ms_mtl_load(mpath, soup, &mtl)) {
+                    snprintf(err, errlen, "%s: out of memory reading its materials", path);
+                    ms_mtl_lib_free(&mtl);
+                    free(copy);
+                    return -1;
+                }
+            }
         buf = copy;
     }
     /* From memory, so that assimp reads exactly the bytes that were checked; the hint picks the one
@@ -98,14 +152,16 @@ int ms_mesh_assimp(const char *buf, size_t len, const char *ext, const char *pat
         first[strcspn(first, "\r\n")] = 0;
         snprintf(err, errlen, "%s: assimp cannot read the mesh: %s", path, first);
         if (sc) aiReleaseImport(sc);
+        ms_mtl_lib_free(&mtl);
         return -1;
     }
     struct aiMatrix4x4 id;
     memset(&id, 0, sizeof id);
     id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
-    walk_ctx w = { sc, soup, 0, (len + 64) * MS_MAX_TRIS_PER_BYTE, 0 };
+    walk_ctx w = { sc, soup, 0, (len + 64) * MS_MAX_TRIS_PER_BYTE, 0, mtl.n ? &mtl : NULL };
     int rc = walk(&w, sc->mRootNode, &id, 0);
     aiReleaseImport(sc);
+    ms_mtl_lib_free(&mtl);
     *added = w.added;
     if (rc && w.full) {
         snprintf(err, errlen, "%s: the mesh expands to more than %zu triangles (%d per byte of file)", path,

@@ -2,7 +2,9 @@
  * and lets us bound its memory (an allocator with a budget), read external buffers ourselves
  * (regular files only) and check every accessor we read against the bytes behind it. */
 #include "scene_internal.h"
+#include "microshadow.h"
 #include "cgltf.h"
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -111,8 +113,8 @@ static void mat4_mul(float r[16], const float a[16], const float b[16])   /* col
     memcpy(r, t, sizeof t);
 }
 
-static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_soup *soup, size_t *added,
-                          size_t max_tris, const char *path, char *err, size_t errlen)
+static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_primitive *pr, const float m[16],
+                          ms_tri_soup *soup, size_t *added, size_t max_tris, const char *path, char *err, size_t errlen)
 {
     if (pr->type != cgltf_primitive_type_triangles && pr->type != cgltf_primitive_type_triangle_strip &&
         pr->type != cgltf_primitive_type_triangle_fan)
@@ -131,6 +133,22 @@ static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_s
             a->data->type == cgltf_type_vec2 && a->data->count == pos->count && accessor_ok(a->data, why, sizeof why))
             tc[a->index] = a->data;
     }
+    /* NORMAL: shading normals (an unusable accessor is ignored like an absent one: the geometric normal
+     * shades), carried to world space by the cofactor matrix of m (the inverse transpose up to scale). */
+    const cgltf_accessor *nrm = NULL;
+    for (size_t i = 0; i < pr->attributes_count; i++) {
+        const cgltf_attribute *a = &pr->attributes[i];
+        if (a->type == cgltf_attribute_type_normal && a->index == 0 && a->data && a->data->type == cgltf_type_vec3 &&
+            a->data->count == pos->count && accessor_ok(a->data, why, sizeof why))
+            nrm = a->data;
+    }
+    float cof[9];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            const int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            cof[3 * r + c] = m[4 * c1 + r1] * m[4 * c2 + r2] - m[4 * c2 + r1] * m[4 * c1 + r2];
+        }
+    const uint32_t material = pr->material && mat_of ? (uint32_t)mat_of[pr->material - d->materials] : MS_NO_MATERIAL;
     if (pos->type != cgltf_type_vec3) { snprintf(err, errlen, "%s: POSITION is not a VEC3 accessor", path); return -1; }
     if (!accessor_ok(pos, why, sizeof why)) { snprintf(err, errlen, "%s: %s", path, why); return -1; }
     const cgltf_accessor *ix = pr->indices;
@@ -154,7 +172,7 @@ static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_s
         if (pr->type == cgltf_primitive_type_triangles) { corner[0] = 3 * t; corner[1] = 3 * t + 1; corner[2] = 3 * t + 2; }
         else if (pr->type == cgltf_primitive_type_triangle_strip) { corner[0] = t; corner[1] = t + 1 + (t & 1); corner[2] = t + 2 - (t & 1); }
         else { corner[0] = t + 1; corner[1] = t + 2; corner[2] = 0; }
-        float v[9], uv[MS_SOUP_UV_SETS][6];
+        float v[9], uv[MS_SOUP_UV_SETS][6], nv[9];
         const float *uvp[MS_SOUP_UV_SETS] = { NULL };
         for (int k = 0; k < 3; k++) {
             size_t idx = ix ? cgltf_accessor_read_index(ix, corner[k]) : corner[k];
@@ -165,6 +183,11 @@ static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_s
             float p[3] = { 0, 0, 0 };
             cgltf_accessor_read_float(pos, idx, p, 3);
             for (int r = 0; r < 3; r++) v[3 * k + r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+            if (nrm) {
+                float q[3] = { 0, 0, 0 };
+                cgltf_accessor_read_float(nrm, idx, q, 3);
+                for (int r = 0; r < 3; r++) nv[3 * k + r] = cof[3 * r] * q[0] + cof[3 * r + 1] * q[1] + cof[3 * r + 2] * q[2];
+            }
             for (int st = 0; st < MS_SOUP_UV_SETS; st++) {
                 if (!tc[st]) continue;
                 uv[st][2 * k] = uv[st][2 * k + 1] = 0.0f;
@@ -172,18 +195,114 @@ static int emit_primitive(const cgltf_primitive *pr, const float m[16], ms_tri_s
                 uvp[st] = uv[st];
             }
         }
-        if (ms_soup_push_uv(soup, v, uvp)) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+        if (ms_soup_push_full(soup, v, uvp, material, nrm ? nv : NULL)) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
         (*added)++;
     }
     return 0;
+}
+
+/* Image i of the glTF as a soup texture: from its buffer view, a data: URI or a file beside the glTF. */
+static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, const char *path, ms_tri_soup *soup,
+                       char *err, size_t errlen)
+{
+    const cgltf_image *im = &d->images[i];
+    char what[64];
+    snprintf(what, sizeof what, "image %zu", i);
+    char full[600];   /* messages name the glTF (its path cut at 500 bytes) and the image */
+    snprintf(full, sizeof full, "%.500s: %s", path, what);
+    if (im->buffer_view) {
+        const cgltf_buffer_view *v = im->buffer_view;
+        if (!v->buffer || !v->buffer->data || !fits(v->offset, v->size, v->buffer->size)) {
+            snprintf(err, errlen, "%s: its buffer view exceeds its buffer", full);
+            return -1;
+        }
+        return ms_soup_add_texture_memory(soup, (const unsigned char *)v->buffer->data + v->offset, v->size, full, 0,
+                                          err, errlen);
+    }
+    if (!im->uri) { snprintf(err, errlen, "%s: has neither a uri nor a bufferView", full); return -1; }
+    if (!strncmp(im->uri, "data:", 5)) {
+        const char *b64 = strstr(im->uri, ";base64,");
+        if (!b64) { snprintf(err, errlen, "%s: a data URI that is not base64", full); return -1; }
+        b64 += 8;
+        size_t n = strlen(b64), size = n / 4 * 3;
+        if (n % 4) { snprintf(err, errlen, "%s: a base64 data URI of %zu characters (not a multiple of 4)", full, n); return -1; }
+        if (n >= 1 && b64[n - 1] == '=') size--;
+        if (n >= 2 && b64[n - 2] == '=') size--;
+        void *data = NULL;
+        if (size == 0 || cgltf_load_buffer_base64(opt, size, b64, &data) != cgltf_result_success) {
+            snprintf(err, errlen, "%s: a bad base64 data URI", full);
+            return -1;
+        }
+        const long r = ms_soup_add_texture_memory(soup, data, size, full, 0, err, errlen);
+        opt->memory.free_func(opt->memory.user_data, data);
+        return r;
+    }
+    /* A relative file: beside the glTF (percent-decoded as glTF URIs are). */
+    if (im->uri[0] == '/' || strstr(im->uri, "://")) { snprintf(err, errlen, "%s: only relative image paths are read", full); return -1; }
+    const char *slash = strrchr(path, '/');
+    const int dl = slash ? (int)(slash - path + 1) : 0;
+    char file[4096];
+    if (snprintf(file, sizeof file, "%.*s%s", dl, path, im->uri) >= (int)sizeof file) {
+        snprintf(err, errlen, "%s: the image path is too long", full);
+        return -1;
+    }
+    cgltf_decode_uri(file + dl);
+    return ms_soup_add_texture_file(soup, file, 0, err, errlen);
+}
+
+static float clamp01(float x) { return x >= 0.0f ? (x <= 1.0f ? x : 1.0f) : 0.0f; }   /* NaN -> 0 */
+
+/* Every material of the glTF (metallic-roughness; the spec's defaults without it) into the soup; images
+ * decoded once each, when a material's base colour uses them. */
+static int load_materials(const cgltf_data *d, const cgltf_options *opt, const char *path, ms_tri_soup *soup,
+                          long *mat_of, char *err, size_t errlen)
+{
+    long *tex_of = malloc((d->images_count ? d->images_count : 1) * sizeof *tex_of);
+    if (!tex_of) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    for (size_t i = 0; i < d->images_count; i++) tex_of[i] = -2;   /* not loaded yet */
+    int rc = 0;
+    for (size_t i = 0; i < d->materials_count && !rc; i++) {
+        const cgltf_material *cm = &d->materials[i];
+        ms_material m = { { 1, 1, 1, 1 }, 1.0f, 1.0f, -1, 0 };
+        if (cm->has_pbr_metallic_roughness) {
+            const cgltf_pbr_metallic_roughness *pb = &cm->pbr_metallic_roughness;
+            for (int c = 0; c < 4; c++) m.base_color[c] = clamp01(pb->base_color_factor[c]);
+            m.metallic = clamp01(pb->metallic_factor);
+            m.roughness = clamp01(pb->roughness_factor);
+            const cgltf_texture_view *tv = &pb->base_color_texture;
+            /* A texture that cannot be used is a warning: the material keeps its factors (geometry and
+             * visibility do not depend on it). */
+            if (tv->texture && tv->texture->image) {
+                const size_t im = (size_t)(tv->texture->image - d->images);
+                if (tv->texcoord < 0 || tv->texcoord >= MS_MAX_UV_SETS) {
+                    ms_warn("%s: material %zu: baseColorTexture uses TEXCOORD_%d (at most %d sets): texture ignored", path, i,
+                            (int)tv->texcoord, MS_MAX_UV_SETS - 1);
+                } else {
+                    if (tex_of[im] == -2) {
+                        char why[1024];
+                        tex_of[im] = load_image(d, opt, im, path, soup, why, sizeof why);
+                        if (tex_of[im] < 0) ms_warn("%s: texture ignored", why);
+                    }
+                    if (tex_of[im] >= 0) {
+                        m.base_color_texture = (int32_t)tex_of[im];
+                        m.base_color_uv = (int32_t)tv->texcoord;
+                    }
+                }
+            }
+        }
+        mat_of[i] = ms_soup_add_material(soup, &m);
+        if (mat_of[i] < 0) { snprintf(err, errlen, "%s: out of memory, or more than %d materials", path, MS_MAX_MATERIALS); rc = -1; }
+    }
+    free(tex_of);
+    return rc;
 }
 
 typedef struct node_item { const cgltf_node *node; float parent[16]; } node_item;
 
 /* Depth-first over the node trees without recursion; every node at most once (glTF requires trees,
  * and a node listed twice would expand exponentially: 41 such nodes are 2^40 instances). */
-static int walk_nodes(const cgltf_data *d, ms_tri_soup *soup, size_t *added, size_t max_tris, const char *path,
-                      char *err, size_t errlen)
+static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup, size_t *added, size_t max_tris,
+                      const char *path, char *err, size_t errlen)
 {
     const cgltf_scene *sc = d->scene ? d->scene : d->scenes_count ? &d->scenes[0] : NULL;
     size_t nn = d->nodes_count;
@@ -210,7 +329,8 @@ static int walk_nodes(const cgltf_data *d, ms_tri_soup *soup, size_t *added, siz
             mat4_mul(world, it.parent, local);
             if (it.node->mesh)
                 for (size_t p = 0; p < it.node->mesh->primitives_count && !rc; p++)
-                    rc = emit_primitive(&it.node->mesh->primitives[p], world, soup, added, max_tris, path, err, errlen);
+                    rc = emit_primitive(d, mat_of, &it.node->mesh->primitives[p], world, soup, added, max_tris, path, err,
+                                        errlen);
             for (size_t c = 0; c < it.node->children_count && !rc; c++) {
                 size_t ci = (size_t)(it.node->children[c] - d->nodes);
                 if (seen[ci]) {
@@ -244,6 +364,7 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
     opt.file.release = release_buffer_file;
     opt.file.user_data = &g;
     cgltf_data *d = NULL;
+    long *mat_of = NULL;   /* glTF material -> soup material */
     cgltf_result r = cgltf_parse(&opt, buf, len, &d);
     if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); return -1; }
     int rc = -1;
@@ -275,8 +396,12 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
     }
     r = cgltf_validate(d);
     if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); goto out; }
-    rc = walk_nodes(d, soup, added, (g.input + 64) * MS_MAX_TRIS_PER_BYTE, path, err, errlen);
+    mat_of = malloc((d->materials_count ? d->materials_count : 1) * sizeof *mat_of);
+    if (!mat_of) { snprintf(err, errlen, "%s: out of memory", path); goto out; }
+    if (load_materials(d, &opt, path, soup, mat_of, err, errlen)) goto out;
+    rc = walk_nodes(d, mat_of, soup, added, (g.input + 64) * MS_MAX_TRIS_PER_BYTE, path, err, errlen);
 out:
+    free(mat_of);
     cgltf_free(d);
     return rc;
 }

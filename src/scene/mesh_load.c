@@ -2,6 +2,7 @@
  * Only formats microshadow checks itself reach an importer: assimp's own format probing is where a
  * few bytes of garbage crash it. */
 #include "scene_internal.h"
+#include "microshadow.h"
 #include <ctype.h>
 #include <math.h>
 #include <stdio.h>
@@ -9,6 +10,12 @@
 #include <string.h>
 
 int ms_soup_push_uv(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS])
+{
+    return ms_soup_push_full(soup, v, uv, MS_NO_MATERIAL, NULL);
+}
+
+int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
+                      uint32_t material, const float *normal9)
 {
     if (soup->n == soup->cap) {
         size_t cap = soup->cap ? 2 * soup->cap : 1024;
@@ -24,7 +31,32 @@ int ms_soup_push_uv(ms_tri_soup *soup, const float v[9], const float *const uv[M
             if (!u) return -1;
             soup->uv[s] = u;
         }
+        if (soup->material) {
+            uint32_t *mt = realloc(soup->material, cap * sizeof *mt);
+            if (!mt) return -1;
+            soup->material = mt;
+        }
+        if (soup->normal) {
+            float *nn = realloc(soup->normal, cap * 9 * sizeof(float));
+            if (!nn) return -1;
+            soup->normal = nn;
+        }
         soup->cap = cap;
+    }
+    if (material != MS_NO_MATERIAL && !soup->material) {   /* the first triangle with a material */
+        soup->material = malloc(soup->cap * sizeof *soup->material);
+        if (!soup->material) return -1;
+        for (size_t i = 0; i < soup->n; i++) soup->material[i] = MS_NO_MATERIAL;
+    }
+    if (soup->material) soup->material[soup->n] = material;
+    if (normal9 && !soup->normal) {
+        soup->normal = malloc(soup->cap * 9 * sizeof(float));
+        if (!soup->normal) return -1;
+        for (size_t i = 0; i < 9 * soup->n; i++) soup->normal[i] = NAN;
+    }
+    if (soup->normal) {
+        if (normal9) memcpy(soup->normal + 9 * soup->n, normal9, 9 * sizeof(float));
+        else for (int i = 0; i < 9; i++) soup->normal[9 * soup->n + i] = NAN;
     }
     for (int s = 0; s < MS_SOUP_UV_SETS; s++) {
         if (uv && uv[s] && !soup->uv[s]) {   /* the set's first triangle: the earlier ones lack it */
@@ -49,6 +81,11 @@ void ms_soup_free(ms_tri_soup *soup)
     free(soup->tri);
     free(soup->mesh);
     for (int s = 0; s < MS_SOUP_UV_SETS; s++) free(soup->uv[s]);
+    free(soup->material);
+    free(soup->normal);
+    free(soup->mats);
+    for (size_t i = 0; i < soup->n_tex; i++) free(soup->tex[i].rgba);
+    free(soup->tex);
     memset(soup, 0, sizeof *soup);
 }
 

@@ -24,10 +24,54 @@ typedef struct ms_tri_soup {
     uint32_t *mesh;
     float *uv[MS_SOUP_UV_SETS];
     uint32_t cur_mesh;
+    /* Surfaces (material.c): per-triangle material index (MS_NO_MATERIAL) and vertex normals (9 floats,
+     * NaN), each appearing with the first triangle that has one; the materials and textures loaded. */
+    uint32_t *material;
+    float *normal;
+    struct ms_material *mats;
+    size_t n_mats;
+    struct ms_texture *tex;
+    size_t n_tex;
+    size_t tex_bytes;   /* decoded texture bytes so far (bounded: MS_MAX_TEXTURE_BYTES) */
 } ms_tri_soup;
 void ms_soup_free(ms_tri_soup *soup);
+/* The same push with a material index (MS_NO_MATERIAL: none) and three vertex normals (or NULL). */
+int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
+                      uint32_t material, const float *normal9);
+/* Appends a material; its index, or -1 when out of memory or past MS_MAX_MATERIALS. */
+long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m);
 
-typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH } ms_input_kind;
+/* Textures (texture.c). At most MS_MAX_TEXTURE_SIDE texels a side, MS_MAX_TEXTURE_BYTES decoded per scene. */
+#define MS_MAX_TEXTURE_SIDE 16384
+#define MS_MAX_TEXTURE_BYTES ((size_t)1 << 30)
+#define MS_MAX_MATERIALS 65536
+/* Decodes a PNG (JPEG is refused with a message) from memory into an RGBA8 texture appended to the soup;
+ * its index, or -1 with one line in err naming `what`. flip_rows: store the rows bottom-up (OBJ's v = 0 is
+ * the image's last row; textures follow glTF, v = 0 the first). Loaders treat a texture that fails as a
+ * warning, the material keeping its factors: a scene whose textures are missing or JPEG still loads. */
+long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
+                                int flip_rows, char *err, size_t errlen);
+/* The same from a file (a regular file of at most MS_MAX_MESH_BYTES). */
+long ms_soup_add_texture_file(ms_tri_soup *soup, const char *path, int flip_rows, char *err, size_t errlen);
+
+/* OBJ materials (mtl.c): the materials of MTL files, by name, added to the soup as they are read. */
+typedef struct ms_mtl_lib {
+    char **names;
+    uint32_t *index;   /* soup material of names[i] */
+    size_t n;
+    char **tex_path;   /* textures read so far, each once: soup texture tex_id[i] (-1: unusable) */
+    long *tex_id;
+    size_t n_tex;
+} ms_mtl_lib;
+/* Reads one MTL file (newmtl, Kd, d, map_Kd, Pr, Pm, Ns) into lib and the soup. A file that cannot be read
+ * and a texture that cannot be used are warnings; 0, or -1 when out of memory. */
+int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib);
+/* The soup material named `name`, or MS_NO_MATERIAL. The last definition of a name wins. */
+uint32_t ms_mtl_find(const ms_mtl_lib *lib, const char *name);
+void ms_mtl_lib_free(ms_mtl_lib *lib);
+
+/* MS_INPUT_AUX: a file a mesh refers to (an MTL file, a texture), named "file" in messages. */
+typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH, MS_INPUT_AUX } ms_input_kind;
 /* Reads a whole regular file of at most max_bytes (a FIFO, device or directory is refused without
  * blocking) into a malloc'ed, NUL-terminated buffer. */
 int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char **out, size_t *len, char *err,

@@ -391,6 +391,12 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     out->tri_mesh = soup.mesh;
     for (int s = 0; s < MS_MAX_UV_SETS; s++) out->tri_uv[s] = soup.uv[s];
     out->n_meshes = (size_t)i;
+    out->materials = soup.mats;   /* surfaces: the soup's arrays change hands (ms_scene_free frees them) */
+    out->n_materials = soup.n_mats;
+    out->tri_material = soup.material;
+    out->tri_normal = soup.normal;
+    out->textures = soup.tex;
+    out->n_textures = soup.n_tex;
     rc = ms_scene_validate(out, json_path, err, errlen);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
@@ -409,5 +415,10 @@ void ms_scene_free(ms_scene *s)
     free(s->tri);
     free(s->tri_mesh);
     for (int i = 0; i < MS_MAX_UV_SETS; i++) free(s->tri_uv[i]);
+    free(s->materials);
+    free(s->tri_material);
+    free(s->tri_normal);
+    for (size_t i = 0; i < s->n_textures; i++) free(s->textures[i].rgba);
+    free(s->textures);
     memset(s, 0, sizeof *s);
 }

@@ -73,5 +73,29 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
             return -1;
         }
     }
+    /* Surfaces (loaders produce them valid; a library caller may not): every reference in range. */
+    for (size_t i = 0; i < s->n_textures; i++) {
+        const ms_texture *t = &s->textures[i];
+        if (!t->rgba || t->width < 1 || t->height < 1 || t->width > MS_MAX_IMAGE_SIZE || t->height > MS_MAX_IMAGE_SIZE) {
+            snprintf(err, errlen, "%s: texture %zu has no pixels or a size outside 1..%d", what, i, MS_MAX_IMAGE_SIZE);
+            return -1;
+        }
+    }
+    for (size_t i = 0; i < s->n_materials; i++) {
+        const ms_material *m = &s->materials[i];
+        int ok = m->metallic >= 0.0f && m->metallic <= 1.0f && m->roughness >= 0.0f && m->roughness <= 1.0f;
+        for (int c = 0; c < 4; c++) ok &= m->base_color[c] >= 0.0f && m->base_color[c] <= 1.0f;
+        if (!ok) { snprintf(err, errlen, "%s: material %zu has a factor outside [0, 1] (or NaN)", what, i); return -1; }
+        if (m->base_color_texture < -1 || (m->base_color_texture >= 0 && (size_t)m->base_color_texture >= s->n_textures) ||
+            m->base_color_uv < 0 || m->base_color_uv >= MS_MAX_UV_SETS) {
+            snprintf(err, errlen, "%s: material %zu names a texture or UV set that does not exist", what, i);
+            return -1;
+        }
+    }
+    for (size_t i = 0; s->tri_material && i < s->n_tris; i++)
+        if (s->tri_material[i] != MS_NO_MATERIAL && s->tri_material[i] >= s->n_materials) {
+            snprintf(err, errlen, "%s: triangle %zu names material %u of %zu", what, i, s->tri_material[i], s->n_materials);
+            return -1;
+        }
     return 0;
 }

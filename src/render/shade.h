@@ -1,0 +1,39 @@
+/* Surface shading of a visible point (docs/shading.md): its material (glTF metallic-roughness), its
+ * shading normal, and its radiance from the light with the two shadow factors:
+ *   L_o = emission * ( c_diff/pi * E_unshadowed(n_s) * S  +  F * LTC_GGX(n_s, v, roughness) * S_spec )
+ * with c_diff = base (1 - metallic), F0 = mix(0.04, base, metallic) and F = F0 + (1 - F0)(1 - n_s.v)^5
+ * (Schlick at the view angle: an approximation, the LTC table carries no Fresnel term). S is the
+ * form-factor ratio of every method (receiver.h); S_spec the same ratio estimator with specular-lobe
+ * weights. Triangles without a material keep the original Lambertian grey (albedo 0.8, no specular). */
+#ifndef MS_SHADE_H
+#define MS_SHADE_H
+#include "microshadow.h"
+#include "../shadow/method.h"
+
+#define MS_DEFAULT_ALBEDO 0.8f
+
+typedef struct ms_surface {
+    float n[3];          /* unit shading normal, on the side of the geometric normal that faces the eye */
+    float v[3];          /* unit direction to the eye */
+    float diffuse[3];    /* c_diff */
+    float f0[3];         /* specular reflectance at normal incidence */
+    float roughness;     /* perceptual (glTF); GGX alpha = roughness^2 */
+    int specular;        /* 0: Lambert only */
+} ms_surface;
+
+/* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye. */
+void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out);
+
+/* S_spec = sum_i w_i v_i / sum_i w_i over the front samples, w_i = f_GGX(v, l_i) max(n_s.l_i, 0)
+ * max(cos theta_l,i, 0) / r_i^2: the specular lobe's share of the light that is unoccluded, from the same
+ * masks as V and S (pts as for ms_resolve_vs). S_spec = V where V is 0 or 1 (exact) and where every
+ * weight is 0. */
+float ms_resolve_spec(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, const uint64_t *front,
+                      const uint64_t *vis, const ms_surface *sf);
+
+/* Linear radiance of the point into rgb[3] with shadow factors s and s_spec; *unshadowed gets the
+ * luminance without shadow (for the exposure). */
+void ms_shade(const ms_light *l, const float p[3], const ms_surface *sf, float s, float s_spec, float rgb[3],
+              float *unshadowed);
+
+#endif
