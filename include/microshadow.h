@@ -65,12 +65,43 @@ typedef struct ms_camera {
     int width, height;
 } ms_camera;
 
-/* Parallelogram light L(s,t) = corner + s*edge_s + t*edge_t, s,t in [0,1]. It emits radiance
- * `emission` (linear RGB) from the side cross(edge_s, edge_t) points to. */
+/* Light shapes (docs/design.md, "Light shapes"). Every shape is sampled on its parallelogram
+ * L(s,t) = corner + s*edge_s + t*edge_t, s,t in [0,1]: the pattern's samples are those of the
+ * parallelogram, and the shape masks off the samples outside it by their parameters (s,t):
+ *   MS_LIGHT_RECT: the parallelogram itself (every sample; the zero value, so older callers keep it);
+ *   MS_LIGHT_DISK: the ellipse inscribed in the parallelogram, (2s-1)^2 + (2t-1)^2 < 1; for a disk of
+ *     centre c, unit normal m and radius r the parallelogram is its bounding square (ms_light_disk). */
+typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1 } ms_light_shape;
+
+/* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
+ * from the samples of its shape. Zero-initialised fields past emission keep a parallelogram. */
 typedef struct ms_light {
     ms_vec3 corner, edge_s, edge_t;
     ms_vec3 emission;
+    ms_light_shape shape;
 } ms_light;
+
+/* Fills l as a disk light of centre c, normal m (emitting towards m; need not be unit length, not zero)
+ * and radius r: its bounding square, edges 2r along two unit vectors perpendicular to m chosen from m
+ * alone, and shape MS_LIGHT_DISK; emission is left as it is. 0, or -1 when m is zero or r not > 0. */
+int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
+
+/* 1 if light parameters (s,t) lie on the light's shape (see ms_light_shape), 0 if not. */
+int ms_light_shape_contains(ms_light_shape shape, float s, float t);
+
+/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk). */
+float ms_light_area(const ms_light *l);
+
+/* Units of a light's emission in a scene file (docs/design.md, "Units"). The renderer works in radiance;
+ * the others are converted by the shape's emitting area A, every light emitting as a one-sided
+ * Lambertian surface (Drobot, GPU Pro 5, "physically based area lights": flux = pi * A * radiance):
+ *   MS_UNITS_RADIANCE: emission is radiance (W sr^-1 m^-2 or the scene's own linear unit);
+ *   MS_UNITS_WATTS: radiant flux Phi in W per channel, radiance = Phi / (pi A);
+ *   MS_UNITS_LUMENS: luminous flux in lm per channel, luminance = Phi_v / (pi A) in cd m^-2 (nits);
+ *     the renderer's radiance unit is then the nit (no 683 lm/W: the image stays photometric). */
+typedef enum ms_light_units { MS_UNITS_RADIANCE = 0, MS_UNITS_WATTS = 1, MS_UNITS_LUMENS = 2 } ms_light_units;
+/* The radiance of light l (its shape and edges set) emitting `amount` in `units`. */
+ms_vec3 ms_light_radiance_from(const ms_light *l, ms_vec3 amount, ms_light_units units);
 
 #define MS_MAX_UV_SETS 4
 
@@ -100,7 +131,15 @@ typedef struct ms_scene {
     float *tri_uv[MS_MAX_UV_SETS];
     size_t n_meshes;
     ms_procedural procedural;
+    /* Several lights (scene file: "lights": [...]): lights[0 .. n_lights-1], each with its own V and S;
+     * light is a copy of lights[0]. n_lights = 0 (lights NULL): the one light `light`. ms_scene_free
+     * frees lights. */
+    ms_light *lights;
+    size_t n_lights;
 } ms_scene;
+
+/* The scene's lights: its n_lights lights, or `light` alone when n_lights is 0. Sets *n. */
+const ms_light *ms_scene_lights(const ms_scene *s, size_t *n);
 
 /* Triangles [first, first + count) of a procedural scene (9 floats each) into out. */
 void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, float *out);
@@ -236,6 +275,9 @@ typedef struct ms_frame {
     float *rgb;       /* 3*width*height linear radiance: albedo/pi * E_unshadowed * S * emission */
     float exposure;   /* scale that maps the 99th percentile of unshadowed radiance to 1 (for PNG) */
     ms_stats stats;
+    /* Lights of the frame (0 means 1). vis, shadow and front hold one width*height plane per light, light l
+     * at vis + l*width*height (the first plane is light 0, as with one light); rgb sums the lights. */
+    int n_lights;
 } ms_frame;
 
 int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
@@ -260,7 +302,8 @@ typedef struct ms_output {
 int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
 int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
 void ms_outputs_cleanup_on_signals(void);
-/* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name); the stats as JSON. */
+/* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name; with several lights the EXR has
+ * one channel per light, V0, V1, ... resp. S0, S1, ..., and the PFM light 0); the stats as JSON. */
 int ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
@@ -273,8 +316,12 @@ int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);
 int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
 int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
 
-/* Exact unshadowed irradiance at point p with unit normal n from the light (polygon form factor,
- * light clipped to the receiver's hemisphere), per unit emitted radiance. */
+/* Unshadowed irradiance at point p with unit normal n from the light, per unit emitted radiance.
+ * Parallelogram: exact (polygon form factor, light clipped to the receiver's hemisphere). Disk over a
+ * square (a circle, as ms_light_disk makes): exact closed form (the disk's vector irradiance from the
+ * parallel and perpendicular differential-element form factors) when the whole disk is above the
+ * receiver's plane; across the horizon, and for an ellipse, the polygon formula on a clipped 256-gon of
+ * the same area (an approximation; error measured in tests/test_lights.c). */
 float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
 
 /* ---- Visibility at any points: the library for bakers (docs/baking.md) ----

@@ -65,14 +65,15 @@ class _Camera(ctypes.Structure):
 
 
 class _Light(ctypes.Structure):
-    _fields_ = [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3)]
+    _fields_ = [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3), ("shape", ctypes.c_int)]
 
 
 class _Scene(ctypes.Structure):
     _fields_ = [("tri", ctypes.POINTER(_f)), ("n_tris", ctypes.c_size_t), ("camera", _Camera), ("light", _Light),
                 ("samples", ctypes.c_int), ("load_s", ctypes.c_double),
                 ("tri_mesh", ctypes.POINTER(ctypes.c_uint32)), ("tri_uv", ctypes.POINTER(_f) * MAX_UV_SETS),
-                ("n_meshes", ctypes.c_size_t)]
+                ("n_meshes", ctypes.c_size_t), ("procedural_type", ctypes.c_int), ("procedural_seed", ctypes.c_uint32),
+                ("lights", ctypes.POINTER(_Light)), ("n_lights", ctypes.c_size_t)]
 
 
 class _Stats(ctypes.Structure):
@@ -88,7 +89,7 @@ class _Stats(ctypes.Structure):
 class _Frame(ctypes.Structure):
     _fields_ = [("width", ctypes.c_int), ("height", ctypes.c_int), ("vis", ctypes.POINTER(_f)),
                 ("shadow", ctypes.POINTER(_f)), ("front", ctypes.POINTER(ctypes.c_uint16)),
-                ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats)]
+                ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats), ("n_lights", ctypes.c_int)]
 
 
 _PROGRESS = ctypes.CFUNCTYPE(None, _p, ctypes.c_double)

@@ -93,6 +93,17 @@ void ms_interleaved_uv(int samples, int set, uint32_t seed, uint32_t *u, uint32_
     }
 }
 
+/* Light parameters of sample n of the stratified pattern. */
+static void stratified_st(int k, uint32_t px, uint32_t py, uint32_t seed, int n, float *s, float *t)
+{
+    const uint32_t hp = ms_hash3(px, py, seed ^ 0xA511E9B3u);
+    const float inv = 1.0f / (float)k;
+    const int i = n % k, j = n / k;
+    const uint32_t h = ms_hash3(hp, (uint32_t)n, seed);
+    *s = ((float)i + ms_hash_unit(h)) * inv;
+    *t = ((float)j + ms_hash_unit(ms_hash3(h, 0x68E31DA4u, 1u))) * inv;
+}
+
 void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed, ms_grid *g)
 {
     const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
@@ -143,15 +154,80 @@ void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px
     const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
     const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
     const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
-    uint32_t hp = ms_hash3(px, py, seed ^ 0xA511E9B3u);
-    float inv = 1.0f / (float)k;
     for (int n = first; n < first + count; n++) {
-        const int i = n % k, j = n / k;
-        uint32_t h = ms_hash3(hp, (uint32_t)n, seed);
-        float s = ((float)i + ms_hash_unit(h)) * inv;
-        float t = ((float)j + ms_hash_unit(ms_hash3(h, 0x68E31DA4u, 1u))) * inv;
+        float s, t;
+        stratified_st(k, px, py, seed, n, &s, &t);
         float *o = xyz + 3 * (n - first);
         for (int c = 0; c < 3; c++) o[c] = P[c] + s * S[c] + t * T[c];
+    }
+}
+
+/* The grid's per-pixel shift (u, v) in [0,1)^2 (ms_grid_for_pixel). */
+static void grid_shift(uint32_t px, uint32_t py, uint32_t seed, float *u, float *v)
+{
+    uint32_t h = ms_hash3(px, py, seed);
+    *u = ms_hash_unit(h);
+    *v = ms_hash_unit(ms_hash3(h, 0x51ED270Bu, seed));
+}
+
+void ms_shape_mask_apply(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                         uint64_t *mask)
+{
+    if (l->shape == MS_LIGHT_RECT) return;
+    const int spp = ms_pattern_spp(p, k);
+    if (p == MS_PATTERN_GRID) {
+        /* s_ij = (i + (k-1-j+u)/k)/k, t_ij = (j + (i+v)/k)/k, in this order of operations (the definition
+         * of the grid's parameters; the world positions are the affine p0 + i ds + j dt of the same). */
+        float u, v;
+        grid_shift(px, py, seed, &u, &v);
+        const float kf = (float)k;
+        for (int j = 0; j < k; j++) {
+            const float a = ((float)(k - 1 - j) + u) / kf;
+            for (int i = 0; i < k; i++) {
+                const float s = ((float)i + a) / kf, t = ((float)j + ((float)i + v) / kf) / kf;
+                const int n = j * k + i;
+                if (!ms_light_shape_contains(l->shape, s, t)) mask[n >> 6] &= ~(UINT64_C(1) << (n & 63));
+            }
+        }
+        return;
+    }
+    if (p == MS_PATTERN_INTERLEAVED) {
+        uint32_t uu[256], vv[256];
+        ms_interleaved_uv(k * k, ms_interleaved_set(px, py), seed, uu, vv);
+        for (int n = 0; n < spp; n++) {
+            const float s = (float)(uu[n] >> 8) * (1.0f / 16777216.0f), t = (float)(vv[n] >> 8) * (1.0f / 16777216.0f);
+            if (!ms_light_shape_contains(l->shape, s, t)) mask[n >> 6] &= ~(UINT64_C(1) << (n & 63));
+        }
+        return;
+    }
+    for (int n = 0; n < spp; n++) {
+        float s, t;
+        stratified_st(k, px, py, seed, n, &s, &t);
+        if (!ms_light_shape_contains(l->shape, s, t)) mask[n >> 6] &= ~(UINT64_C(1) << (n & 63));
+    }
+}
+
+void ms_pattern_st(ms_pattern p, int k, uint32_t px, uint32_t py, uint32_t seed, float *st)
+{
+    const int spp = ms_pattern_spp(p, k);
+    if (p == MS_PATTERN_GRID) {
+        float u, v;
+        grid_shift(px, py, seed, &u, &v);
+        const float kf = (float)k;
+        for (int n = 0; n < spp; n++) {
+            const int i = n % k, j = n / k;
+            st[2 * n] = ((float)i + ((float)(k - 1 - j) + u) / kf) / kf;
+            st[2 * n + 1] = ((float)j + ((float)i + v) / kf) / kf;
+        }
+    } else if (p == MS_PATTERN_INTERLEAVED) {
+        uint32_t uu[256], vv[256];
+        ms_interleaved_uv(k * k, ms_interleaved_set(px, py), seed, uu, vv);
+        for (int n = 0; n < spp; n++) {
+            st[2 * n] = (float)(uu[n] >> 8) * (1.0f / 16777216.0f);
+            st[2 * n + 1] = (float)(vv[n] >> 8) * (1.0f / 16777216.0f);
+        }
+    } else {
+        for (int n = 0; n < spp; n++) stratified_st(k, px, py, seed, n, &st[2 * n], &st[2 * n + 1]);
     }
 }
 

@@ -63,6 +63,8 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
     for (uint32_t i = 0; i < a->bvh.n_tris; i++) a->leaf_of[a->bvh.tri_source[i]] = i;
     a->view = *scene;
     a->view.tri = NULL;
+    a->view.lights = NULL;   /* the scene's first light stays in view.light; the array is the caller's */
+    a->view.n_lights = 0;
     *out = a;
     return MS_OK;
 }

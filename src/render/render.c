@@ -54,6 +54,103 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The shadow phase for one light (ctx->light): front masks, the method's visible masks, V and S into
+ * p's planes, over 16x16 tiles (or the method's frame-level entry). Adds to p's counters and totals.
+ * 0, or -1 when out of memory. */
+typedef struct shadow_pass_io {
+    const ms_hit *hits;
+    int W, H;
+    float *vis, *shadow;
+    uint16_t *front;
+    progress *prog;
+    uint64_t counters[MS_MAX_COUNTERS];
+    uint64_t visible, penumbra, segments;
+    double resolve_thread_s;
+} shadow_pass_io;
+
+static int shadow_pass(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctxp, int threads,
+                       shadow_pass_io *p)
+{
+    const ms_render_ctx ctx = *ctxp;
+    uint64_t visible = 0, penumbra = 0, segments = 0;
+    double resolve_thread_s = 0.0;
+    int failed = 0;
+    const int W = p->W, H = p->H, tx = (W + TILE - 1) / TILE, ty = (H + TILE - 1) / TILE, ntiles = tx * ty;
+    const size_t mw = (size_t)ctx.mask_words;
+    const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
+    const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
+    float *const vis = p->vis, *const shadow = p->shadow;
+    uint16_t *const fr = p->front;
+    const ms_hit *const hits = p->hits;
+    progress *const prog = p->prog;
+#pragma omp parallel num_threads(threads)
+    {
+        uint64_t local[MS_MAX_COUNTERS] = { 0 };
+        uint64_t local_visible = 0, local_penumbra = 0, local_segments = 0;
+        double local_resolve = 0.0;
+        /* Per thread: the tile's front and visible masks, and the stratified pattern's points. */
+        uint64_t *front = aligned_alloc(64, TILE * TILE * mw * sizeof *front);
+        uint64_t *vmask = aligned_alloc(64, TILE * TILE * mw * sizeof *vmask);
+        float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
+        int ok = front && vmask && (pts || !stratified);
+#pragma omp for schedule(dynamic, 1)
+        for (int t = 0; t < shadow_tiles; t++) {
+            int x0 = (t % tx) * TILE, y0 = (t / tx) * TILE;
+            int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
+            ms_shadow_query q[TILE * TILE];
+            size_t where[TILE * TILE];
+            int n = 0;
+            for (int y = y0; y < y1 && ok; y++)
+                for (int x = x0; x < x1; x++) {
+                    size_t i = (size_t)y * W + x;
+                    const ms_hit *h = &hits[i];
+                    if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = -1.0f; fr[i] = 0; continue; }
+                    memcpy(q[n].p, h->p, sizeof h->p);
+                    memcpy(q[n].n, h->n, sizeof h->n);
+                    q[n].prim = h->prim;
+                    q[n].px = (uint32_t)x;
+                    q[n].py = (uint32_t)y;
+                    if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[n].px, q[n].py, ctx.seed, pts);
+                    const int nf = ms_front_mask(&ctx, &q[n], pts, front + (size_t)n * mw);
+                    fr[i] = (uint16_t)nf;
+                    local_segments += (uint64_t)nf;
+                    where[n++] = i;
+                }
+            if (n && ok && sm->visibility(sstate, &ctx, q, n, front, vmask, local)) ok = 0;
+            const double tr = omp_get_wtime();
+            for (int i = 0; i < n && ok; i++) {
+                if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
+                local_penumbra += (uint64_t)ms_resolve_vs(&ctx, &q[i], pts, front + (size_t)i * mw,
+                                                          vmask + (size_t)i * mw, &vis[where[i]],
+                                                          &shadow[where[i]]);
+            }
+            local_resolve += omp_get_wtime() - tr;
+            local_visible += (uint64_t)n;
+            progress_tick(prog);
+        }
+        free(front);
+        free(vmask);
+        free(pts);
+#pragma omp critical(ms_counters)
+        {
+            for (int c = 0; c < MS_MAX_COUNTERS; c++) p->counters[c] += local[c];
+            visible += local_visible;
+            penumbra += local_penumbra;
+            segments += local_segments;
+            resolve_thread_s += local_resolve;
+            failed |= !ok;
+        }
+    }
+    if (sm->visibility_all && !failed)
+        failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, W, H, vis, shadow, fr, p->counters, &visible, &penumbra,
+                                       &segments, &resolve_thread_s) != 0;
+    p->visible += visible;
+    p->penumbra += penumbra;
+    p->segments += segments;
+    p->resolve_thread_s += resolve_thread_s;
+    return failed ? -1 : 0;
+}
+
 int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
@@ -95,6 +192,8 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     }
     int threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
 
+    size_t nlights;
+    const ms_light *lights = ms_scene_lights(scene, &nlights);
     ms_render_ctx ctx;
     memset(&ctx, 0, sizeof ctx);
     if (ms_camera_basis_init(&ctx.cam, &scene->camera, W, H)) {
@@ -106,7 +205,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     if (!streamed && ms_bvh_build(&bvh, scene->tri, scene->n_tris, threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); return -1; }
     ctx.scene = scene;
     ctx.bvh = streamed ? NULL : &bvh;
-    ctx.light = scene->light;
+    ctx.light = lights[0];
     ctx.pattern = opt->pattern;
     ctx.k = k;
     ctx.samples = spp;
@@ -125,9 +224,10 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
 
     size_t npix = (size_t)W * H;
     ms_hit *hits = malloc(npix * sizeof *hits);
-    out->vis = malloc(npix * sizeof(float));
-    out->shadow = malloc(npix * sizeof(float));
-    out->front = malloc(npix * sizeof *out->front);
+    out->vis = malloc(nlights * npix * sizeof(float));
+    out->shadow = malloc(nlights * npix * sizeof(float));
+    out->front = malloc(nlights * npix * sizeof *out->front);
+    out->n_lights = (int)nlights;
     out->rgb = malloc(npix * 3 * sizeof(float));
     void *pstate = NULL, *sstate = NULL;
     int rc = -1;
@@ -138,7 +238,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     const double setup_s = omp_get_wtime() - t_setup;
 
     int tx = (W + TILE - 1) / TILE, ty = (H + TILE - 1) / TILE, ntiles = tx * ty;
-    progress prog = { opt, 0, 2L * ntiles };
+    progress prog = { opt, 0, (long)(1 + nlights) * ntiles };
 
     double t0 = omp_get_wtime();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
@@ -153,77 +253,40 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     }
     double t1 = omp_get_wtime();
 
-    uint64_t counters[MS_MAX_COUNTERS] = { 0 };
-    uint64_t visible = 0, penumbra = 0, segments = 0;
-    double resolve_thread_s = 0.0;
+    /* Each light in turn: its own method state (set-ups such as hpc's light hierarchy and the frusta are
+     * per light), its own V, S and front planes; the primary hits are shared. */
+    shadow_pass_io io;
+    memset(&io, 0, sizeof io);
+    io.hits = hits;
+    io.W = W;
+    io.H = H;
+    io.prog = &prog;
     int failed = 0;
-    const size_t mw = (size_t)ctx.mask_words;
-    const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
-    const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
-#pragma omp parallel num_threads(threads)
-    {
-        uint64_t local[MS_MAX_COUNTERS] = { 0 };
-        uint64_t local_visible = 0, local_penumbra = 0, local_segments = 0;
-        double local_resolve = 0.0;
-        /* Per thread: the tile's front and visible masks, and the stratified pattern's points. */
-        uint64_t *front = aligned_alloc(64, TILE * TILE * mw * sizeof *front);
-        uint64_t *vmask = aligned_alloc(64, TILE * TILE * mw * sizeof *vmask);
-        float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
-        int ok = front && vmask && (pts || !stratified);
-#pragma omp for schedule(dynamic, 1)
-        for (int t = 0; t < shadow_tiles; t++) {
-            int x0 = (t % tx) * TILE, y0 = (t / tx) * TILE;
-            int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
-            ms_shadow_query q[TILE * TILE];
-            size_t where[TILE * TILE];
-            int n = 0;
-            for (int y = y0; y < y1 && ok; y++)
-                for (int x = x0; x < x1; x++) {
-                    size_t i = (size_t)y * W + x;
-                    const ms_hit *h = &hits[i];
-                    if (h->prim == UINT32_MAX) { out->vis[i] = out->shadow[i] = -1.0f; out->front[i] = 0; continue; }
-                    memcpy(q[n].p, h->p, sizeof h->p);
-                    memcpy(q[n].n, h->n, sizeof h->n);
-                    q[n].prim = h->prim;
-                    q[n].px = (uint32_t)x;
-                    q[n].py = (uint32_t)y;
-                    if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[n].px, q[n].py, ctx.seed, pts);
-                    const int nf = ms_front_mask(&ctx, &q[n], pts, front + (size_t)n * mw);
-                    out->front[i] = (uint16_t)nf;
-                    local_segments += (uint64_t)nf;
-                    where[n++] = i;
-                }
-            if (n && ok && sm->visibility(sstate, &ctx, q, n, front, vmask, local)) ok = 0;
-            const double tr = omp_get_wtime();
-            for (int i = 0; i < n && ok; i++) {
-                if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
-                local_penumbra += (uint64_t)ms_resolve_vs(&ctx, &q[i], pts, front + (size_t)i * mw,
-                                                          vmask + (size_t)i * mw, &out->vis[where[i]],
-                                                          &out->shadow[where[i]]);
-            }
-            local_resolve += omp_get_wtime() - tr;
-            local_visible += (uint64_t)n;
-            progress_tick(&prog);
+    double setup_more_s = 0.0;
+    for (size_t l = 0; l < nlights && !failed; l++) {
+        ctx.light = lights[l];
+        if (l > 0) {
+            const double ts = omp_get_wtime();
+            if (sm->create(&ctx, &sstate, err, errlen)) { sstate = NULL; pm->destroy(pstate); goto fail; }
+            setup_more_s += omp_get_wtime() - ts;
         }
-        free(front);
-        free(vmask);
-        free(pts);
-#pragma omp critical(ms_counters)
-        {
-            for (int c = 0; c < MS_MAX_COUNTERS; c++) counters[c] += local[c];
-            visible += local_visible;
-            penumbra += local_penumbra;
-            segments += local_segments;
-            resolve_thread_s += local_resolve;
-            failed |= !ok;
+        io.vis = out->vis + l * npix;
+        io.shadow = out->shadow + l * npix;
+        io.front = out->front + l * npix;
+        failed = shadow_pass(sm, sstate, &ctx, threads, &io) != 0;
+        if (l + 1 < nlights) {
+            /* the last light's state stays for the stats (isa_used, counters_used) */
+            sm->destroy(sstate);
+            sstate = NULL;
         }
     }
-    if (sm->visibility_all && !failed)
-        failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, W, H, out, counters, &visible, &penumbra, &segments,
-                                       &resolve_thread_s) != 0;
+    ctx.light = lights[0];
+    uint64_t *const counters = io.counters;
+    const uint64_t visible = io.visible / nlights, penumbra = io.penumbra, segments = io.segments;
+    const double resolve_thread_s = io.resolve_thread_s;
     if (failed) {
         snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);
-        sm->destroy(sstate);
+        if (sstate) sm->destroy(sstate);
         pm->destroy(pstate);
         goto fail;
     }
@@ -231,7 +294,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     double filter_s = 0.0;
     if (ctx.pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter) {
         const double tf = omp_get_wtime();
-        if (ms_interleave_filter(W, H, hits, out->front, out->vis, out->shadow, threads)) {
+        int ferr = 0;
+        for (size_t l = 0; l < nlights && !ferr; l++)
+            ferr = ms_interleave_filter(W, H, hits, out->front + l * npix, out->vis + l * npix, out->shadow + l * npix,
+                                        threads);
+        if (ferr) {
             snprintf(err, errlen, "out of memory for the interleaved filter of a %dx%d frame", W, H);
             sm->destroy(sstate);
             pm->destroy(pstate);
@@ -245,15 +312,21 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
      * the light is wholly visible or hidden, converging to the shadowed irradiance as k grows). */
     float *lum = malloc(npix * sizeof(float));
     size_t nlum = 0;
-    const ms_light *L = &scene->light;
     for (size_t i = 0; i < npix; i++) {
         float *c = out->rgb + 3 * i;
-        if (hits[i].prim == UINT32_MAX) { c[0] = c[1] = c[2] = 0.0f; continue; }
-        float e = ms_light_irradiance(L, hits[i].p, hits[i].n) * MS_ALBEDO / (float)M_PI;
-        c[0] = e * L->emission.x * out->shadow[i];
-        c[1] = e * L->emission.y * out->shadow[i];
-        c[2] = e * L->emission.z * out->shadow[i];
-        if (lum) lum[nlum++] = e * (0.2126f * L->emission.x + 0.7152f * L->emission.y + 0.0722f * L->emission.z);
+        c[0] = c[1] = c[2] = 0.0f;
+        if (hits[i].prim == UINT32_MAX) continue;
+        float y = 0.0f;
+        for (size_t l = 0; l < nlights; l++) {   /* the lights' radiance adds up */
+            const ms_light *L = &lights[l];
+            const float S = out->shadow[l * npix + i];
+            float e = ms_light_irradiance(L, hits[i].p, hits[i].n) * MS_ALBEDO / (float)M_PI;
+            c[0] += e * L->emission.x * S;
+            c[1] += e * L->emission.y * S;
+            c[2] += e * L->emission.z * S;
+            y += e * (0.2126f * L->emission.x + 0.7152f * L->emission.y + 0.0722f * L->emission.z);
+        }
+        if (lum) lum[nlum++] = y;
     }
     out->exposure = 1.0f;
     if (lum && nlum) {
@@ -269,7 +342,7 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
     st->triangles = scene->n_tris;
     st->load_s = scene->load_s;
     st->build_s = bvh.build_s;
-    st->setup_s = setup_s;
+    st->setup_s = setup_s + setup_more_s;
     st->primary_s = t1 - t0;
     st->shadow_s = t2 - t1;
     st->samples = samples;

@@ -30,7 +30,8 @@ void ms_horizon_edge(const ms_grid *g, const float p[3], const float n[3], float
  * affine function, with rounding far below 1e-5 of its terms. */
 #define HORIZON_MARGIN 1e-5f
 
-int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, uint64_t *front)
+/* The samples in front of q's plane (the horizon alone), as ms_front_mask without the shape. */
+static int horizon_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, uint64_t *front)
 {
     const int k = ctx->k, ns = ctx->samples, nw = ctx->mask_words;
     if (pts) {
@@ -59,6 +60,16 @@ int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
     memset(front, 0xFF, (size_t)nw * sizeof *front);
     ms_raster_clear_halfplane(k, e, front);
     return ms_mask_count(front, nw);
+}
+
+int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, uint64_t *front)
+{
+    const int nf = horizon_mask(ctx, q, pts, front);
+    if (ctx->light.shape == MS_LIGHT_RECT || nf == 0) return nf;
+    /* A disk: the samples off it neither count nor are traced, exactly like those behind the horizon, so
+     * every method (which starts from or traces only the front mask) honours the shape unchanged. */
+    ms_shape_mask_apply(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, front);
+    return ms_mask_count(front, ctx->mask_words);
 }
 
 typedef void (*grid_weights_fn)(const ms_grid *g, const float rel0[3], const float h[3], int k, const uint64_t *front,

@@ -1,0 +1,51 @@
+/* Light shapes and units (microshadow.h, docs/design.md "Light shapes", "Units"): a shape is a mask over the
+ * parameters (s,t) of the light's parallelogram, so every pattern, every method and the weights stay those
+ * of the parallelogram, and a disk costs one more mask per receiver (ms_shape_mask, pattern.c). */
+#include "microshadow.h"
+#include "vec.h"
+#include <math.h>
+
+int ms_light_shape_contains(ms_light_shape shape, float s, float t)
+{
+    if (shape != MS_LIGHT_DISK) return 1;
+    const float x = 2.0f * s - 1.0f, y = 2.0f * t - 1.0f;
+    return x * x + y * y < 1.0f;
+}
+
+int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r)
+{
+    float n[3] = { m.x, m.y, m.z };
+    const float len = v3_len(n);
+    if (!(len > 0.0f) || !(r > 0.0f) || !isfinite(len) || !isfinite(r)) return -1;
+    v3_scale(n, n, 1.0f / len);
+    /* An orthonormal frame from n alone (Duff et al. 2017, "Building an orthonormal basis, revisited"):
+     * continuous except where n.z changes sign, and exact enough that the square is a square. */
+    const float sign = copysignf(1.0f, n[2]), a = -1.0f / (sign + n[2]), b = n[0] * n[1] * a;
+    float e1[3] = { 1.0f + sign * n[0] * n[0] * a, sign * b, -sign * n[0] };
+    float e2[3] = { b, sign + n[1] * n[1] * a, -n[1] };
+    /* cross(e1, e2) = n: the square emits towards m. */
+    const float d = 2.0f * r;
+    l->corner = (ms_vec3){ c.x - r * (e1[0] + e2[0]), c.y - r * (e1[1] + e2[1]), c.z - r * (e1[2] + e2[2]) };
+    l->edge_s = (ms_vec3){ d * e1[0], d * e1[1], d * e1[2] };
+    l->edge_t = (ms_vec3){ d * e2[0], d * e2[1], d * e2[2] };
+    l->shape = MS_LIGHT_DISK;
+    return 0;
+}
+
+float ms_light_area(const ms_light *l)
+{
+    const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z }, T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
+    float n[3];
+    v3_cross(n, S, T);
+    const float a = v3_len(n);
+    return l->shape == MS_LIGHT_DISK ? a * (float)(M_PI / 4.0) : a;
+}
+
+ms_vec3 ms_light_radiance_from(const ms_light *l, ms_vec3 amount, ms_light_units units)
+{
+    if (units == MS_UNITS_RADIANCE) return amount;
+    /* A one-sided Lambertian emitter of area A and radiance L emits flux pi A L (watts from W sr^-1 m^-2,
+     * lumens from cd m^-2); Drobot's chapter converts the artist's lumens to luminance the same way. */
+    const float k = 1.0f / ((float)M_PI * ms_light_area(l));
+    return (ms_vec3){ amount.x * k, amount.y * k, amount.z * k };
+}
