@@ -74,12 +74,23 @@ typedef struct ms_camera {
 typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1 } ms_light_shape;
 
 /* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
- * from the samples of its shape. Zero-initialised fields past emission keep a parallelogram. */
+ * from the samples of its shape. Zero-initialised fields past emission keep a uniform parallelogram.
+ * A textured light (texture non-NULL) emits emission times the texel at its parameters (s,t): the
+ * nearest of texture_width x texture_height linear RGB texels (3 floats each, row 0 at t = 0, column 0
+ * at s = 0). Its texels weight the samples in S (docs/design.md: w_i times the texel's luminance) and
+ * the shading; V stays the unweighted fraction. The caller owns the texels (ms_scene_free frees a loaded
+ * scene's). */
 typedef struct ms_light {
     ms_vec3 corner, edge_s, edge_t;
     ms_vec3 emission;
     ms_light_shape shape;
+    const float *texture;
+    int texture_width, texture_height;
 } ms_light;
+
+/* Luminance of the texel at (s,t) of a textured light (0.2126 R + 0.7152 G + 0.0722 B), and its colour
+ * into rgb when rgb is not NULL; 1 (and white) for an untextured light. */
+float ms_light_texel(const ms_light *l, float s, float t, float *rgb);
 
 /* Fills l as a disk light of centre c, normal m (emitting towards m; need not be unit length, not zero)
  * and radius r: its bounding square, edges 2r along two unit vectors perpendicular to m chosen from m

@@ -65,6 +65,13 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
     a->view.tri = NULL;
     a->view.lights = NULL;   /* the scene's first light stays in view.light; the array is the caller's */
     a->view.n_lights = 0;
+    if (scene->light.texture) {   /* the scene may be freed before the accel: its own copy of the texels */
+        const size_t nt = (size_t)scene->light.texture_width * (size_t)scene->light.texture_height * 3;
+        float *t = malloc(nt * sizeof *t);
+        if (!t) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
+        memcpy(t, scene->light.texture, nt * sizeof *t);
+        a->view.light.texture = t;
+    }
     *out = a;
     return MS_OK;
 }
@@ -74,6 +81,7 @@ void ms_accel_free(ms_accel *a)
     if (!a) return;
     ms_bvh_free(&a->bvh);
     free(a->leaf_of);
+    free((void *)a->view.light.texture);
     free(a);
 }
 

@@ -151,6 +151,39 @@ static int shadow_pass(const ms_shadow_method *sm, void *sstate, const ms_render
     return failed ? -1 : 0;
 }
 
+/* Textured lights: per light and pixel the weighted mean texel colour (ms_light_texture_mean) that scales
+ * its unshadowed irradiance, 3 floats each (NULL entries for untextured lights); *out NULL when no light
+ * is textured. 0, or -1 out of memory. */
+static int texture_means(const ms_render_ctx *ctx0, const ms_light *lights, size_t nlights, const ms_hit *hits, int W,
+                         size_t npix, int threads, float **out)
+{
+    *out = NULL;
+    size_t textured = 0;
+    for (size_t l = 0; l < nlights; l++) textured += lights[l].texture != NULL;
+    if (!textured) return 0;
+    float *t = malloc(nlights * npix * 3 * sizeof *t);
+    if (!t) return -1;
+    for (size_t l = 0; l < nlights; l++) {
+        if (!lights[l].texture) continue;
+        ms_render_ctx ctx = *ctx0;
+        ctx.light = lights[l];
+        float *tl = t + l * npix * 3;
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+        for (size_t i = 0; i < npix; i++) {
+            if (hits[i].prim == UINT32_MAX) continue;
+            ms_shadow_query q;
+            memcpy(q.p, hits[i].p, sizeof q.p);
+            memcpy(q.n, hits[i].n, sizeof q.n);
+            q.prim = hits[i].prim;
+            q.px = (uint32_t)(i % (size_t)W);
+            q.py = (uint32_t)(i / (size_t)W);
+            ms_light_texture_mean(&ctx, &q, tl + 3 * i);
+        }
+    }
+    *out = t;
+    return 0;
+}
+
 int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
@@ -312,6 +345,14 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
      * the light is wholly visible or hidden, converging to the shadowed irradiance as k grows). */
     float *lum = malloc(npix * sizeof(float));
     size_t nlum = 0;
+    float *tex = NULL;   /* textured lights: the mean texel colour each pixel sees */
+    if (texture_means(&ctx, lights, nlights, hits, W, npix, threads, &tex)) {
+        snprintf(err, errlen, "out of memory for the textured lights of a %dx%d frame", W, H);
+        free(lum);
+        sm->destroy(sstate);
+        pm->destroy(pstate);
+        goto fail;
+    }
     for (size_t i = 0; i < npix; i++) {
         float *c = out->rgb + 3 * i;
         c[0] = c[1] = c[2] = 0.0f;
@@ -320,14 +361,17 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         for (size_t l = 0; l < nlights; l++) {   /* the lights' radiance adds up */
             const ms_light *L = &lights[l];
             const float S = out->shadow[l * npix + i];
+            const float *t = tex && L->texture ? tex + 3 * (l * npix + i) : (const float[3]){ 1.0f, 1.0f, 1.0f };
             float e = ms_light_irradiance(L, hits[i].p, hits[i].n) * MS_ALBEDO / (float)M_PI;
-            c[0] += e * L->emission.x * S;
-            c[1] += e * L->emission.y * S;
-            c[2] += e * L->emission.z * S;
-            y += e * (0.2126f * L->emission.x + 0.7152f * L->emission.y + 0.0722f * L->emission.z);
+            const float r = L->emission.x * t[0], g = L->emission.y * t[1], b = L->emission.z * t[2];
+            c[0] += e * r * S;
+            c[1] += e * g * S;
+            c[2] += e * b * S;
+            y += e * (0.2126f * r + 0.7152f * g + 0.0722f * b);
         }
         if (lum) lum[nlum++] = y;
     }
+    free(tex);
     out->exposure = 1.0f;
     if (lum && nlum) {
         qsort(lum, nlum, sizeof *lum, cmp_float);

@@ -13,13 +13,14 @@ int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char *
 {
     *out = NULL;
     *len = 0;
-    const int mesh = kind == MS_INPUT_MESH;
+    const int mesh = kind != MS_INPUT_SCENE;
+    const char *noun = kind == MS_INPUT_TEXTURE ? "texture" : "mesh";
     /* O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer forever. */
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
     if (fd < 0) {
         int e = errno;
-        if (mesh && e == ENOENT) snprintf(err, errlen, "%s: mesh file not found", path);
-        else if (mesh) snprintf(err, errlen, "%s: mesh file is not readable: %s", path, strerror(e));
+        if (mesh && e == ENOENT) snprintf(err, errlen, "%s: %s file not found", path, noun);
+        else if (mesh) snprintf(err, errlen, "%s: %s file is not readable: %s", path, noun, strerror(e));
         else snprintf(err, errlen, "%s: cannot open: %s", path, strerror(e));
         return -1;
     }
@@ -27,13 +28,13 @@ int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char *
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         const char *what = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO"
                          : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device" : "not a regular file";
-        if (mesh) snprintf(err, errlen, "%s: mesh is not a regular file (%s)", path, what);
+        if (mesh) snprintf(err, errlen, "%s: %s is not a regular file (%s)", path, noun, what);
         else snprintf(err, errlen, "%s: cannot read: not a regular file (%s)", path, what);
         close(fd);
         return -1;
     }
     if ((unsigned long long)st.st_size > max_bytes) {
-        snprintf(err, errlen, "%s: %s is %lld bytes, more than the limit of %zu", path, mesh ? "mesh file" : "scene file",
+        snprintf(err, errlen, "%s: %s is %lld bytes, more than the limit of %zu", path, mesh ? (kind == MS_INPUT_TEXTURE ? "texture file" : "mesh file") : "scene file",
                  (long long)st.st_size, max_bytes);
         close(fd);
         return -1;

@@ -1,6 +1,7 @@
 /* Scene files: JSON (cJSON) naming meshes (assimp), camera, light and render settings. */
 #include "microshadow.h"
 #include "scene_internal.h"
+#include "../image/png_read.h"
 _Static_assert(MS_SOUP_UV_SETS == MS_MAX_UV_SETS, "one count of UV sets");
 #include <cjson/cJSON.h>
 #include <ctype.h>
@@ -26,7 +27,7 @@ static const char *const top_keys[] = { "meshes", "procedural", "camera", "light
 static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
 static const char *const camera_keys[] = { "eye", "target", "up", "fov_y", "width", "height", NULL };
 static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t", "center", "normal", "radius",
-                                          "emission", "power", "lumens", NULL };
+                                          "emission", "power", "lumens", "texture", NULL };
 static const char *const render_keys[] = { "samples", NULL };
 static const char *const mesh_keys[] = { "file", NULL };
 
@@ -309,7 +310,41 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
         units = unit_of[u];
     }
     l->emission = ms_light_radiance_from(l, amount, units);
+    const cJSON *tex = cJSON_GetObjectItemCaseSensitive(obj, "texture");
+    if (tex) {
+        if (!cJSON_IsString(tex) || !tex->valuestring[0]) {
+            snprintf(err, errlen, "%s: %s.texture must be the path of a PNG image", path, objname);
+            return -1;
+        }
+        char tex_path[4096];
+        if (ms_path_beside(path, tex->valuestring, tex_path, sizeof tex_path)) {
+            snprintf(err, errlen, "%s: %s.texture: the path is too long", path, objname);
+            return -1;
+        }
+        float *t = NULL;
+        int w = 0, h = 0;
+        char *bytes = NULL;
+        size_t len = 0;
+        char why[1024];
+        int rc = ms_read_input(tex_path, MS_MAX_MESH_BYTES, MS_INPUT_TEXTURE, &bytes, &len, why, sizeof why);
+        if (!rc) rc = ms_png_decode_linear(tex_path, bytes, len, MS_MAX_LIGHT_TEXTURE, &t, &w, &h, why, sizeof why);
+        free(bytes);
+        if (rc) { snprintf(err, errlen, "%s: %s.texture: %s", path, objname, why); return -1; }
+        l->texture = t;
+        l->texture_width = w;
+        l->texture_height = h;
+    }
     return 0;
+}
+
+int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n)
+{
+    if (rel[0] == '/') return snprintf(out, n, "%s", rel) >= (int)n ? -1 : 0;
+    char *dircopy = strdup(json_path);
+    if (!dircopy) return -1;
+    const int k = snprintf(out, n, "%s/%s", dirname(dircopy), rel);
+    free(dircopy);
+    return k < 0 || (size_t)k >= n ? -1 : 0;
 }
 
 static int parse_lights(const cJSON *root, ms_scene *out, const char *path, char *err, size_t errlen)
@@ -328,6 +363,7 @@ static int parse_lights(const cJSON *root, ms_scene *out, const char *path, char
     }
     out->lights = calloc((size_t)n, sizeof *out->lights);
     if (!out->lights) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    out->n_lights = (size_t)n;   /* so that ms_scene_free frees the textures of a failed load */
     for (int i = 0; i < n; i++) {
         char name[32];
         snprintf(name, sizeof name, "lights[%d]", i);
@@ -507,6 +543,10 @@ void ms_scene_free(ms_scene *s)
     free(s->tri);
     free(s->tri_mesh);
     for (int i = 0; i < MS_MAX_UV_SETS; i++) free(s->tri_uv[i]);
+    /* light is a copy of lights[0] when there is an array: each texture once */
+    if (s->n_lights && s->lights)
+        for (size_t i = 0; i < s->n_lights; i++) free((void *)s->lights[i].texture);
+    else free((void *)s->light.texture);
     free(s->lights);
     memset(s, 0, sizeof *s);
 }

@@ -5,7 +5,8 @@
  *     or off the shape are neither visible nor occluded;
  *   - from a method's visible mask (the front samples no triangle occludes), V = visible / front (0 when
  *     no sample is in front) and the shadow factor S = sum_vis w_i / sum_front w_i with the form-factor
- *     weight w_i = max(cos theta_r, 0) max(cos theta_l, 0) / r_i^2 (S = V when every weight is 0: the
+ *     weight w_i = max(cos theta_r, 0) max(cos theta_l, 0) / r_i^2, times the sample's texel luminance for a
+ *     textured light (S = V when every weight is 0: the
  *     light is behind the point or edge-on, and E_unshadowed is 0 there anyway).
  *
  * Masks: ctx->mask_words 64-bit words per point; bit s of the little-endian bit stream is sample s = j*k + i,
@@ -37,6 +38,11 @@ int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
  * (penumbra: some but not all front samples visible), 0 when S follows from the counts. */
 int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, const uint64_t *front,
                    const uint64_t *vis, float *v, float *s);
+
+/* A textured light (ctx->light.texture): the form-factor-weighted mean texel colour over q's front samples,
+ * which times the untextured E_unshadowed approximates the textured light's unshadowed irradiance (a ratio
+ * estimator, exact for a uniform texture). White for an untextured light. */
+void ms_light_texture_mean(const ms_render_ctx *ctx, const ms_shadow_query *q, float rgb[3]);
 
 /* The grid's weight sums over the front (wf) and visible (wv) samples, per ISA (receiver_weights_impl.h). */
 void ms_grid_weights_scalar(const ms_grid *g, const float rel0[3], const float h[3], int k, const uint64_t *front,
