@@ -70,8 +70,11 @@ typedef struct ms_camera {
  * parallelogram, and the shape masks off the samples outside it by their parameters (s,t):
  *   MS_LIGHT_RECT: the parallelogram itself (every sample; the zero value, so older callers keep it);
  *   MS_LIGHT_DISK: the ellipse inscribed in the parallelogram, (2s-1)^2 + (2t-1)^2 < 1; for a disk of
- *     centre c, unit normal m and radius r the parallelogram is its bounding square (ms_light_disk). */
-typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1 } ms_light_shape;
+ *     centre c, unit normal m and radius r the parallelogram is its bounding square (ms_light_disk);
+ *   MS_LIGHT_SPHERE: a sphere (center, radius; the parallelogram fields unused). Seen from a receiver P
+ *     outside it, its outline is a disk facing P (ms_light_sphere_outline): each receiver is sampled on
+ *     its own outline disk, a per-receiver light frame. Frames only (ms_render); not textured. */
+typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2 } ms_light_shape;
 
 /* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
  * from the samples of its shape. Zero-initialised fields past emission keep a uniform parallelogram.
@@ -86,7 +89,17 @@ typedef struct ms_light {
     ms_light_shape shape;
     const float *texture;
     int texture_width, texture_height;
+    ms_vec3 center;      /* MS_LIGHT_SPHERE only */
+    float radius;        /* MS_LIGHT_SPHERE only */
 } ms_light;
+
+/* Fills l as a sphere light of centre c and radius r (emission left as it is). 0, or -1 when r is not > 0. */
+int ms_light_sphere(ms_light *l, ms_vec3 c, float r);
+/* The outline of sphere light l seen from p: the disk where the cone of tangents from p touches the sphere,
+ * centre c + (p - c) r^2/d^2, radius r sqrt(d^2 - r^2)/d (d = |p - c|), facing p, as a disk light
+ * (ms_light_disk) with l's emission. Every ray from p to this disk meets the sphere first at its near side,
+ * and the disk subtends the sphere's solid angle. 0, or -1 when p is not outside the sphere. */
+int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk);
 
 /* Luminance of the texel at (s,t) of a textured light (0.2126 R + 0.7152 G + 0.0722 B), and its colour
  * into rgb when rgb is not NULL; 1 (and white) for an untextured light. */
@@ -100,7 +113,7 @@ int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
 /* 1 if light parameters (s,t) lie on the light's shape (see ms_light_shape), 0 if not. */
 int ms_light_shape_contains(ms_light_shape shape, float s, float t);
 
-/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk). */
+/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk; 4 pi r^2 for a sphere). */
 float ms_light_area(const ms_light *l);
 
 /* Units of a light's emission in a scene file (docs/design.md, "Units"). The renderer works in radiance;
@@ -332,7 +345,9 @@ int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t e
  * square (a circle, as ms_light_disk makes): exact closed form (the disk's vector irradiance from the
  * parallel and perpendicular differential-element form factors) when the whole disk is above the
  * receiver's plane; across the horizon, and for an ellipse, the polygon formula on a clipped 256-gon of
- * the same area (an approximation; error measured in tests/test_lights.c). */
+ * the same area (an approximation; error measured in tests/test_lights.c). Sphere: exact, pi (r/d)^2
+ * cos theta wholly above the horizon, Snyder's closed form across it (as in Lagarde & de Rousiers,
+ * "Moving Frostbite to PBR", 2014); 0 at points inside the sphere. */
 float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
 
 /* ---- Visibility at any points: the library for bakers (docs/baking.md) ----

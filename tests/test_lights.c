@@ -422,6 +422,11 @@ static void test_units(void **st)
     const float ny = L[2].edge_s.z * L[2].edge_t.x - L[2].edge_s.x * L[2].edge_t.z;
     assert_float_equal(ny, -16.0f, 1e-4f);
     assert_float_equal(ms_light_area(&L[2]), (float)M_PI * 4.0f, 1e-5f);
+    /* a sphere of radius 0.5 m emitting 100 W: area pi, L = 100 / (pi * pi) = 10.13212 */
+    ms_light sph;
+    memset(&sph, 0, sizeof sph);
+    ms_light_sphere(&sph, (ms_vec3){ 0, 0, 0 }, 0.5f);
+    assert_float_equal(ms_light_radiance_from(&sph, (ms_vec3){ 100, 100, 100 }, MS_UNITS_WATTS).x, 10.13212f, 1e-4f);
     /* no unit given: radiance 1 */
     assert_float_equal(L[3].emission.x, 1.0f, 0.0f);
     ms_scene_free(&sc);
@@ -452,7 +457,7 @@ static void test_bad_light_json(void **st)
     const char *rect = "\"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2]";
     char buf[1024];
     snprintf(buf, sizeof buf, "\"light\": { \"shape\": \"triangle\", %s }", rect);
-    expect_bad("b1.json", buf, "light.shape must be \"rect\" or \"disk\"");
+    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\" or \"sphere\"");
     expect_bad("b2.json", "\"light\": { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0] }", "light.radius is missing");
     expect_bad("b3.json", "\"light\": { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0], \"radius\": -1 }",
                "light.radius must be in (0,");
@@ -474,6 +479,9 @@ static void test_bad_light_json(void **st)
     expect_bad("b12.json", buf, "light.power must be a number or an array of 3 numbers");
     snprintf(buf, sizeof buf, "\"lights\": [ { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0], \"radius\": 1e39 } ]");
     expect_bad("b13.json", buf, "lights[0].radius");
+    expect_bad("b17.json", "\"light\": { \"shape\": \"sphere\", \"center\": [0, 6, 0] }", "light.radius is missing");
+    expect_bad("b18.json", "\"light\": { \"shape\": \"sphere\", \"center\": [0, 6, 0], \"radius\": 1, \"texture\": \"a.png\" }",
+               "a sphere light cannot be textured");
     snprintf(buf, sizeof buf, "\"light\": { %s, \"texture\": \"nothere.png\" }", rect);
     expect_bad("b14.json", buf, "texture file not found");
     char p[4096];
@@ -650,6 +658,185 @@ static void test_textured_rect(void **st)
     ms_scene_free(&sc);
 }
 
+/* ---- sphere lights ---- */
+
+/* The outline disk against the exact tangent cone: every rim point lies on the sphere and its tangent
+ * plane contains the ray from p, (rim - p) . (rim - c) = 0; the disk faces p. */
+static void test_sphere_outline(void **st)
+{
+    (void)st;
+    tu_rng g = { 99 };
+    for (int trial = 0; trial < 200; trial++) {
+        double v[7];
+        for (int i = 0; i < 7; i++) v[i] = (double)(tu_rng_next(&g) >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0;
+        ms_light sph;
+        memset(&sph, 0, sizeof sph);
+        const float R = 0.1f + (float)fabs(v[3]);
+        assert_int_equal(ms_light_sphere(&sph, (ms_vec3){ (float)v[0], (float)v[1], (float)v[2] }, R), 0);
+        /* a point 1.01 R .. 5 R from the centre */
+        double dir[3] = { v[4], v[5], v[6] };
+        const double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        if (dl < 0.1) continue;
+        const double dist = R * (1.01 + 4.0 * fabs(v[4]));
+        const float p[3] = { (float)(v[0] + dir[0] / dl * dist), (float)(v[1] + dir[1] / dl * dist), (float)(v[2] + dir[2] / dl * dist) };
+        ms_light disk;
+        assert_int_equal(ms_light_sphere_outline(&sph, p, &disk), 0);
+        assert_int_equal(disk.shape, MS_LIGHT_DISK);
+        const double c[3] = { sph.center.x, sph.center.y, sph.center.z };
+        for (int k = 0; k < 16; k++) {
+            /* rim point: the inscribed circle of the square at angle k */
+            const double a = 2.0 * M_PI * k / 16, cs = 0.5 + 0.5 * cos(a), sn = 0.5 + 0.5 * sin(a);
+            double rim[3], pr[3], cr[3];
+            const double P0[3] = { disk.corner.x, disk.corner.y, disk.corner.z };
+            const double S[3] = { disk.edge_s.x, disk.edge_s.y, disk.edge_s.z }, T[3] = { disk.edge_t.x, disk.edge_t.y, disk.edge_t.z };
+            for (int q = 0; q < 3; q++) { rim[q] = P0[q] + cs * S[q] + sn * T[q]; pr[q] = rim[q] - p[q]; cr[q] = rim[q] - c[q]; }
+            const double on = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+            const double tangent = (pr[0] * cr[0] + pr[1] * cr[1] + pr[2] * cr[2]) /
+                                   (sqrt(pr[0] * pr[0] + pr[1] * pr[1] + pr[2] * pr[2]) * on);
+            assert_true(fabs(on - R) <= 2e-5 * (R + dist));
+            assert_true(fabs(tangent) <= 1e-4 * (dist / (dist - R * 0.999)));
+        }
+        /* faces p: cross(edge_s, edge_t) . (p - centre) > 0 */
+        const double nx = (double)disk.edge_s.y * disk.edge_t.z - (double)disk.edge_s.z * disk.edge_t.y;
+        const double ny = (double)disk.edge_s.z * disk.edge_t.x - (double)disk.edge_s.x * disk.edge_t.z;
+        const double nz = (double)disk.edge_s.x * disk.edge_t.y - (double)disk.edge_s.y * disk.edge_t.x;
+        assert_true(nx * (p[0] - c[0]) + ny * (p[1] - c[1]) + nz * (p[2] - c[2]) > 0.0);
+    }
+    /* inside: no outline */
+    ms_light sph, disk;
+    memset(&sph, 0, sizeof sph);
+    ms_light_sphere(&sph, (ms_vec3){ 0, 0, 0 }, 1.0f);
+    const float in[3] = { 0.5f, 0, 0 };
+    assert_int_equal(ms_light_sphere_outline(&sph, in, &disk), -1);
+}
+
+/* Sphere irradiance (Snyder's closed form) against numerical integration over the exact outline disk
+ * (same solid angle, same radiance), above and across the horizon. */
+static void test_sphere_irradiance(void **st)
+{
+    (void)st;
+    tu_rng g = { 4321 };
+    int above = 0, cross = 0;
+    double worst = 0.0;
+    for (int trial = 0; trial < 300 && (above < 30 || cross < 30); trial++) {
+        double v[6];
+        for (int i = 0; i < 6; i++) v[i] = (double)(tu_rng_next(&g) >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0;
+        const float R = 0.3f + 0.5f * (float)fabs(v[0]);
+        ms_light sph;
+        memset(&sph, 0, sizeof sph);
+        ms_light_sphere(&sph, (ms_vec3){ 0, 0, 0 }, R);
+        const double d = R * (1.2 + 3.0 * fabs(v[1]));
+        double dir[3] = { v[2], v[3], v[4] };
+        const double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        if (dl < 0.1) continue;
+        const float p[3] = { (float)(dir[0] / dl * d), (float)(dir[1] / dl * d), (float)(dir[2] / dl * d) };
+        /* normal: at angle theta from the direction to the centre, up to 120 degrees */
+        const double th = fabs(v[5]) * 2.0 * M_PI / 3.0;
+        double a[3] = { -p[0], -p[1], -p[2] }, b[3];
+        const double al = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        for (int q = 0; q < 3; q++) a[q] /= al;
+        b[0] = a[1]; b[1] = -a[0]; b[2] = 0;   /* perpendicular to a (a is never along z only, by chance) */
+        const double bl = sqrt(b[0] * b[0] + b[1] * b[1]);
+        if (bl < 0.1) continue;
+        for (int q = 0; q < 2; q++) b[q] /= bl;
+        const float n[3] = { (float)(cos(th) * a[0] + sin(th) * b[0]), (float)(cos(th) * a[1] + sin(th) * b[1]),
+                             (float)(cos(th) * a[2]) };
+        /* the exact outline in double */
+        const double pd[3] = { p[0], p[1], p[2] }, nd[3] = { n[0], n[1], n[2] };
+        const double dd = sqrt(pd[0] * pd[0] + pd[1] * pd[1] + pd[2] * pd[2]), f = R * R / (dd * dd);
+        disk_geom dg = { { pd[0] * f, pd[1] * f, pd[2] * f }, { pd[0] / dd, pd[1] / dd, pd[2] / dd },
+                         R * sqrt(dd * dd - R * R) / dd };
+        const double want = disk_irradiance_numeric(&dg, pd, nd, 600);
+        const double got = ms_light_irradiance(&sph, p, n);
+        const double sin_s = R / dd;
+        if (cos(th) > sin_s + 0.01) above++;
+        else if (cos(th) < sin_s - 0.01 && cos(th) > -sin_s + 0.01) cross++;
+        else continue;
+        worst = fmax(worst, fabs(got - want) / fmax(want, 1e-3));
+    }
+    printf("sphere irradiance vs numerical integration: %d above the horizon, %d across, worst relative error %.2e\n",
+           above, cross, worst);
+    assert_true(above >= 20 && cross >= 20);
+    assert_true(worst < 1e-4);
+}
+
+/* Every method on a sphere light equals raytrace pixel for pixel; raytrace's V equals the brute force on the
+ * exact outline disk of each receiver, at every pixel the brute force decides whole. */
+static void test_sphere_every_method(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    tu_make_quad(&sc);
+    memset(&sc.light, 0, sizeof sc.light);
+    assert_int_equal(ms_light_sphere(&sc.light, (ms_vec3){ 0.5f, 5.0f, 0.2f }, 0.9f), 0);
+    sc.light.emission = (ms_vec3){ 1, 1, 1 };
+    const int size = 24;
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = size;
+    o.threads = 2;
+    char err[256];
+    ms_frame ref, f;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        long differ = 0;
+        for (int i = 0; i < size * size; i++)
+            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        if (differ) fprintf(stderr, "sphere frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_frame_free(&f);
+    }
+    /* brute force at each pixel */
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
+    ms_render_ctx ctx;
+    tu_ctx_init(&ctx, &sc, &bvh, size, size, 32);
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    void *ps = NULL;
+    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
+    ms_hit hits[24 * 24];
+    pm->trace(ps, &ctx, 0, 0, size, size, hits);
+    pm->destroy(ps);
+    float *pts = malloc(3 * 1024 * sizeof *pts);
+    assert_non_null(pts);
+    int decided = 0, partial = 0;
+    const double c[3] = { sc.light.center.x, sc.light.center.y, sc.light.center.z }, R = sc.light.radius;
+    for (int i = 0; i < size * size; i++) {
+        if (hits[i].prim == UINT32_MAX) continue;
+        ms_light disk;
+        assert_int_equal(ms_light_sphere_outline(&sc.light, hits[i].p, &disk), 0);
+        ms_pattern_points(MS_PATTERN_GRID, &disk, 32, (uint32_t)(i % size), (uint32_t)(i / size), 0, pts);
+        const double p[3] = { hits[i].p[0], hits[i].p[1], hits[i].p[2] };
+        const double w[3] = { p[0] - c[0], p[1] - c[1], p[2] - c[2] };
+        const double d = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), f2 = R * R / (d * d);
+        const disk_geom dg = { { c[0] + w[0] * f2, c[1] + w[1] * f2, c[2] + w[2] * f2 }, { w[0] / d, w[1] / d, w[2] / d },
+                               R * sqrt(d * d - R * R) / d };
+        int nf = 0, nv = 0, unsure = 0;
+        for (int s2 = 0; s2 < 1024; s2++) {
+            verdict cnt, v;
+            brute_sample(&bvh, hits[i].prim, hits[i].p, hits[i].n, pts + 3 * s2, &dg, &cnt, &v);
+            if (cnt == UNSURE || v == UNSURE) { unsure = 1; break; }
+            nf += cnt == YES;
+            nv += v == YES;
+        }
+        if (unsure) continue;
+        decided++;
+        partial += nv > 0 && nv < nf;
+        assert_int_equal(ref.front[i], nf);
+        assert_true(ref.vis[i] == (nf ? (float)nv / (float)nf : 0.0f));
+    }
+    printf("sphere light: the brute force decided %d of %d pixels whole (%d in penumbra)\n", decided, size * size, partial);
+    assert_true(decided > size * size / 2 && partial > 0);
+    free(pts);
+    ms_bvh_free(&bvh);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -662,6 +849,9 @@ int main(void)
         cmocka_unit_test(test_bad_light_json),
         cmocka_unit_test(test_vis_outputs),
         cmocka_unit_test(test_textured_rect),
+        cmocka_unit_test(test_sphere_outline),
+        cmocka_unit_test(test_sphere_irradiance),
+        cmocka_unit_test(test_sphere_every_method),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

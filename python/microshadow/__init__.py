@@ -66,7 +66,8 @@ class _Camera(ctypes.Structure):
 
 class _Light(ctypes.Structure):
     _fields_ = [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3), ("shape", ctypes.c_int),
-                ("texture", ctypes.POINTER(_f)), ("texture_width", ctypes.c_int), ("texture_height", ctypes.c_int)]
+                ("texture", ctypes.POINTER(_f)), ("texture_width", ctypes.c_int), ("texture_height", ctypes.c_int),
+                ("center", _Vec3), ("radius", _f)]
 
 
 class _Scene(ctypes.Structure):

@@ -71,8 +71,25 @@ static double disk_closed_form(const float C[3], const float S[3], const float T
     return M_PI * (fpar * -(double)v3_dot(m, n) + fperp * -nrho);
 }
 
+/* A sphere of radius r at distance d, its centre at angle theta from the normal (sin^2 sigma = (r/d)^2):
+ * pi sin^2 sigma cos theta when wholly above the horizon (cos^2 theta > sin^2 sigma), else Snyder's exact
+ * expression for the part above it (Lagarde & de Rousiers 2014, "illuminanceSphereOrDisk"). */
+static double sphere_irradiance(const ms_light *l, const float p[3], const float n[3])
+{
+    const double w[3] = { (double)l->center.x - p[0], (double)l->center.y - p[1], (double)l->center.z - p[2] };
+    const double d2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], r = l->radius;
+    if (!(d2 > r * r)) return 0.0;
+    const double s2 = r * r / d2;
+    const double ct = (w[0] * n[0] + w[1] * n[1] + w[2] * n[2]) / sqrt(d2);
+    if (ct * ct > s2) return ct > 0.0 ? M_PI * s2 * ct : 0.0;
+    const double st = sqrt(fmax(1.0 - ct * ct, 0.0)), x = sqrt(1.0 / s2 - 1.0);
+    const double y = -x * ct / st, sty = st * sqrt(fmax(1.0 - y * y, 0.0));
+    return fmax((ct * acos(y) - x * sty) * s2 + atan(sty / x), 0.0);
+}
+
 float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3])
 {
+    if (l->shape == MS_LIGHT_SPHERE) return (float)sphere_irradiance(l, p, n);
     const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
     const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
     const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };

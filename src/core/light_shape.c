@@ -4,6 +4,7 @@
 #include "microshadow.h"
 #include "vec.h"
 #include <math.h>
+#include <string.h>
 
 int ms_light_shape_contains(ms_light_shape shape, float s, float t)
 {
@@ -32,8 +33,38 @@ int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r)
     return 0;
 }
 
+int ms_light_sphere(ms_light *l, ms_vec3 c, float r)
+{
+    if (!(r > 0.0f) || !isfinite(r)) return -1;
+    l->shape = MS_LIGHT_SPHERE;
+    l->center = c;
+    l->radius = r;
+    /* The parallelogram fields are unused; a square around the sphere keeps them valid (non-zero area). */
+    l->corner = (ms_vec3){ c.x - r, c.y, c.z - r };
+    l->edge_s = (ms_vec3){ 2.0f * r, 0.0f, 0.0f };
+    l->edge_t = (ms_vec3){ 0.0f, 0.0f, 2.0f * r };
+    return 0;
+}
+
+int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk)
+{
+    /* In double: the tangent circle's radius r sqrt(d^2 - r^2)/d loses everything to cancellation in
+     * float when the point is close to the sphere. */
+    const double c[3] = { l->center.x, l->center.y, l->center.z }, r = l->radius;
+    const double w[3] = { p[0] - c[0], p[1] - c[1], p[2] - c[2] };
+    const double d2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    if (!(d2 > r * r * (1.0 + 1e-6))) return -1;
+    const double f = r * r / d2, rr = r * sqrt(d2 - r * r) / sqrt(d2);
+    const ms_vec3 cc = { (float)(c[0] + w[0] * f), (float)(c[1] + w[1] * f), (float)(c[2] + w[2] * f) };
+    const ms_vec3 m = { (float)w[0], (float)w[1], (float)w[2] };
+    memset(disk, 0, sizeof *disk);
+    disk->emission = l->emission;
+    return ms_light_disk(disk, cc, m, (float)rr);
+}
+
 float ms_light_area(const ms_light *l)
 {
+    if (l->shape == MS_LIGHT_SPHERE) return 4.0f * (float)M_PI * l->radius * l->radius;
     const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z }, T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
     float n[3];
     v3_cross(n, S, T);

@@ -167,6 +167,12 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     if (!a) { snprintf(err, errlen, "ms_visibility_points: no accel"); return MS_ERR_INVALID; }
     if (!light) light = &a->view.light;
     if (!light_ok(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area"); return MS_ERR_INVALID; }
+    if (light->shape == MS_LIGHT_SPHERE) {
+        /* its per-receiver outline disk is done by frames only (render.c) */
+        snprintf(err, errlen, "sphere lights are rendered by frames only (ms_render), not at points");
+        return MS_ERR_INVALID;
+    }
+    if ((unsigned)light->shape > MS_LIGHT_SPHERE) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
     ms_status st = check_points(a, pts, err, errlen);
     if (st) return st;
     const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;

@@ -78,7 +78,14 @@ static int shadow_pass(const ms_shadow_method *sm, void *sstate, const ms_render
     const int W = p->W, H = p->H, tx = (W + TILE - 1) / TILE, ty = (H + TILE - 1) / TILE, ntiles = tx * ty;
     const size_t mw = (size_t)ctx.mask_words;
     const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
-    const int shadow_tiles = sm->visibility_all ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
+    /* A sphere light: each receiver has its own light, the sphere's outline disk seen from it (a per-query
+     * light frame: ms_light_sphere_outline). The method is called one query at a time with a context whose
+     * light is that disk, so every method answers on the same per-receiver samples as raytrace, whatever
+     * it sets up per frame (mft re-derives its light frame per call; hpc sets up its light per call, so
+     * a sphere costs it a pass over every triangle per receiver); frame-level entries are not used. The
+     * price is the block traversal's coherence: groups of one. */
+    const int sphere = ctx.light.shape == MS_LIGHT_SPHERE;
+    const int shadow_tiles = sm->visibility_all && !sphere ? 0 : ntiles;   /* a frame-level method: shadow_frame.c */
     float *const vis = p->vis, *const shadow = p->shadow;
     uint16_t *const fr = p->front;
     const ms_hit *const hits = p->hits;
@@ -99,6 +106,7 @@ static int shadow_pass(const ms_shadow_method *sm, void *sstate, const ms_render
             int x1 = x0 + TILE < W ? x0 + TILE : W, y1 = y0 + TILE < H ? y0 + TILE : H;
             ms_shadow_query q[TILE * TILE];
             size_t where[TILE * TILE];
+            ms_render_ctx qc = ctx;   /* the query's context: the frame's, or with a sphere's outline disk */
             int n = 0;
             for (int y = y0; y < y1 && ok; y++)
                 for (int x = x0; x < x1; x++) {
@@ -110,17 +118,30 @@ static int shadow_pass(const ms_shadow_method *sm, void *sstate, const ms_render
                     q[n].prim = h->prim;
                     q[n].px = (uint32_t)x;
                     q[n].py = (uint32_t)y;
-                    if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[n].px, q[n].py, ctx.seed, pts);
-                    const int nf = ms_front_mask(&ctx, &q[n], pts, front + (size_t)n * mw);
+                    if (sphere && ms_light_sphere_outline(&ctx.light, q[n].p, &qc.light)) {
+                        vis[i] = shadow[i] = 0.0f;   /* inside the sphere: no sample counts */
+                        fr[i] = 0;
+                        local_visible++;
+                        continue;
+                    }
+                    if (pts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[n].px, q[n].py, ctx.seed, pts);
+                    const int nf = ms_front_mask(&qc, &q[n], pts, front + (size_t)n * mw);
                     fr[i] = (uint16_t)nf;
                     local_segments += (uint64_t)nf;
                     where[n++] = i;
                 }
-            if (n && ok && sm->visibility(sstate, &ctx, q, n, front, vmask, local)) ok = 0;
+            if (!sphere) {
+                if (n && ok && sm->visibility(sstate, &ctx, q, n, front, vmask, local)) ok = 0;
+            } else
+                for (int i = 0; i < n && ok; i++) {
+                    ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                    if (sm->visibility(sstate, &qc, &q[i], 1, front + (size_t)i * mw, vmask + (size_t)i * mw, local)) ok = 0;
+                }
             const double tr = omp_get_wtime();
             for (int i = 0; i < n && ok; i++) {
-                if (pts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
-                local_penumbra += (uint64_t)ms_resolve_vs(&ctx, &q[i], pts, front + (size_t)i * mw,
+                if (sphere) ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                if (pts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
+                local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[i], pts, front + (size_t)i * mw,
                                                           vmask + (size_t)i * mw, &vis[where[i]],
                                                           &shadow[where[i]]);
             }
@@ -141,7 +162,7 @@ static int shadow_pass(const ms_shadow_method *sm, void *sstate, const ms_render
             failed |= !ok;
         }
     }
-    if (sm->visibility_all && !failed)
+    if (sm->visibility_all && !sphere && !failed)
         failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, W, H, vis, shadow, fr, p->counters, &visible, &penumbra,
                                        &segments, &resolve_thread_s) != 0;
     p->visible += visible;

@@ -255,7 +255,7 @@ static int get_amount(const cJSON *obj, const char *objname, const char *key, ms
     return 1;
 }
 
-/* One light object: "shape" ("rect", the default, or "disk"), its geometry, and at most one of
+/* One light object: "shape" ("rect", the default, "disk" or "sphere"), its geometry, and at most one of
  * "emission" (radiance), "power" (watts) or "lumens" (luminous flux), default emission 1. */
 static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const char *path, char *err, size_t errlen)
 {
@@ -265,7 +265,7 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
     const cJSON *shape = cJSON_GetObjectItemCaseSensitive(obj, "shape");
     const char *sh = "rect";
     if (shape) {
-        if (!cJSON_IsString(shape)) { snprintf(err, errlen, "%s: %s.shape must be \"rect\" or \"disk\"", path, objname); return -1; }
+        if (!cJSON_IsString(shape)) { snprintf(err, errlen, "%s: %s.shape must be \"rect\", \"disk\" or \"sphere\"", path, objname); return -1; }
         sh = shape->valuestring;
     }
     if (!strcmp(sh, "rect")) {
@@ -288,8 +288,23 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
             snprintf(err, errlen, "%s: %s.normal must not be zero", path, objname);
             return -1;
         }
+    } else if (!strcmp(sh, "sphere")) {
+        ms_vec3 c = { 0, 0, 0 };
+        double r = 0;
+        if (get_vec3(obj, objname, "center", 1, &c, path, err, errlen) ||
+            get_number(obj, objname, "radius", 1, &r, path, err, errlen))
+            return -1;
+        if (!(r > 0) || r > MS_MAX_COORD) {
+            snprintf(err, errlen, "%s: %s.radius must be in (0, %g]", path, objname, (double)MS_MAX_COORD);
+            return -1;
+        }
+        if (cJSON_GetObjectItemCaseSensitive(obj, "texture")) {
+            snprintf(err, errlen, "%s: %s: a sphere light cannot be textured (rect and disk can)", path, objname);
+            return -1;
+        }
+        ms_light_sphere(l, c, (float)r);
     } else {
-        snprintf(err, errlen, "%s: %s.shape must be \"rect\" or \"disk\" (got \"%.40s\")", path, objname, sh);
+        snprintf(err, errlen, "%s: %s.shape must be \"rect\", \"disk\" or \"sphere\" (got \"%.40s\")", path, objname, sh);
         return -1;
     }
     static const char *const unit_key[] = { "emission", "power", "lumens" };

@@ -21,7 +21,13 @@ static int validate_light(const ms_light *l, const char *name, const char *what,
         snprintf(err, errlen, "%s: %s has a NaN or infinite value", what, name);
         return -1;
     }
-    if ((unsigned)l->shape > MS_LIGHT_DISK) {
+    if (l->shape == MS_LIGHT_SPHERE && (!vec_ok(l->center) || !in_range(l->center) || !(l->radius > 0.0f) ||
+                                        !(l->radius <= MS_MAX_COORD) || l->texture)) {
+        snprintf(err, errlen, "%s: %s: a sphere needs a finite center and a radius in (0, %g], and no texture", what,
+                 name, (double)MS_MAX_COORD);
+        return -1;
+    }
+    if ((unsigned)l->shape > MS_LIGHT_SPHERE) {
         snprintf(err, errlen, "%s: %s has an unknown shape %d", what, name, (int)l->shape);
         return -1;
     }
