@@ -1,5 +1,5 @@
 /*
- * microshadow — physically based soft shadows from parallelogram area lights, on the CPU.
+ * microshadow — physically based soft shadows from area lights (rect, disk, sphere, textured), on the CPU.
  *
  * One entry point does a whole frame:
  *
@@ -16,15 +16,17 @@
  * Visibility, defined once for every method (docs/design.md). For a pixel whose primary ray hits the scene
  * at P on triangle T, with n the unit geometric normal of T turned towards the camera, and the light samples
  * L_1..L_N of the pixel's pattern:
- *   - a sample counts only when it lies strictly in front of the receiver's plane, (L_i - P) . n > 0;
- *     samples behind are neither visible nor occluded;
+ *   - a sample counts only when it lies strictly in front of the receiver's plane, (L_i - P) . n > 0, and
+ *     on the light's shape (the disk mask: (2s-1)^2 + (2t-1)^2 < 1 in the parameters of a disk's bounding
+ *     square; a sphere light is sampled, per receiver, on its outline disk seen from P, with that mask);
+ *     other samples are neither visible nor occluded;
  *   - a sample in front is occluded when a triangle other than T meets the segment P + u (L_i - P) at a
  *     parameter u in [1e-4, 1 - 1e-4] (two-sided, purely geometric);
  *   - V = (unoccluded samples in front) / (samples in front), and V = 0 when no sample is in front;
  *   - the shadow factor S = sum_i w_i v_i / sum_i w_i over the samples in front (v_i = 1 when unoccluded),
  *     with the form-factor weight w_i = max(cos theta_r,i, 0) max(cos theta_l,i, 0) / r_i^2 (theta_r at
- *     the receiver, theta_l at the light, whose emitting side is cross(edge_s, edge_t)); S = V when every
- *     w_i is 0. E_unshadowed * S is exact where the light is wholly visible or hidden and converges to
+ *     the receiver, theta_l at the light, whose emitting side is cross(edge_s, edge_t)), times the sample's
+ *     texel luminance for a textured light; S = V when every w_i is 0. With several lights, V and S per light. E_unshadowed * S is exact where the light is wholly visible or hidden and converges to
  *     the shadowed irradiance as N grows (a ratio estimator).
  * P is the hit point itself, not lifted off the surface: V and S do not depend on which side of the
  * surface rounding leaves it. Every shadow method computes V and S on the same samples, so methods can be

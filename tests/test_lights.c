@@ -236,6 +236,30 @@ static void test_disk_frames_equal(void **st)
     ms_scene_free(&sc);
 }
 
+/* The grid's disk mask by row intervals equals the per-sample test, at every k and many pixels and seeds. */
+static void test_disk_mask_rows(void **st)
+{
+    (void)st;
+    ms_light l;
+    memset(&l, 0, sizeof l);
+    assert_int_equal(ms_light_disk(&l, (ms_vec3){ 1, 2, 3 }, (ms_vec3){ 0.3f, -1, 0.2f }, 0.7f), 0);
+    long kept = 0, total = 0;
+    for (int k = 16; k <= 64; k *= 2)
+        for (uint32_t px = 0; px < 64; px++)
+            for (uint32_t seed = 0; seed < 8; seed++) {
+                uint64_t a[64], b[64];
+                memset(a, 0xFF, sizeof a);
+                memset(b, 0xFF, sizeof b);
+                ms_shape_mask_apply(MS_PATTERN_GRID, &l, k, px, 3 * px + 1, seed, a);
+                ms_shape_mask_reference(MS_PATTERN_GRID, &l, k, px, 3 * px + 1, seed, b);
+                for (int w = 0; w < k * k / 64; w++) assert_true(a[w] == b[w]);
+                kept += ms_mask_count(a, k * k / 64);
+                total += k * k;
+            }
+    /* about pi/4 of the square */
+    assert_true(fabs((double)kept / (double)total - M_PI / 4.0) < 0.01);
+}
+
 /* ---- unshadowed irradiance ---- */
 
 /* Numerical integration over the disk: polar midpoint rule, n x 2n cells, double precision,
@@ -840,6 +864,7 @@ static void test_sphere_every_method(void **st)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_disk_mask_rows),
         cmocka_unit_test(test_disk_every_method_grid),
         cmocka_unit_test(test_disk_ray_tracers_other_patterns),
         cmocka_unit_test(test_disk_frames_equal),

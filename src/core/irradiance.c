@@ -48,7 +48,7 @@ static double polygon_irradiance(const float (*rel)[3], int m_in, const float n[
     return 0.5 * fabs(sum);
 }
 
-/* A disk over a square: the closed form, or -1 when part of it is below the horizon. */
+/* A disk over a square: the closed form, 0 wholly below the horizon, or -1 when it crosses the horizon. */
 static double disk_closed_form(const float C[3], const float S[3], const float T[3], const float p[3], const float n[3])
 {
     float m[3], w[3], rho[3];
@@ -59,7 +59,9 @@ static double disk_closed_form(const float C[3], const float S[3], const float T
     float nt[3], cp[3];
     v3_madd(nt, n, m, -v3_dot(n, m));
     v3_sub(cp, C, p);
-    if (!((double)v3_dot(cp, n) > r * (double)v3_len(nt) * (1.0 + 1e-6))) return -1.0;
+    const double above = (double)v3_dot(cp, n), reach = r * (double)v3_len(nt);
+    if (above < -reach * (1.0 + 1e-6)) return 0.0;   /* wholly below the horizon */
+    if (!(above > reach * (1.0 + 1e-6))) return -1.0;
     v3_sub(w, p, C);
     const double h = (double)v3_dot(w, m);
     v3_madd(rho, w, m, -(float)h);

@@ -39,6 +39,10 @@ void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px
  * every sample whose light parameters (s,t) lie off the light's shape; nothing for a parallelogram. */
 void ms_shape_mask_apply(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                          uint64_t *mask);
+/* The same mask by testing every sample's (s,t) one by one (for tests: ms_shape_mask_apply finds the grid's
+ * rows as intervals). */
+void ms_shape_mask_reference(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                             uint64_t *mask);
 /* The light parameters (s,t) of the pixel's samples, 2 * ms_pattern_spp(p, k) floats: the values the
  * shape mask tests (for tests and the textured emission). */
 void ms_pattern_st(ms_pattern p, int k, uint32_t px, uint32_t py, uint32_t seed, float *st);

@@ -374,9 +374,13 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
         pm->destroy(pstate);
         goto fail;
     }
+    /* In parallel (a disk across the horizon costs a 256-gon per pixel): lum[i] per pixel, misses
+     * dropped after. */
+#pragma omp parallel for schedule(dynamic, 1024) num_threads(threads)
     for (size_t i = 0; i < npix; i++) {
         float *c = out->rgb + 3 * i;
         c[0] = c[1] = c[2] = 0.0f;
+        if (lum) lum[i] = -1.0f;
         if (hits[i].prim == UINT32_MAX) continue;
         float y = 0.0f;
         for (size_t l = 0; l < nlights; l++) {   /* the lights' radiance adds up */
@@ -390,9 +394,11 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
             c[2] += e * b * S;
             y += e * (0.2126f * r + 0.7152f * g + 0.0722f * b);
         }
-        if (lum) lum[nlum++] = y;
+        if (lum) lum[i] = y;
     }
     free(tex);
+    for (size_t i = 0; lum && i < npix; i++)
+        if (hits[i].prim != UINT32_MAX) lum[nlum++] = lum[i];
     out->exposure = 1.0f;
     if (lum && nlum) {
         qsort(lum, nlum, sizeof *lum, cmp_float);
