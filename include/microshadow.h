@@ -1,5 +1,5 @@
 /*
- * microshadow — physically based soft shadows from parallelogram area lights, on the CPU.
+ * microshadow — physically based soft shadows from area lights (rect, disk, sphere, textured), on the CPU.
  *
  * One entry point does a whole frame:
  *
@@ -16,15 +16,17 @@
  * Visibility, defined once for every method (docs/design.md). For a pixel whose primary ray hits the scene
  * at P on triangle T, with n the unit geometric normal of T turned towards the camera, and the light samples
  * L_1..L_N of the pixel's pattern:
- *   - a sample counts only when it lies strictly in front of the receiver's plane, (L_i - P) . n > 0;
- *     samples behind are neither visible nor occluded;
+ *   - a sample counts only when it lies strictly in front of the receiver's plane, (L_i - P) . n > 0, and
+ *     on the light's shape (the disk mask: (2s-1)^2 + (2t-1)^2 < 1 in the parameters of a disk's bounding
+ *     square; a sphere light is sampled, per receiver, on its outline disk seen from P, with that mask);
+ *     other samples are neither visible nor occluded;
  *   - a sample in front is occluded when a triangle other than T meets the segment P + u (L_i - P) at a
  *     parameter u in [1e-4, 1 - 1e-4] (two-sided, purely geometric);
  *   - V = (unoccluded samples in front) / (samples in front), and V = 0 when no sample is in front;
  *   - the shadow factor S = sum_i w_i v_i / sum_i w_i over the samples in front (v_i = 1 when unoccluded),
  *     with the form-factor weight w_i = max(cos theta_r,i, 0) max(cos theta_l,i, 0) / r_i^2 (theta_r at
- *     the receiver, theta_l at the light, whose emitting side is cross(edge_s, edge_t)); S = V when every
- *     w_i is 0. E_unshadowed * S is exact where the light is wholly visible or hidden and converges to
+ *     the receiver, theta_l at the light, whose emitting side is cross(edge_s, edge_t)), times the sample's
+ *     texel luminance for a textured light; S = V when every w_i is 0. With several lights, V and S per light. E_unshadowed * S is exact where the light is wholly visible or hidden and converges to
  *     the shadowed irradiance as N grows (a ratio estimator).
  * P is the hit point itself, not lifted off the surface: V and S do not depend on which side of the
  * surface rounding leaves it. Every shadow method computes V and S on the same samples, so methods can be
@@ -65,12 +67,67 @@ typedef struct ms_camera {
     int width, height;
 } ms_camera;
 
-/* Parallelogram light L(s,t) = corner + s*edge_s + t*edge_t, s,t in [0,1]. It emits radiance
- * `emission` (linear RGB) from the side cross(edge_s, edge_t) points to. */
+/* Light shapes (docs/design.md, "Light shapes"). Every shape is sampled on its parallelogram
+ * L(s,t) = corner + s*edge_s + t*edge_t, s,t in [0,1]: the pattern's samples are those of the
+ * parallelogram, and the shape masks off the samples outside it by their parameters (s,t):
+ *   MS_LIGHT_RECT: the parallelogram itself (every sample; the zero value, so older callers keep it);
+ *   MS_LIGHT_DISK: the ellipse inscribed in the parallelogram, (2s-1)^2 + (2t-1)^2 < 1; for a disk of
+ *     centre c, unit normal m and radius r the parallelogram is its bounding square (ms_light_disk);
+ *   MS_LIGHT_SPHERE: a sphere (center, radius; the parallelogram fields unused). Seen from a receiver P
+ *     outside it, its outline is a disk facing P (ms_light_sphere_outline): each receiver is sampled on
+ *     its own outline disk, a per-receiver light frame. Frames only (ms_render); not textured. */
+typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2 } ms_light_shape;
+
+/* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
+ * from the samples of its shape. Zero-initialised fields past emission keep a uniform parallelogram.
+ * A textured light (texture non-NULL) emits emission times the texel at its parameters (s,t): the
+ * nearest of texture_width x texture_height linear RGB texels (3 floats each, row 0 at t = 0, column 0
+ * at s = 0). Its texels weight the samples in S (docs/design.md: w_i times the texel's luminance) and
+ * the shading; V stays the unweighted fraction. The caller owns the texels (ms_scene_free frees a loaded
+ * scene's). */
 typedef struct ms_light {
     ms_vec3 corner, edge_s, edge_t;
     ms_vec3 emission;
+    ms_light_shape shape;
+    const float *texture;
+    int texture_width, texture_height;
+    ms_vec3 center;      /* MS_LIGHT_SPHERE only */
+    float radius;        /* MS_LIGHT_SPHERE only */
 } ms_light;
+
+/* Fills l as a sphere light of centre c and radius r (emission left as it is). 0, or -1 when r is not > 0. */
+int ms_light_sphere(ms_light *l, ms_vec3 c, float r);
+/* The outline of sphere light l seen from p: the disk where the cone of tangents from p touches the sphere,
+ * centre c + (p - c) r^2/d^2, radius r sqrt(d^2 - r^2)/d (d = |p - c|), facing p, as a disk light
+ * (ms_light_disk) with l's emission. Every ray from p to this disk meets the sphere first at its near side,
+ * and the disk subtends the sphere's solid angle. 0, or -1 when p is not outside the sphere. */
+int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk);
+
+/* Luminance of the texel at (s,t) of a textured light (0.2126 R + 0.7152 G + 0.0722 B), and its colour
+ * into rgb when rgb is not NULL; 1 (and white) for an untextured light. */
+float ms_light_texel(const ms_light *l, float s, float t, float *rgb);
+
+/* Fills l as a disk light of centre c, normal m (emitting towards m; need not be unit length, not zero)
+ * and radius r: its bounding square, edges 2r along two unit vectors perpendicular to m chosen from m
+ * alone, and shape MS_LIGHT_DISK; emission is left as it is. 0, or -1 when m is zero or r not > 0. */
+int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
+
+/* 1 if light parameters (s,t) lie on the light's shape (see ms_light_shape), 0 if not. */
+int ms_light_shape_contains(ms_light_shape shape, float s, float t);
+
+/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk; 4 pi r^2 for a sphere). */
+float ms_light_area(const ms_light *l);
+
+/* Units of a light's emission in a scene file (docs/design.md, "Units"). The renderer works in radiance;
+ * the others are converted by the shape's emitting area A, every light emitting as a one-sided
+ * Lambertian surface (Drobot, GPU Pro 5, "physically based area lights": flux = pi * A * radiance):
+ *   MS_UNITS_RADIANCE: emission is radiance (W sr^-1 m^-2 or the scene's own linear unit);
+ *   MS_UNITS_WATTS: radiant flux Phi in W per channel, radiance = Phi / (pi A);
+ *   MS_UNITS_LUMENS: luminous flux in lm per channel, luminance = Phi_v / (pi A) in cd m^-2 (nits);
+ *     the renderer's radiance unit is then the nit (no 683 lm/W: the image stays photometric). */
+typedef enum ms_light_units { MS_UNITS_RADIANCE = 0, MS_UNITS_WATTS = 1, MS_UNITS_LUMENS = 2 } ms_light_units;
+/* The radiance of light l (its shape and edges set) emitting `amount` in `units`. */
+ms_vec3 ms_light_radiance_from(const ms_light *l, ms_vec3 amount, ms_light_units units);
 
 #define MS_MAX_UV_SETS 4
 
@@ -110,6 +167,11 @@ typedef struct ms_scene {
     float *tri_normal;
     struct ms_texture *textures;
     size_t n_textures;
+    /* Several lights (scene file: "lights": [...]): lights[0 .. n_lights-1], each with its own V and S;
+     * light is a copy of lights[0]. n_lights = 0 (lights NULL): the one light `light`. ms_scene_free
+     * frees lights. */
+    ms_light *lights;
+    size_t n_lights;
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX
@@ -128,6 +190,9 @@ typedef struct ms_material {
     int32_t base_color_texture;/* index into ms_scene.textures, -1: none */
     int32_t base_color_uv;     /* UV set (0 .. MS_MAX_UV_SETS-1) of the texture's coordinates */
 } ms_material;
+
+/* The scene's lights: its n_lights lights, or `light` alone when n_lights is 0. Sets *n. */
+const ms_light *ms_scene_lights(const ms_scene *s, size_t *n);
 
 /* Triangles [first, first + count) of a procedural scene (9 floats each) into out. */
 void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, float *out);
@@ -270,6 +335,9 @@ typedef struct ms_frame {
     /* width*height: the specular shadow factor S_spec (docs/shading.md), S where the pixel's material has
      * no specular lobe; -1 where the primary ray missed. */
     float *shadow_spec;
+    /* Lights of the frame (0 means 1). vis, shadow and front hold one width*height plane per light, light l
+     * at vis + l*width*height (the first plane is light 0, as with one light); rgb sums the lights. */
+    int n_lights;
 } ms_frame;
 
 int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
@@ -294,7 +362,8 @@ typedef struct ms_output {
 int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
 int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
 void ms_outputs_cleanup_on_signals(void);
-/* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name); the stats as JSON. */
+/* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name; with several lights the EXR has
+ * one channel per light, V0, V1, ... resp. S0, S1, ..., and the PFM light 0); the stats as JSON. */
 int ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
@@ -307,8 +376,14 @@ int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);
 int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
 int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
 
-/* Exact unshadowed irradiance at point p with unit normal n from the light (polygon form factor,
- * light clipped to the receiver's hemisphere), per unit emitted radiance. */
+/* Unshadowed irradiance at point p with unit normal n from the light, per unit emitted radiance.
+ * Parallelogram: exact (polygon form factor, light clipped to the receiver's hemisphere). Disk over a
+ * square (a circle, as ms_light_disk makes): exact closed form (the disk's vector irradiance from the
+ * parallel and perpendicular differential-element form factors) when the whole disk is above the
+ * receiver's plane; across the horizon, and for an ellipse, the polygon formula on a clipped 256-gon of
+ * the same area (an approximation; error measured in tests/test_lights.c). Sphere: exact, pi (r/d)^2
+ * cos theta wholly above the horizon, Snyder's closed form across it (as in Lagarde & de Rousiers,
+ * "Moving Frostbite to PBR", 2014); 0 at points inside the sphere. */
 float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
 
 /* ---- Visibility at any points: the library for bakers (docs/baking.md) ----

@@ -110,7 +110,7 @@ static void test_ply_binary_header_without_body(void **st)
     write_bytes("nobody.ply", h, strlen(h));
     expect_bad(scene("ply1.json", "nobody.ply", NULL, NULL), NULL, NEEDLES("nobody.ply", "declares 3 instances but only 0 bytes"));
     /* The body cut inside the face list: the walk notices. */
-    char buf[512];
+    char buf[512] = { 0 };   /* the 4 bytes past the count are written too: zeros, not stack garbage */
     size_t n = strlen(h);
     memcpy(buf, h, n);
     memset(buf + n, 0, 36);

@@ -25,7 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const ms_light L = { { 1, 5, -2 }, { 3, 0.5f, 0 }, { 0.8f, 0, 2 }, { 1, 1, 1 } };
+static const ms_light L = { { 1, 5, -2 }, { 3, 0.5f, 0 }, { 0.8f, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
 
 /* 1 if the n points (32-bit fixed point) form a (0,m,2)-net in base 2, n = 2^m: for every split
  * d + (m - d) = m, each of the 2^d x 2^(m-d) elementary intervals holds exactly one point. */

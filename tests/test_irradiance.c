@@ -51,8 +51,8 @@ static void test_against_integration(void **st)
 {
     (void)st;
     /* The Quad light (emits down) and a tilted, non-rectangular one. */
-    ms_light quad = { { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
-    ms_light tilt = { { 0.5f, 3, -1 }, { 1.5f, -0.6f, 0.2f }, { 0.3f, 0.4f, 1.7f }, { 1, 1, 1 } };
+    ms_light quad = { { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
+    ms_light tilt = { { 0.5f, 3, -1 }, { 1.5f, -0.6f, 0.2f }, { 0.3f, 0.4f, 1.7f }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     check(&quad, 0, 0, 0, 0, 1, 0, 1e-4);
     check(&quad, 3, 0, -2, 0, 1, 0, 1e-4);
     check(&quad, 0.5, 4, 0.2, 0, 1, 0, 1e-4);
@@ -76,7 +76,7 @@ static void test_against_integration(void **st)
 static void test_zero_cases(void **st)
 {
     (void)st;
-    ms_light quad = { { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
+    ms_light quad = { { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     double above[3] = { 0, 7, 0 }, below[3] = { 0, 0, 0 }, up[3] = { 0, 1, 0 }, down[3] = { 0, -1, 0 };
     assert_true(eval(&quad, above, up) == 0.0f);      /* behind the light (it emits downwards) */
     assert_true(eval(&quad, above, down) == 0.0f);
@@ -94,7 +94,7 @@ static void test_closed_form(void **st)
     for (int i = 0; i < 4; i++) {
         double a = cases[i][0], b = cases[i][1], c = cases[i][2], X = a / c, Y = b / c;
         double want = 0.5 * (X / sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) + Y / sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)));
-        ms_light l = { { 0, (float)c, 0 }, { (float)a, 0, 0 }, { 0, 0, (float)b }, { 1, 1, 1 } };
+        ms_light l = { { 0, (float)c, 0 }, { (float)a, 0, 0 }, { 0, 0, (float)b }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
         double p[3] = { 0, 0, 0 }, n[3] = { 0, 1, 0 };
         float got = eval(&l, p, n);
         if (!(fabs(got - want) < 1e-5 * (1 + want))) fail_msg("rectangle %g x %g at %g: %.7g, closed form %.7g", a, b, c, got, want);

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const ms_light L = { { 1, 5, -2 }, { 3, 0.5f, 0 }, { 0.8f, 0, 2 }, { 1, 1, 1 } };
+static const ms_light L = { { 1, 5, -2 }, { 3, 0.5f, 0 }, { 0.8f, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
 
 /* Solves p - corner = s S + t T (least squares on the normal equations); returns the residual. */
 static double to_st(const float *p, double *s, double *t)

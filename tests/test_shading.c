@@ -96,9 +96,9 @@ static void test_ltc_against_brute_force(void **st)
 {
     (void)st;
     const ms_light fixed[3] = {
-        { { -1, 2, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } },         /* above, facing down */
-        { { -3, 0.3f, -0.5f }, { 0, 1, 0 }, { 0, 0, 1 }, { 1, 1, 1 } },    /* low, near the horizon, facing +x */
-        { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 }, { 1, 1, 1 } },           /* per view: on the mirror direction */
+        { .corner = { -1, 2, -1 }, .edge_s = { 2, 0, 0 }, .edge_t = { 0, 0, 2 }, .emission = { 1, 1, 1 } },      /* above, facing down */
+        { .corner = { -3, 0.3f, -0.5f }, .edge_s = { 0, 1, 0 }, .edge_t = { 0, 0, 1 }, .emission = { 1, 1, 1 } }, /* low, near the horizon, facing +x */
+        { .corner = { 0, 0, 0 }, .edge_s = { 0, 0, 0 }, .edge_t = { 0, 0, 0 }, .emission = { 1, 1, 1 } },        /* per view: on the mirror direction */
     };
     const double roughness[] = { 0.25, 0.4, 0.6, 0.8, 1.0 };
     const double view_deg[] = { 0, 30, 60, 80 };
@@ -203,7 +203,7 @@ static float s_spec_at(const ms_light *L, int k, uint32_t px, const float p[3], 
 static void test_shadowed_specular_converges(void **st)
 {
     (void)st;
-    const ms_light L = { { -1, 2, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 } };
+    const ms_light L = { .corner = { -1, 2, -1 }, .edge_s = { 2, 0, 0 }, .edge_t = { 0, 0, 2 }, .emission = { 1, 1, 1 } };
     const double roughness[] = { 0.3, 0.6 };
     const double pts[3][3] = { { 0, 0, 0 }, { 0.3, 0, 0.2 }, { -0.2, 0, -0.4 } };
     const int ks[3] = { 16, 32, 64 };

@@ -65,7 +65,9 @@ class _Camera(ctypes.Structure):
 
 
 class _Light(ctypes.Structure):
-    _fields_ = [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3)]
+    _fields_ = [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3), ("shape", ctypes.c_int),
+                ("texture", ctypes.POINTER(_f)), ("texture_width", ctypes.c_int), ("texture_height", ctypes.c_int),
+                ("center", _Vec3), ("radius", _f)]
 
 
 class _Scene(ctypes.Structure):
@@ -75,7 +77,8 @@ class _Scene(ctypes.Structure):
                 ("n_meshes", ctypes.c_size_t), ("procedural_type", ctypes.c_int), ("procedural_seed", ctypes.c_uint32),
                 # surfaces (materials, shading normals, textures): read by the library only
                 ("materials", _p), ("n_materials", ctypes.c_size_t), ("tri_material", ctypes.POINTER(ctypes.c_uint32)),
-                ("tri_normal", ctypes.POINTER(_f)), ("textures", _p), ("n_textures", ctypes.c_size_t)]
+                ("tri_normal", ctypes.POINTER(_f)), ("textures", _p), ("n_textures", ctypes.c_size_t),
+                ("lights", ctypes.POINTER(_Light)), ("n_lights", ctypes.c_size_t)]
 
 
 class _Stats(ctypes.Structure):
@@ -93,7 +96,7 @@ class _Frame(ctypes.Structure):
     _fields_ = [("width", ctypes.c_int), ("height", ctypes.c_int), ("vis", ctypes.POINTER(_f)),
                 ("shadow", ctypes.POINTER(_f)), ("front", ctypes.POINTER(ctypes.c_uint16)),
                 ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats),
-                ("shadow_spec", ctypes.POINTER(_f))]
+                ("shadow_spec", ctypes.POINTER(_f)), ("n_lights", ctypes.c_int)]
 
 
 _PROGRESS = ctypes.CFUNCTYPE(None, _p, ctypes.c_double)

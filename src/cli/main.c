@@ -18,7 +18,7 @@ static void usage(FILE *f)
     fprintf(f,
         "usage: microshadow [SCENE.json] [options]\n"
         "       microshadow bake [SCENE.json] [options]   (a lightmap: microshadow bake --help)\n"
-        "Renders soft shadows from the scene's parallelogram light (the built-in scene without SCENE).\n"
+        "Renders soft shadows from the scene's area lights (rect, disk, textured; the built-in scene without SCENE).\n"
         "\n"
         "  --method M          shadow method:");
     for (const char *const *m = ms_method_names(); *m; m++) fprintf(f, " %s", *m);
@@ -37,6 +37,7 @@ static void usage(FILE *f)
         "                      unshadowed radiance to 1): the PNG shows radiance * 2^EV * auto (default 0)\n"
         "  --vis OUT.pfm|.exr  float visibility V, -1 where the primary ray missed\n"
         "  --shadow OUT.pfm|.exr  float shadow factor S, -1 where the primary ray missed\n"
+        "                      (several lights: an .exr has channels V0, V1, ... resp. S0, S1, ..., a .pfm light 0)\n"
         "  --stats OUT.json    timings and counters\n"
         "  --isa I             cap on the SIMD instruction set: auto (default), avx512, avx2, scalar\n"
         "  --traversal T       micro-raster methods: block (default: 4x4 pixels' frusta together) or pixel\n"

@@ -35,6 +35,17 @@ void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint
  * their rays only where they need them (shadow/mft.c). */
 void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                              int first, int count, float *xyz);
+/* Light shapes (microshadow.h, ms_light_shape): clears in mask (the pixel's samples, bit n = sample n)
+ * every sample whose light parameters (s,t) lie off the light's shape; nothing for a parallelogram. */
+void ms_shape_mask_apply(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                         uint64_t *mask);
+/* The same mask by testing every sample's (s,t) one by one (for tests: ms_shape_mask_apply finds the grid's
+ * rows as intervals). */
+void ms_shape_mask_reference(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
+                             uint64_t *mask);
+/* The light parameters (s,t) of the pixel's samples, 2 * ms_pattern_spp(p, k) floats: the values the
+ * shape mask tests (for tests and the textured emission). */
+void ms_pattern_st(ms_pattern p, int k, uint32_t px, uint32_t py, uint32_t seed, float *st);
 /* k for a sample count N = k*k (16, 64, 256, 1024, 4096), 0 if unsupported. */
 int ms_samples_to_k(int samples);
 /* Samples per pixel of pattern p at N = k*k: k*k, or k*k/16 for interleaved. */

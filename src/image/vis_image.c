@@ -123,14 +123,38 @@ static int write_float_image(const ms_frame *f, const float *data, const char *c
     return -1;
 }
 
+#define MAX_LIGHT_CHANNELS 64
+
+/* Several lights: an EXR gets one channel per light (V0, V1, ... in light order), a PFM light 0. */
+static int write_per_light(const ms_frame *f, const float *data, const char *channel, const char *what, FILE *out,
+                           const char *path, char *err, size_t errlen)
+{
+    const int nl = f->n_lights > 1 ? f->n_lights : 1;
+    if (nl == 1 || !ends_with(path, ".exr")) return write_float_image(f, data, channel, what, out, path, err, errlen);
+    if (nl > MAX_LIGHT_CHANNELS) { snprintf(err, errlen, "%s: more than %d lights for one EXR", path, MAX_LIGHT_CHANNELS); return -1; }
+    char names[MAX_LIGHT_CHANNELS][8];
+    exr_channel ch[MAX_LIGHT_CHANNELS];
+    const size_t npix = (size_t)f->width * (size_t)f->height;
+    /* OpenEXR stores channels sorted by name: "V10" before "V2"; readers find them by name. */
+    for (int l = 0; l < nl; l++) {
+        snprintf(names[l], sizeof names[l], "%s%d", channel, l);
+        ch[l] = (exr_channel){ names[l], data + (size_t)l * npix, 1 };
+    }
+    for (int a = 1; a < nl; a++)
+        for (int b = a; b > 0 && strcmp(ch[b - 1].name, ch[b].name) > 0; b--) {
+            const exr_channel t = ch[b]; ch[b] = ch[b - 1]; ch[b - 1] = t;
+        }
+    return write_exr(f, ch, nl, out, path, err, errlen);
+}
+
 int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
-    return write_float_image(f, f->vis, "V", "visibility", out, path, err, errlen);
+    return write_per_light(f, f->vis, "V", "visibility", out, path, err, errlen);
 }
 
 int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
-    return write_float_image(f, f->shadow, "S", "shadow factor", out, path, err, errlen);
+    return write_per_light(f, f->shadow, "S", "shadow factor", out, path, err, errlen);
 }
 
 int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)

@@ -5,6 +5,7 @@
  * interpolated here in C from the table entries normalised by their (1,1) element (what the demo's
  * texture holds), not by texture hardware. */
 #include "ltc.h"
+#include "microshadow.h"
 #include "ltc_table.h"
 #include "../core/vec.h"
 #include <math.h>
@@ -34,15 +35,45 @@ static void lookup(float roughness, float cos_v, double minv[9], double *mag)
         }
 }
 
-float ms_ltc_ggx(const ms_light *l, const float p[3], const float n[3], const float v[3], float roughness)
+#define DISK_SIDES 32
+
+/* The light's outline as a convex polygon (relative to p) into q[][3]; returns the vertex count, 0 when p
+ * sees no emitting side. A disk (and a sphere's outline disk seen from p) is the regular DISK_SIDES-gon
+ * inscribed in its ellipse, scaled to the ellipse's area (an approximation: the specular of a disk by a
+ * polygon of equal area, off by less than the 32-gon's shape, 0.3% of the radius). */
+static int light_polygon(const ms_light *l0, const float p[3], float q[DISK_SIDES][3])
 {
+    ms_light disk;
+    const ms_light *l = l0;
+    if (l0->shape == MS_LIGHT_SPHERE) {
+        if (ms_light_sphere_outline(l0, p, &disk)) return 0;   /* inside the sphere */
+        l = &disk;
+    }
     const float C[3] = { l->corner.x, l->corner.y, l->corner.z };
     const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
     const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
     float ln[3], rel[3];
     v3_cross(ln, S, T);
     v3_sub(rel, p, C);
-    if (!(v3_dot(rel, ln) > 0.0f)) return 0.0f;   /* behind the emitting side */
+    if (!(v3_dot(rel, ln) > 0.0f)) return 0;   /* behind the emitting side */
+    if (l->shape == MS_LIGHT_RECT) {
+        for (int c = 0; c < 4; c++)
+            for (int i = 0; i < 3; i++) q[c][i] = C[i] + ((c == 1 || c == 2) ? S[i] : 0.0f) + ((c >= 2) ? T[i] : 0.0f) - p[i];
+        return 4;
+    }
+    const double scale = sqrt(M_PI / (0.5 * DISK_SIDES * sin(2.0 * M_PI / DISK_SIDES)));
+    for (int c = 0; c < DISK_SIDES; c++) {
+        const double a = 2.0 * M_PI * c / DISK_SIDES, cs = 0.5 * scale * cos(a), sn = 0.5 * scale * sin(a);
+        for (int i = 0; i < 3; i++) q[c][i] = (float)(C[i] + 0.5 * (S[i] + T[i]) + cs * S[i] + sn * T[i] - p[i]);
+    }
+    return DISK_SIDES;
+}
+
+float ms_ltc_ggx(const ms_light *l, const float p[3], const float n[3], const float v[3], float roughness)
+{
+    float q[DISK_SIDES][3];
+    const int nq = light_polygon(l, p, q);
+    if (!nq) return 0.0f;
     const float nv = v3_dot(n, v);
     if (!(nv > 0.0f)) return 0.0f;
     /* T1: the view's tangential part; at normal incidence any tangent does (the lobe is symmetric). */
@@ -56,18 +87,16 @@ float ms_ltc_ggx(const ms_light *l, const float p[3], const float n[3], const fl
     v3_cross(t2, n, t1);
     double minv[9], mag;
     lookup(roughness, nv > 1.0f ? 1.0f : nv, minv, &mag);
-    double poly[8][3];
-    for (int c = 0; c < 4; c++) {
-        float q[3];
-        for (int i = 0; i < 3; i++) q[i] = C[i] + ((c == 1 || c == 2) ? S[i] : 0.0f) + ((c >= 2) ? T[i] : 0.0f) - p[i];
-        const double loc[3] = { v3_dot(q, t1), v3_dot(q, t2), v3_dot(q, n) };
+    double poly[DISK_SIDES][3];
+    for (int c = 0; c < nq; c++) {
+        const double loc[3] = { v3_dot(q[c], t1), v3_dot(q[c], t2), v3_dot(q[c], n) };
         for (int r = 0; r < 3; r++) poly[c][r] = minv[r] * loc[0] + minv[3 + r] * loc[1] + minv[6 + r] * loc[2];
     }
-    /* Sutherland-Hodgman against z >= 0 (the transformed horizon). */
-    double clip[8][3];
+    /* Sutherland-Hodgman against z >= 0 (the transformed horizon): a convex polygon gains at most one vertex. */
+    double clip[DISK_SIDES + 1][3];
     int m = 0;
-    for (int i = 0; i < 4; i++) {
-        const double *a = poly[i], *b = poly[(i + 1) & 3];
+    for (int i = 0; i < nq; i++) {
+        const double *a = poly[i], *b = poly[(i + 1) % nq];
         if (a[2] >= 0.0) { clip[m][0] = a[0]; clip[m][1] = a[1]; clip[m][2] = a[2]; m++; }
         if ((a[2] >= 0.0) != (b[2] >= 0.0)) {
             const double t = a[2] / (a[2] - b[2]);

@@ -1,4 +1,4 @@
-/* Unshadowed GGX specular from a parallelogram light by linearly transformed cosines (Heitz, Dupuy, Hill
+/* Unshadowed GGX specular from an area light (any shape: ms_light_shape) by linearly transformed cosines (Heitz, Dupuy, Hill
  * and Neubelt 2016, with their fitted table, third_party/ltc). */
 #ifndef MS_LTC_H
 #define MS_LTC_H
@@ -12,7 +12,8 @@
  * clipping to the horizon, like ms_light_irradiance). Approximated: the BRDF lobe by the fitted LTC (the
  * fit's error; tests/test_shading.c measures it against numerical integration), bilinearly interpolated
  * between the 64 x 64 fitted (roughness, sqrt(1 - cos theta_v)) entries; the LTC has unit integral and
- * is scaled by the fitted directional albedo of the BRDF. */
+ * is scaled by the fitted directional albedo of the BRDF; a disk (and a sphere's outline disk seen from
+ * p) by the regular 32-gon of the same area. */
 float ms_ltc_ggx(const ms_light *l, const float p[3], const float n[3], const float v[3], float roughness);
 
 #endif

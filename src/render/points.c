@@ -63,6 +63,15 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
     for (uint32_t i = 0; i < a->bvh.n_tris; i++) a->leaf_of[a->bvh.tri_source[i]] = i;
     a->view = *scene;
     a->view.tri = NULL;
+    a->view.lights = NULL;   /* the scene's first light stays in view.light; the array is the caller's */
+    a->view.n_lights = 0;
+    if (scene->light.texture) {   /* the scene may be freed before the accel: its own copy of the texels */
+        const size_t nt = (size_t)scene->light.texture_width * (size_t)scene->light.texture_height * 3;
+        float *t = malloc(nt * sizeof *t);
+        if (!t) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
+        memcpy(t, scene->light.texture, nt * sizeof *t);
+        a->view.light.texture = t;
+    }
     *out = a;
     return MS_OK;
 }
@@ -72,6 +81,7 @@ void ms_accel_free(ms_accel *a)
     if (!a) return;
     ms_bvh_free(&a->bvh);
     free(a->leaf_of);
+    free((void *)a->view.light.texture);
     free(a);
 }
 
@@ -157,6 +167,12 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     if (!a) { snprintf(err, errlen, "ms_visibility_points: no accel"); return MS_ERR_INVALID; }
     if (!light) light = &a->view.light;
     if (!light_ok(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area"); return MS_ERR_INVALID; }
+    if (light->shape == MS_LIGHT_SPHERE) {
+        /* its per-receiver outline disk is done by frames only (render.c) */
+        snprintf(err, errlen, "sphere lights are rendered by frames only (ms_render), not at points");
+        return MS_ERR_INVALID;
+    }
+    if ((unsigned)light->shape > MS_LIGHT_SPHERE) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
     ms_status st = check_points(a, pts, err, errlen);
     if (st) return st;
     const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;

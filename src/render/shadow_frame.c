@@ -8,7 +8,8 @@
 #include <string.h>
 
 int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, const ms_hit *hits,
-                          const ms_surface *surf, int W, int H, ms_frame *out, uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
+                          const ms_surface *surf, int W, int H, float *vis_out, float *shadow_out, float *spec_out,
+                          uint16_t *front_out, uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
                           uint64_t *segments, double *resolve_thread_s)
 {
     const size_t npix = (size_t)W * H, mw = (size_t)ctx->mask_words;
@@ -24,7 +25,7 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
     n = 0;
     for (size_t i = 0; i < npix; i++) {
         const ms_hit *h = &hits[i];
-        if (h->prim == UINT32_MAX) { out->vis[i] = out->shadow[i] = out->shadow_spec[i] = -1.0f; out->front[i] = 0; continue; }
+        if (h->prim == UINT32_MAX) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; continue; }
         memcpy(q[n].p, h->p, sizeof h->p);
         memcpy(q[n].n, h->n, sizeof h->n);
         q[n].prim = h->prim;
@@ -43,7 +44,7 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
             if (failed) continue;
             if (pts) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
             const int nf = ms_front_mask(ctx, &q[i], pts, front + i * mw);
-            out->front[where[i]] = (uint16_t)nf;
+            front_out[where[i]] = (uint16_t)nf;
             seg += (uint64_t)nf;
         }
         free(pts);
@@ -59,11 +60,11 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
         for (size_t i = 0; i < n; i++) {
             if (failed) continue;
             if (pts) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
-            pen += (uint64_t)ms_resolve_vs(ctx, &q[i], pts, front + i * mw, vis + i * mw, &out->vis[where[i]],
-                                           &out->shadow[where[i]]);
-            out->shadow_spec[where[i]] = surf && surf[where[i]].specular
+            pen += (uint64_t)ms_resolve_vs(ctx, &q[i], pts, front + i * mw, vis + i * mw, &vis_out[where[i]],
+                                           &shadow_out[where[i]]);
+            spec_out[where[i]] = surf && surf[where[i]].specular
                 ? ms_resolve_spec(ctx, &q[i], pts, front + i * mw, vis + i * mw, &surf[where[i]])
-                : out->shadow[where[i]];
+                : shadow_out[where[i]];
         }
         free(pts);
     }

@@ -13,8 +13,8 @@ int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char *
 {
     *out = NULL;
     *len = 0;
-    const int mesh = kind == MS_INPUT_MESH || kind == MS_INPUT_AUX;
-    const char *noun = kind == MS_INPUT_AUX ? "file" : "mesh file";
+    const int mesh = kind != MS_INPUT_SCENE;
+    const char *noun = kind == MS_INPUT_AUX ? "file" : kind == MS_INPUT_TEXTURE ? "texture file" : "mesh file";
     /* O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer forever. */
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
     if (fd < 0) {
@@ -28,7 +28,8 @@ int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char *
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         const char *what = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO"
                          : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device" : "not a regular file";
-        if (mesh) snprintf(err, errlen, "%s: %s is not a regular file (%s)", path, kind == MS_INPUT_AUX ? "it" : "mesh", what);
+        if (mesh) snprintf(err, errlen, "%s: %s is not a regular file (%s)", path,
+                           kind == MS_INPUT_AUX ? "it" : kind == MS_INPUT_TEXTURE ? "texture" : "mesh", what);
         else snprintf(err, errlen, "%s: cannot read: not a regular file (%s)", path, what);
         close(fd);
         return -1;

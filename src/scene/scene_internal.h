@@ -11,9 +11,12 @@
 #define MS_MAX_MESH_BYTES ((size_t)2 << 30)       /* per mesh file, and per glTF buffer */
 #define MS_MAX_POLYGON 256                        /* vertices per face: triangulation is quadratic */
 #define MS_MAX_TRIS_PER_BYTE 4                    /* triangles emitted per input byte (glTF instancing) */
+#define MS_MAX_LIGHT_TEXTURE 8192                 /* texels per side of a light's emission image */
 #define MS_MAX_COORD 1e18f                        /* |coordinate|: squares and cross products stay finite in float */
 
 struct ms_scene;
+/* rel resolved against the folder of json_path (absolute paths as they are) into out; -1 if too long. */
+int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n);
 #define MS_SOUP_UV_SETS 4   /* = MS_MAX_UV_SETS */
 /* Triangles as they are loaded, with the mesh each came from (cur_mesh at the push) and, per UV set,
  * the UVs of its vertices (6 floats; the array appears with the first triangle that has the set, NaN
@@ -70,8 +73,9 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib);
 uint32_t ms_mtl_find(const ms_mtl_lib *lib, const char *name);
 void ms_mtl_lib_free(ms_mtl_lib *lib);
 
-/* MS_INPUT_AUX: a file a mesh refers to (an MTL file, a texture), named "file" in messages. */
-typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH, MS_INPUT_AUX } ms_input_kind;
+/* MS_INPUT_AUX: a file a mesh refers to (an MTL file, a texture), named "file" in messages;
+ * MS_INPUT_TEXTURE: a light's emission image, named "texture file". */
+typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH, MS_INPUT_AUX, MS_INPUT_TEXTURE } ms_input_kind;
 /* Reads a whole regular file of at most max_bytes (a FIFO, device or directory is refused without
  * blocking) into a malloc'ed, NUL-terminated buffer. */
 int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char **out, size_t *len, char *err,

@@ -1,6 +1,7 @@
 /* Scene files: JSON (cJSON) naming meshes (assimp), camera, light and render settings. */
 #include "microshadow.h"
 #include "scene_internal.h"
+#include "../image/png_read.h"
 _Static_assert(MS_SOUP_UV_SETS == MS_MAX_UV_SETS, "one count of UV sets");
 #include <cjson/cJSON.h>
 #include <ctype.h>
@@ -22,10 +23,11 @@ static int line_of(const char *text, size_t off)
 }
 
 /* Known keys, per object, for the unknown-key warnings. */
-static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "render", NULL };
+static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "lights", "render", NULL };
 static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
 static const char *const camera_keys[] = { "eye", "target", "up", "fov_y", "width", "height", NULL };
-static const char *const light_keys[] = { "corner", "edge_s", "edge_t", "emission", NULL };
+static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t", "center", "normal", "radius",
+                                          "emission", "power", "lumens", "texture", NULL };
 static const char *const render_keys[] = { "samples", NULL };
 static const char *const mesh_keys[] = { "file", NULL };
 
@@ -84,7 +86,7 @@ static const char *meant_for(const cJSON *obj, const char *key, const char *cons
 
 static const char *const *known_for(const char *objname)
 {
-    return !strcmp(objname, "camera") ? camera_keys : !strcmp(objname, "light") ? light_keys
+    return !strcmp(objname, "camera") ? camera_keys : !strncmp(objname, "light", 5) ? light_keys
          : !strcmp(objname, "render") ? render_keys : !strcmp(objname, "procedural") ? procedural_keys : top_keys;
 }
 
@@ -227,6 +229,166 @@ static const cJSON *get_object(const cJSON *root, const char *key, const char *p
     return o;
 }
 
+/* ---- Lights: "light": {...} (one) or "lights": [{...}, ...] (docs/design.md, "Light shapes", "Units") ---- */
+
+#define MS_MAX_LIGHTS 64   /* a frame holds V and S per light: bounded memory */
+
+/* Reads key as a number (grey) or an array of three numbers, none negative; 1 if present, 0 if not, -1 bad. */
+static int get_amount(const cJSON *obj, const char *objname, const char *key, ms_vec3 *out, const char *path,
+                      char *err, size_t errlen)
+{
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!a) return 0;
+    if (cJSON_IsNumber(a)) {
+        double d = 0;
+        if (get_number(obj, objname, key, 1, &d, path, err, errlen) || float_ok(d, objname, key, -1, path, err, errlen))
+            return -1;
+        *out = (ms_vec3){ (float)d, (float)d, (float)d };
+    } else if (get_vec3(obj, objname, key, 1, out, path, err, errlen)) {
+        snprintf(err, errlen, "%s: %s.%s must be a number or an array of 3 numbers", path, objname, key);
+        return -1;
+    }
+    if (out->x < 0 || out->y < 0 || out->z < 0) {
+        snprintf(err, errlen, "%s: %s.%s must not be negative", path, objname, key);
+        return -1;
+    }
+    return 1;
+}
+
+/* One light object: "shape" ("rect", the default, "disk" or "sphere"), its geometry, and at most one of
+ * "emission" (radiance), "power" (watts) or "lumens" (luminous flux), default emission 1. */
+static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const char *path, char *err, size_t errlen)
+{
+    if (!cJSON_IsObject(obj)) { snprintf(err, errlen, "%s: %s must be an object", path, objname); return -1; }
+    warn_unknown(obj, objname, light_keys, path);
+    memset(l, 0, sizeof *l);
+    const cJSON *shape = cJSON_GetObjectItemCaseSensitive(obj, "shape");
+    const char *sh = "rect";
+    if (shape) {
+        if (!cJSON_IsString(shape)) { snprintf(err, errlen, "%s: %s.shape must be \"rect\", \"disk\" or \"sphere\"", path, objname); return -1; }
+        sh = shape->valuestring;
+    }
+    if (!strcmp(sh, "rect")) {
+        if (get_vec3(obj, objname, "corner", 1, &l->corner, path, err, errlen) ||
+            get_vec3(obj, objname, "edge_s", 1, &l->edge_s, path, err, errlen) ||
+            get_vec3(obj, objname, "edge_t", 1, &l->edge_t, path, err, errlen))
+            return -1;
+    } else if (!strcmp(sh, "disk")) {
+        ms_vec3 c = { 0, 0, 0 }, m = { 0, 0, 0 };
+        double r = 0;
+        if (get_vec3(obj, objname, "center", 1, &c, path, err, errlen) ||
+            get_vec3(obj, objname, "normal", 1, &m, path, err, errlen) ||
+            get_number(obj, objname, "radius", 1, &r, path, err, errlen))
+            return -1;
+        if (!(r > 0) || r > MS_MAX_COORD) {
+            snprintf(err, errlen, "%s: %s.radius must be in (0, %g]", path, objname, (double)MS_MAX_COORD);
+            return -1;
+        }
+        if (ms_light_disk(l, c, m, (float)r)) {
+            snprintf(err, errlen, "%s: %s.normal must not be zero", path, objname);
+            return -1;
+        }
+    } else if (!strcmp(sh, "sphere")) {
+        ms_vec3 c = { 0, 0, 0 };
+        double r = 0;
+        if (get_vec3(obj, objname, "center", 1, &c, path, err, errlen) ||
+            get_number(obj, objname, "radius", 1, &r, path, err, errlen))
+            return -1;
+        if (!(r > 0) || r > MS_MAX_COORD) {
+            snprintf(err, errlen, "%s: %s.radius must be in (0, %g]", path, objname, (double)MS_MAX_COORD);
+            return -1;
+        }
+        if (cJSON_GetObjectItemCaseSensitive(obj, "texture")) {
+            snprintf(err, errlen, "%s: %s: a sphere light cannot be textured (rect and disk can)", path, objname);
+            return -1;
+        }
+        ms_light_sphere(l, c, (float)r);
+    } else {
+        snprintf(err, errlen, "%s: %s.shape must be \"rect\", \"disk\" or \"sphere\" (got \"%.40s\")", path, objname, sh);
+        return -1;
+    }
+    static const char *const unit_key[] = { "emission", "power", "lumens" };
+    static const ms_light_units unit_of[] = { MS_UNITS_RADIANCE, MS_UNITS_WATTS, MS_UNITS_LUMENS };
+    ms_vec3 amount = { MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION };
+    ms_light_units units = MS_UNITS_RADIANCE;
+    int given = 0;
+    for (int u = 0; u < 3; u++) {
+        ms_vec3 a;
+        const int r = get_amount(obj, objname, unit_key[u], &a, path, err, errlen);
+        if (r < 0) return -1;
+        if (!r) continue;
+        if (given++) {
+            snprintf(err, errlen, "%s: %s: give one of \"emission\", \"power\" and \"lumens\", not several", path, objname);
+            return -1;
+        }
+        amount = a;
+        units = unit_of[u];
+    }
+    l->emission = ms_light_radiance_from(l, amount, units);
+    const cJSON *tex = cJSON_GetObjectItemCaseSensitive(obj, "texture");
+    if (tex) {
+        if (!cJSON_IsString(tex) || !tex->valuestring[0]) {
+            snprintf(err, errlen, "%s: %s.texture must be the path of a PNG image", path, objname);
+            return -1;
+        }
+        char tex_path[4096];
+        if (ms_path_beside(path, tex->valuestring, tex_path, sizeof tex_path)) {
+            snprintf(err, errlen, "%s: %s.texture: the path is too long", path, objname);
+            return -1;
+        }
+        float *t = NULL;
+        int w = 0, h = 0;
+        char *bytes = NULL;
+        size_t len = 0;
+        char why[1024];
+        int rc = ms_read_input(tex_path, MS_MAX_MESH_BYTES, MS_INPUT_TEXTURE, &bytes, &len, why, sizeof why);
+        if (!rc) rc = ms_png_decode_linear(tex_path, bytes, len, MS_MAX_LIGHT_TEXTURE, &t, &w, &h, why, sizeof why);
+        free(bytes);
+        if (rc) { snprintf(err, errlen, "%s: %s.texture: %s", path, objname, why); return -1; }
+        l->texture = t;
+        l->texture_width = w;
+        l->texture_height = h;
+    }
+    return 0;
+}
+
+int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n)
+{
+    if (rel[0] == '/') return snprintf(out, n, "%s", rel) >= (int)n ? -1 : 0;
+    char *dircopy = strdup(json_path);
+    if (!dircopy) return -1;
+    const int k = snprintf(out, n, "%s/%s", dirname(dircopy), rel);
+    free(dircopy);
+    return k < 0 || (size_t)k >= n ? -1 : 0;
+}
+
+static int parse_lights(const cJSON *root, ms_scene *out, const char *path, char *err, size_t errlen)
+{
+    const cJSON *one = cJSON_GetObjectItemCaseSensitive(root, "light");
+    const cJSON *many = cJSON_GetObjectItemCaseSensitive(root, "lights");
+    if (one && many) { snprintf(err, errlen, "%s: give either \"light\" or \"lights\", not both", path); return -1; }
+    if (!many) {
+        const cJSON *light = get_object(root, "light", path, err, errlen);
+        return light ? parse_light(light, "light", &out->light, path, err, errlen) : -1;
+    }
+    const int n = cJSON_IsArray(many) ? cJSON_GetArraySize(many) : 0;
+    if (n < 1 || n > MS_MAX_LIGHTS) {
+        snprintf(err, errlen, "%s: \"lights\" must be an array of 1 to %d light objects", path, MS_MAX_LIGHTS);
+        return -1;
+    }
+    out->lights = calloc((size_t)n, sizeof *out->lights);
+    if (!out->lights) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    out->n_lights = (size_t)n;   /* so that ms_scene_free frees the textures of a failed load */
+    for (int i = 0; i < n; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "lights[%d]", i);
+        if (parse_light(cJSON_GetArrayItem(many, i), name, &out->lights[i], path, err, errlen)) return -1;
+    }
+    out->n_lights = (size_t)n;
+    out->light = out->lights[0];
+    return 0;
+}
+
 int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
@@ -301,20 +463,7 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     if (float_ok(fov, "camera", "fov_y", -1, json_path, err, errlen)) goto done;
     c->fov_y = (float)fov;
 
-    const cJSON *light = get_object(root, "light", json_path, err, errlen);
-    if (!light) goto done;
-    warn_unknown(light, "light", light_keys, json_path);
-    ms_light *l = &out->light;
-    l->emission = (ms_vec3){ MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION };
-    if (get_vec3(light, "light", "corner", 1, &l->corner, json_path, err, errlen) ||
-        get_vec3(light, "light", "edge_s", 1, &l->edge_s, json_path, err, errlen) ||
-        get_vec3(light, "light", "edge_t", 1, &l->edge_t, json_path, err, errlen) ||
-        get_vec3(light, "light", "emission", 0, &l->emission, json_path, err, errlen))
-        goto done;
-    if (l->emission.x < 0 || l->emission.y < 0 || l->emission.z < 0) {
-        snprintf(err, errlen, "%s: light.emission must not be negative", json_path);
-        goto done;
-    }
+    if (parse_lights(root, out, json_path, err, errlen)) goto done;
 
     out->samples = 1024;
     const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
@@ -420,5 +569,10 @@ void ms_scene_free(ms_scene *s)
     free(s->tri_normal);
     for (size_t i = 0; i < s->n_textures; i++) free(s->textures[i].rgba);
     free(s->textures);
+    /* light is a copy of lights[0] when there is an array: each texture once */
+    if (s->n_lights && s->lights)
+        for (size_t i = 0; i < s->n_lights; i++) free((void *)s->lights[i].texture);
+    else free((void *)s->light.texture);
+    free(s->lights);
     memset(s, 0, sizeof *s);
 }

@@ -6,25 +6,68 @@
 #include <stdio.h>
 
 static int vec_ok(ms_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+const ms_light *ms_scene_lights(const ms_scene *s, size_t *n)
+{
+    *n = s->n_lights ? s->n_lights : 1;
+    return s->n_lights ? s->lights : &s->light;
+}
+
 static int in_range(ms_vec3 v) { return fabsf(v.x) <= MS_MAX_COORD && fabsf(v.y) <= MS_MAX_COORD && fabsf(v.z) <= MS_MAX_COORD; }
+
+/* One light, named `name` ("light", "lights[2]") in messages. */
+static int validate_light(const ms_light *l, const char *name, const char *what, char *err, size_t errlen)
+{
+    if (!vec_ok(l->corner) || !vec_ok(l->edge_s) || !vec_ok(l->edge_t) || !vec_ok(l->emission)) {
+        snprintf(err, errlen, "%s: %s has a NaN or infinite value", what, name);
+        return -1;
+    }
+    if (l->shape == MS_LIGHT_SPHERE && (!vec_ok(l->center) || !in_range(l->center) || !(l->radius > 0.0f) ||
+                                        !(l->radius <= MS_MAX_COORD) || l->texture)) {
+        snprintf(err, errlen, "%s: %s: a sphere needs a finite center and a radius in (0, %g], and no texture", what,
+                 name, (double)MS_MAX_COORD);
+        return -1;
+    }
+    if ((unsigned)l->shape > MS_LIGHT_SPHERE) {
+        snprintf(err, errlen, "%s: %s has an unknown shape %d", what, name, (int)l->shape);
+        return -1;
+    }
+    const struct { const char *name; ms_vec3 v; } coords[] = {
+        { "corner", l->corner }, { "edge_s", l->edge_s }, { "edge_t", l->edge_t } };
+    for (size_t i = 0; i < sizeof coords / sizeof coords[0]; i++)
+        if (!in_range(coords[i].v)) {
+            snprintf(err, errlen, "%s: %s.%s has a coordinate beyond +-%g (too large for single precision)", what,
+                     name, coords[i].name, (double)MS_MAX_COORD);
+            return -1;
+        }
+    float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z }, T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z }, n[3];
+    v3_cross(n, S, T);
+    if (!(v3_len(n) > 1e-6f * v3_len(S) * v3_len(T))) {
+        snprintf(err, errlen, "%s: %s has zero area (edge_s and edge_t are zero or parallel)", what, name);
+        return -1;
+    }
+    return 0;
+}
 
 int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen)
 {
     const ms_camera *c = &s->camera;
-    const ms_light *l = &s->light;
     if (!vec_ok(c->eye) || !vec_ok(c->target) || !vec_ok(c->up) || !isfinite(c->fov_y)) {
         snprintf(err, errlen, "%s: camera has a NaN or infinite value", what);
         return -1;
     }
-    if (!vec_ok(l->corner) || !vec_ok(l->edge_s) || !vec_ok(l->edge_t) || !vec_ok(l->emission)) {
-        snprintf(err, errlen, "%s: light has a NaN or infinite value", what);
-        return -1;
+    size_t nl;
+    const ms_light *lights = ms_scene_lights(s, &nl);
+    if (s->n_lights && !s->lights) { snprintf(err, errlen, "%s: the scene has no lights array", what); return -1; }
+    for (size_t i = 0; i < nl; i++) {
+        char name[32];
+        if (s->n_lights) snprintf(name, sizeof name, "lights[%zu]", i);
+        else snprintf(name, sizeof name, "light");
+        if (validate_light(&lights[i], name, what, err, errlen)) return -1;
     }
     /* Beyond 1e18, squared lengths and cross products overflow single precision: the camera basis or
      * the light's area would come out infinite and be misreported as degenerate. */
     const struct { const char *name; ms_vec3 v; } coords[] = {
-        { "camera.eye", c->eye }, { "camera.target", c->target }, { "camera.up", c->up },
-        { "light.corner", l->corner }, { "light.edge_s", l->edge_s }, { "light.edge_t", l->edge_t } };
+        { "camera.eye", c->eye }, { "camera.target", c->target }, { "camera.up", c->up } };
     for (size_t i = 0; i < sizeof coords / sizeof coords[0]; i++)
         if (!in_range(coords[i].v)) {
             snprintf(err, errlen, "%s: %s has a coordinate beyond +-%g (too large for single precision)", what,
@@ -46,12 +89,6 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
     }
     if (ms_camera_basis_init(&b, c, c->width, c->height)) {
         snprintf(err, errlen, "%s: camera.up is zero or parallel to the view direction", what);
-        return -1;
-    }
-    float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z }, T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z }, n[3];
-    v3_cross(n, S, T);
-    if (!(v3_len(n) > 1e-6f * v3_len(S) * v3_len(T))) {
-        snprintf(err, errlen, "%s: light has zero area (edge_s and edge_t are zero or parallel)", what);
         return -1;
     }
     if (!s->tri && s->procedural.type == MS_PROCEDURAL_NONE && s->n_tris) {

@@ -72,6 +72,8 @@ static void d3_cross(double o[3], const double a[3], const double b[3])
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+static void mft_frame_light(ms_mft_frame *f, const ms_light *l);
+
 static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
 {
     mft_method *s = calloc(1, sizeof *s);
@@ -88,7 +90,25 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     f->mask_words = ctx->mask_words;
     f->near = ctx->near;
     f->far = ctx->far;
-    const ms_light *l = &ctx->light;
+    mft_frame_light(f, &ctx->light);
+    f->pattern = ctx->pattern;
+    f->seed = ctx->seed;
+    f->flags = (ctx->no_child_order ? 0 : MS_MFT_ORDER) | (ctx->frustum_shrink ? MS_MFT_FS : 0);
+    /* The paper's own mode: each pixel of a 4x4 block its own set of N/16 points (pattern.c), tested
+     * packet by packet against the whole light's frustum (footprints and CR need samples in cells). */
+    f->cells = ctx->pattern != MS_PATTERN_INTERLEAVED;
+    if (!f->cells) f->flags |= MS_MFT_NO_FOOTPRINT;
+#ifdef MFT_NO_FOOTPRINT
+    f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
+#endif
+    *state = s;
+    return 0;
+}
+
+/* The frame's light: corner, edges and the margin of the stored points. Per frame, or per call when the
+ * context's light is not the frame's (a sphere light's per-receiver outline disk, render.c). */
+static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
+{
     const double P[3] = { l->corner.x, l->corner.y, l->corner.z }, S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
     const double T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
     memcpy(f->lp, P, sizeof P);
@@ -102,19 +122,7 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     for (int a = 0; a < 3; a++) mag += fabs(P[a]) + fabs(S[a]) + fabs(T[a]);
     const double h = d3_len(n) / fmax(d3_len(S), d3_len(T));
     f->margin = 0.01 + (h > 0.0 ? 64.0 * FLT_EPSILON * mag * f->k / h : 0.0);
-    f->pattern = ctx->pattern;
-    f->light = ctx->light;
-    f->seed = ctx->seed;
-    f->flags = (ctx->no_child_order ? 0 : MS_MFT_ORDER) | (ctx->frustum_shrink ? MS_MFT_FS : 0);
-    /* The paper's own mode: each pixel of a 4x4 block its own set of N/16 points (pattern.c), tested
-     * packet by packet against the whole light's frustum (footprints and CR need samples in cells). */
-    f->cells = ctx->pattern != MS_PATTERN_INTERLEAVED;
-    if (!f->cells) f->flags |= MS_MFT_NO_FOOTPRINT;
-#ifdef MFT_NO_FOOTPRINT
-    f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
-#endif
-    *state = s;
-    return 0;
+    f->light = *l;
 }
 
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
@@ -190,6 +198,16 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
     if (!order || !rayf || !kzs) { free(order); free(rayf); free(kzs); return -1; }
     ms_block_order(ctx, q, nq, order);
+    /* A light other than the frame's (a sphere's outline disk): the frame re-derived for it. */
+    const ms_mft_frame *f = &s->f;
+    ms_mft_frame own;
+    const ms_light *cl = &ctx->light, *fl = &s->f.light;
+    if (memcmp(&cl->corner, &fl->corner, sizeof cl->corner) || memcmp(&cl->edge_s, &fl->edge_s, sizeof cl->edge_s) ||
+        memcmp(&cl->edge_t, &fl->edge_t, sizeof cl->edge_t) || cl->shape != fl->shape) {
+        own = s->f;
+        mft_frame_light(&own, cl);
+        f = &own;
+    }
     ms_mft_block blk;
     for (int l = 0; l < MS_BLOCK_LANES; l++) {
         float *base = rayf + (size_t)l * 5 * ns;
@@ -208,9 +226,9 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
             if (ms_mask_count(m, (int)mw) == 0) continue;
             ms_mft_lane *L = &blk.lane[blk.n++];
             L->mask = m;
-            mft_lane_setup(&s->f, &q[i], L);
+            mft_lane_setup(f, &q[i], L);
         }
-        if (blk.n) s->block(&s->f, &blk, ctx->bvh, &s->sh, cnt);
+        if (blk.n) s->block(f, &blk, ctx->bvh, &s->sh, cnt);
         g = end;
     }
     free(order);

@@ -1,0 +1,961 @@
+/* Light shapes, many lights and units (docs/design.md, "Light shapes", "Units"), each against an oracle
+ * of its own:
+ *   - disk lights: every method's front and visible masks equal a brute-force test of every sample (in
+ *     front of the receiver, on the disk by its distance from the centre in world space, occluded by a
+ *     double-precision segment test against every triangle), and equal raytrace's bit for bit;
+ *   - the unshadowed disk irradiance against numerical integration over the disk;
+ *   - two lights: V, S and front of each light equal the single-light renders, the image their sum;
+ *   - units: watts and lumens against hand-computed radiances;
+ *   - bad light JSON: exit 2 and one line naming the file and the problem. */
+#include "testutil.h"
+#include <OpenEXR/openexr.h>
+#include "../src/shadow/method.h"
+#include "../src/shadow/receiver.h"
+#include "../src/core/pattern.h"
+#include "../src/accel/bvh.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- brute force ---- */
+
+typedef enum { NO = 0, YES = 1, UNSURE = 2 } verdict;
+
+/* Segment p -> L against triangle t, double precision: YES if it crosses t at u in [near, far], UNSURE
+ * within 1e-6 of an edge or of the range's ends. */
+static verdict seg_hits(const float *t, const double p[3], const double L[3], double near, double far)
+{
+    double e1[3], e2[3], d[3], s[3], h[3], q[3];
+    for (int c = 0; c < 3; c++) {
+        e1[c] = (double)t[3 + c] - t[c];
+        e2[c] = (double)t[6 + c] - t[c];
+        d[c] = L[c] - p[c];
+        s[c] = p[c] - t[c];
+    }
+    h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
+    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+    if (fabs(det) < 1e-300) return NO;   /* parallel: a segment in the plane of a triangle never counts */
+    const double f = 1.0 / det;
+    const double b1 = f * (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]);
+    q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
+    const double b2 = f * (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
+    const double u = f * (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]);
+    const double m = fmin(fmin(b1, b2), 1.0 - b1 - b2);
+    const double eps = 1e-6;
+    if (m < -eps || u < near - eps || u > far + eps) return NO;
+    if (m < eps || fabs(u - near) < eps || fabs(u - far) < eps) return UNSURE;
+    return YES;
+}
+
+typedef struct disk_geom { double c[3], m[3], r; } disk_geom;
+
+/* The expected bits of sample L for the receiver (p, n, prim): counted (front and on the disk) and visible. */
+static void brute_sample(const ms_bvh *bvh, uint32_t prim, const float *pf, const float *nf, const float *Lf,
+                         const disk_geom *dg, verdict *counted, verdict *visible)
+{
+    double p[3], L[3], d[3], w[3];
+    for (int c = 0; c < 3; c++) { p[c] = pf[c]; L[c] = Lf[c]; d[c] = L[c] - p[c]; w[c] = L[c] - dg->c[c]; }
+    const double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const double f = (d[0] * nf[0] + d[1] * nf[1] + d[2] * nf[2]) / dl;
+    const double r2 = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) / (dg->r * dg->r);
+    verdict cnt = f > 1e-5 && r2 < 1.0 - 1e-4 ? YES : (f < -1e-5 || r2 > 1.0 + 1e-4) ? NO : UNSURE;
+    *counted = cnt;
+    if (cnt == NO) { *visible = NO; return; }
+    verdict occ = NO;
+    for (uint32_t t = 0; t < bvh->n_tris && occ != YES; t++) {
+        if (t == prim) continue;
+        const verdict v = seg_hits(bvh->tri + 9 * (size_t)t, p, L, 1e-4, 1.0 - 1e-4);
+        if (v == YES) occ = YES;
+        else if (v == UNSURE) occ = UNSURE;
+    }
+    *visible = cnt == UNSURE || occ == UNSURE ? UNSURE : occ == YES ? NO : YES;
+}
+
+/* The Quad (ground, occluder) with a disk light. */
+static void make_disk_scene(ms_scene *sc, ms_vec3 c, ms_vec3 m, float r, disk_geom *dg)
+{
+    tu_make_quad(sc);
+    assert_int_equal(ms_light_disk(&sc->light, c, m, r), 0);
+    const double ml = sqrt((double)m.x * m.x + (double)m.y * m.y + (double)m.z * m.z);
+    *dg = (disk_geom){ { c.x, c.y, c.z }, { m.x / ml, m.y / ml, m.z / ml }, r };
+}
+
+/* Every method's masks on a disk light: equal to the brute force where it is sure, equal to raytrace's
+ * everywhere; and some samples of the bounding square really are masked off. */
+static void check_disk_methods(ms_scene *sc, const disk_geom *dg, int size, int k, ms_pattern pat)
+{
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc->tri, sc->n_tris, 1), 0);
+    ms_render_ctx ctx;
+    tu_ctx_init(&ctx, sc, &bvh, size, size, k);
+    tu_ctx_set_pattern(&ctx, pat);
+    ctx.seed = 7;
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    char err[256];
+    void *ps = NULL;
+    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
+    ms_hit *hits = malloc((size_t)size * size * sizeof *hits);
+    ms_shadow_query *q = malloc((size_t)size * size * sizeof *q);
+    assert_non_null(hits);
+    assert_non_null(q);
+    pm->trace(ps, &ctx, 0, 0, size, size, hits);
+    pm->destroy(ps);
+    int nq = 0;
+    for (int i = 0; i < size * size; i++)
+        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[nq++], &hits[i], i % size, i / size);
+    assert_true(nq > 0);
+    const size_t mw = (size_t)ctx.mask_words;
+    const int spp = ctx.samples;
+    uint64_t *front = calloc((size_t)nq * mw, sizeof *front), *ref = calloc((size_t)nq * mw, sizeof *ref);
+    uint64_t *vis = calloc((size_t)nq * mw, sizeof *vis);
+    float *pts = malloc((size_t)spp * 3 * sizeof *pts);
+    assert_true(front && ref && vis && pts);
+    for (int i = 0; i < nq; i++)
+        ms_front_mask(&ctx, &q[i], pat == MS_PATTERN_GRID ? NULL : (ms_pattern_points(pat, &ctx.light, k, q[i].px, q[i].py,
+                                                                                       ctx.seed, pts), pts),
+                      front + i * mw);
+    /* The brute force, once: counted and visible verdicts per sample. */
+    verdict *bc = malloc((size_t)nq * spp * sizeof *bc), *bv = malloc((size_t)nq * spp * sizeof *bv);
+    assert_true(bc && bv);
+    long sure = 0, total = 0, off_disk = 0, front_bad = 0;
+    for (int i = 0; i < nq; i++) {
+        ms_pattern_points(pat, &ctx.light, k, q[i].px, q[i].py, ctx.seed, pts);
+        for (int s = 0; s < spp; s++) {
+            verdict c, v;
+            brute_sample(&bvh, q[i].prim, q[i].p, q[i].n, pts + 3 * s, dg, &c, &v);
+            bc[(size_t)i * spp + s] = c;
+            bv[(size_t)i * spp + s] = v;
+            double w[3];
+            for (int a = 0; a < 3; a++) w[a] = pts[3 * s + a] - dg->c[a];
+            off_disk += w[0] * w[0] + w[1] * w[1] + w[2] * w[2] > dg->r * dg->r * 1.0001;
+            if (c != UNSURE && (int)c != ms_mask_get(front + i * mw, s)) front_bad++;
+        }
+    }
+    assert_int_equal(front_bad, 0);
+    assert_true(off_disk > (long)nq * spp / 8);   /* the corners of the square: about 21% of the samples */
+    /* raytrace first: its masks are the reference for the others */
+    const char *const *names = ms_method_names();
+    int have_ref = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (int mi = 0; names[mi]; mi++) {
+            const int is_rt = !strcmp(names[mi], "raytrace");
+            if ((pass == 0) != is_rt) continue;
+            const ms_shadow_method *sm = ms_find_shadow_method(names[mi]);
+            if (sm->needs_grid && pat != MS_PATTERN_GRID) continue;
+            void *ss = NULL;
+            uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+            assert_int_equal(sm->create(&ctx, &ss, err, sizeof err), 0);
+            memset(vis, 0, (size_t)nq * mw * sizeof *vis);
+            assert_int_equal(sm->visibility(ss, &ctx, q, nq, front, vis, cnt), 0);
+            sm->destroy(ss);
+            long bad = 0, differ = 0;
+            sure = total = 0;
+            for (int i = 0; i < nq; i++)
+                for (int s = 0; s < spp; s++) {
+                    const verdict v = bv[(size_t)i * spp + s];
+                    const int got = ms_mask_get(vis + i * mw, s);
+                    total++;
+                    if (v != UNSURE) { sure++; bad += got != (int)v; }
+                    if (have_ref) differ += got != ms_mask_get(ref + i * mw, s);
+                }
+            if (bad || differ)
+                fprintf(stderr, "disk, %s pattern, method %s: %ld samples differ from the brute force, %ld from raytrace\n",
+                        ms_pattern_name(pat), names[mi], bad, differ);
+            assert_int_equal(bad, 0);
+            assert_int_equal(differ, 0);
+            if (is_rt) { memcpy(ref, vis, (size_t)nq * mw * sizeof *vis); have_ref = 1; }
+        }
+    assert_true(have_ref);
+    assert_true(sure > total * 99 / 100);   /* the brute force decides nearly every sample */
+    free(bc); free(bv); free(front); free(ref); free(vis); free(pts); free(hits); free(q);
+    ms_bvh_free(&bvh);
+}
+
+static void test_disk_every_method_grid(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    disk_geom dg;
+    /* Overhead, tilted: penumbrae of the occluder on the ground. */
+    make_disk_scene(&sc, (ms_vec3){ 0.3f, 6, -0.2f }, (ms_vec3){ 0.2f, -1, 0.1f }, 1.4f, &dg);
+    check_disk_methods(&sc, &dg, 24, 32, MS_PATTERN_GRID);
+    ms_scene_free(&sc);
+    /* Low and steep: the disk crosses the ground's plane (horizon and disk masks together), k = 16. */
+    make_disk_scene(&sc, (ms_vec3){ 0, 0.6f, 4 }, (ms_vec3){ 0, -0.3f, -1 }, 1.5f, &dg);
+    check_disk_methods(&sc, &dg, 24, 16, MS_PATTERN_GRID);
+    ms_scene_free(&sc);
+}
+
+static void test_disk_ray_tracers_other_patterns(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    disk_geom dg;
+    make_disk_scene(&sc, (ms_vec3){ 0.3f, 6, -0.2f }, (ms_vec3){ 0.2f, -1, 0.1f }, 1.4f, &dg);
+    check_disk_methods(&sc, &dg, 16, 16, MS_PATTERN_STRATIFIED);
+    check_disk_methods(&sc, &dg, 16, 32, MS_PATTERN_INTERLEAVED);
+    ms_scene_free(&sc);
+}
+
+/* Whole frames: every method's V and S on a disk light equal raytrace's exactly (same masks, same
+ * resolution), and V is not the parallelogram's. */
+static void test_disk_frames_equal(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    disk_geom dg;
+    make_disk_scene(&sc, (ms_vec3){ 0.3f, 6, -0.2f }, (ms_vec3){ 0.2f, -1, 0.1f }, 1.4f, &dg);
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = 40;
+    o.threads = 2;
+    char err[256];
+    ms_frame ref, f;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        long differ = 0;
+        for (int i = 0; i < 40 * 40; i++)
+            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        if (differ) fprintf(stderr, "disk frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_frame_free(&f);
+    }
+    /* The same square as a parallelogram: more samples in front. */
+    sc.light.shape = MS_LIGHT_RECT;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+    long more = 0;
+    for (int i = 0; i < 40 * 40; i++) more += f.front[i] > ref.front[i];
+    assert_true(more > 40 * 40 / 2);
+    ms_frame_free(&f);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
+/* The grid's disk mask by row intervals equals the per-sample test, at every k and many pixels and seeds. */
+static void test_disk_mask_rows(void **st)
+{
+    (void)st;
+    ms_light l;
+    memset(&l, 0, sizeof l);
+    assert_int_equal(ms_light_disk(&l, (ms_vec3){ 1, 2, 3 }, (ms_vec3){ 0.3f, -1, 0.2f }, 0.7f), 0);
+    long kept = 0, total = 0;
+    for (int k = 16; k <= 64; k *= 2)
+        for (uint32_t px = 0; px < 64; px++)
+            for (uint32_t seed = 0; seed < 8; seed++) {
+                uint64_t a[64], b[64];
+                memset(a, 0xFF, sizeof a);
+                memset(b, 0xFF, sizeof b);
+                ms_shape_mask_apply(MS_PATTERN_GRID, &l, k, px, 3 * px + 1, seed, a);
+                ms_shape_mask_reference(MS_PATTERN_GRID, &l, k, px, 3 * px + 1, seed, b);
+                for (int w = 0; w < k * k / 64; w++) assert_true(a[w] == b[w]);
+                kept += ms_mask_count(a, k * k / 64);
+                total += k * k;
+            }
+    /* about pi/4 of the square */
+    assert_true(fabs((double)kept / (double)total - M_PI / 4.0) < 0.01);
+}
+
+/* ---- unshadowed irradiance ---- */
+
+/* Numerical integration over the disk: polar midpoint rule, n x 2n cells, double precision,
+ * max(cos theta_r, 0) (the horizon). */
+static double disk_irradiance_numeric(const disk_geom *dg, const double p[3], const double n[3], int nr)
+{
+    double e1[3], e2[3];
+    const double *m = dg->m;
+    const double a[3] = { fabs(m[0]) < 0.9 ? 1.0 : 0.0, fabs(m[0]) < 0.9 ? 0.0 : 1.0, 0.0 };
+    e1[0] = a[1] * m[2] - a[2] * m[1]; e1[1] = a[2] * m[0] - a[0] * m[2]; e1[2] = a[0] * m[1] - a[1] * m[0];
+    const double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int c = 0; c < 3; c++) e1[c] /= l1;
+    e2[0] = m[1] * e1[2] - m[2] * e1[1]; e2[1] = m[2] * e1[0] - m[0] * e1[2]; e2[2] = m[0] * e1[1] - m[1] * e1[0];
+    double sum = 0.0;
+    const int nphi = 2 * nr;
+    for (int i = 0; i < nr; i++) {
+        const double r = (i + 0.5) / nr * dg->r, dA = r * (dg->r / nr) * (2.0 * M_PI / nphi);
+        for (int j = 0; j < nphi; j++) {
+            const double ph = (j + 0.5) / nphi * 2.0 * M_PI, cs = cos(ph), sn = sin(ph);
+            double d[3];
+            for (int c = 0; c < 3; c++) d[c] = dg->c[c] + r * (cs * e1[c] + sn * e2[c]) - p[c];
+            const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], dl = sqrt(d2);
+            const double cr = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / dl;
+            const double cl = -(d[0] * m[0] + d[1] * m[1] + d[2] * m[2]) / dl;
+            if (cr > 0.0 && cl > 0.0) sum += cr * cl / d2 * dA;
+        }
+    }
+    return sum;
+}
+
+static void test_disk_irradiance(void **st)
+{
+    (void)st;
+    tu_rng g = { 1234 };
+    double worst_above = 0.0, worst_cross = 0.0;
+    int above = 0, cross = 0;
+    for (int trial = 0; trial < 400 && (above < 40 || cross < 40); trial++) {
+        double v[12];
+        for (int i = 0; i < 12; i++) v[i] = (double)(tu_rng_next(&g) >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0;
+        ms_vec3 c = { (float)v[0], (float)v[1], (float)v[2] }, m = { (float)v[3], (float)v[4], (float)v[5] };
+        const float r = 0.2f + 1.0f * (float)fabs(v[6]);
+        ms_light l;
+        memset(&l, 0, sizeof l);
+        if (ms_light_disk(&l, c, m, r)) continue;
+        disk_geom dg;
+        const double ml = sqrt((double)m.x * m.x + (double)m.y * m.y + (double)m.z * m.z);
+        dg = (disk_geom){ { c.x, c.y, c.z }, { m.x / ml, m.y / ml, m.z / ml }, r };
+        /* a point on the emitting side, 0.1 .. 2.1 from the plane, up to 2 to the side */
+        const double h = 0.1 + 2.0 * fabs(v[7]);
+        double p[3], n[3];
+        for (int a = 0; a < 3; a++) p[a] = dg.c[a] + h * dg.m[a] + 2.0 * v[8 + a % 3] * (a == 1 ? 0.5 : 1.0);
+        const double nl = sqrt(v[9] * v[9] + v[10] * v[10] + v[11] * v[11]);
+        if (nl < 0.1) continue;
+        for (int a = 0; a < 3; a++) n[a] = v[9 + a] / nl;
+        /* the receiver facing the light at least partly */
+        double toc[3] = { dg.c[0] - p[0], dg.c[1] - p[1], dg.c[2] - p[2] };
+        if (toc[0] * n[0] + toc[1] * n[1] + toc[2] * n[2] < 0.0) for (int a = 0; a < 3; a++) n[a] = -n[a];
+        const float pf[3] = { (float)p[0], (float)p[1], (float)p[2] }, nf[3] = { (float)n[0], (float)n[1], (float)n[2] };
+        for (int a = 0; a < 3; a++) { p[a] = pf[a]; n[a] = nf[a]; }
+        const double want = disk_irradiance_numeric(&dg, p, n, 800);
+        const double got = ms_light_irradiance(&l, pf, nf);
+        /* wholly above the horizon? */
+        double nt[3], dn = n[0] * dg.m[0] + n[1] * dg.m[1] + n[2] * dg.m[2];
+        for (int a = 0; a < 3; a++) nt[a] = n[a] - dn * dg.m[a];
+        const double wholly = toc[0] * n[0] + toc[1] * n[1] + toc[2] * n[2] - r * sqrt(nt[0] * nt[0] + nt[1] * nt[1] + nt[2] * nt[2]);
+        const double err = fabs(got - want) / fmax(want, 1e-3);
+        if (wholly > 1e-3) { above++; worst_above = fmax(worst_above, err); }
+        else if (wholly < -1e-3) { cross++; worst_cross = fmax(worst_cross, err); }
+    }
+    printf("disk irradiance vs numerical integration: %d points wholly above the horizon, worst relative error "
+           "%.2e (closed form); %d across it, %.2e (256-gon)\n", above, worst_above, cross, worst_cross);
+    assert_true(above >= 20 && cross >= 20);
+    /* The midpoint rule at 800 x 1600 cells is good to about 1e-5 here; the float closed form adds ~1e-6. */
+    assert_true(worst_above < 1e-4);
+    assert_true(worst_cross < 1e-3);
+}
+
+/* ---- many lights ---- */
+
+static void test_two_lights_equal_single(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    tu_make_quad(&sc);
+    ms_light two[2];
+    two[0] = sc.light;
+    two[0].emission = (ms_vec3){ 1.0f, 0.5f, 0.25f };
+    memset(&two[1], 0, sizeof two[1]);
+    assert_int_equal(ms_light_disk(&two[1], (ms_vec3){ 3, 4, 1 }, (ms_vec3){ -0.5f, -1, 0 }, 1.0f), 0);
+    two[1].emission = (ms_vec3){ 0.2f, 0.4f, 2.0f };
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = 32;
+    o.threads = 2;
+    char err[256];
+    const char *methods[] = { "raytrace", "scanline", "hpc", "mft", NULL };
+    const size_t npix = 32 * 32;
+    for (int mi = 0; methods[mi]; mi++) {
+        o.method = methods[mi];
+        ms_frame single[2], both;
+        for (int l = 0; l < 2; l++) {
+            sc.light = two[l];
+            sc.lights = NULL;
+            sc.n_lights = 0;
+            assert_int_equal(ms_render(&sc, &o, &single[l], err, sizeof err), 0);
+            assert_true(single[l].n_lights == 1);
+        }
+        sc.lights = two;
+        sc.n_lights = 2;
+        sc.light = two[0];
+        assert_int_equal(ms_render(&sc, &o, &both, err, sizeof err), 0);
+        assert_int_equal(both.n_lights, 2);
+        for (int l = 0; l < 2; l++)
+            for (size_t i = 0; i < npix; i++) {
+                assert_true(both.vis[l * npix + i] == single[l].vis[i]);
+                assert_true(both.shadow[l * npix + i] == single[l].shadow[i]);
+                assert_int_equal(both.front[l * npix + i], single[l].front[i]);
+            }
+        for (size_t i = 0; i < 3 * npix; i++) {
+            const float sum = single[0].rgb[i] + single[1].rgb[i];
+            assert_true(fabsf(both.rgb[i] - sum) <= 1e-6f * fabsf(sum) + 1e-12f);
+        }
+        ms_frame_free(&both);
+        ms_frame_free(&single[0]);
+        ms_frame_free(&single[1]);
+        sc.lights = NULL;
+        sc.n_lights = 0;
+    }
+    sc.light = two[0];
+    ms_scene_free(&sc);
+}
+
+/* ---- scene files: lights, units, bad input ---- */
+
+static char g_dir[4096];
+
+static const char *scene_with(const char *name, const char *lights)
+{
+    static char path[4096];
+    char text[4096], p[4096];
+    tu_write_file(tu_path(p, sizeof p, g_dir, "ok.obj"),
+                  "v -10 0 -10\nv 10 0 -10\nv 10 0 10\nv -10 0 10\nv -2 2 -2\nv 2 2 -2\nv 2 2 2\nv -2 2 2\n"
+                  "f 1 3 2\nf 1 4 3\nf 5 7 6\nf 5 8 7\n");
+    snprintf(text, sizeof text,
+             "{ \"meshes\": [ { \"file\": \"ok.obj\" } ],\n"
+             " \"camera\": { \"eye\": [0, 10, 12], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov_y\": 60,"
+             " \"width\": 16, \"height\": 16 },\n %s,\n \"render\": { \"samples\": 256 } }\n", lights);
+    tu_path(path, sizeof path, g_dir, name);
+    assert_int_equal(tu_write_file(path, text), 0);
+    return path;
+}
+
+static void test_units(void **st)
+{
+    (void)st;
+    snprintf(g_dir, sizeof g_dir, "%s", tu_tmpdir("lights_units"));
+    const char *path = scene_with("units.json",
+        "\"lights\": [ { \"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2], \"power\": 100 },\n"
+        "  { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0], \"radius\": 0.5, \"lumens\": [1000, 500, 0] },\n"
+        "  { \"shape\": \"disk\", \"center\": [1, 5, 0], \"normal\": [0, -2, 0], \"radius\": 2, \"emission\": [3, 2, 1] },\n"
+        "  { \"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2] } ]");
+    ms_scene sc;
+    char err[512];
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    assert_int_equal((int)sc.n_lights, 4);
+    size_t n;
+    const ms_light *L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 4);
+    /* 100 W from a 2 m x 2 m Lambertian emitter: L = 100 / (pi * 4) = 7.957747 W sr^-1 m^-2 */
+    assert_float_equal(L[0].emission.x, 7.957747f, 1e-5f);
+    assert_float_equal(L[0].emission.z, 7.957747f, 1e-5f);
+    assert_int_equal(L[0].shape, MS_LIGHT_RECT);
+    /* 1000 lm from a disk of radius 0.5 m (area pi/4): 1000 / (pi * pi / 4) = 405.2847 cd m^-2 */
+    assert_float_equal(L[1].emission.x, 405.2847f, 2e-3f);
+    assert_float_equal(L[1].emission.y, 202.6424f, 1e-3f);
+    assert_float_equal(L[1].emission.z, 0.0f, 0.0f);
+    assert_int_equal(L[1].shape, MS_LIGHT_DISK);
+    /* radiance as given; the disk's square is 4 x 4 centred on (1, 5, 0), emitting towards -y */
+    assert_float_equal(L[2].emission.y, 2.0f, 0.0f);
+    const float cx = L[2].corner.x + 0.5f * (L[2].edge_s.x + L[2].edge_t.x);
+    const float cy = L[2].corner.y + 0.5f * (L[2].edge_s.y + L[2].edge_t.y);
+    assert_float_equal(cx, 1.0f, 1e-6f);
+    assert_float_equal(cy, 5.0f, 1e-6f);
+    const float ny = L[2].edge_s.z * L[2].edge_t.x - L[2].edge_s.x * L[2].edge_t.z;
+    assert_float_equal(ny, -16.0f, 1e-4f);
+    assert_float_equal(ms_light_area(&L[2]), (float)M_PI * 4.0f, 1e-5f);
+    /* a sphere of radius 0.5 m emitting 100 W: area pi, L = 100 / (pi * pi) = 10.13212 */
+    ms_light sph;
+    memset(&sph, 0, sizeof sph);
+    ms_light_sphere(&sph, (ms_vec3){ 0, 0, 0 }, 0.5f);
+    assert_float_equal(ms_light_radiance_from(&sph, (ms_vec3){ 100, 100, 100 }, MS_UNITS_WATTS).x, 10.13212f, 1e-4f);
+    /* no unit given: radiance 1 */
+    assert_float_equal(L[3].emission.x, 1.0f, 0.0f);
+    ms_scene_free(&sc);
+}
+
+/* The CLI on a bad light: exit 2, one line naming the file and the problem. */
+static void expect_bad(const char *name, const char *lights, const char *needle)
+{
+    const char *path = scene_with(name, lights);
+    char out[4096], errbuf[2048];
+    tu_path(out, sizeof out, g_dir, "out.png");
+    const char *args[] = { path, "--quiet", "-o", out, NULL };
+    tu_run_result res;
+    const int rc = tu_run_cli_ex(args, NULL, errbuf, sizeof errbuf, &res);
+    if (rc != 2 || res.lines != 1 || !strstr(errbuf, name) || !strstr(errbuf, needle))
+        fprintf(stderr, "%s: exit %d, %d lines: %s (wanted \"%s\")\n", name, rc, res.lines, errbuf, needle);
+    assert_int_equal(rc, 2);
+    assert_int_equal(res.lines, 1);
+    assert_non_null(strstr(errbuf, name));
+    assert_non_null(strstr(errbuf, needle));
+    assert_false(tu_file_exists(out));
+}
+
+static void test_bad_light_json(void **st)
+{
+    (void)st;
+    snprintf(g_dir, sizeof g_dir, "%s", tu_tmpdir("lights_bad"));
+    const char *rect = "\"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2]";
+    char buf[1024];
+    snprintf(buf, sizeof buf, "\"light\": { \"shape\": \"triangle\", %s }", rect);
+    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\" or \"sphere\"");
+    expect_bad("b2.json", "\"light\": { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0] }", "light.radius is missing");
+    expect_bad("b3.json", "\"light\": { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0], \"radius\": -1 }",
+               "light.radius must be in (0,");
+    expect_bad("b4.json", "\"light\": { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, 0, 0], \"radius\": 1 }",
+               "light.normal must not be zero");
+    snprintf(buf, sizeof buf, "\"light\": { %s, \"emission\": 1, \"power\": 5 }", rect);
+    expect_bad("b5.json", buf, "give one of \"emission\", \"power\" and \"lumens\"");
+    snprintf(buf, sizeof buf, "\"light\": { %s }, \"lights\": [ { %s } ]", rect, rect);
+    expect_bad("b6.json", buf, "either \"light\" or \"lights\"");
+    expect_bad("b7.json", "\"lights\": []", "\"lights\" must be an array of 1 to 64");
+    expect_bad("b8.json", "\"lights\": { \"corner\": [0, 0, 0] }", "\"lights\" must be an array of 1 to 64");
+    snprintf(buf, sizeof buf, "\"lights\": [ { %s }, 3 ]", rect);
+    expect_bad("b9.json", buf, "lights[1] must be an object");
+    snprintf(buf, sizeof buf, "\"lights\": [ { %s }, { \"corner\": [0, 6, 0], \"edge_s\": [1, 0, 0], \"edge_t\": [2, 0, 0] } ]", rect);
+    expect_bad("b10.json", buf, "lights[1] has zero area");
+    snprintf(buf, sizeof buf, "\"light\": { %s, \"lumens\": -3 }", rect);
+    expect_bad("b11.json", buf, "light.lumens must not be negative");
+    snprintf(buf, sizeof buf, "\"light\": { %s, \"power\": \"bright\" }", rect);
+    expect_bad("b12.json", buf, "light.power must be a number or an array of 3 numbers");
+    snprintf(buf, sizeof buf, "\"lights\": [ { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0], \"radius\": 1e39 } ]");
+    expect_bad("b13.json", buf, "lights[0].radius");
+    expect_bad("b17.json", "\"light\": { \"shape\": \"sphere\", \"center\": [0, 6, 0] }", "light.radius is missing");
+    expect_bad("b18.json", "\"light\": { \"shape\": \"sphere\", \"center\": [0, 6, 0], \"radius\": 1, \"texture\": \"a.png\" }",
+               "a sphere light cannot be textured");
+    snprintf(buf, sizeof buf, "\"light\": { %s, \"texture\": \"nothere.png\" }", rect);
+    expect_bad("b14.json", buf, "texture file not found");
+    char p[4096];
+    tu_write_file(tu_path(p, sizeof p, g_dir, "notpng.png"), "this is not a PNG\n");
+    snprintf(buf, sizeof buf, "\"light\": { %s, \"texture\": \"notpng.png\" }", rect);
+    expect_bad("b15.json", buf, "not a readable PNG image");
+    snprintf(buf, sizeof buf, "\"light\": { %s, \"texture\": 7 }", rect);
+    expect_bad("b16.json", buf, "light.texture must be the path of a PNG image");
+}
+
+/* --vis to EXR: one channel per light; to PFM: light 0. */
+static void test_vis_outputs(void **st)
+{
+    (void)st;
+    snprintf(g_dir, sizeof g_dir, "%s", tu_tmpdir("lights_out"));
+    const char *path = scene_with("two.json",
+        "\"lights\": [ { \"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2] },\n"
+        "  { \"shape\": \"disk\", \"center\": [3, 4, 0], \"normal\": [-0.5, -1, 0], \"radius\": 1 } ]");
+    char pfm[4096], exr[4096], err[512];
+    tu_path(pfm, sizeof pfm, g_dir, "v.pfm");
+    tu_path(exr, sizeof exr, g_dir, "s.exr");
+    const char *args[] = { path, "--quiet", "--vis", pfm, "--shadow", exr, NULL };
+    assert_int_equal(tu_run_cli(args, err, sizeof err), 0);
+    assert_true(tu_file_exists(exr));
+    int w, h;
+    float *v = tu_read_pfm(pfm, &w, &h);
+    assert_non_null(v);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    ms_render_options o;
+    ms_render_options_default(&o);
+    ms_frame f;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+    assert_int_equal(w, f.width);
+    for (int i = 0; i < w * h; i++) assert_true(v[i] == f.vis[i]);   /* light 0 */
+    free(v);
+    ms_frame_free(&f);
+    ms_scene_free(&sc);
+}
+
+/* Reads channel `name` of a one-part float EXR of w x h into img; -1 if absent. */
+static int read_exr_channel(const char *path, const char *name, int w, int h, float *img)
+{
+    exr_context_t ctx = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    assert_int_equal(exr_start_read(&ctx, path, &init), EXR_ERR_SUCCESS);
+    const exr_attr_chlist_t *chl = NULL;
+    assert_int_equal(exr_get_channels(ctx, 0, &chl), EXR_ERR_SUCCESS);
+    int want = -1;
+    for (int c = 0; c < chl->num_channels; c++)
+        if (!strcmp(chl->entries[c].name.str, name)) want = c;
+    if (want < 0) { exr_finish(&ctx); return -1; }
+    exr_attr_box2i_t dw;
+    assert_int_equal(exr_get_data_window(ctx, 0, &dw), EXR_ERR_SUCCESS);
+    assert_int_equal(dw.max.x - dw.min.x + 1, w);
+    assert_int_equal(dw.max.y - dw.min.y + 1, h);
+    int lines = 0;
+    assert_int_equal(exr_get_scanlines_per_chunk(ctx, 0, &lines), EXR_ERR_SUCCESS);
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    int dec_init = 0;
+    for (int y = dw.min.y; y <= dw.max.y; y += lines) {
+        exr_chunk_info_t ci;
+        assert_int_equal(exr_read_scanline_chunk_info(ctx, 0, y, &ci), EXR_ERR_SUCCESS);
+        if (!dec_init) assert_int_equal(exr_decoding_initialize(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
+        else assert_int_equal(exr_decoding_update(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
+        for (int c = 0; c < dec.channel_count; c++) dec.channels[c].decode_to_ptr = NULL;   /* skip the others */
+        dec.channels[want].decode_to_ptr = (uint8_t *)(img + (size_t)(ci.start_y - dw.min.y) * w);
+        dec.channels[want].user_pixel_stride = sizeof(float);
+        dec.channels[want].user_line_stride = (int32_t)sizeof(float) * w;
+        dec.channels[want].user_bytes_per_element = sizeof(float);
+        dec.channels[want].user_data_type = EXR_PIXEL_FLOAT;
+        if (!dec_init) { assert_int_equal(exr_decoding_choose_default_routines(ctx, 0, &dec), EXR_ERR_SUCCESS); dec_init = 1; }
+        assert_int_equal(exr_decoding_run(ctx, 0, &dec), EXR_ERR_SUCCESS);
+    }
+    exr_decoding_destroy(ctx, &dec);
+    exr_finish(&ctx);
+    return 0;
+}
+
+/* The per-light EXR channels hold the frame's planes: V0, V1 / S0, S1; no plain "V". */
+static void test_exr_channels_per_light(void **st)
+{
+    (void)st;
+    snprintf(g_dir, sizeof g_dir, "%s", tu_tmpdir("lights_exr"));
+    const char *path = scene_with("two.json",
+        "\"lights\": [ { \"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2] },\n"
+        "  { \"shape\": \"disk\", \"center\": [3, 4, 0], \"normal\": [-0.5, -1, 0], \"radius\": 1 } ]");
+    ms_scene sc;
+    char err[512], v[4096], sh[4096];
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    ms_render_options o;
+    tu_render_options_default(&o);
+    ms_frame f;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+    assert_int_equal(f.n_lights, 2);
+    assert_int_equal(ms_write_vis(&f, tu_path(v, sizeof v, g_dir, "v.exr"), err, sizeof err), 0);
+    assert_int_equal(ms_write_shadow(&f, tu_path(sh, sizeof sh, g_dir, "s.exr"), err, sizeof err), 0);
+    const size_t npix = (size_t)f.width * f.height;
+    float *img = malloc(npix * sizeof *img);
+    assert_non_null(img);
+    const char *names[2][2] = { { "V0", "V1" }, { "S0", "S1" } };
+    for (int l = 0; l < 2; l++) {
+        assert_int_equal(read_exr_channel(v, names[0][l], f.width, f.height, img), 0);
+        assert_memory_equal(img, f.vis + l * npix, npix * sizeof *img);
+        assert_int_equal(read_exr_channel(sh, names[1][l], f.width, f.height, img), 0);
+        assert_memory_equal(img, f.shadow + l * npix, npix * sizeof *img);
+    }
+    assert_int_equal(read_exr_channel(v, "V", f.width, f.height, img), -1);
+    /* the two lights differ somewhere (the channels are not one plane twice) */
+    long differ = 0;
+    for (size_t i = 0; i < npix; i++) differ += f.vis[i] != f.vis[npix + i];
+    assert_true(differ > 0);
+    free(img);
+    ms_frame_free(&f);
+    ms_scene_free(&sc);
+}
+
+/* ---- textured lights ---- */
+
+/* Writes a w x h PNG whose linear texels are rgb (values 0 or 1 survive the 8-bit sRGB round trip exactly). */
+static void write_texture_png(const char *path, int w, int h, const float *rgb)
+{
+    ms_frame f;
+    memset(&f, 0, sizeof f);
+    f.width = w;
+    f.height = h;
+    float *vis = calloc((size_t)w * h, sizeof *vis);
+    assert_non_null(vis);
+    f.vis = vis;
+    f.rgb = (float *)rgb;
+    f.exposure = 1.0f;
+    char err[256];
+    assert_int_equal(ms_write_png(&f, path, err, sizeof err), 0);
+    free(vis);
+}
+
+/* A rect light whose right half (s >= 1/2) emits and left half is black: V unchanged, S the texel-weighted
+ * ratio recomputed here from the visible masks, every method's S equal to raytrace's, and the shading of an
+ * unshadowed point near the exact irradiance of the light's right half. */
+static void test_textured_rect(void **st)
+{
+    (void)st;
+    snprintf(g_dir, sizeof g_dir, "%s", tu_tmpdir("lights_texture"));
+    char png[4096];
+    const float tex[6] = { 0, 0, 0, 1, 1, 1 };
+    write_texture_png(tu_path(png, sizeof png, g_dir, "half.png"), 2, 1, tex);
+    const char *path = scene_with("tex.json",
+        "\"light\": { \"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2], \"texture\": \"half.png\" }");
+    ms_scene sc;
+    char err[512];
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    assert_non_null(sc.light.texture);
+    assert_int_equal(sc.light.texture_width, 2);
+    assert_float_equal(sc.light.texture[0], 0.0f, 0.0f);
+    assert_float_equal(sc.light.texture[3], 1.0f, 0.0f);
+    /* Internal API: masks and S of raytrace on a 16 x 16 frame, S recomputed from the masks. */
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
+    const int size = 16, k = 32;
+    ms_render_ctx ctx;
+    tu_ctx_init(&ctx, &sc, &bvh, size, size, k);
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    void *ps = NULL, *ss = NULL;
+    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
+    ms_hit hits[16 * 16];
+    pm->trace(ps, &ctx, 0, 0, size, size, hits);
+    pm->destroy(ps);
+    ms_shadow_query q[16 * 16];
+    int nq = 0;
+    for (int i = 0; i < size * size; i++)
+        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[nq++], &hits[i], i % size, i / size);
+    const int mw = ctx.mask_words;
+    uint64_t *front = calloc((size_t)nq * mw, 8), *vis = calloc((size_t)nq * mw, 8);
+    float *pts = malloc(3 * 1024 * sizeof *pts);
+    assert_true(front && vis && pts);
+    for (int i = 0; i < nq; i++) ms_front_mask(&ctx, &q[i], NULL, front + i * mw);
+    const ms_shadow_method *rt = ms_find_shadow_method("raytrace");
+    uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+    assert_int_equal(rt->create(&ctx, &ss, err, sizeof err), 0);
+    assert_int_equal(rt->visibility(ss, &ctx, q, nq, front, vis, cnt), 0);
+    rt->destroy(ss);
+    int penumbra_half = 0;
+    for (int i = 0; i < nq; i++) {
+        float v, s;
+        ms_resolve_vs(&ctx, &q[i], NULL, front + i * mw, vis + i * mw, &v, &s);
+        ms_pattern_points(MS_PATTERN_GRID, &sc.light, k, q[i].px, q[i].py, 0, pts);
+        double wf = 0, wv = 0;
+        int nf = 0, nv = 0;
+        for (int j = 0; j < k * k; j++) {
+            if (!ms_mask_get(front + i * mw, j)) continue;
+            const double d[3] = { pts[3 * j] - q[i].p[0], pts[3 * j + 1] - q[i].p[1], pts[3 * j + 2] - q[i].p[2] };
+            const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            /* cos at the light: its normal is -y; the texel: s from the world x (corner -1, edge 2) */
+            const double w = fmax(d[0] * q[i].n[0] + d[1] * q[i].n[1] + d[2] * q[i].n[2], 0.0) * fmax(d[1], 0.0) / (r2 * r2);
+            const double sx = (pts[3 * j] + 1.0) / 2.0;
+            const double tau = fabs(sx - 0.5) < 1e-5 ? -1.0 : sx >= 0.5 ? 1.0 : 0.0;
+            if (tau < 0) continue;   /* on the texel boundary: either texel */
+            nf++;
+            wf += w * tau;
+            if (ms_mask_get(vis + i * mw, j)) { nv++; wv += w * tau; }
+        }
+        const int vis_n = ms_mask_count(vis + i * mw, mw), front_n = ms_mask_count(front + i * mw, mw);
+        if (vis_n == 0 || vis_n == front_n) { assert_float_equal(s, v, 0.0f); continue; }
+        assert_float_equal(v, (float)vis_n / (float)front_n, 0.0f);   /* V unweighted */
+        const double want = wf > 0 ? wv / wf : v;
+        if (fabs(s - want) > 1e-3) fprintf(stderr, "pixel %u,%u: S %.6f, recomputed %.6f\n", q[i].px, q[i].py, s, want);
+        assert_true(fabs(s - want) <= 1e-3);
+        penumbra_half += fabs(s - v) > 0.05;   /* the texture changed S */
+        (void)nv;
+    }
+    assert_true(penumbra_half > 0);
+    free(front); free(vis); free(pts);
+    ms_bvh_free(&bvh);
+    /* Frames: every method's S equals raytrace's; an unshadowed point sees about half the light's irradiance. */
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = 32;
+    o.threads = 2;
+    ms_frame ref, f;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        for (int i = 0; i < 32 * 32; i++) {
+            assert_true(f.vis[i] == ref.vis[i]);
+            assert_true(f.shadow[i] == ref.shadow[i]);
+        }
+        ms_frame_free(&f);
+    }
+    /* The shading's texture factor: E_unshadowed of the whole rect times the weighted mean texel, against
+     * the exact irradiance of the right half alone (the polygon formula), at every receiver of the small
+     * frame above; the ratio estimator's error shrinks with N (measured here at N = 1024). */
+    ms_light right = sc.light;
+    right.texture = NULL;
+    right.corner.x += 1.0f;
+    right.edge_s.x = 1.0f;
+    double worst = 0;
+    for (int i = 0; i < nq; i++) {
+        float t[3];
+        ms_light_texture_mean(&ctx, &q[i], t);
+        const double est = (double)ms_light_irradiance(&sc.light, q[i].p, q[i].n) * t[0];
+        const double exact = ms_light_irradiance(&right, q[i].p, q[i].n);
+        if (exact > 1e-3) worst = fmax(worst, fabs(est - exact) / exact);
+        assert_float_equal(t[0], t[1], 0.0f);
+    }
+    printf("textured light: texture-weighted E vs the exact half-light E, worst relative error %.4f\n", worst);
+    assert_true(worst < 0.01);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
+/* ---- sphere lights ---- */
+
+/* The outline disk against the exact tangent cone: every rim point lies on the sphere and its tangent
+ * plane contains the ray from p, (rim - p) . (rim - c) = 0; the disk faces p. */
+static void test_sphere_outline(void **st)
+{
+    (void)st;
+    tu_rng g = { 99 };
+    for (int trial = 0; trial < 200; trial++) {
+        double v[7];
+        for (int i = 0; i < 7; i++) v[i] = (double)(tu_rng_next(&g) >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0;
+        ms_light sph;
+        memset(&sph, 0, sizeof sph);
+        const float R = 0.1f + (float)fabs(v[3]);
+        assert_int_equal(ms_light_sphere(&sph, (ms_vec3){ (float)v[0], (float)v[1], (float)v[2] }, R), 0);
+        /* a point 1.01 R .. 5 R from the centre */
+        double dir[3] = { v[4], v[5], v[6] };
+        const double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        if (dl < 0.1) continue;
+        const double dist = R * (1.01 + 4.0 * fabs(v[4]));
+        const float p[3] = { (float)(v[0] + dir[0] / dl * dist), (float)(v[1] + dir[1] / dl * dist), (float)(v[2] + dir[2] / dl * dist) };
+        ms_light disk;
+        assert_int_equal(ms_light_sphere_outline(&sph, p, &disk), 0);
+        assert_int_equal(disk.shape, MS_LIGHT_DISK);
+        const double c[3] = { sph.center.x, sph.center.y, sph.center.z };
+        for (int k = 0; k < 16; k++) {
+            /* rim point: the inscribed circle of the square at angle k */
+            const double a = 2.0 * M_PI * k / 16, cs = 0.5 + 0.5 * cos(a), sn = 0.5 + 0.5 * sin(a);
+            double rim[3], pr[3], cr[3];
+            const double P0[3] = { disk.corner.x, disk.corner.y, disk.corner.z };
+            const double S[3] = { disk.edge_s.x, disk.edge_s.y, disk.edge_s.z }, T[3] = { disk.edge_t.x, disk.edge_t.y, disk.edge_t.z };
+            for (int q = 0; q < 3; q++) { rim[q] = P0[q] + cs * S[q] + sn * T[q]; pr[q] = rim[q] - p[q]; cr[q] = rim[q] - c[q]; }
+            const double on = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+            const double tangent = (pr[0] * cr[0] + pr[1] * cr[1] + pr[2] * cr[2]) /
+                                   (sqrt(pr[0] * pr[0] + pr[1] * pr[1] + pr[2] * pr[2]) * on);
+            assert_true(fabs(on - R) <= 2e-5 * (R + dist));
+            assert_true(fabs(tangent) <= 1e-4 * (dist / (dist - R * 0.999)));
+        }
+        /* faces p: cross(edge_s, edge_t) . (p - centre) > 0 */
+        const double nx = (double)disk.edge_s.y * disk.edge_t.z - (double)disk.edge_s.z * disk.edge_t.y;
+        const double ny = (double)disk.edge_s.z * disk.edge_t.x - (double)disk.edge_s.x * disk.edge_t.z;
+        const double nz = (double)disk.edge_s.x * disk.edge_t.y - (double)disk.edge_s.y * disk.edge_t.x;
+        assert_true(nx * (p[0] - c[0]) + ny * (p[1] - c[1]) + nz * (p[2] - c[2]) > 0.0);
+    }
+    /* inside: no outline */
+    ms_light sph, disk;
+    memset(&sph, 0, sizeof sph);
+    ms_light_sphere(&sph, (ms_vec3){ 0, 0, 0 }, 1.0f);
+    const float in[3] = { 0.5f, 0, 0 };
+    assert_int_equal(ms_light_sphere_outline(&sph, in, &disk), -1);
+}
+
+/* Sphere irradiance (Snyder's closed form) against numerical integration over the exact outline disk
+ * (same solid angle, same radiance), above and across the horizon. */
+static void test_sphere_irradiance(void **st)
+{
+    (void)st;
+    tu_rng g = { 4321 };
+    int above = 0, cross = 0;
+    double worst = 0.0;
+    for (int trial = 0; trial < 300 && (above < 30 || cross < 30); trial++) {
+        double v[6];
+        for (int i = 0; i < 6; i++) v[i] = (double)(tu_rng_next(&g) >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0;
+        const float R = 0.3f + 0.5f * (float)fabs(v[0]);
+        ms_light sph;
+        memset(&sph, 0, sizeof sph);
+        ms_light_sphere(&sph, (ms_vec3){ 0, 0, 0 }, R);
+        const double d = R * (1.2 + 3.0 * fabs(v[1]));
+        double dir[3] = { v[2], v[3], v[4] };
+        const double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        if (dl < 0.1) continue;
+        const float p[3] = { (float)(dir[0] / dl * d), (float)(dir[1] / dl * d), (float)(dir[2] / dl * d) };
+        /* normal: at angle theta from the direction to the centre, up to 120 degrees */
+        const double th = fabs(v[5]) * 2.0 * M_PI / 3.0;
+        double a[3] = { -p[0], -p[1], -p[2] }, b[3];
+        const double al = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        for (int q = 0; q < 3; q++) a[q] /= al;
+        b[0] = a[1]; b[1] = -a[0]; b[2] = 0;   /* perpendicular to a (a is never along z only, by chance) */
+        const double bl = sqrt(b[0] * b[0] + b[1] * b[1]);
+        if (bl < 0.1) continue;
+        for (int q = 0; q < 2; q++) b[q] /= bl;
+        const float n[3] = { (float)(cos(th) * a[0] + sin(th) * b[0]), (float)(cos(th) * a[1] + sin(th) * b[1]),
+                             (float)(cos(th) * a[2]) };
+        /* the exact outline in double */
+        const double pd[3] = { p[0], p[1], p[2] }, nd[3] = { n[0], n[1], n[2] };
+        const double dd = sqrt(pd[0] * pd[0] + pd[1] * pd[1] + pd[2] * pd[2]), f = R * R / (dd * dd);
+        disk_geom dg = { { pd[0] * f, pd[1] * f, pd[2] * f }, { pd[0] / dd, pd[1] / dd, pd[2] / dd },
+                         R * sqrt(dd * dd - R * R) / dd };
+        const double want = disk_irradiance_numeric(&dg, pd, nd, 600);
+        const double got = ms_light_irradiance(&sph, p, n);
+        const double sin_s = R / dd;
+        if (cos(th) > sin_s + 0.01) above++;
+        else if (cos(th) < sin_s - 0.01 && cos(th) > -sin_s + 0.01) cross++;
+        else continue;
+        worst = fmax(worst, fabs(got - want) / fmax(want, 1e-3));
+    }
+    printf("sphere irradiance vs numerical integration: %d above the horizon, %d across, worst relative error %.2e\n",
+           above, cross, worst);
+    assert_true(above >= 20 && cross >= 20);
+    assert_true(worst < 1e-4);
+}
+
+/* Every method on a sphere light equals raytrace pixel for pixel; raytrace's V equals the brute force on the
+ * exact outline disk of each receiver, at every pixel the brute force decides whole. */
+static void test_sphere_every_method(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    tu_make_quad(&sc);
+    memset(&sc.light, 0, sizeof sc.light);
+    assert_int_equal(ms_light_sphere(&sc.light, (ms_vec3){ 0.5f, 5.0f, 0.2f }, 0.9f), 0);
+    sc.light.emission = (ms_vec3){ 1, 1, 1 };
+    const int size = 24;
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = size;
+    o.threads = 2;
+    char err[256];
+    ms_frame ref, f;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        long differ = 0;
+        for (int i = 0; i < size * size; i++)
+            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        if (differ) fprintf(stderr, "sphere frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_frame_free(&f);
+    }
+    /* brute force at each pixel */
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
+    ms_render_ctx ctx;
+    tu_ctx_init(&ctx, &sc, &bvh, size, size, 32);
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    void *ps = NULL;
+    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
+    ms_hit hits[24 * 24];
+    pm->trace(ps, &ctx, 0, 0, size, size, hits);
+    pm->destroy(ps);
+    float *pts = malloc(3 * 1024 * sizeof *pts);
+    assert_non_null(pts);
+    int decided = 0, partial = 0;
+    const double c[3] = { sc.light.center.x, sc.light.center.y, sc.light.center.z }, R = sc.light.radius;
+    for (int i = 0; i < size * size; i++) {
+        if (hits[i].prim == UINT32_MAX) continue;
+        ms_light disk;
+        assert_int_equal(ms_light_sphere_outline(&sc.light, hits[i].p, &disk), 0);
+        ms_pattern_points(MS_PATTERN_GRID, &disk, 32, (uint32_t)(i % size), (uint32_t)(i / size), 0, pts);
+        const double p[3] = { hits[i].p[0], hits[i].p[1], hits[i].p[2] };
+        const double w[3] = { p[0] - c[0], p[1] - c[1], p[2] - c[2] };
+        const double d = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), f2 = R * R / (d * d);
+        const disk_geom dg = { { c[0] + w[0] * f2, c[1] + w[1] * f2, c[2] + w[2] * f2 }, { w[0] / d, w[1] / d, w[2] / d },
+                               R * sqrt(d * d - R * R) / d };
+        int nf = 0, nv = 0, unsure = 0;
+        for (int s2 = 0; s2 < 1024; s2++) {
+            verdict cnt, v;
+            brute_sample(&bvh, hits[i].prim, hits[i].p, hits[i].n, pts + 3 * s2, &dg, &cnt, &v);
+            if (cnt == UNSURE || v == UNSURE) { unsure = 1; break; }
+            nf += cnt == YES;
+            nv += v == YES;
+        }
+        if (unsure) continue;
+        decided++;
+        partial += nv > 0 && nv < nf;
+        assert_int_equal(ref.front[i], nf);
+        assert_true(ref.vis[i] == (nf ? (float)nv / (float)nf : 0.0f));
+    }
+    printf("sphere light: the brute force decided %d of %d pixels whole (%d in penumbra)\n", decided, size * size, partial);
+    assert_true(decided > size * size / 2 && partial > 0);
+    free(pts);
+    ms_bvh_free(&bvh);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_disk_mask_rows),
+        cmocka_unit_test(test_disk_every_method_grid),
+        cmocka_unit_test(test_disk_ray_tracers_other_patterns),
+        cmocka_unit_test(test_disk_frames_equal),
+        cmocka_unit_test(test_disk_irradiance),
+        cmocka_unit_test(test_two_lights_equal_single),
+        cmocka_unit_test(test_units),
+        cmocka_unit_test(test_bad_light_json),
+        cmocka_unit_test(test_vis_outputs),
+        cmocka_unit_test(test_exr_channels_per_light),
+        cmocka_unit_test(test_textured_rect),
+        cmocka_unit_test(test_sphere_outline),
+        cmocka_unit_test(test_sphere_irradiance),
+        cmocka_unit_test(test_sphere_every_method),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
