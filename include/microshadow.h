@@ -332,8 +332,8 @@ typedef struct ms_frame {
                        * E_unshadowed * S + F * LTC_GGX * S_spec); without materials albedo 0.8, no specular */
     float exposure;   /* scale that maps the 99th percentile of unshadowed radiance to 1 (for PNG) */
     ms_stats stats;
-    /* width*height: the specular shadow factor S_spec (docs/shading.md), S where the pixel's material has
-     * no specular lobe; -1 where the primary ray missed. */
+    /* The specular shadow factor S_spec (docs/shading.md), one width*height plane per light like shadow:
+     * S where the pixel's material has no specular lobe; -1 where the primary ray missed. */
     float *shadow_spec;
     /* Lights of the frame (0 means 1). vis, shadow and front hold one width*height plane per light, light l
      * at vis + l*width*height (the first plane is light 0, as with one light); rgb sums the lights. */
