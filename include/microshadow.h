@@ -536,6 +536,23 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
                   char *err, size_t errlen);
 void ms_lightmap_free(ms_lightmap *lm);
 
+/* A lightmap row by row, for drivers that spread a bake over processes (the CLI's MPI mode): ms_bake is
+ * ms_bake_layout, ms_bake_rows over every row, ms_bake_finish. A driver may bake any rows in any number of
+ * calls in several lightmaps laid out from the same scene and options, copy the baked rows' vis, shadow and
+ * front into one, and finish that one: the same lightmap bit for bit (each texel's V and S depend only on
+ * the texel, its point and the seed; the irradiance, exposure and dilation, which look across rows, are
+ * finish's). */
+/* The options' checks, the UVs (xatlas where needed) and the texels' points: out->position, normal,
+ * triangle, texels, and frame's arrays (vis, shadow -1 until baked). MS_OK, or an error with out zeroed. */
+ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err, size_t errlen);
+/* V, S and front of the texels of rows [y0, y1) (ms_visibility_points with the texel keys), their stats
+ * added to lm->frame.stats. lm is left as it was on an error. */
+ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1, char *err,
+                       size_t errlen);
+/* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
+ * image fields; total_s: the sum of the parts' seconds. */
+ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
+
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
  * of lightmaps), V and S. An ms_output_write_fn; ends in .exr. */
 int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
