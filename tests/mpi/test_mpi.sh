@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# The CLI's MPI mode (built with -DMS_MPI=ON; docs/mpi.md), against the single-process CLI as the oracle:
+#   - frames: 2 and 3 ranks (oversubscribed), every schedule, give V, S and the PNG byte for byte equal to one
+#     process, on the built-in scene (grid scanline, interleaved raytrace with its frame-wide filter, hpc with
+#     its frame-level entry) and on a shared scene (skipped with a message when ../shared/scenes is absent);
+#   - bakes: 2 and 3 ranks give the single-process lightmap (EXR: R, G, B, S, V) and preview byte for byte;
+#   - the stats report every rank, and the ranks' tiles add up to the frame's;
+#   - hpc-scanline, whose answer at a pixel depends on the whole frame, is refused on 2 ranks (exit 2);
+#   - a rank given an unreadable scene ends the run with exit code 2, that rank's one message line, and no
+#     output file.
+# usage: test_mpi.sh MICROSHADOW MPIEXEC SHARED_SCENES TMPDIR
+set -uo pipefail
+ms=${1:?} mpiexec=${2:?} scenes=${3:?} tmp=${4:?}
+rm -rf "$tmp" && mkdir -p "$tmp" && cd "$tmp" || exit 1
+# Root (CI) needs OpenMPI's consent; --quiet drops mpirun's own banners so that stderr is microshadow's.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export ASAN_OPTIONS=${ASAN_OPTIONS:-}:detect_leaks=0   # OpenMPI's own allocations, if sanitized
+run() { "$mpiexec" --quiet --oversubscribe "$@"; }
+fail=0
+check() { if "$@"; then :; else echo "FAIL: $*"; fail=1; fi; }
+
+# frame NAME SCENE_ARGS... : one process, then 2 and 3 ranks under each schedule, compared byte for byte.
+frame() {
+    local name=$1; shift
+    "$ms" "$@" --threads 1 --quiet -o "$name-1.png" --vis "$name-1-v.pfm" --shadow "$name-1-s.pfm" || { echo "FAIL: $name: single process"; fail=1; return; }
+    for r in 2 3; do
+        for sched in queue counter static; do
+            local o="$name-$r-$sched"
+            run -n $r "$ms" "$@" --threads 1 --quiet --mpi-schedule $sched -o "$o.png" --vis "$o-v.pfm" --shadow "$o-s.pfm" \
+                --stats "$o.json"
+            check test $? -eq 0
+            check cmp -s "$name-1-v.pfm" "$o-v.pfm"
+            check cmp -s "$name-1-s.pfm" "$o-s.pfm"
+            check cmp -s "$name-1.png" "$o.png"
+            check python3 - "$o.json" "$r" <<'EOF'
+import json, sys
+s = json.load(open(sys.argv[1])); m = s["mpi"]; r = int(sys.argv[2])
+tiles = ((s["width"] + 15) // 16) * ((s["height"] + 15) // 16)
+assert m["ranks"] == r and len(m["per_rank"]) == r, m
+assert sum(p["units"] for p in m["per_rank"]) == tiles, (m, tiles)
+EOF
+        done
+    done
+    echo "ok: frame $name: 2 and 3 ranks, queue/counter/static = one process"
+}
+frame builtin --width 96 --height 72 --samples 256
+frame interleaved --width 96 --height 72 --samples 256 --method raytrace --pattern interleaved
+frame hpc --width 80 --height 48 --samples 256 --method hpc
+if [ -f "$scenes/dabrovic-sponza/dabrovic-sponza.json" ]; then
+    frame sponza "$scenes/dabrovic-sponza/dabrovic-sponza.json" --width 64 --height 48 --samples 256
+else
+    echo "skipped: $scenes/dabrovic-sponza absent (the shared scenes): no shared-scene frame"
+fi
+
+# bake NAME ARGS... : a lightmap, one process against 2 and 3 ranks.
+bake() {
+    local name=$1; shift
+    "$ms" bake "$@" --threads 1 --quiet -o "$name-1.exr" --png "$name-1.png" || { echo "FAIL: $name: single-process bake"; fail=1; return; }
+    for r in 2 3; do
+        local sched=queue
+        [ $r = 3 ] && sched=counter
+        run -n $r "$ms" bake "$@" --threads 1 --quiet --mpi-schedule $sched --mpi-chunk 3 -o "$name-$r.exr" --png "$name-$r.png"
+        check test $? -eq 0
+        check cmp -s "$name-1.exr" "$name-$r.exr"
+        check cmp -s "$name-1.png" "$name-$r.png"
+    done
+    echo "ok: bake $name: 2 and 3 ranks = one process"
+}
+bake builtin --size 48 --samples 256
+if [ -f "$scenes/quad/quad.json" ]; then
+    bake quad "$scenes/quad/quad.json" --uv xatlas --size 32 --samples 256
+else
+    echo "skipped: $scenes/quad absent (the shared scenes): no shared-scene bake"
+fi
+
+# A method that cannot be split is refused, not approximated.
+run -n 2 "$ms" --width 32 --height 32 --samples 256 --threads 1 --method hpc-scanline -o refused.png 2> refused.err
+check test $? -eq 2
+check grep -q "hpc-scanline' cannot be split" refused.err
+check test ! -e refused.png
+
+# One rank cannot read its scene: exit 2, its one line, no outputs (nor staging files).
+mkdir out
+run -n 1 "$ms" --width 32 --height 32 --threads 1 --quiet -o out/x.png --vis out/x.pfm : \
+    -n 1 "$ms" "$tmp/no-such-scene.json" --width 32 --height 32 --threads 1 --quiet -o out/x.png --vis out/x.pfm 2> bad.err
+check test $? -eq 2
+check test "$(wc -l < bad.err)" -eq 1
+check grep -q "^microshadow: $tmp/no-such-scene.json: " bad.err
+check test -z "$(ls -A out)"
+run -n 2 "$ms" bake "$tmp/no-such-scene.json" --size 16 --threads 1 --quiet -o out/x.exr 2> badbake.err
+check test $? -eq 2
+check test "$(wc -l < badbake.err)" -eq 1
+check test -z "$(ls -A out)"
+echo "ok: refusals and a failing rank"
+[ $fail = 0 ] && echo "test_mpi: all passed"
+exit $fail
