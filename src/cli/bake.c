@@ -173,6 +173,7 @@ int ms_cli_bake(int argc, char **argv)
     }
     int last = -1;
     ms_lightmap lm;
+    ms_status st = MS_OK;
 #ifdef MS_HAVE_MPI
     if (ms_mpi_active()) {
         /* Every rank bakes its rows; rank 0 alone writes (mpi_bake.c). */
@@ -184,12 +185,10 @@ int ms_cli_bake(int argc, char **argv)
         }
     } else
 #endif
-    if (!quiet && isatty(STDERR_FILENO)) { bo.points.progress = progress_bar; bo.points.progress_user = &last; }
-#ifdef MS_HAVE_MPI
-    ms_status st = ms_mpi_active() ? MS_OK : ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
-#else
-    ms_status st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
-#endif
+    {
+        if (!quiet && isatty(STDERR_FILENO)) { bo.points.progress = progress_bar; bo.points.progress_user = &last; }
+        st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
+    }
     if (st) {
         fprintf(stderr, "microshadow bake: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
         ms_scene_free(&scene);

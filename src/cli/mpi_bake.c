@@ -55,22 +55,20 @@ int ms_mpi_bake(const ms_scene *scene, const char *what, const ms_bake_options *
     const int rows = out->frame.height, W = out->frame.width;
     const double t0 = MPI_Wtime();
     unsigned char *done = malloc((size_t)rows);
+    if (!done) ms_mpi_fatal("out of memory");   /* a few kilobytes: no way to go on in step */
     bake_work w = { accel, opt, out };
     ms_mpi_report rep;
     memset(&rep, 0, sizeof rep);
-    int bad = !done;
-    if (bad) snprintf(err, errlen, "out of memory");
-    unsigned char dummy_done[1];
-    if (ms_mpi_distribute(sched, rows, chunk, bake_chunk, &w, done ? done : dummy_done, &rep, err, errlen) && !bad) bad = 1;
+    const int bad = ms_mpi_distribute(sched, rows, chunk, bake_chunk, &w, done, &rep, err, errlen) != 0;
 
     /* Rank 0 gathers the other ranks' rows. */
     ms_frame *f = &out->frame;
     int mine = 0;
-    for (int y = 0; rank > 0 && done && y < rows; y++) mine += done[y];
+    for (int y = 0; rank > 0 && y < rows; y++) mine += done[y];
     int *ids = malloc(((size_t)mine + 1) * sizeof *ids);
     float *vs = malloc(((size_t)mine + 1) * 2 * W * sizeof *vs);
     uint16_t *fr = malloc(((size_t)mine + 1) * W * sizeof *fr);
-    if (!ids || !vs || !fr) { bad = 1; mine = 0; snprintf(err, errlen, "out of memory"); }
+    if (!ids || !vs || !fr) ms_mpi_fatal("out of memory gathering the ranks' results");
     for (int y = 0, k = 0; rank > 0 && k < mine; y++) {
         if (!done[y]) continue;
         ids[k] = y;
@@ -87,7 +85,7 @@ int ms_mpi_bake(const ms_scene *scene, const char *what, const ms_bake_options *
         d2 = calloc((size_t)size, sizeof *d2);
         c1 = calloc((size_t)size, sizeof *c1);
         d1 = calloc((size_t)size, sizeof *d1);
-        if (!counts || !displ || !c2 || !d2 || !c1 || !d1) { fprintf(stderr, "microshadow bake: out of memory\n"); abort(); }
+        if (!counts || !displ || !c2 || !d2 || !c1 || !d1) ms_mpi_fatal("out of memory gathering the ranks' results");
     }
     MPI_Gather(&mine, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
     for (int r = 0; rank == 0 && r < size; r++) {
@@ -101,7 +99,7 @@ int ms_mpi_bake(const ms_scene *scene, const char *what, const ms_bake_options *
     int *all_ids = rank == 0 ? malloc(((size_t)total + 1) * sizeof *all_ids) : NULL;
     float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * 2 * W * sizeof *all_vs) : NULL;
     uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * W * sizeof *all_fr) : NULL;
-    if (rank == 0 && (!all_ids || !all_vs || !all_fr)) { fprintf(stderr, "microshadow bake: out of memory\n"); abort(); }
+    if (rank == 0 && (!all_ids || !all_vs || !all_fr)) ms_mpi_fatal("out of memory gathering the ranks' results");
     MPI_Gatherv(ids, mine, MPI_INT, all_ids, counts, displ, MPI_INT, 0, MPI_COMM_WORLD);
     MPI_Gatherv(vs, mine * 2 * W, MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
     MPI_Gatherv(fr, mine * W, MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);

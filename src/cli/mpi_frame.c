@@ -67,10 +67,10 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
     const double t0 = MPI_Wtime();
     unsigned char *done = malloc((size_t)ntiles);
     frame_work w = { job, malloc((size_t)chunk * sizeof(int)) };
-    int bad = !done || !w.tiles;
+    if (!done || !w.tiles) ms_mpi_fatal("out of memory");   /* a few kilobytes: no way to go on in step */
+    int bad = 0;
     ms_mpi_report rep;
     memset(&rep, 0, sizeof rep);
-    if (bad) snprintf(err, errlen, "out of memory");
     if (size == 1) {   /* one rank: the whole frame in one call, as ms_render (also for hpc-scanline) */
         if (!bad) bad = ms_frame_job_render(job, NULL, ntiles, err, errlen) != 0;
         rep.ranks = 1;
@@ -85,20 +85,18 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
         } else ms_mpi_report_free(&rep);
     } else {
         /* Every rank enters the distribution (a rank out of memory takes its chunks without rendering). */
-        unsigned char dummy_done[1];
-        if (ms_mpi_distribute(sched, ntiles, chunk, render_chunk, &w, done ? done : dummy_done, &rep, err, errlen) &&
-            !bad) bad = 1;
+        bad = ms_mpi_distribute(sched, ntiles, chunk, render_chunk, &w, done, &rep, err, errlen) != 0;
     }
 
     /* Rank 0 gathers the other ranks' tiles: ids, then V and S (2 x 256 floats a tile) and front counts. */
     ms_frame *f = ms_frame_job_frame(job);
     const int W = f->width, H = f->height;
     int mine = 0;
-    for (int t = 0; size > 1 && rank > 0 && done && t < ntiles; t++) mine += done[t];
+    for (int t = 0; size > 1 && rank > 0 && t < ntiles; t++) mine += done[t];
     int *ids = malloc(((size_t)mine + 1) * sizeof *ids);
     float *vs = malloc(((size_t)mine + 1) * 2 * TP * sizeof *vs);
     uint16_t *fr = malloc(((size_t)mine + 1) * TP * sizeof *fr);
-    if (!ids || !vs || !fr) { bad = 1; mine = 0; snprintf(err, errlen, "out of memory"); }
+    if (!ids || !vs || !fr) ms_mpi_fatal("out of memory gathering the ranks' results");
     for (int t = 0, k = 0; size > 1 && rank > 0 && k < mine; t++) {
         if (!done[t]) continue;
         ids[k] = t;
@@ -123,7 +121,7 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
         MPI_Gather(&mine, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
         int total = 0;
         if (rank == 0) {
-            if (!counts || !displ || !c2 || !d2 || !c1 || !d1) { fprintf(stderr, "microshadow: out of memory\n"); abort(); }
+            if (!counts || !displ || !c2 || !d2 || !c1 || !d1) ms_mpi_fatal("out of memory gathering the ranks' results");
             for (int r = 0; r < size; r++) {
                 displ[r] = total;
                 c2[r] = counts[r] * 2 * TP;
@@ -136,7 +134,7 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
         int *all_ids = rank == 0 ? malloc(((size_t)total + 1) * sizeof *all_ids) : NULL;
         float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * 2 * TP * sizeof *all_vs) : NULL;
         uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * TP * sizeof *all_fr) : NULL;
-        if (rank == 0 && (!all_ids || !all_vs || !all_fr)) { fprintf(stderr, "microshadow: out of memory\n"); abort(); }
+        if (rank == 0 && (!all_ids || !all_vs || !all_fr)) ms_mpi_fatal("out of memory gathering the ranks' results");
         MPI_Gatherv(ids, mine, MPI_INT, all_ids, counts, displ, MPI_INT, 0, MPI_COMM_WORLD);
         MPI_Gatherv(vs, mine * 2 * TP, MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
         MPI_Gatherv(fr, mine * TP, MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);

@@ -74,6 +74,13 @@ int ms_mpi_end(int rc)
     return code;
 }
 
+void ms_mpi_fatal(const char *msg)
+{
+    dprintf(2, "microshadow: rank %d: %s\n", g_rank, msg);
+    MPI_Abort(MPI_COMM_WORLD, 1);
+    exit(1);
+}
+
 int ms_mpi_schedule_from_name(const char *name, ms_mpi_schedule *out)
 {
     if (!strcmp(name, "queue")) *out = MS_MPI_QUEUE;

@@ -25,6 +25,10 @@ int ms_mpi_agree(int failed);
  * of the first failing rank (or rank 0's), finalises MPI. Returns the exit code for every rank. */
 int ms_mpi_end(int rc);
 
+/* Out of memory where the ranks cannot go on in step (the gather's bookkeeping): the message straight to
+ * the real stderr, then MPI_Abort (mpirun ends every rank). */
+void ms_mpi_fatal(const char *msg);
+
 /* Work distribution: how ranks get chunks of work (tiles of a frame, row bands of a lightmap). */
 typedef enum ms_mpi_schedule {
     MS_MPI_QUEUE = 0,    /* rank 0 hands out chunks on request (two-sided messages), rendering between requests */
