@@ -133,44 +133,51 @@ static void run_chunk(runner *r, int c)
 
 enum { TAG_REQUEST = 17, TAG_REPLY = 18 };
 
-/* Rank 0 hands out chunks in order on request and works on the next one itself between requests; workers
- * ask for their next chunk as soon as they start one (one request in flight), so a reply delayed by rank
- * 0's own chunk costs them nothing as long as that chunk is not much longer than theirs. */
+/* Rank 0 hands out chunks in order on request and works on the next one itself between requests. It sees a
+ * request only between its own chunks, so every worker keeps QUEUE_DEPTH requests in flight: asking for the
+ * next chunks as soon as it starts one, it has work in hand while rank 0 is busy, and can take up to
+ * QUEUE_DEPTH chunks per chunk of rank 0's (with one request in flight a worker was paced to rank 0's chunks
+ * and idled: docs/mpi.md). Replies between two ranks arrive in request order (MPI's non-overtaking rule);
+ * once the chunks are out every request gets "none" (-1), QUEUE_DEPTH per worker. */
+#define QUEUE_DEPTH 2
 static void schedule_queue(runner *r, int nchunks)
 {
     int dummy = 0;
     if (g_rank == 0) {
-        int next = 0, active = g_size - 1;
+        int next = 0, nones = (g_size - 1) * QUEUE_DEPTH;   /* "none" replies still to send */
         for (;;) {
             MPI_Status st;
             int flag = 1;
-            while (active > 0 && flag) {
+            while (nones > 0 && flag) {
                 MPI_Iprobe(MPI_ANY_SOURCE, TAG_REQUEST, MPI_COMM_WORLD, &flag, &st);
                 if (!flag) break;
                 MPI_Recv(&dummy, 1, MPI_INT, st.MPI_SOURCE, TAG_REQUEST, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
                 int give = next < nchunks ? next++ : -1;
-                active -= give < 0;
+                nones -= give < 0;
                 MPI_Send(&give, 1, MPI_INT, st.MPI_SOURCE, TAG_REPLY, MPI_COMM_WORLD);
             }
             if (next < nchunks) { run_chunk(r, next++); continue; }
-            if (active == 0) break;
+            if (nones == 0) break;
             MPI_Recv(&dummy, 1, MPI_INT, MPI_ANY_SOURCE, TAG_REQUEST, MPI_COMM_WORLD, &st);
             const int none = -1;
-            active--;
+            nones--;
             MPI_Send(&none, 1, MPI_INT, st.MPI_SOURCE, TAG_REPLY, MPI_COMM_WORLD);
         }
         return;
     }
-    int cur, next;
-    MPI_Send(&dummy, 1, MPI_INT, 0, TAG_REQUEST, MPI_COMM_WORLD);
-    MPI_Recv(&cur, 1, MPI_INT, 0, TAG_REPLY, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    while (cur >= 0) {
-        MPI_Request rq[2];
-        MPI_Isend(&dummy, 1, MPI_INT, 0, TAG_REQUEST, MPI_COMM_WORLD, &rq[0]);
-        MPI_Irecv(&next, 1, MPI_INT, 0, TAG_REPLY, MPI_COMM_WORLD, &rq[1]);
-        run_chunk(r, cur);
-        MPI_Waitall(2, rq, MPI_STATUSES_IGNORE);
-        cur = next;
+    int got[QUEUE_DEPTH], live = QUEUE_DEPTH;
+    MPI_Request rq[QUEUE_DEPTH][2];
+    for (int d = 0; d < QUEUE_DEPTH; d++) {
+        MPI_Isend(&dummy, 1, MPI_INT, 0, TAG_REQUEST, MPI_COMM_WORLD, &rq[d][0]);
+        MPI_Irecv(&got[d], 1, MPI_INT, 0, TAG_REPLY, MPI_COMM_WORLD, &rq[d][1]);
+    }
+    for (int d = 0; live > 0; d = (d + 1) % QUEUE_DEPTH) {
+        MPI_Waitall(2, rq[d], MPI_STATUSES_IGNORE);
+        if (got[d] < 0) { live--; continue; }
+        const int c = got[d];
+        MPI_Isend(&dummy, 1, MPI_INT, 0, TAG_REQUEST, MPI_COMM_WORLD, &rq[d][0]);
+        MPI_Irecv(&got[d], 1, MPI_INT, 0, TAG_REPLY, MPI_COMM_WORLD, &rq[d][1]);
+        run_chunk(r, c);
     }
 }
 
