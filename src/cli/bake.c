@@ -32,7 +32,7 @@ static void usage(FILE *f)
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
 #ifdef MS_HAVE_MPI
-        "  --mpi-schedule S    under mpirun: queue (default), counter or static (see microshadow --help)\n"
+        "  --mpi-schedule S    under mpirun: counter (default), queue or static (see microshadow --help)\n"
         "  --mpi-chunk N       under mpirun: texel rows per hand-out (default 8)\n"
 #endif
         "  --help\n", MS_MAX_UV_SETS - 1);
@@ -81,7 +81,7 @@ int ms_cli_bake(int argc, char **argv)
 #endif
         { 0, 0, 0, 0 } };
 #ifdef MS_HAVE_MPI
-    ms_mpi_schedule schedule = MS_MPI_QUEUE;
+    ms_mpi_schedule schedule = MS_MPI_COUNTER;   /* balanced best (docs/mpi.md) */
     int chunk = 8;
 #endif
     static const char *const exr_suffix[] = { ".exr", NULL };

@@ -47,8 +47,8 @@ static void usage(FILE *f)
         "  --frustum-shrink    block traversal and mft: narrow each frustum as its samples are occluded\n"
         "  --quiet             no progress or summary on stderr\n"
 #ifdef MS_HAVE_MPI
-        "  --mpi-schedule S    under mpirun: how ranks get tiles: queue (default: rank 0 hands them out),\n"
-        "                      counter (a shared counter, MPI one-sided), static (round robin)\n"
+        "  --mpi-schedule S    under mpirun: how ranks get tiles: counter (default: a shared counter, MPI\n"
+        "                      one-sided), queue (rank 0 hands them out), static (round robin)\n"
         "  --mpi-chunk N       under mpirun: tiles per hand-out (default: --threads, or 4)\n"
 #endif
         "  --help, --version\n");
@@ -103,7 +103,7 @@ static int cli_main(int argc, char **argv)
 #endif
         { 0, 0, 0, 0 } };
 #ifdef MS_HAVE_MPI
-    ms_mpi_schedule schedule = MS_MPI_QUEUE;
+    ms_mpi_schedule schedule = MS_MPI_COUNTER;   /* balanced best (docs/mpi.md) */
     int chunk = 0;
 #endif
     ms_render_options opt;
