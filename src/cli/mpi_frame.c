@@ -173,9 +173,9 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
     sums[MS_MAX_COUNTERS] = st->visible_pixels;
     sums[MS_MAX_COUNTERS + 1] = st->penumbra_pixels;
     sums[MS_MAX_COUNTERS + 2] = st->shadow_rays;
-    double resolve = st->shadow_factor_s, resolve_total = 0.0;
+    double secs[2] = { st->shadow_factor_s, st->shadow_cpu_s }, secs_total[2] = { 0.0, 0.0 };
     MPI_Reduce(sums, totals, MS_MAX_COUNTERS + 3, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
-    MPI_Reduce(&resolve, &resolve_total, 1, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+    MPI_Reduce(secs, secs_total, 2, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
     if (bad) fprintf(stderr, "microshadow: %s: %s\n", what, err);
     if (ms_mpi_agree(bad)) {
         ms_frame_job_free(job);
@@ -188,7 +188,8 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
         st->visible_pixels = totals[MS_MAX_COUNTERS];
         st->penumbra_pixels = totals[MS_MAX_COUNTERS + 1];
         st->shadow_rays = totals[MS_MAX_COUNTERS + 2];
-        st->shadow_factor_s = resolve_total;
+        st->shadow_factor_s = secs_total[0];
+        st->shadow_cpu_s = secs_total[1];   /* every rank's CPU seconds in its tiles (finish adds rank 0's filter) */
         /* Seconds under MPI: shadow_s is the distributed phase (every tile's primary and shadow rays, on all
          * ranks, until rank 0 has them all), primary_s what rank 0 then spends on the other tiles' hits. */
         st->primary_s = 0.0;
