@@ -1,9 +1,10 @@
 /* One frame over MPI ranks (mpi_run.h, docs/mpi.md): every rank sets up its own ms_frame_job (scene, BVH,
  * methods), the ranks take chunks of tiles under the chosen schedule, rank 0 gathers the other ranks' tiles
- * (V, S and front counts, unfiltered) and the sums of their stats into its job and finishes the frame
- * there, which makes it ms_render's frame bit for bit (microshadow.h, "A frame tile by tile"). */
+ * (every light's V, S, S_spec and front counts, unfiltered) and the sums of their stats into its job and
+ * finishes the frame there, which makes it ms_render's frame bit for bit (microshadow.h, "A frame tile by tile"). */
 #include "mpi_run.h"
 #include <mpi.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,7 +30,20 @@ static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
     }
     h = ms_mpi_hash(h, &s->procedural, sizeof s->procedural);
     h = ms_mpi_hash(h, &s->camera, sizeof s->camera);
-    h = ms_mpi_hash(h, &s->light, sizeof s->light);
+    size_t nl;
+    const ms_light *lights = ms_scene_lights(s, &nl);
+    h = ms_mpi_hash(h, &nl, sizeof nl);
+    for (size_t l = 0; l < nl; l++) {   /* field by field: no padding, and the texels, not their address */
+        const ms_light *L = &lights[l];
+        const float f[] = { L->corner.x, L->corner.y, L->corner.z, L->edge_s.x, L->edge_s.y, L->edge_s.z,
+                            L->edge_t.x, L->edge_t.y, L->edge_t.z, L->emission.x, L->emission.y, L->emission.z,
+                            L->center.x, L->center.y, L->center.z, L->radius };
+        const int d[] = { (int)L->shape, L->texture != NULL, L->texture_width, L->texture_height };
+        h = ms_mpi_hash(h, f, sizeof f);
+        h = ms_mpi_hash(h, d, sizeof d);
+        if (L->texture)
+            h = ms_mpi_hash(h, L->texture, (size_t)L->texture_width * (size_t)L->texture_height * 3 * sizeof *L->texture);
+    }
     h = ms_mpi_hash(h, &s->samples, sizeof s->samples);
     const char *m = o->method ? o->method : MS_DEFAULT_METHOD;
     h = ms_mpi_hash(h, m, strlen(m));
@@ -64,6 +78,19 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
         ms_frame_job_free(job);
         return -1;
     }
+    /* MPI counts are ints: the gather's floats (3 per pixel and light, whole tiles) must fit one. */
+    {
+        size_t nl = 1;
+        ms_scene_lights(scene, &nl);
+        if (size > 1 && (size_t)ntiles * 3 * nl * TP > (size_t)INT_MAX) {
+            if (rank == 0)
+                fprintf(stderr, "microshadow: %s: a %d-tile frame with %zu lights is too large to gather over MPI ranks "
+                        "(run it with one rank)\n", what, ntiles, nl);
+            ms_mpi_agree(rank == 0);
+            ms_frame_job_free(job);
+            return -1;
+        }
+    }
     const double t0 = MPI_Wtime();
     unsigned char *done = malloc((size_t)ntiles);
     frame_work w = { job, malloc((size_t)chunk * sizeof(int)) };
@@ -88,26 +115,34 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
         bad = ms_mpi_distribute(sched, ntiles, chunk, render_chunk, &w, done, &rep, err, errlen) != 0;
     }
 
-    /* Rank 0 gathers the other ranks' tiles: ids, then V and S (2 x 256 floats a tile) and front counts. */
+    /* Rank 0 gathers the other ranks' tiles: ids, then per light V, S and S_spec (3 x 256 floats a tile and
+     * light) and front counts (256 a tile and light). */
     ms_frame *f = ms_frame_job_frame(job);
     const int W = f->width, H = f->height;
+    const size_t nl = f->n_lights > 0 ? (size_t)f->n_lights : 1, npix = (size_t)W * H;
+    const size_t FT = 3 * nl * TP, UT = nl * TP;   /* floats and front counts of one tile */
     int mine = 0;
     for (int t = 0; size > 1 && rank > 0 && t < ntiles; t++) mine += done[t];
     int *ids = malloc(((size_t)mine + 1) * sizeof *ids);
-    float *vs = malloc(((size_t)mine + 1) * 2 * TP * sizeof *vs);
-    uint16_t *fr = malloc(((size_t)mine + 1) * TP * sizeof *fr);
+    float *vs = malloc(((size_t)mine + 1) * FT * sizeof *vs);
+    uint16_t *fr = malloc(((size_t)mine + 1) * UT * sizeof *fr);
     if (!ids || !vs || !fr) ms_mpi_fatal("out of memory gathering the ranks' results");
     for (int t = 0, k = 0; size > 1 && rank > 0 && k < mine; t++) {
         if (!done[t]) continue;
         ids[k] = t;
         const int x0 = (t % tiles_x) * MS_TILE_SIZE, y0 = (t / tiles_x) * MS_TILE_SIZE;
-        for (int p = 0; p < TP; p++) {
-            const int x = x0 + p % MS_TILE_SIZE, y = y0 + p / MS_TILE_SIZE;
-            const int in = x < W && y < H;
-            const size_t i = in ? (size_t)y * W + x : 0;
-            vs[(size_t)k * 2 * TP + p] = in ? f->vis[i] : 0.0f;
-            vs[(size_t)k * 2 * TP + TP + p] = in ? f->shadow[i] : 0.0f;
-            fr[(size_t)k * TP + p] = in ? f->front[i] : 0;
+        for (size_t l = 0; l < nl; l++) {
+            float *v = vs + (size_t)k * FT + 3 * l * TP;
+            uint16_t *u = fr + (size_t)k * UT + l * TP;
+            for (int p = 0; p < TP; p++) {
+                const int x = x0 + p % MS_TILE_SIZE, y = y0 + p / MS_TILE_SIZE;
+                const int in = x < W && y < H;
+                const size_t i = in ? l * npix + (size_t)y * W + x : 0;
+                v[p] = in ? f->vis[i] : 0.0f;
+                v[TP + p] = in ? f->shadow[i] : 0.0f;
+                v[2 * TP + p] = in ? f->shadow_spec[i] : 0.0f;
+                u[p] = in ? f->front[i] : 0;
+            }
         }
         k++;
     }
@@ -124,30 +159,35 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
             if (!counts || !displ || !c2 || !d2 || !c1 || !d1) ms_mpi_fatal("out of memory gathering the ranks' results");
             for (int r = 0; r < size; r++) {
                 displ[r] = total;
-                c2[r] = counts[r] * 2 * TP;
-                d2[r] = total * 2 * TP;
-                c1[r] = counts[r] * TP;
-                d1[r] = total * TP;
+                c2[r] = (int)((size_t)counts[r] * FT);   /* < INT_MAX: checked before the distribution */
+                d2[r] = (int)((size_t)total * FT);
+                c1[r] = (int)((size_t)counts[r] * UT);
+                d1[r] = (int)((size_t)total * UT);
                 total += counts[r];
             }
         }
         int *all_ids = rank == 0 ? malloc(((size_t)total + 1) * sizeof *all_ids) : NULL;
-        float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * 2 * TP * sizeof *all_vs) : NULL;
-        uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * TP * sizeof *all_fr) : NULL;
+        float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * FT * sizeof *all_vs) : NULL;
+        uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * UT * sizeof *all_fr) : NULL;
         if (rank == 0 && (!all_ids || !all_vs || !all_fr)) ms_mpi_fatal("out of memory gathering the ranks' results");
         MPI_Gatherv(ids, mine, MPI_INT, all_ids, counts, displ, MPI_INT, 0, MPI_COMM_WORLD);
-        MPI_Gatherv(vs, mine * 2 * TP, MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
-        MPI_Gatherv(fr, mine * TP, MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);
+        MPI_Gatherv(vs, (int)((size_t)mine * FT), MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
+        MPI_Gatherv(fr, (int)((size_t)mine * UT), MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);
         for (int k = 0; rank == 0 && k < total; k++) {
             const int t = all_ids[k];
             const int x0 = (t % tiles_x) * MS_TILE_SIZE, y0 = (t / tiles_x) * MS_TILE_SIZE;
-            for (int p = 0; p < TP; p++) {
-                const int x = x0 + p % MS_TILE_SIZE, y = y0 + p / MS_TILE_SIZE;
-                if (x >= W || y >= H) continue;
-                const size_t i = (size_t)y * W + x;
-                f->vis[i] = all_vs[(size_t)k * 2 * TP + p];
-                f->shadow[i] = all_vs[(size_t)k * 2 * TP + TP + p];
-                f->front[i] = all_fr[(size_t)k * TP + p];
+            for (size_t l = 0; l < nl; l++) {
+                const float *v = all_vs + (size_t)k * FT + 3 * l * TP;
+                const uint16_t *u = all_fr + (size_t)k * UT + l * TP;
+                for (int p = 0; p < TP; p++) {
+                    const int x = x0 + p % MS_TILE_SIZE, y = y0 + p / MS_TILE_SIZE;
+                    if (x >= W || y >= H) continue;
+                    const size_t i = l * npix + (size_t)y * W + x;
+                    f->vis[i] = v[p];
+                    f->shadow[i] = v[TP + p];
+                    f->shadow_spec[i] = v[2 * TP + p];
+                    f->front[i] = u[p];
+                }
             }
         }
         free(all_ids);
