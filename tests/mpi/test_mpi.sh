@@ -3,6 +3,8 @@
 #   - frames: 2 and 3 ranks (oversubscribed), every schedule, give V, S and the PNG byte for byte equal to one
 #     process, on the built-in scene (grid scanline, interleaved raytrace with its frame-wide filter, hpc with
 #     its frame-level entry) and on a shared scene (skipped with a message when ../shared/scenes is absent);
+#   - three lights (rect, disk, sphere) and materials with a specular lobe: the EXR with every light's channels
+#     and the shaded PNG byte for byte equal to one process (scanline, interleaved raytrace, hpc);
 #   - bakes: 2 and 3 ranks give the single-process lightmap (EXR: R, G, B, S, V) and preview byte for byte;
 #   - the stats report every rank, and the ranks' tiles add up to the frame's;
 #   - hpc-scanline, whose answer at a pixel depends on the whole frame, is refused on 2 ranks (exit 2);
@@ -51,6 +53,38 @@ if [ -f "$scenes/dabrovic-sponza/dabrovic-sponza.json" ]; then
 else
     echo "skipped: $scenes/dabrovic-sponza absent (the shared scenes): no shared-scene frame"
 fi
+
+# Several lights (rect, disk, sphere) and OBJ/MTL materials, one specular: the EXR (R, G, B and every light's
+# V and S channels) and the PNG, whose shading sums the lights with S_spec, byte for byte against one process.
+printf 'newmtl matte\nKd 0.8 0.3 0.1\n\nnewmtl shiny\nKd 0.9 0.9 0.9\nPm 0.5\nPr 0.3\n' > m.mtl
+printf '%s\n' 'mtllib m.mtl' 'v -3 0 -3' 'v 0 0 -3' 'v 3 0 -3' 'v -3 0 3' 'v 0 0 3' 'v 3 0 3' \
+    'v -0.7 1 -0.7' 'v 0.7 1 -0.7' 'v 0.7 1 0.7' 'v -0.7 1 0.7' \
+    'usemtl matte' 'f 4 5 2' 'f 4 2 1' 'usemtl shiny' 'f 5 6 3' 'f 5 3 2' 'f 7 9 8' 'f 7 10 9' > m.obj
+printf '%s\n' '{ "meshes": [ { "file": "m.obj" } ],' \
+    '  "camera": { "eye": [0, 4, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y": 55, "width": 70, "height": 50 },' \
+    '  "lights": [ { "corner": [-1, 3, -1], "edge_s": [2, 0, 0], "edge_t": [0, 0, 2], "emission": [3, 3, 3] },' \
+    '    { "shape": "disk", "center": [1.5, 2.5, 0], "normal": [-1, -2, 0], "radius": 0.6, "emission": [4, 2, 1] },' \
+    '    { "shape": "sphere", "center": [-1.5, 2, 1], "radius": 0.4, "emission": [1, 2, 4] } ],' \
+    '  "render": { "samples": 256 } }' > lights.json
+lights() {
+    local name=$1; shift
+    "$ms" lights.json "$@" --threads 1 --quiet -o "$name-1.exr" || { echo "FAIL: $name: single process"; fail=1; return; }
+    "$ms" lights.json "$@" --threads 1 --quiet -o "$name-1.png" || { echo "FAIL: $name: single process"; fail=1; return; }
+    for r in 2 3; do
+        local sched=counter
+        [ $r = 3 ] && sched=static
+        run -n $r "$ms" lights.json "$@" --threads 1 --quiet --mpi-schedule $sched -o "$name-$r.exr"
+        check test $? -eq 0
+        check cmp -s "$name-1.exr" "$name-$r.exr"
+        run -n $r "$ms" lights.json "$@" --threads 1 --quiet --mpi-schedule queue --mpi-chunk 2 -o "$name-$r.png"
+        check test $? -eq 0
+        check cmp -s "$name-1.png" "$name-$r.png"
+    done
+    echo "ok: frame $name: three lights and materials, 2 and 3 ranks = one process"
+}
+lights lights-scanline
+lights lights-interleaved --method raytrace --pattern interleaved
+lights lights-hpc --method hpc
 
 # bake NAME ARGS... : a lightmap, one process against 2 and 3 ranks.
 bake() {
