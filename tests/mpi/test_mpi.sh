@@ -4,7 +4,8 @@
 #     process, on the built-in scene (grid scanline, interleaved raytrace with its frame-wide filter, hpc with
 #     its frame-level entry) and on a shared scene (skipped with a message when ../shared/scenes is absent);
 #   - three lights (rect, disk, sphere) and materials with a specular lobe: the EXR with every light's channels
-#     and the shaded PNG byte for byte equal to one process (scanline, interleaved raytrace, hpc);
+#     and the shaded PNG byte for byte equal to one process (scanline, interleaved raytrace, hpc); with a
+#     textured light too, and ranks given that scene with and without the texture refuse to run (exit 2);
 #   - bakes: 2 and 3 ranks give the single-process lightmap (EXR: R, G, B, S, V) and preview byte for byte;
 #   - the stats report every rank, and the ranks' tiles add up to the frame's;
 #   - hpc-scanline, whose answer at a pixel depends on the whole frame, is refused on 2 ranks (exit 2);
@@ -85,6 +86,22 @@ lights() {
 lights lights-scanline
 lights lights-interleaved --method raytrace --pattern interleaved
 lights lights-hpc --method hpc
+# The same scene with a textured light (the PNG just written as its texture): 2 ranks = one process; ranks
+# given the scene with and without the texture (same geometry, other lights) refuse to run (exit 2, no output).
+sed 's|"emission": \[3, 3, 3\] }|"emission": [3, 3, 3], "texture": "lights-scanline-1.png" }|' lights.json > lights-tex.json
+check grep -q texture lights-tex.json
+"$ms" lights-tex.json --threads 1 --quiet -o tex-1.exr
+check test $? -eq 0
+run -n 2 "$ms" lights-tex.json --threads 1 --quiet -o tex-2.exr
+check test $? -eq 0
+check cmp -s tex-1.exr tex-2.exr
+check test -n "$(cmp lights-scanline-1.exr tex-1.exr)"   # the texture changed the image
+run -n 1 "$ms" lights.json --threads 1 --quiet -o mixed.png : -n 1 "$ms" lights-tex.json --threads 1 --quiet -o mixed.png \
+    2> mixed.err
+check test $? -eq 2
+check grep -q "different scenes or options" mixed.err
+check test ! -e mixed.png
+echo "ok: a textured light over 2 ranks; ranks given other lights refuse"
 
 # bake NAME ARGS... : a lightmap, one process against 2 and 3 ranks.
 bake() {
