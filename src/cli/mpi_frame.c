@@ -20,6 +20,8 @@ static int render_chunk(void *user, int first, int count, char *err, size_t errl
     return ms_frame_job_render(w->job, w->tiles, count, err, errlen);
 }
 
+_Static_assert(sizeof(ms_material) == 6 * sizeof(float) + 2 * sizeof(int32_t), "ms_material is hashed as bytes: no padding");
+
 /* The scene and the options that decide the image, so that ranks can check they were given the same. */
 static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
 {
@@ -45,6 +47,20 @@ static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
             h = ms_mpi_hash(h, L->texture, (size_t)L->texture_width * (size_t)L->texture_height * 3 * sizeof *L->texture);
     }
     h = ms_mpi_hash(h, &s->samples, sizeof s->samples);
+    /* The surfaces (materials, their textures and UVs, shading normals) decide S_spec and the shading. */
+    const size_t counts[] = { s->n_materials, s->n_textures, s->tri_material != NULL, s->tri_normal != NULL };
+    h = ms_mpi_hash(h, counts, sizeof counts);
+    if (s->materials) h = ms_mpi_hash(h, s->materials, s->n_materials * sizeof *s->materials);   /* no padding */
+    if (s->tri_material) h = ms_mpi_hash(h, s->tri_material, s->n_tris * sizeof *s->tri_material);
+    if (s->tri_normal) h = ms_mpi_hash(h, s->tri_normal, s->n_tris * 9 * sizeof *s->tri_normal);
+    for (int u = 0; s->n_textures && u < MS_MAX_UV_SETS; u++)
+        if (s->tri_uv[u]) h = ms_mpi_hash(h, s->tri_uv[u], s->n_tris * 6 * sizeof *s->tri_uv[u]);
+    for (size_t t = 0; t < s->n_textures; t++) {
+        const ms_texture *x = &s->textures[t];
+        const int d[] = { x->width, x->height };
+        h = ms_mpi_hash(h, d, sizeof d);
+        if (x->rgba) h = ms_mpi_hash(h, x->rgba, (size_t)x->width * (size_t)x->height * 4);
+    }
     const char *m = o->method ? o->method : MS_DEFAULT_METHOD;
     h = ms_mpi_hash(h, m, strlen(m));
     const int v[] = { (int)o->pattern, o->samples, o->width, o->height, (int)o->seed, (int)o->traversal,

@@ -5,7 +5,8 @@
 #     its frame-level entry) and on a shared scene (skipped with a message when ../shared/scenes is absent);
 #   - three lights (rect, disk, sphere) and materials with a specular lobe: the EXR with every light's channels
 #     and the shaded PNG byte for byte equal to one process (scanline, interleaved raytrace, hpc); with a
-#     textured light too, and ranks given that scene with and without the texture refuse to run (exit 2);
+#     textured light too; ranks given that scene with and without the texture, or with another material
+#     colour, refuse to run (exit 2);
 #   - bakes: 2 and 3 ranks give the single-process lightmap (EXR: R, G, B, S, V) and preview byte for byte;
 #   - the stats report every rank, and the ranks' tiles add up to the frame's;
 #   - hpc-scanline, whose answer at a pixel depends on the whole frame, is refused on 2 ranks (exit 2);
@@ -102,6 +103,17 @@ check test $? -eq 2
 check grep -q "different scenes or options" mixed.err
 check test ! -e mixed.png
 echo "ok: a textured light over 2 ranks; ranks given other lights refuse"
+# Ranks given the scene with another material colour (same geometry and lights) refuse too.
+sed 's/^Kd 0.8 0.3 0.1$/Kd 0.7 0.3 0.1/' m.mtl > m2.mtl
+sed 's/^mtllib m.mtl$/mtllib m2.mtl/' m.obj > m2.obj
+sed 's/"m.obj"/"m2.obj"/' lights.json > lights-mat.json
+check test -n "$(cmp m.mtl m2.mtl)"
+run -n 1 "$ms" lights.json --threads 1 --quiet -o mixed.png : -n 1 "$ms" lights-mat.json --threads 1 --quiet -o mixed.png \
+    2> mixedmat.err
+check test $? -eq 2
+check grep -q "different scenes or options" mixedmat.err
+check test ! -e mixed.png
+echo "ok: ranks given other materials refuse"
 
 # bake NAME ARGS... : a lightmap, one process against 2 and 3 ranks.
 bake() {
