@@ -344,6 +344,44 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
               char *err, size_t errlen);
 void ms_frame_free(ms_frame *f);
 
+/* ---- A frame tile by tile: for drivers that spread one frame over processes (the CLI's MPI mode) ----
+ *
+ * ms_render is ms_frame_job_create, one ms_frame_job_render of every tile, and ms_frame_job_finish. A driver
+ * may instead render any tiles in any number of calls, in several jobs of the same scene and options (one
+ * per process), copy the rendered tiles' pixels of vis, shadow, shadow_spec and front, every light's plane
+ * (ms_frame_job_frame), into one job, and finish that one: its frame equals ms_render's bit for bit, because
+ * a pixel's V, S and S_spec depend only on the pixel, the seed and the scene, and finish does what depends on
+ * the whole frame (primary hits and surfaces of the tiles rendered elsewhere, the interleaved pattern's
+ * filter, the textured lights' mean texels, the shading and its exposure). Tiles are
+ * MS_TILE_SIZE pixels square, numbered row by row: tile t covers x from MS_TILE_SIZE (t % tiles_x) and y
+ * from MS_TILE_SIZE (t / tiles_x), clipped to the frame. A job is used from one thread at a time (each call
+ * threads itself). */
+#define MS_TILE_SIZE 16
+typedef struct ms_frame_job ms_frame_job;
+/* Checks the options, builds the acceleration structure and sets up the methods, the shadow method once per
+ * light, kept until ms_frame_job_free (what ms_render does first, with its messages). 0 and *job, or -1 with
+ * *job = NULL. */
+int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **job, char *err,
+                        size_t errlen);
+/* The number of tiles; tiles_x and tiles_y (may be NULL) get the frame's tiles per row and per column. */
+int ms_frame_job_tiles(const ms_frame_job *job, int *tiles_x, int *tiles_y);
+/* 1 when the method renders split frames with the whole frame's answer; 0 for a frame-level method whose
+ * answer at a pixel depends on the others (hpc-scanline), which ms_frame_job_render then refuses unless given
+ * the whole frame in its first call. */
+int ms_frame_job_splittable(const ms_frame_job *job);
+/* Primary hits, and V, S, S_spec and front for every light, of the n tiles listed (tiles NULL: all of them, n = the number of tiles) into
+ * the job's frame, the stats' visible_pixels, shadow_rays, penumbra_pixels, counters and seconds (primary_s,
+ * shadow_s, shadow_cpu_s, and shadow_factor_s in thread-seconds until finish) summed over calls. 0, or -1 with a message. */
+int ms_frame_job_render(ms_frame_job *job, const int *tiles, int n, char *err, size_t errlen);
+/* The frame being assembled (full size, n_lights planes; only the rendered tiles' pixels are set;
+ * vis, shadow and shadow_spec unfiltered).
+ * Owned by the job. A driver may write other jobs' tiles and sums of their stats into it before finish. */
+ms_frame *ms_frame_job_frame(ms_frame_job *job);
+/* Completes the frame (see above) and moves it to *out (ms_frame_free it); the job is left empty: free it.
+ * Every tile must have been rendered here or copied in. 0, or -1 with a message. */
+int ms_frame_job_finish(ms_frame_job *job, ms_frame *out, char *err, size_t errlen);
+void ms_frame_job_free(ms_frame_job *job);
+
 /* Outputs, all or nothing. A caller that writes several outputs of one frame lists them in an ms_output
  * table: ms_outputs_check before the render refuses bad targets (two outputs to one file, a target that
  * exists and is not a regular file, an unwritable directory, a name past the filesystem's limit, a wrong
@@ -497,6 +535,23 @@ typedef struct ms_lightmap {
 ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
                   char *err, size_t errlen);
 void ms_lightmap_free(ms_lightmap *lm);
+
+/* A lightmap row by row, for drivers that spread a bake over processes (the CLI's MPI mode): ms_bake is
+ * ms_bake_layout, ms_bake_rows over every row, ms_bake_finish. A driver may bake any rows in any number of
+ * calls in several lightmaps laid out from the same scene and options, copy the baked rows' vis, shadow and
+ * front into one, and finish that one: the same lightmap bit for bit (each texel's V and S depend only on
+ * the texel, its point and the seed; the irradiance, exposure and dilation, which look across rows, are
+ * finish's). */
+/* The options' checks, the UVs (xatlas where needed) and the texels' points: out->position, normal,
+ * triangle, texels, and frame's arrays (vis, shadow -1 until baked). MS_OK, or an error with out zeroed. */
+ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err, size_t errlen);
+/* V, S and front of the texels of rows [y0, y1) (ms_visibility_points with the texel keys), their stats
+ * added to lm->frame.stats. lm is left as it was on an error. */
+ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1, char *err,
+                       size_t errlen);
+/* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
+ * image fields; total_s: the sum of the parts' seconds. */
+ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
 
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
  * of lightmaps), V and S. An ms_output_write_fn; ends in .exr. */

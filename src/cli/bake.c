@@ -2,6 +2,9 @@
  * scene's light through ms_bake, written all or nothing (ms_outputs_*). */
 #include "microshadow.h"
 #include "bake.h"
+#ifdef MS_HAVE_MPI
+#include "mpi_run.h"
+#endif
 #include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
@@ -28,6 +31,10 @@ static void usage(FILE *f)
         "  --padding N         texels between xatlas charts (default 2)\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
+#ifdef MS_HAVE_MPI
+        "  --mpi-schedule S    under mpirun: counter (default), queue or static (see microshadow --help)\n"
+        "  --mpi-chunk N       under mpirun: texel rows per hand-out (default 8)\n"
+#endif
         "  --help\n", MS_MAX_UV_SETS - 1);
 }
 
@@ -60,7 +67,7 @@ static int progress_bar(void *user, double frac)
 int ms_cli_bake(int argc, char **argv)
 {
     enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP };
+           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -68,7 +75,15 @@ int ms_cli_bake(int argc, char **argv)
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "seed", required_argument, 0, O_SEED },
         { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
-        { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP }, { 0, 0, 0, 0 } };
+        { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
+#ifdef MS_HAVE_MPI
+        { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
+#endif
+        { 0, 0, 0, 0 } };
+#ifdef MS_HAVE_MPI
+    ms_mpi_schedule schedule = MS_MPI_COUNTER;   /* balanced best (docs/mpi.md) */
+    int chunk = 8;
+#endif
     static const char *const exr_suffix[] = { ".exr", NULL };
     static const char *const png_suffix[] = { ".png", NULL };
     ms_output outs[] = {
@@ -121,6 +136,15 @@ int ms_cli_bake(int argc, char **argv)
         case O_PNG: outs[1].path = optarg; break;
         case O_STATS: outs[2].path = optarg; break;
         case O_QUIET: quiet = 1; break;
+#ifdef MS_HAVE_MPI
+        case O_MPI_SCHEDULE:
+            if (ms_mpi_schedule_from_name(optarg, &schedule)) {
+                fprintf(stderr, "microshadow bake: --mpi-schedule: '%s' is not queue, counter or static\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case O_MPI_CHUNK: if (parse_long("--mpi-chunk", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; chunk = (int)v; break;
+#endif
         case 'h': case O_HELP: usage(stdout); return 0;
         default:
             if (optopt > 0 && optopt < 256) fprintf(stderr, "microshadow bake: option '-%c' is unknown or needs a value (see --help)\n", optopt);
@@ -148,9 +172,23 @@ int ms_cli_bake(int argc, char **argv)
         return 1;
     }
     int last = -1;
-    if (!quiet && isatty(STDERR_FILENO)) { bo.points.progress = progress_bar; bo.points.progress_user = &last; }
     ms_lightmap lm;
-    ms_status st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
+    ms_status st = MS_OK;
+#ifdef MS_HAVE_MPI
+    if (ms_mpi_active()) {
+        /* Every rank bakes its rows; rank 0 alone writes (mpi_bake.c). */
+        outs[2].write = ms_mpi_stats_write_stream;
+        const int mrc = ms_mpi_bake(&scene, scene_path ? scene_path : "built-in scene", &bo, schedule, chunk, &lm, err, sizeof err);
+        if (mrc || ms_mpi_rank() != 0) {
+            ms_scene_free(&scene);
+            return mrc ? EXIT_BAD_INPUT : 0;
+        }
+    } else
+#endif
+    {
+        if (!quiet && isatty(STDERR_FILENO)) { bo.points.progress = progress_bar; bo.points.progress_user = &last; }
+        st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
+    }
     if (st) {
         fprintf(stderr, "microshadow bake: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
         ms_scene_free(&scene);

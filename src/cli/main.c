@@ -1,6 +1,9 @@
 /* The microshadow command line: render a scene file (or the built-in scene) with one shadow method. */
 #include "microshadow.h"
 #include "bake.h"
+#ifdef MS_HAVE_MPI
+#include "mpi_run.h"
+#endif
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
@@ -43,6 +46,11 @@ static void usage(FILE *f)
         "  --traversal T       micro-raster methods: block (default: 4x4 pixels' frusta together) or pixel\n"
         "  --frustum-shrink    block traversal and mft: narrow each frustum as its samples are occluded\n"
         "  --quiet             no progress or summary on stderr\n"
+#ifdef MS_HAVE_MPI
+        "  --mpi-schedule S    under mpirun: how ranks get tiles: counter (default: a shared counter, MPI\n"
+        "                      one-sided), queue (rank 0 hands them out), static (round robin)\n"
+        "  --mpi-chunk N       under mpirun: tiles per hand-out (default: --threads, or 4)\n"
+#endif
         "  --help, --version\n");
 }
 
@@ -74,12 +82,12 @@ static int parse_int(const char *opt, const char *s, long lo, long hi, long *out
     return 0;
 }
 
-int main(int argc, char **argv)
+static int cli_main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
-           O_EXPOSURE };
+           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -90,7 +98,14 @@ int main(int argc, char **argv)
         { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
         { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
         { "exposure", required_argument, 0, O_EXPOSURE },
+#ifdef MS_HAVE_MPI
+        { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
+#endif
         { 0, 0, 0, 0 } };
+#ifdef MS_HAVE_MPI
+    ms_mpi_schedule schedule = MS_MPI_COUNTER;   /* balanced best (docs/mpi.md) */
+    int chunk = 0;
+#endif
     ms_render_options opt;
     ms_render_options_default(&opt);
     /* The library reads no environment; for measuring (docs/embree.md) the CLI maps these onto options. */
@@ -168,6 +183,15 @@ int main(int argc, char **argv)
             }
             break;
         }
+#ifdef MS_HAVE_MPI
+        case O_MPI_SCHEDULE:
+            if (ms_mpi_schedule_from_name(optarg, &schedule)) {
+                fprintf(stderr, "microshadow: --mpi-schedule: '%s' is not queue, counter or static\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case O_MPI_CHUNK: if (parse_int("--mpi-chunk", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; chunk = (int)v; break;
+#endif
         case 'h': case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("microshadow %s\n", MS_VERSION_STRING); return 0;
         default:
@@ -209,12 +233,28 @@ int main(int argc, char **argv)
         return 1;
     }
     int last = -1;
-    if (!quiet && isatty(STDERR_FILENO)) { opt.progress = progress_bar; opt.progress_user = &last; }
     ms_frame frame;
-    if (ms_render(&scene, &opt, &frame, err, sizeof err)) {
-        fprintf(stderr, "microshadow: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
-        ms_scene_free(&scene);
-        return EXIT_BAD_INPUT;
+#ifdef MS_HAVE_MPI
+    if (ms_mpi_active()) {
+        /* Every rank renders its share; rank 0 alone writes (mpi_frame.c). */
+        if (!chunk) chunk = opt.threads > 0 ? opt.threads : 4;
+        outs[OUT_STATS].write = ms_mpi_stats_write_stream;
+        const int mrc = ms_mpi_frame(&scene, scene_path ? scene_path : "built-in scene", &opt, schedule, chunk, &frame, err,
+                                     sizeof err);
+        if (mrc || ms_mpi_rank() != 0) {
+            ms_frame_free(&frame);
+            ms_scene_free(&scene);
+            return mrc ? EXIT_BAD_INPUT : 0;
+        }
+    } else
+#endif
+    {
+        if (!quiet && isatty(STDERR_FILENO)) { opt.progress = progress_bar; opt.progress_user = &last; }
+        if (ms_render(&scene, &opt, &frame, err, sizeof err)) {
+            fprintf(stderr, "microshadow: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
+            ms_scene_free(&scene);
+            return EXIT_BAD_INPUT;
+        }
     }
     frame.exposure *= (float)exp2(exposure_ev);
     int rc = ms_outputs_write(&frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
@@ -230,4 +270,13 @@ int main(int argc, char **argv)
     ms_frame_free(&frame);
     ms_scene_free(&scene);
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+#ifdef MS_HAVE_MPI
+    /* Under mpirun: every rank runs the command line; the ranks agree on the outcome at the end. */
+    if (ms_mpi_start(&argc, &argv)) return ms_mpi_end(cli_main(argc, argv));
+#endif
+    return cli_main(argc, argv);
 }

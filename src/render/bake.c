@@ -211,10 +211,9 @@ static int dilate(ms_frame *f, int passes)
     return 0;
 }
 
-ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *out,
-                  char *err, size_t errlen)
+/* The layout of the lightmap (ms_bake_layout): checks, UVs, texel rasterization, the frame's arrays. */
+ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *out, char *err, size_t errlen)
 {
-    const double t_start = omp_get_wtime();
     if (!out) { snprintf(err, errlen, "ms_bake: out is NULL"); return MS_ERR_INVALID; }
     memset(out, 0, sizeof *out);
     ms_bake_options zero;
@@ -231,97 +230,157 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
         snprintf(err, errlen, "UV set must be in [0, %d], or -1 for xatlas", MS_MAX_UV_SETS - 1);
         return MS_ERR_INVALID;
     }
-    const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
     const int padding = o->padding > 0 ? o->padding : 2;
-    ms_accel *own = NULL;
-    ms_status st;
-    if (!accel) {
-        st = ms_accel_build(scene, o->points.threads, &own, err, errlen);
-        if (st) return st;
-        accel = own;
-    }
-    st = choose_uvs(scene, o, size, padding, out, err, errlen);
+    ms_status st = choose_uvs(scene, o, size, padding, out, err, errlen);
     const double t_raster = omp_get_wtime();
     if (!st) st = rasterize(scene, size, out, err, errlen);
     out->raster_s = omp_get_wtime() - t_raster;
     out->n_tris = scene->n_tris;
     const size_t nt = (size_t)size * size;
     ms_frame *f = &out->frame;
-    float *pos = NULL, *nor = NULL;
-    uint32_t *tri = NULL, *key = NULL;
-    size_t *where = NULL, m = 0;
     if (!st) {
         f->width = f->height = size;
         f->vis = malloc(nt * sizeof(float));
         f->shadow = malloc(nt * sizeof(float));
         f->front = calloc(nt, sizeof *f->front);
         f->rgb = calloc(nt * 3, sizeof(float));
-        for (size_t i = 0; i < nt; i++) m += out->triangle && out->triangle[i] != MS_NO_TRIANGLE;
-        pos = malloc((m ? m : 1) * 3 * sizeof *pos);
-        nor = malloc((m ? m : 1) * 3 * sizeof *nor);
-        tri = malloc((m ? m : 1) * sizeof *tri);
-        key = malloc((m ? m : 1) * 2 * sizeof *key);
-        where = malloc((m ? m : 1) * sizeof *where);
-        if (!f->vis || !f->shadow || !f->front || !f->rgb || !pos || !nor || !tri || !key || !where) {
+        if (!f->vis || !f->shadow || !f->front || !f->rgb) {
             snprintf(err, errlen, "out of memory for a %dx%d lightmap", size, size);
             st = MS_ERR_NO_MEMORY;
         }
     }
-    if (!st) {
-        size_t j = 0;
+    if (!st)
         for (size_t i = 0; i < nt; i++) {
             f->vis[i] = f->shadow[i] = -1.0f;
-            if (out->triangle[i] == MS_NO_TRIANGLE) continue;
-            memcpy(pos + 3 * j, out->position + 3 * i, 3 * sizeof(float));
-            memcpy(nor + 3 * j, out->normal + 3 * i, 3 * sizeof(float));
-            tri[j] = out->triangle[i];
+            out->texels += out->triangle[i] != MS_NO_TRIANGLE;
+        }
+    if (st) ms_lightmap_free(out);
+    return st;
+}
+
+/* Adds one ms_visibility_points call's stats to the lightmap's (the first call's are taken whole). */
+static void add_stats(ms_stats *sum, const ms_stats *s)
+{
+    if (!sum->method) { *sum = *s; return; }
+    sum->setup_s += s->setup_s;
+    sum->shadow_s += s->shadow_s;
+    sum->shadow_factor_s += s->shadow_factor_s;
+    sum->visible_pixels += s->visible_pixels;
+    sum->penumbra_pixels += s->penumbra_pixels;
+    sum->shadow_rays += s->shadow_rays;
+    for (int c = 0; c < s->n_counters && c < MS_MAX_COUNTERS; c++) sum->counter[c] += s->counter[c];
+}
+
+ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *lm, int y0, int y1,
+                       char *err, size_t errlen)
+{
+    ms_bake_options zero;
+    memset(&zero, 0, sizeof zero);
+    const ms_bake_options *o = opt_in ? opt_in : &zero;
+    ms_frame *f = &lm->frame;
+    const int size = f->width;
+    if (!accel || !f->vis || y0 < 0 || y1 > size || y0 > y1) {
+        snprintf(err, errlen, "ms_bake_rows: no accel or layout, or rows [%d, %d) not within [0, %d)", y0, y1, size);
+        return MS_ERR_INVALID;
+    }
+    const size_t first = (size_t)y0 * size, last = (size_t)y1 * size;
+    size_t m = 0;
+    for (size_t i = first; i < last; i++) m += lm->triangle[i] != MS_NO_TRIANGLE;
+    float *pos = malloc((m ? m : 1) * 3 * sizeof *pos), *nor = malloc((m ? m : 1) * 3 * sizeof *nor);
+    uint32_t *tri = malloc((m ? m : 1) * sizeof *tri), *key = malloc((m ? m : 1) * 2 * sizeof *key);
+    size_t *where = malloc((m ? m : 1) * sizeof *where);
+    float *v = malloc((m ? m : 1) * sizeof *v), *s = malloc((m ? m : 1) * sizeof *s);
+    uint16_t *fr = malloc((m ? m : 1) * sizeof *fr);
+    ms_status st = MS_OK;
+    if (!pos || !nor || !tri || !key || !where || !v || !s || !fr) { snprintf(err, errlen, "out of memory for %zu texels", m); st = MS_ERR_NO_MEMORY; }
+    if (!st) {
+        size_t j = 0;
+        for (size_t i = first; i < last; i++) {
+            if (lm->triangle[i] == MS_NO_TRIANGLE) continue;
+            memcpy(pos + 3 * j, lm->position + 3 * i, 3 * sizeof(float));
+            memcpy(nor + 3 * j, lm->normal + 3 * i, 3 * sizeof(float));
+            tri[j] = lm->triangle[i];
             key[2 * j] = (uint32_t)(i % (size_t)size);
             key[2 * j + 1] = (uint32_t)(i / (size_t)size);
             where[j++] = i;
         }
-        out->texels = m;
-        float *v = malloc((m ? m : 1) * sizeof *v), *s = malloc((m ? m : 1) * sizeof *s);
-        uint16_t *fr = malloc((m ? m : 1) * sizeof *fr);
-        if (!v || !s || !fr) { snprintf(err, errlen, "out of memory for %zu texels", m); st = MS_ERR_NO_MEMORY; }
         ms_points pts = { m, pos, nor, tri, key };
-        if (!st) st = ms_visibility_points(accel, NULL, &pts, &o->points, v, s, fr, &f->stats, err, errlen);
+        ms_stats one;
+        memset(&one, 0, sizeof one);
+        st = ms_visibility_points(accel, NULL, &pts, &o->points, v, s, fr, &one, err, errlen);
         if (!st) {
-            const ms_light L = scene->light;
-            float *lum = malloc((m ? m : 1) * sizeof *lum);
             for (size_t k = 0; k < m; k++) {
-                const size_t i = where[k];
-                f->vis[i] = v[k];
-                f->shadow[i] = s[k];
-                f->front[i] = fr[k];
-                const float e = ms_light_irradiance(&L, pos + 3 * k, nor + 3 * k);
-                f->rgb[3 * i] = e * L.emission.x * s[k];
-                f->rgb[3 * i + 1] = e * L.emission.y * s[k];
-                f->rgb[3 * i + 2] = e * L.emission.z * s[k];
-                if (lum) lum[k] = e * (0.2126f * L.emission.x + 0.7152f * L.emission.y + 0.0722f * L.emission.z);
+                f->vis[where[k]] = v[k];
+                f->shadow[where[k]] = s[k];
+                f->front[where[k]] = fr[k];
             }
-            f->exposure = 1.0f;
-            if (lum && m) {
-                qsort(lum, m, sizeof *lum, cmp_float);
-                const float p99 = lum[(size_t)(0.99 * (double)(m - 1))];
-                if (p99 > 0.0f) f->exposure = 1.0f / p99;
-            }
-            free(lum);
-            if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); st = MS_ERR_NO_MEMORY; }
+            add_stats(&f->stats, &one);
         }
-        free(v);
-        free(s);
-        free(fr);
     }
     free(pos);
     free(nor);
     free(tri);
     free(key);
     free(where);
-    ms_accel_free(own);
-    if (st) { ms_lightmap_free(out); return st; }
+    free(v);
+    free(s);
+    free(fr);
+    return st;
+}
+
+ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *lm, char *err, size_t errlen)
+{
+    ms_bake_options zero;
+    memset(&zero, 0, sizeof zero);
+    const ms_bake_options *o = opt_in ? opt_in : &zero;
+    const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
+    ms_frame *f = &lm->frame;
+    const int size = f->width;
+    const size_t nt = (size_t)size * size, m = lm->texels;
+    /* Irradiance and the exposure (99th percentile), texels in row order. */
+    const ms_light L = scene->light;
+    float *lum = malloc((m ? m : 1) * sizeof *lum);
+    size_t k = 0;
+    for (size_t i = 0; i < nt; i++) {
+        if (lm->triangle[i] == MS_NO_TRIANGLE) continue;
+        const float e = ms_light_irradiance(&L, lm->position + 3 * i, lm->normal + 3 * i);
+        f->rgb[3 * i] = e * L.emission.x * f->shadow[i];
+        f->rgb[3 * i + 1] = e * L.emission.y * f->shadow[i];
+        f->rgb[3 * i + 2] = e * L.emission.z * f->shadow[i];
+        if (lum) lum[k] = e * (0.2126f * L.emission.x + 0.7152f * L.emission.y + 0.0722f * L.emission.z);
+        k++;
+    }
+    f->exposure = 1.0f;
+    if (lum && m) {
+        qsort(lum, m, sizeof *lum, cmp_float);
+        const float p99 = lum[(size_t)(0.99 * (double)(m - 1))];
+        if (p99 > 0.0f) f->exposure = 1.0f / p99;
+    }
+    free(lum);
+    if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); return MS_ERR_NO_MEMORY; }
     f->stats.width = f->stats.height = size;
     f->stats.triangles = scene->n_tris;
     f->stats.load_s = scene->load_s;
-    f->stats.total_s = omp_get_wtime() - t_start + scene->load_s;
+    f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s;
+    return MS_OK;
+}
+
+/* ms_bake_layout, every row in one ms_bake_rows call, ms_bake_finish. */
+ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *out,
+                  char *err, size_t errlen)
+{
+    const double t_start = omp_get_wtime();
+    ms_status st = ms_bake_layout(scene, opt_in, out, err, errlen);
+    if (st) return st;
+    ms_accel *own = NULL;
+    if (!accel) {
+        st = ms_accel_build(scene, opt_in ? opt_in->points.threads : 0, &own, err, errlen);
+        accel = own;
+    }
+    if (!st) st = ms_bake_rows(accel, opt_in, out, 0, out->frame.height, err, errlen);
+    if (!st) st = ms_bake_finish(scene, opt_in, out, err, errlen);
+    ms_accel_free(own);
+    if (st) { ms_lightmap_free(out); return st; }
+    out->frame.stats.total_s = omp_get_wtime() - t_start + scene->load_s;
     return MS_OK;
 }

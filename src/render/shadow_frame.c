@@ -1,5 +1,5 @@
 /* The whole-frame shadow phase (shadow_frame.h): the same front masks and the same V/S resolution as the
- * tiled phase of render.c, around one call of the method's frame-level entry. */
+ * tiled phase of frame_job.c, around one call of the method's frame-level entry. */
 #include "shadow_frame.h"
 #include "../core/pattern.h"
 #include "../shadow/receiver.h"
@@ -8,14 +8,15 @@
 #include <string.h>
 
 int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, const ms_hit *hits,
-                          const ms_surface *surf, int W, int H, float *vis_out, float *shadow_out, float *spec_out,
+                          const ms_surface *surf, int W, int H, const size_t *pixels, size_t npixels, float *vis_out, float *shadow_out, float *spec_out,
                           uint16_t *front_out, uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
                           uint64_t *segments, double *resolve_thread_s)
 {
-    const size_t npix = (size_t)W * H, mw = (size_t)ctx->mask_words;
+    const size_t npix = pixels ? npixels : (size_t)W * H, mw = (size_t)ctx->mask_words;
+    (void)H;
     const int stratified = ctx->pattern != MS_PATTERN_GRID;
     size_t n = 0;
-    for (size_t i = 0; i < npix; i++) n += hits[i].prim != UINT32_MAX;
+    for (size_t j = 0; j < npix; j++) n += hits[pixels ? pixels[j] : j].prim != UINT32_MAX;
     ms_shadow_query *q = malloc((n ? n : 1) * sizeof *q);
     size_t *where = malloc((n ? n : 1) * sizeof *where);
     uint64_t *front = malloc((n ? n : 1) * mw * sizeof *front);
@@ -23,7 +24,8 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
     int rc = -1;
     if (!q || !where || !front || !vis) goto done;
     n = 0;
-    for (size_t i = 0; i < npix; i++) {
+    for (size_t j = 0; j < npix; j++) {
+        const size_t i = pixels ? pixels[j] : j;
         const ms_hit *h = &hits[i];
         if (h->prim == UINT32_MAX) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; continue; }
         memcpy(q[n].p, h->p, sizeof h->p);

@@ -9,9 +9,11 @@
 /* Gathers every visible pixel of hits (W x H) as a query with its front mask, calls the method once, and
  * resolves V and S with ms_resolve_vs exactly as the tiled path does (and S_spec where surf, per pixel or
  * NULL, has a specular lobe); writes vis, shadow, spec and front (W x H each) and adds to counters and the
- * frame's totals. 0, or -1 out of memory or when the method fails. */
+ * frame's totals. pixels: NULL for the whole frame in row-major order, else only those npixels pixel
+ * indices, in that order (a part of the frame: frame_job.c). 0, or -1 out of memory or when the method
+ * fails. */
 int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, const ms_hit *hits,
-                          const ms_surface *surf, int W, int H, float *vis, float *shadow, float *spec, uint16_t *front,
+                          const ms_surface *surf, int W, int H, const size_t *pixels, size_t npixels, float *vis, float *shadow, float *spec, uint16_t *front,
                           uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
                           uint64_t *segments, double *resolve_thread_s);
 

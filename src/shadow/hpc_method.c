@@ -156,7 +156,7 @@ static void hpc_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
 const ms_shadow_method ms_shadow_hpc = {
     .name = "hpc", .primary = "bvh", .needs_grid = 1, .streams = 1, .n_counters = HPC_N_COUNTERS,
     .counter_names = HPC_COUNTER_NAMES,
-    .create = hpc_create, .visibility = hpc_tile, .visibility_all = hpc_all, .destroy = hpc_destroy,
+    .create = hpc_create, .visibility = hpc_tile, .visibility_all = hpc_all, .split_exact = 1, .destroy = hpc_destroy,
     .isa_used = hpc_isa_used,
 };
 

@@ -71,6 +71,11 @@ typedef struct ms_shadow_method {
      * every method (ms_resolve_vs). 0, or -1 when out of memory. */
     int (*visibility_all)(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, size_t n,
                           const uint64_t *front, uint64_t *vis, uint64_t *counters);
+    /* With visibility_all: 1 when a receiver's masks do not depend on the other receivers of the call (hpc:
+     * every sample decided by raytrace's exact test), so a frame may be split into parts (ms_frame_job, e.g.
+     * over MPI ranks) with the same answer; 0 (hpc-scanline: which triangles its hierarchy rasterizes for a
+     * receiver, and so its rounding at their edges, depends on all receivers): only whole frames. */
+    int split_exact;
     /* Optional (NULL: the method has no ISA-dispatched code): the instruction sets its kernel and its
      * traversal run, as chosen by create under ctx->isa_cap, for ms_stats. */
     void (*isa_used)(const void *state, ms_isa *kernel, ms_isa *traversal);

@@ -1,0 +1,522 @@
+/* A frame tile by tile (ms_frame_job, microshadow.h): the set-up, the tiled primary and shadow phases and
+ * the frame-global finish that ms_render runs in one go, split so that a driver can render any tiles in
+ * any number of calls (the CLI's MPI mode hands tiles out to processes) and still get ms_render's image bit
+ * for bit. Why that holds: a pixel's hit point, surface, samples and V/S/S_spec for every light depend only
+ * on the pixel, the seed and the scene (the block methods group 4x4 pixel blocks, which never straddle a
+ * 16x16 tile; a sphere light is answered one query at a time); what depends on the whole frame (the
+ * interleaved pattern's filter, which reads neighbours across tiles, the exposure's 99th percentile, the
+ * shading's hit points) runs in finish over the whole frame. Frame-level methods (visibility_all) get the
+ * receivers of one call at once, which is exact only for methods whose answer does not depend on the other
+ * receivers (method.h, split_exact); the others only render whole frames. Each light has its own method
+ * state for the job's life (set-ups such as hpc's light hierarchy and the frusta are per light), so that
+ * any call can render any tile for every light. */
+#include "microshadow.h"
+#include "../core/pattern.h"
+#include "../shadow/method.h"
+#include "../shadow/receiver.h"
+#include "frame_job.h"
+#include "shadow_frame.h"
+#include "shade.h"
+#include "render_materialise.h"
+#include "interleave_filter.h"
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define TILE MS_TILE_SIZE
+#define MS_NEAR 1e-4f        /* segment parameter: occluders closer than this to the receiver are ignored */
+#define MS_FAR (1.0f - 1e-4f)/* ... and this close to the light plane (a light set into a ceiling) */
+
+struct ms_frame_job {
+    ms_scene soup;                /* a procedural scene materialised for a method that does not stream */
+    int own_soup;
+    const ms_scene *scene;
+    const ms_shadow_method *sm;
+    const ms_primary_method *pm;
+    ms_render_ctx ctx;            /* ctx.light: light 0; each light's pass uses a copy with its light */
+    const ms_light *lights;
+    size_t nlights;
+    ms_bvh bvh;
+    void *pstate;
+    void **sstate;                /* per light */
+    ms_render_options opt;
+    int W, H, tx, ty, ntiles, samples, spp, threads, rendered_any, streamed;
+    ms_hit *hits;
+    ms_surface *surf;             /* per pixel, only for scenes with materials or normals (shade.h) */
+    uint8_t *traced;              /* per tile: primary hits (and surfaces) are in hits (and surf) */
+    ms_frame frame;
+    double t_start;
+    long done, total;             /* progress: tiles over the primary phase and every light's shadow phase */
+};
+
+/* CPU seconds of all the process's threads: on a shared machine, where wall time depends on the
+ * neighbours, the figure to compare methods by. */
+static double process_cpu_s(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts)) return 0.0;
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void progress_tick(ms_frame_job *j)
+{
+    long d;
+#pragma omp atomic capture
+    d = ++j->done;
+    if (j->opt.progress && omp_get_thread_num() == 0) j->opt.progress(j->opt.progress_user, (double)d / (double)j->total);
+}
+
+void ms_frame_job_free(ms_frame_job *j)
+{
+    if (!j) return;
+    for (size_t l = 0; j->sstate && l < j->nlights; l++)
+        if (j->sstate[l]) j->sm->destroy(j->sstate[l]);
+    free(j->sstate);
+    if (j->pm && j->pstate) j->pm->destroy(j->pstate);
+    ms_bvh_free(&j->bvh);
+    free(j->hits);
+    free(j->surf);
+    free(j->traced);
+    ms_frame_free(&j->frame);
+    if (j->own_soup) free(j->soup.tri);
+    free(j);
+}
+
+int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **out, char *err, size_t errlen)
+{
+    *out = NULL;
+    const double t_start = omp_get_wtime();
+    const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;   /* zeroed options: defaults */
+    const ms_shadow_method *sm = ms_find_shadow_method(method);
+    if (!sm) {
+        if (ms_method_available(method) < 0) snprintf(err, errlen, "method '%s' is not compiled into this build", method);
+        else snprintf(err, errlen, "unknown method '%s'", method);
+        return -1;
+    }
+    ms_frame_job *j = calloc(1, sizeof *j);
+    if (!j) { snprintf(err, errlen, "out of memory"); return -1; }
+    j->t_start = t_start;
+    j->opt = *opt;
+    j->sm = sm;
+    j->threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
+    /* A procedural scene: streamed by the methods that can (primary by a depth pass, no BVH), else
+     * materialised. */
+    int streamed = scene->procedural.type != MS_PROCEDURAL_NONE;
+    if (streamed && !sm->streams) {
+        if (ms_scene_materialise(scene, j->threads, &j->soup, err, errlen)) { free(j); return -1; }
+        j->own_soup = 1;
+        scene = &j->soup;
+        streamed = 0;
+        j->t_start = omp_get_wtime();   /* the generation counts as loading (soup.load_s) */
+    }
+    j->scene = scene;
+    j->streamed = streamed;
+    j->lights = ms_scene_lights(scene, &j->nlights);
+    const ms_primary_method *pm = ms_find_primary_method(streamed ? "depth" : sm->primary);
+    if (!pm) { snprintf(err, errlen, "primary method '%s' is not compiled into this build", sm->primary); goto fail; }
+    const int samples = opt->samples > 0 ? opt->samples : scene->samples;
+    if ((unsigned)opt->pattern > MS_PATTERN_INTERLEAVED) { snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern); goto fail; }
+    if ((unsigned)opt->traversal > MS_TRAVERSAL_PIXEL) { snprintf(err, errlen, "unknown traversal %d", (int)opt->traversal); goto fail; }
+    /* Samples per pixel: N, or N/16 for interleaved; always a multiple of 16 (full ray packets). */
+    const int spp = ms_pattern_samples_per_pixel(opt->pattern, samples);
+    if (!spp) {
+        snprintf(err, errlen, "samples must be %s with the %s pattern (got %d)",
+                 opt->pattern == MS_PATTERN_STRATIFIED ? "16, 64, 256, 1024 or 4096" : "256, 1024 or 4096",
+                 ms_pattern_name(opt->pattern), samples);
+        goto fail;
+    }
+    if (sm->needs_grid && opt->pattern != MS_PATTERN_GRID) {
+        snprintf(err, errlen, "method '%s' needs --pattern grid", sm->name);
+        goto fail;
+    }
+    const int W = opt->width > 0 ? opt->width : scene->camera.width;
+    const int H = opt->height > 0 ? opt->height : scene->camera.height;
+    if (W < 1 || H < 1 || W > MS_MAX_IMAGE_SIZE || H > MS_MAX_IMAGE_SIZE) {
+        snprintf(err, errlen, "width and height must be in [1, %d]", MS_MAX_IMAGE_SIZE);
+        goto fail;
+    }
+    ms_render_ctx *ctx = &j->ctx;
+    if (ms_camera_basis_init(&ctx->cam, &scene->camera, W, H)) {
+        snprintf(err, errlen, "camera is degenerate (eye = target, or up parallel to the view)");
+        goto fail;
+    }
+    if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); goto fail; }
+    ctx->scene = scene;
+    ctx->bvh = streamed ? NULL : &j->bvh;
+    ctx->light = j->lights[0];
+    ctx->pattern = opt->pattern;
+    ctx->k = ms_samples_to_k(samples);
+    ctx->samples = spp;
+    ctx->mask_words = (spp + 63) / 64;   /* bits past spp stay 0 */
+    ctx->seed = opt->seed;
+    ctx->near = MS_NEAR;
+    ctx->far = MS_FAR;
+    ctx->threads = j->threads;
+    ctx->isa_cap = opt->isa;
+    ctx->no_occlusion_cull = opt->no_occlusion_cull;
+    ctx->no_child_order = opt->no_child_order;
+    ctx->traversal = opt->traversal;
+    ctx->frustum_shrink = opt->frustum_shrink;
+    ctx->embree_mode = opt->embree_mode;
+    ctx->embree_filter = opt->embree_filter;
+    j->W = W;
+    j->H = H;
+    j->samples = samples;
+    j->spp = spp;
+    j->tx = (W + TILE - 1) / TILE;
+    j->ty = (H + TILE - 1) / TILE;
+    j->ntiles = j->tx * j->ty;
+    j->total = (long)(1 + j->nlights) * j->ntiles;
+
+    const size_t npix = (size_t)W * H, nl = j->nlights;
+    j->hits = malloc(npix * sizeof *j->hits);
+    j->traced = calloc((size_t)j->ntiles, 1);
+    j->sstate = calloc(nl, sizeof *j->sstate);
+    ms_frame *f = &j->frame;
+    f->vis = malloc(nl * npix * sizeof(float));
+    f->shadow = malloc(nl * npix * sizeof(float));
+    f->shadow_spec = malloc(nl * npix * sizeof(float));
+    f->front = calloc(nl * npix, sizeof *f->front);
+    f->rgb = malloc(npix * 3 * sizeof(float));
+    f->n_lights = (int)nl;
+    if (!j->hits || !j->traced || !j->sstate || !f->vis || !f->shadow || !f->shadow_spec || !f->front || !f->rgb) {
+        snprintf(err, errlen, "out of memory for a %dx%d frame", W, H);
+        goto fail;
+    }
+    /* The surfaces (material, shading normal) of the hits: S_spec needs them with the masks. */
+    if (!streamed && (scene->tri_material || scene->tri_normal)) {
+        j->surf = malloc(npix * sizeof *j->surf);
+        if (!j->surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); goto fail; }
+    }
+    f->width = W;
+    f->height = H;
+    const double t_setup = omp_get_wtime();
+    void *pstate = NULL;
+    if (pm->create(ctx, &pstate, err, errlen)) goto fail;
+    j->pm = pm;
+    j->pstate = pstate;
+    for (size_t l = 0; l < nl; l++) {
+        ms_render_ctx lc = *ctx;
+        lc.light = j->lights[l];
+        if (sm->create(&lc, &j->sstate[l], err, errlen)) { j->sstate[l] = NULL; goto fail; }
+    }
+    ms_stats *st = &f->stats;
+    st->setup_s = omp_get_wtime() - t_setup;
+    st->build_s = j->bvh.build_s;
+    /* The last light's state speaks for the stats (isa_used, counters_used), as the counters sum over lights. */
+    void *const last = j->sstate[nl - 1];
+    const char *const *cnames = sm->counter_names;
+    st->n_counters = sm->n_counters;
+    if (sm->counters_used) {
+        const int n = sm->counters_used(last, &cnames);
+        if (n >= 0) st->n_counters = n;
+        else cnames = sm->counter_names;
+    }
+    for (int c = 0; c < st->n_counters; c++) st->counter_name[c] = cnames[c];
+    *out = j;
+    return 0;
+fail:
+    ms_frame_job_free(j);
+    return -1;
+}
+
+int ms_frame_job_tiles(const ms_frame_job *j, int *tiles_x, int *tiles_y)
+{
+    if (tiles_x) *tiles_x = j->tx;
+    if (tiles_y) *tiles_y = j->ty;
+    return j->ntiles;
+}
+
+int ms_frame_job_splittable(const ms_frame_job *j)
+{
+    return !j->sm->visibility_all || j->sm->split_exact;
+}
+
+ms_frame *ms_frame_job_frame(ms_frame_job *j) { return &j->frame; }
+
+static void tile_rect(const ms_frame_job *j, int t, int *x0, int *y0, int *x1, int *y1)
+{
+    *x0 = (t % j->tx) * TILE;
+    *y0 = (t / j->tx) * TILE;
+    *x1 = *x0 + TILE < j->W ? *x0 + TILE : j->W;
+    *y1 = *y0 + TILE < j->H ? *y0 + TILE : j->H;
+}
+
+/* Primary hits of tiles[0..n) (tiles == NULL: 0..n-1) into j->hits. */
+static void trace_tiles(ms_frame_job *j, const int *tiles, int n, int tick)
+{
+#pragma omp parallel for schedule(dynamic, 1) num_threads(j->threads)
+    for (int i = 0; i < n; i++) {
+        const int t = tiles ? tiles[i] : i;
+        int x0, y0, x1, y1;
+        tile_rect(j, t, &x0, &y0, &x1, &y1);
+        ms_hit tile[TILE * TILE];
+        j->pm->trace(j->pstate, &j->ctx, x0, y0, x1, y1, tile);
+        for (int y = y0; y < y1; y++)
+            memcpy(&j->hits[(size_t)y * j->W + x0], &tile[(y - y0) * (x1 - x0)], (size_t)(x1 - x0) * sizeof *tile);
+        j->traced[t] = 1;
+        if (tick) progress_tick(j);
+    }
+}
+
+/* The surfaces of the hits of tiles[0..n) (tiles == NULL: 0..n-1), when the scene has any. */
+static void surface_tiles(ms_frame_job *j, const int *tiles, int n)
+{
+    if (!j->surf) return;
+    const float eye[3] = { j->scene->camera.eye.x, j->scene->camera.eye.y, j->scene->camera.eye.z };
+#pragma omp parallel for schedule(dynamic, 1) num_threads(j->threads)
+    for (int i = 0; i < n; i++) {
+        int x0, y0, x1, y1;
+        tile_rect(j, tiles ? tiles[i] : i, &x0, &y0, &x1, &y1);
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) {
+                const size_t p = (size_t)y * j->W + x;
+                ms_surface_at(j->scene, &j->bvh, &j->hits[p], eye, &j->surf[p]);
+            }
+    }
+}
+
+/* Sums of the shadow passes of one call. */
+typedef struct pass_sums {
+    uint64_t counters[MS_MAX_COUNTERS];
+    uint64_t visible, penumbra, segments;
+    double resolve_thread_s;
+} pass_sums;
+
+/* The shadow phase of light l over tiles[0..n) (tiles == NULL: 0..n-1; whole: the frame's first and only
+ * call): front masks, the method's visible masks, V, S and S_spec into light l's planes, over 16x16 tiles
+ * (or the method's frame-level entry). Adds to p. 0, or -1 out of memory or when the method fails. */
+static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int whole, pass_sums *p)
+{
+    const ms_shadow_method *sm = j->sm;
+    void *const sstate = j->sstate[l];
+    ms_render_ctx lctx = j->ctx;
+    lctx.light = j->lights[l];
+    const ms_render_ctx ctx = lctx;
+    const int W = j->W;
+    const size_t npix = (size_t)W * j->H, mw = (size_t)ctx.mask_words;
+    ms_frame *const out = &j->frame;
+    float *const vis = out->vis + l * npix, *const shadow = out->shadow + l * npix;
+    float *const spec = out->shadow_spec + l * npix;   /* S_spec (shade.h) where surf has a specular lobe, else S */
+    uint16_t *const fr = out->front + l * npix;
+    const ms_surface *const surf = j->surf;
+    const ms_hit *const hits = j->hits;
+    uint64_t visible = 0, penumbra = 0, segments = 0;
+    double resolve_thread_s = 0.0;
+    int failed = 0;
+    const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
+    /* A sphere light: each receiver has its own light, the sphere's outline disk seen from it (a per-query
+     * light frame: ms_light_sphere_outline). The method is called one query at a time with a context whose
+     * light is that disk, so every method answers on the same per-receiver samples as raytrace, whatever
+     * it sets up per frame (mft re-derives its light frame per call; hpc sets up its light per call, so
+     * a sphere costs it a pass over every triangle per receiver); frame-level entries are not used. The
+     * price is the block traversal's coherence: groups of one. */
+    const int sphere = ctx.light.shape == MS_LIGHT_SPHERE;
+    const int shadow_tiles = sm->visibility_all && !sphere ? 0 : n;   /* a frame-level method: shadow_frame.c */
+#pragma omp parallel num_threads(j->threads)
+    {
+        uint64_t local[MS_MAX_COUNTERS] = { 0 };
+        uint64_t local_visible = 0, local_penumbra = 0, local_segments = 0;
+        double local_resolve = 0.0;
+        /* Per thread: the tile's front and visible masks, and the stratified pattern's points. */
+        uint64_t *front = aligned_alloc(64, TILE * TILE * mw * sizeof *front);
+        uint64_t *vmask = aligned_alloc(64, TILE * TILE * mw * sizeof *vmask);
+        float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
+        int ok = front && vmask && (pts || !stratified);
+#pragma omp for schedule(dynamic, 1)
+        for (int ti = 0; ti < shadow_tiles; ti++) {
+            int x0, y0, x1, y1;
+            tile_rect(j, tiles ? tiles[ti] : ti, &x0, &y0, &x1, &y1);
+            ms_shadow_query q[TILE * TILE];
+            size_t where[TILE * TILE];
+            ms_render_ctx qc = ctx;   /* the query's context: the frame's, or with a sphere's outline disk */
+            int nq = 0;
+            for (int y = y0; y < y1 && ok; y++)
+                for (int x = x0; x < x1; x++) {
+                    size_t i = (size_t)y * W + x;
+                    const ms_hit *h = &hits[i];
+                    if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
+                    memcpy(q[nq].p, h->p, sizeof h->p);
+                    memcpy(q[nq].n, h->n, sizeof h->n);
+                    q[nq].prim = h->prim;
+                    q[nq].px = (uint32_t)x;
+                    q[nq].py = (uint32_t)y;
+                    if (sphere && ms_light_sphere_outline(&ctx.light, q[nq].p, &qc.light)) {
+                        vis[i] = shadow[i] = spec[i] = 0.0f;   /* inside the sphere: no sample counts */
+                        fr[i] = 0;
+                        local_visible++;
+                        continue;
+                    }
+                    if (pts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[nq].px, q[nq].py, ctx.seed, pts);
+                    const int nf = ms_front_mask(&qc, &q[nq], pts, front + (size_t)nq * mw);
+                    fr[i] = (uint16_t)nf;
+                    local_segments += (uint64_t)nf;
+                    where[nq++] = i;
+                }
+            if (!sphere) {
+                if (nq && ok && sm->visibility(sstate, &ctx, q, nq, front, vmask, local)) ok = 0;
+            } else
+                for (int i = 0; i < nq && ok; i++) {
+                    ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                    if (sm->visibility(sstate, &qc, &q[i], 1, front + (size_t)i * mw, vmask + (size_t)i * mw, local)) ok = 0;
+                }
+            const double tr = omp_get_wtime();
+            for (int i = 0; i < nq && ok; i++) {
+                if (sphere) ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                if (pts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
+                local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[i], pts, front + (size_t)i * mw,
+                                                          vmask + (size_t)i * mw, &vis[where[i]],
+                                                          &shadow[where[i]]);
+                spec[where[i]] = surf && surf[where[i]].specular
+                    ? ms_resolve_spec(&qc, &q[i], pts, front + (size_t)i * mw, vmask + (size_t)i * mw, &surf[where[i]])
+                    : shadow[where[i]];
+            }
+            local_resolve += omp_get_wtime() - tr;
+            local_visible += (uint64_t)nq;
+            progress_tick(j);
+        }
+        free(front);
+        free(vmask);
+        free(pts);
+#pragma omp critical(ms_counters)
+        {
+            for (int c = 0; c < MS_MAX_COUNTERS; c++) p->counters[c] += local[c];
+            visible += local_visible;
+            penumbra += local_penumbra;
+            segments += local_segments;
+            resolve_thread_s += local_resolve;
+            failed |= !ok;
+        }
+    }
+    if (sm->visibility_all && !sphere && !failed) {
+        size_t *pixels = NULL, np = 0;
+        if (!whole) {   /* the listed tiles' pixels, tile after tile */
+            pixels = malloc((size_t)n * TILE * TILE * sizeof *pixels);
+            failed = !pixels;
+            for (int ti = 0; ti < n && pixels; ti++) {
+                int x0, y0, x1, y1;
+                tile_rect(j, tiles ? tiles[ti] : ti, &x0, &y0, &x1, &y1);
+                for (int y = y0; y < y1; y++)
+                    for (int x = x0; x < x1; x++) pixels[np++] = (size_t)y * W + x;
+            }
+        }
+        if (!failed)
+            failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, surf, W, j->H, pixels, np, vis, shadow, spec, fr,
+                                           p->counters, &visible, &penumbra, &segments, &resolve_thread_s) != 0;
+        free(pixels);
+    }
+    p->visible += visible;
+    p->penumbra += penumbra;
+    p->segments += segments;
+    p->resolve_thread_s += resolve_thread_s;
+    return failed ? -1 : 0;
+}
+
+int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, size_t errlen)
+{
+    const ms_shadow_method *sm = j->sm;
+    const int whole = !tiles && n == j->ntiles && !j->rendered_any;
+    if (!tiles && n != j->ntiles) { snprintf(err, errlen, "ms_frame_job_render: tiles is NULL but n is not the frame's %d tiles", j->ntiles); return -1; }
+    for (int i = 0; tiles && i < n; i++)
+        if (tiles[i] < 0 || tiles[i] >= j->ntiles) { snprintf(err, errlen, "ms_frame_job_render: tile %d is not in [0, %d)", tiles[i], j->ntiles); return -1; }
+    if (!whole && !ms_frame_job_splittable(j)) {
+        snprintf(err, errlen, "method '%s' renders only whole frames (the receivers its hierarchy rasterizes triangles for, "
+                 "and so its rounding at their edges, depend on all of the frame's pixels)", sm->name);
+        return -1;
+    }
+    j->rendered_any = 1;
+    ms_stats *st = &j->frame.stats;
+    const double t0 = omp_get_wtime();
+    trace_tiles(j, tiles, n, 1);
+    const double t1 = omp_get_wtime();
+    const double c1 = process_cpu_s();
+
+    /* The surfaces are timed with the shadow phase (a lookup per pixel, far below the shadow cost). Each
+     * light in turn, with its own state and planes; the hits and surfaces are shared. */
+    surface_tiles(j, tiles, n);
+    pass_sums p;
+    memset(&p, 0, sizeof p);
+    int failed = 0;
+    for (size_t l = 0; l < j->nlights && !failed; l++) failed = shadow_pass(j, l, tiles, n, whole, &p) != 0;
+    if (failed) {
+        snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);
+        return -1;
+    }
+    st->primary_s += t1 - t0;
+    st->shadow_s += omp_get_wtime() - t1;
+    st->shadow_cpu_s += process_cpu_s() - c1;
+    for (int c = 0; c < MS_MAX_COUNTERS; c++) st->counter[c] += p.counters[c];
+    st->visible_pixels += p.visible / j->nlights;   /* every light's pass counts each visible pixel once */
+    st->penumbra_pixels += p.penumbra;
+    st->shadow_rays += p.segments;
+    st->shadow_factor_s += p.resolve_thread_s;
+    return 0;
+}
+
+int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    ms_frame *f = &j->frame;
+    ms_stats *st = &f->stats;
+    const int W = j->W, H = j->H;
+    const size_t npix = (size_t)W * H, nl = j->nlights;
+    /* Hit points (and surfaces) of the tiles other jobs rendered: the filter and the shading need them all. */
+    int *missing = malloc((size_t)j->ntiles * sizeof *missing), nm = 0;
+    if (!missing) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); return -1; }
+    for (int t = 0; t < j->ntiles; t++)
+        if (!j->traced[t]) missing[nm++] = t;
+    const double tp = omp_get_wtime();
+    if (nm) {
+        trace_tiles(j, missing, nm, 0);
+        surface_tiles(j, missing, nm);
+    }
+    free(missing);
+    st->primary_s += omp_get_wtime() - tp;
+    /* The interleaved pattern's filter belongs to its shadow cost (timed in shadow_s and on its own). */
+    if (j->ctx.pattern == MS_PATTERN_INTERLEAVED && !j->opt.no_filter) {
+        const double tf = omp_get_wtime(), cf = process_cpu_s();
+        /* S_spec through the same filter, with the same raw V deciding the neighbours. */
+        float *raw_vis = j->surf ? malloc(npix * sizeof *raw_vis) : NULL;
+        int ferr = j->surf && !raw_vis;
+        for (size_t l = 0; l < nl && !ferr; l++) {
+            if (raw_vis) memcpy(raw_vis, f->vis + l * npix, npix * sizeof *raw_vis);
+            ferr = ms_interleave_filter(W, H, j->hits, f->front + l * npix, f->vis + l * npix, f->shadow + l * npix,
+                                        j->threads) ||
+                   (raw_vis && ms_interleave_filter(W, H, j->hits, f->front + l * npix, raw_vis, f->shadow_spec + l * npix,
+                                                    j->threads));
+        }
+        free(raw_vis);
+        if (ferr) {
+            snprintf(err, errlen, "out of memory for the interleaved filter of a %dx%d frame", W, H);
+            return -1;
+        }
+        st->filter_s = omp_get_wtime() - tf;
+        st->shadow_s += st->filter_s;
+        st->shadow_cpu_s += process_cpu_s() - cf;
+    }
+    if (ms_frame_shade(j->scene, &j->ctx, j->lights, nl, j->hits, j->surf, j->threads, f)) {
+        snprintf(err, errlen, "out of memory for the textured lights of a %dx%d frame", W, H);
+        return -1;
+    }
+
+    st->triangles = j->scene->n_tris;
+    st->load_s = j->scene->load_s;
+    st->samples = j->samples;
+    st->samples_per_pixel = j->spp;
+    st->threads = j->threads;
+    st->width = W;
+    st->height = H;
+    st->method = j->sm->name;
+    ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
+    if (j->sm->isa_used) j->sm->isa_used(j->sstate[nl - 1], &kisa, &tisa);
+    st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
+    st->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
+    st->pattern = ms_pattern_name(j->opt.pattern);
+    st->shadow_factor_s /= j->threads;   /* thread-seconds to seconds */
+    st->total_s = omp_get_wtime() - j->t_start + j->scene->load_s;
+    *out = *f;
+    memset(f, 0, sizeof *f);
+    return 0;
+}
