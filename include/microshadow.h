@@ -59,12 +59,32 @@ extern "C" {
 
 typedef struct ms_vec3 { float x, y, z; } ms_vec3;
 
-/* Pinhole camera. Pixel (x,y), y = 0 the top row; the primary ray passes through (x+0.5, y+0.5).
- * right = normalize(cross(forward, up)), true up = cross(right, forward). fov_y in degrees. */
+/* Camera projections (scene file: camera.type; docs/cameras.md). The view frame is forward =
+ * normalize(target - eye), right = normalize(cross(forward, up)), true up = cross(right, forward).
+ *   MS_CAMERA_PINHOLE: perspective through a planar image, vertical field of view fov_y (degrees);
+ *   MS_CAMERA_ORTHOGRAPHIC: parallel rays along forward from the plane through eye; the image spans
+ *     ortho_height world units vertically (width in proportion);
+ *   MS_CAMERA_FISHEYE: equidistant, the angle from forward proportional to the distance from the image
+ *     centre; the circle inscribed in the image spans fov degrees (up to 360); pixels outside it see nothing;
+ *   MS_CAMERA_LATLONG: the 360 x 180 degree panorama (light probes, VR): x is the longitude around up
+ *     (the centre column looks along forward, right at 3/4 of the width), y the latitude from up (row 0)
+ *     to down;
+ *   MS_CAMERA_PARABOLIC: the hemisphere around forward by the paraboloid map (Heidrich & Seidel 1998) on
+ *     the disk inscribed in the image; pixels outside it see nothing. */
+typedef enum ms_camera_type {
+    MS_CAMERA_PINHOLE = 0, MS_CAMERA_ORTHOGRAPHIC = 1, MS_CAMERA_FISHEYE = 2, MS_CAMERA_LATLONG = 3,
+    MS_CAMERA_PARABOLIC = 4
+} ms_camera_type;
+
+/* A camera. Pixel (x,y), y = 0 the top row; the primary ray passes through (x+0.5, y+0.5). Zeroed
+ * fields past height keep a pinhole camera. */
 typedef struct ms_camera {
     ms_vec3 eye, target, up;
-    float fov_y;
+    float fov_y;         /* MS_CAMERA_PINHOLE: vertical field of view, degrees in (0, 180) */
     int width, height;
+    ms_camera_type type;
+    float fov;           /* MS_CAMERA_FISHEYE: field of view of the inscribed circle, degrees in (0, 360] */
+    float ortho_height;  /* MS_CAMERA_ORTHOGRAPHIC: the image's height in world units, > 0 */
 } ms_camera;
 
 /* Light shapes (docs/design.md, "Light shapes"). Every shape is sampled on its parallelogram

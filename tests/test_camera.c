@@ -14,18 +14,18 @@ static void test_hand_computed(void **st)
 {
     (void)st;
     /* Looking down -z from the origin, fov 90 (tan = 1), 4x2 pixels (aspect 2). */
-    ms_camera c = { { 0, 0, 0 }, { 0, 0, -1 }, { 0, 1, 0 }, 90.0f, 4, 2 };
+    ms_camera c = { { 0, 0, 0 }, { 0, 0, -1 }, { 0, 1, 0 }, 90.0f, 4, 2, MS_CAMERA_PINHOLE, 0, 0 };
     ms_camera_basis b;
     assert_int_equal(ms_camera_basis_init(&b, &c, 4, 2), 0);
     NEAR(b.forward[0], 0); NEAR(b.forward[1], 0); NEAR(b.forward[2], -1);
     NEAR(b.right[0], 1); NEAR(b.right[1], 0); NEAR(b.right[2], 0);   /* cross(forward, up) = +x */
     NEAR(b.up[0], 0); NEAR(b.up[1], 1); NEAR(b.up[2], 0);
-    float d[3];
+    float d[3], o0[3];
     /* Pixel (0,0), the top-left: sx = (2*0.5/4 - 1) * 1 * 2 = -1.5, sy = (1 - 2*0.5/2) = 0.5. */
-    ms_camera_ray(&b, 0, 0, d);
+    ms_camera_ray(&b, 0, 0, o0, d);
     NEAR(d[0], -1.5); NEAR(d[1], 0.5); NEAR(d[2], -1);
     /* Pixel (3,1), the bottom-right: sx = (2*3.5/4 - 1) * 2 = 1.5, sy = 1 - 2*1.5/2 = -0.5. */
-    ms_camera_ray(&b, 3, 1, d);
+    ms_camera_ray(&b, 3, 1, o0, d);
     NEAR(d[0], 1.5); NEAR(d[1], -0.5); NEAR(d[2], -1);
     /* (1, 0.5, -2): sx = 1 / (2 * 1 * 2) = 0.25 -> px = 0.5 * 1.25 * 4 = 2.5;
      * sy = 0.5 / 2 = 0.25 -> py = 0.5 * 0.75 * 2 = 0.75. */
@@ -37,7 +37,7 @@ static void test_hand_computed(void **st)
 
     /* The Quad camera: eye (0,10,12) looking at the origin; the target projects to the image centre and
      * a point on the +x side to the right half, one higher up (+y) to a smaller row. */
-    ms_camera q = { { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 64, 48 };
+    ms_camera q = { { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 64, 48, MS_CAMERA_PINHOLE, 0, 0 };
     assert_int_equal(ms_camera_basis_init(&b, &q, 64, 48), 0);
     float o[3] = { 0, 0, 0 };
     assert_int_equal(ms_camera_project(&b, o, &px, &py), 0);
@@ -57,7 +57,7 @@ static void test_round_trip(void **st)
         float r[10];
         for (int k = 0; k < 10; k++) { h = h * 1664525u + 1013904223u; r[k] = (float)(h >> 8) / 16777216.0f; }
         ms_camera c = { { 20 * r[0] - 10, 20 * r[1] - 10, 20 * r[2] - 10 }, { 4 * r[3] - 2, 4 * r[4] - 2, 4 * r[5] - 2 },
-                        { 0, 1, 0 }, 10 + 150 * r[6], 1 + (int)(300 * r[7]), 1 + (int)(300 * r[8]) };
+                        { 0, 1, 0 }, 10 + 150 * r[6], 1 + (int)(300 * r[7]), 1 + (int)(300 * r[8]), MS_CAMERA_PINHOLE, 0, 0 };
         ms_camera_basis b;
         if (ms_camera_basis_init(&b, &c, c.width, c.height)) continue;
         /* The basis is orthogonal. */
@@ -65,8 +65,8 @@ static void test_round_trip(void **st)
         NEAR(b.up[0] * b.right[0] + b.up[1] * b.right[1] + b.up[2] * b.right[2], 0);
         for (int y = 0; y < c.height; y += 1 + c.height / 7)
             for (int x = 0; x < c.width; x += 1 + c.width / 7) {
-                float d[3], p[3], px, py;
-                ms_camera_ray(&b, x, y, d);
+                float o[3], d[3], p[3], px, py;
+                ms_camera_ray(&b, x, y, o, d);
                 for (int a = 0; a < 3; a++) p[a] = b.eye[a] + (1 + 5 * r[9]) * d[a];
                 assert_int_equal(ms_camera_project(&b, p, &px, &py), 0);
                 assert_true(fabsf(px - ((float)x + 0.5f)) < 2e-3f * (1 + c.width / 100.0f));
@@ -79,11 +79,11 @@ static void test_degenerate(void **st)
 {
     (void)st;
     ms_camera_basis b;
-    ms_camera same = { { 1, 2, 3 }, { 1, 2, 3 }, { 0, 1, 0 }, 60, 8, 8 };
-    ms_camera par = { { 0, 5, 0 }, { 0, 0, 0 }, { 0, 1, 0 }, 60, 8, 8 };     /* up parallel to the view */
-    ms_camera zero_up = { { 0, 0, 5 }, { 0, 0, 0 }, { 0, 0, 0 }, 60, 8, 8 };
-    ms_camera fov0 = { { 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, 0, 8, 8 };
-    ms_camera fov180 = { { 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, 180, 8, 8 };
+    ms_camera same = { { 1, 2, 3 }, { 1, 2, 3 }, { 0, 1, 0 }, 60, 8, 8, MS_CAMERA_PINHOLE, 0, 0 };
+    ms_camera par = { { 0, 5, 0 }, { 0, 0, 0 }, { 0, 1, 0 }, 60, 8, 8, MS_CAMERA_PINHOLE, 0, 0 };     /* up parallel to the view */
+    ms_camera zero_up = { { 0, 0, 5 }, { 0, 0, 0 }, { 0, 0, 0 }, 60, 8, 8, MS_CAMERA_PINHOLE, 0, 0 };
+    ms_camera fov0 = { { 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, 0, 8, 8, MS_CAMERA_PINHOLE, 0, 0 };
+    ms_camera fov180 = { { 0, 0, 5 }, { 0, 0, 0 }, { 0, 1, 0 }, 180, 8, 8, MS_CAMERA_PINHOLE, 0, 0 };
     assert_int_equal(ms_camera_basis_init(&b, &same, 8, 8), -1);
     assert_int_equal(ms_camera_basis_init(&b, &par, 8, 8), -1);
     assert_int_equal(ms_camera_basis_init(&b, &zero_up, 8, 8), -1);

@@ -31,7 +31,7 @@ static void make_quad_scene(ms_scene *s)
         const int idx[6] = { 0, 2, 1, 0, 3, 2 };
         for (int v = 0; v < 6; v++) memcpy(s->tri + 18 * q + 3 * v, quads[q][idx[v]], 3 * sizeof(float));
     }
-    s->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, W, H };
+    s->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, W, H, MS_CAMERA_PINHOLE, 0, 0 };
     s->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     s->samples = 1024;
 }

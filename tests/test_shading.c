@@ -490,8 +490,8 @@ static void test_gltf_materials(void **st)
     double worst = 0;
     for (int y = 0; y < fr.height; y++)
         for (int x = 0; x < fr.width; x++) {
-            float d[3];
-            ms_camera_ray(&cb, x, y, d);
+            float o[3], d[3];
+            ms_camera_ray(&cb, x, y, o, d);
             if (!(d[1] < 0)) continue;
             const double t = -cb.eye[1] / d[1];
             const float p[3] = { (float)(cb.eye[0] + t * d[0]), 0.0f, (float)(cb.eye[2] + t * d[2]) };
@@ -667,8 +667,8 @@ static void test_obj_mtl_materials(void **st)
     int checked[2] = { 0, 0 };
     for (int y = 0; y < fr.height; y++)
         for (int x = 0; x < fr.width; x++) {
-            float d[3];
-            ms_camera_ray(&cb, x, y, d);
+            float o[3], d[3];
+            ms_camera_ray(&cb, x, y, o, d);
             if (!(d[1] < 0)) continue;
             const double t = -cb.eye[1] / d[1];
             const float p[3] = { (float)(cb.eye[0] + t * d[0]), 0.0f, (float)(cb.eye[2] + t * d[2]) };

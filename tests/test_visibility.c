@@ -130,7 +130,7 @@ static size_t make_cut_scene(ms_scene *sc, tu_rng *rng)
             for (int a = 0; a < 3; a++)
                 sc->tri[9 * (nr + t) + 3 * v + a] = c[a] + ((float)(tu_rng_next(rng) % 1000) / 1000.0f - 0.5f) * 0.8f;
     }
-    sc->camera = (ms_camera){ { 0, 2, 12 }, { 0, 2, 0 }, { 0, 1, 0 }, 60.0f, 64, 64 };
+    sc->camera = (ms_camera){ { 0, 2, 12 }, { 0, 2, 0 }, { 0, 1, 0 }, 60.0f, 64, 64, MS_CAMERA_PINHOLE, 0, 0 };
     sc->light = (ms_light){ { -1, 4, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     sc->samples = 1024;
     return nr;
@@ -278,7 +278,7 @@ static void bumpy_sphere(ms_scene *sc, int nu, int nv, tu_rng *rng)
     t += 2;
     sc->n_tris = t;
     free(vert);
-    sc->camera = (ms_camera){ { 2.5f, 3.0f, 4.0f }, { 0, 1.0f, 0 }, { 0, 1, 0 }, 50.0f, 96, 96 };
+    sc->camera = (ms_camera){ { 2.5f, 3.0f, 4.0f }, { 0, 1.0f, 0 }, { 0, 1, 0 }, 50.0f, 96, 96, MS_CAMERA_PINHOLE, 0, 0 };
     sc->light = (ms_light){ { -3, 3.0f, -1 }, { 6, 0, 0 }, { 0, 0.5f, 3 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     sc->samples = 1024;
 }
@@ -397,7 +397,7 @@ static void test_ceiling_from_below(void **st)
     sc.tri = malloc(sizeof tri);
     memcpy(sc.tri, tri, sizeof tri);
     sc.n_tris = 2;
-    sc.camera = (ms_camera){ { 0, 0, 0 }, { 0, 3, 0.5f }, { 0, 0, 1 }, 60.0f, 32, 32 };
+    sc.camera = (ms_camera){ { 0, 0, 0 }, { 0, 3, 0.5f }, { 0, 0, 1 }, 60.0f, 32, 32, MS_CAMERA_PINHOLE, 0, 0 };
     sc.light = (ms_light){ { -1, 5, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };   /* above, emitting down */
     sc.samples = 256;
     for (size_t m = 0; m < N_METHODS; m++) {
@@ -453,7 +453,7 @@ static void test_quad_shaded(void **st)
     memcpy(sc.tri, tri, sizeof tri);
     sc.n_tris = 4;
     const int W = 128;
-    sc.camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, W, W };
+    sc.camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, W, W, MS_CAMERA_PINHOLE, 0, 0 };
     sc.light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     sc.samples = 1024;
     const char *const shaded_methods[] = { "scanline", "raytrace" };

@@ -450,7 +450,7 @@ static void leak_scene(ms_scene *sc, const float c[3], int n, uint64_t seed)
     mesh_tri(&m, g0, g2, g3);
     soup_append(&sc->tri, &sc->n_tris, &m);
     mesh_free(&m);
-    sc->camera = (ms_camera){ { c[0] + 0.05f, c[1] + 1.0f, c[2] - 0.03f }, { c[0], c[1], c[2] }, { 0, 0, 1 }, 90.0f, 64, 64 };
+    sc->camera = (ms_camera){ { c[0] + 0.05f, c[1] + 1.0f, c[2] - 0.03f }, { c[0], c[1], c[2] }, { 0, 0, 1 }, 90.0f, 64, 64, MS_CAMERA_PINHOLE, 0, 0 };
     sc->light = (ms_light){ { c[0] - 0.25f, c[1] + 2.0f, c[2] - 0.25f }, { 0.5f, 0, 0 }, { 0, 0, 0.5f }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     sc->samples = 256;
 }
@@ -576,7 +576,7 @@ static void sphere_scene(ms_scene *sc, const float c[3], uint64_t seed)
     soup_append(&sc->tri, &sc->n_tris, &m);
     mesh_free(&m);
     /* camera off the centre, looking at a wall with a wide field of view */
-    sc->camera = (ms_camera){ { c[0] + 0.13f, c[1] - 0.21f, c[2] + 0.07f }, { c[0] + 1.0f, c[1] + 0.3f, c[2] + 0.2f }, { 0, 1, 0 }, 120.0f, 64, 64 };
+    sc->camera = (ms_camera){ { c[0] + 0.13f, c[1] - 0.21f, c[2] + 0.07f }, { c[0] + 1.0f, c[1] + 0.3f, c[2] + 0.2f }, { 0, 1, 0 }, 120.0f, 64, 64, MS_CAMERA_PINHOLE, 0, 0 };
     sc->light = (ms_light){ { c[0] - 0.3f, c[1] + 0.5f, c[2] - 0.1f }, { 0.2f, 0, 0 }, { 0, 0, 0.2f }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     sc->samples = 256;
 }

@@ -61,7 +61,7 @@ class _Vec3(ctypes.Structure):
 
 class _Camera(ctypes.Structure):
     _fields_ = [("eye", _Vec3), ("target", _Vec3), ("up", _Vec3), ("fov_y", _f), ("width", ctypes.c_int),
-                ("height", ctypes.c_int)]
+                ("height", ctypes.c_int), ("type", ctypes.c_int), ("fov", _f), ("ortho_height", _f)]
 
 
 class _Light(ctypes.Structure):

@@ -68,7 +68,7 @@ int ms_scene_default(ms_scene *out)
     out->n_tris = s.n;
     out->tri_mesh = s.mesh;
     out->n_meshes = 1;
-    out->camera = (ms_camera){ { 0.0f, 6.5f, 10.0f }, { 0.0f, 0.6f, 0.0f }, { 0.0f, 1.0f, 0.0f }, 50.0f, 1024, 768 };
+    out->camera = (ms_camera){ { 0.0f, 6.5f, 10.0f }, { 0.0f, 0.6f, 0.0f }, { 0.0f, 1.0f, 0.0f }, 50.0f, 1024, 768, MS_CAMERA_PINHOLE, 0.0f, 0.0f };
     out->light = (ms_light){ { -1.25f, 6.0f, -1.25f }, { 2.5f, 0.0f, 0.0f }, { 0.0f, 0.0f, 2.5f },
                              { MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     out->samples = 1024;

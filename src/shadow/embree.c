@@ -447,10 +447,10 @@ static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int 
         for (int bx = x0; bx < x1; bx += 4) {
             for (int l = 0; l < 16; l++) {
                 int x = bx + (l & 3), y = by + (l >> 2);
-                float d[3] = { 0.0f, 0.0f, 1.0f };
+                float o[3] = { ctx->cam.eye[0], ctx->cam.eye[1], ctx->cam.eye[2] }, d[3] = { 0.0f, 0.0f, 1.0f };
                 valid[l] = x < x1 && y < y1 ? -1 : 0;
-                if (valid[l]) ms_camera_ray(&ctx->cam, x, y, d);
-                rh.ray.org_x[l] = ctx->cam.eye[0]; rh.ray.org_y[l] = ctx->cam.eye[1]; rh.ray.org_z[l] = ctx->cam.eye[2];
+                if (valid[l] && ms_camera_ray(&ctx->cam, x, y, o, d)) valid[l] = 0;
+                rh.ray.org_x[l] = o[0]; rh.ray.org_y[l] = o[1]; rh.ray.org_z[l] = o[2];
                 rh.ray.dir_x[l] = d[0]; rh.ray.dir_y[l] = d[1]; rh.ray.dir_z[l] = d[2];
                 rh.ray.tnear[l] = 0.0f;
                 rh.ray.tfar[l] = INFINITY;

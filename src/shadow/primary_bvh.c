@@ -37,8 +37,7 @@ static void bvh_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int
             ms_ray r;
             ms_ray_hit hit;
             ms_hit *h = out++;
-            for (int a = 0; a < 3; a++) r.o[a] = ctx->cam.eye[a];
-            ms_camera_ray(&ctx->cam, x, y, r.d);
+            if (ms_camera_ray(&ctx->cam, x, y, r.o, r.d)) { h->prim = UINT32_MAX; continue; }
             r.tmin = 0.0f;
             r.tmax = INFINITY;
             if (ms_bvh_closest(ctx->bvh, &r, &hit)) ms_hit_finish(ctx, r.o, r.d, hit.t, hit.prim, h);

@@ -29,8 +29,8 @@ static void depth_triangle(const ms_render_ctx *ctx, depth_state *s, const float
 {
     const ms_camera_basis *cb = &ctx->cam;
     float xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-    int behind = 0;
-    for (int v = 0; v < 3; v++) {
+    int behind = !ms_camera_planar(cb);   /* curved edge images: the box of the vertices does not bound them */
+    for (int v = 0; v < 3 && !behind; v++) {
         float px, py;
         if (ms_camera_project(cb, tri + 3 * v, &px, &py)) { behind = 1; break; }
         xmin = ms_minf(xmin, px); xmax = ms_maxf(xmax, px);
@@ -50,10 +50,10 @@ static void depth_triangle(const ms_render_ctx *ctx, depth_state *s, const float
     ms_wt_normal(tri, N);
     for (int y = by0; y <= by1; y++)
         for (int x = bx0; x <= bx1; x++) {
-            float d[3], t, u, v;
-            ms_camera_ray(cb, x, y, d);
+            float o[3], d[3], t, u, v;
+            if (ms_camera_ray(cb, x, y, o, d)) continue;
             ms_wt_ray w;
-            ms_wt_prepare(&w, cb->eye, d);
+            ms_wt_prepare(&w, o, d);
             const size_t i = (size_t)y * s->W + x;
             if (!ms_wt_intersect(&w, tri, N, 0.0f, s->t[i], &t, &u, &v)) continue;
             if (t == s->t[i] && s->hits[i].prim < id) continue;
@@ -65,7 +65,7 @@ static void depth_triangle(const ms_render_ctx *ctx, depth_state *s, const float
             v3_cross(n, e1, e2);
             v3_normalize(n, n);
             if (v3_dot(n, d) > 0.0f) v3_scale(n, n, -1.0f);
-            v3_madd(h->p, cb->eye, d, t);
+            v3_madd(h->p, o, d, t);
             memcpy(h->n, n, sizeof n);
             h->prim = id;
         }

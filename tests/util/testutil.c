@@ -278,7 +278,7 @@ void tu_make_quad(ms_scene *sc)
     assert_non_null(sc->tri);
     memcpy(sc->tri, tri, sizeof tri);
     sc->n_tris = 4;
-    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96 };
+    sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96, MS_CAMERA_PINHOLE, 0, 0 };
     sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     sc->samples = 1024;
 }
