@@ -177,3 +177,9 @@ void ms_alpha_raster(const ms_alpha_pixel *ap, const ms_raster_frame *f, ms_rast
     ms_alpha_filter_mask(ap->ctx, ap->q, prim, scratch);
     for (int w = 0; w < mw; w++) b[w] &= ~scratch[w];
 }
+
+int ms_alpha_ray_filter(const void *user, uint32_t prim, const ms_ray *r)
+{
+    const ms_alpha *a = user;
+    return !a->flag[prim] || ms_alpha_ray_occludes(a, prim, r->o, r->d);
+}

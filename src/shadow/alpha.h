@@ -68,6 +68,10 @@ int ms_alpha_segment_occludes(const ms_alpha *a, uint32_t prim, const float P[3]
  * t is not needed: the line alone decides. */
 int ms_alpha_ray_occludes(const ms_alpha *a, uint32_t prim, const float o[3], const float d[3]);
 
+/* The same as a BVH closest-hit filter (ms_bvh_closest_filter; user: the const ms_alpha *): 1 for an opaque
+ * triangle, else ms_alpha_ray_occludes on the ray's origin and direction. For primary methods. */
+int ms_alpha_ray_filter(const void *user, uint32_t prim, const ms_ray *r);
+
 /* ---- For the micro-rasterization methods (microraster.c, block_raster_impl.h, hpc.c) ----
  *
  * A query's alpha context, hung on its ms_raster_frame (frame.alpha) when ctx->alpha is set. The kernels never see
