@@ -21,7 +21,10 @@
  *     square; a sphere light is sampled, per receiver, on its outline disk seen from P, with that mask);
  *     other samples are neither visible nor occluded;
  *   - a sample in front is occluded when a triangle other than T meets the segment P + u (L_i - P) at a
- *     parameter u in [1e-4, 1 - 1e-4] (two-sided, purely geometric);
+ *     parameter u in [1e-4, 1 - 1e-4] (two-sided, purely geometric); a triangle with an alpha-tested material
+ *     (ms_material.alpha_mode) occludes only where its alpha at the point the segment meets its plane is
+ *     >= the cutoff (one function of the triangle, P and L_i, computed in double: docs/design.md), and camera
+ *     rays pass through it where it is below;
  *   - V = (unoccluded samples in front) / (samples in front), and V = 0 when no sample is in front;
  *   - the shadow factor S = sum_i w_i v_i / sum_i w_i over the samples in front (v_i = 1 when unoccluded),
  *     with the form-factor weight w_i = max(cos theta_r,i, 0) max(cos theta_l,i, 0) / r_i^2 (theta_r at

@@ -16,6 +16,13 @@ void ms_alpha_free(ms_alpha *a)
     free(a);
 }
 
+static void d3cross(double r[3], const double a[3], const double b[3])
+{
+    r[0] = a[1] * b[2] - a[2] * b[1];
+    r[1] = a[2] * b[0] - a[0] * b[2];
+    r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 /* The alpha map of scene texture t: its alpha channel, or (grey = 1, an MTL map_d) its red channel when the
  * alpha channel is 255 everywhere. 0, or -1 when out of memory. */
 static int copy_map(const ms_texture *t, int grey, ms_alpha_map *m)
@@ -66,10 +73,19 @@ int ms_alpha_build(const ms_scene *s, const ms_bvh *b, ms_alpha **out)
         a->flag[i] = 1;
         a->slot[i] = (uint32_t)k++;
         const float *v = b->tri + 9 * (size_t)i;
+        double e1[3], e2[3];
         for (int c = 0; c < 3; c++) {
             at->v0[c] = v[c];
-            at->e1[c] = (double)v[3 + c] - (double)v[c];
-            at->e2[c] = (double)v[6 + c] - (double)v[c];
+            e1[c] = (double)v[3 + c] - (double)v[c];
+            e2[c] = (double)v[6 + c] - (double)v[c];
+        }
+        d3cross(at->n, e1, e2);
+        const double nn = at->n[0] * at->n[0] + at->n[1] * at->n[1] + at->n[2] * at->n[2];
+        d3cross(at->g1, e2, at->n);
+        d3cross(at->g2, at->n, e1);
+        for (int c = 0; c < 3; c++) {   /* a degenerate triangle (nn = 0): g = 0, and ms_alpha_value sees N = 0 */
+            at->g1[c] = nn > 0.0 ? at->g1[c] / nn : 0.0;
+            at->g2[c] = nn > 0.0 ? at->g2[c] / nn : 0.0;
         }
         at->factor = m->base_color[3];
         at->cutoff = m->alpha_cutoff;
@@ -96,42 +112,45 @@ int ms_alpha_build(const ms_scene *s, const ms_bvh *b, ms_alpha **out)
     return 0;
 }
 
+/* i mod n for a texel index held in a double (huge or negative UVs): the common in-range case without fmod. */
+static size_t wrap(double i, int n)
+{
+    if (i >= 0.0 && i < n) return (size_t)i;
+    double w = fmod(i, n);
+    if (w < 0) w += n;
+    return (size_t)w;
+}
+
 /* Bilinear with repeat, texel centres at (i + 0.5) / width (shade.c's sampler), in double; 0..1. */
 static double map_bilinear(const ms_alpha_map *m, double u, double v)
 {
     const double x = u * m->width - 0.5, y = v * m->height - 0.5;
     const double fx0 = floor(x), fy0 = floor(y);
     const double fx = x - fx0, fy = y - fy0;
-    const double w = m->width, h = m->height;
-    double xw = fmod(fx0, w), yw = fmod(fy0, h);
-    if (xw < 0) xw += w;
-    if (yw < 0) yw += h;
-    const size_t x0 = (size_t)xw, y0 = (size_t)yw;
+    const size_t x0 = wrap(fx0, m->width), y0 = wrap(fy0, m->height);
     const size_t x1 = x0 + 1 == (size_t)m->width ? 0 : x0 + 1, y1 = y0 + 1 == (size_t)m->height ? 0 : y0 + 1;
     const size_t W = (size_t)m->width;
     const double a00 = m->a[y0 * W + x0], a10 = m->a[y0 * W + x1], a01 = m->a[y1 * W + x0], a11 = m->a[y1 * W + x1];
-    return ((1.0 - fx) * (1.0 - fy) * a00 + fx * (1.0 - fy) * a10 + (1.0 - fx) * fy * a01 + fx * fy * a11) / 255.0;
+    return ((1.0 - fx) * (1.0 - fy) * a00 + fx * (1.0 - fy) * a10 + (1.0 - fx) * fy * a01 + fx * fy * a11) * (1.0 / 255.0);
 }
 
 double ms_alpha_value(const ms_alpha *a, uint32_t prim, const double o[3], const double d[3])
 {
     const ms_alpha_tri *t = &a->tri[a->slot[prim]];
     if (t->map < 0) return t->factor;
-    /* Moller-Trumbore's barycentrics of the line o + u d: p = d x e2, det = e1 . p, b1 = (o - v0) . p / det,
-     * b2 = d . ((o - v0) x e1) / det. */
-    const double *e1 = t->e1, *e2 = t->e2;
-    const double p[3] = { d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0] };
-    const double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
-    if (det == 0.0 || !isfinite(det)) return t->factor;
+    const double *n = t->n;
+    const double den = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    if (den == 0.0 || !isfinite(den)) return t->factor;   /* parallel, or a degenerate triangle */
     const double s[3] = { o[0] - t->v0[0], o[1] - t->v0[1], o[2] - t->v0[2] };
-    const double q[3] = { s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0] };
-    const double b1 = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
-    const double b2 = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+    const double u = -(s[0] * n[0] + s[1] * n[1] + s[2] * n[2]) / den;
+    const double x[3] = { s[0] + u * d[0], s[1] + u * d[1], s[2] + u * d[2] };   /* X - v0 */
+    const double b1 = x[0] * t->g1[0] + x[1] * t->g1[1] + x[2] * t->g1[2];
+    const double b2 = x[0] * t->g2[0] + x[1] * t->g2[1] + x[2] * t->g2[2];
     const double b0 = 1.0 - b1 - b2;
-    const double u = b0 * t->uv[0] + b1 * t->uv[2] + b2 * t->uv[4];
-    const double v = b0 * t->uv[1] + b1 * t->uv[3] + b2 * t->uv[5];
-    if (!isfinite(u) || !isfinite(v)) return t->factor;
-    return t->factor * map_bilinear(&a->maps[t->map], u, v);
+    const double tu = b0 * t->uv[0] + b1 * t->uv[2] + b2 * t->uv[4];
+    const double tv = b0 * t->uv[1] + b1 * t->uv[3] + b2 * t->uv[5];
+    if (!isfinite(tu) || !isfinite(tv)) return t->factor;
+    return t->factor * map_bilinear(&a->maps[t->map], tu, tv);
 }
 
 int ms_alpha_segment_occludes(const ms_alpha *a, uint32_t prim, const float P[3], const float L[3])

@@ -3,16 +3,19 @@
  * material is alpha-tested. The answer is a pure function of (triangle, P, L) — or of (triangle, o, d) for a
  * ray — so that every method, every ISA and every traversal gives bit-identical decisions:
  *
- *   - the barycentrics of the point where the line P + u (L - P) meets the triangle's plane, computed in
- *     double precision (Moller-Trumbore's formulas, which do not need the parameter u) from the triangle's
- *     vertices (the BVH's leaf-order copy: the scene's floats) and d = L - P formed in double;
+ *   - the barycentrics of the point X where the line P + u (L - P) meets the triangle's plane, in double
+ *     precision from the triangle's vertices (the BVH's leaf-order copy: the scene's floats) and d = L - P
+ *     formed in double: with N = e1 x e2 (e1 = v1 - v0, e2 = v2 - v0), u = ((v0 - P) . N) / (d . N),
+ *     X - v0 = (P - v0) + u d, b1 = (X - v0) . (e2 x N) / |N|^2, b2 = (X - v0) . (N x e1) / |N|^2 (the
+ *     vectors per triangle precomputed at set-up);
  *   - the UVs of the material's texture set interpolated with them (double);
  *   - alpha = the material's alpha factor times the texture's value there: the base-colour texture's alpha
  *     channel (glTF; bilinear with repeat, texel centres at (i + 0.5) / width, like the base colour in
  *     shade.c, but computed in double) or the MTL map_d value (its alpha channel, or its red channel when
  *     the image is opaque everywhere, i.e. a grey mask), the same filter;
- *   - the triangle occludes there iff alpha >= cutoff. A line parallel to the plane (det = 0), UVs that are
- *     not finite, or a material whose texture is missing: the factor alone decides.
+ *   - the triangle occludes there iff alpha >= cutoff. A line parallel to the plane (d . N = 0), a degenerate
+ *     triangle (N = 0), UVs that are not finite, or a material whose texture is missing: the factor alone
+ *     decides.
  *
  * Set-up (ms_alpha_build, once per frame or accel): a flag byte per leaf-order triangle (0 opaque: an opaque
  * scene pays one load, or nothing when ms_alpha is absent), and for alpha-tested triangles the vertex and
@@ -28,7 +31,8 @@
 #include "../raster/raster.h"
 
 typedef struct ms_alpha_tri {
-    double v0[3], e1[3], e2[3];  /* vertex 0 and the edges v1 - v0, v2 - v0, in double */
+    double v0[3], n[3];          /* vertex 0 and the plane normal N = e1 x e2, in double */
+    double g1[3], g2[3];         /* (e2 x N) / |N|^2 and (N x e1) / |N|^2: b1, b2 = (X - v0) . g1, g2 */
     double uv[6];                /* (u, v) of the three vertices in the material's texture set */
     float factor, cutoff;        /* alpha = factor * texture; occludes iff alpha >= cutoff */
     int32_t map;                 /* index into ms_alpha.maps, -1: none */
