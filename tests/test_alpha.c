@@ -763,6 +763,77 @@ static void test_opaque_cards_are_quads(void **state)
     setup_free(&s);
 }
 
+/* Loading: BLEND is tested as MASK at 0.5 with one warning; `d` without map_d stays opaque; a bad alpha mode or
+ * cutoff from a library caller is refused by validation. */
+static int n_warnings;
+static char last_warning[512];
+static void on_warning(void *user, const char *msg)
+{
+    (void)user;
+    n_warnings++;
+    snprintf(last_warning, sizeof last_warning, "%s", msg);
+}
+
+static void test_loading_rules(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    char dir[4096], path[4096], err[512];
+    load_scene("gltf", &sc, dir, sizeof dir);
+    ms_scene_free(&sc);
+    /* The same glTF with BLEND instead of MASK (and a cutoff BLEND ignores). */
+    FILE *f = fopen(tu_path(path, sizeof path, dir, "leaves.gltf"), "r");
+    assert_non_null(f);
+    static char text[16384];
+    const size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = 0;
+    char *m = strstr(text, "\"alphaMode\":\"MASK\",\"alphaCutoff\":0.5");
+    assert_non_null(m);
+    memcpy(m, "\"alphaMode\":\"BLEND\",\"alphaCutoff\":0.9", strlen("\"alphaMode\":\"BLEND\",\"alphaCutoff\":0.9"));
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "leaves.gltf"), text), 0);
+    n_warnings = 0;
+    ms_set_warning_handler(on_warning, NULL);
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "scene.json"), &sc, err, sizeof err), 0);
+    ms_set_warning_handler(NULL, NULL);
+    printf("BLEND: %d warning(s): %s\n", n_warnings, last_warning);
+    assert_int_equal(n_warnings, 1);
+    assert_non_null(strstr(last_warning, "BLEND"));
+    assert_int_equal((int)sc.n_materials, 1);
+    assert_int_equal(sc.materials[0].alpha_mode, MS_ALPHA_MASK);
+    assert_true(sc.materials[0].alpha_cutoff == 0.5f);
+    /* A library caller's bad alpha fields. */
+    sc.materials[0].alpha_cutoff = 1.5f;
+    assert_int_not_equal(ms_scene_validate(&sc, "caller", err, sizeof err), 0);
+    printf("refused: %s\n", err);
+    sc.materials[0].alpha_cutoff = 0.5f;
+    sc.materials[0].alpha_mode = 7;
+    assert_int_not_equal(ms_scene_validate(&sc, "caller", err, sizeof err), 0);
+    sc.materials[0].alpha_mode = MS_ALPHA_MASK_MAP;
+    sc.materials[0].alpha_texture = 99;
+    assert_int_not_equal(ms_scene_validate(&sc, "caller", err, sizeof err), 0);
+    ms_scene_free(&sc);
+    /* OBJ: d 0.3 without map_d is opaque; with map_d the map decides. */
+    load_scene("obj", &sc, dir, sizeof dir);
+    ms_scene_free(&sc);
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "leaves.mtl"),
+                                   "newmtl ground\nKd 0.8 0.8 0.8\n\nnewmtl leaf\nKd 0.2 0.6 0.2\nd 0.3\nmap_Kd leaf.png\n"), 0);
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "scene.json"), &sc, err, sizeof err), 0);
+    for (size_t i = 0; i < sc.n_materials; i++) assert_int_equal(sc.materials[i].alpha_mode, MS_ALPHA_OPAQUE);
+    ms_scene_free(&sc);
+    /* A map_d that cannot be read: one warning, opaque. */
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "leaves.mtl"),
+                                   "newmtl leaf\nmap_d missing.png\n"), 0);
+    n_warnings = 0;
+    ms_set_warning_handler(on_warning, NULL);
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "scene.json"), &sc, err, sizeof err), 0);
+    ms_set_warning_handler(NULL, NULL);
+    printf("missing map_d: %d warning(s): %s\n", n_warnings, last_warning);
+    assert_int_equal(n_warnings, 1);
+    for (size_t i = 0; i < sc.n_materials; i++) assert_int_equal(sc.materials[i].alpha_mode, MS_ALPHA_OPAQUE);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -774,6 +845,7 @@ int main(void)
         cmocka_unit_test(test_primary_obj),
         cmocka_unit_test(test_frames_equal_raytrace),
         cmocka_unit_test(test_opaque_cards_are_quads),
+        cmocka_unit_test(test_loading_rules),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -26,6 +26,10 @@
  * ms_render_options.embree_filter: plane (default), always, or none (for measuring only: the receiver's
  * triangle then occludes, V is wrong).
  *
+ * Alpha-tested triangles (alpha.h): the same context filter, set for every pixel when the scene has any, rejects
+ * a hit where the triangle is transparent for that ray's segment (the receiver point and the sample point, the
+ * ray id being the sample index), so Embree goes on looking; for primary rays the ray's own line decides.
+ *
  * FTZ/DAZ: Embree wants flush-to-zero and denormals-are-zero; every entry point that calls into
  * Embree sets them in MXCSR for the calling thread and restores the caller's MXCSR on return, so that
  * other methods run on the same OpenMP threads are not affected.
