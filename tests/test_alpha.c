@@ -152,7 +152,7 @@ static void add_card(const double c[3], const double a[3], const double b[3], do
     const double uv[4][2] = { { 0, 0 }, { rep, 0 }, { rep, rep }, { 0, rep } };
     for (int k = 0; k < 4; k++)
         for (int i = 0; i < 3; i++) p[k][i] = c[i] + su[k] * ha * a[i] + sv[k] * hb * b[i];
-    static const int idx[2][3] = { { 0, 1, 2 }, { 0, 2, 3 } };
+    static const int idx[2][3] = { { 0, 2, 1 }, { 0, 3, 2 } };   /* wound to face +b x a (up for the flat cards) */
     for (int t = 0; t < 2; t++) {
         otri *T = &tris[n_tris++];
         T->alpha = 1;
@@ -167,7 +167,7 @@ static void make_geometry(void)
 {
     n_tris = 0;
     const double g[4][3] = { { -4, 0, -4 }, { 4, 0, -4 }, { 4, 0, 4 }, { -4, 0, 4 } };
-    static const int gi[2][3] = { { 0, 1, 2 }, { 0, 2, 3 } };
+    static const int gi[2][3] = { { 0, 2, 1 }, { 0, 3, 2 } };   /* facing up: bake takes the winding's normal */
     for (int t = 0; t < 2; t++) {
         otri *T = &tris[n_tris++];
         memset(T, 0, sizeof *T);
@@ -763,6 +763,42 @@ static void test_opaque_cards_are_quads(void **state)
     setup_free(&s);
 }
 
+/* Baking goes through the points API, so it honours alpha: the same lightmap with the cards alpha-tested and
+ * opaque has every texel at least as visible (the alpha test only gives samples back, on the same samples)
+ * and many texels more. */
+static void test_bake_honours_alpha(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    char dir[4096], err[512];
+    load_scene("gltf", &sc, dir, sizeof dir);
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = 64;
+    bo.uv_set = -1;   /* xatlas for every triangle: the cards' own UVs overlap (and repeat) */
+    bo.points.threads = 1;
+    bo.points.isa = tu_isa_cap();
+    ms_lightmap a, o;
+    ms_status rc = ms_bake(&sc, NULL, &bo, &a, err, sizeof err);
+    if (rc) fprintf(stderr, "%s\n", err);
+    assert_int_equal(rc, MS_OK);
+    sc.materials[0].alpha_mode = MS_ALPHA_OPAQUE;
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &o, err, sizeof err), MS_OK);
+    long more = 0, less = 0, texels = 0;
+    for (int i = 0; i < 64 * 64; i++) {
+        if (a.triangle[i] == MS_NO_TRIANGLE) continue;
+        texels++;
+        more += a.frame.vis[i] > o.frame.vis[i];
+        less += a.frame.vis[i] < o.frame.vis[i];
+    }
+    printf("bake: %ld texels on triangles, %ld more visible with alpha-tested cards, %ld less\n", texels, more, less);
+    assert_true(more > texels / 50);
+    assert_int_equal(less, 0);
+    ms_lightmap_free(&a);
+    ms_lightmap_free(&o);
+    ms_scene_free(&sc);
+}
+
 /* Loading: BLEND is tested as MASK at 0.5 with one warning; `d` without map_d stays opaque; a bad alpha mode or
  * cutoff from a library caller is refused by validation. */
 static int n_warnings;
@@ -846,6 +882,7 @@ int main(void)
         cmocka_unit_test(test_frames_equal_raytrace),
         cmocka_unit_test(test_opaque_cards_are_quads),
         cmocka_unit_test(test_loading_rules),
+        cmocka_unit_test(test_bake_honours_alpha),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
