@@ -1,206 +1,229 @@
 #!/usr/bin/env python3
-"""Writes the foliage scene of docs/shading.md into a directory: a glTF 2.0 file with textured PBR
-materials and alpha-tested leaf cards (alphaMode MASK), its PNG textures, and a scene file lighting it
-with a rect, a disk and a sphere light.
+"""Writes the foliage demo scene of docs/shading.md ("Alpha-tested occluders") into a directory:
 
-    python3 scripts/make_foliage_scene.py OUT_DIR [--leaves N]
+    scripts/make_foliage_scene.py OUTDIR     # then: microshadow OUTDIR/foliage.json -o foliage.png
 
-Deterministic: the same arguments write the same bytes. Standard library only (PNG by zlib)."""
-import argparse
+A glTF 2.0 file with textured PBR materials (a checkered ground, a stone pedestal, a striped metal ball, a
+stem) and a plant of leaf cards cut out by a leaf-shaped alpha mask (alphaMode MASK, cutoff 0.5), lit by a
+rect, a disk and a sphere light. Everything is generated (deterministic: a fixed seed), so the repository
+holds this script, not the binaries. Standard library only (zlib for the PNGs)."""
 import json
 import math
 import os
 import random
 import struct
+import sys
 import zlib
 
 
-def write_png(path, width, height, rgba_rows):
-    """8-bit RGBA PNG; rgba_rows: height rows of width*4 bytes, row 0 the top (glTF v = 0)."""
-    raw = b"".join(b"\x00" + bytes(r) for r in rgba_rows)
+def png(path, w, h, rgba):
+    """8-bit RGBA PNG from a flat list of (r, g, b, a) tuples, row 0 at the top."""
+    raw = bytearray()
+    for y in range(h):
+        raw.append(0)
+        for x in range(w):
+            raw.extend(max(0, min(255, int(c))) for c in rgba[y * w + x])
 
-    def chunk(tag, data):
-        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+    def chunk(t, d):
+        c = zlib.crc32(t + d) & 0xFFFFFFFF
+        return struct.pack(">I", len(d)) + t + d + struct.pack(">I", c)
 
-    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0))
-    png += chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b"")
     with open(path, "wb") as f:
-        f.write(png)
+        f.write(b"\x89PNG\r\n\x1a\n")
+        f.write(chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 6, 0, 0, 0)))
+        f.write(chunk(b"IDAT", zlib.compress(bytes(raw), 9)))
+        f.write(chunk(b"IEND", b""))
 
 
-def leaf_alpha(u, v):
-    """The leaf's shape on its card, u across, v along (0 at the stem): 1 inside, 0 outside."""
-    half = 0.46 * math.sin(math.pi * v) ** 0.75 * (1.0 - 0.25 * v)
-    if abs(u - 0.5) >= half or v < 0.03 or v > 0.985:
-        return 0
-    for cu, cv, r in ((0.40, 0.42, 0.055), (0.62, 0.66, 0.04)):   # two holes bitten out of it
-        if (u - cu) ** 2 + (v - cv) ** 2 < r * r:
-            return 0
-    return 1
+def leaf_texture(path):
+    """A pointed leaf along u with a midrib and veins; transparent around it and in a bite out of one side."""
+    w, h = 128, 64
+    px = []
+    for y in range(h):
+        for x in range(w):
+            u, v = (x + 0.5) / w, (y + 0.5) / h
+            half = 0.46 * math.sin(math.pi * min(max((u - 0.04) / 0.92, 0.0), 1.0)) ** 0.8  # half width at u
+            d = abs(v - 0.5)
+            bite = (u - 0.62) ** 2 + ((v - 0.88) * 1.6) ** 2 < 0.012
+            inside = d < half and not bite
+            f = (u - 1.1 * d) * 7.0
+            vein = d < 0.015 or abs(f - math.floor(f) - 0.5) < 0.035
+            g = 0.55 + 0.25 * (1 - d / max(half, 1e-3))
+            col = (40, int(120 + 90 * g), 45) if not vein else (90, 170, 70)
+            px.append(col + ((255 if inside else 0),))
+    png(path, w, h, px)
 
 
-def leaf_texture(n):
-    rows = []
-    for y in range(n):
-        v = (y + 0.5) / n
-        row = bytearray()
-        for x in range(n):
-            u = (x + 0.5) / n
-            a = leaf_alpha(u, v)
-            vein = abs(u - 0.5) < 0.012 or abs(abs(u - 0.5) - 0.35 * (v % 0.2) / 0.2) < 0.01
-            g = 150 if vein else 110 + int(40 * v)
-            row += bytes((40 if vein else 52, g, 38 if vein else 30, 255 if a else 0))
-        rows.append(row)
-    return rows
+def checker_texture(path):
+    w = h = 64
+    px = []
+    for y in range(h):
+        for x in range(w):
+            c = ((x // 32) + (y // 32)) % 2
+            n = random.randint(-8, 8)
+            px.append((170 + n, 120 + n, 90 + n, 255) if c else (210 + n, 200 + n, 180 + n, 255))
+    png(path, w, h, px)
 
 
-def checker_texture(n, cells):
-    rows = []
-    for y in range(n):
-        row = bytearray()
-        for x in range(n):
-            c = ((x * cells // n) + (y * cells // n)) % 2
-            row += bytes((186, 150, 118, 255) if c else (120, 92, 74, 255))
-        rows.append(row)
-    return rows
+def stripe_texture(path):
+    w, h = 64, 32
+    px = []
+    for y in range(h):
+        for x in range(w):
+            px.append((60, 90, 200, 255) if (x // 8) % 2 else (230, 190, 60, 255))
+    png(path, w, h, px)
 
 
 class Mesh:
     def __init__(self):
-        self.pos, self.nrm, self.uv, self.idx = [], [], [], []
+        self.pos, self.uv, self.nrm = [], [], []
 
-    def quad(self, p0, p1, p2, p3, uvs=((0, 0), (1, 0), (1, 1), (0, 1))):
-        e1 = [p1[i] - p0[i] for i in range(3)]
-        e2 = [p3[i] - p0[i] for i in range(3)]
-        n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
-        ln = math.sqrt(sum(c * c for c in n)) or 1.0
-        n = [c / ln for c in n]
-        b = len(self.pos)
-        for p, t in zip((p0, p1, p2, p3), uvs):
-            self.pos.append(tuple(p))
-            self.nrm.append(tuple(n))
-            self.uv.append(tuple(t))
-        self.idx += [b, b + 1, b + 2, b, b + 2, b + 3]
+    def tri(self, a, b, c, ta, tb, tc, n=None):
+        if n is None:
+            e1 = [b[i] - a[i] for i in range(3)]
+            e2 = [c[i] - a[i] for i in range(3)]
+            n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+            ln = math.sqrt(sum(x * x for x in n)) or 1.0
+            n = [x / ln for x in n]
+            n = [n, n, n]
+        self.pos += [a, b, c]
+        self.uv += [ta, tb, tc]
+        self.nrm += n
+
+    def quad(self, p0, p1, p2, p3, uv=((0, 0), (1, 0), (1, 1), (0, 1))):
+        self.tri(p0, p1, p2, uv[0], uv[1], uv[2])
+        self.tri(p0, p2, p3, uv[0], uv[2], uv[3])
 
     def box(self, lo, hi):
         x0, y0, z0 = lo
         x1, y1, z1 = hi
-        self.quad((x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0))   # top
-        self.quad((x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1))   # +z
-        self.quad((x1, y0, z0), (x0, y0, z0), (x0, y1, z0), (x1, y1, z0))   # -z
-        self.quad((x1, y0, z1), (x1, y0, z0), (x1, y1, z0), (x1, y1, z1))   # +x
-        self.quad((x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0))   # -x
+        c = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0), (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+        for f in ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (3, 7, 6, 2), (0, 4, 7, 3), (1, 2, 6, 5)):
+            self.quad(*[c[i] for i in f])
 
 
-def leaf_cards(mesh, n, seed):
-    """A plant: n leaf cards on stems around an axis, tilted out and drooping, each a textured quad."""
-    rng = random.Random(seed)
-    for i in range(n):
-        az = 2 * math.pi * (i * 0.618034 % 1.0) + rng.uniform(-0.2, 0.2)
-        base_h = 0.35 + 1.1 * i / n + rng.uniform(-0.05, 0.05)
-        tilt = math.radians(rng.uniform(35, 70))
-        length, width = rng.uniform(0.75, 1.0), rng.uniform(0.38, 0.5)
-        d = (math.cos(az) * math.sin(tilt), math.cos(tilt), math.sin(az) * math.sin(tilt))   # along the leaf
-        s = (-math.sin(az), 0.0, math.cos(az))                                               # across it
-        roll = rng.uniform(-0.35, 0.35)   # turn the blade about its axis
-        s = (s[0] * math.cos(roll) + 0.0, math.sin(roll), s[2] * math.cos(roll))
-        origin = (0.06 * math.cos(az), base_h, 0.06 * math.sin(az))
-        p = lambda a, b: tuple(origin[k] + a * s[k] * width + b * d[k] * length for k in range(3))
-        mesh.quad(p(-0.5, 0), p(0.5, 0), p(0.5, 1), p(-0.5, 1))
+def sphere(m, c, r, nu=32, nv=16):
+    def p(i, j):
+        th, ph = 2 * math.pi * i / nu, math.pi * j / nv
+        n = (math.sin(ph) * math.cos(th), math.cos(ph), math.sin(ph) * math.sin(th))
+        return tuple(c[k] + r * n[k] for k in range(3)), n, (i / nu, j / nv)
+
+    for i in range(nu):
+        for j in range(nv):
+            a, b, cc, d = p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)
+            for t in ((a, b, cc), (a, cc, d)):
+                m.tri(t[0][0], t[1][0], t[2][0], t[0][2], t[1][2], t[2][2], [t[0][1], t[1][1], t[2][1]])
 
 
-def gltf(out_dir, leaves):
-    parts = {"ground": Mesh(), "stone": Mesh(), "lacquer": Mesh(), "brass": Mesh(), "leaf": Mesh()}
-    parts["ground"].quad((-6, 0, 6), (6, 0, 6), (6, 0, -6), (-6, 0, -6), ((0, 6), (6, 6), (6, 0), (0, 0)))
-    parts["stone"].box((-0.45, 0.0, -0.45), (0.45, 0.3, 0.45))      # the pot
-    parts["stone"].box((1.6, 0.0, -1.9), (2.6, 1.4, -0.9))          # a block behind
-    parts["lacquer"].box((-2.6, 0.0, 0.4), (-1.8, 0.8, 1.2))        # a glossy red cube
-    parts["brass"].box((0.9, 0.0, 1.3), (1.3, 0.25, 1.7))           # a small brass block
-    leaf_cards(parts["leaf"], leaves, 7)
+def plant(leaves, stem, n_leaves, seed):
+    rnd = random.Random(seed)
+    base = (0.0, 0.5, 0.0)
+    stem.box((-0.035, 0.5, -0.035), (0.035, 2.3, 0.035))
+    for k in range(n_leaves):
+        t = k / (n_leaves - 1)
+        y = base[1] + 0.25 + 1.95 * t
+        az = k * 2.39996 + rnd.uniform(-0.2, 0.2)          # golden angle
+        length = 1.05 - 0.45 * t + rnd.uniform(-0.05, 0.05)
+        width = 0.5 * length
+        droop = 0.35 + 0.5 * t + rnd.uniform(-0.1, 0.1)     # radians below horizontal at the tip
+        d = (math.cos(az) * math.cos(droop), -math.sin(droop) * 0.6 + 0.25, math.sin(az) * math.cos(droop))
+        ln = math.sqrt(sum(x * x for x in d))
+        d = tuple(x / ln for x in d)
+        side = (-math.sin(az), 0.0, math.cos(az))
+        roll = rnd.uniform(-0.5, 0.5)
+        up = (d[1] * side[2] - d[2] * side[1], d[2] * side[0] - d[0] * side[2], d[0] * side[1] - d[1] * side[0])
+        s = tuple(math.cos(roll) * side[i] + math.sin(roll) * up[i] for i in range(3))
+        o = (0.0, y, 0.0)
+        p0 = tuple(o[i] - 0.5 * width * s[i] for i in range(3))
+        p1 = tuple(o[i] + length * d[i] - 0.5 * width * s[i] for i in range(3))
+        p2 = tuple(o[i] + length * d[i] + 0.5 * width * s[i] for i in range(3))
+        p3 = tuple(o[i] + 0.5 * width * s[i] for i in range(3))
+        leaves.quad(p0, p1, p2, p3, ((0, 0), (1, 0), (1, 1), (0, 1)))
 
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: make_foliage_scene.py OUTDIR")
+    out = sys.argv[1]
+    os.makedirs(out, exist_ok=True)
+    random.seed(15)
+    leaf_texture(os.path.join(out, "leaf.png"))
+    checker_texture(os.path.join(out, "checker.png"))
+    stripe_texture(os.path.join(out, "stripes.png"))
+
+    ground, pedestal, ball, stem, leaves = Mesh(), Mesh(), Mesh(), Mesh(), Mesh()
+    ground.quad((-6, 0, -6), (-6, 0, 6), (6, 0, 6), (6, 0, -6), ((0, 0), (0, 6), (6, 6), (6, 0)))
+    pedestal.box((-0.45, 0.0, -0.45), (0.45, 0.5, 0.45))
+    sphere(ball, (1.35, 0.42, 0.75), 0.42)
+    plant(leaves, stem, 26, 7)
+
+    # (mesh, material): materials 0 ground, 1 pedestal, 2 ball, 3 stem, 4 leaves
+    meshes = [(ground, 0), (pedestal, 1), (ball, 2), (stem, 3), (leaves, 4)]
     blob = bytearray()
-    views, accessors, meshes = [], [], []
+    views, accessors, gmeshes = [], [], []
 
-    def add(data, fmt, count, comps, ctype, target, minmax=None):
+    def add(data, fmt, n, typ, minmax=None):
         while len(blob) % 4:
             blob.append(0)
         off = len(blob)
-        blob.extend(struct.pack("<%d%s" % (len(data), fmt), *data))
-        views.append({"buffer": 0, "byteOffset": off, "byteLength": len(blob) - off, "target": target})
-        acc = {"bufferView": len(views) - 1, "componentType": ctype, "count": count, "type": comps}
+        for item in data:
+            blob.extend(struct.pack(fmt, *item))
+        views.append({"buffer": 0, "byteOffset": off, "byteLength": len(blob) - off})
+        acc = {"bufferView": len(views) - 1, "componentType": 5126, "count": n, "type": typ}
         if minmax:
             acc["min"], acc["max"] = minmax
         accessors.append(acc)
         return len(accessors) - 1
 
-    materials = [
-        {"name": "ground", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0,
-                                                    "roughnessFactor": 0.85}},
-        {"name": "stone", "pbrMetallicRoughness": {"baseColorFactor": [0.62, 0.60, 0.56, 1.0],
-                                                   "metallicFactor": 0.0, "roughnessFactor": 0.55}},
-        {"name": "lacquer", "pbrMetallicRoughness": {"baseColorFactor": [0.62, 0.08, 0.05, 1.0],
-                                                     "metallicFactor": 0.0, "roughnessFactor": 0.25}},
-        {"name": "brass", "pbrMetallicRoughness": {"baseColorFactor": [0.91, 0.78, 0.42, 1.0],
-                                                   "metallicFactor": 1.0, "roughnessFactor": 0.5}},
-        {"name": "leaf", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}, "metallicFactor": 0.0,
-                                                  "roughnessFactor": 0.6},
-         "alphaMode": "MASK", "alphaCutoff": 0.5, "doubleSided": True},
-    ]
-    for mi, name in enumerate(("ground", "stone", "lacquer", "brass", "leaf")):
-        m = parts[name]
-        flat = [c for p in m.pos for c in p]
-        lo = [min(p[k] for p in m.pos) for k in range(3)]
-        hi = [max(p[k] for p in m.pos) for k in range(3)]
-        a_pos = add(flat, "f", len(m.pos), "VEC3", 5126, 34962, (lo, hi))
-        a_nrm = add([c for n in m.nrm for c in n], "f", len(m.nrm), "VEC3", 5126, 34962)
-        a_uv = add([c for t in m.uv for c in t], "f", len(m.uv), "VEC2", 5126, 34962)
-        a_idx = add(m.idx, "I", len(m.idx), "SCALAR", 5125, 34963)
-        meshes.append({"name": name, "primitives": [{"attributes": {"POSITION": a_pos, "NORMAL": a_nrm,
-                                                                     "TEXCOORD_0": a_uv},
-                                                      "indices": a_idx, "material": mi}]})
-    with open(os.path.join(out_dir, "foliage.bin"), "wb") as f:
+    for m, mat in meshes:
+        lo = [min(p[i] for p in m.pos) for i in range(3)]
+        hi = [max(p[i] for p in m.pos) for i in range(3)]
+        ip = add(m.pos, "<3f", len(m.pos), "VEC3", (lo, hi))
+        inn = add(m.nrm, "<3f", len(m.nrm), "VEC3")
+        it = add(m.uv, "<2f", len(m.uv), "VEC2")
+        gmeshes.append({"primitives": [{"attributes": {"POSITION": ip, "NORMAL": inn, "TEXCOORD_0": it}, "material": mat}]})
+    with open(os.path.join(out, "foliage.bin"), "wb") as f:
         f.write(blob)
-    doc = {
+
+    def mat(tex, rough, metal=0.0, color=(1, 1, 1, 1), alpha=None):
+        pbr = {"baseColorFactor": list(color), "metallicFactor": metal, "roughnessFactor": rough}
+        if tex is not None:
+            pbr["baseColorTexture"] = {"index": tex}
+        m = {"pbrMetallicRoughness": pbr}
+        if alpha:
+            m.update({"alphaMode": "MASK", "alphaCutoff": 0.5, "doubleSided": True})
+        return m
+
+    gltf = {
         "asset": {"version": "2.0", "generator": "microshadow scripts/make_foliage_scene.py"},
         "scene": 0, "scenes": [{"nodes": list(range(len(meshes)))}],
         "nodes": [{"mesh": i} for i in range(len(meshes))],
-        "meshes": meshes, "materials": materials,
-        "textures": [{"source": 0, "sampler": 0}, {"source": 1, "sampler": 0}],
-        "images": [{"uri": "ground.png"}, {"uri": "leaf.png"}],
+        "meshes": gmeshes,
+        "materials": [mat(0, 0.8), mat(None, 0.35, 0.0, (0.55, 0.52, 0.48, 1)), mat(1, 0.25, 0.9),
+                      mat(None, 0.7, 0.0, (0.25, 0.45, 0.15, 1)), mat(2, 0.55, 0.0, (1, 1, 1, 1), alpha=True)],
+        "textures": [{"source": 0, "sampler": 0}, {"source": 1, "sampler": 0}, {"source": 2, "sampler": 0}],
         "samplers": [{"wrapS": 10497, "wrapT": 10497}],
+        "images": [{"uri": "checker.png"}, {"uri": "stripes.png"}, {"uri": "leaf.png"}],
         "buffers": [{"uri": "foliage.bin", "byteLength": len(blob)}],
         "bufferViews": views, "accessors": accessors,
     }
-    with open(os.path.join(out_dir, "foliage.gltf"), "w") as f:
-        json.dump(doc, f, indent=1, sort_keys=True)
-        f.write("\n")
+    with open(os.path.join(out, "foliage.gltf"), "w") as f:
+        json.dump(gltf, f, indent=1)
 
-
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("out_dir")
-    ap.add_argument("--leaves", type=int, default=24)
-    ap.add_argument("--size", type=int, nargs=2, default=(960, 640), metavar=("W", "H"))
-    a = ap.parse_args()
-    os.makedirs(a.out_dir, exist_ok=True)
-    write_png(os.path.join(a.out_dir, "leaf.png"), 128, 128, leaf_texture(128))
-    write_png(os.path.join(a.out_dir, "ground.png"), 64, 64, checker_texture(64, 8))
-    gltf(a.out_dir, a.leaves)
     scene = {
         "meshes": [{"file": "foliage.gltf"}],
-        "camera": {"eye": [3.2, 3.1, 5.2], "target": [0.0, 0.9, 0.0], "up": [0, 1, 0], "fov_y": 45,
-                   "width": a.size[0], "height": a.size[1]},
+        "camera": {"eye": [2.9, 2.4, 3.7], "target": [0.15, 1.0, 0.1], "up": [0, 1, 0], "fov_y": 45,
+                   "width": 640, "height": 400},
         "lights": [
-            {"corner": [-0.9, 3.4, -2.4], "edge_s": [1.4, 0, 0], "edge_t": [0, 0, 1.0], "power": 260},
-            {"shape": "disk", "center": [-3.2, 2.6, 2.4], "normal": [0.8, -0.45, -0.4], "radius": 0.45,
-             "power": [110, 80, 50]},
-            {"shape": "sphere", "center": [2.3, 2.4, 1.4], "radius": 0.25, "power": [40, 55, 90]},
+            {"shape": "rect", "corner": [-1.6, 3.6, -0.9], "edge_s": [1.0, 0, 0], "edge_t": [0, 0, 1.0], "power": 260},
+            {"shape": "disk", "center": [2.8, 3.4, -1.2], "normal": [-0.45, -1, 0.3], "radius": 0.35,
+             "power": [120, 95, 70]},
+            {"shape": "sphere", "center": [0.9, 2.6, 2.0], "radius": 0.15, "power": [40, 50, 90]},
         ],
         "render": {"samples": 1024},
     }
-    with open(os.path.join(a.out_dir, "foliage.json"), "w") as f:
+    with open(os.path.join(out, "foliage.json"), "w") as f:
         json.dump(scene, f, indent=1)
-        f.write("\n")
 
 
 if __name__ == "__main__":
