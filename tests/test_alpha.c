@@ -638,9 +638,9 @@ static void primary(const char *format, const char *pname)
     long through = 0, differ = 0, amb = 0, on_cards = 0;
     for (int y = 0; y < size; y++)
         for (int x = 0; x < size; x++) {
-            float df[3];
-            ms_camera_ray(&ctx.cam, x, y, df);
-            const double o[3] = { ctx.cam.eye[0], ctx.cam.eye[1], ctx.cam.eye[2] }, d[3] = { df[0], df[1], df[2] };
+            float of[3], df[3];
+            assert_int_equal(ms_camera_ray(&ctx.cam, x, y, of, df), 0);
+            const double o[3] = { of[0], of[1], of[2] }, d[3] = { df[0], df[1], df[2] };
             /* The oracle: the nearest triangle hit where opaque; ambiguous if a hit nearer than it is near the
              * cutoff or an edge. */
             int best = -1, ambiguous = 0, crossed = 0;
