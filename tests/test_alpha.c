@@ -309,6 +309,7 @@ static int oracle_hit(const otri *T, const double o[3], const double d[3], doubl
     p[0] = d[1] * e2[2] - d[2] * e2[1]; p[1] = d[2] * e2[0] - d[0] * e2[2]; p[2] = d[0] * e2[1] - d[1] * e2[0];
     const double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
     *near_edge = 0;
+    *t = *b1 = *b2 = 0.0;   /* defined when the line is parallel to the plane */
     if (fabs(det) < 1e-300) return 0;
     q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
     const double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det, v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
