@@ -75,7 +75,7 @@ typedef struct ms_camera {
  *     centre c, unit normal m and radius r the parallelogram is its bounding square (ms_light_disk);
  *   MS_LIGHT_SPHERE: a sphere (center, radius; the parallelogram fields unused). Seen from a receiver P
  *     outside it, its outline is a disk facing P (ms_light_sphere_outline): each receiver is sampled on
- *     its own outline disk, a per-receiver light frame. Frames only (ms_render); not textured. */
+ *     its own outline disk, a per-receiver light frame (frames, points and bakes alike); not textured. */
 typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2 } ms_light_shape;
 
 /* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
@@ -459,6 +459,9 @@ typedef struct ms_accel ms_accel;
 ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
 void ms_accel_free(ms_accel *a);
 size_t ms_accel_triangles(const ms_accel *a);
+/* The lights of the scene the accel was built from (its own copies, texels included: valid until
+ * ms_accel_free); *n gets their number (ms_scene_lights of that scene). */
+const ms_light *ms_accel_lights(const ms_accel *a, size_t *n);
 
 #define MS_NO_TRIANGLE UINT32_MAX
 
@@ -488,7 +491,8 @@ typedef struct ms_points_options {
 } ms_points_options;
 
 /* V, S and the front count of each point (any output may be NULL; each has n entries). light: NULL for
- * the light of the scene the accel was built from. Stats (timing, counters, no image fields) into
+ * the first light of the scene the accel was built from (ms_accel_lights lists them all). A sphere light
+ * is sampled per point on its outline disk as in frames; a point inside the sphere gets V = S = 0. Stats (timing, counters, no image fields) into
  * stats when non-NULL. */
 ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
                                const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
