@@ -36,6 +36,7 @@ static void usage(FILE *f)
         "  --padding N         texels between xatlas charts (default 2)\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
+        "  --verbose           every warning in full (e.g. each unusable material file or texture)\n"
 #ifdef MS_HAVE_MPI
         "  --mpi-schedule S    under mpirun: counter (default), queue or static (see microshadow --help)\n"
         "  --mpi-chunk N       under mpirun: texel rows per hand-out (default 8)\n"
@@ -72,7 +73,7 @@ static int progress_bar(void *user, double frac)
 int ms_cli_bake(int argc, char **argv)
 {
     enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK };
+           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -82,6 +83,7 @@ int ms_cli_bake(int argc, char **argv)
         { "samples", required_argument, 0, O_SAMPLES }, { "seed", required_argument, 0, O_SEED },
         { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
         { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
+        { "verbose", no_argument, 0, O_VERBOSE },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -146,6 +148,7 @@ int ms_cli_bake(int argc, char **argv)
         case O_VIS: outs[3].path = optarg; break;
         case O_SHADOW: outs[4].path = optarg; break;
         case O_QUIET: quiet = 1; break;
+        case O_VERBOSE: ms_set_warning_verbose(1); break;
 #ifdef MS_HAVE_MPI
         case O_MPI_SCHEDULE:
             if (ms_mpi_schedule_from_name(optarg, &schedule)) {

@@ -168,7 +168,7 @@ int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *path, char *er
     }
     /* Several lights: R, G, B (their sum) and every light's S and V as in --shadow/--vis: S0, S1, ..., V0, ... */
     if (nl > MAX_LIGHT_CHANNELS) { snprintf(err, errlen, "%s: more than %d lights for one EXR", path, MAX_LIGHT_CHANNELS); return -1; }
-    char names[2][MAX_LIGHT_CHANNELS][8];
+    char names[2][MAX_LIGHT_CHANNELS][12];
     exr_channel ch[3 + 2 * MAX_LIGHT_CHANNELS] = { { "B", f->rgb + 2, 3 }, { "G", f->rgb + 1, 3 }, { "R", f->rgb, 3 } };
     const size_t npix = (size_t)f->width * (size_t)f->height;
     int n = 3;

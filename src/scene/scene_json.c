@@ -410,11 +410,13 @@ int ms_scene_parse(const char *text, size_t len, const char *json_path, ms_scene
     warn_list w;
     w.n = 0;
     g_warnings = &w;
+    ms_material_warnings_begin();
     int rc = scene_parse(text, len, json_path, out, err, errlen);
     g_warnings = NULL;
     if (rc) ms_one_line(err);
     else
         for (int i = 0; i < w.n; i++) ms_warn("%s", w.line[i]);
+    ms_material_warnings_end(rc == 0);   /* one line for all the unusable material files and textures */
     return rc;
 }
 
