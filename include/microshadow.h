@@ -524,8 +524,9 @@ typedef struct ms_bake_options {
 } ms_bake_options;
 
 typedef struct ms_lightmap {
-    /* width = height = size; rgb: irradiance E (not radiance), vis and shadow V and S (-1 where neither
-     * a triangle nor dilation reached), front: the texel's front samples (0 off the triangles);
+    /* width = height = size; rgb: irradiance E (not radiance, summed over the lights), vis and shadow V
+     * and S per light (-1 where neither a triangle nor dilation reached), front: the texel's front samples
+     * per light (0 off the triangles);
      * exposure and stats as for frames (visible_pixels: texels on triangles). The ms_output writers and
      * ms_exr_write_stream take &lightmap.frame. */
     ms_frame frame;
@@ -538,8 +539,9 @@ typedef struct ms_lightmap {
     double unwrap_s, raster_s; /* seconds in xatlas and in the texel rasterization */
 } ms_lightmap;
 
-/* Bakes the scene's light into a lightmap. accel: the scene's (ms_accel_build), or NULL to build one
- * here. MS_OK, or an error with out zeroed. */
+/* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
+ * vis + l*size*size, as frames hold them), the irradiance summed over the lights. accel: the scene's
+ * (ms_accel_build), or NULL to build one here. MS_OK, or an error with out zeroed. */
 ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
                   char *err, size_t errlen);
 void ms_lightmap_free(ms_lightmap *lm);
@@ -553,8 +555,9 @@ void ms_lightmap_free(ms_lightmap *lm);
 /* The options' checks, the UVs (xatlas where needed) and the texels' points: out->position, normal,
  * triangle, texels, and frame's arrays (vis, shadow -1 until baked). MS_OK, or an error with out zeroed. */
 ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err, size_t errlen);
-/* V, S and front of the texels of rows [y0, y1) (ms_visibility_points with the texel keys), their stats
- * added to lm->frame.stats. lm is left as it was on an error. */
+/* V, S and front of the texels of rows [y0, y1) for every light of the accel (ms_visibility_points with
+ * the texel keys, one call per light), their stats added to lm->frame.stats. lm is left as it was on an
+ * error. */
 ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1, char *err,
                        size_t errlen);
 /* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
@@ -562,7 +565,8 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lig
 ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
 
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
- * of lightmaps), V and S. An ms_output_write_fn; ends in .exr. */
+ * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
+ * and V. An ms_output_write_fn; ends in .exr. */
 int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 
 #ifdef __cplusplus
