@@ -3280,6 +3280,9 @@ private:
 		for (;;) {
 			worker->cv.wait(lock, [=]{ return worker->wakeup.load(); });
 			worker->wakeup = false;
+			// microshadow: tasks run without the worker's mutex, which run() now takes to wake workers (a task
+			// that runs subtasks would otherwise lock its own worker's mutex twice).
+			lock.unlock();
 			for (;;) {
 				if (scheduler->m_shutdown)
 					return;
@@ -3303,6 +3306,7 @@ private:
 				task->func(group->userData, task->userData);
 				group->ref--;
 			}
+			lock.lock();
 		}
 	}
 };
