@@ -35,7 +35,7 @@ static void usage(FILE *f)
         "  --threads T         threads (default: all cores)\n"
         "  --seed S            seed of the per-pixel sample patterns (default 0)\n"
         "  -o OUT.png|.exr     shaded image (default microshadow.png): PNG tone-mapped sRGB, EXR linear HDR\n"
-        "                      radiance (channels R, G, B, V, S)\n"
+        "                      radiance (channels R, G, B, V, S; several lights: V0, V1, ..., S0, S1, ...)\n"
         "  --exposure EV       PNG: stops added to the automatic exposure (which maps the 99th percentile of\n"
         "                      unshadowed radiance to 1): the PNG shows radiance * 2^EV * auto (default 0)\n"
         "  --vis OUT.pfm|.exr  float visibility V, -1 where the primary ray missed\n"
