@@ -88,7 +88,11 @@ int ms_exr_decode_linear(const char *name, const void *bytes, size_t len, int ma
     for (int c = 0; c < chl->num_channels; c++) {
         const exr_attr_chlist_entry_t *e = &chl->entries[c];
         if (e->x_sampling != 1 || e->y_sampling != 1) {
-            snprintf(err, errlen, "%s: channel '%.32s' is subsampled (not supported)", name, e->name.str);
+            char cn[33];   /* the file's name for it, made printable: the message is one line */
+            snprintf(cn, sizeof cn, "%s", e->name.str ? e->name.str : "");
+            for (char *q = cn; *q; q++)
+                if ((unsigned char)*q < 0x20 || *q == 0x7f) *q = '?';
+            snprintf(err, errlen, "%s: channel '%s' is subsampled (not supported)", name, cn);
             goto done;
         }
         if (!strcmp(e->name.str, "R")) want[0] = c;
