@@ -98,7 +98,7 @@ typedef struct ms_camera {
  *     centre c, unit normal m and radius r the parallelogram is its bounding square (ms_light_disk);
  *   MS_LIGHT_SPHERE: a sphere (center, radius; the parallelogram fields unused). Seen from a receiver P
  *     outside it, its outline is a disk facing P (ms_light_sphere_outline): each receiver is sampled on
- *     its own outline disk, a per-receiver light frame. Frames only (ms_render); not textured. */
+ *     its own outline disk, a per-receiver light frame (frames, points and bakes alike); not textured. */
 typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2 } ms_light_shape;
 
 /* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
@@ -235,6 +235,10 @@ void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, floa
  * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */
 typedef void (*ms_warning_fn)(void *user, const char *message);
 void ms_set_warning_handler(ms_warning_fn fn, void *user);
+/* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, JPEG, an
+ * absolute path) are one warning per ms_scene_load: that warning, or "N material files or textures could not
+ * be used ... (first: ...)". With verbose non-zero (process-wide, like the handler) each is its own warning. */
+void ms_set_warning_verbose(int verbose);
 
 /* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL through assimp, glTF 2.0 through cgltf; paths
  * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
@@ -493,6 +497,9 @@ typedef struct ms_accel ms_accel;
 ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
 void ms_accel_free(ms_accel *a);
 size_t ms_accel_triangles(const ms_accel *a);
+/* The lights of the scene the accel was built from (its own copies, texels included: valid until
+ * ms_accel_free); *n gets their number (ms_scene_lights of that scene). */
+const ms_light *ms_accel_lights(const ms_accel *a, size_t *n);
 
 #define MS_NO_TRIANGLE UINT32_MAX
 
@@ -522,7 +529,8 @@ typedef struct ms_points_options {
 } ms_points_options;
 
 /* V, S and the front count of each point (any output may be NULL; each has n entries). light: NULL for
- * the light of the scene the accel was built from. Stats (timing, counters, no image fields) into
+ * the first light of the scene the accel was built from (ms_accel_lights lists them all). A sphere light
+ * is sampled per point on its outline disk as in frames; a point inside the sphere gets V = S = 0. Stats (timing, counters, no image fields) into
  * stats when non-NULL. */
 ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
                                const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
@@ -550,8 +558,9 @@ typedef struct ms_bake_options {
 } ms_bake_options;
 
 typedef struct ms_lightmap {
-    /* width = height = size; rgb: irradiance E (not radiance), vis and shadow V and S (-1 where neither
-     * a triangle nor dilation reached), front: the texel's front samples (0 off the triangles);
+    /* width = height = size; rgb: irradiance E (not radiance, summed over the lights), vis and shadow V
+     * and S per light (-1 where neither a triangle nor dilation reached), front: the texel's front samples
+     * per light (0 off the triangles);
      * exposure and stats as for frames (visible_pixels: texels on triangles). The ms_output writers and
      * ms_exr_write_stream take &lightmap.frame. */
     ms_frame frame;
@@ -564,8 +573,9 @@ typedef struct ms_lightmap {
     double unwrap_s, raster_s; /* seconds in xatlas and in the texel rasterization */
 } ms_lightmap;
 
-/* Bakes the scene's light into a lightmap. accel: the scene's (ms_accel_build), or NULL to build one
- * here. MS_OK, or an error with out zeroed. */
+/* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
+ * vis + l*size*size, as frames hold them), the irradiance summed over the lights. accel: the scene's
+ * (ms_accel_build), or NULL to build one here. MS_OK, or an error with out zeroed. */
 ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
                   char *err, size_t errlen);
 void ms_lightmap_free(ms_lightmap *lm);
@@ -579,8 +589,9 @@ void ms_lightmap_free(ms_lightmap *lm);
 /* The options' checks, the UVs (xatlas where needed) and the texels' points: out->position, normal,
  * triangle, texels, and frame's arrays (vis, shadow -1 until baked). MS_OK, or an error with out zeroed. */
 ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err, size_t errlen);
-/* V, S and front of the texels of rows [y0, y1) (ms_visibility_points with the texel keys), their stats
- * added to lm->frame.stats. lm is left as it was on an error. */
+/* V, S and front of the texels of rows [y0, y1) for every light of the accel (ms_visibility_points with
+ * the texel keys, one call per light), their stats added to lm->frame.stats. lm is left as it was on an
+ * error. */
 ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1, char *err,
                        size_t errlen);
 /* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
@@ -588,7 +599,8 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lig
 ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
 
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
- * of lightmaps), V and S. An ms_output_write_fn; ends in .exr. */
+ * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
+ * and V. An ms_output_write_fn; ends in .exr. */
 int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 
 #ifdef __cplusplus

@@ -4,7 +4,9 @@
  * Outputs: distinct targets, regular files only, names up to the filesystem's limit, mode from the
  * umask, staging files removed on errors and signals, one message of ours on a full disk. */
 #include "testutil.h"
+#include <OpenEXR/openexr.h>
 #include <errno.h>
+#include <math.h>
 #include <dirent.h>
 #include <fcntl.h>
 #include <pthread.h>
@@ -575,6 +577,62 @@ static void test_outputs_sigterm_trials(void **st)
     assert_true(killed > 0);
 }
 
+/* ------------------------------------------------------------------ light textures (EXR) */
+
+static const char *exr_light_scene(const char *json, const char *tex)
+{
+    char light[512];
+    snprintf(light, sizeof light, "{ \"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2], \"texture\": \"%s\" }", tex);
+    return scene(json, "ok.obj", NULL, light);
+}
+
+/* Bad EXR light textures: one line naming the file and the problem, exit 2, bounded time and memory. */
+static void test_light_texture_exr(void **st)
+{
+    (void)st;
+    enum { W = 8, H = 8, N = W * H };
+    float r[N], nan_r[N], neg_r[N];
+    for (int i = 0; i < N; i++) r[i] = nan_r[i] = neg_r[i] = 0.5f + (float)i;
+    nan_r[9] = NAN;
+    neg_r[3] = -1.0f;
+    const char *rgb[] = { "R", "G", "B" }, *z[] = { "Z" };
+    const float *const ok[] = { r, r, r }, *const nan3[] = { nan_r, r, r }, *const neg3[] = { r, r, neg_r };
+    assert_int_equal(tu_write_exr(inpath("good.exr"), W, H, 3, rgb, ok, 0, EXR_COMPRESSION_NONE), 0);
+    assert_int_equal(tu_write_exr(inpath("nan.exr"), W, H, 3, rgb, nan3, 0, EXR_COMPRESSION_ZIP), 0);
+    assert_int_equal(tu_write_exr(inpath("neg.exr"), W, H, 3, rgb, neg3, 0, EXR_COMPRESSION_ZIP), 0);
+    assert_int_equal(tu_write_exr(inpath("z.exr"), W, H, 1, z, ok, 0, EXR_COMPRESSION_ZIP), 0);
+    FILE *f = fopen(inpath("good.exr"), "rb");
+    assert_non_null(f);
+    static char buf[1 << 16];
+    const size_t n = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    assert_true(n > 100 && n < sizeof buf);
+    /* the good one loads: the failures below are the damage's */
+    ms_scene sc;
+    char err[512];
+    assert_int_equal(ms_scene_load(exr_light_scene("exr-good.json", "good.exr"), &sc, err, sizeof err), 0);
+    ms_scene_free(&sc);
+    write_bytes("cut.exr", buf, n / 2);                     /* pixel data cut off */
+    write_bytes("header-cut.exr", buf, 40);                 /* inside the header */
+    write_bytes("magic.exr", "\x76\x2f\x31\x01garbage after the magic number, no header at all", 52);
+    /* a data window of 1,000,000 x 1,000,000 in a file of a few hundred bytes: refused before any texel memory */
+    char *dwin = memmem(buf, n, "dataWindow\0box2i\0", 17);
+    assert_non_null(dwin);
+    const int32_t big[4] = { 0, 0, 999999, 999999 };
+    memcpy(dwin + 17 + 4, big, sizeof big);
+    write_bytes("huge.exr", buf, n);
+    memcpy(dwin + 17 + 4, (const int32_t[4]){ 0, 0, 9000, 2 }, 16);   /* just past our 8192 */
+    write_bytes("wide.exr", buf, n);
+    expect_bad(exr_light_scene("exr-cut.json", "cut.exr"), NULL, NEEDLES("cut.exr", "EXR"));
+    expect_bad(exr_light_scene("exr-hcut.json", "header-cut.exr"), NULL, NEEDLES("header-cut.exr", "not a readable EXR image"));
+    expect_bad(exr_light_scene("exr-magic.json", "magic.exr"), NULL, NEEDLES("magic.exr", "not a readable EXR image"));
+    expect_bad(exr_light_scene("exr-huge.json", "huge.exr"), NULL, NEEDLES("huge.exr", "EXR"));
+    expect_bad(exr_light_scene("exr-wide.json", "wide.exr"), NULL, NEEDLES("wide.exr", "EXR"));
+    expect_bad(exr_light_scene("exr-nan.json", "nan.exr"), NULL, NEEDLES("nan.exr", "texel (1, 1) is negative, NaN or infinite"));
+    expect_bad(exr_light_scene("exr-neg.json", "neg.exr"), NULL, NEEDLES("neg.exr", "texel (3, 0) is negative, NaN or infinite"));
+    expect_bad(exr_light_scene("exr-z.json", "z.exr"), NULL, NEEDLES("z.exr", "no R, G and B (or Y) channels"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -598,6 +656,7 @@ int main(void)
         cmocka_unit_test(test_outputs_signal_removes_staging),
         cmocka_unit_test(test_outputs_signal_on_other_thread),
         cmocka_unit_test(test_outputs_sigterm_trials),
+        cmocka_unit_test(test_light_texture_exr),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -514,7 +514,7 @@ static void test_bad_light_json(void **st)
     snprintf(buf, sizeof buf, "\"light\": { %s, \"texture\": \"notpng.png\" }", rect);
     expect_bad("b15.json", buf, "not a readable PNG image");
     snprintf(buf, sizeof buf, "\"light\": { %s, \"texture\": 7 }", rect);
-    expect_bad("b16.json", buf, "light.texture must be the path of a PNG image");
+    expect_bad("b16.json", buf, "light.texture must be the path of a PNG or EXR image");
 }
 
 /* --vis to EXR: one channel per light; to PFM: light 0. */

@@ -574,12 +574,15 @@ static void test_normals_change_shading_not_visibility(void **st)
     }
 }
 
-static char g_warning[1024];
+static char g_warning[2048];
 static int g_warnings;
+static char g_first_warning[1024];
+
 static void catch_warning(void *user, const char *msg)
 {
     (void)user;
     snprintf(g_warning, sizeof g_warning, "%s", msg);
+    if (!g_warnings) snprintf(g_first_warning, sizeof g_first_warning, "%s", msg);
     g_warnings++;
 }
 
@@ -774,13 +777,39 @@ static void test_hostile_mtl(void **st)
         "\"camera\":{\"eye\":[0,4,4],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":16,\"height\":16},"
         "\"light\":{\"corner\":[-1,3,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2]}}"), 0);
     ms_set_warning_handler(catch_warning, NULL);
+    /* verbose: one warning per unusable file; then the default: one line with their number and the first */
+    ms_set_warning_verbose(1);
     g_warnings = 0;
+    g_first_warning[0] = 0;
     ms_scene sc;
     char err[512];
     assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "scene.json"), &sc, err, sizeof err), 0);
+    ms_scene_free(&sc);
+    const int each = g_warnings;
+    char first[1024];
+    snprintf(first, sizeof first, "%s", g_first_warning);
+    printf("%d warnings, the first: %s\n", each, first);
+    assert_true(each >= 5);   /* fifo.mtl, /abs/x.mtl, fifo.png, adir.png, /etc/passwd */
+    ms_set_warning_verbose(0);
+    g_warnings = 0;
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "scene.json"), &sc, err, sizeof err), 0);
     ms_set_warning_handler(NULL, NULL);
-    printf("%d warnings, the last: %s\n", g_warnings, g_warning);
-    assert_true(g_warnings >= 5);   /* fifo.mtl, /abs/x.mtl, fifo.png, adir.png, /etc/passwd */
+    printf("summary: %s\n", g_warning);
+    assert_int_equal(g_warnings, 1);
+    char want[1400];
+    snprintf(want, sizeof want, "%d material files or textures could not be used", each);
+    assert_non_null(strstr(g_warning, want));
+    snprintf(want, sizeof want, "(first: %s)", first);
+    assert_non_null(strstr(g_warning, want));
+    /* the CLI: one warning line; --verbose every one */
+    char out_png[512], errs[8192];
+    const char *quiet_args[] = { path, "--quiet", "-o", tu_path(out_png, sizeof out_png, dir, "w.png"), NULL };
+    const char *verbose_args[] = { path, "--quiet", "--verbose", "-o", out_png, NULL };
+    tu_run_result rr;
+    assert_int_equal(tu_run_cli_ex(quiet_args, NULL, errs, sizeof errs, &rr), 0);
+    assert_int_equal(rr.lines, 1);
+    assert_int_equal(tu_run_cli_ex(verbose_args, NULL, errs, sizeof errs, &rr), 0);
+    assert_int_equal(rr.lines, each);
     assert_int_equal((int)sc.n_materials, 4);
     assert_int_equal((int)sc.n_textures, 0);
     for (size_t i = 0; i < sc.n_materials; i++) {

@@ -1,5 +1,6 @@
 /* `microshadow bake SCENE.json --uv N --size S -o lightmap.exr [--png preview.png]`: a lightmap of the
- * scene's light through ms_bake, written all or nothing (ms_outputs_*). */
+ * scene's lights through ms_bake (V and S per light, the irradiance summed), written all or nothing
+ * (ms_outputs_*). */
 #include "microshadow.h"
 #include "bake.h"
 #ifdef MS_HAVE_MPI
@@ -18,19 +19,24 @@ static void usage(FILE *f)
 {
     fprintf(f,
         "usage: microshadow bake [SCENE.json] [options]\n"
-        "Bakes the scene's light into a lightmap (the built-in scene without SCENE): V, S and irradiance per\n"
-        "texel of a UV set; triangles without that set get UVs from xatlas.\n"
+        "Bakes the scene's lights (rect, disk, sphere, textured) into a lightmap (the built-in scene without\n"
+        "SCENE): V and S per light and the irradiance summed over the lights, per texel of a UV set;\n"
+        "triangles without that set get UVs from xatlas.\n"
         "\n"
         "  --uv N              UV set to bake into: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1),\n"
         "                      or 'xatlas' to unwrap every mesh\n"
         "  --size N            lightmap width and height in texels (default 1024)\n"
-        "  -o OUT.exr          channels R, G, B (irradiance), S and V (default lightmap.exr)\n"
+        "  -o OUT.exr          channels R, G, B (irradiance), S and V (default lightmap.exr);\n"
+        "                      several lights: S0, S1, ..., V0, V1, ... (one per light)\n"
+        "  --vis OUT.pfm|.exr  float V (several lights: an .exr has V0, V1, ..., a .pfm light 0)\n"
+        "  --shadow OUT.pfm|.exr  float S, likewise\n"
         "  --png OUT.png       tone-mapped preview\n"
         "  --stats OUT.json    timings and counters\n"
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
         "  --padding N         texels between xatlas charts (default 2)\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
+        "  --verbose           every warning in full (e.g. each unusable material file or texture)\n"
 #ifdef MS_HAVE_MPI
         "  --mpi-schedule S    under mpirun: counter (default), queue or static (see microshadow --help)\n"
         "  --mpi-chunk N       under mpirun: texel rows per hand-out (default 8)\n"
@@ -66,16 +72,18 @@ static int progress_bar(void *user, double frac)
 
 int ms_cli_bake(int argc, char **argv)
 {
-    enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK };
+    enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
+           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
+        { "vis", required_argument, 0, O_VIS }, { "shadow", required_argument, 0, O_SHADOW },
         { "dilate", required_argument, 0, O_DILATE }, { "padding", required_argument, 0, O_PADDING },
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "seed", required_argument, 0, O_SEED },
         { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
         { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
+        { "verbose", no_argument, 0, O_VERBOSE },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -90,6 +98,8 @@ int ms_cli_bake(int argc, char **argv)
         { "-o", "lightmap.exr", ms_exr_write_stream, exr_suffix },
         { "--png", NULL, ms_png_write_stream, png_suffix },
         { "--stats", NULL, ms_stats_write_stream, NULL },
+        { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
+        { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
     };
     enum { N_OUTS = sizeof outs / sizeof outs[0] };
     ms_bake_options bo;
@@ -135,7 +145,10 @@ int ms_cli_bake(int argc, char **argv)
         case 'o': outs[0].path = optarg; break;
         case O_PNG: outs[1].path = optarg; break;
         case O_STATS: outs[2].path = optarg; break;
+        case O_VIS: outs[3].path = optarg; break;
+        case O_SHADOW: outs[4].path = optarg; break;
         case O_QUIET: quiet = 1; break;
+        case O_VERBOSE: ms_set_warning_verbose(1); break;
 #ifdef MS_HAVE_MPI
         case O_MPI_SCHEDULE:
             if (ms_mpi_schedule_from_name(optarg, &schedule)) {
@@ -198,10 +211,11 @@ int ms_cli_bake(int argc, char **argv)
     if (rc) fprintf(stderr, "microshadow bake: %s\n", err);
     if (!quiet && !rc) {
         const ms_stats *s = &lm.frame.stats;
+        const int nl = lm.frame.n_lights > 1 ? lm.frame.n_lights : 1;
         fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
-                "(rasterized in %.3fs), %d samples, method %s, %d threads: shadow %.3fs (%.0f texels/s), total %.3fs -> %s\n",
+                "(rasterized in %.3fs), %d light%s, %d samples, method %s, %d threads: shadow %.3fs (%.0f texels/s), total %.3fs -> %s\n",
                 scene_path ? scene_path : "built-in scene", s->triangles, lm.unwrapped_tris, lm.unwrap_s, lm.frame.width,
-                lm.frame.height, lm.texels, lm.raster_s, s->samples, s->method, s->threads, s->shadow_s,
+                lm.frame.height, lm.texels, lm.raster_s, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads, s->shadow_s,
                 s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, outs[0].path);
     }
     ms_lightmap_free(&lm);

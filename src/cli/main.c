@@ -35,7 +35,7 @@ static void usage(FILE *f)
         "  --threads T         threads (default: all cores)\n"
         "  --seed S            seed of the per-pixel sample patterns (default 0)\n"
         "  -o OUT.png|.exr     shaded image (default microshadow.png): PNG tone-mapped sRGB, EXR linear HDR\n"
-        "                      radiance (channels R, G, B, V, S)\n"
+        "                      radiance (channels R, G, B, V, S; several lights: V0, V1, ..., S0, S1, ...)\n"
         "  --exposure EV       PNG: stops added to the automatic exposure (which maps the 99th percentile of\n"
         "                      unshadowed radiance to 1): the PNG shows radiance * 2^EV * auto (default 0)\n"
         "  --vis OUT.pfm|.exr  float visibility V, -1 where the primary ray missed\n"
@@ -46,6 +46,8 @@ static void usage(FILE *f)
         "  --traversal T       micro-raster methods: block (default: 4x4 pixels' frusta together) or pixel\n"
         "  --frustum-shrink    block traversal and mft: narrow each frustum as its samples are occluded\n"
         "  --quiet             no progress or summary on stderr\n"
+        "  --verbose           every warning in full (e.g. each unusable material file or texture, which\n"
+        "                      are otherwise one line per scene: their number and the first)\n"
 #ifdef MS_HAVE_MPI
         "  --mpi-schedule S    under mpirun: how ranks get tiles: counter (default: a shared counter, MPI\n"
         "                      one-sided), queue (rank 0 hands them out), static (round robin)\n"
@@ -87,7 +89,7 @@ static int cli_main(int argc, char **argv)
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
-           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK };
+           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -95,6 +97,7 @@ static int cli_main(int argc, char **argv)
         { "seed", required_argument, 0, O_SEED }, { "vis", required_argument, 0, O_VIS },
         { "shadow", required_argument, 0, O_SHADOW }, { "isa", required_argument, 0, O_ISA },
         { "stats", required_argument, 0, O_STATS }, { "quiet", no_argument, 0, O_QUIET },
+        { "verbose", no_argument, 0, O_VERBOSE },
         { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
         { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
         { "exposure", required_argument, 0, O_EXPOSURE },
@@ -172,6 +175,7 @@ static int cli_main(int argc, char **argv)
         case O_FRUSTUM_SHRINK: opt.frustum_shrink = 1; break;
         case O_STATS: outs[OUT_STATS].path = optarg; break;
         case O_QUIET: quiet = 1; break;
+        case O_VERBOSE: ms_set_warning_verbose(1); break;
         case O_NO_FILTER: opt.no_filter = 1; break;
         case O_EXPOSURE: {
             char *end;

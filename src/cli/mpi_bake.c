@@ -3,6 +3,7 @@
  * schedule, rank 0 gathers the other ranks' rows (V, S, front) and the sums of their stats and finishes the
  * lightmap (irradiance, exposure, dilation), which makes it ms_bake's bit for bit (microshadow.h). */
 #include "mpi_run.h"
+#include <limits.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,10 +17,11 @@ static int bake_chunk(void *user, int first, int count, char *err, size_t errlen
     return ms_bake_rows(w->accel, w->opt, w->lm, first, first + count, err, errlen) != MS_OK ? -1 : 0;
 }
 
-static uint64_t fingerprint(const ms_lightmap *lm, const ms_bake_options *o)
+static uint64_t fingerprint(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_options *o)
 {
     const size_t nt = (size_t)lm->frame.width * lm->frame.height;
     uint64_t h = ms_mpi_hash(0, &nt, sizeof nt);
+    h = ms_mpi_hash_lights(h, scene);   /* every light's planes are baked and gathered */
     /* the texels' points decide the answer: word by word */
     const uint32_t *w = (const uint32_t *)lm->position;
     for (size_t i = 0; i < 3 * nt; i++) h = (h ^ w[i]) * 1099511628211ull;
@@ -43,7 +45,7 @@ int ms_mpi_bake(const ms_scene *scene, const char *what, const ms_bake_options *
         ms_lightmap_free(out);
         return -1;
     }
-    if (!ms_mpi_same(fingerprint(out, opt))) {
+    if (!ms_mpi_same(fingerprint(scene, out, opt))) {
         if (rank == 0) fprintf(stderr, "microshadow bake: the MPI ranks were given different scenes or options\n");
         ms_mpi_agree(rank == 0);
         ms_accel_free(accel);
@@ -53,6 +55,16 @@ int ms_mpi_bake(const ms_scene *scene, const char *what, const ms_bake_options *
     /* Zero texels: the stats' names and set-up, whichever rows this rank gets (maybe none). */
     if (ms_bake_rows(accel, opt, out, 0, 0, err, errlen)) fprintf(stderr, "microshadow bake: %s: %s\n", what, err);
     const int rows = out->frame.height, W = out->frame.width;
+    const size_t nl = out->frame.n_lights > 1 ? (size_t)out->frame.n_lights : 1, np = (size_t)rows * W;
+    if ((double)rows * 2.0 * (double)W * (double)nl > (double)INT_MAX) {
+        /* MPI counts are ints; every rank sees the same sizes, so every rank stops here alike */
+        snprintf(err, errlen, "a %dx%d lightmap of %zu lights is too large for one MPI gather", W, rows, nl);
+        fprintf(stderr, "microshadow bake: %s: %s\n", what, err);
+        ms_mpi_agree(1);
+        ms_accel_free(accel);
+        ms_lightmap_free(out);
+        return -1;
+    }
     const double t0 = MPI_Wtime();
     unsigned char *done = malloc((size_t)rows);
     if (!done) ms_mpi_fatal("out of memory");   /* a few kilobytes: no way to go on in step */
@@ -61,20 +73,23 @@ int ms_mpi_bake(const ms_scene *scene, const char *what, const ms_bake_options *
     memset(&rep, 0, sizeof rep);
     const int bad = ms_mpi_distribute(sched, rows, chunk, bake_chunk, &w, done, &rep, err, errlen) != 0;
 
-    /* Rank 0 gathers the other ranks' rows. */
+    /* Rank 0 gathers the other ranks' rows: per row, every light's V and S (2 W nl floats) and front (W nl). */
     ms_frame *f = &out->frame;
+    const size_t rw = 2 * (size_t)W * nl, fw = (size_t)W * nl;   /* floats and fronts per gathered row */
     int mine = 0;
     for (int y = 0; rank > 0 && y < rows; y++) mine += done[y];
     int *ids = malloc(((size_t)mine + 1) * sizeof *ids);
-    float *vs = malloc(((size_t)mine + 1) * 2 * W * sizeof *vs);
-    uint16_t *fr = malloc(((size_t)mine + 1) * W * sizeof *fr);
+    float *vs = malloc(((size_t)mine + 1) * rw * sizeof *vs);
+    uint16_t *fr = malloc(((size_t)mine + 1) * fw * sizeof *fr);
     if (!ids || !vs || !fr) ms_mpi_fatal("out of memory gathering the ranks' results");
     for (int y = 0, k = 0; rank > 0 && k < mine; y++) {
         if (!done[y]) continue;
         ids[k] = y;
-        memcpy(vs + (size_t)k * 2 * W, f->vis + (size_t)y * W, (size_t)W * sizeof *vs);
-        memcpy(vs + (size_t)k * 2 * W + W, f->shadow + (size_t)y * W, (size_t)W * sizeof *vs);
-        memcpy(fr + (size_t)k * W, f->front + (size_t)y * W, (size_t)W * sizeof *fr);
+        for (size_t l = 0; l < nl; l++) {
+            memcpy(vs + (size_t)k * rw + 2 * l * W, f->vis + l * np + (size_t)y * W, (size_t)W * sizeof *vs);
+            memcpy(vs + (size_t)k * rw + (2 * l + 1) * W, f->shadow + l * np + (size_t)y * W, (size_t)W * sizeof *vs);
+            memcpy(fr + (size_t)k * fw + l * W, f->front + l * np + (size_t)y * W, (size_t)W * sizeof *fr);
+        }
         k++;
     }
     int *counts = NULL, *displ = NULL, *c2 = NULL, *d2 = NULL, *c1 = NULL, *d1 = NULL, total = 0;
@@ -90,24 +105,26 @@ int ms_mpi_bake(const ms_scene *scene, const char *what, const ms_bake_options *
     MPI_Gather(&mine, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
     for (int r = 0; rank == 0 && r < size; r++) {
         displ[r] = total;
-        c2[r] = counts[r] * 2 * W;
-        d2[r] = total * 2 * W;
-        c1[r] = counts[r] * W;
-        d1[r] = total * W;
+        c2[r] = counts[r] * (int)rw;
+        d2[r] = total * (int)rw;
+        c1[r] = counts[r] * (int)fw;
+        d1[r] = total * (int)fw;
         total += counts[r];
     }
     int *all_ids = rank == 0 ? malloc(((size_t)total + 1) * sizeof *all_ids) : NULL;
-    float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * 2 * W * sizeof *all_vs) : NULL;
-    uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * W * sizeof *all_fr) : NULL;
+    float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * rw * sizeof *all_vs) : NULL;
+    uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * fw * sizeof *all_fr) : NULL;
     if (rank == 0 && (!all_ids || !all_vs || !all_fr)) ms_mpi_fatal("out of memory gathering the ranks' results");
     MPI_Gatherv(ids, mine, MPI_INT, all_ids, counts, displ, MPI_INT, 0, MPI_COMM_WORLD);
-    MPI_Gatherv(vs, mine * 2 * W, MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
-    MPI_Gatherv(fr, mine * W, MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);
+    MPI_Gatherv(vs, mine * (int)rw, MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
+    MPI_Gatherv(fr, mine * (int)fw, MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);
     for (int k = 0; rank == 0 && k < total; k++) {
         const int y = all_ids[k];
-        memcpy(f->vis + (size_t)y * W, all_vs + (size_t)k * 2 * W, (size_t)W * sizeof *all_vs);
-        memcpy(f->shadow + (size_t)y * W, all_vs + (size_t)k * 2 * W + W, (size_t)W * sizeof *all_vs);
-        memcpy(f->front + (size_t)y * W, all_fr + (size_t)k * W, (size_t)W * sizeof *all_fr);
+        for (size_t l = 0; l < nl; l++) {
+            memcpy(f->vis + l * np + (size_t)y * W, all_vs + (size_t)k * rw + 2 * l * W, (size_t)W * sizeof *all_vs);
+            memcpy(f->shadow + l * np + (size_t)y * W, all_vs + (size_t)k * rw + (2 * l + 1) * W, (size_t)W * sizeof *all_vs);
+            memcpy(f->front + l * np + (size_t)y * W, all_fr + (size_t)k * fw + l * W, (size_t)W * sizeof *all_fr);
+        }
     }
     free(all_ids);
     free(all_vs);

@@ -32,20 +32,7 @@ static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
     }
     h = ms_mpi_hash(h, &s->procedural, sizeof s->procedural);
     h = ms_mpi_hash(h, &s->camera, sizeof s->camera);
-    size_t nl;
-    const ms_light *lights = ms_scene_lights(s, &nl);
-    h = ms_mpi_hash(h, &nl, sizeof nl);
-    for (size_t l = 0; l < nl; l++) {   /* field by field: no padding, and the texels, not their address */
-        const ms_light *L = &lights[l];
-        const float f[] = { L->corner.x, L->corner.y, L->corner.z, L->edge_s.x, L->edge_s.y, L->edge_s.z,
-                            L->edge_t.x, L->edge_t.y, L->edge_t.z, L->emission.x, L->emission.y, L->emission.z,
-                            L->center.x, L->center.y, L->center.z, L->radius };
-        const int d[] = { (int)L->shape, L->texture != NULL, L->texture_width, L->texture_height };
-        h = ms_mpi_hash(h, f, sizeof f);
-        h = ms_mpi_hash(h, d, sizeof d);
-        if (L->texture)
-            h = ms_mpi_hash(h, L->texture, (size_t)L->texture_width * (size_t)L->texture_height * 3 * sizeof *L->texture);
-    }
+    h = ms_mpi_hash_lights(h, s);
     h = ms_mpi_hash(h, &s->samples, sizeof s->samples);
     /* The surfaces (materials, their textures and UVs, shading normals) decide S_spec and the shading. */
     const size_t counts[] = { s->n_materials, s->n_textures, s->tri_material != NULL, s->tri_normal != NULL };

@@ -296,6 +296,25 @@ uint64_t ms_mpi_hash(uint64_t h, const void *data, size_t n)
     return h;
 }
 
+uint64_t ms_mpi_hash_lights(uint64_t h, const ms_scene *s)
+{
+    size_t nl;
+    const ms_light *lights = ms_scene_lights(s, &nl);
+    h = ms_mpi_hash(h, &nl, sizeof nl);
+    for (size_t l = 0; l < nl; l++) {   /* field by field: no padding, and the texels, not their address */
+        const ms_light *L = &lights[l];
+        const float f[] = { L->corner.x, L->corner.y, L->corner.z, L->edge_s.x, L->edge_s.y, L->edge_s.z,
+                            L->edge_t.x, L->edge_t.y, L->edge_t.z, L->emission.x, L->emission.y, L->emission.z,
+                            L->center.x, L->center.y, L->center.z, L->radius };
+        const int d[] = { (int)L->shape, L->texture != NULL, L->texture_width, L->texture_height };
+        h = ms_mpi_hash(h, f, sizeof f);
+        h = ms_mpi_hash(h, d, sizeof d);
+        if (L->texture)
+            h = ms_mpi_hash(h, L->texture, (size_t)L->texture_width * (size_t)L->texture_height * 3 * sizeof *L->texture);
+    }
+    return h;
+}
+
 int ms_mpi_same(uint64_t h)
 {
     uint64_t h0 = h;

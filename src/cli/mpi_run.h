@@ -66,6 +66,8 @@ extern ms_mpi_report ms_mpi_last_report;
 
 /* A fingerprint of the scene and options; ranks compare theirs (ms_mpi_same). */
 uint64_t ms_mpi_hash(uint64_t h, const void *data, size_t n);
+/* h extended by every light of the scene (shape, frame, emission, texels). */
+uint64_t ms_mpi_hash_lights(uint64_t h, const ms_scene *s);
 /* Collective: 1 when every rank's h is rank 0's. */
 int ms_mpi_same(uint64_t h);
 

@@ -1,6 +1,6 @@
 /* The float images of V and S: PFM (written here: a header and raw floats, rows bottom to top as the
  * format requires) or OpenEXR (through OpenEXRCore, one FLOAT channel "V" resp. "S", ZIP compressed);
- * and the whole frame or lightmap as one EXR (R, G, B, S, V). */
+ * and the whole frame or lightmap as one EXR (R, G, B, S, V; with several lights S0, S1, ..., V0, V1, ...). */
 #include "microshadow.h"
 #include "microshadow.h"
 #include <errno.h>
@@ -160,7 +160,28 @@ int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *path, char 
 int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
     if (!ends_with(path, ".exr")) { snprintf(err, errlen, "%s: the RGB image must end in .exr", path); return -1; }
-    const exr_channel ch[5] = { { "B", f->rgb + 2, 3 }, { "G", f->rgb + 1, 3 }, { "R", f->rgb, 3 },
-                                { "S", f->shadow, 1 }, { "V", f->vis, 1 } };
-    return write_exr(f, ch, 5, out, path, err, errlen);
+    const int nl = f->n_lights > 1 ? f->n_lights : 1;
+    if (nl == 1) {
+        const exr_channel ch[5] = { { "B", f->rgb + 2, 3 }, { "G", f->rgb + 1, 3 }, { "R", f->rgb, 3 },
+                                    { "S", f->shadow, 1 }, { "V", f->vis, 1 } };
+        return write_exr(f, ch, 5, out, path, err, errlen);
+    }
+    /* Several lights: R, G, B (their sum) and every light's S and V as in --shadow/--vis: S0, S1, ..., V0, ... */
+    if (nl > MAX_LIGHT_CHANNELS) { snprintf(err, errlen, "%s: more than %d lights for one EXR", path, MAX_LIGHT_CHANNELS); return -1; }
+    char names[2][MAX_LIGHT_CHANNELS][12];
+    exr_channel ch[3 + 2 * MAX_LIGHT_CHANNELS] = { { "B", f->rgb + 2, 3 }, { "G", f->rgb + 1, 3 }, { "R", f->rgb, 3 } };
+    const size_t npix = (size_t)f->width * (size_t)f->height;
+    int n = 3;
+    for (int which = 0; which < 2; which++) {   /* S before V: the file's order is by name */
+        const int first = n;
+        for (int l = 0; l < nl; l++) {
+            snprintf(names[which][l], sizeof names[which][l], "%c%d", which ? 'V' : 'S', l);
+            ch[n++] = (exr_channel){ names[which][l], (which ? f->vis : f->shadow) + (size_t)l * npix, 1 };
+        }
+        for (int a = first + 1; a < n; a++)
+            for (int b = a; b > first && strcmp(ch[b - 1].name, ch[b].name) > 0; b--) {
+                const exr_channel t = ch[b]; ch[b] = ch[b - 1]; ch[b - 1] = t;
+            }
+    }
+    return write_exr(f, ch, n, out, path, err, errlen);
 }

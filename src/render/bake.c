@@ -4,6 +4,8 @@
  * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
 #include "microshadow.h"
 #include "lightmap_unwrap.h"
+#include "../core/pattern.h"
+#include "../shadow/receiver.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -172,20 +174,23 @@ static ms_status rasterize(const ms_scene *sc, int size, ms_lightmap *lm, char *
     return MS_OK;
 }
 
-/* Fills texels off the triangles from the average of their filled 8-neighbours, `passes` rings deep. */
+/* Fills texels off the triangles from the average of their filled 8-neighbours, `passes` rings deep: the
+ * irradiance and every light's V and S. */
 static int dilate(ms_frame *f, int passes)
 {
     const int W = f->width, H = f->height;
-    uint8_t *filled = malloc((size_t)W * H), *next = malloc((size_t)W * H);
-    if (!filled || !next) { free(filled); free(next); return -1; }
-    for (size_t i = 0; i < (size_t)W * H; i++) filled[i] = f->vis[i] >= 0.0f;
+    const size_t nl = f->n_lights > 1 ? (size_t)f->n_lights : 1, np = (size_t)W * H;
+    uint8_t *filled = malloc(np), *next = malloc(np);
+    double *acc = malloc((3 + 2 * nl) * sizeof *acc);
+    if (!filled || !next || !acc) { free(filled); free(next); free(acc); return -1; }
+    for (size_t i = 0; i < np; i++) filled[i] = f->vis[i] >= 0.0f;
     for (int pass = 0; pass < passes; pass++) {
-        memcpy(next, filled, (size_t)W * H);
+        memcpy(next, filled, np);
         for (int y = 0; y < H; y++)
             for (int x = 0; x < W; x++) {
                 const size_t i = (size_t)y * W + x;
                 if (filled[i]) continue;
-                double acc[5] = { 0 };
+                memset(acc, 0, (3 + 2 * nl) * sizeof *acc);
                 int cnt = 0;
                 for (int dy = -1; dy <= 1; dy++)
                     for (int dx = -1; dx <= 1; dx++) {
@@ -194,20 +199,25 @@ static int dilate(ms_frame *f, int passes)
                         const size_t j = (size_t)yy * W + xx;
                         if (!filled[j]) continue;
                         for (int c = 0; c < 3; c++) acc[c] += f->rgb[3 * j + c];
-                        acc[3] += f->vis[j];
-                        acc[4] += f->shadow[j];
+                        for (size_t l = 0; l < nl; l++) {
+                            acc[3 + 2 * l] += f->vis[l * np + j];
+                            acc[4 + 2 * l] += f->shadow[l * np + j];
+                        }
                         cnt++;
                     }
                 if (!cnt) continue;
                 for (int c = 0; c < 3; c++) f->rgb[3 * i + c] = (float)(acc[c] / cnt);
-                f->vis[i] = (float)(acc[3] / cnt);
-                f->shadow[i] = (float)(acc[4] / cnt);
+                for (size_t l = 0; l < nl; l++) {
+                    f->vis[l * np + i] = (float)(acc[3 + 2 * l] / cnt);
+                    f->shadow[l * np + i] = (float)(acc[4 + 2 * l] / cnt);
+                }
                 next[i] = 1;
             }
         uint8_t *t = filled; filled = next; next = t;
     }
     free(filled);
     free(next);
+    free(acc);
     return 0;
 }
 
@@ -237,12 +247,16 @@ ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, m
     out->raster_s = omp_get_wtime() - t_raster;
     out->n_tris = scene->n_tris;
     const size_t nt = (size_t)size * size;
+    size_t nl;
+    ms_scene_lights(scene, &nl);
     ms_frame *f = &out->frame;
     if (!st) {
+        /* One plane of V, S and front per light, as frames have them (ms_frame.n_lights). */
         f->width = f->height = size;
-        f->vis = malloc(nt * sizeof(float));
-        f->shadow = malloc(nt * sizeof(float));
-        f->front = calloc(nt, sizeof *f->front);
+        f->n_lights = (int)nl;
+        f->vis = malloc(nl * nt * sizeof(float));
+        f->shadow = malloc(nl * nt * sizeof(float));
+        f->front = calloc(nl * nt, sizeof *f->front);
         f->rgb = calloc(nt * 3, sizeof(float));
         if (!f->vis || !f->shadow || !f->front || !f->rgb) {
             snprintf(err, errlen, "out of memory for a %dx%d lightmap", size, size);
@@ -251,24 +265,39 @@ ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     if (!st)
         for (size_t i = 0; i < nt; i++) {
-            f->vis[i] = f->shadow[i] = -1.0f;
+            for (size_t l = 0; l < nl; l++) f->vis[l * nt + i] = f->shadow[l * nt + i] = -1.0f;
             out->texels += out->triangle[i] != MS_NO_TRIANGLE;
         }
     if (st) ms_lightmap_free(out);
     return st;
 }
 
-/* Adds one ms_visibility_points call's stats to the lightmap's (the first call's are taken whole). */
-static void add_stats(ms_stats *sum, const ms_stats *s)
+/* Adds one ms_visibility_points call's stats to the lightmap's (the first call's are taken whole); the
+ * texels count once (count_texels: the first light's call), the segments and penumbrae per light, as in
+ * frames. */
+static void add_stats(ms_stats *sum, const ms_stats *s, int count_texels)
 {
     if (!sum->method) { *sum = *s; return; }
     sum->setup_s += s->setup_s;
     sum->shadow_s += s->shadow_s;
     sum->shadow_factor_s += s->shadow_factor_s;
-    sum->visible_pixels += s->visible_pixels;
+    if (count_texels) sum->visible_pixels += s->visible_pixels;
     sum->penumbra_pixels += s->penumbra_pixels;
     sum->shadow_rays += s->shadow_rays;
     for (int c = 0; c < s->n_counters && c < MS_MAX_COUNTERS; c++) sum->counter[c] += s->counter[c];
+}
+
+/* Progress over several lights: light l's fraction f is (l + f) / n of the rows' bake. */
+typedef struct bake_progress {
+    ms_progress_cancel_fn fn;
+    void *user;
+    size_t light, n;
+} bake_progress;
+
+static int light_progress(void *user, double f)
+{
+    const bake_progress *p = user;
+    return p->fn(p->user, ((double)p->light + f) / (double)p->n);
 }
 
 ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *lm, int y0, int y1,
@@ -289,10 +318,8 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
     float *pos = malloc((m ? m : 1) * 3 * sizeof *pos), *nor = malloc((m ? m : 1) * 3 * sizeof *nor);
     uint32_t *tri = malloc((m ? m : 1) * sizeof *tri), *key = malloc((m ? m : 1) * 2 * sizeof *key);
     size_t *where = malloc((m ? m : 1) * sizeof *where);
-    float *v = malloc((m ? m : 1) * sizeof *v), *s = malloc((m ? m : 1) * sizeof *s);
-    uint16_t *fr = malloc((m ? m : 1) * sizeof *fr);
     ms_status st = MS_OK;
-    if (!pos || !nor || !tri || !key || !where || !v || !s || !fr) { snprintf(err, errlen, "out of memory for %zu texels", m); st = MS_ERR_NO_MEMORY; }
+    if (!pos || !nor || !tri || !key || !where) { snprintf(err, errlen, "out of memory for %zu texels", m); st = MS_ERR_NO_MEMORY; }
     if (!st) {
         size_t j = 0;
         for (size_t i = first; i < last; i++) {
@@ -305,26 +332,48 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
             where[j++] = i;
         }
         ms_points pts = { m, pos, nor, tri, key };
-        ms_stats one;
-        memset(&one, 0, sizeof one);
-        st = ms_visibility_points(accel, NULL, &pts, &o->points, v, s, fr, &one, err, errlen);
-        if (!st) {
-            for (size_t k = 0; k < m; k++) {
-                f->vis[where[k]] = v[k];
-                f->shadow[where[k]] = s[k];
-                f->front[where[k]] = fr[k];
-            }
-            add_stats(&f->stats, &one);
+        size_t nl;
+        const ms_light *lights = ms_accel_lights(accel, &nl);
+        if (f->n_lights != (int)nl) {
+            snprintf(err, errlen, "ms_bake_rows: the lightmap was laid out for %d lights, the accel has %zu", f->n_lights, nl);
+            st = MS_ERR_INVALID;
         }
+        /* Each light in turn (its own ms_visibility_points call, as frames run a shadow pass per light),
+         * the results kept aside until every light succeeded: lm is left as it was on an error. */
+        const size_t nt = (size_t)size * size;
+        float *vl = st ? NULL : malloc((m ? m : 1) * nl * sizeof *vl), *sl = st ? NULL : malloc((m ? m : 1) * nl * sizeof *sl);
+        uint16_t *fl = st ? NULL : malloc((m ? m : 1) * nl * sizeof *fl);
+        ms_stats sum;
+        memset(&sum, 0, sizeof sum);
+        if (!st && (!vl || !sl || !fl)) { snprintf(err, errlen, "out of memory for %zu texels", m); st = MS_ERR_NO_MEMORY; }
+        bake_progress bp = { o->points.progress, o->points.progress_user, 0, nl };
+        ms_points_options po = o->points;
+        if (po.progress) { po.progress = light_progress; po.progress_user = &bp; }
+        for (size_t l = 0; l < nl && !st; l++) {
+            ms_stats one;
+            memset(&one, 0, sizeof one);
+            bp.light = l;
+            st = ms_visibility_points(accel, &lights[l], &pts, &po, vl + l * m, sl + l * m, fl + l * m, &one, err, errlen);
+            if (!st) add_stats(&sum, &one, l == 0);
+        }
+        if (!st) {
+            for (size_t l = 0; l < nl; l++)
+                for (size_t k = 0; k < m; k++) {
+                    f->vis[l * nt + where[k]] = vl[l * m + k];
+                    f->shadow[l * nt + where[k]] = sl[l * m + k];
+                    f->front[l * nt + where[k]] = fl[l * m + k];
+                }
+            add_stats(&f->stats, &sum, 1);
+        }
+        free(vl);
+        free(sl);
+        free(fl);
     }
     free(pos);
     free(nor);
     free(tri);
     free(key);
     free(where);
-    free(v);
-    free(s);
-    free(fr);
     return st;
 }
 
@@ -337,19 +386,60 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     ms_frame *f = &lm->frame;
     const int size = f->width;
     const size_t nt = (size_t)size * size, m = lm->texels;
-    /* Irradiance and the exposure (99th percentile), texels in row order. */
-    const ms_light L = scene->light;
-    float *lum = malloc((m ? m : 1) * sizeof *lum);
-    size_t k = 0;
+    /* Irradiance summed over the lights and the exposure (99th percentile), texels in row order: per light
+     * E_unshadowed * S * emission, a textured light's emission times the weighted mean texel the texel's
+     * front samples see (as frames shade, render.c). */
+    size_t nl;
+    const ms_light *lights = ms_scene_lights(scene, &nl);
+    if (f->n_lights != (int)nl) {
+        snprintf(err, errlen, "ms_bake_finish: the lightmap has %d lights, the scene %zu", f->n_lights, nl);
+        return MS_ERR_INVALID;
+    }
+    const int samples = o->points.samples > 0 ? o->points.samples : MS_SAMPLES_DEFAULT;
+    ms_render_ctx tctx;   /* for the textured lights' mean texels: the points' pattern (points.c) */
+    memset(&tctx, 0, sizeof tctx);
+    tctx.pattern = o->points.pattern;
+    tctx.k = ms_samples_to_k(samples);
+    tctx.samples = tctx.k * tctx.k;
+    tctx.mask_words = tctx.samples / 64;
+    tctx.seed = o->points.seed;
+    float *lum = malloc((nt ? nt : 1) * sizeof *lum);
+    if (!lum) { snprintf(err, errlen, "out of memory for a %dx%d lightmap", size, size); return MS_ERR_NO_MEMORY; }
+    const int threads = o->points.threads > 0 ? o->points.threads : omp_get_num_procs();
+#pragma omp parallel for schedule(dynamic, 1024) num_threads(threads)
     for (size_t i = 0; i < nt; i++) {
         if (lm->triangle[i] == MS_NO_TRIANGLE) continue;
-        const float e = ms_light_irradiance(&L, lm->position + 3 * i, lm->normal + 3 * i);
-        f->rgb[3 * i] = e * L.emission.x * f->shadow[i];
-        f->rgb[3 * i + 1] = e * L.emission.y * f->shadow[i];
-        f->rgb[3 * i + 2] = e * L.emission.z * f->shadow[i];
-        if (lum) lum[k] = e * (0.2126f * L.emission.x + 0.7152f * L.emission.y + 0.0722f * L.emission.z);
-        k++;
+        const float *p = lm->position + 3 * i, *n = lm->normal + 3 * i;
+        float c[3] = { 0, 0, 0 }, y = 0.0f;
+        for (size_t l = 0; l < nl; l++) {
+            ms_light L = lights[l];
+            if (L.texture && L.shape != MS_LIGHT_SPHERE) {
+                ms_render_ctx ctx = tctx;
+                ctx.light = L;
+                ms_shadow_query q;
+                memcpy(q.p, p, sizeof q.p);
+                memcpy(q.n, n, sizeof q.n);
+                q.prim = UINT32_MAX;
+                q.px = (uint32_t)(i % (size_t)size);
+                q.py = (uint32_t)(i / (size_t)size);
+                float t[3];
+                ms_light_texture_mean(&ctx, &q, t);
+                L.emission.x *= t[0];
+                L.emission.y *= t[1];
+                L.emission.z *= t[2];
+            }
+            const float e = ms_light_irradiance(&L, p, n), sh = f->shadow[l * nt + i];
+            c[0] += e * L.emission.x * sh;
+            c[1] += e * L.emission.y * sh;
+            c[2] += e * L.emission.z * sh;
+            y += e * (0.2126f * L.emission.x + 0.7152f * L.emission.y + 0.0722f * L.emission.z);
+        }
+        memcpy(f->rgb + 3 * i, c, sizeof c);
+        lum[i] = y;
     }
+    size_t kk = 0;   /* the texels' luminances, in row order */
+    for (size_t i = 0; i < nt; i++)
+        if (lm->triangle[i] != MS_NO_TRIANGLE) lum[kk++] = lum[i];
     f->exposure = 1.0f;
     if (lum && m) {
         qsort(lum, m, sizeof *lum, cmp_float);

@@ -25,7 +25,9 @@ struct ms_accel {
     ms_bvh bvh;
     struct ms_alpha *alpha;    /* alpha-tested triangles, own copies of what they need (NULL: none) */
     uint32_t *leaf_of;         /* scene triangle index -> BVH leaf-order prim id */
-    ms_scene view;             /* the scene's light and counts (tri = NULL: the BVH holds the triangles) */
+    ms_scene view;             /* the scene's counts, light = lights[0] (tri = NULL: the BVH holds the triangles) */
+    ms_light *lights;          /* copies of the scene's lights, each with its own texels */
+    size_t n_lights;
     int threads;
 };
 
@@ -66,15 +68,25 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
     for (uint32_t i = 0; i < a->bvh.n_tris; i++) a->leaf_of[a->bvh.tri_source[i]] = i;
     a->view = *scene;
     a->view.tri = NULL;
-    a->view.lights = NULL;   /* the scene's first light stays in view.light; the array is the caller's */
+    a->view.lights = NULL;   /* the caller's array: the accel keeps its own copies in a->lights */
     a->view.n_lights = 0;
-    if (scene->light.texture) {   /* the scene may be freed before the accel: its own copy of the texels */
-        const size_t nt = (size_t)scene->light.texture_width * (size_t)scene->light.texture_height * 3;
+    /* Every light of the scene, with its own copy of any texels: the scene may be freed before the accel. */
+    size_t nl;
+    const ms_light *src = ms_scene_lights(scene, &nl);
+    a->lights = calloc(nl, sizeof *a->lights);
+    if (!a->lights) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
+    a->n_lights = nl;
+    for (size_t l = 0; l < nl; l++) {
+        a->lights[l] = src[l];
+        a->lights[l].texture = NULL;
+        if (!src[l].texture) continue;
+        const size_t nt = (size_t)src[l].texture_width * (size_t)src[l].texture_height * 3;
         float *t = malloc(nt * sizeof *t);
         if (!t) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
-        memcpy(t, scene->light.texture, nt * sizeof *t);
-        a->view.light.texture = t;
+        memcpy(t, src[l].texture, nt * sizeof *t);
+        a->lights[l].texture = t;
     }
+    a->view.light = a->lights[0];
     *out = a;
     return MS_OK;
 }
@@ -85,11 +97,18 @@ void ms_accel_free(ms_accel *a)
     ms_bvh_free(&a->bvh);
     ms_alpha_free(a->alpha);
     free(a->leaf_of);
-    free((void *)a->view.light.texture);
+    for (size_t l = 0; a->lights && l < a->n_lights; l++) free((void *)a->lights[l].texture);
+    free(a->lights);
     free(a);
 }
 
 size_t ms_accel_triangles(const ms_accel *a) { return a ? a->view.n_tris : 0; }
+
+const ms_light *ms_accel_lights(const ms_accel *a, size_t *n)
+{
+    *n = a ? a->n_lights : 0;
+    return a ? a->lights : NULL;
+}
 
 /* Spreads the low 10 bits of x to every third bit. */
 static uint32_t spread3(uint32_t x)
@@ -115,9 +134,13 @@ static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && 
 
 static int light_ok(const ms_light *l)
 {
-    const float v[12] = { l->corner.x, l->corner.y, l->corner.z, l->edge_s.x, l->edge_s.y, l->edge_s.z,
-                          l->edge_t.x, l->edge_t.y, l->edge_t.z, l->emission.x, l->emission.y, l->emission.z };
-    for (int i = 0; i < 12; i++) if (!isfinite(v[i])) return 0;
+    if (!isfinite(l->emission.x) || !isfinite(l->emission.y) || !isfinite(l->emission.z)) return 0;
+    if (l->shape == MS_LIGHT_SPHERE)   /* centre and radius; the parallelogram fields are unused */
+        return isfinite(l->center.x) && isfinite(l->center.y) && isfinite(l->center.z) && isfinite(l->radius) &&
+               l->radius > 0.0f;
+    const float v[9] = { l->corner.x, l->corner.y, l->corner.z, l->edge_s.x, l->edge_s.y, l->edge_s.z,
+                         l->edge_t.x, l->edge_t.y, l->edge_t.z };
+    for (int i = 0; i < 9; i++) if (!isfinite(v[i])) return 0;
     const float nx = l->edge_s.y * l->edge_t.z - l->edge_s.z * l->edge_t.y;
     const float ny = l->edge_s.z * l->edge_t.x - l->edge_s.x * l->edge_t.z;
     const float nz = l->edge_s.x * l->edge_t.y - l->edge_s.y * l->edge_t.x;
@@ -170,12 +193,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     if (stats) memset(stats, 0, sizeof *stats);
     if (!a) { snprintf(err, errlen, "ms_visibility_points: no accel"); return MS_ERR_INVALID; }
     if (!light) light = &a->view.light;
-    if (!light_ok(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area"); return MS_ERR_INVALID; }
-    if (light->shape == MS_LIGHT_SPHERE) {
-        /* its per-receiver outline disk is done by frames only (render.c) */
-        snprintf(err, errlen, "sphere lights are rendered by frames only (ms_render), not at points");
-        return MS_ERR_INVALID;
-    }
+    if (!light_ok(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area (a sphere: radius not > 0)"); return MS_ERR_INVALID; }
     if ((unsigned)light->shape > MS_LIGHT_SPHERE) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
     ms_status st = check_points(a, pts, err, errlen);
     if (st) return st;
@@ -204,9 +222,20 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     }
     const int threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
 
+    /* The hpc methods (those with a frame-level entry) read the scene's triangles in scene order
+     * (hpc_method.c), which the accel keeps only in the BVH's leaf order: a scene-order copy for this call. */
+    ms_scene view = a->view;
+    float *scene_tri = NULL;
+    if (sm->visibility_all && a->view.n_tris) {
+        scene_tri = calloc(a->view.n_tris * 9, sizeof *scene_tri);
+        if (!scene_tri) { snprintf(err, errlen, "out of memory for the triangles of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
+        for (uint32_t i = 0; i < a->bvh.n_tris; i++)
+            memcpy(scene_tri + 9 * (size_t)a->bvh.tri_source[i], a->bvh.tri + 9 * (size_t)i, 9 * sizeof *scene_tri);
+        view.tri = scene_tri;
+    }
     ms_render_ctx ctx;
     memset(&ctx, 0, sizeof ctx);
-    ctx.scene = &a->view;
+    ctx.scene = &view;
     ctx.bvh = &a->bvh;
     ctx.alpha = a->alpha;
     ctx.light = *light;
@@ -222,11 +251,12 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     ctx.embree_mode = opt->embree_mode;
     ctx.embree_filter = opt->embree_filter;
     ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
+    const int sphere = light->shape == MS_LIGHT_SPHERE;
 
     const size_t n = pts->n;
     /* Proximity order: Morton codes in the points' bounding box, ties by index (a total order). */
     morton_item *order = malloc((n ? n : 1) * sizeof *order);
-    if (!order) { snprintf(err, errlen, "out of memory for %zu points", n); return MS_ERR_NO_MEMORY; }
+    if (!order) { free(scene_tri); snprintf(err, errlen, "out of memory for %zu points", n); return MS_ERR_NO_MEMORY; }
     float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {
@@ -248,7 +278,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
 
     void *sstate = NULL;
     const double t_setup = omp_get_wtime();
-    if (sm->create(&ctx, &sstate, err, errlen)) { free(order); return MS_ERR_METHOD; }
+    if (sm->create(&ctx, &sstate, err, errlen)) { free(order); free(scene_tri); return MS_ERR_METHOD; }
     const double setup_s = omp_get_wtime() - t_setup;
 
     const long nbatch = (long)((n + BATCH - 1) / BATCH);
@@ -282,26 +312,47 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
             if (!ok || stop) continue;
             const size_t i0 = (size_t)b * BATCH, i1 = i0 + BATCH < n ? i0 + BATCH : n;
             const int m = (int)(i1 - i0);
+            /* A sphere light: each point has its own light, the sphere's outline disk seen from it, and the
+             * method is called one point at a time with it, exactly as frames do (frame_job.c); a point
+             * inside the sphere has no sample in front (V = S = 0). */
+            ms_render_ctx qc = ctx;
+            int nq = 0;
+            size_t where[BATCH];
             for (int j = 0; j < m; j++) {
                 const size_t i = order[i0 + j].index;
-                make_query(a, pts, i, &q[j]);
-                if (spts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
-                const int nf = ms_front_mask(&ctx, &q[j], spts, fm + (size_t)j * mw);
+                make_query(a, pts, i, &q[nq]);
+                if (sphere && ms_light_sphere_outline(&ctx.light, q[nq].p, &qc.light)) {
+                    if (front_out) front_out[i] = 0;
+                    if (vis) vis[i] = 0.0f;
+                    if (shadow) shadow[i] = 0.0f;
+                    continue;
+                }
+                if (spts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[nq].px, q[nq].py, ctx.seed, spts);
+                const int nf = ms_front_mask(&qc, &q[nq], spts, fm + (size_t)nq * mw);
                 if (front_out) front_out[i] = (uint16_t)nf;
                 local_segments += (uint64_t)nf;
+                where[nq++] = i;
             }
-            if (sm->visibility(sstate, &ctx, q, m, fm, vm, local)) {
+            int vfail = 0;
+            if (!sphere) vfail = nq && sm->visibility(sstate, &ctx, q, nq, fm, vm, local);
+            else
+                for (int j = 0; j < nq && !vfail; j++) {
+                    ms_light_sphere_outline(&ctx.light, q[j].p, &qc.light);
+                    vfail = sm->visibility(sstate, &qc, &q[j], 1, fm + (size_t)j * mw, vm + (size_t)j * mw, local);
+                }
+            if (vfail) {
                 ok = 0;
 #pragma omp atomic write
                 failed = 1;
                 continue;
             }
             const double tr = omp_get_wtime();
-            for (int j = 0; j < m; j++) {
-                const size_t i = order[i0 + j].index;
+            for (int j = 0; j < nq; j++) {
+                const size_t i = where[j];
                 float v, s;
-                if (spts) ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
-                local_penumbra += (uint64_t)ms_resolve_vs(&ctx, &q[j], spts, fm + (size_t)j * mw, vm + (size_t)j * mw, &v, &s);
+                if (sphere) ms_light_sphere_outline(&ctx.light, q[j].p, &qc.light);
+                if (spts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
+                local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[j], spts, fm + (size_t)j * mw, vm + (size_t)j * mw, &v, &s);
                 if (vis) vis[i] = v;
                 if (shadow) shadow[i] = s;
             }
@@ -335,6 +386,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
     if (sm->isa_used) sm->isa_used(sstate, &kisa, &tisa);
     sm->destroy(sstate);
+    free(scene_tri);
     if (failed) { snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
     if (cancelled) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
     if (stats) {

@@ -126,7 +126,7 @@ int ms_mesh_assimp(const char *buf, size_t len, const char *ext, const char *pat
                 char mpath[4096];
                 if (e == a) continue;
                 if (copy[a] == '/' || snprintf(mpath, sizeof mpath, "%.*s%.*s", dl, path, (int)(e - a), copy + a) >= (int)sizeof mpath) {
-                    ms_warn("%s: mtllib '%.*s': only relative paths are read: materials ignored", path, (int)(e - a > 200 ? 200 : e - a), copy + a);
+                    ms_warn_material("%s: mtllib '%.*s': only relative paths are read: materials ignored", path, (int)(e - a > 200 ? 200 : e - a), copy + a);
                     continue;
                 }
                 if (ms_mtl_load(mpath, soup, &mtl)) {

@@ -275,13 +275,13 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
             if (tv->texture && tv->texture->image) {
                 const size_t im = (size_t)(tv->texture->image - d->images);
                 if (tv->texcoord < 0 || tv->texcoord >= MS_MAX_UV_SETS) {
-                    ms_warn("%s: material %zu: baseColorTexture uses TEXCOORD_%d (at most %d sets): texture ignored", path, i,
+                    ms_warn_material("%s: material %zu: baseColorTexture uses TEXCOORD_%d (at most %d sets): texture ignored", path, i,
                             (int)tv->texcoord, MS_MAX_UV_SETS - 1);
                 } else {
                     if (tex_of[im] == -2) {
                         char why[1024];
                         tex_of[im] = load_image(d, opt, im, path, soup, why, sizeof why);
-                        if (tex_of[im] < 0) ms_warn("%s: texture ignored", why);
+                        if (tex_of[im] < 0) ms_warn_material("%s: texture ignored", why);
                     }
                     if (tex_of[im] >= 0) {
                         m.base_color_texture = (int32_t)tex_of[im];

@@ -38,7 +38,7 @@ static long texture(ms_mtl_lib *lib, ms_tri_soup *soup, const char *full)
         if (!strcmp(lib->tex_path[i], full)) return lib->tex_id[i];
     char err[1024];
     const long t = ms_soup_add_texture_file(soup, full, 1, err, sizeof err);
-    if (t < 0) ms_warn("%s: texture ignored", err);
+    if (t < 0) ms_warn_material("%s: texture ignored", err);
     char **np = realloc(lib->tex_path, (lib->n_tex + 1) * sizeof *np);
     if (!np) return -2;
     lib->tex_path = np;
@@ -100,7 +100,7 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
     char *buf, err[1024];
     size_t len;
     if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_AUX, &buf, &len, err, sizeof err)) {
-        ms_warn("%s: materials ignored", err);
+        ms_warn_material("%s: materials ignored", err);
         return 0;
     }
     const char *slash = strrchr(path, '/');
@@ -152,7 +152,7 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
             file = file ? file + 1 : arg;
             char full[4096];
             if (file[0] == '/' || snprintf(full, sizeof full, "%.*s%s", dl, path, file) >= (int)sizeof full) {
-                ms_warn("%s: %s '%s': only relative paths are read: texture ignored", path, is_d ? "map_d" : "map_Kd", file);
+                ms_warn_material("%s: %s '%s': only relative paths are read: texture ignored", path, is_d ? "map_d" : "map_Kd", file);
             } else {
                 const long t = texture(lib, soup, full);
                 if (t == -2) { rc = -1; break; }

@@ -112,5 +112,12 @@ int ms_scene_parse(const char *text, size_t len, const char *json_path, struct m
 void ms_one_line(char *err);
 /* Reports a warning through the handler set with ms_set_warning_handler. */
 void ms_warn(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+/* A material file or texture that cannot be used (the geometry loads; its material keeps its factors or the
+ * default). Between ms_material_warnings_begin and _end (one scene load) they are counted, and _end reports
+ * them as one line: the warning itself when there was one, else their number and the first; each at once
+ * when ms_set_warning_verbose is on, or outside a load. report 0: drop them (the load failed). */
+void ms_warn_material(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+void ms_material_warnings_begin(void);
+void ms_material_warnings_end(int report);
 
 #endif

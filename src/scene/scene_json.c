@@ -2,6 +2,7 @@
 #include "microshadow.h"
 #include "scene_internal.h"
 #include "../image/png_read.h"
+#include "../image/exr_read.h"
 _Static_assert(MS_SOUP_UV_SETS == MS_MAX_UV_SETS, "one count of UV sets");
 #include <cjson/cJSON.h>
 #include <ctype.h>
@@ -328,7 +329,7 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
     const cJSON *tex = cJSON_GetObjectItemCaseSensitive(obj, "texture");
     if (tex) {
         if (!cJSON_IsString(tex) || !tex->valuestring[0]) {
-            snprintf(err, errlen, "%s: %s.texture must be the path of a PNG image", path, objname);
+            snprintf(err, errlen, "%s: %s.texture must be the path of a PNG or EXR image", path, objname);
             return -1;
         }
         char tex_path[4096];
@@ -342,7 +343,9 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
         size_t len = 0;
         char why[1024];
         int rc = ms_read_input(tex_path, MS_MAX_MESH_BYTES, MS_INPUT_TEXTURE, &bytes, &len, why, sizeof why);
-        if (!rc) rc = ms_png_decode_linear(tex_path, bytes, len, MS_MAX_LIGHT_TEXTURE, &t, &w, &h, why, sizeof why);
+        /* By content, not by name: an EXR's magic number, else PNG (whose decoder names anything else). */
+        if (!rc && ms_is_exr(bytes, len)) rc = ms_exr_decode_linear(tex_path, bytes, len, MS_MAX_LIGHT_TEXTURE, &t, &w, &h, why, sizeof why);
+        else if (!rc) rc = ms_png_decode_linear(tex_path, bytes, len, MS_MAX_LIGHT_TEXTURE, &t, &w, &h, why, sizeof why);
         free(bytes);
         if (rc) { snprintf(err, errlen, "%s: %s.texture: %s", path, objname, why); return -1; }
         l->texture = t;
@@ -407,11 +410,13 @@ int ms_scene_parse(const char *text, size_t len, const char *json_path, ms_scene
     warn_list w;
     w.n = 0;
     g_warnings = &w;
+    ms_material_warnings_begin();
     int rc = scene_parse(text, len, json_path, out, err, errlen);
     g_warnings = NULL;
     if (rc) ms_one_line(err);
     else
         for (int i = 0; i < w.n; i++) ms_warn("%s", w.line[i]);
+    ms_material_warnings_end(rc == 0);   /* one line for all the unusable material files and textures */
     return rc;
 }
 

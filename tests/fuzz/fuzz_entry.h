@@ -6,6 +6,7 @@
 #define MS_FUZZ_ENTRY_H
 #include "microshadow.h"
 #include "scene/scene_internal.h"
+#include "image/exr_read.h"
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,6 +41,25 @@ static inline int ms_fuzz_mesh(const char *ext, const uint8_t *data, size_t size
     else if (soup.n == 0) abort();   /* success means triangles */
     ms_soup_free(&soup);
     free(buf);
+    return rc;
+}
+
+/* A light's emission texture as an EXR file, from bytes (the decoder the scene loader calls for one);
+ * 0 if it decoded. Success means texels within the size limit, each finite and not negative. */
+static inline int ms_fuzz_exr(const uint8_t *data, size_t size)
+{
+    const char *path = MS_FUZZ_MESH_PATH "exr";
+    float *rgb = NULL;
+    int w = 0, h = 0;
+    char err[1024] = "";
+    int rc = ms_exr_decode_linear(path, data, size, MS_MAX_LIGHT_TEXTURE, &rgb, &w, &h, err, sizeof err);
+    if (rc) ms_fuzz_check_message(err, path);
+    else {
+        if (w < 1 || h < 1 || w > MS_MAX_LIGHT_TEXTURE || h > MS_MAX_LIGHT_TEXTURE) abort();
+        for (size_t i = 0; i < (size_t)w * (size_t)h * 3; i++)
+            if (!(rgb[i] >= 0.0f) || rgb[i] > 3.4e38f) abort();
+    }
+    free(rgb);
     return rc;
 }
 

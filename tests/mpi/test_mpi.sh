@@ -7,7 +7,9 @@
 #     and the shaded PNG byte for byte equal to one process (scanline, interleaved raytrace, hpc); with a
 #     textured light too; ranks given that scene with and without the texture, or with another material
 #     colour, refuse to run (exit 2);
-#   - bakes: 2 and 3 ranks give the single-process lightmap (EXR: R, G, B, S, V) and preview byte for byte;
+#   - bakes: 2 and 3 ranks give the single-process lightmap (EXR: R, G, B, S, V; with several lights every
+#     light's S and V) and preview byte for byte, also of the three-light and the textured scene; ranks given
+#     other lights refuse to bake;
 #   - the stats report every rank, and the ranks' tiles add up to the frame's;
 #   - hpc-scanline, whose answer at a pixel depends on the whole frame, is refused on 2 ranks (exit 2);
 #   - a rank given an unreadable scene ends the run with exit code 2, that rank's one message line, and no
@@ -130,6 +132,16 @@ bake() {
     echo "ok: bake $name: 2 and 3 ranks = one process"
 }
 bake builtin --size 48 --samples 256
+# Every light of the three-light scene (rect, disk, sphere) and the textured one: the EXR holds each light's
+# S and V (S0.. V0..); and ranks given the scene with and without the texture refuse to bake.
+bake lights lights.json --uv xatlas --size 24 --samples 256
+bake lights-tex lights-tex.json --uv xatlas --size 24 --samples 256 --method raytrace
+check test -n "$(cmp lights-1.exr lights-tex-1.exr)"
+run -n 1 "$ms" bake lights.json --uv xatlas --size 16 --samples 256 --threads 1 --quiet -o mixed.exr : \
+    -n 1 "$ms" bake lights-tex.json --uv xatlas --size 16 --samples 256 --threads 1 --quiet -o mixed.exr 2> mixedbake.err
+check test $? -eq 2
+check grep -q "different scenes or options" mixedbake.err
+check test ! -e mixed.exr
 if [ -f "$scenes/quad/quad.json" ]; then
     bake quad "$scenes/quad/quad.json" --uv xatlas --size 32 --samples 256
 else

@@ -1,5 +1,6 @@
 #include "testutil.h"
 #include "shadow/receiver.h"
+#include <OpenEXR/openexr.h>
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -281,4 +282,70 @@ void tu_make_quad(ms_scene *sc)
     sc->camera = (ms_camera){ { 0, 10, 12 }, { 0, 0, 0 }, { 0, 1, 0 }, 60.0f, 96, 96, MS_CAMERA_PINHOLE, 0, 0 };
     sc->light = (ms_light){ { -1, 6, -1 }, { 2, 0, 0 }, { 0, 0, 2 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     sc->samples = 1024;
+}
+
+/* float -> half for the values tests use (normal halves, zero): exact or -1. */
+static int to_half(float f, uint16_t *out)
+{
+    if (f == 0.0f) { *out = signbit(f) ? 0x8000 : 0; return 0; }
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    const uint32_t sign = u >> 31, mant = u & 0x7fffff;
+    const int e = (int)((u >> 23) & 0xff) - 127;
+    if (e < -14 || e > 15 || (mant & 0x1fff)) return -1;   /* not a normal half, or inexact */
+    *out = (uint16_t)(sign << 15 | (uint32_t)(e + 15) << 10 | mant >> 13);
+    return 0;
+}
+
+int tu_write_exr(const char *path, int w, int h, int nch, const char *const *names, const float *const *plane, int half,
+                 int compression)
+{
+    uint16_t *hp[16] = { 0 };
+    if (nch < 1 || nch > 16) return -1;
+    int rc = -1;
+    for (int c = 0; c < nch && half; c++) {
+        hp[c] = malloc((size_t)w * h * sizeof *hp[c]);
+        if (!hp[c]) goto out;
+        for (size_t i = 0; i < (size_t)w * h; i++)
+            if (to_half(plane[c][i], &hp[c][i])) goto out;
+    }
+    exr_context_t ctx = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_result_t r = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    int part = 0, lines = 1, enc_init = 0;
+    exr_encode_pipeline_t enc;
+    if (r == EXR_ERR_SUCCESS) r = exr_add_part(ctx, "tex", EXR_STORAGE_SCANLINE, &part);
+    if (r == EXR_ERR_SUCCESS) r = exr_initialize_required_attr_simple(ctx, part, w, h, (exr_compression_t)compression);
+    /* OpenEXR keeps channels sorted by name: add them in that order */
+    int order[16];
+    for (int c = 0; c < nch; c++) order[c] = c;
+    for (int a = 1; a < nch; a++)
+        for (int b = a; b > 0 && strcmp(names[order[b - 1]], names[order[b]]) > 0; b--) { int t = order[b]; order[b] = order[b - 1]; order[b - 1] = t; }
+    for (int c = 0; c < nch && r == EXR_ERR_SUCCESS; c++)
+        r = exr_add_channel(ctx, part, names[order[c]], half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+    if (r == EXR_ERR_SUCCESS) r = exr_write_header(ctx);
+    if (r == EXR_ERR_SUCCESS) r = exr_get_scanlines_per_chunk(ctx, part, &lines);
+    for (int y = 0; r == EXR_ERR_SUCCESS && y < h; y += lines) {
+        exr_chunk_info_t ci;
+        r = exr_write_scanline_chunk_info(ctx, part, y, &ci);
+        if (r == EXR_ERR_SUCCESS) r = enc_init ? exr_encoding_update(ctx, part, &ci, &enc) : exr_encoding_initialize(ctx, part, &ci, &enc);
+        if (r != EXR_ERR_SUCCESS) break;
+        for (int c = 0; c < nch; c++) {
+            const int src = order[c];
+            const size_t esz = half ? 2 : 4;
+            enc.channels[c].encode_from_ptr = half ? (const uint8_t *)(hp[src] + (size_t)y * w) : (const uint8_t *)(plane[src] + (size_t)y * w);
+            enc.channels[c].user_pixel_stride = (int32_t)esz;
+            enc.channels[c].user_line_stride = (int32_t)(esz * (size_t)w);
+            enc.channels[c].user_bytes_per_element = (int16_t)esz;
+            enc.channels[c].user_data_type = (uint16_t)(half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT);
+        }
+        if (!enc_init) { r = exr_encoding_choose_default_routines(ctx, part, &enc); enc_init = 1; }
+        if (r == EXR_ERR_SUCCESS) r = exr_encoding_run(ctx, part, &enc);
+    }
+    if (enc_init) exr_encoding_destroy(ctx, &enc);
+    const exr_result_t fin = ctx ? exr_finish(&ctx) : EXR_ERR_SUCCESS;
+    rc = r == EXR_ERR_SUCCESS && fin == EXR_ERR_SUCCESS ? 0 : -1;
+out:
+    for (int c = 0; c < 16; c++) free(hp[c]);
+    return rc;
 }

@@ -13,6 +13,11 @@ const char *tu_tmpdir(const char *test_name);
 /* Path buf = dir/name. */
 const char *tu_path(char *buf, size_t n, const char *dir, const char *name);
 int tu_write_file(const char *path, const char *text);
+/* Writes a one-part scanline EXR of w x h with nch channels (names[c], plane[c]: w*h floats, row 0 first),
+ * each stored as half (half != 0; the values must be exact halves) or float, with the given compression
+ * (an exr_compression_t). 0, or -1. */
+int tu_write_exr(const char *path, int w, int h, int nch, const char *const *names, const float *const *plane, int half,
+                 int compression);
 int tu_file_exists(const char *path);
 /* Number of entries in dir other than . and .. (to prove nothing was left behind). */
 int tu_count_entries(const char *dir);

@@ -3153,7 +3153,12 @@ public:
 		for (uint32_t i = 0; i < m_workers.size(); i++) {
 			Worker &worker = m_workers[i];
 			XA_DEBUG_ASSERT(worker.thread);
-			worker.wakeup = true;
+			{
+				// microshadow: under the worker's mutex, or the wakeup can land between the worker's
+				// predicate check and its wait, and the join below never returns (third_party/xatlas/VENDORED.md).
+				std::lock_guard<std::mutex> wakeupLock(worker.mutex);
+				worker.wakeup = true;
+			}
 			worker.cv.notify_one();
 			if (worker.thread->joinable())
 				worker.thread->join();
@@ -3207,7 +3212,10 @@ public:
 		group.ref++;
 		// Wake up a worker to run this task.
 		for (uint32_t i = 0; i < m_workers.size(); i++) {
-			m_workers[i].wakeup = true;
+			{
+				std::lock_guard<std::mutex> wakeupLock(m_workers[i].mutex);   // microshadow: see ~TaskScheduler
+				m_workers[i].wakeup = true;
+			}
 			m_workers[i].cv.notify_one();
 		}
 	}
@@ -3272,6 +3280,9 @@ private:
 		for (;;) {
 			worker->cv.wait(lock, [=]{ return worker->wakeup.load(); });
 			worker->wakeup = false;
+			// microshadow: tasks run without the worker's mutex, which run() now takes to wake workers (a task
+			// that runs subtasks would otherwise lock its own worker's mutex twice).
+			lock.unlock();
 			for (;;) {
 				if (scheduler->m_shutdown)
 					return;
@@ -3295,6 +3306,7 @@ private:
 				task->func(group->userData, task->userData);
 				group->ref--;
 			}
+			lock.lock();
 		}
 	}
 };
