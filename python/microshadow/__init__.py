@@ -89,7 +89,8 @@ class _Stats(ctypes.Structure):
         [(n, ctypes.c_uint64) for n in ("visible_pixels", "shadow_rays", "penumbra_pixels")] + \
         [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
          ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS),
-         ("shadow_cpu_s", ctypes.c_double)]
+         ("shadow_cpu_s", ctypes.c_double), ("primary", ctypes.c_char_p)] + \
+        [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes")]
 
 
 class _Frame(ctypes.Structure):
@@ -109,7 +110,8 @@ class _RenderOptions(ctypes.Structure):
                 ("seed", ctypes.c_uint32), ("progress", _PROGRESS), ("progress_user", _p), ("isa", ctypes.c_int),
                 ("no_occlusion_cull", ctypes.c_int), ("no_child_order", ctypes.c_int),
                 ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
-                ("traversal", ctypes.c_int), ("frustum_shrink", ctypes.c_int), ("no_filter", ctypes.c_int)]
+                ("traversal", ctypes.c_int), ("frustum_shrink", ctypes.c_int), ("no_filter", ctypes.c_int),
+                ("primary", ctypes.c_char_p), ("consistent_primary", ctypes.c_int)]
 
 
 class _Points(ctypes.Structure):
