@@ -104,14 +104,14 @@ int ms_e3_tile_planar(const ms_e3_tri *T, const double q[4][3], double qmag)
 int ms_e3_tile_cone(const ms_e3_tri *T, const double a[3], double alpha)
 {
     if (!T->ok) return 0;
-    if (alpha >= M_PI) return 1;
+    if (alpha + E3_REL >= 0.5 * M_PI) return 1;
+    /* angle(m, a) > pi/2 + alpha  <=>  cos angle(m, a) < -sin alpha (alpha < pi/2): no acos per edge */
+    const double lim = -sin(alpha + E3_REL);
     for (int i = 0; i < 3; i++) {
         const double *m = T->m[i];
         const double mm = sqrt(dot3(m, m));
         if (!(mm > 0.0)) return 0;
-        double c = dot3(m, a) / mm;
-        c = c > 1.0 ? 1.0 : c < -1.0 ? -1.0 : c;
-        if (acos(c) > 0.5 * M_PI + alpha + E3_REL) return 0;
+        if (dot3(m, a) < lim * mm) return 0;
     }
     return 1;
 }

@@ -41,6 +41,15 @@
 
 enum { V_BB, V_BIN, V_FC, V_FS, V_FULL };
 
+/* A triangle's set-up, bounds and nearest distance: the BVH variants keep one per triangle, made once,
+ * as a frustum split revisits the leaves (the paper sets a triangle up at every visit). */
+typedef struct r3_setup {
+    ms_e3_tri T;
+    ms_e3_box box[2];
+    int nb;
+    float near;
+} r3_setup;
+
 typedef struct r3_state {
     int variant, W, H, bw, bh, planar, streamed;
     ms_e3_cam cam;
@@ -50,6 +59,7 @@ typedef struct r3_state {
     float *bfar;          /* per 8x8 block the farthest stored distance (INFINITY: some pixel unhit) */
     uint8_t *dirty;       /* block's bfar stale */
     ms_hit *hits;         /* streamed: finished at write (no BVH to finish from later) */
+    r3_setup *setups;     /* BVH variants: per triangle (leaf order) */
     uint64_t cnt[3];      /* S, E, N */
     const ms_render_ctx *ctx;
 } r3_state;
@@ -212,12 +222,21 @@ static float tri_near(const r3_state *s, const ms_e3_tri *T, const float *tri)
     return dd == dd ? (float)(dd * (1.0 - 1e-6)) : 0.0f;
 }
 
-/* One triangle into the pixels of [cx0,cx1] x [cy0,cy1] (a band or a frustum). */
-static void draw_triangle(r3_thread *th, const float *tri, uint32_t id, int binning, int cx0, int cy0, int cx1, int cy1)
+static void make_setup(const r3_state *s, const float *tri, r3_setup *u)
+{
+    u->nb = ms_e3_bounds(&s->ctx->cam, tri, u->box);
+    ms_e3_setup(&s->cam, tri, &u->T);
+    u->near = tri_near(s, &u->T, tri);
+}
+
+/* One triangle into the pixels of [cx0,cx1] x [cy0,cy1] (a band or a frustum); pre: its set-up, or NULL. */
+static void draw_triangle(r3_thread *th, const float *tri, uint32_t id, int binning, int cx0, int cy0, int cx1, int cy1,
+                          const r3_setup *pre)
 {
     r3_state *s = th->s;
     ms_e3_box box[2];
-    const int nb = ms_e3_bounds(&s->ctx->cam, tri, box);
+    const int nb = pre ? pre->nb : ms_e3_bounds(&s->ctx->cam, tri, box);
+    if (pre) memcpy(box, pre->box, sizeof box);
     int any = 0;
     for (int b = 0; b < nb; b++) {
         box[b].x0 = box[b].x0 > cx0 ? box[b].x0 : cx0; box[b].x1 = box[b].x1 < cx1 ? box[b].x1 : cx1;
@@ -225,15 +244,19 @@ static void draw_triangle(r3_thread *th, const float *tri, uint32_t id, int binn
         any |= box[b].x0 <= box[b].x1 && box[b].y0 <= box[b].y1;
     }
     if (!any) return;
-    ms_e3_tri T;
-    ms_e3_setup(&s->cam, tri, &T);
-    th->S++;
-    if (!T.ok) return;
-    const float near = binning ? tri_near(s, &T, tri) : 0.0f;
+    ms_e3_tri Tl;
+    const ms_e3_tri *T = &Tl;
+    if (pre) T = &pre->T;
+    else {
+        ms_e3_setup(&s->cam, tri, &Tl);
+        th->S++;
+    }
+    if (!T->ok) return;
+    const float near = pre ? pre->near : binning ? tri_near(s, T, tri) : 0.0f;
     for (int b = 0; b < nb; b++) {
         if (box[b].x0 > box[b].x1 || box[b].y0 > box[b].y1) continue;
-        if (binning) bin_rect(th, &T, tri, id, near, box[b].x0, box[b].y0, box[b].x1, box[b].y1);
-        else raster_rect(th, &T, tri, id, box[b].x0, box[b].y0, box[b].x1, box[b].y1);
+        if (binning) bin_rect(th, T, tri, id, near, box[b].x0, box[b].y0, box[b].x1, box[b].y1);
+        else raster_rect(th, T, tri, id, box[b].x0, box[b].y0, box[b].x1, box[b].y1);
     }
 }
 
@@ -242,7 +265,7 @@ static void draw_triangle(r3_thread *th, const float *tri, uint32_t id, int binn
 typedef struct r3_frustum {
     int x0, y0, x1, y1;       /* pixels, inclusive */
     int cone;                 /* 1: cone (axis, alpha); 0 and ortho: origin rectangle; 0 otherwise: no culling */
-    double axis[3], alpha;
+    double axis[3], alpha, cos_a, sin_a;
     double a0, a1, c0, c1;    /* orthographic: the origins' right and up ranges (relative to the eye) */
 } r3_frustum;
 
@@ -277,10 +300,14 @@ static void frustum_init(const r3_state *s, r3_frustum *f, int x0, int y0, int x
             amax = a > amax ? a : amax;
         }
         f->alpha = amax * (1.0 + 1e-4) + 1e-6;
+        f->cos_a = cos(f->alpha);
+        f->sin_a = sin(f->alpha);
         f->cone = 1;
         return;
     }
     f->cone = rect_cone(s, x0, y0, x1, y1, f->axis, &f->alpha);
+    f->cos_a = cos(f->alpha);
+    f->sin_a = sin(f->alpha);
 }
 
 /* 1 when no ray of f can reach the box (conservative). */
@@ -313,9 +340,10 @@ static int frustum_culls(const r3_state *s, const r3_frustum *f, const ms_bvh_no
     }
     const double r = sqrt(r2) * (1.0 + 1e-6), dist = sqrt(v2);
     if (dist <= r) return 0;
-    double cs = va / dist;
-    cs = cs > 1.0 ? 1.0 : cs < -1.0 ? -1.0 : cs;
-    return acos(cs) - asin(r / dist) > f->alpha;
+    /* angle(v, axis) > alpha + beta, sin beta = r / dist, without acos/asin: cos angle < cos(alpha + beta) */
+    const double sb = r / dist, cb = sqrt(1.0 - sb * sb);
+    if (f->alpha >= 0.5 * M_PI) return 0;   /* (beta < pi/2: alpha + beta < pi below) */
+    return va / dist < f->cos_a * cb - f->sin_a * sb - 1e-12;
 }
 
 /* Nearest distance from the ray origins to the box (lower bound; 0 when an origin may be inside). */
@@ -379,7 +407,7 @@ static void frustum_leaf(r3_thread *th, const r3_frustum *f, const ms_bvh_node *
 {
     const ms_bvh *bvh = th->s->ctx->bvh;
     for (uint32_t i = n->first; i < n->first + n->count; i++)
-        draw_triangle(th, bvh->tri + 9 * (size_t)i, i, binning, f->x0, f->y0, f->x1, f->y1);
+        draw_triangle(th, bvh->tri + 9 * (size_t)i, i, binning, f->x0, f->y0, f->x1, f->y1, &th->s->setups[i]);
 }
 
 /* 3dr-fc: one frustum through the BVH, near child first. */
@@ -444,7 +472,7 @@ static void traverse_fs(r3_thread *th, const r3_frustum *f, uint32_t node, int b
 static void r3_free(r3_state *s)
 {
     if (!s) return;
-    free(s->q); free(s->t); free(s->id); free(s->bfar); free(s->dirty); free(s->hits);
+    free(s->q); free(s->t); free(s->id); free(s->bfar); free(s->dirty); free(s->hits); free(s->setups);
     free(s);
 }
 
@@ -512,11 +540,21 @@ static int r3_create(const ms_render_ctx *ctx, void **state, char *err, size_t e
                 const int y0 = R3_BIN * (int)((long)s->bh * me / nt), y1 = R3_BIN * (int)((long)s->bh * (me + 1) / nt);
                 r3_thread th = { s, 0, 0, 0 };
                 for (size_t i = 0; i < n && y0 < y1; i++)
-                    draw_triangle(&th, tris + 9 * i, (uint32_t)(first + i), binning, 0, y0, W - 1, (y1 < H ? y1 : H) - 1);
+                    draw_triangle(&th, tris + 9 * i, (uint32_t)(first + i), binning, 0, y0, W - 1, (y1 < H ? y1 : H) - 1, NULL);
                 S += th.S; E += th.E; N += th.N;
             }
         }
     } else if (ctx->bvh->n_nodes) {
+        s->setups = malloc((size_t)ctx->bvh->n_tris * sizeof *s->setups);
+        if (!s->setups) {
+            r3_free(s);
+            snprintf(err, errlen, "out of memory for the triangle set-ups of the 3D rasterization");
+            return -1;
+        }
+        const long nt = (long)ctx->bvh->n_tris;
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (long i = 0; i < nt; i++) make_setup(s, ctx->bvh->tri + 9 * (size_t)i, &s->setups[i]);
+        S = (uint64_t)nt;
         const int fx = (W + R3_FRUSTUM - 1) / R3_FRUSTUM, fy = (H + R3_FRUSTUM - 1) / R3_FRUSTUM;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : S, E, N)
         for (int fi = 0; fi < fx * fy; fi++) {
