@@ -2,9 +2,10 @@
  * Table 1) beside our BVH ray caster (watertight and --consistent) and Embree's. For each scene, camera
  * (the scene's pinhole, and a latlong panorama from the scene's eye, forward towards its target) and size:
  * per primary the seconds of its whole pass (create + trace of every 16x16 tile, as a frame does; Embree's
- * scene build is reported apart), triangle set-ups S, edge-function evaluations E, BVH nodes N (where the
+ * scene build is reported apart; wall ms and the process's CPU ms, the latter less disturbed by other work;
+ * the CPU ms of Embree include its build), triangle set-ups S, edge-function evaluations E, BVH nodes N (where the
  * method counts them), E per pixel, pixels hit, and pixels whose hit triangle differs from bvh --consistent
- * (0 expected for every 3dr variant). Each primary runs `--reps` times, alternating, the best is kept.
+ * (0 expected for every 3dr variant). Each primary runs `--reps` times, alternating; the run of least CPU time is kept.
  * Prints Markdown.
  *
  * usage: bench_primary [--sizes 1024,4096] [--cameras pinhole,latlong] [--threads T] [--reps R]
@@ -21,8 +22,17 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
-typedef struct run { double s, build_s; uint64_t c[3]; long hit, differ; int has_c; } run;
+typedef struct run { double s, cpu_s, build_s; uint64_t c[3]; long hit, differ; int has_c; } run;
+
+/* CPU seconds of the process (all threads): the figure that a machine shared with other work disturbs least. */
+static double cpu_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
 
 static int run_primary(const char *name, int consistent, ms_render_ctx *ctx, const uint32_t *ref, uint32_t *prims, run *r)
 {
@@ -32,6 +42,7 @@ static int run_primary(const char *name, int consistent, ms_render_ctx *ctx, con
     ctx->consistent_primary = consistent;
     char err[256];
     void *st = NULL;
+    const double c0 = cpu_s();
     const double t0 = omp_get_wtime();
     if (pm->create(ctx, &st, err, sizeof err)) { fprintf(stderr, "bench_primary: %s: %s\n", name, err); return -1; }
     const double t1 = omp_get_wtime();
@@ -46,6 +57,7 @@ static int run_primary(const char *name, int consistent, ms_render_ctx *ctx, con
             for (int x = x0; x < x1; x++) prims[(size_t)y * W + x] = tile[(y - y0) * (x1 - x0) + (x - x0)].prim;
     }
     const double t2 = omp_get_wtime();
+    r->cpu_s = cpu_s() - c0;
     /* Embree builds its scene in create: a set-up, not the per-frame pass */
     const int is_embree = strcmp(name, "embree") == 0;
     r->build_s = is_embree ? t1 - t0 : 0.0;
@@ -130,8 +142,8 @@ int main(int argc, char **argv)
         return 0;
     }
     printf("threads %d, best of %d (alternating)\n\n", threads, reps);
-    printf("| scene | T | camera | size | primary | ms | S | E | N | E/pixel | hit pixels | differ from bvh --consistent |\n");
-    printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("| scene | T | camera | size | primary | ms | CPU ms | S | E | N | E/pixel | hit pixels | differ from bvh --consistent |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int a = first_scene; a < argc; a++) {
         ms_scene sc;
         char err[512];
@@ -164,7 +176,7 @@ int main(int argc, char **argv)
                         char *sp = strchr(nm, ' ');
                         if (sp) *sp = 0;
                         if (run_primary(nm, cons, &ctx, ref, prims, &r)) continue;
-                        if (best[p].s < 0.0 || r.s < best[p].s) best[p] = r;
+                        if (best[p].s < 0.0 || r.cpu_s < best[p].cpu_s) best[p] = r;   /* the least disturbed run */
                     }
                 for (int p = 0; p < nprim; p++) {
                     if (best[p].s < 0.0) continue;
@@ -176,9 +188,9 @@ int main(int argc, char **argv)
                         snprintf(N, sizeof N, "%.0fk", b->c[2] / 1e3);
                         snprintf(EP, sizeof EP, "%.1f", (double)b->c[1] / ((double)W * H));
                     }
-                    printf("| %s | %zu | %s | %d² | %s | %.0f%s | %s | %s | %s | %s | %ld | %ld |\n", sname, sc.n_tris,
-                           cam ? "latlong" : "pinhole", W, prim_names[p], b->s * 1e3, "", S, E, N, EP, b->hit, b->differ);
-                    if (b->build_s > 0.0) printf("|  |  |  |  | (embree scene build) | %.0f |  |  |  |  |  |  |\n", b->build_s * 1e3);
+                    printf("| %s | %zu | %s | %d² | %s | %.0f | %.0f | %s | %s | %s | %s | %ld | %ld |\n", sname, sc.n_tris,
+                           cam ? "latlong" : "pinhole", W, prim_names[p], b->s * 1e3, b->cpu_s * 1e3, S, E, N, EP, b->hit, b->differ);
+                    if (b->build_s > 0.0) printf("|  |  |  |  | (embree scene build) | %.0f |  |  |  |  |  |  |  |\n", b->build_s * 1e3);
                 }
                 fflush(stdout);
                 free(ref);

@@ -266,7 +266,9 @@ typedef struct r3_frustum {
     int x0, y0, x1, y1;       /* pixels, inclusive */
     int cone;                 /* 1: cone (axis, alpha); 0 and ortho: origin rectangle; 0 otherwise: no culling */
     double axis[3], alpha, cos_a, sin_a;
-    double a0, a1, c0, c1;    /* orthographic: the origins' right and up ranges (relative to the eye) */
+    double a0, a1, c0, c1;
+    float co[3], cd[3];       /* the centre ray (cok: it exists) */
+    int cok;    /* orthographic: the origins' right and up ranges (relative to the eye) */
 } r3_frustum;
 
 static void frustum_init(const r3_state *s, r3_frustum *f, int x0, int y0, int x1, int y1)
@@ -274,6 +276,7 @@ static void frustum_init(const r3_state *s, r3_frustum *f, int x0, int y0, int x
     const ms_camera_basis *b = &s->ctx->cam;
     f->x0 = x0; f->y0 = y0; f->x1 = x1; f->y1 = y1;
     f->cone = 0;
+    f->cok = !ms_camera_ray_at(b, 0.5f * (float)(x0 + x1 + 1), 0.5f * (float)(y0 + y1 + 1), f->co, f->cd);
     if (b->type == MS_CAMERA_ORTHOGRAPHIC) {
         const double hw = b->half_w, hh = b->half_h;
         f->a0 = (2.0 * (x0 + 0.5) / b->width - 1.0) * hw;
@@ -286,20 +289,18 @@ static void frustum_init(const r3_state *s, r3_frustum *f, int x0, int y0, int x
     }
     if (b->type == MS_CAMERA_PINHOLE) {
         float o[3], d[3];
-        ms_camera_ray_at(b, 0.5f * (float)(x0 + x1 + 1), 0.5f * (float)(y0 + y1 + 1), o, d);
-        double l = sqrt((double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2]);
-        for (int k = 0; k < 3; k++) f->axis[k] = d[k] / l;
-        double amax = 0.0;
+        const float *cd = f->cd;
+        double l = sqrt((double)cd[0] * cd[0] + (double)cd[1] * cd[1] + (double)cd[2] * cd[2]);
+        for (int k = 0; k < 3; k++) f->axis[k] = cd[k] / l;
+        double cmin = 1.0;
         const int xs[2] = { x0, x1 }, ys[2] = { y0, y1 };
         for (int c = 0; c < 4; c++) {
             ms_camera_ray(b, xs[c & 1], ys[c >> 1], o, d);
             l = sqrt((double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2]);
-            double cs = (d[0] * f->axis[0] + d[1] * f->axis[1] + d[2] * f->axis[2]) / l;
-            cs = cs > 1.0 ? 1.0 : cs;
-            const double a = acos(cs);
-            amax = a > amax ? a : amax;
+            const double cs = (d[0] * f->axis[0] + d[1] * f->axis[1] + d[2] * f->axis[2]) / l;
+            cmin = cs < cmin ? cs : cmin;
         }
-        f->alpha = amax * (1.0 + 1e-4) + 1e-6;
+        f->alpha = acos(cmin > 1.0 ? 1.0 : cmin < -1.0 ? -1.0 : cmin) * (1.0 + 1e-4) + 1e-6;
         f->cos_a = cos(f->alpha);
         f->sin_a = sin(f->alpha);
         f->cone = 1;
@@ -372,8 +373,9 @@ static float node_near(const r3_state *s, const ms_bvh_node *n)
 /* Does the frustum's centre ray meet the box? (the split oracle; not a culling test) */
 static int centre_ray_hits(const r3_state *s, const r3_frustum *f, const ms_bvh_node *n)
 {
-    float o[3], d[3];
-    if (ms_camera_ray_at(&s->ctx->cam, 0.5f * (float)(f->x0 + f->x1 + 1), 0.5f * (float)(f->y0 + f->y1 + 1), o, d)) return 1;
+    (void)s;
+    if (!f->cok) return 1;
+    const float *o = f->co, *d = f->cd;
     double tn = 0.0, tf = INFINITY;
     for (int k = 0; k < 3; k++) {
         const double inv = 1.0 / d[k];
