@@ -277,11 +277,15 @@ def visibility_points(scene, positions, normals, triangles=None, keys=None, meth
     return (V, S, F) if return_front else (V, S)
 
 
-def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto"):
+def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto",
+           primary=None, consistent_primary=False):
     """A frame (ms_render): dict of vis, shadow (H, W) float32 (-1 where the primary ray missed), front
-    (H, W) uint16, rgb (H, W, 3) linear radiance, exposure, and stats (a dict)."""
+    (H, W) uint16, rgb (H, W, 3) linear radiance, exposure, and stats (a dict). primary: the primary
+    visibility method (docs/primary.md; None: the method's pairing)."""
     opt = _RenderOptions()
     opt.method = method.encode() if method else None
+    opt.primary = primary.encode() if primary else None
+    opt.consistent_primary = 1 if consistent_primary else 0
     opt.pattern = _PATTERNS[pattern]
     opt.samples, opt.width, opt.height, opt.threads, opt.seed = int(samples), int(width), int(height), int(threads), int(seed)
     opt.isa = _ISAS[isa]
@@ -305,7 +309,7 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
 
 def _stats_dict(st):
     d = {n: getattr(st, n) for n, _ in _Stats._fields_ if n not in ("counter_name", "counter")}
-    for k in ("method", "pattern", "kernel_isa", "traversal_isa"):
+    for k in ("method", "pattern", "kernel_isa", "traversal_isa", "primary"):
         d[k] = d[k].decode() if d[k] else None
     d["counters"] = {st.counter_name[i].decode(): int(st.counter[i]) for i in range(st.n_counters)}
     return d
