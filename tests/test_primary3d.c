@@ -276,7 +276,8 @@ static void test_against_watertight(void **st)
     (void)st;
     ms_scene sc;
     long bad = 0, ties = 0;
-    static const char *const scenes[] = { NULL, "stanford-bunny/stanford-bunny.json", "sibenik/sibenik.json" };
+    static const char *const scenes[] = { NULL, "stanford-bunny/stanford-bunny.json", "sibenik/sibenik.json",
+                                          "crytek-sponza-partial/crytek-sponza-partial.json" };
     for (size_t s = 0; s < sizeof scenes / sizeof *scenes; s++) {
         char path[1024], err[256];
         if (!scenes[s]) assert_int_equal(ms_scene_default(&sc), 0);
