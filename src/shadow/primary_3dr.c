@@ -306,7 +306,13 @@ static void frustum_init(const r3_state *s, r3_frustum *f, int x0, int y0, int x
         f->cone = 1;
         return;
     }
-    f->cone = rect_cone(s, x0, y0, x1, y1, f->axis, &f->alpha);
+    /* curved: the cone of the tile (rect_cone), from the centre ray made above */
+    f->cone = f->cok;
+    if (f->cok) {
+        const double l = sqrt((double)f->cd[0] * f->cd[0] + (double)f->cd[1] * f->cd[1] + (double)f->cd[2] * f->cd[2]);
+        for (int k = 0; k < 3; k++) f->axis[k] = f->cd[k] / l;
+        f->alpha = ms_camera_angle_per_pixel(b) * 0.5 * hypot((double)(x1 - x0), (double)(y1 - y0)) * (1.0 + 1e-4) + 1e-6;
+    }
     f->cos_a = cos(f->alpha);
     f->sin_a = sin(f->alpha);
 }
