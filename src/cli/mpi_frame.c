@@ -20,7 +20,7 @@ static int render_chunk(void *user, int first, int count, char *err, size_t errl
     return ms_frame_job_render(w->job, w->tiles, count, err, errlen);
 }
 
-_Static_assert(sizeof(ms_material) == 6 * sizeof(float) + 2 * sizeof(int32_t), "ms_material is hashed as bytes: no padding");
+_Static_assert(sizeof(ms_material) == 7 * sizeof(float) + 4 * sizeof(int32_t), "ms_material is hashed as bytes: no padding");
 
 /* The scene and the options that decide the image, so that ranks can check they were given the same. */
 static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)

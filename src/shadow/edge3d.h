@@ -35,6 +35,7 @@
 #include <math.h>
 #include <stdint.h>
 #include "../camera/camera.h"
+#include "alpha.h"
 
 #ifdef __clang__
 #pragma STDC FP_CONTRACT OFF
@@ -100,12 +101,12 @@ int ms_e3_tile_cone(const ms_e3_tri *T, const double a[3], double alpha);
 typedef struct ms_e3_box { int x0, y0, x1, y1; } ms_e3_box;
 int ms_e3_bounds(const ms_camera_basis *b, const float tri[9], ms_e3_box box[2]);
 
-/* The hook where a primary accepts a hit: the alpha test of alpha-tested materials goes here (the
- * triangle, its ray and t), so that every primary that uses ms_e3_hit skips the same texels. */
-static inline int ms_e3_accept(uint32_t prim, const float o[3], const float d[3], float t)
+/* Where a primary accepts a hit: alpha-tested triangles count only where opaque (alpha.h, the one decision
+ * every method shares), so every primary that uses ms_e3_hit looks through the same texels. a: the frame's
+ * table (leaf-order ids; NULL: every triangle opaque, e.g. a streamed scene). */
+static inline int ms_e3_accept(const ms_alpha *a, uint32_t prim, const float o[3], const float d[3])
 {
-    (void)prim; (void)o; (void)d; (void)t;
-    return 1;
+    return !ms_alpha_tested(a, prim) || ms_alpha_ray_occludes(a, prim, o, d);
 }
 
 #endif

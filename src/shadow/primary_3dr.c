@@ -136,7 +136,7 @@ static void raster_rect(r3_thread *th, const ms_e3_tri *T, const float *tri, uin
             float t;
             if (!ms_e3_hit(T, o, d, q, &t)) continue;
             if (t > s->t[i] || (t == s->t[i] && id > s->id[i])) continue;
-            if (!ms_e3_accept(id, o, d, t)) continue;   /* alpha test hook */
+            if (!ms_e3_accept(s->ctx->alpha, id, o, d)) continue;   /* a cut-out's hole (alpha.h) */
             s->t[i] = t;
             s->id[i] = id;
             s->dirty[(size_t)(y / R3_BIN) * s->bw + x / R3_BIN] = 1;

@@ -4,6 +4,7 @@
  * ties in t to the smaller triangle id, so it agrees with every "3dr-*" primary bit for bit. And the hit
  * finishing every primary method shares. */
 #include "method.h"
+#include "alpha.h"
 #include "edge3d.h"
 #include "../accel/ray_triangle.h"
 #include "../core/vec.h"
@@ -52,8 +53,8 @@ static int bvh_primary_create(const ms_render_ctx *ctx, void **state, char *err,
  * margin, ms_wt_box_origins, is far above the double rounding of the edge functions), leaves decided by
  * ms_e3_hit; a node is skipped only when its box starts beyond the best t, so an equal t of a smaller id
  * is still found. Triangles are set up per ray (S counts them). */
-static uint32_t consistent_closest(const bvh_primary_state *s, const ms_bvh *b, const float o[3], const float d[3],
-                                   float *tbest, uint64_t c[3])
+static uint32_t consistent_closest(const bvh_primary_state *s, const ms_bvh *b, const ms_alpha *a, const float o[3],
+                                   const float d[3], float *tbest, uint64_t c[3])
 {
     const float *q = ms_e3_q(&s->cam, o, d);
     float olo[3], ohi[3], inv[3];
@@ -85,7 +86,7 @@ static uint32_t consistent_closest(const bvh_primary_state *s, const ms_bvh *b, 
                 float t;
                 if (!ms_e3_hit(&T, o, d, q, &t)) continue;
                 if (t > bt || (t == bt && i > best)) continue;
-                if (!ms_e3_accept(i, o, d, t)) continue;   /* alpha test hook */
+                if (!ms_e3_accept(a, i, o, d)) continue;   /* a cut-out's hole: the ray goes on */
                 bt = t;
                 best = i;
             }
@@ -112,14 +113,17 @@ static void bvh_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int
             if (ms_camera_ray(&ctx->cam, x, y, r.o, r.d)) { h->prim = UINT32_MAX; continue; }
             if (ctx->consistent_primary) {
                 float t;
-                const uint32_t p = consistent_closest(s, ctx->bvh, r.o, r.d, &t, c);
+                const uint32_t p = consistent_closest(s, ctx->bvh, ctx->alpha, r.o, r.d, &t, c);
                 if (p != UINT32_MAX) ms_hit_finish(ctx, r.o, r.d, t, p, h);
                 else h->prim = UINT32_MAX;
                 continue;
             }
             r.tmin = 0.0f;
             r.tmax = INFINITY;
-            if (ms_bvh_closest(ctx->bvh, &r, &hit)) ms_hit_finish(ctx, r.o, r.d, hit.t, hit.prim, h);
+            /* Alpha-tested triangles: only where opaque (alpha.h), so a ray goes on through a cut-out's holes. */
+            const int found = ctx->alpha ? ms_bvh_closest_filter(ctx->bvh, &r, &hit, ms_alpha_ray_filter, ctx->alpha)
+                                         : ms_bvh_closest(ctx->bvh, &r, &hit);
+            if (found) ms_hit_finish(ctx, r.o, r.d, hit.t, hit.prim, h);
             else h->prim = UINT32_MAX;
         }
     if (ctx->consistent_primary) {
