@@ -321,6 +321,13 @@ typedef struct ms_render_options {
     int frustum_shrink;     /* block traversal and mft: also narrow a pixel's traversal frustum as its samples are
                              * occluded (the paper's "FS"; off: only its leaf rectangle shrinks, "CR") */
     int no_filter;          /* interleaved pattern: leave out the 4x4 discontinuity-aware filter (raw V, S) */
+    /* Primary visibility (docs/primary.md): NULL pairs it with the shadow method ("bvh", "embree"; "depth"
+     * for a streamed procedural scene), else one of bvh, embree, depth (procedural scenes only), 3dr-bb,
+     * 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full. A procedural scene is streamed when both the shadow method and the
+     * primary stream (3dr-bb, 3dr-bin, depth), else materialised. */
+    const char *primary;
+    int consistent_primary; /* bvh primary: decide each ray with the 3D rasterizers' consistent edge test
+                             * (ties by the top-left rule, t ties to the smaller id): the same hits as 3dr-* */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
@@ -356,6 +363,10 @@ typedef struct ms_stats {
     double shadow_cpu_s;           /* frames: the process's CPU seconds (all threads) during shadow_s, the
                                     * figure to compare methods by on a machine shared with other work;
                                     * 0 from the points API (other callers may share the process) */
+    const char *primary;           /* the primary-visibility method used */
+    /* Its counters where it has them (the 3D rasterizers, the consistent bvh caster; Dachsbacher et al.'s
+     * Table 1): triangle set-ups, edge-function evaluations, BVH nodes visited; 0 otherwise. */
+    uint64_t primary_setups, primary_edge_evals, primary_nodes;
 } ms_stats;
 
 typedef struct ms_frame {

@@ -725,6 +725,45 @@ static void test_frames_equal_raytrace(void **state)
     ms_scene_free(&sc);
 }
 
+/* The 3D-rasterization primaries and bvh --consistent (issue 14) look through the cut-outs as the bvh primary
+ * does: the same V and S bit for bit among themselves, and no pixel hit by one and missed by the watertight
+ * bvh primary (which would mean a hole seen differently). */
+static void test_primaries_through_cutouts(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    char dir[4096], err[512];
+    load_scene("gltf", &sc, dir, sizeof dir);
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.method = "raytrace";
+    o.samples = 256;
+    o.width = o.height = 40;
+    o.threads = 1;
+    ms_frame wt, ref;
+    assert_int_equal(ms_render(&sc, &o, &wt, err, sizeof err), 0);
+    o.primary = "bvh";
+    o.consistent_primary = 1;
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    o.consistent_primary = 0;
+    const tu_agreement w = tu_compare_frames(&ref, &wt);
+    printf("bvh --consistent vs bvh through cut-outs: %ld of %ld pixels differ in V, %ld hit by one only\n", w.differ,
+           w.pixels, w.miss_mismatch);
+    assert_int_equal(w.miss_mismatch, 0);
+    static const char *const names[] = { "3dr-bb", "3dr-bin", "3dr-fc", "3dr-fs", "3dr-full" };
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+        ms_frame f;
+        o.primary = names[i];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        assert_memory_equal(f.vis, ref.vis, (size_t)40 * 40 * sizeof(float));
+        assert_memory_equal(f.shadow, ref.shadow, (size_t)40 * 40 * sizeof(float));
+        ms_frame_free(&f);
+    }
+    ms_frame_free(&ref);
+    ms_frame_free(&wt);
+    ms_scene_free(&sc);
+}
+
 /* Without the alpha table (what an opaque material gives) the cards occlude as whole quads: the alpha test only
  * ever gives samples back, and it does give many. */
 static void test_opaque_cards_are_quads(void **state)
@@ -881,6 +920,7 @@ int main(void)
         cmocka_unit_test(test_primary_gltf),
         cmocka_unit_test(test_primary_obj),
         cmocka_unit_test(test_frames_equal_raytrace),
+        cmocka_unit_test(test_primaries_through_cutouts),
         cmocka_unit_test(test_opaque_cards_are_quads),
         cmocka_unit_test(test_loading_rules),
         cmocka_unit_test(test_bake_honours_alpha),

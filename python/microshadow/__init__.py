@@ -89,7 +89,8 @@ class _Stats(ctypes.Structure):
         [(n, ctypes.c_uint64) for n in ("visible_pixels", "shadow_rays", "penumbra_pixels")] + \
         [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
          ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS),
-         ("shadow_cpu_s", ctypes.c_double)]
+         ("shadow_cpu_s", ctypes.c_double), ("primary", ctypes.c_char_p)] + \
+        [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes")]
 
 
 class _Frame(ctypes.Structure):
@@ -109,7 +110,8 @@ class _RenderOptions(ctypes.Structure):
                 ("seed", ctypes.c_uint32), ("progress", _PROGRESS), ("progress_user", _p), ("isa", ctypes.c_int),
                 ("no_occlusion_cull", ctypes.c_int), ("no_child_order", ctypes.c_int),
                 ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
-                ("traversal", ctypes.c_int), ("frustum_shrink", ctypes.c_int), ("no_filter", ctypes.c_int)]
+                ("traversal", ctypes.c_int), ("frustum_shrink", ctypes.c_int), ("no_filter", ctypes.c_int),
+                ("primary", ctypes.c_char_p), ("consistent_primary", ctypes.c_int)]
 
 
 class _Points(ctypes.Structure):
@@ -275,11 +277,15 @@ def visibility_points(scene, positions, normals, triangles=None, keys=None, meth
     return (V, S, F) if return_front else (V, S)
 
 
-def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto"):
+def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto",
+           primary=None, consistent_primary=False):
     """A frame (ms_render): dict of vis, shadow (H, W) float32 (-1 where the primary ray missed), front
-    (H, W) uint16, rgb (H, W, 3) linear radiance, exposure, and stats (a dict)."""
+    (H, W) uint16, rgb (H, W, 3) linear radiance, exposure, and stats (a dict). primary: the primary
+    visibility method (docs/primary.md; None: the method's pairing)."""
     opt = _RenderOptions()
     opt.method = method.encode() if method else None
+    opt.primary = primary.encode() if primary else None
+    opt.consistent_primary = 1 if consistent_primary else 0
     opt.pattern = _PATTERNS[pattern]
     opt.samples, opt.width, opt.height, opt.threads, opt.seed = int(samples), int(width), int(height), int(threads), int(seed)
     opt.isa = _ISAS[isa]
@@ -303,7 +309,7 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
 
 def _stats_dict(st):
     d = {n: getattr(st, n) for n, _ in _Stats._fields_ if n not in ("counter_name", "counter")}
-    for k in ("method", "pattern", "kernel_isa", "traversal_isa"):
+    for k in ("method", "pattern", "kernel_isa", "traversal_isa", "primary"):
         d[k] = d[k].decode() if d[k] else None
     d["counters"] = {st.counter_name[i].decode(): int(st.counter[i]) for i in range(st.n_counters)}
     return d

@@ -45,6 +45,9 @@ static void usage(FILE *f)
         "  --isa I             cap on the SIMD instruction set: auto (default), avx512, avx2, scalar\n"
         "  --traversal T       micro-raster methods: block (default: 4x4 pixels' frusta together) or pixel\n"
         "  --frustum-shrink    block traversal and mft: narrow each frustum as its samples are occluded\n"
+        "  --primary P         primary visibility: bvh, embree, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full,\n"
+        "                      depth (default: the method's pairing; docs/primary.md)\n"
+        "  --consistent        bvh primary: the 3D rasterizers' consistent edge test (same hits as 3dr-*)\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture, which\n"
         "                      are otherwise one line per scene: their number and the first)\n"
@@ -89,7 +92,7 @@ static int cli_main(int argc, char **argv)
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
-           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE };
+           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -100,7 +103,8 @@ static int cli_main(int argc, char **argv)
         { "verbose", no_argument, 0, O_VERBOSE },
         { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
         { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
-        { "exposure", required_argument, 0, O_EXPOSURE },
+        { "exposure", required_argument, 0, O_EXPOSURE }, { "primary", required_argument, 0, O_PRIMARY },
+        { "consistent", no_argument, 0, O_CONSISTENT },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -177,6 +181,8 @@ static int cli_main(int argc, char **argv)
         case O_QUIET: quiet = 1; break;
         case O_VERBOSE: ms_set_warning_verbose(1); break;
         case O_NO_FILTER: opt.no_filter = 1; break;
+        case O_PRIMARY: opt.primary = optarg; break;
+        case O_CONSISTENT: opt.consistent_primary = 1; break;
         case O_EXPOSURE: {
             char *end;
             errno = 0;

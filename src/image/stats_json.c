@@ -24,7 +24,11 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     cJSON_AddNumberToObject(o, "load_s", s->load_s);
     cJSON_AddNumberToObject(o, "build_s", s->build_s);
     cJSON_AddNumberToObject(o, "setup_s", s->setup_s);
+    cJSON_AddStringToObject(o, "primary", s->primary ? s->primary : "none");
     cJSON_AddNumberToObject(o, "primary_s", s->primary_s);
+    cJSON_AddNumberToObject(o, "primary_setups", (double)s->primary_setups);
+    cJSON_AddNumberToObject(o, "primary_edge_evals", (double)s->primary_edge_evals);
+    cJSON_AddNumberToObject(o, "primary_nodes", (double)s->primary_nodes);
     cJSON_AddNumberToObject(o, "shadow_s", s->shadow_s);
     cJSON_AddNumberToObject(o, "shadow_cpu_s", s->shadow_cpu_s);
     cJSON_AddNumberToObject(o, "total_s", s->total_s);

@@ -104,10 +104,24 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->opt = *opt;
     j->sm = sm;
     j->threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
-    /* A procedural scene: streamed by the methods that can (primary by a depth pass, no BVH), else
-     * materialised. */
-    int streamed = scene->procedural.type != MS_PROCEDURAL_NONE;
-    if (streamed && !sm->streams) {
+    /* The primary: the option's, else the shadow method's pairing ("depth" for a streamed scene). */
+    const int procedural = scene->procedural.type != MS_PROCEDURAL_NONE;
+    const char *pname = opt->primary ? opt->primary : procedural && sm->streams ? "depth" : sm->primary;
+    const ms_primary_method *pm = ms_find_primary_method(pname);
+    if (!pm) {
+        if (strcmp(pname, "embree") == 0) snprintf(err, errlen, "primary method 'embree' is not compiled into this build");
+        else snprintf(err, errlen, "unknown primary method '%s' (bvh, embree, depth, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)", pname);
+        free(j);
+        return -1;
+    }
+    if (strcmp(pm->name, "depth") == 0 && !(procedural && sm->streams)) {
+        snprintf(err, errlen, "primary method 'depth' needs a procedural scene and a streaming shadow method (e.g. hpc)");
+        free(j);
+        return -1;
+    }
+    /* A procedural scene: streamed when the shadow method and the primary can (no BVH), else materialised. */
+    int streamed = procedural;
+    if (streamed && !(sm->streams && pm->streams)) {
         if (ms_scene_materialise(scene, j->threads, &j->soup, err, errlen)) { free(j); return -1; }
         j->own_soup = 1;
         scene = &j->soup;
@@ -117,8 +131,6 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->scene = scene;
     j->streamed = streamed;
     j->lights = ms_scene_lights(scene, &j->nlights);
-    const ms_primary_method *pm = ms_find_primary_method(streamed ? "depth" : sm->primary);
-    if (!pm) { snprintf(err, errlen, "primary method '%s' is not compiled into this build", sm->primary); goto fail; }
     const int samples = opt->samples > 0 ? opt->samples : scene->samples;
     if ((unsigned)opt->pattern > MS_PATTERN_INTERLEAVED) { snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern); goto fail; }
     if ((unsigned)opt->traversal > MS_TRAVERSAL_PIXEL) { snprintf(err, errlen, "unknown traversal %d", (int)opt->traversal); goto fail; }
@@ -166,6 +178,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     ctx->frustum_shrink = opt->frustum_shrink;
     ctx->embree_mode = opt->embree_mode;
     ctx->embree_filter = opt->embree_filter;
+    ctx->consistent_primary = opt->consistent_primary;
     j->W = W;
     j->H = H;
     j->samples = samples;
@@ -197,11 +210,15 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     }
     f->width = W;
     f->height = H;
-    const double t_setup = omp_get_wtime();
+    /* The primary's create is timed as primary visibility: the rasterizing primaries (3dr-*, depth) do
+     * their whole pass there. */
+    const double t_primary = omp_get_wtime();
     void *pstate = NULL;
     if (pm->create(ctx, &pstate, err, errlen)) goto fail;
     j->pm = pm;
     j->pstate = pstate;
+    f->stats.primary_s = omp_get_wtime() - t_primary;
+    const double t_setup = omp_get_wtime();
     for (size_t l = 0; l < nl; l++) {
         ms_render_ctx lc = *ctx;
         lc.light = j->lights[l];
@@ -514,6 +531,14 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
     st->width = W;
     st->height = H;
     st->method = j->sm->name;
+    st->primary = j->pm->name;
+    if (j->pm->counters) {
+        uint64_t c[3];
+        j->pm->counters(j->pstate, c);
+        st->primary_setups = c[0];
+        st->primary_edge_evals = c[1];
+        st->primary_nodes = c[2];
+    }
     ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
     if (j->sm->isa_used) j->sm->isa_used(j->sstate[nl - 1], &kisa, &tisa);
     st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);

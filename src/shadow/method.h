@@ -38,6 +38,7 @@ typedef struct ms_render_ctx {
     /* Alpha-tested triangles (alpha.h: ms_alpha_build), NULL when every triangle is opaque. A method that finds
      * a segment or ray meeting a flagged triangle asks ms_alpha_segment_occludes / ms_alpha_ray_occludes. */
     const struct ms_alpha *alpha;
+    int consistent_primary;            /* bvh primary: the 3D edge-function test (edge3d.h) in its leaves */
 } ms_render_ctx;
 
 /* One visible point: the pixel, its hit point, the unit geometric normal facing the camera (its plane is
@@ -99,6 +100,10 @@ typedef struct ms_primary_method {
     /* Hits for pixels [x0,x1) x [y0,y1), row-major into out. Thread-safe. */
     void (*trace)(void *state, const ms_render_ctx *ctx, int x0, int y0, int x1, int y1, ms_hit *out);
     void (*destroy)(void *state);
+    /* Optional (NULL: none): the counters of the paper's Table 1 (Dachsbacher et al.) over the frame so far:
+     * triangle set-ups S, edge-function evaluations E, BVH nodes visited N. */
+    void (*counters)(const void *state, uint64_t c[3]);
+    int streams;                 /* 1: reads a procedural scene in batches (ctx->bvh NULL), never all at once */
 } ms_primary_method;
 
 /* Known methods, compiled in or not (registry.c). */
@@ -110,6 +115,8 @@ const ms_primary_method *ms_find_primary_method(const char *name);
  * the ray's origin. Shared by every primary method so that all agree on the receiver. */
 void ms_hit_finish(const ms_render_ctx *ctx, const float o[3], const float d[3], float t, uint32_t prim,
                    ms_hit *h);
+/* The same from the triangle's 9 floats (for passes without a BVH). */
+void ms_hit_finish_tri(const float *tri, const float o[3], const float d[3], float t, uint32_t prim, ms_hit *h);
 
 /* The reference answer for one point (raytrace.c): writes to vis the front samples that are unoccluded and
  * returns their number. pts: scratch for 3*k*k floats; cnt: the raytrace method's 3 counters. */

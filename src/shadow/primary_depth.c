@@ -132,4 +132,5 @@ const ms_primary_method ms_primary_depth = {
     .create = depth_create,
     .trace = depth_trace,
     .destroy = depth_destroy,
+    .streams = 1,
 };

@@ -7,6 +7,8 @@ extern const ms_shadow_method ms_shadow_raytrace, ms_shadow_mft;
 extern const ms_shadow_method ms_shadow_scanline, ms_shadow_bounds, ms_shadow_hierarchical;
 extern const ms_shadow_method ms_shadow_hpc, ms_shadow_hpc_scanline;
 extern const ms_primary_method ms_primary_bvh, ms_primary_depth;
+extern const ms_primary_method ms_primary_3dr_bb, ms_primary_3dr_bin, ms_primary_3dr_fc, ms_primary_3dr_fs,
+    ms_primary_3dr_full;
 #ifdef MS_HAVE_EMBREE
 extern const ms_shadow_method ms_shadow_embree;
 extern const ms_primary_method ms_primary_embree;
@@ -35,11 +37,15 @@ const ms_shadow_method *ms_find_shadow_method(const char *name)
 
 const ms_primary_method *ms_find_primary_method(const char *name)
 {
-    if (strcmp(name, "bvh") == 0) return &ms_primary_bvh;
-    if (strcmp(name, "depth") == 0) return &ms_primary_depth;
+    static const ms_primary_method *const primaries[] = {
+        &ms_primary_bvh, &ms_primary_depth, &ms_primary_3dr_bb, &ms_primary_3dr_bin, &ms_primary_3dr_fc,
+        &ms_primary_3dr_fs, &ms_primary_3dr_full,
 #ifdef MS_HAVE_EMBREE
-    if (strcmp(name, "embree") == 0) return &ms_primary_embree;
+        &ms_primary_embree,
 #endif
+    };
+    for (size_t i = 0; i < sizeof primaries / sizeof *primaries; i++)
+        if (strcmp(primaries[i]->name, name) == 0) return primaries[i];
     return NULL;
 }
 

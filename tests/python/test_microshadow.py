@@ -140,6 +140,16 @@ class QuadTest(unittest.TestCase):
         # methods agree sample for sample but for ties: at most one sample in 256 apart
         self.assertLessEqual(np.abs(a["vis"] - b["vis"]).max() * 256, 1.0 + 1e-3)
         self.assertEqual(a["stats"]["method"], "scanline")
+        self.assertEqual(a["stats"]["primary"], "bvh")
+        # the primary option and its stats fields (the struct tails): the 3D rasterizers and the
+        # consistent BVH caster agree bit for bit
+        r = ms.render(self.scene, method="scanline", samples=256, primary="3dr-full")
+        q = ms.render(self.scene, method="scanline", samples=256, primary="bvh", consistent_primary=True)
+        self.assertEqual(r["stats"]["primary"], "3dr-full")
+        self.assertGreater(r["stats"]["primary_setups"], 0)
+        self.assertGreater(r["stats"]["primary_edge_evals"], 0)
+        self.assertGreater(q["stats"]["primary_nodes"], 0)
+        np.testing.assert_array_equal(r["vis"], q["vis"])
         self.assertIn("raytrace", ms.method_names())
         # the interleaved pattern: N/16 samples per pixel, filtered; the stats' layout matches the C struct
         c = ms.render(self.scene, method="raytrace", samples=256, pattern="interleaved")
