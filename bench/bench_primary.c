@@ -1,5 +1,5 @@
-/* The primary methods against each other: the 3D rasterization continuum of Dachsbacher et al. (GI 2012,
- * Table 1) beside our BVH ray caster (watertight and --consistent) and Embree's. For each scene, camera
+/* The primary methods against each other: the 3D rasterization continuum of Dachsbacher et al. ("3D
+ * Rasterization - Unifying Rasterization and Ray Casting", Table 1) beside our BVH ray caster (watertight and --consistent) and Embree's. For each scene, camera
  * (the scene's pinhole, and a latlong panorama from the scene's eye, forward towards its target) and size:
  * per primary the seconds of its whole pass (create + trace of every 16x16 tile, as a frame does; Embree's
  * scene build is reported apart; wall ms and the process's CPU ms, the latter less disturbed by other work;

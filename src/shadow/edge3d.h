@@ -1,6 +1,6 @@
-/* 3D edge functions (Dachsbacher, Vogelgsang, Stamminger et al., "3D Rasterization: A Bridge between
- * Rasterization and Ray Casting", GI 2012): the one per-pixel decision every 3D-rasterization primary
- * ("3dr-*", primary_3dr.c) and the consistent BVH caster (primary_bvh.c, --consistent) share, so all of
+/* 3D edge functions (Dachsbacher, Slusallek, Davidovic, Engelhardt, Phillips, Georgiev, "3D Rasterization
+ * - Unifying Rasterization and Ray Casting"; ../shared/papers/dachsbacher-3d-rasterization.txt): the one
+ * per-pixel decision every 3D-rasterization primary ("3dr-*", primary_3dr.c) and the consistent BVH caster (primary_bvh.c, --consistent) share, so all of
  * them give the same hit triangle and the same t at every pixel, bit for bit.
  *
  * Set-up (ms_e3_setup), in the appendix's homogeneous form with one code path for both kinds of camera:

@@ -1,5 +1,6 @@
 /* Primary methods "3dr-bb", "3dr-bin", "3dr-fc", "3dr-fs", "3dr-full": the sample points of the 3D
- * rasterization continuum of Dachsbacher et al. (GI 2012, sec. 4.4 and 5), every one deciding each pixel
+ * rasterization continuum of Dachsbacher et al. ("3D Rasterization - Unifying Rasterization and Ray
+ * Casting", sec. 4.4 and 5), every one deciding each pixel
  * with the one 3D edge-function test of edge3d.h on the ray of ms_camera_ray, so all of them (and the
  * consistent BVH caster) give bit-identical hits: the nearest t, ties to the smaller triangle id.
  *
