@@ -13,8 +13,11 @@
  *  - 3dr-fc: the screen in frusta of 256x256 pixels, each culled through our BVH (frustum vs box), binning
  *    for the triangles of the leaves it reaches.
  *  - 3dr-fs: no binning; occlusion culling (a node's nearest distance behind the frustum's farthest stored
- *    one) and adaptive frustum splitting down to 8x8 pixels when the frustum's centre ray misses a node's
- *    box or the box is small against the frustum; per-pixel tests over the leaf triangles' bounds.
+ *    one) and adaptive frustum splitting down to 32x32 pixels (the paper: 8x8) when the frustum's centre
+ *    ray misses a node's box or the box is small against the frustum; per-pixel tests over the leaf
+ *    triangles' bounds. 32, not 8: each split pays a frustum set-up (corner or centre rays, a cone), and
+ *    below 32x32 that cost exceeded the pixel tests it saved on every shared scene (docs/primary.md:
+ *    3dr-full at 1024² 0.30-0.84x of bvh with 32, 0.58-1.37x with 8; 64 measured the same as 32).
  *  - 3dr-full: 3dr-fs with binning and early-z in the leaves.
  * Departures: the paper culls back faces (microshadow's visibility is two-sided); it evaluates edge
  * functions incrementally or directly, here always directly in double (edge3d.h); frusta of curved
@@ -38,7 +41,7 @@
 #define R3_BATCH 65536
 #define R3_BIN 8          /* binning stops at 8x8 pixels; also the early-z block */
 #define R3_FRUSTUM 256
-#define R3_FS_MIN 8
+#define R3_FS_MIN 32      /* frustum splitting stops here (see above) */
 
 enum { V_BB, V_BIN, V_FC, V_FS, V_FULL };
 
