@@ -132,17 +132,24 @@ int ms_camera_project(const ms_camera_basis *b, const float p[3], float *px, flo
     if (!(len > 0.0f)) return -1;
     switch (b->type) {
     case MS_CAMERA_FISHEYE: {
-        float th = acosf(ms_maxf(-1.0f, ms_minf(1.0f, z / len)));
-        if (!(th <= b->max_theta)) return -1;
+        /* atan2, not acos(z/len): acos loses half the digits near the axis (0.1 pixel at 1024^2, 180 deg) */
         float lat = sqrtf(a * a + c * c);
+        float th = atan2f(lat, z);
+        if (!(th <= b->max_theta)) return -1;
         float r = th / b->max_theta * b->radius;
-        *px = b->cx + (lat > 0.0f ? r * a / lat : 0.0f);
-        *py = b->cy - (lat > 0.0f ? r * c / lat : 0.0f);
+        if (!(lat > 0.0f)) {
+            /* On the axis: the centre, or (fov 360) the antipode, which the whole rim sees: take its right end. */
+            *px = b->cx + (z < 0.0f ? r : 0.0f);
+            *py = b->cy;
+            return 0;
+        }
+        *px = b->cx + r * a / lat;
+        *py = b->cy - r * c / lat;
         return 0;
     }
     case MS_CAMERA_LATLONG: {
         float lon = atan2f(a, z);
-        float th = acosf(ms_maxf(-1.0f, ms_minf(1.0f, c / len)));
+        float th = atan2f(sqrtf(a * a + z * z), c);   /* from up; atan2 keeps the poles accurate */
         float x = (lon / (2.0f * (float)M_PI) + 0.5f) * (float)b->width;
         if (x >= (float)b->width) x -= (float)b->width;
         if (x < 0.0f) x = 0.0f;
@@ -186,4 +193,12 @@ float ms_camera_angle_per_pixel(const ms_camera_basis *b)
     default:
         return 0.0f;
     }
+}
+
+void ms_camera_viewer(const ms_camera_basis *b, const float p[3], float viewer[3])
+{
+    if (b->type == MS_CAMERA_ORTHOGRAPHIC)
+        for (int k = 0; k < 3; k++) viewer[k] = p[k] - b->forward[k];
+    else
+        for (int k = 0; k < 3; k++) viewer[k] = b->eye[k];
 }
