@@ -40,6 +40,8 @@ int ms_camera_basis_init(ms_camera_basis *b, const ms_camera *c, int width, int 
     b->aspect = (float)width / (float)height;
     b->half_h = c->type == MS_CAMERA_ORTHOGRAPHIC ? 0.5f * c->ortho_height : 0.0f;
     b->half_w = b->half_h * b->aspect;
+    /* ray origins stay within the coordinate range scenes are checked against (1e18, scene_validate.c) */
+    if (!(b->half_w <= 1e18f && b->half_h <= 1e18f)) return -1;
     b->cx = 0.5f * (float)width;
     b->cy = 0.5f * (float)height;
     b->radius = 0.5f * (float)(width < height ? width : height);
