@@ -222,6 +222,8 @@ static void test_values(void **st)
     expect_bad(write_scene("c6.json", &p), NULL, NEEDLES("c6.json", "camera.ortho_height must be in (0, "));
     p = good; p.size = ", \"type\": \"fisheye\"";
     expect_bad(write_scene("c7.json", &p), NULL, NEEDLES("c7.json", "camera.fov is missing"));
+    p = good; p.size = ", \"type\": \"fisheye\"";   /* good.fov is the pinhole's fov_y */
+    expect_bad(write_scene("c7b.json", &p), NULL, NEEDLES("c7b.json", "camera.fov is missing (\"fov_y\" is another camera type's key)"));
     p = good; p.size = ", \"type\": \"fisheye\", \"fov\": 360.5";
     expect_bad(write_scene("c8.json", &p), NULL, NEEDLES("c8.json", "camera.fov must be in (0, 360] degrees"));
     p = good; p.size = ", \"type\": \"fisheye\", \"fov\": -10";

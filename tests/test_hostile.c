@@ -247,11 +247,11 @@ static void test_scene_keys(void **st)
     expect_bad(p, NULL, NEEDLES("dup.json", "duplicate key \"camera.fov_y\""));
     tu_write_file(inpath("dup2.json"), "{\"meshes\":[{\"file\":\"ok.obj\",\"file\":\"x.obj\"}],\"camera\":{},\"light\":{}}");
     expect_bad(inpath("dup2.json"), NULL, NEEDLES("dup2.json", "duplicate key \"meshes[0].file\""));
-    /* "fov" for "fov_y": the error names the typo (one line), and a stray unknown key in a good scene
+    /* "fov" (the fisheye's key) for "fov_y": the error names it (one line), and a stray unknown key in a good scene
      * is a warning naming the key and the nearest known one, after which the render succeeds. */
     tu_write_file(inpath("typo.json"), "{\"meshes\":[{\"file\":\"ok.obj\"}],\"camera\":{\"eye\":[0,10,12],\"target\":[0,0,0],"
                   "\"up\":[0,1,0],\"fov\":60},\"light\":{\"corner\":[-1,6,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2]}}");
-    expect_bad(inpath("typo.json"), NULL, NEEDLES("typo.json", "camera.fov_y is missing", "\"fov\" is not a known key"));
+    expect_bad(inpath("typo.json"), NULL, NEEDLES("typo.json", "camera.fov_y is missing", "\"fov\" is another camera type's key"));
     char png[4096], err[4096];
     const char *args[] = { scene("warn.json", "ok.obj", ", \"fovv\": 1, \"widht\": 3", NULL), "--quiet", "-o",
                            tu_path(png, sizeof png, tu_tmpdir("hostile_warn"), "w.png"), NULL };

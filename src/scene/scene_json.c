@@ -110,7 +110,9 @@ static void missing(const cJSON *obj, const char *objname, const char *key, cons
 {
     const char *typo = meant_for(obj, key, known_for(objname));
     char hint[128] = "";
-    if (typo) snprintf(hint, sizeof hint, " (\"%.40s\" is not a known key: a typo?)", typo);
+    if (typo && !strcmp(objname, "camera") && is_known(typo, camera_keys_any))
+        snprintf(hint, sizeof hint, " (\"%.40s\" is another camera type's key)", typo);
+    else if (typo) snprintf(hint, sizeof hint, " (\"%.40s\" is not a known key: a typo?)", typo);
     if (objname[0]) snprintf(err, errlen, "%s: %s.%s is missing%s", path, objname, key, hint);
     else snprintf(err, errlen, "%s: \"%s\" is missing%s", path, key, hint);
 }
