@@ -21,7 +21,10 @@
  *     square; a sphere light is sampled, per receiver, on its outline disk seen from P, with that mask);
  *     other samples are neither visible nor occluded;
  *   - a sample in front is occluded when a triangle other than T meets the segment P + u (L_i - P) at a
- *     parameter u in [1e-4, 1 - 1e-4] (two-sided, purely geometric);
+ *     parameter u in [1e-4, 1 - 1e-4] (two-sided, purely geometric); a triangle with an alpha-tested material
+ *     (ms_material.alpha_mode) occludes only where its alpha at the point the segment meets its plane is
+ *     >= the cutoff (one function of the triangle, P and L_i, computed in double: docs/design.md), and camera
+ *     rays pass through it where it is below;
  *   - V = (unoccluded samples in front) / (samples in front), and V = 0 when no sample is in front;
  *   - the shadow factor S = sum_i w_i v_i / sum_i w_i over the samples in front (v_i = 1 when unoccluded),
  *     with the form-factor weight w_i = max(cos theta_r,i, 0) max(cos theta_l,i, 0) / r_i^2 (theta_r at
@@ -209,7 +212,18 @@ typedef struct ms_material {
     float metallic, roughness; /* in [0, 1]; roughness is perceptual: GGX alpha = roughness^2 */
     int32_t base_color_texture;/* index into ms_scene.textures, -1: none */
     int32_t base_color_uv;     /* UV set (0 .. MS_MAX_UV_SETS-1) of the texture's coordinates */
+    /* Alpha testing (docs/shading.md, "Alpha-tested occluders"); zero: opaque, as older initialisers leave it.
+     * An alpha-tested triangle occludes shadow segments and camera rays only where its alpha >= alpha_cutoff,
+     * alpha = base_color[3] times the texture's value at the point (bilinear with repeat, UV set base_color_uv):
+     * MS_ALPHA_MASK: the base-colour texture's alpha channel (glTF alphaMode MASK, and BLEND, loaded as MASK);
+     * MS_ALPHA_MASK_MAP: the separate map alpha_texture (MTL map_d: its alpha channel, or its red channel when
+     * the image is opaque everywhere). No texture: base_color[3] alone decides. */
+    int32_t alpha_mode;        /* MS_ALPHA_OPAQUE, MS_ALPHA_MASK, MS_ALPHA_MASK_MAP */
+    float alpha_cutoff;        /* glTF alphaCutoff (default 0.5); MTL map_d: 0.5 */
+    int32_t alpha_texture;     /* MS_ALPHA_MASK_MAP: index into ms_scene.textures (-1: none) */
 } ms_material;
+
+enum { MS_ALPHA_OPAQUE = 0, MS_ALPHA_MASK = 1, MS_ALPHA_MASK_MAP = 2 };
 
 /* The scene's lights: its n_lights lights, or `light` alone when n_lights is 0. Sets *n. */
 const ms_light *ms_scene_lights(const ms_scene *s, size_t *n);

@@ -41,6 +41,11 @@ void ms_bvh_free(ms_bvh *b);
 
 /* 1 and the nearest hit in (tmin, tmax), or 0. */
 int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit);
+/* The same, counting only the hits accept(user, prim, r) returns non-zero for (a rejected hit does not shorten
+ * the ray: traversal goes on past it; e.g. alpha-tested triangles where they are transparent). accept NULL:
+ * ms_bvh_closest. */
+typedef int (*ms_bvh_hit_filter)(const void *user, uint32_t prim, const ms_ray *r);
+int ms_bvh_closest_filter(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit, ms_bvh_hit_filter accept, const void *user);
 /* 1 if any triangle other than skip_prim is hit with t in [tmin, tmax]. */
 int ms_bvh_occluded(const ms_bvh *b, const ms_ray *r, uint32_t skip_prim);
 

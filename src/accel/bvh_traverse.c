@@ -42,7 +42,10 @@ static inline float box_enter(const ms_bvh_node *n, const ray_pre *rp, float tmi
     return t0 <= t1 * MS_WT_FAR_SCALE ? t0 : INFINITY;
 }
 
-int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
+/* Closest hit; accept NULL or a filter of the hits. Inlined into both entry points, so that the unfiltered one
+ * compiles to the traversal it always was (the filter test folds away). */
+static inline __attribute__((always_inline)) int closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit,
+                                                         ms_bvh_hit_filter accept, const void *user)
 {
     ray_pre rp;
     ray_prepare(&rp, b, r);
@@ -58,7 +61,8 @@ int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
         if (n->count) {
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 float t, u, v;
-                if (ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i, r->tmin, best, &t, &u, &v)) {
+                if (ms_wt_intersect(&rp.wt, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i, r->tmin, best, &t, &u, &v) &&
+                    (!accept || accept(user, i, r))) {
                     best = t; hit->t = t; hit->u = u; hit->v = v; hit->prim = i;
                 }
             }
@@ -82,6 +86,13 @@ int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit)
             if (box_enter(&b->nodes[ni], &rp, r->tmin, best) != INFINITY) break;
         }
     }
+}
+
+int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit) { return closest(b, r, hit, NULL, NULL); }
+
+int ms_bvh_closest_filter(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit, ms_bvh_hit_filter accept, const void *user)
+{
+    return closest(b, r, hit, accept, user);
 }
 
 int ms_bvh_occluded(const ms_bvh *b, const ms_ray *r, uint32_t skip_prim)

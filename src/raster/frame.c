@@ -39,6 +39,7 @@ int ms_raster_frame_init(ms_raster_frame *f, const float c[3], const ms_grid *g,
     f->far = far;
     f->k = g->k;
     f->cull_backfaces = cull_backfaces;
+    f->alpha = NULL;
     return 0;
 }
 

@@ -14,6 +14,7 @@
 #include "../core/pattern.h"
 #include "../shadow/method.h"
 #include "../shadow/receiver.h"
+#include "../shadow/alpha.h"
 #include "frame_job.h"
 #include "shadow_frame.h"
 #include "shade.h"
@@ -39,6 +40,7 @@ struct ms_frame_job {
     const ms_light *lights;
     size_t nlights;
     ms_bvh bvh;
+    struct ms_alpha *alpha;       /* alpha-tested triangles (NULL: none), ctx.alpha */
     void *pstate;
     void **sstate;                /* per light */
     ms_render_options opt;
@@ -76,6 +78,7 @@ void ms_frame_job_free(ms_frame_job *j)
     free(j->sstate);
     if (j->pm && j->pstate) j->pm->destroy(j->pstate);
     ms_bvh_free(&j->bvh);
+    ms_alpha_free(j->alpha);
     free(j->hits);
     free(j->surf);
     free(j->traced);
@@ -143,6 +146,8 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         goto fail;
     }
     if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); goto fail; }
+    if (!streamed && ms_alpha_build(scene, &j->bvh, &j->alpha)) { snprintf(err, errlen, "out of memory for the alpha-tested triangles"); goto fail; }
+    ctx->alpha = j->alpha;
     ctx->scene = scene;
     ctx->bvh = streamed ? NULL : &j->bvh;
     ctx->light = j->lights[0];

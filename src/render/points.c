@@ -8,6 +8,7 @@
 #include "../core/pattern.h"
 #include "../shadow/method.h"
 #include "../shadow/receiver.h"
+#include "../shadow/alpha.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -22,6 +23,7 @@
 
 struct ms_accel {
     ms_bvh bvh;
+    struct ms_alpha *alpha;    /* alpha-tested triangles, own copies of what they need (NULL: none) */
     uint32_t *leaf_of;         /* scene triangle index -> BVH leaf-order prim id */
     ms_scene view;             /* the scene's light and counts (tri = NULL: the BVH holds the triangles) */
     int threads;
@@ -58,6 +60,7 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
         snprintf(err, errlen, "BVH build failed: out of memory");
         return MS_ERR_NO_MEMORY;
     }
+    if (ms_alpha_build(scene, &a->bvh, &a->alpha)) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
     a->leaf_of = malloc((scene->n_tris ? scene->n_tris : 1) * sizeof *a->leaf_of);
     if (!a->leaf_of) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
     for (uint32_t i = 0; i < a->bvh.n_tris; i++) a->leaf_of[a->bvh.tri_source[i]] = i;
@@ -80,6 +83,7 @@ void ms_accel_free(ms_accel *a)
 {
     if (!a) return;
     ms_bvh_free(&a->bvh);
+    ms_alpha_free(a->alpha);
     free(a->leaf_of);
     free((void *)a->view.light.texture);
     free(a);
@@ -204,6 +208,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     memset(&ctx, 0, sizeof ctx);
     ctx.scene = &a->view;
     ctx.bvh = &a->bvh;
+    ctx.alpha = a->alpha;
     ctx.light = *light;
     ctx.pattern = opt->pattern;
     ctx.k = k;

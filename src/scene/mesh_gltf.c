@@ -260,10 +260,10 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
     long *tex_of = malloc((d->images_count ? d->images_count : 1) * sizeof *tex_of);
     if (!tex_of) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
     for (size_t i = 0; i < d->images_count; i++) tex_of[i] = -2;   /* not loaded yet */
-    int rc = 0;
+    int rc = 0, warned_blend = 0;
     for (size_t i = 0; i < d->materials_count && !rc; i++) {
         const cgltf_material *cm = &d->materials[i];
-        ms_material m = { { 1, 1, 1, 1 }, 1.0f, 1.0f, -1, 0 };
+        ms_material m = { { 1, 1, 1, 1 }, 1.0f, 1.0f, -1, 0, MS_ALPHA_OPAQUE, 0.5f, -1 };
         if (cm->has_pbr_metallic_roughness) {
             const cgltf_pbr_metallic_roughness *pb = &cm->pbr_metallic_roughness;
             for (int c = 0; c < 4; c++) m.base_color[c] = clamp01(pb->base_color_factor[c]);
@@ -288,6 +288,17 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
                         m.base_color_uv = (int32_t)tv->texcoord;
                     }
                 }
+            }
+        }
+        /* Alpha testing (docs/shading.md): MASK with its cutoff; BLEND, which a shadow renderer cannot
+         * blend, is tested like MASK at the spec's default cutoff 0.5, with one warning per file. */
+        if (cm->alpha_mode == cgltf_alpha_mode_mask || cm->alpha_mode == cgltf_alpha_mode_blend) {
+            m.alpha_mode = MS_ALPHA_MASK;
+            m.alpha_cutoff = cm->alpha_mode == cgltf_alpha_mode_mask ? clamp01(cm->alpha_cutoff) : 0.5f;
+            m.alpha_texture = -1;
+            if (cm->alpha_mode == cgltf_alpha_mode_blend && !warned_blend) {
+                ms_warn("%s: material %zu: alphaMode BLEND is alpha-tested as MASK at cutoff 0.5", path, i);
+                warned_blend = 1;
             }
         }
         mat_of[i] = ms_soup_add_material(soup, &m);

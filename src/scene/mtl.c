@@ -2,7 +2,9 @@
  * blocks on a FIFO): regular files only, at most MS_MAX_MESH_BYTES, one line at a time. Mapped onto
  * metallic-roughness (docs/shading.md): base colour Kd (default 0.8) times map_Kd, alpha d (or 1 - Tr),
  * metallic Pm (default 0), roughness Pr, else from the Phong exponent Ns as GGX alpha = sqrt(2 / (Ns + 2))
- * (Walter et al. 2007, eq. 33: the Beckmann width of a Phong lobe), else 1. */
+ * (Walter et al. 2007, eq. 33: the Beckmann width of a Phong lobe), else 1. map_d makes the material
+ * alpha-tested (MS_ALPHA_MASK_MAP, cutoff 0.5, alpha = d times the map); d alone (no map) stays opaque for
+ * visibility: a uniformly translucent surface is not a cut-out. */
 #include "scene_internal.h"
 #include "microshadow.h"
 #include <ctype.h>
@@ -124,7 +126,7 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
             memset(&p, 0, sizeof p);
             p.open = 1;
             snprintf(p.name, sizeof p.name, "%s", arg);
-            p.m = (ms_material){ { 0.8f, 0.8f, 0.8f, 1.0f }, 0.0f, 1.0f, -1, 0 };
+            p.m = (ms_material){ { 0.8f, 0.8f, 0.8f, 1.0f }, 0.0f, 1.0f, -1, 0, MS_ALPHA_OPAQUE, 0.5f, -1 };
         } else if (!p.open) {
             /* statements before the first newmtl belong to no material */
         } else if (KEY("Kd") && floats(arg, f, 3) == 3) {
@@ -141,19 +143,23 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
         } else if (KEY("Ns") && floats(arg, f, 1) == 1) {
             p.ns = f[0];
             p.have_ns = 1;
-        } else if (KEY("map_Kd") && *arg) {
+        } else if ((KEY("map_Kd") || KEY("map_d")) && *arg) {
             /* Options (-bm 1, -s 1 1 1, ...) come first: the file is the last word. */
+            const int is_d = KEY("map_d");
             const char *file = strrchr(arg, ' ');
             const char *tab = strrchr(arg, '\t');
             if (tab && (!file || tab > file)) file = tab;
             file = file ? file + 1 : arg;
             char full[4096];
             if (file[0] == '/' || snprintf(full, sizeof full, "%.*s%s", dl, path, file) >= (int)sizeof full) {
-                ms_warn("%s: map_Kd '%s': only relative paths are read: texture ignored", path, file);
+                ms_warn("%s: %s '%s': only relative paths are read: texture ignored", path, is_d ? "map_d" : "map_Kd", file);
             } else {
                 const long t = texture(lib, soup, full);
                 if (t == -2) { rc = -1; break; }
-                if (t >= 0) { p.m.base_color_texture = (int32_t)t; p.m.base_color_uv = 0; }
+                if (t >= 0 && !is_d) { p.m.base_color_texture = (int32_t)t; p.m.base_color_uv = 0; }
+                /* map_d: alpha-tested at 0.5 against d times the map (docs/shading.md); a map that cannot be
+                 * read leaves the material opaque (one warning, above). */
+                if (t >= 0 && is_d) { p.m.alpha_mode = MS_ALPHA_MASK_MAP; p.m.alpha_cutoff = 0.5f; p.m.alpha_texture = (int32_t)t; }
             }
         }
 #undef KEY

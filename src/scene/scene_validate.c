@@ -155,6 +155,13 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
             snprintf(err, errlen, "%s: material %zu names a texture or UV set that does not exist", what, i);
             return -1;
         }
+        if (m->alpha_mode < MS_ALPHA_OPAQUE || m->alpha_mode > MS_ALPHA_MASK_MAP ||
+            (m->alpha_mode != MS_ALPHA_OPAQUE && !(m->alpha_cutoff >= 0.0f && m->alpha_cutoff <= 1.0f)) ||
+            (m->alpha_mode == MS_ALPHA_MASK_MAP &&
+             (m->alpha_texture < -1 || (m->alpha_texture >= 0 && (size_t)m->alpha_texture >= s->n_textures)))) {
+            snprintf(err, errlen, "%s: material %zu has a bad alpha mode, cutoff (outside [0, 1]) or alpha texture", what, i);
+            return -1;
+        }
     }
     for (size_t i = 0; s->tri_material && i < s->n_tris; i++)
         if (s->tri_material[i] != MS_NO_MATERIAL && s->tri_material[i] >= s->n_materials) {

@@ -28,7 +28,7 @@
 #include "block_raster.h"
 #include "lanes16.h"
 #include "../raster/raster_internal.h"
-#include "frustum_traverse.h"   /* MS_TRAV_SIDE_SLACK */
+#include "frustum_traverse.h"   /* MS_TRAV_SIDE_SLACK; alpha.h */
 
 #ifndef MS_BR_COMMON
 #define MS_BR_COMMON
@@ -295,7 +295,9 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
             /* Behind C somewhere (front clear): the kernel scans its whole rectangle, which holds visible
              * samples by construction. */
             if ((front >> l & 1) && !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], ix0[l], ix1[l], iy0[l], iy1[l])) { c_cov++; continue; }
-            s->raster(in->frame[l], tri, in->buf[l]);
+            /* An alpha-tested triangle clears only its opaque samples (alpha.h): the rectangle, coverage and
+             * early-out tests that read the buffer afterwards see only what it really occludes. */
+            ms_raster_or_alpha(in->frame[l], s->raster, tri, t, in->buf[l]);
             rasterized |= 1u << l;
             c_rast++;
         }

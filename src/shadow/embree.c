@@ -26,6 +26,10 @@
  * ms_render_options.embree_filter: plane (default), always, or none (for measuring only: the receiver's
  * triangle then occludes, V is wrong).
  *
+ * Alpha-tested triangles (alpha.h): the same context filter, set for every pixel when the scene has any, rejects
+ * a hit where the triangle is transparent for that ray's segment (the receiver point and the sample point, the
+ * ray id being the sample index), so Embree goes on looking; for primary rays the ray's own line decides.
+ *
  * FTZ/DAZ: Embree wants flush-to-zero and denormals-are-zero; every entry point that calls into
  * Embree sets them in MXCSR for the calling thread and restores the caller's MXCSR on return, so that
  * other methods run on the same OpenMP threads are not affected.
@@ -39,6 +43,7 @@
  * frame as the counter "embree_build_us". */
 #include "method.h"
 #include "receiver.h"
+#include "alpha.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
 #include "../accel/ray_triangle.h"
@@ -76,8 +81,13 @@ static eb_shared *cache;
 /* RTCIntersectContext extended with what the filter needs; Embree hands the filter our pointer. */
 typedef struct eb_ictx {
     struct RTCIntersectContext c;   /* must be first */
-    uint32_t skip;
+    uint32_t skip;                  /* the receiver's triangle, UINT32_MAX: none to reject */
     uint64_t *cnt;
+    /* Alpha-tested triangles (alpha.h), NULL: none. Shadow rays: the receiver point and its sample points
+     * (ray id = sample index); primary rays (primary = 1): the ray's own origin and direction decide. */
+    const ms_alpha *alpha;
+    const float *p, *pts;
+    int primary;
 } eb_ictx;
 
 /* ---- FTZ/DAZ around every call into Embree ---- */
@@ -154,7 +164,7 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
         snprintf(err, errlen, "this Embree was built with back-face culling; the embree method needs two-sided triangles");
         return -1;
     }
-    if (s->filter != MS_EMBREE_FILTER_NONE && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED)) {
+    if ((s->filter != MS_EMBREE_FILTER_NONE || ctx->alpha) && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED)) {
         snprintf(err, errlen, "this Embree was built without filter functions; the embree method needs them");
         return -1;
     }
@@ -175,7 +185,8 @@ static int eb_build(const ms_render_ctx *ctx, eb_shared *s, char *err, size_t er
     /* Robust: watertight, like our ray tests. The context filter must be enabled on the scene to be
      * called at all ("none": no filter). */
     rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_ROBUST |
-                               (s->filter != MS_EMBREE_FILTER_NONE ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION : RTC_SCENE_FLAG_NONE));
+                               (s->filter != MS_EMBREE_FILTER_NONE || ctx->alpha ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION
+                                                                                 : RTC_SCENE_FLAG_NONE));
     rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (eb_check(s, "geometry creation", err, errlen)) goto out;
@@ -258,15 +269,35 @@ static void eb_release(void *state)
 
 /* ---- shadow rays ---- */
 
+/* The context filter: rejects the receiver's own triangle, and a hit on an alpha-tested triangle where it is
+ * transparent (any hit for shadow rays, closest hit for primary rays: Embree then goes on past it), by the
+ * decision every method shares (alpha.h): the segment from the receiver to the ray's sample point, or the
+ * camera ray's line. */
 static void eb_filter_fn(const struct RTCFilterFunctionNArguments *a)
 {
     const eb_ictx *c = (const eb_ictx *)a->context;
     const unsigned *prim = (const unsigned *)a->hit + 5 * a->N;   /* RTCHitN primID lane array */
-    for (unsigned i = 0; i < a->N; i++)
-        if (a->valid[i] && prim[i] == c->skip) {
+    for (unsigned i = 0; i < a->N; i++) {
+        if (!a->valid[i]) continue;
+        if (prim[i] == c->skip) {
             a->valid[i] = 0;
-            c->cnt[C_FILTER_REJECTS]++;
+            if (c->cnt) c->cnt[C_FILTER_REJECTS]++;
+            continue;
         }
+        if (!ms_alpha_tested(c->alpha, prim[i])) continue;
+        /* RTCRayN lane arrays (rtcore_ray.h's accessors are C++ only): org_x..z at 0..2, dir_x..z at 4..6, id at 10. */
+        const float *rf = (const float *)a->ray;
+        const unsigned *ru = (const unsigned *)a->ray, N = a->N;
+        int opaque;
+        if (c->primary) {
+            const float o[3] = { rf[0 * N + i], rf[1 * N + i], rf[2 * N + i] };
+            const float d[3] = { rf[4 * N + i], rf[5 * N + i], rf[6 * N + i] };
+            opaque = ms_alpha_ray_occludes(c->alpha, prim[i], o, d);
+        } else {
+            opaque = ms_alpha_segment_occludes(c->alpha, prim[i], c->p, c->pts + 3 * (size_t)ru[10 * N + i]);
+        }
+        if (!opaque) a->valid[i] = 0;
+    }
 }
 
 /* 1 if a segment from q.p to a front sample can cross the plane of q's own triangle within the
@@ -385,6 +416,9 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
     rtcInitIntersectContext(&ic.c);
     ic.c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     ic.cnt = cnt;
+    ic.alpha = ctx->alpha;
+    ic.pts = w.pts;
+    ic.primary = 0;
     for (int qi = 0; qi < nq; qi++) {
         const uint64_t *fm = front + qi * mw;
         uint64_t *vm = vis + qi * mw;
@@ -392,8 +426,9 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
         if (!ms_mask_count(fm, (int)mw)) continue;
         ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[qi].px, q[qi].py, ctx->seed, w.pts);
         int filt = s->filter == MS_EMBREE_FILTER_ALWAYS || (s->filter == MS_EMBREE_FILTER_PLANE && eb_needs_filter(ctx, &q[qi]));
-        ic.c.filter = filt ? eb_filter_fn : NULL;
-        ic.skip = q[qi].prim;
+        ic.c.filter = filt || ctx->alpha ? eb_filter_fn : NULL;
+        ic.skip = filt ? q[qi].prim : UINT32_MAX;
+        ic.p = q[qi].p;
         cnt[C_FILTERED_PIXELS] += (uint64_t)filt;
         if (s->mode == MS_EMBREE_STREAM) eb_trace_stream(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
         else eb_trace_packet16(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
@@ -438,9 +473,12 @@ static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int 
     eb_shared *s = state;
     const int tw = x1 - x0;
     unsigned mx = eb_enter();
-    struct RTCIntersectContext ic;
-    rtcInitIntersectContext(&ic);
-    ic.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    /* Alpha-tested triangles: the context filter lets camera rays through their transparent texels. */
+    eb_ictx ec = { .skip = UINT32_MAX, .alpha = ctx->alpha, .primary = 1 };
+    struct RTCIntersectContext *const icp = &ec.c;
+    rtcInitIntersectContext(icp);
+    icp->flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    if (ctx->alpha) icp->filter = eb_filter_fn;
     struct RTCRayHit16 rh __attribute__((aligned(64)));
     int valid[16] __attribute__((aligned(64)));
     int inside[16];   /* the pixel is in the tile (it may still have no ray: outside a fisheye's circle) */
@@ -463,7 +501,7 @@ static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int 
                 rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
                 rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
             }
-            rtcIntersect16(valid, s->scene, &ic, &rh);
+            rtcIntersect16(valid, s->scene, icp, &rh);
             for (int l = 0; l < 16; l++) {
                 if (!inside[l]) continue;
                 int x = bx + (l & 3), y = by + (l >> 2);

@@ -9,6 +9,7 @@
 #include "../accel/bvh.h"
 #include "../raster/raster.h"
 #include "../core/perk.h"
+#include "alpha.h"
 
 enum {
     MS_FT_FRUSTA, MS_FT_NODES_VISITED, MS_FT_NODES_CULLED_FRUSTUM, MS_FT_NODES_CULLED_OCCLUDED,
@@ -37,14 +38,16 @@ MS_PERK_DECLARE(void, ms_frustum_trace, scalar, MS_FT_PARAMS);
 MS_PERK_DECLARE(void, ms_frustum_trace, avx2, MS_FT_PARAMS);
 MS_PERK_DECLARE(void, ms_frustum_trace, avx512, MS_FT_PARAMS);
 
-/* Rasterizes the triangles of leaf n (but `skip`) into buf; returns how many. Shared by every instance. */
+/* Rasterizes the triangles of leaf n (but `skip`) into buf; returns how many. Shared by every instance. An
+ * alpha-tested triangle clears only its opaque samples (alpha.h, ms_alpha_raster), so the coverage cull that
+ * reads buf afterwards never sees it as a full occluder. */
 static inline uint64_t ms_ft_raster_leaf(const ms_bvh *b, const ms_bvh_node *n, const ms_raster_frame *f,
                                          ms_raster_fn raster, uint32_t skip, void *buf)
 {
     uint64_t count = 0;
     for (uint32_t i = n->first; i < n->first + n->count; i++) {
         if (i == skip) continue;
-        raster(f, b->tri + 9 * (size_t)i, buf);
+        ms_raster_or_alpha(f, raster, b->tri + 9 * (size_t)i, i, buf);   /* alpha-tested: filtered coverage */
         count++;
     }
     return count;

@@ -58,6 +58,7 @@
 #include "hpc_volume.h"
 #include "method.h"
 #include "receiver.h"
+#include "alpha.h"
 #include "../accel/ray_triangle.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
@@ -470,13 +471,24 @@ static int sample_blocked(const float o[3], const float d[3], int kz, const floa
     return det != 0.0f && aden > 0.0f && ns >= tmin * aden && ns <= tmax * aden;
 }
 
-/* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. */
+/* Alpha-tested triangle t (alpha.h) at sample (i, j) of q's grid: 1 where it occludes. The sample point is the
+ * pattern's float, formed as ms_pattern_points_range forms it. */
+static int alpha_opaque(const shared *sh, const tri_job *t, const ms_shadow_query *q, const ms_grid *g, int i, int j)
+{
+    float L[3];
+    for (int a = 0; a < 3; a++) L[a] = g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a];
+    return ms_alpha_segment_occludes(sh->ctx->alpha, t->self, q->p, L);
+}
+
+/* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
+ * alpha-tested triangle blocks a sample only where it is opaque (any hit, alpha.h). */
 static int cast_group(const shared *sh, chunk *c, uint64_t *open, const int8_t *kz, int gk, const ms_shadow_query *q,
                       const ms_grid *g, const tri_job *t, const float A[3], const float B[3], const float C[3], float num)
 {
     const int k = sh->k, gs = sh->gs, gpr = k / gs;
     const int i0 = (gk % gpr) * gs, j0 = (gk / gpr) * gs;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;   /* gs <= 8 */
+    const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
     int left = 0;
     for (int j = j0; j < j0 + gs; j++) {
         const int s0 = j * k + i0, w = s0 >> 6, b = s0 & 63;
@@ -488,7 +500,8 @@ static int cast_group(const shared *sh, chunk *c, uint64_t *open, const int8_t *
             float d[3];
             for (int a = 0; a < 3; a++) d[a] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
             c->cnt[C_SAMPLE_TESTS]++;
-            if (sample_blocked(q->p, d, kz[s / LANES], t->v, t->N, A, B, C, num, sh->ctx->near, sh->ctx->far)) {
+            if (sample_blocked(q->p, d, kz[s / LANES], t->v, t->N, A, B, C, num, sh->ctx->near, sh->ctx->far) &&
+                !(alpha && !alpha_opaque(sh, t, q, g, i, j))) {
                 open[w] &= ~(UINT64_C(1) << (b + di));
                 c->cnt[C_SAMPLES_BLOCKED]++;
             }
@@ -538,7 +551,12 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
         }
         if (any) {
             c->cnt[C_RASTER_CALLS]++;
-            sh->raster(slot_frame(sh, c, s), t->v, open);
+            if (ms_alpha_tested(sh->ctx->alpha, t->self)) {   /* its opaque samples only (alpha.h) */
+                const ms_alpha_pixel ap = { sh->ctx, q };
+                ms_alpha_raster(&ap, slot_frame(sh, c, s), sh->raster, t->v, t->self, open);
+            } else {
+                sh->raster(slot_frame(sh, c, s), t->v, open);
+            }
             for (int gk = 0; gk < sh->G; gk++)
                 if (!(gu >> gk & 1u) && group_done(sh, open, gk)) gu |= UINT64_C(1) << gk;
         }

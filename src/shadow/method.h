@@ -35,6 +35,9 @@ typedef struct ms_render_ctx {
     int frustum_shrink;
     ms_embree_mode embree_mode;        /* embree: how rays are handed over, and when the receiver is filtered */
     ms_embree_filter embree_filter;
+    /* Alpha-tested triangles (alpha.h: ms_alpha_build), NULL when every triangle is opaque. A method that finds
+     * a segment or ray meeting a flagged triangle asks ms_alpha_segment_occludes / ms_alpha_ray_occludes. */
+    const struct ms_alpha *alpha;
 } ms_render_ctx;
 
 /* One visible point: the pixel, its hit point, the unit geometric normal facing the camera (its plane is

@@ -93,6 +93,7 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     mft_frame_light(f, &ctx->light);
     f->pattern = ctx->pattern;
     f->seed = ctx->seed;
+    f->alpha = ctx->alpha;
     f->flags = (ctx->no_child_order ? 0 : MS_MFT_ORDER) | (ctx->frustum_shrink ? MS_MFT_FS : 0);
     /* The paper's own mode: each pixel of a 4x4 block its own set of N/16 points (pattern.c), tested
      * packet by packet against the whole light's frustum (footprints and CR need samples in cells). */

@@ -28,6 +28,7 @@ typedef struct ms_mft_frame {
                                    * (N/16 points per pixel, the whole light as rectangle, no footprints) */
     ms_light light;
     uint32_t seed;
+    const struct ms_alpha *alpha; /* alpha-tested triangles (alpha.h), NULL: none */
 } ms_mft_frame;
 
 /* Flags: near-first child order; frustum shrinking of the traversal's bounds too (the paper's FS; CR,

@@ -48,6 +48,8 @@
 #include "lanes16.h"
 #include "../core/perk.h"
 #include "../accel/ray_triangle.h"
+#include "../core/pattern.h"
+#include "alpha.h"
 
 #define MFT_REL 1e-5f
 #define MFT_MAX_SKIP MS_BLOCK_LANES
@@ -297,6 +299,21 @@ static inline int mft_floor(float x)
     return i - ((float)i > x);
 }
 
+#ifndef MFT_ALPHA_FILTER
+#define MFT_ALPHA_FILTER
+/* The bits of hit (rays of packet ch of lane L that alpha-tested triangle t meets) where t is opaque. */
+static unsigned mft_alpha_filter(const ms_mft_frame *f, const ms_mft_lane *L, int ch, uint32_t t, unsigned hit)
+{
+    float pts[3 * 16];
+    ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
+    for (unsigned m = hit; m; m &= m - 1) {
+        const int b = __builtin_ctz(m);
+        if (!ms_alpha_segment_occludes(f->alpha, t, L->c, pts + 3 * b)) hit &= ~(1u << b);
+    }
+    return hit;
+}
+#endif
+
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
 {
     ms_block_frusta *fr = s->fr;
@@ -463,7 +480,10 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                     if (!bits) continue;
                     if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
                     isec++;
-                    const unsigned hit = mft_packet(L, ch, bits, tri, N, V, numv[l], f->near, f->far);
+                    unsigned hit = mft_packet(L, ch, bits, tri, N, V, numv[l], f->near, f->far);
+                    /* Any hit: an alpha-tested triangle keeps only the rays where it is opaque (alpha.h, the
+                     * decision every method shares: the segment from C to the pattern's sample point). */
+                    if (hit && f->alpha && f->alpha->flag[t]) hit = mft_alpha_filter(f, L, ch, t, hit);
                     if (!hit) continue;
                     L->mask[ch >> 2] &= ~((uint64_t)hit << sh);
                     cleared = 1;

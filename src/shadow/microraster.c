@@ -22,6 +22,7 @@
 #include "block_raster.h"
 #include "block_group.h"
 #include "receiver.h"
+#include "alpha.h"
 #include <math.h>
 #include "../core/vec.h"
 #include <stdio.h>
@@ -82,7 +83,7 @@ static int mr_create_hier(const ms_render_ctx *c, void **s, char *e, size_t n) {
  * sets up its frame. Returns 1 when the frame is to be traversed, 0 when the buffer is final: no front
  * sample, or an edge-on point, traced per sample (counted in *edge_on), or -1 when out of memory. */
 static int mr_start(const ms_render_ctx *ctx, const ms_shadow_query *q, const uint64_t *fm, uint64_t *buf,
-                    ms_raster_frame *f, float **pts, uint64_t *edge_on)
+                    ms_raster_frame *f, ms_alpha_pixel *ap, float **pts, uint64_t *edge_on)
 {
     const size_t mw = (size_t)ctx->mask_words;
     memcpy(buf, fm, mw * sizeof *buf);
@@ -100,6 +101,10 @@ static int mr_start(const ms_render_ctx *ctx, const ms_shadow_query *q, const ui
         ++*edge_on;
         return 0;
     }
+    /* Alpha-tested triangles need the query to find their samples (alpha.h); opaque scenes: NULL. */
+    ap->ctx = ctx;
+    ap->q = q;
+    f->alpha = ctx->alpha ? ap : NULL;
     return 1;
 }
 
@@ -110,8 +115,9 @@ static int mr_visibility_pixel(const mr_state *s, const ms_render_ctx *ctx, cons
     float *pts = NULL;
     for (int qi = 0; qi < nq; qi++) {
         ms_raster_frame f;
+        ms_alpha_pixel ap;
         uint64_t *buf = vis + qi * mw;   /* the k x k occlusion buffer itself (receiver.h) */
-        const int go = mr_start(ctx, &q[qi], front + qi * mw, buf, &f, &pts, &cnt[MS_FT_TRACED_EDGE_ON]);
+        const int go = mr_start(ctx, &q[qi], front + qi * mw, buf, &f, &ap, &pts, &cnt[MS_FT_TRACED_EDGE_ON]);
         if (go < 0) { free(pts); return -1; }
         if (!go) continue;
         cnt[MS_FT_FRUSTA]++;
@@ -135,12 +141,13 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
     for (int g = 0; g < nq && !rc;) {
         ms_block_input in;
         ms_raster_frame frames[MS_BLOCK_LANES];
+        ms_alpha_pixel aps[MS_BLOCK_LANES];
         in.n = 0;
         const int end = ms_block_group_end(ctx, q, order, nq, g);
         for (int e = g; e < end; e++) {
             const int i = order[e];
             uint64_t *buf = vis + (size_t)i * mw;
-            const int go = mr_start(ctx, &q[i], front + (size_t)i * mw, buf, &frames[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
+            const int go = mr_start(ctx, &q[i], front + (size_t)i * mw, buf, &frames[in.n], &aps[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
             if (go < 0) { rc = -1; break; }
             if (!go) continue;
             in.frame[in.n] = &frames[in.n];

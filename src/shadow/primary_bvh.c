@@ -1,5 +1,6 @@
 /* Primary method "bvh": camera rays through our BVH; and the hit finishing every primary method shares. */
 #include "method.h"
+#include "alpha.h"
 #include "../core/vec.h"
 #include <math.h>
 
@@ -40,7 +41,10 @@ static void bvh_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int
             if (ms_camera_ray(&ctx->cam, x, y, r.o, r.d)) { h->prim = UINT32_MAX; continue; }
             r.tmin = 0.0f;
             r.tmax = INFINITY;
-            if (ms_bvh_closest(ctx->bvh, &r, &hit)) ms_hit_finish(ctx, r.o, r.d, hit.t, hit.prim, h);
+            /* Alpha-tested triangles: only where opaque (alpha.h), so a ray goes on through a cut-out's holes. */
+            const int found = ctx->alpha ? ms_bvh_closest_filter(ctx->bvh, &r, &hit, ms_alpha_ray_filter, ctx->alpha)
+                                         : ms_bvh_closest(ctx->bvh, &r, &hit);
+            if (found) ms_hit_finish(ctx, r.o, r.d, hit.t, hit.prim, h);
             else h->prim = UINT32_MAX;
         }
 }

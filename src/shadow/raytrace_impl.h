@@ -5,6 +5,7 @@
  * same masks. Included once per file; defines ms_raytrace_samples_<isa>. */
 #include "method.h"
 #include "raytrace.h"
+#include "alpha.h"
 #include "../core/perk.h"
 #include "../core/pattern.h"
 #include "../core/vec.h"
@@ -144,7 +145,10 @@ static void packet_triangle(packet *pk, const float *tri, const float N[3])
         }
 }
 
-static void trace_packet(const ms_bvh *b, packet *pk, uint32_t skip, uint64_t *cnt)
+/* Any hit: an alpha-tested triangle (al non-NULL and flagged) first takes the lanes it meets geometrically, as
+ * any triangle does; the lanes where it is transparent at the sample's segment (alpha.h: the one decision every
+ * method shares) are then given back, and traversal goes on for them. pts: the packet's 16 sample points. */
+static void trace_packet(const ms_bvh *b, packet *pk, uint32_t skip, const ms_alpha *al, const float *pts, uint64_t *cnt)
 {
     uint32_t stack[MS_BVH_STACK];
     int sp = 0;
@@ -159,6 +163,14 @@ static void trace_packet(const ms_bvh *b, packet *pk, uint32_t skip, uint64_t *c
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 if (i == skip) continue;
                 cnt[C_TRI_TESTS]++;
+                if (al && al->flag[i]) {
+                    int before[LANES];
+                    memcpy(before, pk->live, sizeof before);
+                    packet_triangle(pk, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i);
+                    for (int l = 0; l < LANES; l++)
+                        if (before[l] && !pk->live[l] && !ms_alpha_segment_occludes(al, i, pk->o, pts + 3 * l)) pk->live[l] = 1;
+                    continue;
+                }
                 packet_triangle(pk, b->tri + 9 * (size_t)i, b->tri_n + 3 * (size_t)i);
             }
             if (!any_live(pk->live)) return;
@@ -192,7 +204,7 @@ int MS_CAT(ms_raytrace_samples_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, const 
             pk.live[l] = (int)(lanes >> l & 1u);
         }
         packet_shear(&pk);
-        trace_packet(ctx->bvh, &pk, q->prim, cnt);
+        trace_packet(ctx->bvh, &pk, q->prim, ctx->alpha, pts + 3 * base, cnt);
         uint64_t bits = 0;
         for (int l = 0; l < LANES; l++) bits |= (uint64_t)(pk.live[l] != 0) << l;
         vis[base >> 6] |= bits << (base & 63);
