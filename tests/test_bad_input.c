@@ -206,6 +206,35 @@ static void test_values(void **st)
     expect_bad(write_scene("v13.json", &p), NULL, NEEDLES("v13.json", "camera.height must be an integer in [1, 16384]"));
     p = good; p.size = ", \"width\": 16.5, \"height\": 16";
     expect_bad(write_scene("v14.json", &p), NULL, NEEDLES("v14.json", "camera.width must be an integer"));
+    /* camera.type (docs/cameras.md): the type by name, each type's own number required and in range */
+    p = good; p.size = ", \"type\": \"spherical\"";
+    expect_bad(write_scene("c1.json", &p), NULL, NEEDLES("c1.json", "camera.type must be \"pinhole\", \"orthographic\", "
+                                                       "\"fisheye\", \"latlong\" or \"parabolic\""));
+    p = good; p.size = ", \"type\": 2";
+    expect_bad(write_scene("c2.json", &p), NULL, NEEDLES("c2.json", "camera.type must be \"pinhole\""));
+    p = good; p.size = ", \"type\": \"orthographic\"";
+    expect_bad(write_scene("c3.json", &p), NULL, NEEDLES("c3.json", "camera.ortho_height is missing"));
+    p = good; p.size = ", \"type\": \"orthographic\", \"ortho_height\": 0";
+    expect_bad(write_scene("c4.json", &p), NULL, NEEDLES("c4.json", "camera.ortho_height must be in (0, "));
+    p = good; p.size = ", \"type\": \"orthographic\", \"ortho_height\": 1e300";
+    expect_bad(write_scene("c5.json", &p), NULL, NEEDLES("c5.json", "camera.ortho_height = 1e+300 overflows a float"));
+    p = good; p.size = ", \"type\": \"orthographic\", \"ortho_height\": 1e30";
+    expect_bad(write_scene("c6.json", &p), NULL, NEEDLES("c6.json", "camera.ortho_height must be in (0, "));
+    p = good; p.size = ", \"type\": \"fisheye\"";
+    expect_bad(write_scene("c7.json", &p), NULL, NEEDLES("c7.json", "camera.fov is missing"));
+    p = good; p.size = ", \"type\": \"fisheye\"";   /* good.fov is the pinhole's fov_y */
+    expect_bad(write_scene("c7b.json", &p), NULL, NEEDLES("c7b.json", "camera.fov is missing (\"fov_y\" is another camera type's key)"));
+    p = good; p.size = ", \"type\": \"fisheye\", \"fov\": 360.5";
+    expect_bad(write_scene("c8.json", &p), NULL, NEEDLES("c8.json", "camera.fov must be in (0, 360] degrees"));
+    p = good; p.size = ", \"type\": \"fisheye\", \"fov\": -10";
+    expect_bad(write_scene("c9.json", &p), NULL, NEEDLES("c9.json", "camera.fov must be in (0, 360] degrees"));
+    p = good; p.size = ", \"type\": \"fisheye\", \"fov\": \"wide\"";
+    expect_bad(write_scene("c10.json", &p), NULL, NEEDLES("c10.json", "camera.fov must be a finite number"));
+    p = good; p.size = ", \"type\": \"latlong\""; p.up = "[0, 0, 0]";
+    expect_bad(write_scene("c11.json", &p), NULL, NEEDLES("c11.json", "camera.up"));
+    /* the pinhole still needs fov_y in range when another type's key is given */
+    p = good; p.fov = "200"; p.size = ", \"fov\": 100";
+    expect_bad(write_scene("c12.json", &p), NULL, NEEDLES("c12.json", "fov_y must be in (0, 180)"));
     p = good; p.render = "{ \"samples\": 0 }";
     expect_bad(write_scene("v15.json", &p), NULL, NEEDLES("v15.json", "render.samples must be an integer"));
     p = good; p.render = "{ \"samples\": 100 }";

@@ -249,11 +249,11 @@ static void test_scene_keys(void **st)
     expect_bad(p, NULL, NEEDLES("dup.json", "duplicate key \"camera.fov_y\""));
     tu_write_file(inpath("dup2.json"), "{\"meshes\":[{\"file\":\"ok.obj\",\"file\":\"x.obj\"}],\"camera\":{},\"light\":{}}");
     expect_bad(inpath("dup2.json"), NULL, NEEDLES("dup2.json", "duplicate key \"meshes[0].file\""));
-    /* "fov" for "fov_y": the error names the typo (one line), and a stray unknown key in a good scene
+    /* "fov" (the fisheye's key) for "fov_y": the error names it (one line), and a stray unknown key in a good scene
      * is a warning naming the key and the nearest known one, after which the render succeeds. */
     tu_write_file(inpath("typo.json"), "{\"meshes\":[{\"file\":\"ok.obj\"}],\"camera\":{\"eye\":[0,10,12],\"target\":[0,0,0],"
                   "\"up\":[0,1,0],\"fov\":60},\"light\":{\"corner\":[-1,6,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2]}}");
-    expect_bad(inpath("typo.json"), NULL, NEEDLES("typo.json", "camera.fov_y is missing", "\"fov\" is not a known key"));
+    expect_bad(inpath("typo.json"), NULL, NEEDLES("typo.json", "camera.fov_y is missing", "\"fov\" is another camera type's key"));
     char png[4096], err[4096];
     const char *args[] = { scene("warn.json", "ok.obj", ", \"fovv\": 1, \"widht\": 3", NULL), "--quiet", "-o",
                            tu_path(png, sizeof png, tu_tmpdir("hostile_warn"), "w.png"), NULL };
@@ -265,6 +265,25 @@ static void test_scene_keys(void **st)
     assert_non_null(strstr(err, "unknown key \"camera.fovv\" ignored (the nearest known key is \"fov_y\")"));
     assert_non_null(strstr(err, "unknown key \"camera.widht\" ignored (the nearest known key is \"width\")"));
     assert_true(tu_file_exists(png));
+
+    /* camera types: a duplicate type is an error; a latlong needs no fov_y, and the pinhole's fov_y given
+     * to it (the common template) is a warning naming the type, after which the render succeeds */
+    snprintf(p, sizeof p, "%s", scene("dup3.json", "ok.obj", ", \"type\": \"latlong\", \"type\": \"fisheye\"", NULL));
+    expect_bad(p, NULL, NEEDLES("dup3.json", "duplicate key \"camera.type\""));
+    const char *args2[] = { scene("warn2.json", "ok.obj", ", \"type\": \"latlong\", \"ortho_hieght\": 2", NULL),
+                            "--quiet", "-o", png, NULL };
+    rc = tu_run_cli_ex(args2, NULL, err, sizeof err, &r);
+    if (rc != 0) fail_msg("exit %d: %s", rc, err);
+    assert_int_equal(r.lines, 2);
+    assert_non_null(strstr(err, "camera.fov_y ignored (a latlong camera does not use it)"));
+    assert_non_null(strstr(err, "unknown key \"camera.ortho_hieght\" ignored"));
+    tu_write_file(inpath("latlong.json"), "{\"meshes\":[{\"file\":\"ok.obj\"}],\"camera\":{\"type\":\"latlong\","
+                  "\"eye\":[0,3,0],\"target\":[0,3,-1],\"up\":[0,1,0],\"width\":32,\"height\":16},"
+                  "\"light\":{\"corner\":[-1,6,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2]},\"render\":{\"samples\":256}}");
+    const char *args3[] = { inpath("latlong.json"), "--quiet", "-o", png, NULL };
+    rc = tu_run_cli_ex(args3, NULL, err, sizeof err, &r);
+    if (rc != 0) fail_msg("exit %d: %s", rc, err);
+    assert_int_equal(r.lines, 0);
 }
 
 static void test_scene_nul_in_path(void **st)

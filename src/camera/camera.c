@@ -40,6 +40,8 @@ int ms_camera_basis_init(ms_camera_basis *b, const ms_camera *c, int width, int 
     b->aspect = (float)width / (float)height;
     b->half_h = c->type == MS_CAMERA_ORTHOGRAPHIC ? 0.5f * c->ortho_height : 0.0f;
     b->half_w = b->half_h * b->aspect;
+    /* ray origins stay within the coordinate range scenes are checked against (1e18, scene_validate.c) */
+    if (!(b->half_w <= 1e18f && b->half_h <= 1e18f)) return -1;
     b->cx = 0.5f * (float)width;
     b->cy = 0.5f * (float)height;
     b->radius = 0.5f * (float)(width < height ? width : height);
@@ -132,17 +134,24 @@ int ms_camera_project(const ms_camera_basis *b, const float p[3], float *px, flo
     if (!(len > 0.0f)) return -1;
     switch (b->type) {
     case MS_CAMERA_FISHEYE: {
-        float th = acosf(ms_maxf(-1.0f, ms_minf(1.0f, z / len)));
-        if (!(th <= b->max_theta)) return -1;
+        /* atan2, not acos(z/len): acos loses half the digits near the axis (0.1 pixel at 1024^2, 180 deg) */
         float lat = sqrtf(a * a + c * c);
+        float th = atan2f(lat, z);
+        if (!(th <= b->max_theta)) return -1;
         float r = th / b->max_theta * b->radius;
-        *px = b->cx + (lat > 0.0f ? r * a / lat : 0.0f);
-        *py = b->cy - (lat > 0.0f ? r * c / lat : 0.0f);
+        if (!(lat > 0.0f)) {
+            /* On the axis: the centre, or (fov 360) the antipode, which the whole rim sees: take its right end. */
+            *px = b->cx + (z < 0.0f ? r : 0.0f);
+            *py = b->cy;
+            return 0;
+        }
+        *px = b->cx + r * a / lat;
+        *py = b->cy - r * c / lat;
         return 0;
     }
     case MS_CAMERA_LATLONG: {
         float lon = atan2f(a, z);
-        float th = acosf(ms_maxf(-1.0f, ms_minf(1.0f, c / len)));
+        float th = atan2f(sqrtf(a * a + z * z), c);   /* from up; atan2 keeps the poles accurate */
         float x = (lon / (2.0f * (float)M_PI) + 0.5f) * (float)b->width;
         if (x >= (float)b->width) x -= (float)b->width;
         if (x < 0.0f) x = 0.0f;
@@ -186,4 +195,12 @@ float ms_camera_angle_per_pixel(const ms_camera_basis *b)
     default:
         return 0.0f;
     }
+}
+
+void ms_camera_viewer(const ms_camera_basis *b, const float p[3], float viewer[3])
+{
+    if (b->type == MS_CAMERA_ORTHOGRAPHIC)
+        for (int k = 0; k < 3; k++) viewer[k] = p[k] - b->forward[k];
+    else
+        for (int k = 0; k < 3; k++) viewer[k] = b->eye[k];
 }

@@ -41,4 +41,9 @@ int ms_camera_planar(const ms_camera_basis *b);
  * centre, half-angle L times its half-diagonal). 0 for the planar ones. */
 float ms_camera_angle_per_pixel(const ms_camera_basis *b);
 
+/* A point from which the surface point p is seen along its primary ray, for the view vector in shading
+ * (normalize(viewer - p)): the eye for the central projections; p - forward for the orthographic one,
+ * whose rays start on a plane (so the view vector is -forward whatever p's pixel). */
+void ms_camera_viewer(const ms_camera_basis *b, const float p[3], float viewer[3]);
+
 #endif

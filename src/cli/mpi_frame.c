@@ -21,6 +21,8 @@ static int render_chunk(void *user, int first, int count, char *err, size_t errl
 }
 
 _Static_assert(sizeof(ms_material) == 7 * sizeof(float) + 4 * sizeof(int32_t), "ms_material is hashed as bytes: no padding");
+_Static_assert(sizeof(ms_camera) == 3 * sizeof(ms_vec3) + 3 * sizeof(float) + 2 * sizeof(int) + sizeof(ms_camera_type),
+               "ms_camera is hashed as bytes: no padding");
 
 /* The scene and the options that decide the image, so that ranks can check they were given the same. */
 static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
@@ -31,6 +33,7 @@ static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
         for (size_t i = 0; i < s->n_tris * 9; i++) h = (h ^ w[i]) * 1099511628211ull;
     }
     h = ms_mpi_hash(h, &s->procedural, sizeof s->procedural);
+    /* the whole camera: type, fov and ortho_height included */
     h = ms_mpi_hash(h, &s->camera, sizeof s->camera);
     h = ms_mpi_hash_lights(h, s);
     h = ms_mpi_hash(h, &s->samples, sizeof s->samples);

@@ -154,7 +154,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     }
     ms_render_ctx *ctx = &j->ctx;
     if (ms_camera_basis_init(&ctx->cam, &scene->camera, W, H)) {
-        snprintf(err, errlen, "camera is degenerate (eye = target, or up parallel to the view)");
+        snprintf(err, errlen, "camera is degenerate (eye = target, up parallel to the view, or a field of view, extent or type out of range)");
         goto fail;
     }
     if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); goto fail; }
@@ -287,7 +287,6 @@ static void trace_tiles(ms_frame_job *j, const int *tiles, int n, int tick)
 static void surface_tiles(ms_frame_job *j, const int *tiles, int n)
 {
     if (!j->surf) return;
-    const float eye[3] = { j->scene->camera.eye.x, j->scene->camera.eye.y, j->scene->camera.eye.z };
 #pragma omp parallel for schedule(dynamic, 1) num_threads(j->threads)
     for (int i = 0; i < n; i++) {
         int x0, y0, x1, y1;
@@ -295,7 +294,9 @@ static void surface_tiles(ms_frame_job *j, const int *tiles, int n)
         for (int y = y0; y < y1; y++)
             for (int x = x0; x < x1; x++) {
                 const size_t p = (size_t)y * j->W + x;
-                ms_surface_at(j->scene, &j->bvh, &j->hits[p], eye, &j->surf[p]);
+                float viewer[3];   /* the eye, or up the pixel's own ray for an orthographic camera */
+                ms_camera_viewer(&j->ctx.cam, j->hits[p].p, viewer);
+                ms_surface_at(j->scene, &j->bvh, &j->hits[p], viewer, &j->surf[p]);
             }
     }
 }

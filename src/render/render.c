@@ -78,7 +78,6 @@ int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_lig
     if (texture_means(ctx, lights, nlights, hits, W, npix, threads, &tex)) return -1;
     float *lum = malloc(npix * sizeof(float));
     size_t nlum = 0;
-    const float eye[3] = { scene->camera.eye.x, scene->camera.eye.y, scene->camera.eye.z };
     /* In parallel (a disk across the horizon costs a 256-gon per pixel): lum[i] per pixel, misses
      * dropped after. */
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(threads)
@@ -88,7 +87,11 @@ int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_lig
         if (lum) lum[i] = -1.0f;
         if (hits[i].prim == UINT32_MAX) continue;
         ms_surface grey;
-        if (!surf) ms_surface_at(scene, NULL, &hits[i], eye, &grey);
+        if (!surf) {
+            float viewer[3];   /* the eye, or up the pixel's own ray for an orthographic camera */
+            ms_camera_viewer(&ctx->cam, hits[i].p, viewer);
+            ms_surface_at(scene, NULL, &hits[i], viewer, &grey);
+        }
         float y = 0.0f;
         for (size_t l = 0; l < nlights; l++) {
             ms_light L = lights[l];

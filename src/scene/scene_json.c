@@ -26,7 +26,22 @@ static int line_of(const char *text, size_t off)
 /* Known keys, per object, for the unknown-key warnings. */
 static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "lights", "render", NULL };
 static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
-static const char *const camera_keys[] = { "eye", "target", "up", "fov_y", "width", "height", NULL };
+/* The camera's keys depend on camera.type (docs/cameras.md): each type reads the common ones and its own. */
+#define CAMERA_COMMON_KEYS "type", "eye", "target", "up", "width", "height"
+static const char *const camera_keys_pinhole[] = { CAMERA_COMMON_KEYS, "fov_y", NULL };
+static const char *const camera_keys_ortho[] = { CAMERA_COMMON_KEYS, "ortho_height", NULL };
+static const char *const camera_keys_fisheye[] = { CAMERA_COMMON_KEYS, "fov", NULL };
+static const char *const camera_keys_panorama[] = { CAMERA_COMMON_KEYS, NULL };
+static const char *const camera_keys_any[] = { CAMERA_COMMON_KEYS, "fov_y", "ortho_height", "fov", NULL };
+static const struct { const char *name; ms_camera_type type; const char *const *keys; const char *own; } camera_types[] = {
+    { "pinhole", MS_CAMERA_PINHOLE, camera_keys_pinhole, "fov_y" },
+    { "orthographic", MS_CAMERA_ORTHOGRAPHIC, camera_keys_ortho, "ortho_height" },
+    { "fisheye", MS_CAMERA_FISHEYE, camera_keys_fisheye, "fov" },
+    { "latlong", MS_CAMERA_LATLONG, camera_keys_panorama, NULL },
+    { "parabolic", MS_CAMERA_PARABOLIC, camera_keys_panorama, NULL },
+};
+/* The keys of the camera being parsed (its type's), for the unknown-key warnings and typo hints. */
+static _Thread_local const char *const *camera_keys = camera_keys_pinhole;
 static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t", "center", "normal", "radius",
                                           "emission", "power", "lumens", "texture", NULL };
 static const char *const render_keys[] = { "samples", NULL };
@@ -96,7 +111,9 @@ static void missing(const cJSON *obj, const char *objname, const char *key, cons
 {
     const char *typo = meant_for(obj, key, known_for(objname));
     char hint[128] = "";
-    if (typo) snprintf(hint, sizeof hint, " (\"%.40s\" is not a known key: a typo?)", typo);
+    if (typo && !strcmp(objname, "camera") && is_known(typo, camera_keys_any))
+        snprintf(hint, sizeof hint, " (\"%.40s\" is another camera type's key)", typo);
+    else if (typo) snprintf(hint, sizeof hint, " (\"%.40s\" is not a known key: a typo?)", typo);
     if (objname[0]) snprintf(err, errlen, "%s: %s.%s is missing%s", path, objname, key, hint);
     else snprintf(err, errlen, "%s: \"%s\" is missing%s", path, key, hint);
 }
@@ -115,6 +132,33 @@ static void warn_unknown(const cJSON *obj, const char *objname, const char *cons
             if (d < bd) { bd = d; best = known[k]; }
         }
         if (!found && g_warnings && g_warnings->n < MAX_WARNINGS)
+            snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
+                     "%.200s: unknown key \"%s%s%.40s\" ignored (the nearest known key is \"%s\")", path, objname,
+                     objname[0] ? "." : "", it->string, best);
+    }
+}
+
+/* Keys another camera type reads: a warning that says so, rather than "unknown". */
+static void warn_camera_keys(const cJSON *cam, const char *type_name, const char *path)
+{
+    const cJSON *it;
+    cJSON_ArrayForEach(it, cam)
+        if (!is_known(it->string, camera_keys) && is_known(it->string, camera_keys_any) && g_warnings &&
+            g_warnings->n < MAX_WARNINGS)
+            snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
+                     "%.200s: camera.%s ignored (a %s camera does not use it)", path, it->string, type_name);
+}
+
+/* warn_unknown, silent about the keys in also (warned about otherwise). */
+static void warn_unknown_except(const cJSON *obj, const char *objname, const char *const *known,
+                                const char *const *also, const char *path)
+{
+    const cJSON *it;
+    cJSON_ArrayForEach(it, obj) {
+        if (is_known(it->string, also)) continue;
+        size_t d;
+        const char *best = nearest_key(it->string, known, &d);
+        if (!is_known(it->string, known) && g_warnings && g_warnings->n < MAX_WARNINGS)
             snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
                      "%.200s: unknown key \"%s%s%.40s\" ignored (the nearest known key is \"%s\")", path, objname,
                      objname[0] ? "." : "", it->string, best);
@@ -454,19 +498,42 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
 
     const cJSON *cam = get_object(root, "camera", json_path, err, errlen);
     if (!cam) goto done;
-    warn_unknown(cam, "camera", camera_keys, json_path);
+    size_t ct = 0;   /* camera_types[0]: pinhole, when "type" is absent */
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(cam, "type");
+    if (type) {
+        ct = sizeof camera_types / sizeof camera_types[0];
+        for (size_t i = 0; cJSON_IsString(type) && i < ct; i++)
+            if (!strcmp(type->valuestring, camera_types[i].name)) ct = i;
+        if (ct == sizeof camera_types / sizeof camera_types[0]) {
+            snprintf(err, errlen, "%s: camera.type must be \"pinhole\", \"orthographic\", \"fisheye\", \"latlong\" or "
+                     "\"parabolic\"", json_path);
+            goto done;
+        }
+    }
+    camera_keys = camera_types[ct].keys;
+    warn_camera_keys(cam, camera_types[ct].name, json_path);
+    warn_unknown_except(cam, "camera", camera_keys, camera_keys_any, json_path);
     ms_camera *c = &out->camera;
-    double fov = 60.0;
+    c->type = camera_types[ct].type;
     c->width = 1024; c->height = 1024;
     if (get_vec3(cam, "camera", "eye", 1, &c->eye, json_path, err, errlen) ||
         get_vec3(cam, "camera", "target", 1, &c->target, json_path, err, errlen) ||
         get_vec3(cam, "camera", "up", 1, &c->up, json_path, err, errlen) ||
-        get_number(cam, "camera", "fov_y", 1, &fov, json_path, err, errlen) ||
         get_int(cam, "camera", "width", 0, 1, MS_MAX_IMAGE_SIZE, &c->width, json_path, err, errlen) ||
         get_int(cam, "camera", "height", 0, 1, MS_MAX_IMAGE_SIZE, &c->height, json_path, err, errlen))
         goto done;
-    if (float_ok(fov, "camera", "fov_y", -1, json_path, err, errlen)) goto done;
-    c->fov_y = (float)fov;
+    /* The type's own number (pinhole fov_y, orthographic ortho_height, fisheye fov), required; its range
+     * is checked with the scene (ms_scene_validate), for scenes built through the API too. */
+    const char *own = camera_types[ct].own;
+    if (own) {
+        double v = 0.0;
+        if (get_number(cam, "camera", own, 1, &v, json_path, err, errlen) ||
+            float_ok(v, "camera", own, -1, json_path, err, errlen))
+            goto done;
+        if (c->type == MS_CAMERA_PINHOLE) c->fov_y = (float)v;
+        else if (c->type == MS_CAMERA_ORTHOGRAPHIC) c->ortho_height = (float)v;
+        else c->fov = (float)v;
+    }
 
     if (parse_lights(root, out, json_path, err, errlen)) goto done;
 

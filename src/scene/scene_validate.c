@@ -51,7 +51,10 @@ static int validate_light(const ms_light *l, const char *name, const char *what,
 int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen)
 {
     const ms_camera *c = &s->camera;
-    if (!vec_ok(c->eye) || !vec_ok(c->target) || !vec_ok(c->up) || !isfinite(c->fov_y)) {
+    /* Each type's own number only (the others are unused and may be anything). */
+    const float own = c->type == MS_CAMERA_PINHOLE ? c->fov_y : c->type == MS_CAMERA_ORTHOGRAPHIC ? c->ortho_height
+                    : c->type == MS_CAMERA_FISHEYE ? c->fov : 0.0f;
+    if (!vec_ok(c->eye) || !vec_ok(c->target) || !vec_ok(c->up) || !isfinite(own)) {
         snprintf(err, errlen, "%s: camera has a NaN or infinite value", what);
         return -1;
     }
@@ -74,8 +77,32 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
                      coords[i].name, (double)MS_MAX_COORD);
             return -1;
         }
-    if (!(c->fov_y > 0.0f && c->fov_y < 180.0f)) {
-        snprintf(err, errlen, "%s: camera.fov_y must be in (0, 180) degrees", what);
+    switch (c->type) {
+    case MS_CAMERA_PINHOLE:
+        if (!(c->fov_y > 0.0f && c->fov_y < 180.0f)) {
+            snprintf(err, errlen, "%s: camera.fov_y must be in (0, 180) degrees", what);
+            return -1;
+        }
+        break;
+    case MS_CAMERA_ORTHOGRAPHIC:
+        /* the image's extent, at most MS_MAX_IMAGE_SIZE times its height, keeps the ray origins in range */
+        if (!(c->ortho_height > 0.0f && c->ortho_height <= MS_MAX_COORD / MS_MAX_IMAGE_SIZE)) {
+            snprintf(err, errlen, "%s: camera.ortho_height must be in (0, %g] world units", what,
+                     (double)(MS_MAX_COORD / MS_MAX_IMAGE_SIZE));
+            return -1;
+        }
+        break;
+    case MS_CAMERA_FISHEYE:
+        if (!(c->fov > 0.0f && c->fov <= 360.0f)) {
+            snprintf(err, errlen, "%s: camera.fov must be in (0, 360] degrees", what);
+            return -1;
+        }
+        break;
+    case MS_CAMERA_LATLONG:
+    case MS_CAMERA_PARABOLIC:
+        break;
+    default:
+        snprintf(err, errlen, "%s: camera.type %d is unknown", what, (int)c->type);
         return -1;
     }
     if (c->width < 1 || c->height < 1 || c->width > MS_MAX_IMAGE_SIZE || c->height > MS_MAX_IMAGE_SIZE) {

@@ -481,12 +481,14 @@ static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int 
     if (ctx->alpha) icp->filter = eb_filter_fn;
     struct RTCRayHit16 rh __attribute__((aligned(64)));
     int valid[16] __attribute__((aligned(64)));
+    int inside[16];   /* the pixel is in the tile (it may still have no ray: outside a fisheye's circle) */
     for (int by = y0; by < y1; by += 4)
         for (int bx = x0; bx < x1; bx += 4) {
             for (int l = 0; l < 16; l++) {
                 int x = bx + (l & 3), y = by + (l >> 2);
                 float o[3] = { ctx->cam.eye[0], ctx->cam.eye[1], ctx->cam.eye[2] }, d[3] = { 0.0f, 0.0f, 1.0f };
-                valid[l] = x < x1 && y < y1 ? -1 : 0;
+                inside[l] = x < x1 && y < y1;
+                valid[l] = inside[l] ? -1 : 0;
                 if (valid[l] && ms_camera_ray(&ctx->cam, x, y, o, d)) valid[l] = 0;
                 rh.ray.org_x[l] = o[0]; rh.ray.org_y[l] = o[1]; rh.ray.org_z[l] = o[2];
                 rh.ray.dir_x[l] = d[0]; rh.ray.dir_y[l] = d[1]; rh.ray.dir_z[l] = d[2];
@@ -501,10 +503,10 @@ static void eb_primary_trace(void *state, const ms_render_ctx *ctx, int x0, int 
             }
             rtcIntersect16(valid, s->scene, icp, &rh);
             for (int l = 0; l < 16; l++) {
-                if (!valid[l]) continue;
+                if (!inside[l]) continue;
                 int x = bx + (l & 3), y = by + (l >> 2);
                 ms_hit *h = &out[(y - y0) * tw + (x - x0)];
-                if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) { h->prim = UINT32_MAX; continue; }
+                if (!valid[l] || rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) { h->prim = UINT32_MAX; continue; }
                 const float o[3] = { rh.ray.org_x[l], rh.ray.org_y[l], rh.ray.org_z[l] };
                 const float d[3] = { rh.ray.dir_x[l], rh.ray.dir_y[l], rh.ray.dir_z[l] };
                 uint32_t prim = rh.hit.primID[l];

@@ -2,7 +2,8 @@
  * sec. 3.2, "rasterize the scene, store depth values of visible surfaces"), a depth-buffer pass over the
  * scene's triangles in batches, so that no stage of the frame holds the scene. Per triangle, the pixel
  * centres its projection may cover (its screen box widened by a pixel; the whole screen when a vertex is
- * behind the eye) are tested with the same watertight ray/triangle test and the same rays as the BVH
+ * behind the eye; for the curved cameras the box of the cone around it, curved_box) are tested with the
+ * same watertight ray/triangle test and the same rays as the BVH
  * primary (ms_camera_ray, ms_wt_intersect with the triangle's ms_wt_normal, t in [0, inf)), keeping the
  * nearest; ties go to the smaller triangle index (the BVH keeps the last one it tests, so the two may
  * differ only at exact ties). The hit is finished as ms_hit_finish does (point o + t d, normal of the
@@ -25,12 +26,80 @@ typedef struct depth_state {
     float *t;
 } depth_state;
 
+/* The curved projections (latlong, fisheye, parabolic): a screen box of the pixel centres whose rays may
+ * meet the triangle, from the cone around it seen from the eye (axis to its centroid, half-angle
+ * asin(radius / distance), widened for rounding): the cone's range of polar angle and, when it contains
+ * neither pole (axis), of longitude (azimuth), imaged by the projection's monotone maps. 0: the box;
+ * 1: no pixel can see it; -1: no useful bound (the eye within the triangle's bounding sphere, a cap over
+ * a pole or the latlong seam): the whole image. */
+static int curved_box(const ms_camera_basis *cb, const float *tri, float *xmin, float *xmax, float *ymin, float *ymax)
+{
+    float c[3], a[3], rho = 0.0f;
+    for (int k = 0; k < 3; k++) c[k] = (tri[k] + tri[3 + k] + tri[6 + k]) / 3.0f;
+    for (int v = 0; v < 3; v++) {
+        float e[3];
+        v3_sub(e, tri + 3 * v, c);
+        rho = ms_maxf(rho, v3_len(e));
+    }
+    v3_sub(a, c, cb->eye);
+    const float D = v3_len(a);
+    if (!(D > 1.001f * rho + 1e-6f * D)) return -1;
+    const float alpha = asinf(rho / D) * 1.0001f + 1e-5f;
+    const float ax = v3_dot(a, cb->right) / D, ay = v3_dot(a, cb->up) / D, az = v3_dot(a, cb->forward) / D;
+    const float pi = (float)M_PI;
+    if (cb->type == MS_CAMERA_LATLONG) {
+        const float th = atan2f(sqrtf(ax * ax + az * az), ay), t0 = th - alpha, t1 = th + alpha;
+        *ymin = (float)cb->height * ms_maxf(0.0f, t0) / pi;
+        *ymax = (float)cb->height * ms_minf(pi, t1) / pi;
+        *xmin = 0.0f;
+        *xmax = (float)cb->width;
+        if (t0 <= 0.0f || t1 >= pi) return 0;   /* over a pole: every longitude */
+        const float lc = atan2f(ax, az), dl = asinf(ms_minf(1.0f, sinf(alpha) / sinf(th))) * 1.0001f + 1e-5f;
+        if (lc - dl <= -pi || lc + dl >= pi) return 0;   /* across the seam */
+        *xmin = ((lc - dl) / (2.0f * pi) + 0.5f) * (float)cb->width;
+        *xmax = ((lc + dl) / (2.0f * pi) + 0.5f) * (float)cb->width;
+        return 0;
+    }
+    /* fisheye, parabolic: polar angle from forward to image radius, monotone */
+    const float th = atan2f(sqrtf(ax * ax + ay * ay), az), lim = cb->type == MS_CAMERA_FISHEYE ? cb->max_theta : 0.5f * pi;
+    const float t0 = ms_maxf(0.0f, th - alpha), t1 = ms_minf(lim, th + alpha);
+    if (t0 > lim) return 1;
+    const float r0 = cb->type == MS_CAMERA_FISHEYE ? t0 / cb->max_theta * cb->radius : cb->radius * tanf(0.5f * t0);
+    const float r1 = cb->type == MS_CAMERA_FISHEYE ? t1 / cb->max_theta * cb->radius : cb->radius * tanf(0.5f * t1);
+    if (th - alpha <= 0.0f || th + alpha >= pi) {   /* over the axis or its antipode: every azimuth */
+        *xmin = cb->cx - r1; *xmax = cb->cx + r1; *ymin = cb->cy - r1; *ymax = cb->cy + r1;
+        return 0;
+    }
+    const float pc = atan2f(ay, ax), dp = asinf(ms_minf(1.0f, sinf(alpha) / sinf(th))) * 1.0001f + 1e-5f;
+    *xmin = *ymin = INFINITY;
+    *xmax = *ymax = -INFINITY;
+    /* the annular sector's box: its four corners and its outer arc's extreme points within the range */
+    const float r[2] = { r0, r1 }, ph[2] = { pc - dp, pc + dp };
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++) {
+            const float x = cb->cx + r[i] * cosf(ph[j]), y = cb->cy - r[i] * sinf(ph[j]);
+            *xmin = ms_minf(*xmin, x); *xmax = ms_maxf(*xmax, x); *ymin = ms_minf(*ymin, y); *ymax = ms_maxf(*ymax, y);
+        }
+    for (int q = -4; q <= 4; q++) {
+        const float p = 0.5f * pi * (float)q;
+        if (p < ph[0] || p > ph[1]) continue;
+        const float x = cb->cx + r1 * cosf(p), y = cb->cy - r1 * sinf(p);
+        *xmin = ms_minf(*xmin, x); *xmax = ms_maxf(*xmax, x); *ymin = ms_minf(*ymin, y); *ymax = ms_maxf(*ymax, y);
+    }
+    return 0;
+}
+
 static void depth_triangle(const ms_render_ctx *ctx, depth_state *s, const float *tri, uint32_t id, int y0, int y1)
 {
     const ms_camera_basis *cb = &ctx->cam;
     float xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-    int behind = !ms_camera_planar(cb);   /* curved edge images: the box of the vertices does not bound them */
-    for (int v = 0; v < 3 && !behind; v++) {
+    int behind = 0;
+    if (!ms_camera_planar(cb)) {   /* curved edge images: the box of the vertices does not bound them */
+        const int rc = curved_box(cb, tri, &xmin, &xmax, &ymin, &ymax);
+        if (rc > 0) return;
+        behind = rc < 0;
+    }
+    for (int v = 0; v < 3 && !behind && ms_camera_planar(cb); v++) {
         float px, py;
         if (ms_camera_project(cb, tri + 3 * v, &px, &py)) { behind = 1; break; }
         xmin = ms_minf(xmin, px); xmax = ms_maxf(xmax, px);

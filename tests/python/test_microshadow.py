@@ -162,6 +162,22 @@ class QuadTest(unittest.TestCase):
         self.assertEqual(b["stats"]["samples_per_pixel"], 256)
         self.assertEqual(b["stats"]["filter_s"], 0.0)
 
+    def test_camera_types(self):
+        # the mirrored ms_camera: a fisheye of 180 degrees (MS_CAMERA_FISHEYE = 2) on the same eye: no ray
+        # outside the inscribed circle (V = -1, black), the centre sees the ground
+        cam = self.scene._s.camera
+        saved = (cam.type, cam.fov)
+        try:
+            cam.type, cam.fov = 2, 180.0
+            f = ms.render(self.scene, method="raytrace", samples=256)
+            yy, xx = np.mgrid[0:48, 0:48] + 0.5
+            outside = np.hypot(xx - 24, yy - 24) > 24
+            self.assertTrue(np.all(f["vis"][outside] == -1))
+            self.assertTrue(np.all(f["rgb"][outside] == 0))
+            self.assertGreaterEqual(f["vis"][24, 24], 0)
+        finally:
+            cam.type, cam.fov = saved
+
     def test_bake(self):
         lm = ms.bake(self.scene, size=64, uv=None, samples=256)
         self.assertEqual(lm["irradiance"].shape, (64, 64, 3))
