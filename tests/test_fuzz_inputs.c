@@ -30,6 +30,8 @@ static int replay(const char *kind, int want_ok)
         char dir[4096];
         snprintf(dir, sizeof dir, "%s/%s/%s", MS_FUZZ_DIR, kind, targets[t]);
         DIR *d = opendir(dir);
+        /* every harness has seeds: a missing corpus (e.g. files a .gitignore kept out) is a failure */
+        if (!d && want_ok) fail_msg("%s: no seed corpus", dir);
         if (!d) continue;
         struct dirent *e;
         while ((e = readdir(d))) {
