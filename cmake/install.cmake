@@ -36,3 +36,9 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/microshadow.pc ${CMAKE_CURRENT_BINARY_
 # The Python module, beside the library it loads (python/microshadow finds ../../../libmicroshadow.so).
 install(DIRECTORY python/microshadow DESTINATION ${CMAKE_INSTALL_LIBDIR}/python3/dist-packages
   PATTERN __pycache__ EXCLUDE)
+
+# The licence and the vendored parts' notices, with the installed library that contains their code.
+install(FILES LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/microshadow)
+install(FILES third_party/cgltf/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/microshadow RENAME LICENSE.cgltf)
+install(FILES third_party/xatlas/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/microshadow RENAME LICENSE.xatlas)
+install(FILES third_party/ltc/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/microshadow RENAME LICENSE.ltc)
