@@ -4,7 +4,7 @@
 # (microshadow: shared; microshadow-static: the archive and everything it needs).
 include(CMakePackageConfigHelpers)
 
-install(FILES include/microshadow.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES include/microshadow.h ${PROJECT_BINARY_DIR}/include/microshadow_version.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS microshadow microshadow_shared microshadow_cli EXPORT microshadowTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -49,7 +49,24 @@
 extern "C" {
 #endif
 
-#define MS_VERSION_STRING "0.1.0"
+/* The version, from CMake's project() (microshadow_version.h is generated into the build tree and installed
+ * beside this header): MS_VERSION_MAJOR, MS_VERSION_MINOR, MS_VERSION_PATCH and MS_VERSION_STRING are what a
+ * program was compiled against; ms_version() is what it runs with. Before 1.0 every minor version may change
+ * the ABI, so the shared library's soname carries major.minor (libmicroshadow.so.0.2); from 1.0 on, the major. */
+#include "microshadow_version.h"
+
+/* Only declarations marked MS_API are exported from the shared library (the rest is built with hidden
+ * visibility and a version script keeps everything else local: tests/check_exports.sh). */
+#if defined(__GNUC__) || defined(__clang__)
+#define MS_API __attribute__((visibility("default")))
+#else
+#define MS_API
+#endif
+
+/* The version of the library that is running: the string (e.g. "0.2.0"), and its numbers through whichever
+ * pointers are not NULL. Compare with MS_VERSION_MAJOR/MINOR to detect a library other than the one a
+ * program was built against. */
+MS_API const char *ms_version(int *major, int *minor, int *patch);
 
 /* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a frame has N = 256, 1024 or 4096 light
  * samples (a k x k grid, k = 16, 32, 64), the stratified pattern also 16 or 64 (k = 4, 8). Every pixel
@@ -119,27 +136,27 @@ typedef struct ms_light {
 } ms_light;
 
 /* Fills l as a sphere light of centre c and radius r (emission left as it is). 0, or -1 when r is not > 0. */
-int ms_light_sphere(ms_light *l, ms_vec3 c, float r);
+MS_API int ms_light_sphere(ms_light *l, ms_vec3 c, float r);
 /* The outline of sphere light l seen from p: the disk where the cone of tangents from p touches the sphere,
  * centre c + (p - c) r^2/d^2, radius r sqrt(d^2 - r^2)/d (d = |p - c|), facing p, as a disk light
  * (ms_light_disk) with l's emission. Every ray from p to this disk meets the sphere first at its near side,
  * and the disk subtends the sphere's solid angle. 0, or -1 when p is not outside the sphere. */
-int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk);
+MS_API int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk);
 
 /* Luminance of the texel at (s,t) of a textured light (0.2126 R + 0.7152 G + 0.0722 B), and its colour
  * into rgb when rgb is not NULL; 1 (and white) for an untextured light. */
-float ms_light_texel(const ms_light *l, float s, float t, float *rgb);
+MS_API float ms_light_texel(const ms_light *l, float s, float t, float *rgb);
 
 /* Fills l as a disk light of centre c, normal m (emitting towards m; need not be unit length, not zero)
  * and radius r: its bounding square, edges 2r along two unit vectors perpendicular to m chosen from m
  * alone, and shape MS_LIGHT_DISK; emission is left as it is. 0, or -1 when m is zero or r not > 0. */
-int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
+MS_API int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
 
 /* 1 if light parameters (s,t) lie on the light's shape (see ms_light_shape), 0 if not. */
-int ms_light_shape_contains(ms_light_shape shape, float s, float t);
+MS_API int ms_light_shape_contains(ms_light_shape shape, float s, float t);
 
 /* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk; 4 pi r^2 for a sphere). */
-float ms_light_area(const ms_light *l);
+MS_API float ms_light_area(const ms_light *l);
 
 /* Units of a light's emission in a scene file (docs/design.md, "Units"). The renderer works in radiance;
  * the others are converted by the shape's emitting area A, every light emitting as a one-sided
@@ -150,7 +167,7 @@ float ms_light_area(const ms_light *l);
  *     the renderer's radiance unit is then the nit (no 683 lm/W: the image stays photometric). */
 typedef enum ms_light_units { MS_UNITS_RADIANCE = 0, MS_UNITS_WATTS = 1, MS_UNITS_LUMENS = 2 } ms_light_units;
 /* The radiance of light l (its shape and edges set) emitting `amount` in `units`. */
-ms_vec3 ms_light_radiance_from(const ms_light *l, ms_vec3 amount, ms_light_units units);
+MS_API ms_vec3 ms_light_radiance_from(const ms_light *l, ms_vec3 amount, ms_light_units units);
 
 #define MS_MAX_UV_SETS 4
 
@@ -226,29 +243,29 @@ typedef struct ms_material {
 enum { MS_ALPHA_OPAQUE = 0, MS_ALPHA_MASK = 1, MS_ALPHA_MASK_MAP = 2 };
 
 /* The scene's lights: its n_lights lights, or `light` alone when n_lights is 0. Sets *n. */
-const ms_light *ms_scene_lights(const ms_scene *s, size_t *n);
+MS_API const ms_light *ms_scene_lights(const ms_scene *s, size_t *n);
 
 /* Triangles [first, first + count) of a procedural scene (9 floats each) into out. */
-void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, float *out);
+MS_API void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, float *out);
 
 /* Warnings (an unknown key in a scene file) go to this handler, one line each without a newline; by
  * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */
 typedef void (*ms_warning_fn)(void *user, const char *message);
-void ms_set_warning_handler(ms_warning_fn fn, void *user);
+MS_API void ms_set_warning_handler(ms_warning_fn fn, void *user);
 /* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, JPEG, an
  * absolute path) are one warning per ms_scene_load: that warning, or "N material files or textures could not
  * be used ... (first: ...)". With verbose non-zero (process-wide, like the handler) each is its own warning. */
-void ms_set_warning_verbose(int verbose);
+MS_API void ms_set_warning_verbose(int verbose);
 
 /* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL through assimp, glTF 2.0 through cgltf; paths
  * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
  * unknown keys warnings. */
-int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
+MS_API int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light. */
-int ms_scene_default(ms_scene *out);
+MS_API int ms_scene_default(ms_scene *out);
 /* Checks camera, light and geometry for NaN/inf and degenerate cases. `what` names the source. */
-int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen);
-void ms_scene_free(ms_scene *s);
+MS_API int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen);
+MS_API void ms_scene_free(ms_scene *s);
 
 typedef enum ms_pattern {
     MS_PATTERN_GRID = 0,       /* k x k lattice, slightly rotated and shifted per pixel (Woop, sec. 6) */
@@ -258,9 +275,9 @@ typedef enum ms_pattern {
 } ms_pattern;
 
 /* "grid", "stratified", "interleaved" ("unknown" otherwise). */
-const char *ms_pattern_name(ms_pattern p);
+MS_API const char *ms_pattern_name(ms_pattern p);
 /* Parses one of those names; 0, or -1 for anything else. */
-int ms_pattern_from_name(const char *name, ms_pattern *out);
+MS_API int ms_pattern_from_name(const char *name, ms_pattern *out);
 
 /* Instruction-set levels of the SIMD kernels and the traversal, in increasing order. As a cap,
  * MS_ISA_AUTO (0) means none: the best level the CPU runs; a cap above the CPU gives the CPU's best. */
@@ -272,11 +289,11 @@ typedef enum ms_isa {
 } ms_isa;
 
 /* "auto", "scalar", "avx2", "avx512". */
-const char *ms_isa_name(ms_isa isa);
+MS_API const char *ms_isa_name(ms_isa isa);
 /* Parses one of those names; 0, or -1 for anything else. */
-int ms_isa_from_name(const char *name, ms_isa *out);
+MS_API int ms_isa_from_name(const char *name, ms_isa *out);
 /* The best level this CPU (and OS: saved register state) runs. */
-ms_isa ms_cpu_isa(void);
+MS_API ms_isa ms_cpu_isa(void);
 
 typedef void (*ms_progress_fn)(void *user, double fraction_done);
 
@@ -331,12 +348,12 @@ typedef struct ms_render_options {
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
-void ms_render_options_default(ms_render_options *o);
+MS_API void ms_render_options_default(ms_render_options *o);
 
 /* Names of the shadow methods compiled in, NULL-terminated. */
-const char *const *ms_method_names(void);
+MS_API const char *const *ms_method_names(void);
 /* 1 if `name` is a known method compiled into this build, 0 if unknown, -1 if known but not compiled in. */
-int ms_method_available(const char *name);
+MS_API int ms_method_available(const char *name);
 
 #define MS_MAX_COUNTERS 24
 
@@ -389,9 +406,9 @@ typedef struct ms_frame {
     int n_lights;
 } ms_frame;
 
-int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
+MS_API int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
               char *err, size_t errlen);
-void ms_frame_free(ms_frame *f);
+MS_API void ms_frame_free(ms_frame *f);
 
 /* ---- A frame tile by tile: for drivers that spread one frame over processes (the CLI's MPI mode) ----
  *
@@ -410,26 +427,26 @@ typedef struct ms_frame_job ms_frame_job;
 /* Checks the options, builds the acceleration structure and sets up the methods, the shadow method once per
  * light, kept until ms_frame_job_free (what ms_render does first, with its messages). 0 and *job, or -1 with
  * *job = NULL. */
-int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **job, char *err,
+MS_API int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **job, char *err,
                         size_t errlen);
 /* The number of tiles; tiles_x and tiles_y (may be NULL) get the frame's tiles per row and per column. */
-int ms_frame_job_tiles(const ms_frame_job *job, int *tiles_x, int *tiles_y);
+MS_API int ms_frame_job_tiles(const ms_frame_job *job, int *tiles_x, int *tiles_y);
 /* 1 when the method renders split frames with the whole frame's answer; 0 for a frame-level method whose
  * answer at a pixel depends on the others (hpc-scanline), which ms_frame_job_render then refuses unless given
  * the whole frame in its first call. */
-int ms_frame_job_splittable(const ms_frame_job *job);
+MS_API int ms_frame_job_splittable(const ms_frame_job *job);
 /* Primary hits, and V, S, S_spec and front for every light, of the n tiles listed (tiles NULL: all of them, n = the number of tiles) into
  * the job's frame, the stats' visible_pixels, shadow_rays, penumbra_pixels, counters and seconds (primary_s,
  * shadow_s, shadow_cpu_s, and shadow_factor_s in thread-seconds until finish) summed over calls. 0, or -1 with a message. */
-int ms_frame_job_render(ms_frame_job *job, const int *tiles, int n, char *err, size_t errlen);
+MS_API int ms_frame_job_render(ms_frame_job *job, const int *tiles, int n, char *err, size_t errlen);
 /* The frame being assembled (full size, n_lights planes; only the rendered tiles' pixels are set;
  * vis, shadow and shadow_spec unfiltered).
  * Owned by the job. A driver may write other jobs' tiles and sums of their stats into it before finish. */
-ms_frame *ms_frame_job_frame(ms_frame_job *job);
+MS_API ms_frame *ms_frame_job_frame(ms_frame_job *job);
 /* Completes the frame (see above) and moves it to *out (ms_frame_free it); the job is left empty: free it.
  * Every tile must have been rendered here or copied in. 0, or -1 with a message. */
-int ms_frame_job_finish(ms_frame_job *job, ms_frame *out, char *err, size_t errlen);
-void ms_frame_job_free(ms_frame_job *job);
+MS_API int ms_frame_job_finish(ms_frame_job *job, ms_frame *out, char *err, size_t errlen);
+MS_API void ms_frame_job_free(ms_frame_job *job);
 
 /* Outputs, all or nothing. A caller that writes several outputs of one frame lists them in an ms_output
  * table: ms_outputs_check before the render refuses bad targets (two outputs to one file, a target that
@@ -446,22 +463,22 @@ typedef struct ms_output {
     const char *const *suffixes;  /* NULL-terminated accepted endings (case-insensitive), or NULL: any */
 } ms_output;
 #define MS_MAX_OUTPUTS 8
-int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
-int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
-void ms_outputs_cleanup_on_signals(void);
+MS_API int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
+MS_API int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
+MS_API void ms_outputs_cleanup_on_signals(void);
 /* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name; with several lights the EXR has
  * one channel per light, V0, V1, ... resp. S0, S1, ..., and the PFM light 0); the stats as JSON. */
-int ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
-int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
-int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
-int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API int ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 extern const char *const ms_float_image_suffixes[];   /* ".pfm", ".exr" */
 
 /* One output alone, all or nothing (checked, staged and renamed). */
-int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */
-int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .pfm or .exr, float V */
-int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
-int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
+MS_API int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */
+MS_API int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .pfm or .exr, float V */
+MS_API int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
+MS_API int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
 
 /* Unshadowed irradiance at point p with unit normal n from the light, per unit emitted radiance.
  * Parallelogram: exact (polygon form factor, light clipped to the receiver's hemisphere). Disk over a
@@ -471,7 +488,7 @@ int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t e
  * the same area (an approximation; error measured in tests/test_lights.c). Sphere: exact, pi (r/d)^2
  * cos theta wholly above the horizon, Snyder's closed form across it (as in Lagarde & de Rousiers,
  * "Moving Frostbite to PBR", 2014); 0 at points inside the sphere. */
-float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
+MS_API float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
 
 /* ---- Visibility at any points: the library for bakers (docs/baking.md) ----
  *
@@ -495,7 +512,7 @@ typedef enum ms_status {
     MS_ERR_IO = 5           /* reading or writing a file failed */
 } ms_status;
 /* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o". */
-const char *ms_status_name(ms_status s);
+MS_API const char *ms_status_name(ms_status s);
 
 /* Progress with cancellation (like Embree's progress monitor): called with the fraction done, from one
  * thread at a time (never concurrently for one call); return 0 to go on, non-zero to cancel the call,
@@ -505,12 +522,12 @@ typedef int (*ms_progress_cancel_fn)(void *user, double fraction_done);
 typedef struct ms_accel ms_accel;
 /* Builds the acceleration structure of the scene's triangles (copied: the scene may be freed after).
  * threads: 0 for all cores. MS_OK and *out, or an error with *out = NULL. */
-ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
-void ms_accel_free(ms_accel *a);
-size_t ms_accel_triangles(const ms_accel *a);
+MS_API ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
+MS_API void ms_accel_free(ms_accel *a);
+MS_API size_t ms_accel_triangles(const ms_accel *a);
 /* The lights of the scene the accel was built from (its own copies, texels included: valid until
  * ms_accel_free); *n gets their number (ms_scene_lights of that scene). */
-const ms_light *ms_accel_lights(const ms_accel *a, size_t *n);
+MS_API const ms_light *ms_accel_lights(const ms_accel *a, size_t *n);
 
 #define MS_NO_TRIANGLE UINT32_MAX
 
@@ -543,7 +560,7 @@ typedef struct ms_points_options {
  * the first light of the scene the accel was built from (ms_accel_lights lists them all). A sphere light
  * is sampled per point on its outline disk as in frames; a point inside the sphere gets V = S = 0. Stats (timing, counters, no image fields) into
  * stats when non-NULL. */
-ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
+MS_API ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
                                const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
                                ms_stats *stats, char *err, size_t errlen);
 
@@ -587,9 +604,9 @@ typedef struct ms_lightmap {
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
  * vis + l*size*size, as frames hold them), the irradiance summed over the lights. accel: the scene's
  * (ms_accel_build), or NULL to build one here. MS_OK, or an error with out zeroed. */
-ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
+MS_API ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
                   char *err, size_t errlen);
-void ms_lightmap_free(ms_lightmap *lm);
+MS_API void ms_lightmap_free(ms_lightmap *lm);
 
 /* A lightmap row by row, for drivers that spread a bake over processes (the CLI's MPI mode): ms_bake is
  * ms_bake_layout, ms_bake_rows over every row, ms_bake_finish. A driver may bake any rows in any number of
@@ -599,20 +616,20 @@ void ms_lightmap_free(ms_lightmap *lm);
  * finish's). */
 /* The options' checks, the UVs (xatlas where needed) and the texels' points: out->position, normal,
  * triangle, texels, and frame's arrays (vis, shadow -1 until baked). MS_OK, or an error with out zeroed. */
-ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err, size_t errlen);
+MS_API ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err, size_t errlen);
 /* V, S and front of the texels of rows [y0, y1) for every light of the accel (ms_visibility_points with
  * the texel keys, one call per light), their stats added to lm->frame.stats. lm is left as it was on an
  * error. */
-ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1, char *err,
+MS_API ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1, char *err,
                        size_t errlen);
 /* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
  * image fields; total_s: the sum of the parts' seconds. */
-ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
+MS_API ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
 
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
  * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
  * and V. An ms_output_write_fn; ends in .exr. */
-int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 
 #ifdef __cplusplus
 }

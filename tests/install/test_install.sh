@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Installs the build into a fresh prefix inside the build tree, then builds and runs a small C program
 # against the installed package both ways, find_package (shared and static) and pkg-config (shared and
-# --static), and runs the installed CLI. Usage: test_install.sh BUILD_DIR CC "EXTRA_FLAGS"
+# --static), a C++-only project with find_package, and runs the installed CLI.
+# Usage: test_install.sh BUILD_DIR CC "EXTRA_FLAGS" CXX
 set -euo pipefail
 build=$(cd "$1" && pwd)
 cc=$2
 flags=$3
+cxx=$4
 src=$(cd "$(dirname "$0")" && pwd)
 work=$build/tests/install-test
 rm -rf "$work"
@@ -13,7 +15,7 @@ mkdir -p "$work"
 prefix=$work/prefix
 cmake --install "$build" --prefix "$prefix" >"$work/install.log"
 libdir=$(dirname "$(find "$prefix" -name libmicroshadow.a | head -1)")
-for f in "$prefix/include/microshadow.h" "$libdir/libmicroshadow.a" "$libdir/libmicroshadow.so" \
+for f in "$prefix/include/microshadow.h" "$prefix/include/microshadow_version.h" "$prefix/share/doc/microshadow/LICENSE" "$libdir/libmicroshadow.a" "$libdir/libmicroshadow.so" \
          "$prefix/bin/microshadow" "$libdir/cmake/microshadow/microshadowConfig.cmake" \
          "$libdir/pkgconfig/microshadow.pc" "$libdir/pkgconfig/microshadow-static.pc"; do
     [ -e "$f" ] || { echo "test_install: not installed: ${f#"$prefix"/}"; exit 1; }
@@ -32,6 +34,17 @@ cmake --build "$work/consumer" -j 2 >"$work/consumer-build.log" || { cat "$work/
 deps=$(ldd "$work/consumer/consumer_shared")
 grep -q "$libdir/libmicroshadow.so" <<<"$deps" \
     || { echo "test_install: consumer_shared does not load $libdir/libmicroshadow.so"; echo "$deps"; exit 1; }
+
+echo "--- find_package from a C++-only project"
+CXX=$cxx cmake -S "$src/consumer_cxx" -B "$work/consumer_cxx" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$flags" >"$work/consumer-cxx-configure.log" \
+    || { cat "$work/consumer-cxx-configure.log"; exit 1; }
+cmake --build "$work/consumer_cxx" -j 2 >"$work/consumer-cxx-build.log" || { cat "$work/consumer-cxx-build.log"; exit 1; }
+"$work/consumer_cxx/consumer_cxx_shared"
+"$work/consumer_cxx/consumer_cxx_static"
+
+echo "--- the installed shared library exports only the API"
+bash "$src/../check_exports.sh" "$libdir/libmicroshadow.so" "$prefix/include/microshadow.h"
 
 echo "--- pkg-config"
 export PKG_CONFIG_PATH=$libdir/pkgconfig
