@@ -68,6 +68,11 @@ extern "C" {
  * program was built against. */
 MS_API const char *ms_version(int *major, int *minor, int *patch);
 
+/* Of the NULL-terminated names, the one nearest to word by edit distance (case-insensitive), and that
+ * distance in *distance (may be NULL); NULL when names is empty. For "did you mean" hints: the scene
+ * loader's unknown keys, the command line's unknown options and method names. */
+MS_API const char *ms_nearest_name(const char *word, const char *const *names, size_t *distance);
+
 /* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a frame has N = 256, 1024 or 4096 light
  * samples (a k x k grid, k = 16, 32, 64), the stratified pattern also 16 or 64 (k = 4, 8). Every pixel
  * gets all N, except with the interleaved pattern: N/16 per pixel. */

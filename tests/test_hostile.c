@@ -265,6 +265,24 @@ static void test_scene_keys(void **st)
     assert_non_null(strstr(err, "unknown key \"camera.fovv\" ignored (the nearest known key is \"fov_y\")"));
     assert_non_null(strstr(err, "unknown key \"camera.widht\" ignored (the nearest known key is \"width\")"));
     assert_true(tu_file_exists(png));
+    /* keys that begin with '_' are JSON's comments: no warning, at the top level or inside an object */
+    tu_write_file(inpath("comments.json"), "{\"_comment\":\"a note\",\"meshes\":[{\"file\":\"ok.obj\",\"_why\":1}],"
+                  "\"camera\":{\"eye\":[0,10,12],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":16,"
+                  "\"height\":16,\"_note\":[1,2]},\"light\":{\"corner\":[-1,6,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2],"
+                  "\"_c\":0},\"render\":{\"samples\":256,\"_c\":\"x\"},\"_comment2\":{}}");
+    const char *argsc[] = { inpath("comments.json"), "--quiet", "-o", png, NULL };
+    rc = tu_run_cli_ex(argsc, NULL, err, sizeof err, &r);
+    if (rc != 0) fail_msg("exit %d: %s", rc, err);
+    if (r.lines != 0) fail_msg("comment keys warned: %s", err);
+    /* ... but "comment" without the underscore is an unknown key */
+    tu_write_file(inpath("nocomment.json"), "{\"comment\":\"a note\",\"meshes\":[{\"file\":\"ok.obj\"}],"
+                  "\"camera\":{\"eye\":[0,10,12],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":16,"
+                  "\"height\":16},\"light\":{\"corner\":[-1,6,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2]}}");
+    const char *argsn[] = { inpath("nocomment.json"), "--quiet", "-o", png, NULL };
+    rc = tu_run_cli_ex(argsn, NULL, err, sizeof err, &r);
+    if (rc != 0) fail_msg("exit %d: %s", rc, err);
+    assert_int_equal(r.lines, 1);
+    assert_non_null(strstr(err, "unknown key \"comment\" ignored"));
 
     /* camera types: a duplicate type is an error; a latlong needs no fov_y, and the pinhole's fov_y given
      * to it (the common template) is a warning naming the type, after which the render succeeds */
@@ -318,9 +336,9 @@ static void test_outputs_same_target(void **st)
     (void)st;
     const char *s = scene("outs.json", "ok.obj", NULL, NULL);
     char x[4096], y[4096], z[4096], dotted[4200];
-    tu_path(x, sizeof x, g_out, "x.pfm");
+    tu_path(x, sizeof x, g_out, "x.exr");
     assert_int_equal(tu_write_file(x, "keep"), 0);
-    expect_bad(s, FLAGS("-o", x, "--vis", x), NEEDLES("x.pfm", "given to both -o and --vis"));
+    expect_bad(s, FLAGS("-o", x, "--vis", x), NEEDLES("x.exr", "given to both -o and --vis"));
     FILE *f = fopen(x, "rb");
     char b[16] = "";
     assert_non_null(fgets(b, sizeof b, f));

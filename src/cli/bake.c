@@ -3,17 +3,16 @@
  * (ms_outputs_*). */
 #include "microshadow.h"
 #include "bake.h"
+#include "options.h"
 #ifdef MS_HAVE_MPI
 #include "mpi_run.h"
 #endif
 #include <errno.h>
-#include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#define EXIT_BAD_INPUT 2
 
 static void usage(FILE *f)
 {
@@ -42,19 +41,6 @@ static void usage(FILE *f)
         "  --mpi-chunk N       under mpirun: texel rows per hand-out (default 8)\n"
 #endif
         "  --help\n", MS_MAX_UV_SETS - 1);
-}
-
-static int parse_long(const char *opt, const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || end == s || *end || v < lo || v > hi) {
-        fprintf(stderr, "microshadow bake: %s: '%s' is not an integer in [%ld, %ld]\n", opt, s, lo, hi);
-        return -1;
-    }
-    *out = v;
-    return 0;
 }
 
 static int progress_bar(void *user, double frac)
@@ -94,10 +80,11 @@ int ms_cli_bake(int argc, char **argv)
 #endif
     static const char *const exr_suffix[] = { ".exr", NULL };
     static const char *const png_suffix[] = { ".png", NULL };
+    static const char *const json_suffix[] = { ".json", NULL };
     ms_output outs[] = {
         { "-o", "lightmap.exr", ms_exr_write_stream, exr_suffix },
         { "--png", NULL, ms_png_write_stream, png_suffix },
-        { "--stats", NULL, ms_stats_write_stream, NULL },
+        { "--stats", NULL, ms_stats_write_stream, json_suffix },
         { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
         { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
     };
@@ -108,18 +95,18 @@ int ms_cli_bake(int argc, char **argv)
     bo.size = 1024;
     int quiet = 0, c;
     long v;
-    opterr = 0;
-    optind = 1;
-    while ((c = getopt_long(argc, argv, "o:h", longopts, NULL)) != -1) {
+    ms_cli_parser cli;
+    ms_cli_parser_init(&cli, "microshadow bake", longopts);
+    while ((c = ms_cli_next(&cli, argc, argv)) != -1) {
         switch (c) {
         case O_UV:
             if (!strcmp(optarg, "xatlas")) bo.uv_set = -1;
-            else if (parse_long("--uv", optarg, 0, MS_MAX_UV_SETS - 1, &v)) return EXIT_BAD_INPUT;
+            else if (ms_cli_parse_long(&cli, "--uv", optarg, 0, MS_MAX_UV_SETS - 1, &v)) return EXIT_BAD_INPUT;
             else bo.uv_set = (int)v;
             break;
-        case O_SIZE: if (parse_long("--size", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; bo.size = (int)v; break;
-        case O_DILATE: if (parse_long("--dilate", optarg, 0, 1 << 16, &v)) return EXIT_BAD_INPUT; bo.dilate = v ? (int)v : -1; break;
-        case O_PADDING: if (parse_long("--padding", optarg, 1, 256, &v)) return EXIT_BAD_INPUT; bo.padding = (int)v; break;
+        case O_SIZE: if (ms_cli_parse_long(&cli, "--size", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; bo.size = (int)v; break;
+        case O_DILATE: if (ms_cli_parse_long(&cli, "--dilate", optarg, 0, 1 << 16, &v)) return EXIT_BAD_INPUT; bo.dilate = v ? (int)v : -1; break;
+        case O_PADDING: if (ms_cli_parse_long(&cli, "--padding", optarg, 1, 256, &v)) return EXIT_BAD_INPUT; bo.padding = (int)v; break;
         case O_METHOD: bo.points.method = optarg; break;
         case O_PATTERN:
             if (!strcmp(optarg, "grid")) bo.points.pattern = MS_PATTERN_GRID;
@@ -127,15 +114,15 @@ int ms_cli_bake(int argc, char **argv)
             else { fprintf(stderr, "microshadow bake: --pattern: '%s' is not grid or stratified\n", optarg); return EXIT_BAD_INPUT; }
             break;
         case O_SAMPLES:
-            if (parse_long("--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
+            if (ms_cli_parse_long(&cli, "--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
             if (v != 256 && v != 1024 && v != 4096) {
                 fprintf(stderr, "microshadow bake: --samples: %ld is not one of 256, 1024, 4096\n", v);
                 return EXIT_BAD_INPUT;
             }
             bo.points.samples = (int)v;
             break;
-        case O_SEED: if (parse_long("--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; bo.points.seed = (uint32_t)v; break;
-        case O_THREADS: if (parse_long("--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; bo.points.threads = (int)v; break;
+        case O_SEED: if (ms_cli_parse_long(&cli, "--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; bo.points.seed = (uint32_t)v; break;
+        case O_THREADS: if (ms_cli_parse_long(&cli, "--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; bo.points.threads = (int)v; break;
         case O_ISA:
             if (ms_isa_from_name(optarg, &bo.points.isa)) {
                 fprintf(stderr, "microshadow bake: --isa: '%s' is not auto, avx512, avx2 or scalar\n", optarg);
@@ -156,24 +143,16 @@ int ms_cli_bake(int argc, char **argv)
                 return EXIT_BAD_INPUT;
             }
             break;
-        case O_MPI_CHUNK: if (parse_long("--mpi-chunk", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; chunk = (int)v; break;
+        case O_MPI_CHUNK: if (ms_cli_parse_long(&cli, "--mpi-chunk", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; chunk = (int)v; break;
 #endif
         case 'h': case O_HELP: usage(stdout); return 0;
-        default:
-            if (optopt > 0 && optopt < 256) fprintf(stderr, "microshadow bake: option '-%c' is unknown or needs a value (see --help)\n", optopt);
-            else fprintf(stderr, "microshadow bake: option '%s' is unknown or needs a value (see --help)\n", argv[optind - 1]);
-            return EXIT_BAD_INPUT;
+        default: return EXIT_BAD_INPUT;   /* ms_cli_next said why */
         }
     }
     if (argc - optind > 1) { fprintf(stderr, "microshadow bake: more than one scene file given\n"); return EXIT_BAD_INPUT; }
     const char *scene_path = optind < argc ? argv[optind] : NULL;
     const char *method = bo.points.method ? bo.points.method : MS_DEFAULT_METHOD;
-    int avail = ms_method_available(method);
-    if (avail <= 0) {
-        fprintf(stderr, "microshadow bake: --method: '%s' %s\n", method,
-                avail < 0 ? "is not compiled into this build" : "is not a known method (see --help)");
-        return EXIT_BAD_INPUT;
-    }
+    if (ms_cli_check_method(&cli, method)) return EXIT_BAD_INPUT;
     char err[1024];
     ms_outputs_cleanup_on_signals();
     if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) { fprintf(stderr, "microshadow bake: %s\n", err); return EXIT_BAD_INPUT; }

@@ -1,11 +1,11 @@
 /* The microshadow command line: render a scene file (or the built-in scene) with one shadow method. */
 #include "microshadow.h"
 #include "bake.h"
+#include "options.h"
 #ifdef MS_HAVE_MPI
 #include "mpi_run.h"
 #endif
 #include <errno.h>
-#include <getopt.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -14,7 +14,6 @@
 #include <strings.h>
 #include <unistd.h>
 
-#define EXIT_BAD_INPUT 2
 
 static void usage(FILE *f)
 {
@@ -74,19 +73,6 @@ static void progress_bar(void *user, double frac)
     fflush(stderr);
 }
 
-static int parse_int(const char *opt, const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || end == s || *end || v < lo || v > hi) {
-        fprintf(stderr, "microshadow: %s: '%s' is not an integer in [%ld, %ld]\n", opt, s, lo, hi);
-        return -1;
-    }
-    *out = v;
-    return 0;
-}
-
 static int cli_main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
@@ -128,20 +114,25 @@ static int cli_main(int argc, char **argv)
         else if (!strcmp(ef, "none")) opt.embree_filter = MS_EMBREE_FILTER_NONE;
         else { fprintf(stderr, "microshadow: MS_EMBREE_FILTER: '%s' is not plane, always or none\n", ef); return EXIT_BAD_INPUT; }
     }
+    /* A name whose ending the CLI does not write (out.jpg, out.tiff, no ending) is refused, not written as
+     * PNG bytes under that name. */
+    static const char *const image_suffixes[] = { ".png", ".exr", NULL };
+    static const char *const json_suffix[] = { ".json", NULL };
     /* Every output the command line can ask for: one row each, checked before the render and written
      * all or nothing after it (ms_outputs_check, ms_outputs_write). */
     ms_output outs[] = {
-        { "-o", "microshadow.png", ms_png_write_stream, NULL },
+        { "-o", "microshadow.png", ms_png_write_stream, image_suffixes },
         { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
         { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
-        { "--stats", NULL, ms_stats_write_stream, NULL },
+        { "--stats", NULL, ms_stats_write_stream, json_suffix },
     };
     enum { OUT_PNG, OUT_VIS, OUT_SHADOW, OUT_STATS, N_OUTS = sizeof outs / sizeof outs[0] };
     int quiet = 0, c;
     long v;
     double exposure_ev = 0.0;   /* --exposure: stops on top of the automatic exposure (PNG only) */
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:h", longopts, NULL)) != -1) {
+    ms_cli_parser cli;
+    ms_cli_parser_init(&cli, "microshadow", longopts);
+    while ((c = ms_cli_next(&cli, argc, argv)) != -1) {
         switch (c) {
         case O_METHOD: opt.method = optarg; break;
         case O_PATTERN:
@@ -151,17 +142,17 @@ static int cli_main(int argc, char **argv)
             }
             break;
         case O_SAMPLES:
-            if (parse_int("--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
+            if (ms_cli_parse_long(&cli, "--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
             if (v != 16 && v != 64 && v != 256 && v != 1024 && v != 4096) {
                 fprintf(stderr, "microshadow: --samples: %ld is not one of 16, 64, 256, 1024, 4096\n", v);
                 return EXIT_BAD_INPUT;
             }
             opt.samples = (int)v;
             break;
-        case O_WIDTH: if (parse_int("--width", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; opt.width = (int)v; break;
-        case O_HEIGHT: if (parse_int("--height", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; opt.height = (int)v; break;
-        case O_THREADS: if (parse_int("--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; opt.threads = (int)v; break;
-        case O_SEED: if (parse_int("--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; opt.seed = (uint32_t)v; break;
+        case O_WIDTH: if (ms_cli_parse_long(&cli, "--width", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; opt.width = (int)v; break;
+        case O_HEIGHT: if (ms_cli_parse_long(&cli, "--height", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; opt.height = (int)v; break;
+        case O_THREADS: if (ms_cli_parse_long(&cli, "--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; opt.threads = (int)v; break;
+        case O_SEED: if (ms_cli_parse_long(&cli, "--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; opt.seed = (uint32_t)v; break;
         case 'o': outs[OUT_PNG].path = optarg; break;
         case O_VIS: outs[OUT_VIS].path = optarg; break;
         case O_SHADOW: outs[OUT_SHADOW].path = optarg; break;
@@ -200,16 +191,11 @@ static int cli_main(int argc, char **argv)
                 return EXIT_BAD_INPUT;
             }
             break;
-        case O_MPI_CHUNK: if (parse_int("--mpi-chunk", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; chunk = (int)v; break;
+        case O_MPI_CHUNK: if (ms_cli_parse_long(&cli, "--mpi-chunk", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; chunk = (int)v; break;
 #endif
         case 'h': case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("microshadow %s\n", MS_VERSION_STRING); return 0;
-        default:
-            /* optopt is the short option's character, or a long option's val (>= 256) when its value
-             * is missing: then argv[optind - 1] names it, as it does an unknown long option. */
-            if (optopt > 0 && optopt < 256) fprintf(stderr, "microshadow: option '-%c' is unknown or needs a value (see --help)\n", optopt);
-            else fprintf(stderr, "microshadow: option '%s' is unknown or needs a value (see --help)\n", argv[optind - 1]);
-            return EXIT_BAD_INPUT;
+        default: return EXIT_BAD_INPUT;   /* ms_cli_next said why */
         }
     }
     if (argc - optind > 1) { fprintf(stderr, "microshadow: more than one scene file given\n"); return EXIT_BAD_INPUT; }
@@ -218,12 +204,7 @@ static int cli_main(int argc, char **argv)
     const size_t olen = strlen(outs[OUT_PNG].path);
     if (olen >= 4 && !strcasecmp(outs[OUT_PNG].path + olen - 4, ".exr")) outs[OUT_PNG].write = ms_exr_write_stream;
 
-    int avail = ms_method_available(opt.method);
-    if (avail <= 0) {
-        fprintf(stderr, "microshadow: --method: '%s' %s\n", opt.method,
-                avail < 0 ? "is not compiled into this build" : "is not a known method (see --help)");
-        return EXIT_BAD_INPUT;
-    }
+    if (ms_cli_check_method(&cli, opt.method)) return EXIT_BAD_INPUT;
     char err[1024];
     /* Refuse bad outputs before a long render; from here on a signal removes any staging file. */
     ms_outputs_cleanup_on_signals();

@@ -197,15 +197,6 @@ int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
         const char *p = outs[i].path;
         if (!p) continue;
         if (!p[0]) { snprintf(err, errlen, "empty output path (%s)", outs[i].flag); return -1; }
-        if (outs[i].suffixes) {
-            int ok = 0;
-            char list[128] = "";
-            for (int k = 0; outs[i].suffixes[k]; k++) {
-                ok |= has_suffix(p, outs[i].suffixes[k]);
-                snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? " or " : "", outs[i].suffixes[k]);
-            }
-            if (!ok) { snprintf(err, errlen, "%s: %s needs a file ending in %s", p, outs[i].flag, list); return -1; }
-        }
         for (int j = 0; j < i; j++)
             if (outs[j].path && same_target(outs[j].path, p)) {
                 snprintf(err, errlen, "%s: given to both %s and %s (each output needs its own file)", p, outs[j].flag, outs[i].flag);
@@ -228,6 +219,19 @@ int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
         if (slot < 0) return -1;
         close(fd);
         stage_remove(slot);
+    }
+    /* The endings last: two outputs on one file, a device or a directory are named as such whatever the
+     * names end in. */
+    for (int i = 0; i < n; i++) {
+        const char *p = outs[i].path;
+        if (!p || !outs[i].suffixes) continue;
+        int ok = 0;
+        char list[128] = "";
+        for (int k = 0; outs[i].suffixes[k]; k++) {
+            ok |= has_suffix(p, outs[i].suffixes[k]);
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? " or " : "", outs[i].suffixes[k]);
+        }
+        if (!ok) { snprintf(err, errlen, "%s: %s needs a file ending in %s", p, outs[i].flag, list); return -1; }
     }
     return 0;
 }

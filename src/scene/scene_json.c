@@ -47,42 +47,10 @@ static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t",
 static const char *const render_keys[] = { "samples", NULL };
 static const char *const mesh_keys[] = { "file", NULL };
 
-static size_t edit_distance(const char *a, const char *b)
-{
-    size_t n = strlen(b), row[64];
-    if (n >= 64 || strlen(a) >= 64) return 64;
-    for (size_t j = 0; j <= n; j++) row[j] = j;
-    for (size_t i = 1; a[i - 1]; i++) {
-        size_t diag = row[0];
-        row[0] = i;
-        for (size_t j = 1; j <= n; j++) {
-            size_t up = row[j];
-            size_t sub = diag + (tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]));
-            row[j] = sub < up + 1 ? sub : up + 1;
-            if (row[j - 1] + 1 < row[j]) row[j] = row[j - 1] + 1;
-            diag = up;
-        }
-    }
-    return row[n];
-}
-
 /* Warnings wait until the scene loaded: a failed load prints its one error line only. */
 #define MAX_WARNINGS 16
 typedef struct warn_list { int n; char line[MAX_WARNINGS][320]; } warn_list;
 static _Thread_local warn_list *g_warnings;
-
-/* The known key nearest to name (by edit distance). */
-static const char *nearest_key(const char *name, const char *const *known, size_t *dist)
-{
-    const char *best = known[0];
-    size_t bd = (size_t)-1;
-    for (int k = 0; known[k]; k++) {
-        size_t d = edit_distance(name, known[k]);
-        if (d < bd) { bd = d; best = known[k]; }
-    }
-    if (dist) *dist = bd;
-    return best;
-}
 
 static int is_known(const char *name, const char *const *known)
 {
@@ -96,7 +64,7 @@ static const char *meant_for(const cJSON *obj, const char *key, const char *cons
 {
     const cJSON *it;
     cJSON_ArrayForEach(it, obj)
-        if (!is_known(it->string, known) && !strcmp(nearest_key(it->string, known, NULL), key)) return it->string;
+        if (!is_known(it->string, known) && !strcmp(ms_nearest_name(it->string, known, NULL), key)) return it->string;
     return NULL;
 }
 
@@ -118,24 +86,24 @@ static void missing(const cJSON *obj, const char *objname, const char *key, cons
     else snprintf(err, errlen, "%s: \"%s\" is missing%s", path, key, hint);
 }
 
-/* Warns about each key of obj not in known, naming the nearest known key. */
-static void warn_unknown(const cJSON *obj, const char *objname, const char *const *known, const char *path)
+/* Warns about each key of obj in neither known nor also (NULL: none), naming the nearest known key. Keys
+ * that begin with '_' are comments ("_comment", "_note"): JSON has no other kind, so they pass silently. */
+static void warn_unknown_except(const cJSON *obj, const char *objname, const char *const *known,
+                                const char *const *also, const char *path)
 {
     const cJSON *it;
     cJSON_ArrayForEach(it, obj) {
-        int found = 0;
-        const char *best = known[0];
-        size_t bd = (size_t)-1;
-        for (int k = 0; known[k]; k++) {
-            if (!strcmp(it->string, known[k])) { found = 1; break; }
-            size_t d = edit_distance(it->string, known[k]);
-            if (d < bd) { bd = d; best = known[k]; }
-        }
-        if (!found && g_warnings && g_warnings->n < MAX_WARNINGS)
+        if (it->string[0] == '_' || is_known(it->string, known) || (also && is_known(it->string, also))) continue;
+        if (g_warnings && g_warnings->n < MAX_WARNINGS)
             snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
                      "%.200s: unknown key \"%s%s%.40s\" ignored (the nearest known key is \"%s\")", path, objname,
-                     objname[0] ? "." : "", it->string, best);
+                     objname[0] ? "." : "", it->string, ms_nearest_name(it->string, known, NULL));
     }
+}
+
+static void warn_unknown(const cJSON *obj, const char *objname, const char *const *known, const char *path)
+{
+    warn_unknown_except(obj, objname, known, NULL, path);
 }
 
 /* Keys another camera type reads: a warning that says so, rather than "unknown". */
@@ -147,22 +115,6 @@ static void warn_camera_keys(const cJSON *cam, const char *type_name, const char
             g_warnings->n < MAX_WARNINGS)
             snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
                      "%.200s: camera.%s ignored (a %s camera does not use it)", path, it->string, type_name);
-}
-
-/* warn_unknown, silent about the keys in also (warned about otherwise). */
-static void warn_unknown_except(const cJSON *obj, const char *objname, const char *const *known,
-                                const char *const *also, const char *path)
-{
-    const cJSON *it;
-    cJSON_ArrayForEach(it, obj) {
-        if (is_known(it->string, also)) continue;
-        size_t d;
-        const char *best = nearest_key(it->string, known, &d);
-        if (!is_known(it->string, known) && g_warnings && g_warnings->n < MAX_WARNINGS)
-            snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0],
-                     "%.200s: unknown key \"%s%s%.40s\" ignored (the nearest known key is \"%s\")", path, objname,
-                     objname[0] ? "." : "", it->string, best);
-    }
 }
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
