@@ -73,6 +73,12 @@ MS_API const char *ms_version(int *major, int *minor, int *patch);
  * loader's unknown keys, the command line's unknown options and method names. */
 MS_API const char *ms_nearest_name(const char *word, const char *const *names, size_t *distance);
 
+/* The layout of a public struct as this library was compiled: with field NULL, the struct's size in *size;
+ * else the field's offset and size. 0, or -1 when the struct or field is not listed (src/core/layout.c
+ * lists what bindings read). For bindings that mirror the structs (the Python module checks its mirror at
+ * load time with it); C and C++ programs have the header. offset and size may be NULL. */
+MS_API int ms_layout(const char *structure, const char *field, size_t *offset, size_t *size);
+
 /* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a frame has N = 256, 1024 or 4096 light
  * samples (a k x k grid, k = 16, 32, 64), the stratified pattern also 16 or 64 (k = 4, 8). Every pixel
  * gets all N, except with the interleaved pattern: N/16 per pixel. */
@@ -331,7 +337,7 @@ typedef struct ms_render_options {
     int width, height;      /* 0: the scene camera's */
     int threads;            /* 0: all cores; the host's OpenMP settings are left alone */
     uint32_t seed;
-    ms_progress_fn progress;/* may be NULL; called from one thread */
+    ms_progress_fn progress;/* may be NULL; called one thread at a time (any thread), fractions growing to 1 */
     void *progress_user;
     ms_isa isa;             /* cap on the instruction set of kernels and traversal; MS_ISA_AUTO: the CPU's best */
     /* Switches to measure what a part buys; leave them 0. */

@@ -2,10 +2,12 @@
 # Installs the Debian packages microshadow needs that are missing (root, or sudo when available).
 set -euo pipefail
 # clang, libclang-rt-dev (sanitizer and libFuzzer runtimes) and libomp-dev (OpenMP for clang): the clang
-# build and the fuzzers of .ci/run. python3-numpy: the Python module's tests (python/, run by ctest).
+# build and the fuzzers of .ci/run. python3-numpy: the Python module's tests (python/, run by ctest); python3-pip
+# and python3-setuptools: its package (python/pyproject.toml) installed offline by test_python_package.
 # libopenmpi-dev and openmpi-bin: the CLI's optional MPI mode (-DMS_MPI=ON; .ci/run builds and tests it).
 pkgs=(build-essential cmake pkg-config libassimp-dev libcjson-dev libpng-dev libopenexr-dev libembree-dev
-      libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev python3-numpy libopenmpi-dev openmpi-bin)
+      libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev python3-numpy python3-pip python3-setuptools
+      libopenmpi-dev openmpi-bin)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,4 +1,4 @@
-"""microshadow from Python: exact soft shadows from a parallelogram area light, on the CPU.
+"""microshadow from Python: exact soft shadows from area lights (rect, disk, sphere, many at once), on the CPU.
 
 A thin ctypes layer over the shared library (libmicroshadow.so); numpy arrays in and out.
 
@@ -17,7 +17,7 @@ import os
 import numpy as np
 
 __all__ = ["Error", "Scene", "Accel", "load", "default_scene", "visibility_points", "render", "bake",
-           "method_names", "light_irradiance"]
+           "method_names", "light_irradiance", "__version__"]
 
 MAX_UV_SETS = 4
 MAX_COUNTERS = 24
@@ -53,76 +53,7 @@ _lib = ctypes.CDLL(_find_library())
 
 _f = ctypes.c_float
 _p = ctypes.c_void_p
-
-
-class _Vec3(ctypes.Structure):
-    _fields_ = [("x", _f), ("y", _f), ("z", _f)]
-
-
-class _Camera(ctypes.Structure):
-    _fields_ = [("eye", _Vec3), ("target", _Vec3), ("up", _Vec3), ("fov_y", _f), ("width", ctypes.c_int),
-                ("height", ctypes.c_int), ("type", ctypes.c_int), ("fov", _f), ("ortho_height", _f)]
-
-
-class _Light(ctypes.Structure):
-    _fields_ = [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3), ("shape", ctypes.c_int),
-                ("texture", ctypes.POINTER(_f)), ("texture_width", ctypes.c_int), ("texture_height", ctypes.c_int),
-                ("center", _Vec3), ("radius", _f)]
-
-
-class _Scene(ctypes.Structure):
-    _fields_ = [("tri", ctypes.POINTER(_f)), ("n_tris", ctypes.c_size_t), ("camera", _Camera), ("light", _Light),
-                ("samples", ctypes.c_int), ("load_s", ctypes.c_double),
-                ("tri_mesh", ctypes.POINTER(ctypes.c_uint32)), ("tri_uv", ctypes.POINTER(_f) * MAX_UV_SETS),
-                ("n_meshes", ctypes.c_size_t), ("procedural_type", ctypes.c_int), ("procedural_seed", ctypes.c_uint32),
-                # surfaces (materials, shading normals, textures): read by the library only
-                ("materials", _p), ("n_materials", ctypes.c_size_t), ("tri_material", ctypes.POINTER(ctypes.c_uint32)),
-                ("tri_normal", ctypes.POINTER(_f)), ("textures", _p), ("n_textures", ctypes.c_size_t),
-                ("lights", ctypes.POINTER(_Light)), ("n_lights", ctypes.c_size_t)]
-
-
-class _Stats(ctypes.Structure):
-    _fields_ = [("triangles", ctypes.c_size_t)] + \
-        [(n, ctypes.c_double) for n in ("load_s", "build_s", "setup_s", "primary_s", "shadow_s", "total_s")] + \
-        [(n, ctypes.c_int) for n in ("samples", "threads", "width", "height", "samples_per_pixel")] + \
-        [(n, ctypes.c_char_p) for n in ("method", "pattern", "kernel_isa", "traversal_isa")] + \
-        [(n, ctypes.c_uint64) for n in ("visible_pixels", "shadow_rays", "penumbra_pixels")] + \
-        [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
-         ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS),
-         ("shadow_cpu_s", ctypes.c_double), ("primary", ctypes.c_char_p)] + \
-        [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes")]
-
-
-class _Frame(ctypes.Structure):
-    _fields_ = [("width", ctypes.c_int), ("height", ctypes.c_int), ("vis", ctypes.POINTER(_f)),
-                ("shadow", ctypes.POINTER(_f)), ("front", ctypes.POINTER(ctypes.c_uint16)),
-                ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats),
-                ("shadow_spec", ctypes.POINTER(_f)), ("n_lights", ctypes.c_int)]
-
-
-_PROGRESS = ctypes.CFUNCTYPE(None, _p, ctypes.c_double)
-_PROGRESS_CANCEL = ctypes.CFUNCTYPE(ctypes.c_int, _p, ctypes.c_double)
-
-
-class _RenderOptions(ctypes.Structure):
-    _fields_ = [("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int),
-                ("width", ctypes.c_int), ("height", ctypes.c_int), ("threads", ctypes.c_int),
-                ("seed", ctypes.c_uint32), ("progress", _PROGRESS), ("progress_user", _p), ("isa", ctypes.c_int),
-                ("no_occlusion_cull", ctypes.c_int), ("no_child_order", ctypes.c_int),
-                ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
-                ("traversal", ctypes.c_int), ("frustum_shrink", ctypes.c_int), ("no_filter", ctypes.c_int),
-                ("primary", ctypes.c_char_p), ("consistent_primary", ctypes.c_int)]
-
-
-class _Points(ctypes.Structure):
-    _fields_ = [("n", ctypes.c_size_t), ("position", _p), ("normal", _p), ("triangle", _p), ("key", _p)]
-
-
-class _PointsOptions(ctypes.Structure):
-    _fields_ = [("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int),
-                ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("isa", ctypes.c_int),
-                ("progress", _PROGRESS_CANCEL), ("progress_user", _p), ("embree_mode", ctypes.c_int),
-                ("embree_filter", ctypes.c_int)]
+_size = ctypes.c_size_t
 
 
 def _sig(name, res, *args):
@@ -132,27 +63,175 @@ def _sig(name, res, *args):
     return fn
 
 
+_layout = _sig("ms_layout", ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(_size), ctypes.POINTER(_size))
+
+
+def _mirror(cname, fields):
+    """A ctypes mirror of the C struct `cname` holding `fields` (name, ctype) where the library says they
+    are (ms_layout): each field at its offset, bytes the module does not use as padding, the struct's size
+    as compiled. A library whose layout does not fit (a field missing or of another size) fails the import
+    here, with the struct and field named, instead of corrupting memory later."""
+    off, size = _size(), _size()
+    if _layout(cname.encode(), None, None, ctypes.byref(size)) != 0:
+        raise ImportError("microshadow: the library does not describe struct %s (an older library?)" % cname)
+    total = size.value
+    placed = []
+    for name, ctype in fields:
+        if _layout(cname.encode(), name.encode(), ctypes.byref(off), ctypes.byref(size)) != 0:
+            raise ImportError("microshadow: the library's %s has no field %s" % (cname, name))
+        if size.value != ctypes.sizeof(ctype):
+            raise ImportError("microshadow: %s.%s is %d bytes in the library, %d here" % (cname, name, size.value,
+                                                                                        ctypes.sizeof(ctype)))
+        placed.append((off.value, name, ctype))
+    placed.sort(key=lambda t: t[0])
+    out, pos = [], 0
+    for offset, name, ctype in placed:
+        if offset < pos:
+            raise ImportError("microshadow: %s.%s overlaps the field before it" % (cname, name))
+        if offset > pos:
+            out.append(("_pad%d" % pos, ctypes.c_ubyte * (offset - pos)))
+        out.append((name, ctype))
+        pos = offset + ctypes.sizeof(ctype)
+    if total > pos:
+        out.append(("_pad%d" % pos, ctypes.c_ubyte * (total - pos)))
+    cls = type(cname, (ctypes.Structure,), {"_fields_": out})
+    # ctypes aligns members by their types as C does; check that it put each one where C has it
+    for offset, name, _ in placed:
+        if getattr(cls, name).offset != offset:
+            raise ImportError("microshadow: %s.%s lands at %d here, %d in the library" % (cname, name,
+                                                                                        getattr(cls, name).offset, offset))
+    if ctypes.sizeof(cls) != total:
+        raise ImportError("microshadow: %s is %d bytes here, %d in the library" % (cname, ctypes.sizeof(cls), total))
+    return cls
+
+
+_Vec3 = _mirror("ms_vec3", [("x", _f), ("y", _f), ("z", _f)])
+_Camera = _mirror("ms_camera", [("eye", _Vec3), ("target", _Vec3), ("up", _Vec3), ("fov_y", _f),
+                                ("width", ctypes.c_int), ("height", ctypes.c_int), ("type", ctypes.c_int), ("fov", _f),
+                                ("ortho_height", _f)])
+_Light = _mirror("ms_light", [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3),
+                              ("shape", ctypes.c_int), ("texture", ctypes.POINTER(_f)), ("texture_width", ctypes.c_int),
+                              ("texture_height", ctypes.c_int), ("center", _Vec3), ("radius", _f)])
+_Scene = _mirror("ms_scene", [("tri", ctypes.POINTER(_f)), ("n_tris", _size), ("camera", _Camera), ("light", _Light),
+                              ("samples", ctypes.c_int), ("load_s", ctypes.c_double),
+                              ("tri_mesh", ctypes.POINTER(ctypes.c_uint32)), ("tri_uv", ctypes.POINTER(_f) * MAX_UV_SETS),
+                              ("n_meshes", _size), ("lights", ctypes.POINTER(_Light)), ("n_lights", _size)])
+_Stats = _mirror("ms_stats", [("triangles", _size)] +
+                 [(n, ctypes.c_double) for n in ("load_s", "build_s", "setup_s", "primary_s", "shadow_s", "total_s")] +
+                 [(n, ctypes.c_int) for n in ("samples", "threads", "width", "height", "samples_per_pixel")] +
+                 [(n, ctypes.c_char_p) for n in ("method", "pattern", "kernel_isa", "traversal_isa")] +
+                 [(n, ctypes.c_uint64) for n in ("visible_pixels", "shadow_rays", "penumbra_pixels")] +
+                 [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
+                  ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS),
+                  ("shadow_cpu_s", ctypes.c_double), ("primary", ctypes.c_char_p)] +
+                 [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes")])
+_Frame = _mirror("ms_frame", [("width", ctypes.c_int), ("height", ctypes.c_int), ("vis", ctypes.POINTER(_f)),
+                              ("shadow", ctypes.POINTER(_f)), ("front", ctypes.POINTER(ctypes.c_uint16)),
+                              ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats),
+                              ("shadow_spec", ctypes.POINTER(_f)), ("n_lights", ctypes.c_int)])
+
+_PROGRESS = ctypes.CFUNCTYPE(None, _p, ctypes.c_double)
+_PROGRESS_CANCEL = ctypes.CFUNCTYPE(ctypes.c_int, _p, ctypes.c_double)
+
+_RenderOptions = _mirror("ms_render_options", [
+    ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("width", ctypes.c_int),
+    ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS),
+    ("progress_user", _p), ("isa", ctypes.c_int), ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
+    ("traversal", ctypes.c_int), ("no_filter", ctypes.c_int), ("primary", ctypes.c_char_p),
+    ("consistent_primary", ctypes.c_int)])
+_Points = _mirror("ms_points", [("n", _size), ("position", _p), ("normal", _p), ("triangle", _p), ("key", _p)])
+_PointsOptions = _mirror("ms_points_options", [
+    ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("threads", ctypes.c_int),
+    ("seed", ctypes.c_uint32), ("isa", ctypes.c_int), ("progress", _PROGRESS_CANCEL), ("progress_user", _p),
+    ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int)])
+_Lightmap = _mirror("ms_lightmap", [
+    ("frame", _Frame), ("position", ctypes.POINTER(_f)), ("normal", ctypes.POINTER(_f)),
+    ("triangle", ctypes.POINTER(ctypes.c_uint32)), ("uv", ctypes.POINTER(_f)), ("n_tris", _size), ("texels", _size),
+    ("unwrapped_tris", _size), ("unwrap_s", ctypes.c_double), ("raster_s", ctypes.c_double)])
+_BakeOptions = _mirror("ms_bake_options", [("points", _PointsOptions), ("size", ctypes.c_int), ("uv_set", ctypes.c_int),
+                                           ("dilate", ctypes.c_int), ("padding", ctypes.c_int)])
+
 _ERR = ctypes.c_char_p
-_scene_load = _sig("ms_scene_load", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_Scene), _ERR, ctypes.c_size_t)
+_scene_load = _sig("ms_scene_load", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_Scene), _ERR, _size)
 _scene_default = _sig("ms_scene_default", ctypes.c_int, ctypes.POINTER(_Scene))
 _scene_free = _sig("ms_scene_free", None, ctypes.POINTER(_Scene))
-_accel_build = _sig("ms_accel_build", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.c_int, ctypes.POINTER(_p), _ERR,
-                    ctypes.c_size_t)
+_accel_build = _sig("ms_accel_build", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.c_int, ctypes.POINTER(_p), _ERR, _size)
 _accel_free = _sig("ms_accel_free", None, _p)
+_accel_lights = _sig("ms_accel_lights", ctypes.POINTER(_Light), _p, ctypes.POINTER(_size))
 _vis_points = _sig("ms_visibility_points", ctypes.c_int, _p, ctypes.POINTER(_Light), ctypes.POINTER(_Points),
-                   ctypes.POINTER(_PointsOptions), _p, _p, _p, ctypes.POINTER(_Stats), _ERR, ctypes.c_size_t)
+                   ctypes.POINTER(_PointsOptions), _p, _p, _p, ctypes.POINTER(_Stats), _ERR, _size)
 _render = _sig("ms_render", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.POINTER(_RenderOptions),
-               ctypes.POINTER(_Frame), _ERR, ctypes.c_size_t)
+               ctypes.POINTER(_Frame), _ERR, _size)
 _frame_free = _sig("ms_frame_free", None, ctypes.POINTER(_Frame))
 _method_names = _sig("ms_method_names", ctypes.POINTER(ctypes.c_char_p))
 _irradiance = _sig("ms_light_irradiance", _f, ctypes.POINTER(_Light), ctypes.POINTER(_f), ctypes.POINTER(_f))
+_light_disk = _sig("ms_light_disk", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _Vec3, _f)
+_light_sphere = _sig("ms_light_sphere", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _f)
+_nearest = _sig("ms_nearest_name", ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(_size))
+_version = _sig("ms_version", ctypes.c_char_p, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
+                ctypes.POINTER(ctypes.c_int))
+_bake = _sig("ms_bake", ctypes.c_int, ctypes.POINTER(_Scene), _p, ctypes.POINTER(_BakeOptions),
+             ctypes.POINTER(_Lightmap), _ERR, _size)
+_lightmap_free = _sig("ms_lightmap_free", None, ctypes.POINTER(_Lightmap))
+
+__version__ = _version(None, None, None).decode()
 
 _PATTERNS = {"grid": 0, "stratified": 1, "interleaved": 2}
 _ISAS = {"auto": 0, "scalar": 1, "avx2": 2, "avx512": 3}
+_SHAPES = {"rect": 0, "disk": 1, "sphere": 2}
+_SHAPE_NAMES = {v: k for k, v in _SHAPES.items()}
+# A light dict's keys per shape: required, then optional.
+_LIGHT_KEYS = {"rect": (("corner", "edge_s", "edge_t"), ("shape", "emission", "texture")),
+               "disk": (("center", "normal", "radius"), ("shape", "emission", "texture")),
+               "sphere": (("center", "radius"), ("shape", "emission"))}
 
 
 def _errbuf():
     return ctypes.create_string_buffer(1024)
+
+
+def _suggest(word, names):
+    arr = (ctypes.c_char_p * (len(names) + 1))(*[n.encode() for n in names], None)
+    best = _nearest(str(word).encode(), arr, None)
+    return best.decode() if best else None
+
+
+def _choice(arg, value, table):
+    """table[value], or a ValueError naming the argument, the choices and the nearest one."""
+    if isinstance(value, str) and value in table:
+        return table[value]
+    names = list(table)
+    raise ValueError("%s: %r is not one of %s (did you mean %r?)" % (arg, value, ", ".join(names),
+                                                                     _suggest(value, names)))
+
+
+def _array(arg, a, cols, kind, n=None):
+    """a as a C-contiguous array of shape (n, cols) (cols None: (n,)), of float32 (kind "float", from any
+    real number type) or uint32 (kind "index", from integer types only); ValueError naming the argument
+    and the shape it needs otherwise: no silent reshaping, truncation or wrap-around."""
+    want = "(n,)" if cols is None else "(n, %d)" % cols
+    if n is not None:
+        want = want.replace("n", str(n))
+    arr = np.asarray(a)
+    if arr.dtype == object or arr.dtype.kind not in ("f", "i", "u"):
+        raise ValueError("%s: expected a numeric array of shape %s, got dtype %s" % (arg, want, arr.dtype))
+    shape_ok = arr.ndim == 1 if cols is None else (arr.ndim == 2 and arr.shape[1] == cols)
+    if not shape_ok or (n is not None and arr.shape[0] != n):
+        raise ValueError("%s: expected shape %s, got %s" % (arg, want, tuple(arr.shape)))
+    if kind == "index":
+        if arr.dtype.kind == "f":
+            raise ValueError("%s: expected integers (shape %s), got dtype %s" % (arg, want, arr.dtype))
+        if arr.size and (arr.min() < 0 or arr.max() > 0xFFFFFFFF):
+            raise ValueError("%s: values must lie in [0, 2**32)" % arg)
+        return np.ascontiguousarray(arr, dtype=np.uint32)
+    return np.ascontiguousarray(arr, dtype=np.float32)
+
+
+def _vec3(arg, v):
+    a = np.asarray(v, dtype=np.float64)
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise ValueError("%s: expected 3 finite numbers, got %r" % (arg, v))
+    return _Vec3(*[float(x) for x in a])
 
 
 def method_names():
@@ -164,8 +243,66 @@ def method_names():
     return names
 
 
+def _light_dict(L):
+    """A light as a dict: its shape's parameters (rect: corner, edge_s, edge_t; disk: center, normal,
+    radius; sphere: center, radius), emission, and the texture (h, w, 3) when it has one."""
+    v = lambda a: (a.x, a.y, a.z)  # noqa: E731
+    shape = _SHAPE_NAMES.get(L.shape, "rect")
+    d = {"shape": shape, "emission": v(L.emission)}
+    if shape == "rect":
+        d.update(corner=v(L.corner), edge_s=v(L.edge_s), edge_t=v(L.edge_t))
+    elif shape == "disk":
+        c, es, et = (np.array(v(x), np.float64) for x in (L.corner, L.edge_s, L.edge_t))
+        m = np.cross(es, et)
+        d.update(center=tuple(c + (es + et) / 2), normal=tuple(m / np.linalg.norm(m)),
+                 radius=float(np.linalg.norm(es) / 2))
+    else:
+        d.update(center=v(L.center), radius=float(L.radius))
+    if L.texture and shape != "sphere":
+        d["texture"] = np.ctypeslib.as_array(L.texture, shape=(L.texture_height, L.texture_width, 3)).copy()
+    return d
+
+
+def _light_struct(light, arg="light"):
+    """(ms_light, what must stay alive while it is used) from a light dict (see Scene.lights)."""
+    if not isinstance(light, dict):
+        raise ValueError("%s: expected a dict (see Scene.lights), got %s" % (arg, type(light).__name__))
+    shape = light.get("shape", "rect")
+    _choice(arg + "['shape']", shape, _SHAPES)
+    required, optional = _LIGHT_KEYS[shape]
+    for k in light:
+        if k not in required and k not in optional:
+            raise ValueError("%s: %r is not a key of a %s light (did you mean %r?)" % (arg, k, shape,
+                                                                                  _suggest(k, required + optional)))
+    for k in required:
+        if k not in light:
+            raise ValueError("%s: a %s light needs %r" % (arg, shape, k))
+    L, keep = _Light(), None
+    L.emission = _vec3(arg + "['emission']", light.get("emission", (1.0, 1.0, 1.0)))
+    if shape == "rect":
+        L.corner, L.edge_s, L.edge_t = (_vec3(arg + "[%r]" % k, light[k]) for k in required)
+    elif shape == "disk":
+        if _light_disk(ctypes.byref(L), _vec3(arg + "['center']", light["center"]),
+                       _vec3(arg + "['normal']", light["normal"]), float(light["radius"])) != 0:
+            raise ValueError("%s: a disk needs a non-zero normal and a radius > 0" % arg)
+    elif _light_sphere(ctypes.byref(L), _vec3(arg + "['center']", light["center"]), float(light["radius"])) != 0:
+        raise ValueError("%s: a sphere needs a radius > 0" % arg)
+    if light.get("texture") is not None:
+        t = np.asarray(light["texture"])
+        if t.ndim != 3 or t.shape[2] != 3 or t.shape[0] < 1 or t.shape[1] < 1 or t.dtype.kind not in ("f", "i", "u"):
+            raise ValueError("%s['texture']: expected a numeric array of shape (h, w, 3), got %s %s"
+                             % (arg, t.dtype, tuple(t.shape)))
+        keep = np.ascontiguousarray(t, dtype=np.float32)
+        if not np.all(np.isfinite(keep)) or keep.min() < 0:
+            raise ValueError("%s['texture']: texels must be finite and >= 0" % arg)
+        L.texture = keep.ctypes.data_as(ctypes.POINTER(_f))
+        L.texture_height, L.texture_width = keep.shape[0], keep.shape[1]
+    return L, keep
+
+
 class Scene:
-    """A loaded scene (ms_scene). .triangles is an (n, 3, 3) float32 copy; .light a dict."""
+    """A loaded scene (ms_scene). .triangles is an (n, 3, 3) float32 copy; .lights a list of dicts (the
+    first is also .light)."""
 
     def __init__(self, _s):
         self._s = _s
@@ -182,20 +319,28 @@ class Scene:
     @property
     def triangles(self):
         n = self.n_triangles
+        if n and not self._s.tri:
+            raise ValueError("a procedural scene's triangles are generated when rendering, not held")
         return np.ctypeslib.as_array(self._s.tri, shape=(n, 3, 3)).copy() if n else np.zeros((0, 3, 3), np.float32)
 
     def uv(self, uv_set):
         """(n, 3, 2) UVs of each triangle's vertices in that set (NaN where its mesh lacks it), or None."""
+        if not isinstance(uv_set, (int, np.integer)) or not 0 <= uv_set < MAX_UV_SETS:
+            raise ValueError("uv_set: expected an integer in [0, %d), got %r" % (MAX_UV_SETS, uv_set))
         p = self._s.tri_uv[uv_set]
         if not p:
             return None
         return np.ctypeslib.as_array(p, shape=(self.n_triangles, 3, 2)).copy()
 
     @property
+    def lights(self):
+        if self._s.n_lights:
+            return [_light_dict(self._s.lights[i]) for i in range(self._s.n_lights)]
+        return [_light_dict(self._s.light)]
+
+    @property
     def light(self):
-        L = self._s.light
-        v = lambda a: (a.x, a.y, a.z)  # noqa: E731
-        return {"corner": v(L.corner), "edge_s": v(L.edge_s), "edge_t": v(L.edge_t), "emission": v(L.emission)}
+        return self.lights[0]
 
 
 def load(path):
@@ -217,6 +362,8 @@ class Accel:
     """The scene's acceleration structure, built once for many visibility_points calls."""
 
     def __init__(self, scene, threads=0):
+        if not isinstance(scene, Scene):
+            raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
         self.scene = scene
         self._h = _p()
         err = _errbuf()
@@ -229,12 +376,11 @@ class Accel:
             _accel_free(self._h)
             self._h = None
 
-
-def _light_struct(light):
-    L = _Light()
-    for k in ("corner", "edge_s", "edge_t", "emission"):
-        setattr(L, k, _Vec3(*[float(x) for x in light[k]]))
-    return L
+    @property
+    def n_lights(self):
+        n = _size()
+        _accel_lights(self._h, ctypes.byref(n))
+        return int(n.value)
 
 
 def _progress_cancel(fn):
@@ -250,57 +396,91 @@ def visibility_points(scene, positions, normals, triangles=None, keys=None, meth
 
     scene: a Scene or an Accel (reused); positions, normals: (n, 3); triangles: (n,) scene triangle
     each point lies on (never occludes it; NO_TRIANGLE for none); keys: (n, 2) pixel whose sample
-    pattern a point uses (default (i, 0)); light: a dict like Scene.light (default the scene's);
-    progress: fn(fraction) -> truthy to cancel (Error with status 3). Returns (V, S) float32 arrays,
-    and the front counts as a third when return_front."""
+    pattern a point uses (default (i, 0)); light: None (the scene's first), the index of one of the
+    scene's lights, "all" (every light: the results get a leading axis, one row per light), or a light
+    dict (see Scene.lights: rect, disk or sphere); progress: fn(fraction) -> truthy to cancel (Error
+    with status 3). Returns (V, S) float32 arrays, and the front counts as a third when return_front.
+    A wrong shape or dtype is a ValueError naming the argument and the shape it needs."""
     acc = scene if isinstance(scene, Accel) else Accel(scene, threads)
-    pos = np.ascontiguousarray(positions, dtype=np.float32).reshape(-1, 3)
-    nor = np.ascontiguousarray(normals, dtype=np.float32).reshape(-1, 3)
-    if pos.shape != nor.shape:
-        raise ValueError("positions and normals must have the same shape (n, 3)")
+    pos = _array("positions", positions, 3, "float")
     n = pos.shape[0]
-    tri = None if triangles is None else np.ascontiguousarray(triangles, dtype=np.uint32).reshape(n)
-    key = None if keys is None else np.ascontiguousarray(keys, dtype=np.uint32).reshape(n, 2)
+    nor = _array("normals", normals, 3, "float", n)
+    tri = None if triangles is None else _array("triangles", triangles, None, "index", n)
+    key = None if keys is None else _array("keys", keys, 2, "index", n)
+    if isinstance(light, str) and light == "all":
+        rows = [visibility_points(acc, pos, nor, tri, key, method, samples, pattern, seed, threads, i, isa, progress,
+                                  return_front) for i in range(acc.n_lights)]
+        return tuple(np.stack([r[k] for r in rows]) for k in range(len(rows[0])))
     pts = _Points(n, pos.ctypes.data, nor.ctypes.data, None if tri is None else tri.ctypes.data,
                   None if key is None else key.ctypes.data)
     cb = _progress_cancel(progress)
-    opt = _PointsOptions(method.encode() if method else None, _PATTERNS[pattern], int(samples), int(threads),
-                         int(seed), _ISAS[isa], cb, None, 0, 0)
+    opt = _PointsOptions()
+    opt.method = method.encode() if method else None
+    opt.pattern, opt.isa = _choice("pattern", pattern, _PATTERNS), _choice("isa", isa, _ISAS)
+    opt.samples, opt.threads, opt.seed = int(samples), int(threads), int(seed)
+    opt.progress = cb
+    keep = None
+    if light is None:
+        L = None
+    elif isinstance(light, (int, np.integer)) and not isinstance(light, bool):
+        nl = _size()
+        arr = _accel_lights(acc._h, ctypes.byref(nl))
+        if not 0 <= light < nl.value:
+            raise ValueError("light: %d is not the index of one of the scene's %d lights" % (light, nl.value))
+        L = ctypes.byref(arr[int(light)])
+    else:
+        Ls, keep = _light_struct(light)
+        L = ctypes.byref(Ls)
     V, S = np.empty(n, np.float32), np.empty(n, np.float32)
     F = np.empty(n, np.uint16)
-    L = None if light is None else ctypes.byref(_light_struct(light))
     err = _errbuf()
     st = _vis_points(acc._h, L, ctypes.byref(pts), ctypes.byref(opt), V.ctypes.data, S.ctypes.data, F.ctypes.data,
                      None, err, len(err))
+    del keep
     if st != 0:
         raise Error(st, err.value.decode(errors="replace"))
     return (V, S, F) if return_front else (V, S)
 
 
+def _planes(ptr, n_lights, h, w, shape=None):
+    """n_lights planes of h x w (light l at ptr + l*h*w) as copies."""
+    if not ptr:
+        return None
+    return np.ctypeslib.as_array(ptr, shape=(n_lights, h, w) + (shape or ())).copy()
+
+
 def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto",
-           primary=None, consistent_primary=False):
+           primary=None, consistent_primary=False, progress=None):
     """A frame (ms_render): dict of vis, shadow (H, W) float32 (-1 where the primary ray missed), front
-    (H, W) uint16, rgb (H, W, 3) linear radiance, exposure, and stats (a dict). primary: the primary
-    visibility method (docs/primary.md; None: the method's pairing)."""
+    (H, W) uint16 (all of light 0), rgb (H, W, 3) linear radiance summed over the lights, exposure, stats
+    (a dict), and lights: one dict per light of the scene with its vis, shadow, shadow_spec and front
+    (H, W). primary: the primary visibility method (docs/primary.md; None: the method's pairing).
+    progress: fn(fraction), called from one thread (frames cannot be cancelled yet)."""
+    if not isinstance(scene, Scene):
+        raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
     opt = _RenderOptions()
     opt.method = method.encode() if method else None
     opt.primary = primary.encode() if primary else None
     opt.consistent_primary = 1 if consistent_primary else 0
-    opt.pattern = _PATTERNS[pattern]
+    opt.pattern = _choice("pattern", pattern, _PATTERNS)
     opt.samples, opt.width, opt.height, opt.threads, opt.seed = int(samples), int(width), int(height), int(threads), int(seed)
-    opt.isa = _ISAS[isa]
+    opt.isa = _choice("isa", isa, _ISAS)
+    cb = _PROGRESS() if progress is None else _PROGRESS(lambda user, frac: progress(frac) and None)
+    opt.progress = cb
     fr, err = _Frame(), _errbuf()
     if _render(ctypes.byref(scene._s), ctypes.byref(opt), ctypes.byref(fr), err, len(err)) != 0:
         raise Error(-1, err.value.decode(errors="replace"))
     try:
-        W, H = fr.width, fr.height
+        W, H, nl = fr.width, fr.height, max(1, fr.n_lights)
+        vis, shadow = _planes(fr.vis, nl, H, W), _planes(fr.shadow, nl, H, W)
+        front, spec = _planes(fr.front, nl, H, W), _planes(fr.shadow_spec, nl, H, W)
         out = {
-            "vis": np.ctypeslib.as_array(fr.vis, shape=(H, W)).copy(),
-            "shadow": np.ctypeslib.as_array(fr.shadow, shape=(H, W)).copy(),
-            "front": np.ctypeslib.as_array(fr.front, shape=(H, W)).copy(),
+            "vis": vis[0], "shadow": shadow[0], "front": front[0],
             "rgb": np.ctypeslib.as_array(fr.rgb, shape=(H, W, 3)).copy(),
             "exposure": float(fr.exposure),
             "stats": _stats_dict(fr.stats),
+            "lights": [{"vis": vis[l], "shadow": shadow[l], "front": front[l],
+                        "shadow_spec": spec[l] if spec is not None else shadow[l]} for l in range(nl)],
         }
     finally:
         _frame_free(ctypes.byref(fr))
@@ -308,7 +488,7 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
 
 
 def _stats_dict(st):
-    d = {n: getattr(st, n) for n, _ in _Stats._fields_ if n not in ("counter_name", "counter")}
+    d = {n: getattr(st, n) for n, _ in st._fields_ if not n.startswith("_pad") and n not in ("counter_name", "counter")}
     for k in ("method", "pattern", "kernel_isa", "traversal_isa", "primary"):
         d[k] = d[k].decode() if d[k] else None
     d["counters"] = {st.counter_name[i].decode(): int(st.counter[i]) for i in range(st.n_counters)}
@@ -316,38 +496,37 @@ def _stats_dict(st):
 
 
 def light_irradiance(light, point, normal):
-    """Exact unshadowed irradiance per unit emitted radiance at point with unit normal."""
-    p = (_f * 3)(*[float(x) for x in point])
-    n = (_f * 3)(*[float(x) for x in normal])
-    return float(_irradiance(ctypes.byref(_light_struct(light)), p, n))
-
-
-class _Lightmap(ctypes.Structure):
-    _fields_ = [("frame", _Frame), ("position", ctypes.POINTER(_f)), ("normal", ctypes.POINTER(_f)),
-                ("triangle", ctypes.POINTER(ctypes.c_uint32)), ("uv", ctypes.POINTER(_f)), ("n_tris", ctypes.c_size_t),
-                ("texels", ctypes.c_size_t), ("unwrapped_tris", ctypes.c_size_t), ("unwrap_s", ctypes.c_double),
-                ("raster_s", ctypes.c_double)]
-
-
-class _BakeOptions(ctypes.Structure):
-    _fields_ = [("points", _PointsOptions), ("size", ctypes.c_int), ("uv_set", ctypes.c_int), ("dilate", ctypes.c_int),
-                ("padding", ctypes.c_int)]
-
-
-_bake = _sig("ms_bake", ctypes.c_int, ctypes.POINTER(_Scene), _p, ctypes.POINTER(_BakeOptions),
-             ctypes.POINTER(_Lightmap), _ERR, ctypes.c_size_t)
-_lightmap_free = _sig("ms_lightmap_free", None, ctypes.POINTER(_Lightmap))
+    """Exact unshadowed irradiance per unit emitted radiance at point with unit normal (light: a dict as
+    in Scene.lights; a sphere's irradiance through its outline disk seen from point)."""
+    p = (_f * 3)(*[float(x) for x in _array("point", [point], 3, "float")[0]])
+    n = (_f * 3)(*[float(x) for x in _array("normal", [normal], 3, "float")[0]])
+    L, keep = _light_struct(light)
+    try:
+        return float(_irradiance(ctypes.byref(L), p, n))
+    finally:
+        del keep
 
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
          dilate=4, padding=2, accel=None, progress=None):
-    """A lightmap (ms_bake): dict of irradiance (size, size, 3), vis and shadow (size, size; -1 where
-    nothing reached), front, position and normal (size, size, 3; NaN off the triangles), triangle
-    (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked into, and counts and
-    timings. uv: the UV set (0..3) or None for xatlas everywhere; dilate 0: none."""
+    """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
+    (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off
+    the triangles), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked
+    into, lights: one dict per light with its vis, shadow and front, and counts and timings. uv: the UV
+    set (0..3) or None for xatlas everywhere; dilate 0: none; progress: fn(fraction) -> truthy to cancel
+    (Error with status 3)."""
+    if not isinstance(scene, Scene):
+        raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
+    if accel is not None and not isinstance(accel, Accel):
+        raise ValueError("accel: expected an Accel of this scene or None, got %s" % type(accel).__name__)
+    if uv is not None and (not isinstance(uv, (int, np.integer)) or not 0 <= uv < MAX_UV_SETS):
+        raise ValueError("uv: expected a UV set in [0, %d) or None (xatlas), got %r" % (MAX_UV_SETS, uv))
     o = _BakeOptions()
-    o.points = _PointsOptions(method.encode() if method else None, _PATTERNS[pattern], int(samples), int(threads),
-                              int(seed), _ISAS[isa], _progress_cancel(progress), None, 0, 0)
+    cb = _progress_cancel(progress)
+    o.points.method = method.encode() if method else None
+    o.points.pattern, o.points.isa = _choice("pattern", pattern, _PATTERNS), _choice("isa", isa, _ISAS)
+    o.points.samples, o.points.threads, o.points.seed = int(samples), int(threads), int(seed)
+    o.points.progress = cb
     o.size = int(size)
     o.uv_set = -1 if uv is None else int(uv)
     o.dilate = -1 if dilate == 0 else int(dilate)
@@ -358,13 +537,13 @@ def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed
     if st != 0:
         raise Error(st, err.value.decode(errors="replace"))
     try:
-        n = lm.frame.width
+        n, nl = lm.frame.width, max(1, lm.frame.n_lights)
         a = np.ctypeslib.as_array
+        vis, shadow, front = (_planes(p, nl, n, n) for p in (lm.frame.vis, lm.frame.shadow, lm.frame.front))
         out = {
             "irradiance": a(lm.frame.rgb, shape=(n, n, 3)).copy(),
-            "vis": a(lm.frame.vis, shape=(n, n)).copy(),
-            "shadow": a(lm.frame.shadow, shape=(n, n)).copy(),
-            "front": a(lm.frame.front, shape=(n, n)).copy(),
+            "vis": vis[0], "shadow": shadow[0], "front": front[0],
+            "lights": [{"vis": vis[l], "shadow": shadow[l], "front": front[l]} for l in range(nl)],
             "position": a(lm.position, shape=(n, n, 3)).copy(),
             "normal": a(lm.normal, shape=(n, n, 3)).copy(),
             "triangle": a(lm.triangle, shape=(n, n)).copy(),

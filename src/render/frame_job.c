@@ -51,6 +51,7 @@ struct ms_frame_job {
     ms_frame frame;
     double t_start;
     long done, total;             /* progress: tiles over the primary phase and every light's shadow phase */
+    long reported;                /* the largest `done` handed to the progress callback */
 };
 
 /* CPU seconds of all the process's threads: on a shared machine, where wall time depends on the
@@ -62,12 +63,20 @@ static double process_cpu_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* One tile done. The callback runs on whichever thread finished a tile, one thread at a time and with
+ * fractions that only grow (a late smaller count is dropped): reporting from thread 0 alone, as before,
+ * said nothing at all when the other threads took every tile (a small frame), and missed the final 1. */
 static void progress_tick(ms_frame_job *j)
 {
     long d;
 #pragma omp atomic capture
     d = ++j->done;
-    if (j->opt.progress && omp_get_thread_num() == 0) j->opt.progress(j->opt.progress_user, (double)d / (double)j->total);
+    if (!j->opt.progress) return;
+#pragma omp critical(ms_frame_progress)
+    if (d > j->reported) {
+        j->reported = d;
+        j->opt.progress(j->opt.progress_user, (double)d / (double)j->total);
+    }
 }
 
 void ms_frame_job_free(ms_frame_job *j)

@@ -2,6 +2,8 @@
 and a 2x2 light at y = 6, all parallel), where the visible fraction of the light at a ground point is
 the light's area outside the occluder's projection onto the light plane, computed here in numpy; frames
 and lightmaps through the module; errors, cancellation and dtype handling."""
+import ctypes
+import json
 import os
 import sys
 import tempfile
@@ -197,6 +199,180 @@ class QuadTest(unittest.TestCase):
         np.testing.assert_allclose(E[lit], E0[lit], rtol=1e-6)     # S = 1 exactly where all is visible
         self.assertTrue(np.all(E[dark] == 0.0))
         self.assertLess(np.abs(lm["vis"][ground] - truth).max(), 0.1)
+
+
+LIGHTS = {"rect": {"shape": "rect", "corner": [-1, 6, -1], "edge_s": [2, 0, 0], "edge_t": [0, 0, 2],
+                   "emission": [1, 0.5, 0.25]},
+          "disk": {"shape": "disk", "center": [0, 6, 0], "normal": [0, -1, 0], "radius": 1.0, "emission": [0.5, 1, 1]},
+          "sphere": {"shape": "sphere", "center": [0, 6, 0], "radius": 0.5, "emission": [2, 2, 2]}}
+
+
+def scene_json(lights):
+    return json.dumps({"meshes": [{"file": "quad.obj"}],
+                       "camera": {"eye": [0, 10, 12], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y": 60,
+                                  "width": 32, "height": 32},
+                       "lights": lights, "render": {"samples": 256}})
+
+
+class LightsTest(unittest.TestCase):
+    """Every light shape and several lights in and out: each light's V and S in a many-light frame or bake
+    equal those of a scene with that light alone, bit for bit; disk and sphere against the Quad's
+    analytic umbra and fully lit regions; a light dict read from a scene gives the same answers as the
+    scene's own light."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.TemporaryDirectory()
+        with open(os.path.join(cls.dir.name, "quad.obj"), "w") as f:
+            f.write(OBJ)
+        cls.scenes = {}
+        for name, lights in [("all", list(LIGHTS.values()))] + [(k, [v]) for k, v in LIGHTS.items()]:
+            path = os.path.join(cls.dir.name, name + ".json")
+            with open(path, "w") as f:
+                f.write(scene_json(lights))
+            cls.scenes[name] = ms.load(path)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.dir.cleanup()
+
+    def test_lights_out(self):
+        got = self.scenes["all"].lights
+        self.assertEqual([l["shape"] for l in got], ["rect", "disk", "sphere"])
+        for l, want in zip(got, LIGHTS.values()):
+            for k, v in want.items():
+                if k != "shape":
+                    np.testing.assert_allclose(np.asarray(l[k], float), np.asarray(v, float), rtol=0, atol=1e-6, err_msg=k)
+        self.assertEqual(self.scenes["all"].light["shape"], "rect")
+
+    def test_frame_per_light(self):
+        many = ms.render(self.scenes["all"], method="raytrace", samples=256)
+        self.assertEqual(len(many["lights"]), 3)
+        np.testing.assert_array_equal(many["vis"], many["lights"][0]["vis"])
+        for i, name in enumerate(LIGHTS):
+            one = ms.render(self.scenes[name], method="raytrace", samples=256)
+            self.assertEqual(len(one["lights"]), 1)
+            for k in ("vis", "shadow", "front"):
+                np.testing.assert_array_equal(many["lights"][i][k], one[k], err_msg=name + " " + k)
+            self.assertGreater(np.count_nonzero((one["vis"] > 0) & (one["vis"] < 1)), 10, name)
+
+    def ground(self, n=600):
+        rng = np.random.default_rng(9)
+        p = np.zeros((n, 3))
+        p[:, 0], p[:, 2] = rng.uniform(-6, 6, n), rng.uniform(-6, 6, n)
+        return p, np.tile([0.0, 1.0, 0.0], (n, 1))
+
+    def test_points_every_shape(self):
+        pos, nor = self.ground()
+        acc = ms.Accel(self.scenes["all"])
+        self.assertEqual(acc.n_lights, 3)
+        V_all, S_all = ms.visibility_points(acc, pos, nor, light="all")
+        self.assertEqual(V_all.shape, (3, len(pos)))
+        # The rays from ground point p to the light form a convex cone; the occluder is the square [-2,2]^2
+        # at y = 2. The light is wholly hidden where the cone's section with y = 2 lies inside the square,
+        # and wholly visible where the section lies beyond one of the square's edge lines. The section is
+        # the hull of the light's points projected from p onto y = 2: the disk's rim, and for the sphere
+        # points all over its surface (its outline seen from p is among them), with a margin for sampling.
+        u = np.linspace(0, 2 * np.pi, 720, endpoint=False)
+        rim = np.stack([np.cos(u), np.zeros_like(u), np.sin(u)], 1) + [0, 6, 0]        # disk: radius 1 at y = 6
+        k = np.arange(4000) + 0.5
+        th, ph = np.arccos(1 - 2 * k / 4000), np.pi * (1 + 5 ** 0.5) * k
+        ball = 0.5 * np.stack([np.sin(th) * np.cos(ph), np.cos(th), np.sin(th) * np.sin(ph)], 1) + [0, 6, 0]
+        rect = np.array([[x, 6, z] for x in np.linspace(-1, 1, 41) for z in (-1, 1)] +
+                        [[x, 6, z] for z in np.linspace(-1, 1, 41) for x in (-1, 1)])
+        outline = {"rect": rect, "disk": rim, "sphere": ball}
+        for i, name in enumerate(LIGHTS):
+            q = outline[name]
+            t = 2.0 / q[None, :, 1]                                          # from p (y = 0) to y = 2
+            proj = pos[:, None, [0, 2]] + t[..., None] * (q[None, :, [0, 2]] - pos[:, None, [0, 2]])
+            inside = np.all(np.abs(proj) <= 2.0 - 0.02, axis=(1, 2))
+            clear = np.any(np.all(proj > 2.02, axis=1) | np.all(proj < -2.02, axis=1), axis=1)
+            self.assertGreater(inside.sum(), 5, name)
+            self.assertGreater(clear.sum(), 100, name)
+            V = V_all[i]
+            self.assertTrue(np.all(V[inside] == 0.0), name)
+            self.assertTrue(np.all(V[clear] == 1.0), name)
+            # the same light by index, by the dict the scene gives back, and from a scene holding it alone
+            Vi, Si = ms.visibility_points(acc, pos, nor, light=i)
+            Vd, Sd = ms.visibility_points(acc, pos, nor, light=self.scenes["all"].lights[i])
+            V1, S1 = ms.visibility_points(self.scenes[name], pos, nor)
+            for a, b in ((Vi, V), (Vd, V), (V1, V), (Si, S_all[i]), (Sd, S_all[i]), (S1, S_all[i])):
+                np.testing.assert_array_equal(a, b, err_msg=name)
+
+    def test_bake_per_light(self):
+        many = ms.bake(self.scenes["all"], size=32, uv=None, samples=256, method="raytrace")
+        self.assertEqual(len(many["lights"]), 3)
+        for i, name in enumerate(LIGHTS):
+            one = ms.bake(self.scenes[name], size=32, uv=None, samples=256, method="raytrace")
+            for k in ("vis", "shadow", "front"):
+                np.testing.assert_array_equal(many["lights"][i][k], one[k], err_msg=name + " " + k)
+
+    def test_render_progress(self):
+        seen = []
+        ms.render(self.scenes["rect"], samples=256, progress=seen.append)
+        self.assertGreater(len(seen), 1)
+        self.assertEqual(seen[-1], 1.0)
+        self.assertTrue(all(a <= b for a, b in zip(seen, seen[1:])))
+
+
+class StrictTest(unittest.TestCase):
+    """Wrong shapes, dtypes, names and keys are ValueErrors that name the argument and what it needs; the
+    struct mirrors are checked against the library's own layout."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.scene = ms.default_scene()
+
+    def err(self, fn, *needles):
+        with self.assertRaises(ValueError) as cm:
+            fn()
+        for n in needles:
+            self.assertIn(n, str(cm.exception))
+
+    def test_arguments(self):
+        pos, nor = np.zeros((4, 3)), np.tile([0.0, 1.0, 0.0], (4, 1))
+        vp = lambda **kw: ms.visibility_points(self.scene, **{"positions": pos, "normals": nor, **kw})  # noqa: E731
+        self.err(lambda: vp(positions=np.zeros((6, 2))), "positions", "(n, 3)", "(6, 2)")
+        self.err(lambda: vp(positions=np.zeros(12)), "positions", "(n, 3)")
+        self.err(lambda: vp(normals=np.zeros((3, 3))), "normals", "(4, 3)")
+        self.err(lambda: vp(positions=np.array([["a", "b", "c"]] * 4)), "positions", "numeric")
+        self.err(lambda: vp(triangles=np.zeros(4)), "triangles", "integers")
+        self.err(lambda: vp(triangles=np.zeros(3, np.int64)), "triangles", "(4,)")
+        self.err(lambda: vp(keys=-np.ones((4, 2), np.int64)), "keys", "[0, 2**32)")
+        self.err(lambda: vp(pattern="gird"), "pattern", "'gird'", "did you mean 'grid'")
+        self.err(lambda: vp(isa="avx"), "isa", "did you mean")
+        self.err(lambda: vp(light=7), "light", "7", "1 lights")
+        self.err(lambda: vp(light={"shape": "disk", "center": [0, 5, 0], "radius": 1}), "disk", "'normal'")
+        self.err(lambda: vp(light={"shape": "rect", "corner": [0, 5, 0], "edge_s": [1, 0, 0], "edge_t": [0, 0, 1],
+                                   "colour": [1, 1, 1]}), "'colour'", "did you mean 'corner'")
+        self.err(lambda: vp(light={"shape": "tube"}), "light['shape']", "'tube'")
+        self.err(lambda: vp(light={"shape": "sphere", "center": [0, 5, 0], "radius": -1}), "radius > 0")
+        self.err(lambda: vp(light={"shape": "rect", "corner": [0, 5, np.nan], "edge_s": [1, 0, 0],
+                                   "edge_t": [0, 0, 1]}), "light['corner']", "finite")
+        self.err(lambda: ms.render(self.scene, pattern="Grid"), "pattern", "did you mean 'grid'")
+        self.err(lambda: ms.bake(self.scene, uv=7), "uv", "[0, 4)")
+        self.err(lambda: ms.render("scene.json"), "scene", "expected a Scene")
+        # integer positions are numbers: converted, not refused
+        V, _ = vp(positions=np.zeros((4, 3), np.int32))
+        self.assertEqual(V.shape, (4,))
+
+    def test_layout_checked(self):
+        # the mirrors follow the library's ms_layout; a mirror that disagrees fails loudly
+        with self.assertRaises(ImportError) as cm:
+            ms._mirror("ms_vec3", [("x", ctypes.c_double)])
+        self.assertIn("ms_vec3.x", str(cm.exception))
+        with self.assertRaises(ImportError):
+            ms._mirror("ms_vec3", [("w", ctypes.c_float)])
+        with self.assertRaises(ImportError):
+            ms._mirror("ms_no_such_struct", [])
+        for mirror, cname in ((ms._Scene, "ms_scene"), (ms._Frame, "ms_frame"), (ms._RenderOptions, "ms_render_options"),
+                              (ms._Stats, "ms_stats"), (ms._Lightmap, "ms_lightmap")):
+            size = ctypes.c_size_t()
+            self.assertEqual(ms._layout(cname.encode(), None, None, ctypes.byref(size)), 0)
+            self.assertEqual(ctypes.sizeof(mirror), size.value, cname)
+
+    def test_version(self):
+        self.assertRegex(ms.__version__, r"^\d+\.\d+\.\d+$")
 
 
 if __name__ == "__main__":
