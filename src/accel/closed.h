@@ -1,0 +1,43 @@
+/* Closed components of a triangle soup, for exact back-face culling of shadow occluders (docs/culling.md).
+ *
+ * A component (triangles connected through shared edges) is closed when every one of its edges is shared
+ * by exactly two of its triangles that traverse it in opposite directions (consistently oriented, no
+ * boundary, no fin). Vertices are shared when their three coordinates are bitwise equal, as a loader that
+ * reads an indexed mesh leaves them. A closed component bounds a solid; its orientation (outward when the
+ * signed volume is positive, inward otherwise) says which side is inside. A segment from a point to a light
+ * sample outside that solid's box leaves the solid through a triangle whose outward side faces the sample,
+ * so a triangle that has the whole light behind its outward side never decides whether such a segment is
+ * occluded (docs/culling.md proves it, with the cases it needs: the light outside the component's box by
+ * more than the far range, no alpha-tested triangle, no self-intersection). */
+#ifndef MS_ACCEL_CLOSED_H
+#define MS_ACCEL_CLOSED_H
+#include <stddef.h>
+#include <stdint.h>
+
+#define MS_OPEN_COMPONENT UINT32_MAX
+
+typedef struct ms_closed {
+    size_t n_tris;
+    uint32_t *component;   /* per triangle: its closed component, or MS_OPEN_COMPONENT */
+    size_t n_components;   /* closed components */
+    float (*box)[6];       /* per closed component: min x, y, z, max x, y, z */
+    int8_t *outward;       /* per closed component: +1 when the triangles' winding (cross(b - a, c - a))
+                            * points out of the solid (positive signed volume), -1 when it points in */
+    size_t closed_tris;    /* triangles in closed components */
+} ms_closed;
+
+/* The closed components of n triangles (tri: 9 floats each). Work O(n log n), memory O(n). 0, or -1 when
+ * out of memory (out zeroed). */
+int ms_closed_find(const float *tri, size_t n, ms_closed *out);
+void ms_closed_free(ms_closed *c);
+
+/* For a light whose every point lies in the convex hull of the n_pts points pts (3 floats each; e.g. the
+ * corners of a rect light's parallelogram, of a disk's bounding square, of a sphere's bounding box), and
+ * whose box is lbox: keep[t] = 0 for each triangle t of a closed component that the proof allows to skip
+ * (the component's box and lbox apart by more than margin, every pts behind or on the triangle's outward
+ * plane), 1 otherwise. The plane test is done in double with a relative slack, so a triangle is culled
+ * only when every light point is behind it beyond rounding. margin: the segments' far range times the
+ * longest segment (docs/culling.md). Returns the number of triangles culled. */
+size_t ms_closed_cull(const ms_closed *c, const float *tri, const float (*pts)[3], int n_pts, const float lbox[6],
+                      double margin, uint8_t *keep);
+#endif
