@@ -26,13 +26,17 @@ static volatile sig_atomic_t g_live[MS_MAX_OUTPUTS];
  * renames.) */
 enum { STATE_IDLE, STATE_BUSY, STATE_DYING };
 static atomic_int g_state = STATE_IDLE;
-static volatile sig_atomic_t g_pending;
+/* The deferred signal: written by a handler on one thread, read by the writer on another, so an atomic
+ * (lock-free here, hence safe in a handler), not a volatile sig_atomic_t, which orders only within one
+ * thread (ThreadSanitizer found the race). */
+_Static_assert(ATOMIC_INT_LOCK_FREE == 2, "the signal handler needs a lock-free atomic int");
+static atomic_int g_pending;
 
 static void on_signal(int sig)
 {
     int expect = STATE_IDLE;
     if (!atomic_compare_exchange_strong(&g_state, &expect, STATE_DYING) && expect == STATE_BUSY) {
-        g_pending = sig;
+        atomic_store(&g_pending, sig);
         /* The writer may have left between the failed exchange and the store above; then nobody
          * would re-raise, so try once more. */
         expect = STATE_IDLE;
@@ -78,7 +82,7 @@ static void block(sigset_t *old)
 static void unblock(const sigset_t *old)
 {
     atomic_store(&g_state, STATE_IDLE);
-    int sig = g_pending;
+    const int sig = atomic_load(&g_pending);
     pthread_sigmask(SIG_SETMASK, old, NULL);
     if (sig) raise(sig);   /* the deferred signal, now with nothing half done */
 }
