@@ -1,6 +1,5 @@
-/* Mesh files: chosen by extension, checked for structure and size, then imported (assimp or cgltf).
- * Only formats microshadow checks itself reach an importer: assimp's own format probing is where a
- * few bytes of garbage crash it. */
+/* Mesh files: chosen by extension (no probing), read by microshadow's own readers (OBJ, PLY, OFF, STL:
+ * mesh_reader.h) or cgltf (glTF), then checked for finite coordinates. */
 #include "scene_internal.h"
 #include "mesh_reader.h"
 #include "microshadow.h"
@@ -107,7 +106,7 @@ static int load_memory(const char *buf, size_t len, const char *ext, const char 
 {
     size_t added = 0, before = soup->n;
     int rc;
-    if (len == 0) { snprintf(err, errlen, "%s: the mesh file is empty", path); return -1; }   /* assimp asserts on it */
+    if (len == 0) { snprintf(err, errlen, "%s: the mesh file is empty", path); return -1; }
     if (!strcmp(ext, "gltf") || !strcmp(ext, "glb")) {
         rc = ms_mesh_gltf(buf, len, path, soup, &added, err, errlen);
     } else {

@@ -29,14 +29,18 @@ static void rest_of_line(const char *p, const char *e, const char **rb, const ch
 }
 
 /* An index field of a face vertex: nonzero integer, resolved against the `count` defined so far
- * (negative) or all of them (positive, forward references allowed); 0-based, or -1. */
+ * (negative) or all of them (positive, forward references allowed); 0-based, or -1 when it is not an
+ * integer, -2 when it is out of range. */
 static long obj_index(const char *s, size_t n, uint64_t so_far, uint64_t total)
 {
     int64_t v;
-    if (ms_parse_int(s, n, &v) || v == 0) return -1;
-    if (v > 0) return (uint64_t)v <= total ? (long)(v - 1) : -1;
-    return (uint64_t)(-v) <= so_far ? (long)((int64_t)so_far + v) : -1;
+    if (ms_parse_int(s, n, &v)) return -1;
+    if (v > 0) return (uint64_t)v <= total ? (long)(v - 1) : -2;
+    if (v == 0) return -2;
+    return (uint64_t)(-v) <= so_far ? (long)((int64_t)so_far + v) : -2;
 }
+
+static const char *index_problem(long r) { return r == -1 ? "is not an integer" : "is not"; }
 
 /* The MTL files of the mtllib lines, read relative to the OBJ before the faces (mtl.c). An absolute
  * path is a warning (the materials are left out). */
@@ -122,20 +126,20 @@ static int obj_face(obj_state *s, const char *p, const char *e, const char *path
             }
         vi[n] = obj_index(f[0], fl[0], s->nv, s->tv);
         if (vi[n] < 0)
-            MS_FAIL("%s: line %zu: vertex index '%.*s' is malformed or not in 1..%llu (or -1..-%llu)", path, line,
-                    MS_TOKQ(fl[0]), f[0], (unsigned long long)s->tv, (unsigned long long)s->nv);
+            MS_FAIL("%s: line %zu: vertex index '%.*s' %s in 1..%llu (or -1..-%llu) (malformed)", path, line,
+                    MS_TOKQ(fl[0]), f[0], index_problem(vi[n]), (unsigned long long)s->tv, (unsigned long long)s->nv);
         ti[n] = ni[n] = -1;
         if (nf >= 2 && fl[1]) {
             ti[n] = obj_index(f[1], fl[1], s->nvt, s->tvt);
             if (ti[n] < 0)
-                MS_FAIL("%s: line %zu: texture index '%.*s' is malformed or not in 1..%llu", path, line,
-                        MS_TOKQ(fl[1]), f[1], (unsigned long long)s->tvt);
+                MS_FAIL("%s: line %zu: texture index '%.*s' %s in 1..%llu (malformed)", path, line,
+                        MS_TOKQ(fl[1]), f[1], index_problem(ti[n]), (unsigned long long)s->tvt);
         }
         if (nf == 3 && fl[2]) {
             ni[n] = obj_index(f[2], fl[2], s->nvn, s->tvn);
             if (ni[n] < 0)
-                MS_FAIL("%s: line %zu: normal index '%.*s' is malformed or not in 1..%llu", path, line,
-                        MS_TOKQ(fl[2]), f[2], (unsigned long long)s->tvn);
+                MS_FAIL("%s: line %zu: normal index '%.*s' %s in 1..%llu (malformed)", path, line,
+                        MS_TOKQ(fl[2]), f[2], index_problem(ni[n]), (unsigned long long)s->tvn);
         }
         n++;
     }

@@ -109,6 +109,10 @@ static int header(const char *buf, size_t len, const char *path, ply_elem *el, i
     ply_elem *cur = NULL;
     for (;;) {
         if (!ms_text_line(&c, &b, &e)) MS_FAIL("%s: the PLY header has no end_header line (malformed)", path);
+        for (const char *q = b; q < e; q++)
+            if ((unsigned char)*q < 0x20 && *q != '\t')
+                MS_FAIL("%s: line %zu: control character 0x%02x in the PLY header (malformed)", path, c.line,
+                        (unsigned char)*q);
         p = b;
         if (!ms_text_token(&p, e, &tb, &tn)) continue;
         if (ms_tok_is(tb, tn, "comment") || ms_tok_is(tb, tn, "obj_info")) continue;
@@ -254,7 +258,7 @@ static int body(const char *buf, size_t len, size_t off, const char *path, const
                 if (read_value(&r, pr->count_t, &n, &dv))
                     MS_FAIL("%s: %s %llu: truncated or malformed list count", path, E->name, (unsigned long long)k);
                 if (n < 0 || (uint64_t)n > values_left(&r, pr->t))
-                    MS_FAIL("%s: %s %llu: a list of %lld entries where %llu bytes are left (malformed)", path, E->name,
+                    MS_FAIL("%s: %s %llu: truncated: a list of %lld entries where %llu bytes are left (malformed)", path, E->name,
                             (unsigned long long)k, (long long)n, (unsigned long long)(r.end - r.p));
                 const int keep = pr->role == R_INDICES;
                 if (keep && E->kind == 2 && n > MS_MAX_POLYGON)

@@ -67,8 +67,11 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
     const char *tb;
     size_t tn;
     if (!tok(&s, &tb, &tn) || !ms_tok_is(tb, tn, "solid")) {
+        if (len >= 84 && (uint64_t)count * 50 + 84 > len)
+            MS_FAIL("%s: binary STL declares %u triangles, more than its %zu bytes hold (malformed; not ASCII STL "
+                    "either)", path, count, len);
         if (len >= 84)
-            MS_FAIL("%s: not an STL file (binary STL of %u triangles takes %llu bytes, not %zu; nor ASCII STL)", path,
+            MS_FAIL("%s: binary STL of %u triangles takes %llu bytes, not %zu (malformed; not ASCII STL either)", path,
                     count, (unsigned long long)count * 50 + 84, len);
         MS_FAIL("%s: not an STL file (too short for binary STL, and not ASCII STL)", path);
     }

@@ -1,4 +1,4 @@
-/* Scene files: JSON (cJSON) naming meshes (assimp), camera, light and render settings. */
+/* Scene files: JSON (cJSON) naming meshes (mesh_load.c), camera, light and render settings. */
 #include "microshadow.h"
 #include "scene_internal.h"
 #include "../image/png_read.h"
