@@ -121,8 +121,8 @@ int ms_mesh_off(const char *buf, size_t len, const char *path, ms_tri_soup *soup
         if (n > MS_MAX_POLYGON) OFAIL("%s: line %zu: a face of %lld vertices (over the limit of %d)", path, c.line, (long long)n, MS_MAX_POLYGON);
         for (int64_t i = 0; i < n; i++)
             if (!ms_text_token(&p, e, &tb, &tn) || ms_parse_int(tb, tn, &idx[i]) || idx[i] < 0 || (uint64_t)idx[i] >= nv)
-                OFAIL("%s: line %zu: vertex index %lld of the face is missing or not in 0..%lld (malformed)", path, c.line,
-                      (long long)i, (long long)nv - 1);
+                OFAIL("%s: line %zu: the face's index %lld of %lld is missing or not in 0..%lld (malformed)", path, c.line,
+                      (long long)i + 1, (long long)n, (long long)nv - 1);
         while (ms_text_token(&p, e, &tb, &tn)) {   /* the face's colour */
             float x;
             if (ms_parse_real_f(tb, tn, &x)) OFAIL("%s: line %zu: '%.*s' is not a number (malformed)", path, c.line, MS_TOKQ(tn), tb);
