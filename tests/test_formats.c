@@ -5,6 +5,7 @@
  * per-mesh transforms against hand-computed boxes, the matrix form against the equivalent TRS, mirrors
  * keeping outward winding, a file listed twice read once, bad transforms refused. */
 #include "testutil.h"
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -408,6 +409,9 @@ static void test_stl_variants(void **st)
     }
     tu_write_file(in("a.stl"), t);
     expect_known("a.stl");
+    for (size_t i = 0; t[i]; i++) t[i] = (char)toupper((unsigned char)t[i]);   /* keywords in capitals */
+    tu_write_file(in("upper.stl"), t);
+    expect_known("upper.stl");
     for (int solid = 0; solid < 2; solid++) {
         wbuf w = { NULL, 0, 0, 1 };
         unsigned char hdr[80];

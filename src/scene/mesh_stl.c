@@ -1,7 +1,7 @@
 /* STL: binary when the file is exactly 84 + 50 * count bytes (whatever its 80-byte header says: many
  * binary files begin with "solid"), else ASCII: solid NAME, facets (facet normal x y z, outer loop,
  * vertex x y z per corner, endloop, endfacet), endsolid, any number of solids, tokens separated by any
- * white space. The facet normal is each corner's vertex normal (as assimp gave it), unless it is zero or
+ * white space, keywords in any case. The facet normal is each corner's vertex normal (as assimp gave it), unless it is zero or
  * not finite. A loop of more than three vertices is triangulated as a polygon.
  *
  * Bounded: the binary count is compared with the size in 64 bits; ASCII is one walk over the tokens. */
@@ -9,6 +9,10 @@
 #include "microshadow.h"
 #include <math.h>
 #include <string.h>
+#include <strings.h>
+
+/* Keywords in any case: some exporters write them in capitals. */
+static int kw(const char *s, size_t n, const char *w) { return n == strlen(w) && !strncasecmp(s, w, n); }
 
 static int space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
 
@@ -66,7 +70,7 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
     stl_cur s = { buf, buf + len, 1 };
     const char *tb;
     size_t tn;
-    if (!tok(&s, &tb, &tn) || !ms_tok_is(tb, tn, "solid")) {
+    if (!tok(&s, &tb, &tn) || !kw(tb, tn, "solid")) {
         if (len >= 84 && (uint64_t)count * 50 + 84 > len)
             MS_FAIL("%s: binary STL declares %u triangles, more than its %zu bytes hold (malformed; not ASCII STL "
                     "either)", path, count, len);
@@ -78,7 +82,7 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
     ms_emit em;
     ms_emit_init(&em, soup, len, path);
 #define SFAIL(...) do { *added = em.added; snprintf(err, errlen, __VA_ARGS__); return -1; } while (0)
-#define EXPECT(w) do { if (!tok(&s, &tb, &tn) || !ms_tok_is(tb, tn, w)) \
+#define EXPECT(w) do { if (!tok(&s, &tb, &tn) || !kw(tb, tn, w)) \
         SFAIL("%s: line %zu: expected '%s' (malformed ASCII STL)", path, s.line, w); } while (0)
 #define NUMBER(x) do { if (!tok(&s, &tb, &tn) || ms_parse_real_f(tb, tn, &(x))) \
         SFAIL("%s: line %zu: expected a number (malformed ASCII STL)", path, s.line); } while (0)
@@ -87,11 +91,11 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
         while (s.p < s.end && *s.p != '\n' && *s.p != '\r') s.p++;
         for (;;) {
             if (!tok(&s, &tb, &tn)) SFAIL("%s: the file ends before 'endsolid' (malformed ASCII STL)", path);
-            if (ms_tok_is(tb, tn, "endsolid")) {
+            if (kw(tb, tn, "endsolid")) {
                 while (s.p < s.end && *s.p != '\n' && *s.p != '\r') s.p++;
                 break;
             }
-            if (!ms_tok_is(tb, tn, "facet")) SFAIL("%s: line %zu: expected 'facet' or 'endsolid' (malformed ASCII STL)", path, s.line);
+            if (!kw(tb, tn, "facet")) SFAIL("%s: line %zu: expected 'facet' or 'endsolid' (malformed ASCII STL)", path, s.line);
             float nrm[3], pos[3 * MS_MAX_POLYGON];
             EXPECT("normal");
             NUMBER(nrm[0]); NUMBER(nrm[1]); NUMBER(nrm[2]);
@@ -100,8 +104,8 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
             int n = 0;
             for (;;) {
                 if (!tok(&s, &tb, &tn)) SFAIL("%s: the file ends inside a facet (malformed ASCII STL)", path);
-                if (ms_tok_is(tb, tn, "endloop")) break;
-                if (!ms_tok_is(tb, tn, "vertex")) SFAIL("%s: line %zu: expected 'vertex' or 'endloop' (malformed ASCII STL)", path, s.line);
+                if (kw(tb, tn, "endloop")) break;
+                if (!kw(tb, tn, "vertex")) SFAIL("%s: line %zu: expected 'vertex' or 'endloop' (malformed ASCII STL)", path, s.line);
                 if (n == MS_MAX_POLYGON) SFAIL("%s: line %zu: a facet of more than %d vertices (over the limit)", path, s.line, MS_MAX_POLYGON);
                 NUMBER(pos[3 * n]); NUMBER(pos[3 * n + 1]); NUMBER(pos[3 * n + 2]);
                 n++;
@@ -117,7 +121,7 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
             }
         }
         if (!tok(&s, &tb, &tn)) break;
-        if (!ms_tok_is(tb, tn, "solid")) SFAIL("%s: line %zu: expected 'solid' after 'endsolid' (malformed ASCII STL)", path, s.line);
+        if (!kw(tb, tn, "solid")) SFAIL("%s: line %zu: expected 'solid' after 'endsolid' (malformed ASCII STL)", path, s.line);
     }
     *added = em.added;
     return 0;
