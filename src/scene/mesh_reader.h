@@ -19,7 +19,8 @@
 /* Lines of text split at \n, \r\n, \r or \f; `line` is the 1-based number of the last line returned. */
 typedef struct ms_text { const char *p, *end; size_t line; } ms_text;
 int ms_text_line(ms_text *c, const char **b, const char **e);
-/* The next token of [*p, e) separated by blanks (space, tab, vertical tab); 0 at the end. */
+/* The next token of [*p, e) separated by blanks (space, tab, vertical tab, and \x01: the mark mesh_obj.c
+ * leaves where it joined a continued line); 0 at the end. */
 int ms_text_token(const char **p, const char *e, const char **tb, size_t *tn);
 static inline int ms_is_blank(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\x01'; }
 static inline int ms_tok_is(const char *s, size_t n, const char *w)
