@@ -268,7 +268,7 @@ MS_API void ms_set_warning_handler(ms_warning_fn fn, void *user);
  * be used ... (first: ...)". With verbose non-zero (process-wide, like the handler) each is its own warning. */
 MS_API void ms_set_warning_verbose(int verbose);
 
-/* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL through assimp, glTF 2.0 through cgltf; paths
+/* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL read by microshadow, glTF 2.0 through cgltf; paths
  * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
  * unknown keys warnings. */
 MS_API int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);

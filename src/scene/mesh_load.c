@@ -1,7 +1,7 @@
-/* Mesh files: chosen by extension, checked for structure and size, then imported (assimp or cgltf).
- * Only formats microshadow checks itself reach an importer: assimp's own format probing is where a
- * few bytes of garbage crash it. */
+/* Mesh files: chosen by extension (no probing), read by microshadow's own readers (OBJ, PLY, OFF, STL:
+ * mesh_reader.h) or cgltf (glTF), then checked for finite coordinates. */
 #include "scene_internal.h"
+#include "mesh_reader.h"
 #include "microshadow.h"
 #include <ctype.h>
 #include <math.h>
@@ -106,20 +106,19 @@ static int load_memory(const char *buf, size_t len, const char *ext, const char 
 {
     size_t added = 0, before = soup->n;
     int rc;
-    if (len == 0) { snprintf(err, errlen, "%s: the mesh file is empty", path); return -1; }   /* assimp asserts on it */
+    if (len == 0) { snprintf(err, errlen, "%s: the mesh file is empty", path); return -1; }
     if (!strcmp(ext, "gltf") || !strcmp(ext, "glb")) {
         rc = ms_mesh_gltf(buf, len, path, soup, &added, err, errlen);
     } else {
-        int (*check)(const char *, size_t, const char *, char *, size_t) =
-            !strcmp(ext, "obj") ? ms_preflight_obj : !strcmp(ext, "ply") ? ms_preflight_ply
-          : !strcmp(ext, "off") ? ms_preflight_off : !strcmp(ext, "stl") ? ms_preflight_stl : NULL;
-        if (!check) {
+        int (*reader)(const char *, size_t, const char *, ms_tri_soup *, size_t *, char *, size_t) =
+            !strcmp(ext, "obj") ? ms_mesh_obj : !strcmp(ext, "ply") ? ms_mesh_ply
+          : !strcmp(ext, "off") ? ms_mesh_off : !strcmp(ext, "stl") ? ms_mesh_stl : NULL;
+        if (!reader) {
             snprintf(err, errlen, "%s: unsupported mesh format '.%s' (microshadow reads .obj, .ply, .off, .stl, "
                      ".gltf, .glb)", path, ext);
             return -1;
         }
-        rc = check(buf, len, path, err, errlen);
-        if (!rc) rc = ms_mesh_assimp(buf, len, ext, path, soup, &added, err, errlen);
+        rc = reader(buf, len, path, soup, &added, err, errlen);
     }
     if (rc) { soup->n = before; return -1; }
     if (added == 0) { snprintf(err, errlen, "%s: the mesh has no triangles", path); return -1; }

@@ -81,7 +81,7 @@ typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH, MS_INPUT_AUX, MS_INP
 int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char **out, size_t *len, char *err,
                   size_t errlen);
 
-/* Appends the triangles of a mesh file (OBJ, PLY, OFF, STL through assimp after a structural check;
+/* Appends the triangles of a mesh file (OBJ, PLY, OFF, STL through microshadow's own readers;
  * glTF 2.0 through cgltf), triangulated, node transforms applied. Fails with one line naming the file. */
 int ms_mesh_load(const char *path, ms_tri_soup *soup, char *err, size_t errlen);
 /* The same from bytes already in memory (the fuzzers' entry point). `ext` is the lower-case extension
@@ -92,16 +92,8 @@ int ms_soup_push(ms_tri_soup *soup, const float v[9]);
 /* The same with UVs: uv[s] is 6 floats (three vertices' u, v) or NULL when the triangle lacks set s. */
 int ms_soup_push_uv(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS]);
 
-/* Structural checks before assimp sees a file: declared counts against the bytes present, indices in
- * range, polygon sizes; 0 if the file is well-formed. buf is NUL-terminated at buf[len]. */
-int ms_preflight_obj(const char *buf, size_t len, const char *path, char *err, size_t errlen);
-int ms_preflight_ply(const char *buf, size_t len, const char *path, char *err, size_t errlen);
-int ms_preflight_off(const char *buf, size_t len, const char *path, char *err, size_t errlen);
-int ms_preflight_stl(const char *buf, size_t len, const char *path, char *err, size_t errlen);
-
-/* Importers behind the checks; each appends to soup and sets *added. */
-int ms_mesh_assimp(const char *buf, size_t len, const char *ext, const char *path, ms_tri_soup *soup,
-                   size_t *added, char *err, size_t errlen);
+/* glTF 2.0 through cgltf (mesh_gltf.c); OBJ, PLY, OFF and STL: mesh_reader.h. Each appends to soup and
+ * sets *added. */
 int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *soup, size_t *added, char *err,
                  size_t errlen);
 

@@ -1,6 +1,7 @@
-/* Scene files: JSON (cJSON) naming meshes (assimp), camera, light and render settings. */
+/* Scene files: JSON (cJSON) naming meshes (mesh_load.c), camera, light and render settings. */
 #include "microshadow.h"
 #include "scene_internal.h"
+#include "mesh_transform.h"
 #include "../image/png_read.h"
 #include "../image/exr_read.h"
 _Static_assert(MS_SOUP_UV_SETS == MS_MAX_UV_SETS, "one count of UV sets");
@@ -45,7 +46,7 @@ static _Thread_local const char *const *camera_keys = camera_keys_pinhole;
 static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t", "center", "normal", "radius",
                                           "emission", "power", "lumens", "texture", NULL };
 static const char *const render_keys[] = { "samples", NULL };
-static const char *const mesh_keys[] = { "file", NULL };
+static const char *const mesh_keys[] = { "file", "transform", NULL };
 
 /* Warnings wait until the scene loaded: a failed load prints its one error line only. */
 #define MAX_WARNINGS 16
@@ -538,6 +539,10 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     ms_tri_soup soup = { 0 };
     int i = 0;
     const cJSON *m;
+    /* Per entry: its triangles [from, to) and transform, applied once every file is read; a file listed
+     * again (same path) is copied from its first entry rather than read again. */
+    struct { char *path; size_t from, to; int has_xf; double xf[12]; } *ent = calloc((size_t)cJSON_GetArraySize(meshes), sizeof *ent);
+    if (!ent) { snprintf(err, errlen, "%s: out of memory", json_path); free(dircopy); goto done; }
     cJSON_ArrayForEach(m, meshes) {
         const cJSON *file = cJSON_IsObject(m) ? cJSON_GetObjectItemCaseSensitive(m, "file") : NULL;
         if (!cJSON_IsString(file) || !file->valuestring[0]) {
@@ -554,10 +559,27 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
             snprintf(err, errlen, "%s: meshes[%d].file: the path is longer than %zu bytes", json_path, i, sizeof mesh_path - 1);
             goto mesh_fail;
         }
+        const cJSON *xf = cJSON_GetObjectItemCaseSensitive(m, "transform");
+        if (xf && ms_mesh_transform_parse(xf, objname, json_path, ent[i].xf, err, errlen)) goto mesh_fail;
+        ent[i].has_xf = xf != NULL;
         soup.cur_mesh = (uint32_t)i;
-        if (ms_mesh_load(mesh_path, &soup, err, errlen)) goto mesh_fail;
+        ent[i].from = soup.n;
+        int j = 0;
+        while (j < i && strcmp(ent[j].path, mesh_path)) j++;
+        if (j < i) {
+            if (ms_soup_copy_range(&soup, ent[j].from, ent[j].to)) { snprintf(err, errlen, "%s: out of memory", json_path); goto mesh_fail; }
+        } else if (ms_mesh_load(mesh_path, &soup, err, errlen)) {
+            goto mesh_fail;
+        }
+        ent[i].to = soup.n;
+        if (!(ent[i].path = strdup(mesh_path))) { snprintf(err, errlen, "%s: out of memory", json_path); goto mesh_fail; }
         i++;
     }
+    for (int k = 0; k < i; k++) {
+        if (ent[k].has_xf) ms_soup_transform(&soup, ent[k].from, ent[k].to, ent[k].xf);
+        free(ent[k].path);
+    }
+    free(ent);
     free(dircopy);
     out->tri = soup.tri;
     out->n_tris = soup.n;
@@ -575,6 +597,8 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     goto done;
 mesh_fail:
+    for (int k = 0; k <= i; k++) free(ent[k].path);
+    free(ent);
     free(dircopy);
     ms_soup_free(&soup);
 done:
