@@ -4,7 +4,7 @@ set -euo pipefail
 # clang, libclang-rt-dev (sanitizer and libFuzzer runtimes) and libomp-dev (OpenMP for clang): the clang
 # build and the fuzzers of .ci/run. python3-numpy: the Python module's tests (python/, run by ctest).
 # libopenmpi-dev and openmpi-bin: the CLI's optional MPI mode (-DMS_MPI=ON; .ci/run builds and tests it).
-pkgs=(build-essential cmake pkg-config libassimp-dev libcjson-dev libpng-dev libopenexr-dev libembree-dev
+pkgs=(build-essential cmake pkg-config libassimp-dev libcjson-dev libpng-dev libturbojpeg0-dev libopenexr-dev libembree-dev
       libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev python3-numpy libopenmpi-dev openmpi-bin)
 missing=()
 for p in "${pkgs[@]}"; do

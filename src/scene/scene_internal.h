@@ -48,10 +48,15 @@ long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m);
 #define MS_MAX_TEXTURE_SIDE 16384
 #define MS_MAX_TEXTURE_BYTES ((size_t)1 << 30)
 #define MS_MAX_MATERIALS 65536
-/* Decodes a PNG (JPEG is refused with a message) from memory into an RGBA8 texture appended to the soup;
- * its index, or -1 with one line in err naming `what`. flip_rows: store the rows bottom-up (OBJ's v = 0 is
+/* Decodes a PNG, JPEG or KTX2 image (texture.c) from memory into RGBA8 (colour as the file encodes it,
+ * sRGB for colour textures), at most MS_MAX_TEXTURE_SIDE a side and `budget` bytes decoded; 0, or -1 with
+ * one line in err naming `what` (out->rgba NULL). */
+struct ms_texture;
+int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                      struct ms_texture *out, char *err, size_t errlen);
+/* The same decode appended to the soup as a texture; its index, or -1 with one line in err naming `what`. flip_rows: store the rows bottom-up (OBJ's v = 0 is
  * the image's last row; textures follow glTF, v = 0 the first). Loaders treat a texture that fails as a
- * warning, the material keeping its factors: a scene whose textures are missing or JPEG still loads. */
+ * warning, the material keeping its factors: a scene whose textures are missing or undecodable still loads. */
 long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
                                 int flip_rows, char *err, size_t errlen);
 /* The same from a file (a regular file of at most MS_MAX_MESH_BYTES). */
