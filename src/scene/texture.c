@@ -74,7 +74,8 @@ static int decode_jpeg(const unsigned char *buf, size_t len, const char *what, i
         snprintf(err, errlen, "%s: bad JPEG: %s", what, tjGetErrorStr2(tj));
         goto out;
     }
-    if (w < 0 || h < 0 || !size_ok((unsigned)w, (unsigned)h, budget, what, err, errlen)) goto out;
+    if (w < 1 || h < 1) { snprintf(err, errlen, "%s: bad JPEG: no frame header (a file cut short?)", what); goto out; }
+    if (!size_ok((unsigned)w, (unsigned)h, budget, what, err, errlen)) goto out;
     if (!(px = malloc((size_t)w * (size_t)h * 4))) {
         snprintf(err, errlen, "%s: out of memory for a %dx%d texture", what, w, h);
         goto out;
