@@ -195,6 +195,10 @@ typedef struct ms_scene {
      * frees lights. */
     ms_light *lights;
     size_t n_lights;
+    /* Normal-map tangents (NULL where no mesh has them): tri_tangent[12*i .. 12*i+11], (x, y, z, w) of
+     * triangle i's three vertices, NaN where its mesh has none (glTF TANGENT, else MikkTSpace for primitives
+     * with a normal map; w: the bitangent is w n x t). */
+    float *tri_tangent;
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX

@@ -85,6 +85,16 @@ static size_t make_ktx2(uint8_t *out, uint32_t vk, uint32_t w, uint32_t h, uint3
     return 104 + n;
 }
 
+static int g_tangent_w;   /* write_scene: 0 no TANGENT; +1 or -1: TANGENT (1, 0, 0, w) on every vertex */
+
+static const char *tangent_attr(int accessor)
+{
+    static char b[64];
+    if (!g_tangent_w) return "";
+    snprintf(b, sizeof b, ",\"TANGENT\":%d", accessor);
+    return b;
+}
+
 /* The ground quads q = 0..nq-1: x in [2q, 2q + 1.6], z in [-0.8, 0.8], y = 0, normal +y, two triangles,
  * TEXCOORD_0 (u, v) = ((x - 2q) / 1.6, (z + 0.8) / 1.6) and TEXCOORD_1 constant (0.99, 0.99); primitive q
  * has material q. With occluder, a 0.5 x 0.5 quad at y = 0.5 over quad 0's corner, material-less.
@@ -94,7 +104,7 @@ static void write_scene(const char *dir, int nq, int occluder, const char *mater
 {
     enum { MAXQ = 8 };
     const int nquads = nq + (occluder != 0);
-    float pos[MAXQ * 6][3], uv0[MAXQ * 6][2], uv1[MAXQ * 6][2], nrm[MAXQ * 6][3];
+    float pos[MAXQ * 6][3], uv0[MAXQ * 6][2], uv1[MAXQ * 6][2], nrm[MAXQ * 6][3], tan[MAXQ * 6][4];
     int nv = 0;
     for (int q = 0; q < nquads; q++) {
         const float x0 = q < nq ? 2.0f * q : 0.9f, x1 = q < nq ? x0 + 1.6f : 1.4f, z0 = q < nq ? -0.8f : -0.2f,
@@ -105,14 +115,16 @@ static void write_scene(const char *dir, int nq, int occluder, const char *mater
             uv0[nv][0] = (cx[i] - x0) / 1.6f; uv0[nv][1] = (cz[i] + 0.8f) / 1.6f;
             uv1[nv][0] = uv1[nv][1] = 0.99f;
             nrm[nv][0] = 0; nrm[nv][1] = 1; nrm[nv][2] = 0;
+            tan[nv][0] = 1; tan[nv][1] = 0; tan[nv][2] = 0; tan[nv][3] = (float)g_tangent_w;
         }
     }
-    static uint8_t buf[MAXQ * 6 * 40];
+    static uint8_t buf[MAXQ * 6 * 56];
     size_t bl = 0;
     memcpy(buf + bl, pos, (size_t)nv * 12); bl += (size_t)nv * 12;
     memcpy(buf + bl, uv0, (size_t)nv * 8); bl += (size_t)nv * 8;
     memcpy(buf + bl, uv1, (size_t)nv * 8); bl += (size_t)nv * 8;
     memcpy(buf + bl, nrm, (size_t)nv * 12); bl += (size_t)nv * 12;
+    memcpy(buf + bl, tan, (size_t)nv * 16); bl += (size_t)nv * 16;
     write_bytes(dir, "scene.bin", buf, bl);
     static char acc[8192], prims[4096], gl[32768];
     size_t al = 0, pl = 0;
@@ -123,23 +135,25 @@ static void write_scene(const char *dir, int nq, int occluder, const char *mater
             "%s{\"bufferView\":0,\"byteOffset\":%d,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\",\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
             "{\"bufferView\":1,\"byteOffset\":%d,\"componentType\":5126,\"count\":6,\"type\":\"VEC2\"},"
             "{\"bufferView\":2,\"byteOffset\":%d,\"componentType\":5126,\"count\":6,\"type\":\"VEC2\"},"
-            "{\"bufferView\":3,\"byteOffset\":%d,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"}",
-            q ? "," : "", q * 72, x0, y, z0, x1, y, z1, q * 48, q * 48, q * 72);
+            "{\"bufferView\":3,\"byteOffset\":%d,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"},"
+            "{\"bufferView\":4,\"byteOffset\":%d,\"componentType\":5126,\"count\":6,\"type\":\"VEC4\"}",
+            q ? "," : "", q * 72, x0, y, z0, x1, y, z1, q * 48, q * 48, q * 72, q * 96);
         char mat[32] = "";
         if (q < nq) snprintf(mat, sizeof mat, ",\"material\":%d", q);
         pl += (size_t)snprintf(prims + pl, sizeof prims - pl,
-            "%s{\"attributes\":{\"POSITION\":%d,\"TEXCOORD_0\":%d,\"TEXCOORD_1\":%d,\"NORMAL\":%d}%s}", q ? "," : "", 4 * q,
-            4 * q + 1, 4 * q + 2, 4 * q + 3, mat);
+            "%s{\"attributes\":{\"POSITION\":%d,\"TEXCOORD_0\":%d,\"TEXCOORD_1\":%d,\"NORMAL\":%d%s}%s}", q ? "," : "",
+            5 * q, 5 * q + 1, 5 * q + 2, 5 * q + 3, tangent_attr(5 * q + 4), mat);
     }
     snprintf(gl, sizeof gl,
         "{\"asset\":{\"version\":\"2.0\"},%s\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
         "\"meshes\":[{\"primitives\":[%s]}],\"materials\":[%s],\"textures\":[%s],\"images\":[%s],\"samplers\":[%s],"
         "\"buffers\":[{\"byteLength\":%zu,\"uri\":\"scene.bin\"}],"
         "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d},"
-        "{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d}],"
+        "{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d},"
+        "{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d}],"
         "\"accessors\":[%s]}",
         root_extra ? root_extra : "", prims, materials, textures, images, samplers, bl, nv * 12, nv * 12, nv * 8,
-        nv * 20, nv * 8, nv * 28, nv * 12, acc);
+        nv * 20, nv * 8, nv * 28, nv * 12, nv * 40, nv * 16, acc);
     char path[512];
     assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "scene.gltf"), gl), 0);
     /* An orthographic camera straight down (image up = -z), 48 pixels per 2 units; a light over everything. */
@@ -365,6 +379,7 @@ typedef struct nm_case {
     uint8_t texel[4][3];
     double scale, emissive[3];
     int normal_map, checked;
+    double w;
     double worst;
 } nm_case;
 
@@ -378,13 +393,14 @@ static void check_nm_pixel(void *user, int q, size_t i, const float p[3], const 
     float n[3] = { 0, 1, 0 };
     if (c->normal_map) {
         /* tangent-space (x, y, z) = 2 texel / 255 - 1, x and y times the scale; T = +x (u grows with x),
-         * B = +z (v grows with z), N = +y */
+         * N = +y, B = w N x T = -w z: glTF's +Y runs up the image, towards decreasing v, and v grows with z
+         * here (w = 1: MikkTSpace's frame where the asset has no TANGENT; the TANGENT's w otherwise) */
         const uint8_t *t = c->texel[(int)fy * 2 + (int)fx];
         const double x = (2.0 * t[0] / 255 - 1) * c->scale, y = (2.0 * t[1] / 255 - 1) * c->scale, z = 2.0 * t[2] / 255 - 1;
         const double l = sqrt(x * x + y * y + z * z);
         n[0] = (float)(x / l);
         n[1] = (float)(z / l);
-        n[2] = (float)(y / l);
+        n[2] = (float)(-c->w * y / l);
     }
     const double base[3] = { 0.6, 0.6, 0.6 };
     double want[3];
@@ -410,32 +426,41 @@ static void test_normal_map_and_emission(void **st)
     static const uint8_t texel[4][3] = { { 200, 128, 220 }, { 128, 60, 230 }, { 90, 180, 210 }, { 150, 100, 240 } };
     memcpy(c.texel, texel, sizeof texel);
     c.scale = 0.8;
-    ms_scene sc[3];
-    ms_frame fr[3];
-    for (int variant = 0; variant < 3; variant++) {   /* 0: no map, 1: the normal map, 2: emission */
-        const char *dir = tu_tmpdir(variant == 0 ? "textures_nm0" : variant == 1 ? "textures_nm1" : "textures_em");
+    ms_scene sc[4];
+    ms_frame fr[4];
+    static const char *const names[5] = { "textures_nm0", "textures_nm1", "textures_em", "textures_nm_tan", "textures_nm_tanm" };
+    for (int variant = 0; variant < 5; variant++) {
+        /* 0: no map, 1: the normal map (MikkTSpace), 2: emission, 3, 4: the map with TANGENT (1, 0, 0, +-1) */
+        const char *dir = tu_tmpdir(names[variant]);
+        g_tangent_w = variant == 3 ? 1 : variant == 4 ? -1 : 0;
+        c.w = variant == 4 ? -1.0 : 1.0;
         uint8_t rgba[16];
         for (int i = 0; i < 4; i++) { memcpy(rgba + 4 * i, texel[i], 3); rgba[4 * i + 3] = 255; }
         write_png(dir, "n.png", 2, 2, 8, PNG_COLOR_TYPE_RGB_ALPHA, rgba, 8, NULL, 0);
         const char *m = variant == 0 ? "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.6,0.6,0.6,1],\"metallicFactor\":0}}"
-                      : variant == 1 ? "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.6,0.6,0.6,1],\"metallicFactor\":0},"
+                      : variant != 2 ? "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.6,0.6,0.6,1],\"metallicFactor\":0},"
                                        "\"normalTexture\":{\"index\":0,\"scale\":0.8},\"occlusionTexture\":{\"index\":0}}"
                                      : "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.6,0.6,0.6,1],\"metallicFactor\":0},"
                                        "\"emissiveFactor\":[0.5,0.25,1],\"extensions\":{\"KHR_materials_emissive_strength\":"
                                        "{\"emissiveStrength\":4}}}";
         write_scene(dir, 1, 1, m, "{\"source\":0,\"sampler\":0}", "{\"uri\":\"n.png\"}", "{\"magFilter\":9728}",
                     variant == 2 ? "\"extensionsUsed\":[\"KHR_materials_emissive_strength\"]," : NULL);
-        assert_int_equal(load_render(dir, &sc[variant], &fr[variant]), 0);
-        c.sc = &sc[variant];
-        c.fr = &fr[variant];
-        c.normal_map = variant == 1;
+        const int k = variant < 3 ? variant : 3;   /* frames 0..2 kept; 3, 4 checked and freed */
+        assert_int_equal(load_render(dir, &sc[k], &fr[k]), 0);
+        if (variant == 1) assert_non_null(sc[k].tri_tangent);   /* MikkTSpace ran */
+        c.sc = &sc[k];
+        c.fr = &fr[k];
+        c.normal_map = variant == 1 || variant >= 3;
         for (int k = 0; k < 3; k++) c.emissive[k] = variant == 2 ? (k == 0 ? 2.0 : k == 1 ? 1.0 : 4.0) : 0.0;
         c.checked = 0;
-        each_pixel(&sc[variant], &fr[variant], 1, check_nm_pixel, &c);
-        printf("%s: %d pixels checked, worst relative error %.2g\n",
-               variant == 0 ? "no normal map" : variant == 1 ? "normal map" : "emission", c.checked, c.worst);
+        each_pixel(&sc[k], &fr[k], 1, check_nm_pixel, &c);
+        printf("%s: %d pixels checked, worst relative error %.2g\n", variant == 0 ? "no normal map" : variant == 1 ?
+               "normal map (MikkTSpace)" : variant == 2 ? "emission" : variant == 3 ? "normal map, TANGENT w = 1" :
+               "normal map, TANGENT w = -1", c.checked, c.worst);
         assert_true(c.checked > 100);
+        if (k == 3) { ms_frame_free(&fr[3]); ms_scene_free(&sc[3]); }
     }
+    g_tangent_w = 0;
     /* V and S: identical with and without the normal map, with a penumbra present */
     const size_t n = (size_t)fr[0].width * fr[0].height;
     size_t pen = 0, diff_rgb = 0;

@@ -78,7 +78,7 @@ class _Scene(ctypes.Structure):
                 # surfaces (materials, shading normals, textures): read by the library only
                 ("materials", _p), ("n_materials", ctypes.c_size_t), ("tri_material", ctypes.POINTER(ctypes.c_uint32)),
                 ("tri_normal", ctypes.POINTER(_f)), ("textures", _p), ("n_textures", ctypes.c_size_t),
-                ("lights", ctypes.POINTER(_Light)), ("n_lights", ctypes.c_size_t)]
+                ("lights", ctypes.POINTER(_Light)), ("n_lights", ctypes.c_size_t), ("tri_tangent", ctypes.POINTER(_f))]
 
 
 class _Stats(ctypes.Structure):

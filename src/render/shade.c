@@ -89,32 +89,44 @@ static int lookup(const ms_scene *s, size_t t, const float b[3], int32_t tex, in
     return 1;
 }
 
-/* The normal map's perturbation of the unit shading normal n (before it is turned to the eye): the
- * tangent frame from the triangle's positions and the map's UVs (dP/du, dP/dv), T made orthogonal to n,
- * B = sign * n x T with the UVs' handedness; n' = normalize(x T + y B + z n), (x, y, z) = (2 texel - 1)
- * with x, y times the scale. Per triangle, not per vertex: MikkTSpace's tangents agree where a triangle's
- * UVs are an affine map of a flat patch (docs/shading.md). */
+/* The normal map's perturbation of the unit shading normal n (before it is turned to the eye): texel t ->
+ * (x, y, z) = 2 t - 1 (linear), x and y times the scale; n' = normalize(x T + y B + z n) with T the tangent
+ * made orthogonal to n and B = w n x T (glTF). The tangent: the scene's (the asset's TANGENT, or MikkTSpace
+ * at load) interpolated at the hit; else one frame per triangle, T = dP/du and w such that B runs up the
+ * image (towards decreasing glTF v), which MikkTSpace's frame equals where the triangle's UVs are an affine
+ * map of a flat patch (docs/shading.md). */
 static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_material *m, float n[3])
 {
     float tex[4];
     if (!lookup(s, t, b, m->normal_texture, m->normal_uv, &m->normal_sampling, 0, tex)) return;
-    const float *p = s->tri + 9 * t, *uv = s->tri_uv[m->normal_uv] + 6 * t;
-    float e1[3], e2[3];
-    v3_sub(e1, p + 3, p);
-    v3_sub(e2, p + 6, p);
-    const float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
-    const float r = du1 * dv2 - du2 * dv1;
-    if (!(fabsf(r) > 0.0f)) return;   /* degenerate UVs: no tangent frame */
-    float T[3], B[3], tn[3], nb[3], out[3];
-    for (int c = 0; c < 3; c++) {
-        T[c] = (e1[c] * dv2 - e2[c] * dv1) / r;
-        B[c] = (e2[c] * du1 - e1[c] * du2) / r;
+    float T[3] = { 0, 0, 0 }, B[3], nb[3], tn[3], out[3];
+    const float *tg = s->tri_tangent ? s->tri_tangent + 12 * t : NULL;
+    for (int k = 0; tg && k < 12; k++)
+        if (!isfinite(tg[k])) tg = NULL;
+    float w = 1.0f;
+    if (tg) {
+        for (int k = 0; k < 3; k++) v3_madd(T, T, tg + 4 * k, b[k]);
+        w = tg[3] < 0.0f ? -1.0f : 1.0f;
+    } else {
+        const float *p = s->tri + 9 * t, *uv = s->tri_uv[m->normal_uv] + 6 * t;
+        float e1[3], e2[3];
+        v3_sub(e1, p + 3, p);
+        v3_sub(e2, p + 6, p);
+        const float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
+        const float r = du1 * dv2 - du2 * dv1;
+        if (!(fabsf(r) > 0.0f)) return;   /* degenerate UVs: no tangent frame */
+        for (int c = 0; c < 3; c++) {
+            T[c] = (e1[c] * dv2 - e2[c] * dv1) / r;   /* dP/du */
+            B[c] = (e1[c] * du2 - e2[c] * du1) / r;   /* -dP/dv: up the image */
+        }
+        v3_cross(nb, n, T);
+        if (v3_dot(nb, B) < 0.0f) w = -1.0f;
     }
     v3_madd(T, T, n, -v3_dot(n, T));
     if (!v3_finite(T) || !(v3_len(T) > 1e-20f)) return;
     v3_normalize(T, T);
     v3_cross(nb, n, T);
-    if (v3_dot(nb, B) < 0.0f) v3_scale(nb, nb, -1.0f);
+    v3_scale(nb, nb, w);
     for (int c = 0; c < 3; c++) tn[c] = 2.0f * tex[c] - 1.0f;
     tn[0] *= m->normal_scale;
     tn[1] *= m->normal_scale;

@@ -167,6 +167,21 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
                  MS_MAX_TRIS_PER_BYTE);
         return -1;
     }
+    /* Normal-mapped primitives: the asset's TANGENT (xyz carried by m, w times the sign of m's determinant:
+     * a mirroring transform flips the bitangent), else MikkTSpace over the primitive once it is pushed. */
+    const ms_material *mm = material != MS_NO_MATERIAL ? &soup->mats[material] : NULL;
+    const int mapped = mm && mm->normal_map;
+    const cgltf_accessor *tan = NULL;
+    for (size_t i = 0; mapped && i < pr->attributes_count; i++) {
+        const cgltf_attribute *a = &pr->attributes[i];
+        if (a->type == cgltf_attribute_type_tangent && a->index == 0 && a->data && a->data->type == cgltf_type_vec4 &&
+            a->data->count == pos->count && accessor_ok(a->data, why, sizeof why))
+            tan = a->data;
+    }
+    const float det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+    float *t12 = tan && tris ? malloc(tris * 12 * sizeof *t12) : NULL;
+    if (tan && tris && !t12) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    const size_t first = soup->n;
     for (size_t t = 0; t < tris; t++) {
         size_t corner[3];
         if (pr->type == cgltf_primitive_type_triangles) { corner[0] = 3 * t; corner[1] = 3 * t + 1; corner[2] = 3 * t + 2; }
@@ -178,7 +193,14 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
             size_t idx = ix ? cgltf_accessor_read_index(ix, corner[k]) : corner[k];
             if (idx >= pos->count) {
                 snprintf(err, errlen, "%s: index %zu is beyond the %zu vertices", path, idx, (size_t)pos->count);
+                free(t12);
                 return -1;
+            }
+            if (t12) {
+                float q[4] = { 0, 0, 0, 1 }, *o = t12 + 12 * t + 4 * k;
+                cgltf_accessor_read_float(tan, idx, q, 4);
+                for (int r = 0; r < 3; r++) o[r] = m[r] * q[0] + m[4 + r] * q[1] + m[8 + r] * q[2];
+                o[3] = (q[3] < 0.0f) != (det < 0.0f) ? -1.0f : 1.0f;
             }
             float p[3] = { 0, 0, 0 };
             cgltf_accessor_read_float(pos, idx, p, 3);
@@ -195,9 +217,17 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
                 uvp[st] = uv[st];
             }
         }
-        if (ms_soup_push_full(soup, v, uvp, material, nrm ? nv : NULL)) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+        if (ms_soup_push_full(soup, v, uvp, material, nrm ? nv : NULL)) {
+            snprintf(err, errlen, "%s: out of memory", path);
+            free(t12);
+            return -1;
+        }
         (*added)++;
     }
+    const int trc = !mapped || !tris ? 0 : t12 ? ms_soup_set_tangents(soup, first, tris, t12)
+                                               : ms_soup_mikktspace(soup, first, tris, mm->normal_uv);
+    free(t12);
+    if (trc) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
     return 0;
 }
 

@@ -36,7 +36,18 @@ typedef struct ms_tri_soup {
     struct ms_texture *tex;
     size_t n_tex;
     size_t tex_bytes;   /* decoded texture bytes so far (bounded: MS_MAX_TEXTURE_BYTES) */
+    /* Normal-map tangents (tangent.c): 12 floats per triangle (x, y, z, w per vertex) for triangles
+     * [0, tangent_n), NaN where none; NULL until a primitive has them. */
+    float *tangent;
+    size_t tangent_n;
 } ms_tri_soup;
+/* Tangents t12 (12 floats per triangle) of triangles [first, first + count); 0, or -1 out of memory. */
+int ms_soup_set_tangents(ms_tri_soup *soup, size_t first, size_t count, const float *t12);
+/* MikkTSpace tangents of triangles [first, first + count) from their positions, normals (face normals where
+ * none) and UV set `set` (nothing when the set is absent or the input is not finite); 0, or -1 out of memory. */
+int ms_soup_mikktspace(ms_tri_soup *soup, size_t first, size_t count, int set);
+/* The tangent array for all soup->n triangles (NaN-filled past the last set), handed over (NULL: none). */
+float *ms_soup_take_tangents(ms_tri_soup *soup);
 void ms_soup_free(ms_tri_soup *soup);
 /* The same push with a material index (MS_NO_MATERIAL: none) and three vertex normals (or NULL). */
 int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
