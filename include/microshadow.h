@@ -266,9 +266,9 @@ void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, floa
  * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */
 typedef void (*ms_warning_fn)(void *user, const char *message);
 void ms_set_warning_handler(ms_warning_fn fn, void *user);
-/* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, JPEG, an
- * absolute path) are one warning per ms_scene_load: that warning, or "N material files or textures could not
- * be used ... (first: ...)". With verbose non-zero (process-wide, like the handler) each is its own warning. */
+/* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, an undecoded
+ * format, an absolute path) are one warning per ms_scene_load: that warning, or "N material files, textures or glTF features could not
+ * be used ... (first: ...)" (unimplemented glTF extensions and features are counted with them). With verbose non-zero (process-wide, like the handler) each is its own warning. */
 void ms_set_warning_verbose(int verbose);
 
 /* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL through assimp, glTF 2.0 through cgltf; paths

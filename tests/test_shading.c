@@ -797,7 +797,7 @@ static void test_hostile_mtl(void **st)
     printf("summary: %s\n", g_warning);
     assert_int_equal(g_warnings, 1);
     char want[1400];
-    snprintf(want, sizeof want, "%d material files or textures could not be used", each);
+    snprintf(want, sizeof want, "%d material files, textures or glTF features could not be used", each);
     assert_non_null(strstr(g_warning, want));
     snprintf(want, sizeof want, "(first: %s)", first);
     assert_non_null(strstr(g_warning, want));

@@ -524,6 +524,16 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
     if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); return -1; }
     int rc = -1;
     if (check_extensions(d, path, err, errlen)) goto out;
+    /* Core features a static shadow renderer leaves out: one warning each (docs/shading.md). */
+    size_t morphs = 0;
+    for (size_t i = 0; i < d->meshes_count; i++)
+        for (size_t p = 0; p < d->meshes[i].primitives_count; p++) morphs += d->meshes[i].primitives[p].targets_count > 0;
+    if (d->skins_count)
+        ms_warn_material("%s: %zu skins are not applied: skinned meshes are drawn in their bind pose, placed by their nodes",
+                         path, (size_t)d->skins_count);
+    if (morphs) ms_warn_material("%s: morph targets are not applied (%zu primitives have some): base shapes drawn", path, morphs);
+    if (d->animations_count)
+        ms_warn_material("%s: %zu animations are ignored: the nodes' static transforms are drawn", path, (size_t)d->animations_count);
     /* A data: URI's declared length must fit in its text before cgltf allocates it. */
     for (size_t i = 0; i < d->buffers_count; i++) {
         const char *uri = d->buffers[i].uri;
