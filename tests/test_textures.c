@@ -1,6 +1,7 @@
 /* Textures and materials as real assets have them (issue 30), against oracles computed here:
  *   - one glTF, written here, with a JPEG, a KTX2 (R8G8B8A8_SRGB), a 16-bit PNG, a paletted PNG and a
- *     KHR_texture_transform'ed PNG (with the texCoord override): at pixels well inside a texel, the shaded
+ *     KHR_texture_transform'ed PNG (with the texCoord override), and the same image through a sampler with
+ *     wrapS CLAMP_TO_EDGE, wrapT MIRRORED_REPEAT and a transform reaching past [0, 1]: at pixels well inside a texel, the shaded
  *     colour equals emission * (base/pi * E + F * LTC) with base the texel the test selects and decodes
  *     itself (the JPEG with TurboJPEG here, the others from the bytes the test wrote), E and LTC from
  *     ms_light_irradiance and ms_ltc_ggx (each checked against brute force in test_irradiance and
@@ -216,11 +217,12 @@ static void expected(const ms_scene *sc, const float p[3], const float n[3], con
 }
 
 /* ---- the textured quads ---- */
-enum { Q_JPEG, Q_KTX2, Q_PNG16, Q_PALETTE, Q_XFORM, NQ };
+enum { Q_JPEG, Q_KTX2, Q_PNG16, Q_PALETTE, Q_XFORM, Q_WRAP, NQ };
 typedef struct tex_case {
     int w[NQ], h[NQ];
     double lin[NQ][16][3];   /* linear texels, row-major from the top row */
-    double xf[6];            /* the transform of Q_XFORM (as KHR_texture_transform defines it) */
+    double xf[NQ][6];        /* the transforms of Q_XFORM and Q_WRAP (as KHR_texture_transform defines them) */
+    int wrap_s[NQ], wrap_t[NQ];   /* 0 repeat, 1 clamp to edge, 2 mirrored repeat */
     const ms_scene *sc;
     const ms_frame *fr;
     int checked[NQ];
@@ -229,17 +231,27 @@ typedef struct tex_case {
 
 static double frac(double x) { return x - floor(x); }
 
+/* Texel index i (a floor) in 0..n-1 by the glTF wrap mode: 0 repeat, 1 clamp to edge, 2 mirrored repeat
+ * (period 2n: 0..n-1 then n-1..0). */
+static int wrap_texel(double i, int n, int mode)
+{
+    if (mode == 1) return i < 0 ? 0 : i > n - 1 ? n - 1 : (int)i;
+    const int period = mode == 2 ? 2 * n : n;
+    int k = (int)(i - period * floor(i / period));
+    return k < n ? k : period - 1 - k;
+}
+
 static void check_tex_pixel(void *user, int q, size_t i, const float p[3], const float v[3], double u, double tv)
 {
     tex_case *tc = user;
-    if (q == Q_XFORM) {   /* uv' = T R S uv, then repeat */
-        const double *m = tc->xf, uu = m[0] * u + m[2] * tv + m[4], vv = m[1] * u + m[3] * tv + m[5];
-        u = frac(uu);
-        tv = frac(vv);
+    if (q == Q_XFORM || q == Q_WRAP) {   /* uv' = T R S uv */
+        const double *m = tc->xf[q], uu = m[0] * u + m[2] * tv + m[4], vv = m[1] * u + m[3] * tv + m[5];
+        u = uu;
+        tv = vv;
     }
     const double fx = u * tc->w[q], fy = tv * tc->h[q];
     if (frac(fx) < 0.1 || frac(fx) > 0.9 || frac(fy) < 0.1 || frac(fy) > 0.9) return;   /* near a texel edge */
-    const int tx = (int)fx, ty = (int)fy;
+    const int tx = wrap_texel(floor(fx), tc->w[q], tc->wrap_s[q]), ty = wrap_texel(floor(fy), tc->h[q], tc->wrap_t[q]);
     assert_true(tc->fr->vis[i] == 1.0f && tc->fr->shadow[i] == 1.0f);
     const float n[3] = { 0, 1, 0 };
     double want[3];
@@ -333,7 +345,15 @@ static void test_texture_formats(void **st)
             for (int c = 0; c < 3; c++) tc.lin[Q_XFORM][i][c] = srgb_lin(rgba[4 * i + c]);
         const double r = 0.4, sx = 1.5, sy = 0.7;
         const double xf[6] = { sx * cos(r), -sx * sin(r), sy * sin(r), sy * cos(r), 0.3, 0.1 };
-        memcpy(tc.xf, xf, sizeof xf);
+        memcpy(tc.xf[Q_XFORM], xf, sizeof xf);
+        /* Q_WRAP: the same image through another texture, sampler wrapS CLAMP_TO_EDGE, wrapT MIRRORED_REPEAT,
+         * nearest, transformed to (2.2 u - 0.6, 2 v - 0.5): both modes reached on both sides */
+        const double xw[6] = { 2.2, 0, 0, 2.0, -0.6, -0.5 };
+        memcpy(tc.xf[Q_WRAP], xw, sizeof xw);
+        tc.wrap_s[Q_WRAP] = 1;
+        tc.wrap_t[Q_WRAP] = 2;
+        tc.w[Q_WRAP] = tc.h[Q_WRAP] = 4;
+        memcpy(tc.lin[Q_WRAP], tc.lin[Q_XFORM], sizeof tc.lin[Q_XFORM]);
         /* the spec's example, through the same formula: (u, v) in [0,1]^2 -> u' in [0, 0.5], v' in [0.5, 1] */
         for (int k = 0; k < 4; k++) {
             const double u = k & 1, v = k >> 1, c = cos(M_PI / 2), s = sin(M_PI / 2);
@@ -348,25 +368,28 @@ static void test_texture_formats(void **st)
         ml += (size_t)snprintf(mats + ml, sizeof mats - ml, q ? "," : "");
         ml += (size_t)snprintf(mats + ml, sizeof mats - ml, mat, q,
                                q == Q_XFORM ? ",\"texCoord\":1,\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.3,0.1],"
-                                              "\"rotation\":0.4,\"scale\":[1.5,0.7],\"texCoord\":0}}" : "");
+                                              "\"rotation\":0.4,\"scale\":[1.5,0.7],\"texCoord\":0}}"
+                               : q == Q_WRAP ? ",\"extensions\":{\"KHR_texture_transform\":{\"offset\":[-0.6,-0.5],"
+                                               "\"scale\":[2.2,2.0]}}" : "");
     }
     write_scene(dir, NQ, 0, mats,
                 "{\"source\":0,\"sampler\":0},{\"sampler\":0,\"extensions\":{\"KHR_texture_basisu\":{\"source\":1}}},"
-                "{\"source\":2,\"sampler\":0},{\"source\":3,\"sampler\":0},{\"source\":4,\"sampler\":0}",
+                "{\"source\":2,\"sampler\":0},{\"source\":3,\"sampler\":0},{\"source\":4,\"sampler\":0},{\"source\":4,\"sampler\":1}",
                 "{\"uri\":\"a.jpg\"},{\"uri\":\"b.ktx2\",\"mimeType\":\"image/ktx2\"},{\"uri\":\"c.png\"},{\"uri\":\"d.png\"},"
                 "{\"uri\":\"e.png\"}",
-                "{\"magFilter\":9728,\"minFilter\":9728}",
+                "{\"magFilter\":9728,\"minFilter\":9728},{\"magFilter\":9728,\"wrapS\":33071,\"wrapT\":33648}",
                 "\"extensionsUsed\":[\"KHR_texture_transform\",\"KHR_texture_basisu\"],"
                 "\"extensionsRequired\":[\"KHR_texture_transform\",\"KHR_texture_basisu\"],");
     ms_scene sc;
     ms_frame fr;
     assert_int_equal(load_render(dir, &sc, &fr), 0);
-    assert_int_equal((int)sc.n_textures, NQ);
+    assert_int_equal((int)sc.n_textures, NQ - 1);   /* e.png decoded once for two textures */
     tc.sc = &sc;
     tc.fr = &fr;
     each_pixel(&sc, &fr, NQ, check_tex_pixel, &tc);
-    printf("textures: pixels checked: JPEG %d, KTX2 %d, 16-bit PNG %d, paletted PNG %d, transformed %d; worst relative "
-           "error %.2g\n", tc.checked[0], tc.checked[1], tc.checked[2], tc.checked[3], tc.checked[4], tc.worst);
+    printf("textures: pixels checked: JPEG %d, KTX2 %d, 16-bit PNG %d, paletted PNG %d, transformed %d, clamp/mirror %d; "
+           "worst relative error %.2g\n", tc.checked[0], tc.checked[1], tc.checked[2], tc.checked[3], tc.checked[4],
+           tc.checked[5], tc.worst);
     for (int q = 0; q < NQ; q++) assert_true(tc.checked[q] > 100);
     ms_frame_free(&fr);
     ms_scene_free(&sc);
