@@ -95,8 +95,15 @@ int ms_soup_mikktspace(ms_tri_soup *soup, size_t first, size_t count, int set)
     if (count == 0 || count > (size_t)(INT32_MAX / 3) || set < 0 || set >= MS_SOUP_UV_SETS || !soup->uv[set]) return 0;
     /* Only finite, bounded input (the scene's validation refuses the rest later; MikkTSpace would convert
      * NaN to int when it sorts vertices into cells). */
-    for (size_t i = 9 * first; i < 9 * (first + count); i++)
+    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (size_t i = 9 * first; i < 9 * (first + count); i++) {
         if (!(fabsf(soup->tri[i]) <= MS_MAX_COORD)) return 0;
+        lo[i % 3] = fminf(lo[i % 3], soup->tri[i]);
+        hi[i % 3] = fmaxf(hi[i % 3], soup->tri[i]);
+    }
+    /* Every vertex at one point: MikkTSpace's vertex grid divides by the extent, 0/0 (found by fuzz_gltf);
+     * such a primitive has no area to shade anyway. */
+    if (hi[0] == lo[0] && hi[1] == lo[1] && hi[2] == lo[2]) return 0;
     for (size_t i = 6 * first; i < 6 * (first + count); i++)
         if (!(fabsf(soup->uv[set][i]) <= 1e18f)) return 0;
     for (size_t i = 9 * first; soup->normal && i < 9 * (first + count); i++)
