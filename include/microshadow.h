@@ -223,6 +223,10 @@ typedef struct ms_scene {
      * frees lights. */
     ms_light *lights;
     size_t n_lights;
+    /* Normal-map tangents (NULL where no mesh has them): tri_tangent[12*i .. 12*i+11], (x, y, z, w) of
+     * triangle i's three vertices, NaN where its mesh has none (glTF TANGENT, else MikkTSpace for primitives
+     * with a normal map; w: the bitangent is w n x t). */
+    float *tri_tangent;
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX
@@ -235,6 +239,17 @@ typedef struct ms_texture {
 
 /* glTF 2.0 metallic-roughness (OBJ/MTL maps Kd/map_Kd, Pr, Pm onto it). base = base_color * texture
  * (sampled bilinearly with repeat at the triangle's UVs of set base_color_uv). */
+/* How a material samples one of its textures (glTF sampler and KHR_texture_transform). Zero is glTF's
+ * default: repeat, bilinear, untransformed. */
+typedef struct ms_texture_sampling {
+    int32_t wrap_s, wrap_t;    /* MS_WRAP_REPEAT (0), MS_WRAP_CLAMP, MS_WRAP_MIRROR */
+    int32_t nearest;           /* 1: the nearest texel (magFilter NEAREST); 0: bilinear */
+    int32_t transformed;       /* 1: (u, v) -> (t[0] u + t[2] v + t[4], t[1] u + t[3] v + t[5]) before the lookup */
+    float transform[6];
+} ms_texture_sampling;
+
+enum { MS_WRAP_REPEAT = 0, MS_WRAP_CLAMP = 1, MS_WRAP_MIRROR = 2 };
+
 typedef struct ms_material {
     float base_color[4];       /* linear RGBA factor */
     float metallic, roughness; /* in [0, 1]; roughness is perceptual: GGX alpha = roughness^2 */
@@ -249,6 +264,22 @@ typedef struct ms_material {
     int32_t alpha_mode;        /* MS_ALPHA_OPAQUE, MS_ALPHA_MASK, MS_ALPHA_MASK_MAP */
     float alpha_cutoff;        /* glTF alphaCutoff (default 0.5); MTL map_d: 0.5 */
     int32_t alpha_texture;     /* MS_ALPHA_MASK_MAP: index into ms_scene.textures (-1: none) */
+    /* Issue 30 (zero: as before). The base-colour texture's sampler and transform (the alpha test uses the
+     * transform too). A tangent-space normal map when normal_map is 1: texture normal_texture (linear RGB,
+     * n = 2 rgb - 1, x and y times normal_scale) at UV set normal_uv, tangents from the triangle's positions
+     * and UVs (docs/shading.md). Emission: emissive (linear, times KHR_materials_emissive_strength) times
+     * the sRGB texture emissive_texture when emissive_map is 1, added to the shaded radiance. */
+    ms_texture_sampling base_color_sampling;
+    int32_t normal_map, normal_texture, normal_uv;
+    float normal_scale;
+    ms_texture_sampling normal_sampling;
+    float emissive[3];
+    int32_t emissive_map, emissive_texture, emissive_uv;
+    ms_texture_sampling emissive_sampling;
+    /* glTF metallicRoughnessTexture when mr_map is 1: metallic times its blue channel, roughness times its
+     * green (linear). */
+    int32_t mr_map, mr_texture, mr_uv;
+    ms_texture_sampling mr_sampling;
 } ms_material;
 
 enum { MS_ALPHA_OPAQUE = 0, MS_ALPHA_MASK = 1, MS_ALPHA_MASK_MAP = 2 };
@@ -263,9 +294,10 @@ MS_API void ms_procedural_triangles(const ms_scene *s, size_t first, size_t coun
  * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */
 typedef void (*ms_warning_fn)(void *user, const char *message);
 MS_API void ms_set_warning_handler(ms_warning_fn fn, void *user);
-/* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, JPEG, an
- * absolute path) are one warning per ms_scene_load: that warning, or "N material files or textures could not
- * be used ... (first: ...)". With verbose non-zero (process-wide, like the handler) each is its own warning. */
+/* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, an undecoded
+ * format, an absolute path) are one warning per ms_scene_load: that warning, or "N material files, textures or
+ * glTF features could not be used ... (first: ...)" (unimplemented glTF extensions and features are counted with
+ * them). With verbose non-zero (process-wide, like the handler) each is its own warning. */
 MS_API void ms_set_warning_verbose(int verbose);
 
 /* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL read by microshadow, glTF 2.0 through cgltf; paths

@@ -5,7 +5,7 @@ set -euo pipefail
 # build and the fuzzers of .ci/run. python3-numpy: the Python module's tests (python/, run by ctest); python3-pip
 # and python3-setuptools: its package (python/pyproject.toml) installed offline by test_python_package.
 # libopenmpi-dev and openmpi-bin: the CLI's optional MPI mode (-DMS_MPI=ON; .ci/run builds and tests it).
-pkgs=(build-essential cmake pkg-config libcjson-dev libpng-dev libopenexr-dev libembree-dev
+pkgs=(build-essential cmake pkg-config libcjson-dev libpng-dev libturbojpeg0-dev libopenexr-dev libembree-dev
       libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev python3-numpy python3-pip python3-setuptools
       libopenmpi-dev openmpi-bin)
 missing=()

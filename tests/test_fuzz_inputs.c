@@ -7,7 +7,7 @@
 #include <dirent.h>
 #include <sys/stat.h>
 
-static const char *const targets[] = { "obj", "ply", "off", "stl", "gltf", "scene", "exr" };
+static const char *const targets[] = { "obj", "ply", "off", "stl", "gltf", "scene", "exr", "jpeg" };
 
 static uint8_t *slurp(const char *path, size_t *n)
 {
@@ -42,7 +42,8 @@ static int replay(const char *kind, int want_ok)
             uint8_t *b = slurp(p, &n);
             assert_non_null(b);
             int rc = !strcmp(targets[t], "scene") ? ms_fuzz_scene(ms_fuzz_scene_dir(), b, n)
-                     : !strcmp(targets[t], "exr") ? ms_fuzz_exr(b, n) : ms_fuzz_mesh(targets[t], b, n);
+                     : !strcmp(targets[t], "exr") ? ms_fuzz_exr(b, n)
+                     : !strcmp(targets[t], "jpeg") ? ms_fuzz_jpeg(b, n) : ms_fuzz_mesh(targets[t], b, n);
             free(b);
             if ((rc == 0) != want_ok) {
                 closedir(d);

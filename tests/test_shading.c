@@ -601,8 +601,8 @@ static void test_bad_textures(void **st)
     uint8_t cut[128];
     size_t cn = tiny_png(one, 1, 1, cut) - 20;   /* ends inside IDAT */
     const struct { const uint8_t *b; size_t n; const char *needle; } cases[4] = {
-        { jpeg, sizeof jpeg, "JPEG textures are not supported" },
-        { (const uint8_t *)"not an image at all", 19, "not a PNG image" },
+        { jpeg, sizeof jpeg, "bad JPEG" },
+        { (const uint8_t *)"not an image at all", 19, "not a PNG, JPEG or KTX2 image" },
         { big, bn, "a 20000x1 texture (at most 16384 a side)" },
         { cut, cn, "bad PNG" },
     };
@@ -797,7 +797,7 @@ static void test_hostile_mtl(void **st)
     printf("summary: %s\n", g_warning);
     assert_int_equal(g_warnings, 1);
     char want[1400];
-    snprintf(want, sizeof want, "%d material files or textures could not be used", each);
+    snprintf(want, sizeof want, "%d material files, textures or glTF features could not be used", each);
     assert_non_null(strstr(g_warning, want));
     snprintf(want, sizeof want, "(first: %s)", first);
     assert_non_null(strstr(g_warning, want));

@@ -43,6 +43,7 @@ static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
     if (s->materials) h = ms_mpi_hash(h, s->materials, s->n_materials * sizeof *s->materials);   /* no padding */
     if (s->tri_material) h = ms_mpi_hash(h, s->tri_material, s->n_tris * sizeof *s->tri_material);
     if (s->tri_normal) h = ms_mpi_hash(h, s->tri_normal, s->n_tris * 9 * sizeof *s->tri_normal);
+    if (s->tri_tangent) h = ms_mpi_hash(h, s->tri_tangent, s->n_tris * 12 * sizeof *s->tri_tangent);
     for (int u = 0; s->n_textures && u < MS_MAX_UV_SETS; u++)
         if (s->tri_uv[u]) h = ms_mpi_hash(h, s->tri_uv[u], s->n_tris * 6 * sizeof *s->tri_uv[u]);
     for (size_t t = 0; t < s->n_textures; t++) {

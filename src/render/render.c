@@ -109,6 +109,11 @@ int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_lig
             c[2] += rgb[2];
             y += u;
         }
+        const float *em = surf ? surf[i].emissive : grey.emissive;   /* emission: once, not per light */
+        if (em[0] != 0.0f || em[1] != 0.0f || em[2] != 0.0f) {
+            for (int k = 0; k < 3; k++) c[k] += em[k];
+            y += 0.2126f * em[0] + 0.7152f * em[1] + 0.0722f * em[2];
+        }
         if (lum) lum[i] = y;
     }
     free(tex);

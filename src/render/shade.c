@@ -14,27 +14,125 @@ static float srgb_to_linear(uint8_t c)
     return x <= 0.04045f ? x / 12.92f : powf((x + 0.055f) / 1.055f, 2.4f);
 }
 
-/* Bilinear lookup with repeat (glTF's default sampler), texel centres at (i + 0.5) / width. */
-static void texture_rgba(const ms_texture *t, float u, float v, float out[4])
+/* Texel index i (a floor, held in a float) wrapped into 0..n-1 by the sampler's mode; in double so that
+ * huge UVs do not overflow an int. */
+static long long wrap_index(float i, long long n, int mode)
 {
-    const float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
+    if (mode == MS_WRAP_CLAMP) return i <= 0.0f ? 0 : i >= (float)n ? n - 1 : (long long)i;
+    const long long period = mode == MS_WRAP_MIRROR ? 2 * n : n;
+    long long k = (long long)fmod((double)i, (double)period);
+    if (k < 0) k += period;
+    return k < n ? k : period - 1 - k;
+}
+
+/* The texture at (u, v) (texel centres at (i + 0.5) / width) through the material's sampling: its
+ * transform, then bilinear or nearest, with repeat (glTF's default), clamp or mirrored repeat. Colour
+ * channels sRGB-decoded when srgb, else raw / 255 (normal maps). */
+static void texture_rgba(const ms_texture *t, const ms_texture_sampling *sm, float u, float v, int srgb, float out[4])
+{
+    if (sm->transformed) {
+        const float *m = sm->transform;
+        const float tu = m[0] * u + m[2] * v + m[4], tv = m[1] * u + m[3] * v + m[5];
+        u = tu;
+        v = tv;
+    }
+    const long long w = t->width, h = t->height;
+    for (int c = 0; c < 4; c++) out[c] = 0.0f;
+    if (sm->nearest) {
+        const long long x = wrap_index(floorf(u * (float)w), w, sm->wrap_s), y = wrap_index(floorf(v * (float)h), h, sm->wrap_t);
+        const uint8_t *px = t->rgba + 4 * ((size_t)y * (size_t)w + (size_t)x);
+        for (int c = 0; c < 3; c++) out[c] = srgb ? srgb_to_linear(px[c]) : (float)px[c] / 255.0f;
+        out[3] = (float)px[3] / 255.0f;
+        return;
+    }
+    const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
     const float fx0 = floorf(x), fy0 = floorf(y);
     const float fx = x - fx0, fy = y - fy0;
-    /* Wrap in double so that huge UVs do not overflow an int. */
-    const long long w = t->width, h = t->height;
-    long long x0 = (long long)fmod((double)fx0, (double)w), y0 = (long long)fmod((double)fy0, (double)h);
-    if (x0 < 0) x0 += w;
-    if (y0 < 0) y0 += h;
-    const long long x1 = (x0 + 1) % w, y1 = (y0 + 1) % h;
-    for (int c = 0; c < 4; c++) out[c] = 0.0f;
+    long long x0, y0, x1, y1;
+    if (sm->wrap_s == MS_WRAP_REPEAT) {   /* the original repeat arithmetic, kept bit for bit */
+        x0 = (long long)fmod((double)fx0, (double)w);
+        if (x0 < 0) x0 += w;
+        x1 = (x0 + 1) % w;
+    } else {
+        x0 = wrap_index(fx0, w, sm->wrap_s);
+        x1 = wrap_index(fx0 + 1.0f, w, sm->wrap_s);
+    }
+    if (sm->wrap_t == MS_WRAP_REPEAT) {
+        y0 = (long long)fmod((double)fy0, (double)h);
+        if (y0 < 0) y0 += h;
+        y1 = (y0 + 1) % h;
+    } else {
+        y0 = wrap_index(fy0, h, sm->wrap_t);
+        y1 = wrap_index(fy0 + 1.0f, h, sm->wrap_t);
+    }
     const long long xs[2] = { x0, x1 }, ys[2] = { y0, y1 };
     for (int j = 0; j < 2; j++)
         for (int i = 0; i < 2; i++) {
             const float wgt = (i ? fx : 1.0f - fx) * (j ? fy : 1.0f - fy);
             const uint8_t *px = t->rgba + 4 * ((size_t)ys[j] * (size_t)w + (size_t)xs[i]);
-            for (int c = 0; c < 3; c++) out[c] += wgt * srgb_to_linear(px[c]);
+            for (int c = 0; c < 3; c++) out[c] += wgt * (srgb ? srgb_to_linear(px[c]) : (float)px[c] / 255.0f);
             out[3] += wgt * (float)px[3] / 255.0f;
         }
+}
+
+/* The material's texture tex at the hit (barycentrics b of triangle t, UV set set); 0 when it has none
+ * there (no UVs, non-finite UVs, an empty texture). */
+static int lookup(const ms_scene *s, size_t t, const float b[3], int32_t tex, int32_t set, const ms_texture_sampling *sm,
+                  int srgb, float out[4])
+{
+    if (tex < 0 || (size_t)tex >= s->n_textures || set < 0 || set >= MS_MAX_UV_SETS || !s->tri_uv[set]) return 0;
+    const float *uv = s->tri_uv[set] + 6 * t;
+    const float u = b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4], v = b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5];
+    const ms_texture *tx = &s->textures[tex];
+    if (!isfinite(u) || !isfinite(v) || !tx->rgba || tx->width <= 0 || tx->height <= 0) return 0;
+    texture_rgba(tx, sm, u, v, srgb, out);
+    return 1;
+}
+
+/* The normal map's perturbation of the unit shading normal n (before it is turned to the eye): texel t ->
+ * (x, y, z) = 2 t - 1 (linear), x and y times the scale; n' = normalize(x T + y B + z n) with T the tangent
+ * made orthogonal to n and B = w n x T (glTF). The tangent: the scene's (the asset's TANGENT, or MikkTSpace
+ * at load) interpolated at the hit; else one frame per triangle, T = dP/du and w such that B runs up the
+ * image (towards decreasing glTF v), which MikkTSpace's frame equals where the triangle's UVs are an affine
+ * map of a flat patch (docs/shading.md). */
+static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_material *m, float n[3])
+{
+    float tex[4];
+    if (!lookup(s, t, b, m->normal_texture, m->normal_uv, &m->normal_sampling, 0, tex)) return;
+    float T[3] = { 0, 0, 0 }, B[3], nb[3], tn[3], out[3];
+    const float *tg = s->tri_tangent ? s->tri_tangent + 12 * t : NULL;
+    for (int k = 0; tg && k < 12; k++)
+        if (!isfinite(tg[k])) tg = NULL;
+    float w = 1.0f;
+    if (tg) {
+        for (int k = 0; k < 3; k++) v3_madd(T, T, tg + 4 * k, b[k]);
+        w = tg[3] < 0.0f ? -1.0f : 1.0f;
+    } else {
+        const float *p = s->tri + 9 * t, *uv = s->tri_uv[m->normal_uv] + 6 * t;
+        float e1[3], e2[3];
+        v3_sub(e1, p + 3, p);
+        v3_sub(e2, p + 6, p);
+        const float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
+        const float r = du1 * dv2 - du2 * dv1;
+        if (!(fabsf(r) > 0.0f)) return;   /* degenerate UVs: no tangent frame */
+        for (int c = 0; c < 3; c++) {
+            T[c] = (e1[c] * dv2 - e2[c] * dv1) / r;   /* dP/du */
+            B[c] = (e1[c] * du2 - e2[c] * du1) / r;   /* -dP/dv: up the image */
+        }
+        v3_cross(nb, n, T);
+        if (v3_dot(nb, B) < 0.0f) w = -1.0f;
+    }
+    v3_madd(T, T, n, -v3_dot(n, T));
+    if (!v3_finite(T) || !(v3_len(T) > 1e-20f)) return;
+    v3_normalize(T, T);
+    v3_cross(nb, n, T);
+    v3_scale(nb, nb, w);
+    for (int c = 0; c < 3; c++) tn[c] = 2.0f * tex[c] - 1.0f;
+    tn[0] *= m->normal_scale;
+    tn[1] *= m->normal_scale;
+    for (int c = 0; c < 3; c++) out[c] = tn[0] * T[c] + tn[1] * nb[c] + tn[2] * n[c];
+    if (!v3_finite(out) || !(v3_len(out) > 1e-12f)) return;
+    v3_normalize(n, out);
 }
 
 /* Barycentric coordinates of p (on the triangle's plane) in tri. */
@@ -68,36 +166,36 @@ void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const 
     const ms_material *m = mi < s->n_materials ? &s->materials[mi] : NULL;
     float b[3];
     barycentric(s->tri + 9 * t, h->p, b);
+    float ns[3];
+    memcpy(ns, h->n, sizeof ns);
     if (s->tri_normal) {
         const float *vn = s->tri_normal + 9 * t;
-        float ns[3] = { 0, 0, 0 };
-        for (int k = 0; k < 3; k++) v3_madd(ns, ns, vn + 3 * k, b[k]);
-        /* Interpolated, normalised, and turned to the eye's side of the surface like h->n. */
-        if (v3_finite(ns) && v3_len(ns) > 1e-12f) {
-            v3_normalize(ns, ns);
-            if (v3_dot(ns, h->n) < 0.0f) v3_scale(ns, ns, -1.0f);
-            memcpy(out->n, ns, sizeof ns);
-        }
+        float ni[3] = { 0, 0, 0 };
+        for (int k = 0; k < 3; k++) v3_madd(ni, ni, vn + 3 * k, b[k]);
+        if (v3_finite(ni) && v3_len(ni) > 1e-12f) v3_normalize(ns, ni);
     }
+    /* The normal map perturbs the interpolated normal on its own side of the surface; then the result is
+     * turned to the eye's side of the surface like h->n. */
+    if (m && m->normal_map) normal_map(s, t, b, m, ns);
+    if (v3_dot(ns, h->n) < 0.0f) v3_scale(ns, ns, -1.0f);
+    memcpy(out->n, ns, sizeof ns);
     if (!m) return;
-    float base[4] = { m->base_color[0], m->base_color[1], m->base_color[2], m->base_color[3] };
-    if (m->base_color_texture >= 0 && (size_t)m->base_color_texture < s->n_textures && m->base_color_uv >= 0 &&
-        m->base_color_uv < MS_MAX_UV_SETS && s->tri_uv[m->base_color_uv]) {
-        const float *uv = s->tri_uv[m->base_color_uv] + 6 * t;
-        const float u = b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4], v = b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5];
-        const ms_texture *tx = &s->textures[m->base_color_texture];
-        if (isfinite(u) && isfinite(v) && tx->rgba && tx->width > 0 && tx->height > 0) {
-            float tex[4];
-            texture_rgba(tx, u, v, tex);
-            for (int c = 0; c < 4; c++) base[c] *= tex[c];
-        }
+    float base[4] = { m->base_color[0], m->base_color[1], m->base_color[2], m->base_color[3] }, tex[4];
+    if (lookup(s, t, b, m->base_color_texture, m->base_color_uv, &m->base_color_sampling, 1, tex))
+        for (int c = 0; c < 4; c++) base[c] *= tex[c];
+    for (int c = 0; c < 3; c++) out->emissive[c] = m->emissive[c];
+    if (m->emissive_map && lookup(s, t, b, m->emissive_texture, m->emissive_uv, &m->emissive_sampling, 1, tex))
+        for (int c = 0; c < 3; c++) out->emissive[c] *= tex[c];
+    float metal = m->metallic, rough = m->roughness;
+    if (m->mr_map && lookup(s, t, b, m->mr_texture, m->mr_uv, &m->mr_sampling, 0, tex)) {
+        metal *= tex[2];
+        rough *= tex[1];
     }
-    const float metal = m->metallic;
     for (int c = 0; c < 3; c++) {
         out->diffuse[c] = base[c] * (1.0f - metal);
         out->f0[c] = 0.04f * (1.0f - metal) + base[c] * metal;
     }
-    out->roughness = m->roughness;
+    out->roughness = rough;
     out->specular = 1;
 }
 

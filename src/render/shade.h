@@ -19,6 +19,7 @@ typedef struct ms_surface {
     float f0[3];         /* specular reflectance at normal incidence */
     float roughness;     /* perceptual (glTF); GGX alpha = roughness^2 */
     int specular;        /* 0: Lambert only */
+    float emissive[3];   /* emitted radiance (material emission x strength x texture), added once per pixel */
 } ms_surface;
 
 /* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye. */

@@ -167,6 +167,21 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
                  MS_MAX_TRIS_PER_BYTE);
         return -1;
     }
+    /* Normal-mapped primitives: the asset's TANGENT (xyz carried by m, w times the sign of m's determinant:
+     * a mirroring transform flips the bitangent), else MikkTSpace over the primitive once it is pushed. */
+    const ms_material *mm = material != MS_NO_MATERIAL ? &soup->mats[material] : NULL;
+    const int mapped = mm && mm->normal_map;
+    const cgltf_accessor *tan = NULL;
+    for (size_t i = 0; mapped && i < pr->attributes_count; i++) {
+        const cgltf_attribute *a = &pr->attributes[i];
+        if (a->type == cgltf_attribute_type_tangent && a->index == 0 && a->data && a->data->type == cgltf_type_vec4 &&
+            a->data->count == pos->count && accessor_ok(a->data, why, sizeof why))
+            tan = a->data;
+    }
+    const float det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+    float *t12 = tan && tris ? malloc(tris * 12 * sizeof *t12) : NULL;
+    if (tan && tris && !t12) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    const size_t first = soup->n;
     for (size_t t = 0; t < tris; t++) {
         size_t corner[3];
         if (pr->type == cgltf_primitive_type_triangles) { corner[0] = 3 * t; corner[1] = 3 * t + 1; corner[2] = 3 * t + 2; }
@@ -178,7 +193,14 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
             size_t idx = ix ? cgltf_accessor_read_index(ix, corner[k]) : corner[k];
             if (idx >= pos->count) {
                 snprintf(err, errlen, "%s: index %zu is beyond the %zu vertices", path, idx, (size_t)pos->count);
+                free(t12);
                 return -1;
+            }
+            if (t12) {
+                float q[4] = { 0, 0, 0, 1 }, *o = t12 + 12 * t + 4 * k;
+                cgltf_accessor_read_float(tan, idx, q, 4);
+                for (int r = 0; r < 3; r++) o[r] = m[r] * q[0] + m[4 + r] * q[1] + m[8 + r] * q[2];
+                o[3] = (q[3] < 0.0f) != (det < 0.0f) ? -1.0f : 1.0f;
             }
             float p[3] = { 0, 0, 0 };
             cgltf_accessor_read_float(pos, idx, p, 3);
@@ -195,9 +217,17 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
                 uvp[st] = uv[st];
             }
         }
-        if (ms_soup_push_full(soup, v, uvp, material, nrm ? nv : NULL)) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+        if (ms_soup_push_full(soup, v, uvp, material, nrm ? nv : NULL)) {
+            snprintf(err, errlen, "%s: out of memory", path);
+            free(t12);
+            return -1;
+        }
         (*added)++;
     }
+    const int trc = !mapped || !tris ? 0 : t12 ? ms_soup_set_tangents(soup, first, tris, t12)
+                                               : ms_soup_mikktspace(soup, first, tris, mm->normal_uv);
+    free(t12);
+    if (trc) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
     return 0;
 }
 
@@ -252,8 +282,105 @@ static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, 
 
 static float clamp01(float x) { return x >= 0.0f ? (x <= 1.0f ? x : 1.0f) : 0.0f; }   /* NaN -> 0 */
 
+static int32_t wrap_of(cgltf_wrap_mode w)
+{
+    return w == cgltf_wrap_mode_clamp_to_edge ? MS_WRAP_CLAMP : w == cgltf_wrap_mode_mirrored_repeat ? MS_WRAP_MIRROR : MS_WRAP_REPEAT;
+}
+
+/* A finite float within +-1e6 (a transform's entries; the scene's validation demands it), else 0. */
+static float bounded(float x) { return x >= -1e6f && x <= 1e6f ? x : 0.0f; }
+
+/* The texture of texture view tv (slot names it in warnings: "baseColorTexture", ...) as a soup texture,
+ * its UV set and sampling: the sampler's wrap modes and magnification filter (no mipmaps: each pixel is
+ * shaded at one point without a footprint, so there is no level of detail to choose; the minification
+ * filter is not used) and KHR_texture_transform (its texCoord overriding the view's). -1 with one warning
+ * when it cannot be used (the material keeps its factors). Images are decoded once (tex_of). */
+static long texture_of(const cgltf_data *d, const cgltf_options *opt, const cgltf_texture_view *tv, const char *path,
+                       size_t mi, const char *slot, ms_tri_soup *soup, long *tex_of, int32_t *uv, ms_texture_sampling *sm)
+{
+    const cgltf_texture *tx = tv->texture;
+    if (!tx) return -1;
+    /* KHR_texture_basisu's KTX2 image only where there is no PNG/JPEG fallback (texture.c decodes
+     * uncompressed KTX2 and names what it cannot decode). */
+    const cgltf_image *img = tx->image ? tx->image : tx->has_basisu ? tx->basisu_image : NULL;
+    if (!img) {
+        ms_warn_material("%s: material %zu: %s: texture %zu has no PNG, JPEG or KTX2 image%s: texture ignored", path, mi, slot,
+                         (size_t)(tx - d->textures), tx->has_webp ? " (EXT_texture_webp: WebP is not decoded)" : "");
+        return -1;
+    }
+    int32_t set = (int32_t)tv->texcoord;
+    memset(sm, 0, sizeof *sm);
+    if (tv->has_transform) {
+        const cgltf_texture_transform *x = &tv->transform;
+        if (x->has_texcoord) set = (int32_t)x->texcoord;
+        /* uv' = T R S uv (KHR_texture_transform): R rotates the UVs counter-clockwise in the image (v down). */
+        const float c = cosf(x->rotation), sn = sinf(x->rotation);
+        const float t[6] = { x->scale[0] * c, -x->scale[0] * sn, x->scale[1] * sn, x->scale[1] * c, x->offset[0], x->offset[1] };
+        for (int k = 0; k < 6; k++) sm->transform[k] = bounded(t[k]);
+        sm->transformed = 1;
+    }
+    if (tx->sampler) {
+        sm->wrap_s = wrap_of(tx->sampler->wrap_s);
+        sm->wrap_t = wrap_of(tx->sampler->wrap_t);
+        sm->nearest = tx->sampler->mag_filter == cgltf_filter_type_nearest;
+    }
+    if (set < 0 || set >= MS_MAX_UV_SETS) {
+        ms_warn_material("%s: material %zu: %s uses TEXCOORD_%d (at most %d sets): texture ignored", path, mi, slot, (int)set,
+                         MS_MAX_UV_SETS - 1);
+        return -1;
+    }
+    const size_t im = (size_t)(img - d->images);
+    if (tex_of[im] == -2) {
+        char why[1024];
+        tex_of[im] = load_image(d, opt, im, path, soup, why, sizeof why);
+        if (tex_of[im] < 0) ms_warn_material("%s: texture ignored", why);
+    }
+    *uv = set;
+    return tex_of[im];
+}
+
+/* Extensions microshadow implements (KHR_texture_basisu: its KTX2 images, uncompressed ones decoded, the
+ * others named in a warning); any other in extensionsRequired is an error, in extensionsUsed one warning
+ * each saying what is left out. */
+static const char *const known_ext[] = { "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_texture_basisu",
+                                         "KHR_mesh_quantization" };
+static const struct { const char *name, *left_out; } ext_left_out[] = {
+    { "KHR_lights_punctual", "its lights are ignored (lights come from the scene file)" },
+    { "KHR_materials_unlit", "unlit materials are shaded as lit" },
+    { "KHR_materials_pbrSpecularGlossiness", "specular-glossiness is ignored (metallic-roughness or the defaults shade)" },
+    { "KHR_materials_variants", "only the default materials are used" },
+    { "EXT_mesh_gpu_instancing", "instances are not expanded (each instanced mesh is drawn once, at its node)" },
+    { "EXT_texture_webp", "WebP images are not decoded (a PNG/JPEG fallback source is used)" },
+    { "KHR_draco_mesh_compression", "Draco-compressed primitives cannot be read" },
+    { "EXT_meshopt_compression", "meshopt-compressed buffers cannot be read" },
+};
+
+static int check_extensions(const cgltf_data *d, const char *path, char *err, size_t errlen)
+{
+    for (int req = 1; req >= 0; req--) {
+        char **names = req ? d->extensions_required : d->extensions_used;
+        const size_t n = req ? d->extensions_required_count : d->extensions_used_count;
+        for (size_t i = 0; i < n; i++) {
+            const char *e = names[i] ? names[i] : "";
+            int known = 0;
+            for (size_t k = 0; k < sizeof known_ext / sizeof *known_ext; k++) known |= !strcmp(e, known_ext[k]);
+            if (known) continue;
+            if (req) {
+                snprintf(err, errlen, "%s: requires glTF extension %.200s, which microshadow does not implement", path, e);
+                return -1;
+            }
+            const char *what = NULL;
+            for (size_t k = 0; k < sizeof ext_left_out / sizeof *ext_left_out; k++)
+                if (!strcmp(e, ext_left_out[k].name)) what = ext_left_out[k].left_out;
+            if (!what && !strncmp(e, "KHR_materials_", 14)) what = "ignored (the metallic-roughness base layer is shaded)";
+            ms_warn_material("%s: glTF extension %.200s is not implemented: %s", path, e, what ? what : "ignored");
+        }
+    }
+    return 0;
+}
+
 /* Every material of the glTF (metallic-roughness; the spec's defaults without it) into the soup; images
- * decoded once each, when a material's base colour uses them. */
+ * decoded once each, when a material uses them. */
 static int load_materials(const cgltf_data *d, const cgltf_options *opt, const char *path, ms_tri_soup *soup,
                           long *mat_of, char *err, size_t errlen)
 {
@@ -263,33 +390,50 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
     int rc = 0, warned_blend = 0;
     for (size_t i = 0; i < d->materials_count && !rc; i++) {
         const cgltf_material *cm = &d->materials[i];
-        ms_material m = { { 1, 1, 1, 1 }, 1.0f, 1.0f, -1, 0, MS_ALPHA_OPAQUE, 0.5f, -1 };
+        ms_material m = { .base_color = { 1, 1, 1, 1 }, .metallic = 1.0f, .roughness = 1.0f, .base_color_texture = -1,
+                          .alpha_cutoff = 0.5f, .alpha_texture = -1 };
+        long t;
+        int32_t set;
+        /* A texture that cannot be used is a warning: the material keeps its factors (geometry and
+         * visibility do not depend on it). */
         if (cm->has_pbr_metallic_roughness) {
             const cgltf_pbr_metallic_roughness *pb = &cm->pbr_metallic_roughness;
             for (int c = 0; c < 4; c++) m.base_color[c] = clamp01(pb->base_color_factor[c]);
             m.metallic = clamp01(pb->metallic_factor);
             m.roughness = clamp01(pb->roughness_factor);
-            const cgltf_texture_view *tv = &pb->base_color_texture;
-            /* A texture that cannot be used is a warning: the material keeps its factors (geometry and
-             * visibility do not depend on it). */
-            if (tv->texture && tv->texture->image) {
-                const size_t im = (size_t)(tv->texture->image - d->images);
-                if (tv->texcoord < 0 || tv->texcoord >= MS_MAX_UV_SETS) {
-                    ms_warn_material("%s: material %zu: baseColorTexture uses TEXCOORD_%d (at most %d sets): texture ignored", path, i,
-                            (int)tv->texcoord, MS_MAX_UV_SETS - 1);
-                } else {
-                    if (tex_of[im] == -2) {
-                        char why[1024];
-                        tex_of[im] = load_image(d, opt, im, path, soup, why, sizeof why);
-                        if (tex_of[im] < 0) ms_warn_material("%s: texture ignored", why);
-                    }
-                    if (tex_of[im] >= 0) {
-                        m.base_color_texture = (int32_t)tex_of[im];
-                        m.base_color_uv = (int32_t)tv->texcoord;
-                    }
-                }
+            if ((t = texture_of(d, opt, &pb->base_color_texture, path, i, "baseColorTexture", soup, tex_of, &set,
+                                &m.base_color_sampling)) >= 0) {
+                m.base_color_texture = (int32_t)t;
+                m.base_color_uv = set;
+            }
+            if ((t = texture_of(d, opt, &pb->metallic_roughness_texture, path, i, "metallicRoughnessTexture", soup, tex_of,
+                                &set, &m.mr_sampling)) >= 0) {
+                m.mr_map = 1;
+                m.mr_texture = (int32_t)t;
+                m.mr_uv = set;
             }
         }
+        if ((t = texture_of(d, opt, &cm->normal_texture, path, i, "normalTexture", soup, tex_of, &set, &m.normal_sampling)) >= 0) {
+            m.normal_map = 1;
+            m.normal_texture = (int32_t)t;
+            m.normal_uv = set;
+            m.normal_scale = bounded(cm->normal_texture.scale);
+        }
+        /* Emission: emissiveFactor x KHR_materials_emissive_strength (x emissiveTexture), linear radiance. */
+        const float strength = cm->has_emissive_strength ? cm->emissive_strength.emissive_strength : 1.0f;
+        for (int c = 0; c < 3; c++) {
+            const float e = cm->emissive_factor[c] * strength;
+            m.emissive[c] = e >= 0.0f && e <= 1e30f ? e : 0.0f;
+        }
+        if ((m.emissive[0] > 0.0f || m.emissive[1] > 0.0f || m.emissive[2] > 0.0f) &&
+            (t = texture_of(d, opt, &cm->emissive_texture, path, i, "emissiveTexture", soup, tex_of, &set,
+                            &m.emissive_sampling)) >= 0) {
+            m.emissive_map = 1;
+            m.emissive_texture = (int32_t)t;
+            m.emissive_uv = set;
+        }
+        /* occlusionTexture is not read: it attenuates indirect (ambient) light only (glTF 2.0, 3.9.3), and
+         * microshadow computes direct light. */
         /* Alpha testing (docs/shading.md): MASK with its cutoff; BLEND, which a shadow renderer cannot
          * blend, is tested like MASK at the spec's default cutoff 0.5, with one warning per file. */
         if (cm->alpha_mode == cgltf_alpha_mode_mask || cm->alpha_mode == cgltf_alpha_mode_blend) {
@@ -379,6 +523,17 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
     cgltf_result r = cgltf_parse(&opt, buf, len, &d);
     if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); return -1; }
     int rc = -1;
+    if (check_extensions(d, path, err, errlen)) goto out;
+    /* Core features a static shadow renderer leaves out: one warning each (docs/shading.md). */
+    size_t morphs = 0;
+    for (size_t i = 0; i < d->meshes_count; i++)
+        for (size_t p = 0; p < d->meshes[i].primitives_count; p++) morphs += d->meshes[i].primitives[p].targets_count > 0;
+    if (d->skins_count)
+        ms_warn_material("%s: %zu skins are not applied: skinned meshes are drawn in their bind pose, placed by their nodes",
+                         path, (size_t)d->skins_count);
+    if (morphs) ms_warn_material("%s: morph targets are not applied (%zu primitives have some): base shapes drawn", path, morphs);
+    if (d->animations_count)
+        ms_warn_material("%s: %zu animations are ignored: the nodes' static transforms are drawn", path, (size_t)d->animations_count);
     /* A data: URI's declared length must fit in its text before cgltf allocates it. */
     for (size_t i = 0; i < d->buffers_count; i++) {
         const char *uri = d->buffers[i].uri;

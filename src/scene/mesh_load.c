@@ -83,6 +83,7 @@ void ms_soup_free(ms_tri_soup *soup)
     for (int s = 0; s < MS_SOUP_UV_SETS; s++) free(soup->uv[s]);
     free(soup->material);
     free(soup->normal);
+    free(soup->tangent);
     free(soup->mats);
     for (size_t i = 0; i < soup->n_tex; i++) free(soup->tex[i].rgba);
     free(soup->tex);

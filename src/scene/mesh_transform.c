@@ -143,10 +143,24 @@ void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m
                 const double f = l1 > 0 && isfinite(l1) ? (flip ? -l0 : l0) / l1 : 0;
                 for (int r = 0; r < 3; r++) nv[3 * k + r] = (float)(o[r] * f);   /* NaN stays NaN */
             }
+        /* Normal-map tangents (x, y, z, w per corner) are directions along the surface: by m itself, each
+         * keeping its length; w (the bitangent's handedness) turns with a mirror. */
+        float *tv = t < soup->tangent_n ? soup->tangent + 12 * t : NULL;
+        if (tv)
+            for (int k = 0; k < 3; k++) {
+                const double x = tv[4 * k], y = tv[4 * k + 1], z = tv[4 * k + 2];
+                double o[3];
+                for (int r = 0; r < 3; r++) o[r] = m[4 * r] * x + m[4 * r + 1] * y + m[4 * r + 2] * z;
+                const double l0 = sqrt(x * x + y * y + z * z), l1 = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+                const double f = l1 > 0 && isfinite(l1) ? l0 / l1 : 0;
+                for (int r = 0; r < 3; r++) tv[4 * k + r] = (float)(o[r] * f);   /* NaN stays NaN */
+                if (flip) tv[4 * k + 3] = -tv[4 * k + 3];
+            }
         if (!flip) continue;
-        float tmp[3];
-        memcpy(tmp, v + 3, sizeof tmp); memcpy(v + 3, v + 6, sizeof tmp); memcpy(v + 6, tmp, sizeof tmp);
-        if (nv) { memcpy(tmp, nv + 3, sizeof tmp); memcpy(nv + 3, nv + 6, sizeof tmp); memcpy(nv + 6, tmp, sizeof tmp); }
+        float tmp[4];
+        memcpy(tmp, v + 3, 3 * sizeof *tmp); memcpy(v + 3, v + 6, 3 * sizeof *tmp); memcpy(v + 6, tmp, 3 * sizeof *tmp);
+        if (nv) { memcpy(tmp, nv + 3, 3 * sizeof *tmp); memcpy(nv + 3, nv + 6, 3 * sizeof *tmp); memcpy(nv + 6, tmp, 3 * sizeof *tmp); }
+        if (tv) { memcpy(tmp, tv + 4, sizeof tmp); memcpy(tv + 4, tv + 8, sizeof tmp); memcpy(tv + 8, tmp, sizeof tmp); }
         for (int s = 0; s < MS_SOUP_UV_SETS; s++) {
             if (!soup->uv[s]) continue;
             float *u = soup->uv[s] + 6 * t, w[2];
@@ -166,6 +180,11 @@ int ms_soup_copy_range(ms_tri_soup *soup, size_t from, size_t to)
             if (soup->uv[s]) { memcpy(uv[s], soup->uv[s] + 6 * t, sizeof uv[s]); uvp[s] = uv[s]; }
         const uint32_t mat = soup->material ? soup->material[t] : MS_NO_MATERIAL;
         if (ms_soup_push_full(soup, v, uvp, mat, soup->normal ? n : NULL)) return -1;
+        if (t < soup->tangent_n) {   /* copied first: setting them may move the array */
+            float tg[12];
+            memcpy(tg, soup->tangent + 12 * t, sizeof tg);
+            if (ms_soup_set_tangents(soup, soup->n - 1, 1, tg)) return -1;
+        }
     }
     return 0;
 }

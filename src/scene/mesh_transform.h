@@ -12,8 +12,8 @@ struct cJSON;
 int ms_mesh_transform_parse(const struct cJSON *t, const char *objname, const char *path, double m[12], char *err,
                             size_t errlen);
 /* Applies m to triangles [from, to) of the soup: positions, vertex normals (inverse transpose, each keeping
- * its length), and for a negative determinant the winding (corners 1 and 2 swapped with their normals
- * and UVs). */
+ * its length), normal-map tangents (by m, each keeping its length), and for a negative determinant the
+ * winding (corners 1 and 2 swapped with their normals, tangents and UVs) and the tangents' handedness. */
 void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m[12]);
 /* Appends a copy of triangles [from, to) (with cur_mesh as their mesh); -1 when out of memory. */
 int ms_soup_copy_range(ms_tri_soup *soup, size_t from, size_t to);

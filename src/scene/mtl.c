@@ -126,7 +126,8 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
             memset(&p, 0, sizeof p);
             p.open = 1;
             snprintf(p.name, sizeof p.name, "%s", arg);
-            p.m = (ms_material){ { 0.8f, 0.8f, 0.8f, 1.0f }, 0.0f, 1.0f, -1, 0, MS_ALPHA_OPAQUE, 0.5f, -1 };
+            p.m = (ms_material){ .base_color = { 0.8f, 0.8f, 0.8f, 1.0f }, .metallic = 0.0f, .roughness = 1.0f, .base_color_texture = -1,
+                                 .alpha_cutoff = 0.5f, .alpha_texture = -1 };
         } else if (!p.open) {
             /* statements before the first newmtl belong to no material */
         } else if (KEY("Kd") && floats(arg, f, 3) == 3) {

@@ -36,7 +36,18 @@ typedef struct ms_tri_soup {
     struct ms_texture *tex;
     size_t n_tex;
     size_t tex_bytes;   /* decoded texture bytes so far (bounded: MS_MAX_TEXTURE_BYTES) */
+    /* Normal-map tangents (tangent.c): 12 floats per triangle (x, y, z, w per vertex) for triangles
+     * [0, tangent_n), NaN where none; NULL until a primitive has them. */
+    float *tangent;
+    size_t tangent_n;
 } ms_tri_soup;
+/* Tangents t12 (12 floats per triangle) of triangles [first, first + count); 0, or -1 out of memory. */
+int ms_soup_set_tangents(ms_tri_soup *soup, size_t first, size_t count, const float *t12);
+/* MikkTSpace tangents of triangles [first, first + count) from their positions, normals (face normals where
+ * none) and UV set `set` (nothing when the set is absent or the input is not finite); 0, or -1 out of memory. */
+int ms_soup_mikktspace(ms_tri_soup *soup, size_t first, size_t count, int set);
+/* The tangent array for all soup->n triangles (NaN-filled past the last set), handed over (NULL: none). */
+float *ms_soup_take_tangents(ms_tri_soup *soup);
 void ms_soup_free(ms_tri_soup *soup);
 /* The same push with a material index (MS_NO_MATERIAL: none) and three vertex normals (or NULL). */
 int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
@@ -48,10 +59,15 @@ long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m);
 #define MS_MAX_TEXTURE_SIDE 16384
 #define MS_MAX_TEXTURE_BYTES ((size_t)1 << 30)
 #define MS_MAX_MATERIALS 65536
-/* Decodes a PNG (JPEG is refused with a message) from memory into an RGBA8 texture appended to the soup;
- * its index, or -1 with one line in err naming `what`. flip_rows: store the rows bottom-up (OBJ's v = 0 is
+/* Decodes a PNG, JPEG or KTX2 image (texture.c) from memory into RGBA8 (colour as the file encodes it,
+ * sRGB for colour textures), at most MS_MAX_TEXTURE_SIDE a side and `budget` bytes decoded; 0, or -1 with
+ * one line in err naming `what` (out->rgba NULL). */
+struct ms_texture;
+int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                      struct ms_texture *out, char *err, size_t errlen);
+/* The same decode appended to the soup as a texture; its index, or -1 with one line in err naming `what`. flip_rows: store the rows bottom-up (OBJ's v = 0 is
  * the image's last row; textures follow glTF, v = 0 the first). Loaders treat a texture that fails as a
- * warning, the material keeping its factors: a scene whose textures are missing or JPEG still loads. */
+ * warning, the material keeping its factors: a scene whose textures are missing or undecodable still loads. */
 long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
                                 int flip_rows, char *err, size_t errlen);
 /* The same from a file (a regular file of at most MS_MAX_MESH_BYTES). */

@@ -590,6 +590,7 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     out->n_materials = soup.n_mats;
     out->tri_material = soup.material;
     out->tri_normal = soup.normal;
+    out->tri_tangent = ms_soup_take_tangents(&soup);
     out->textures = soup.tex;
     out->n_textures = soup.n_tex;
     rc = ms_scene_validate(out, json_path, err, errlen);
@@ -615,6 +616,7 @@ void ms_scene_free(ms_scene *s)
     free(s->materials);
     free(s->tri_material);
     free(s->tri_normal);
+    free(s->tri_tangent);
     for (size_t i = 0; i < s->n_textures; i++) free(s->textures[i].rgba);
     free(s->textures);
     /* light is a copy of lights[0] when there is an array: each texture once */

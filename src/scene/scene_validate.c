@@ -162,6 +162,24 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
             snprintf(err, errlen, "%s: material %zu has a bad alpha mode, cutoff (outside [0, 1]) or alpha texture", what, i);
             return -1;
         }
+        /* issue 30's fields: samplers, maps and emission */
+        const ms_texture_sampling *sm[4] = { &m->base_color_sampling, &m->normal_sampling, &m->emissive_sampling, &m->mr_sampling };
+        const int32_t map[3] = { m->normal_map, m->emissive_map, m->mr_map }, tex[3] = { m->normal_texture, m->emissive_texture, m->mr_texture },
+                      set[3] = { m->normal_uv, m->emissive_uv, m->mr_uv };
+        ok = isfinite(m->normal_scale) && fabsf(m->normal_scale) <= 1e6f;
+        for (int c = 0; c < 3; c++) ok &= m->emissive[c] >= 0.0f && m->emissive[c] <= 1e30f;
+        for (int k = 0; k < 4; k++) {
+            ok &= sm[k]->wrap_s >= MS_WRAP_REPEAT && sm[k]->wrap_s <= MS_WRAP_MIRROR && sm[k]->wrap_t >= MS_WRAP_REPEAT &&
+                  sm[k]->wrap_t <= MS_WRAP_MIRROR;
+            for (int c = 0; c < 6; c++) ok &= isfinite(sm[k]->transform[c]) && fabsf(sm[k]->transform[c]) <= 1e6f;
+        }
+        for (int k = 0; k < 3; k++)
+            ok &= !map[k] || (map[k] == 1 && tex[k] >= 0 && (size_t)tex[k] < s->n_textures && set[k] >= 0 && set[k] < MS_MAX_UV_SETS);
+        if (!ok) {
+            snprintf(err, errlen, "%s: material %zu has a bad sampler, transform, normal, emissive or metallic-roughness map, or emission "
+                     "(negative, non-finite or beyond 1e30)", what, i);
+            return -1;
+        }
     }
     for (size_t i = 0; s->tri_material && i < s->n_tris; i++)
         if (s->tri_material[i] != MS_NO_MATERIAL && s->tri_material[i] >= s->n_materials) {

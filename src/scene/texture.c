@@ -1,21 +1,33 @@
-/* Base-colour textures: PNG through libpng's simplified API into RGBA8, with the size checked against
- * the limits before any pixel memory is allocated. JPEG is refused (one line): PNG is the one decoder
- * microshadow links. */
+/* Material textures into RGBA8, told apart by content: PNG (libpng's simplified API: 8- and 16-bit,
+ * paletted, grey), JPEG (libjpeg-turbo's TurboJPEG API, which reports errors and never exits) and KTX2
+ * (the container parsed here; its uncompressed 8-bit formats). The size is checked against the limits
+ * from the header before any pixel memory is allocated. */
 #include "scene_internal.h"
 #include "microshadow.h"
 #include <png.h>
+#include <turbojpeg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
-                                int flip_rows, char *err, size_t errlen)
+/* The size check every decoder makes before allocating: at most MS_MAX_TEXTURE_SIDE a side, and the
+ * decoded RGBA8 within the budget left. */
+static int size_ok(unsigned w, unsigned h, size_t budget, const char *what, char *err, size_t errlen)
 {
-    if (len >= 3 && buf[0] == 0xFF && buf[1] == 0xD8 && buf[2] == 0xFF) {
-        snprintf(err, errlen, "%s: JPEG textures are not supported (use PNG)", what);
-        return -1;
+    if (w == 0 || h == 0 || w > MS_MAX_TEXTURE_SIDE || h > MS_MAX_TEXTURE_SIDE) {
+        snprintf(err, errlen, "%s: a %ux%u texture (at most %d a side)", what, w, h, MS_MAX_TEXTURE_SIDE);
+        return 0;
     }
-    if (len < 8 || png_sig_cmp(buf, 0, 8)) { snprintf(err, errlen, "%s: not a PNG image", what); return -1; }
+    if ((size_t)w * h * 4 > budget) {
+        snprintf(err, errlen, "%s: the scene's textures exceed %zu MiB decoded", what, MS_MAX_TEXTURE_BYTES >> 20);
+        return 0;
+    }
+    return 1;
+}
+
+static int decode_png(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                      ms_texture *out, char *err, size_t errlen)
+{
     png_image img;
     memset(&img, 0, sizeof img);
     img.version = PNG_IMAGE_VERSION;
@@ -23,27 +35,19 @@ long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, siz
         snprintf(err, errlen, "%s: bad PNG: %s", what, img.message);
         return -1;
     }
-    if (img.width == 0 || img.height == 0 || img.width > MS_MAX_TEXTURE_SIDE || img.height > MS_MAX_TEXTURE_SIDE) {
-        snprintf(err, errlen, "%s: a %ux%u texture (at most %d a side)", what, img.width, img.height, MS_MAX_TEXTURE_SIDE);
-        png_image_free(&img);
-        return -1;
-    }
+    if (!size_ok(img.width, img.height, budget, what, err, errlen)) { png_image_free(&img); return -1; }
+    /* Colour stays sRGB-encoded (shade.c converts at lookup). A 16-bit file without gAMA/sRGB chunks is
+     * sRGB-encoded too (glTF's textures are), not the linear data libpng assumes by default; it is
+     * reduced to 8 bits. Palettes and grey are expanded by libpng. */
+    img.format = PNG_FORMAT_RGBA;
+    img.flags |= PNG_IMAGE_FLAG_16BIT_sRGB;
     const size_t bytes = (size_t)img.width * img.height * 4;
-    if (bytes > MS_MAX_TEXTURE_BYTES - soup->tex_bytes) {
-        snprintf(err, errlen, "%s: the scene's textures exceed %zu MiB decoded", what, MS_MAX_TEXTURE_BYTES >> 20);
-        png_image_free(&img);
-        return -1;
-    }
-    img.format = PNG_FORMAT_RGBA;   /* colour stays sRGB-encoded: shade.c converts at lookup */
     uint8_t *px = malloc(bytes);
-    ms_texture *t = px ? realloc(soup->tex, (soup->n_tex + 1) * sizeof *t) : NULL;
-    if (!t) {
-        free(px);
+    if (!px) {
         png_image_free(&img);
         snprintf(err, errlen, "%s: out of memory for a %ux%u texture", what, img.width, img.height);
         return -1;
     }
-    soup->tex = t;
     /* A negative row stride makes libpng write the rows bottom-up. */
     const png_int_32 stride = (png_int_32)(4 * img.width);
     if (!png_image_finish_read(&img, NULL, px, flip_rows ? -stride : stride, NULL)) {
@@ -52,10 +56,141 @@ long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, siz
         png_image_free(&img);
         return -1;
     }
-    t[soup->n_tex].width = (int)img.width;
-    t[soup->n_tex].height = (int)img.height;
-    t[soup->n_tex].rgba = px;
-    soup->tex_bytes += bytes;
+    out->width = (int)img.width;
+    out->height = (int)img.height;
+    out->rgba = px;
+    return 0;
+}
+
+static int decode_jpeg(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                       ms_texture *out, char *err, size_t errlen)
+{
+    if (len > (size_t)0xFFFFFFFFu) { snprintf(err, errlen, "%s: a JPEG of more than 4 GiB", what); return -1; }
+    tjhandle tj = tjInitDecompress();
+    if (!tj) { snprintf(err, errlen, "%s: cannot start the JPEG decoder", what); return -1; }
+    int w = 0, h = 0, sub = 0, cs = 0, rc = -1;
+    uint8_t *px = NULL;
+    if (tjDecompressHeader3(tj, buf, (unsigned long)len, &w, &h, &sub, &cs)) {
+        snprintf(err, errlen, "%s: bad JPEG: %s", what, tjGetErrorStr2(tj));
+        goto out;
+    }
+    if (w < 1 || h < 1) { snprintf(err, errlen, "%s: bad JPEG: no frame header (a file cut short?)", what); goto out; }
+    if (!size_ok((unsigned)w, (unsigned)h, budget, what, err, errlen)) goto out;
+    if (!(px = malloc((size_t)w * (size_t)h * 4))) {
+        snprintf(err, errlen, "%s: out of memory for a %dx%d texture", what, w, h);
+        goto out;
+    }
+    /* TJFLAG_LIMITSCANS: a progressive file of more than 500 scans is an error (each scan is a pass over
+     * the whole coefficient buffer: a small file could cost minutes). A warning (e.g. a truncated file,
+     * whose missing rows libjpeg fills) still gives a whole image: it is used. */
+    const int flags = TJFLAG_LIMITSCANS | TJFLAG_ACCURATEDCT | (flip_rows ? TJFLAG_BOTTOMUP : 0);
+    if (tjDecompress2(tj, buf, (unsigned long)len, px, w, 4 * w, h, TJPF_RGBA, flags) &&
+        tjGetErrorCode(tj) != TJERR_WARNING) {
+        snprintf(err, errlen, "%s: bad JPEG: %s", what, tjGetErrorStr2(tj));
+        goto out;
+    }
+    out->width = w;
+    out->height = h;
+    out->rgba = px;
+    px = NULL;
+    rc = 0;
+out:
+    free(px);
+    tjDestroy(tj);
+    return rc;
+}
+
+static uint32_t rd32(const unsigned char *p) { return p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint64_t rd64(const unsigned char *p) { return rd32(p) | (uint64_t)rd32(p + 4) << 32; }
+
+static const unsigned char ktx2_id[12] = { 0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n' };
+
+/* KTX2 (Khronos KTX 2.0): the header, the level index, level 0 of an uncompressed 8-bit format (rows
+ * tightly packed, top row first as glTF expects); supercompressed (BasisLZ, Zstandard, ZLIB) and
+ * block-compressed payloads are refused naming what they are (no decoder here). */
+static int decode_ktx2(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                       ms_texture *out, char *err, size_t errlen)
+{
+    if (len < 80 + 24) { snprintf(err, errlen, "%s: bad KTX2: %zu bytes, shorter than its header", what, len); return -1; }
+    const uint32_t vk = rd32(buf + 12), w = rd32(buf + 20), h = rd32(buf + 24), depth = rd32(buf + 28),
+                   layers = rd32(buf + 32), faces = rd32(buf + 36), levels = rd32(buf + 40), scheme = rd32(buf + 44);
+    static const char *const schemes[] = { "none", "BasisLZ", "Zstandard", "ZLIB" };
+    if (scheme != 0) {
+        snprintf(err, errlen, "%s: KTX2 with %s supercompression%s is not decoded (no decoder)", what,
+                 scheme < 4 ? schemes[scheme] : "unknown", scheme == 1 ? " (KHR_texture_basisu)" : "");
+        return -1;
+    }
+    /* bytes per texel and where R, G, B, A are (-1: absent) */
+    int bpp = 0, ch[4] = { -1, -1, -1, -1 };
+    switch (vk) {
+    case 9: case 15: bpp = 1; ch[0] = 0; break;                                   /* R8_UNORM, R8_SRGB */
+    case 16: case 22: bpp = 2; ch[0] = 0; ch[1] = 1; break;                       /* R8G8_UNORM, _SRGB */
+    case 23: case 29: bpp = 3; ch[0] = 0; ch[1] = 1; ch[2] = 2; break;            /* R8G8B8_UNORM, _SRGB */
+    case 30: case 36: bpp = 3; ch[0] = 2; ch[1] = 1; ch[2] = 0; break;            /* B8G8R8_UNORM, _SRGB */
+    case 37: case 43: bpp = 4; ch[0] = 0; ch[1] = 1; ch[2] = 2; ch[3] = 3; break; /* R8G8B8A8_UNORM, _SRGB */
+    case 44: case 50: bpp = 4; ch[0] = 2; ch[1] = 1; ch[2] = 0; ch[3] = 3; break; /* B8G8R8A8_UNORM, _SRGB */
+    default:
+        snprintf(err, errlen, "%s: KTX2 vkFormat %u is not decoded (%s; 8-bit R, RG, RGB, BGR, RGBA, BGRA are)", what, vk,
+                 vk == 0 ? "UASTC or another format described only by its DFD" : "a block-compressed, packed or wider format");
+        return -1;
+    }
+    if (depth > 1 || layers > 1 || faces != 1) {
+        snprintf(err, errlen, "%s: a KTX2 %s is not a 2D texture", what, depth > 1 ? "3D texture" : layers > 1 ? "array" : "cube map");
+        return -1;
+    }
+    if (!size_ok(w, h, budget, what, err, errlen)) return -1;
+    if (levels > 64 || 80 + 24 * (size_t)(levels ? levels : 1) > len) {
+        snprintf(err, errlen, "%s: bad KTX2: a level index of %u levels past the end of the file", what, levels);
+        return -1;
+    }
+    const uint64_t off = rd64(buf + 80), n = rd64(buf + 88);
+    const size_t need = (size_t)w * h * (size_t)bpp;
+    if (n < need || off > len || need > len - off) {
+        snprintf(err, errlen, "%s: bad KTX2: level 0 (%llu bytes at %llu) does not hold %ux%u texels within the %zu-byte file",
+                 what, (unsigned long long)n, (unsigned long long)off, w, h, len);
+        return -1;
+    }
+    uint8_t *px = malloc((size_t)w * h * 4);
+    if (!px) { snprintf(err, errlen, "%s: out of memory for a %ux%u texture", what, w, h); return -1; }
+    for (size_t y = 0; y < h; y++) {
+        const unsigned char *src = buf + off + y * w * (size_t)bpp;
+        uint8_t *dst = px + (flip_rows ? h - 1 - y : y) * w * 4;
+        for (size_t x = 0; x < w; x++)
+            for (int c = 0; c < 4; c++)
+                dst[4 * x + c] = ch[c] >= 0 ? src[x * (size_t)bpp + (size_t)ch[c]] : c == 3 ? 255 : 0;
+    }
+    out->width = (int)w;
+    out->height = (int)h;
+    out->rgba = px;
+    return 0;
+}
+
+int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                      ms_texture *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    if (len >= 3 && buf[0] == 0xFF && buf[1] == 0xD8 && buf[2] == 0xFF)
+        return decode_jpeg(buf, len, what, flip_rows, budget, out, err, errlen);
+    if (len >= 12 && !memcmp(buf, ktx2_id, 12)) return decode_ktx2(buf, len, what, flip_rows, budget, out, err, errlen);
+    if (len >= 8 && !png_sig_cmp(buf, 0, 8)) return decode_png(buf, len, what, flip_rows, budget, out, err, errlen);
+    snprintf(err, errlen, "%s: not a PNG, JPEG or KTX2 image", what);
+    return -1;
+}
+
+long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
+                                int flip_rows, char *err, size_t errlen)
+{
+    ms_texture t;
+    if (ms_texture_decode(buf, len, what, flip_rows, MS_MAX_TEXTURE_BYTES - soup->tex_bytes, &t, err, errlen)) return -1;
+    ms_texture *a = realloc(soup->tex, (soup->n_tex + 1) * sizeof *a);
+    if (!a) {
+        free(t.rgba);
+        snprintf(err, errlen, "%s: out of memory for a %dx%d texture", what, t.width, t.height);
+        return -1;
+    }
+    soup->tex = a;
+    a[soup->n_tex] = t;
+    soup->tex_bytes += (size_t)t.width * (size_t)t.height * 4;
     return (long)soup->n_tex++;
 }
 

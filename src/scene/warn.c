@@ -62,8 +62,8 @@ void ms_material_warnings_end(int report)
     if (report && g_mat.count == 1) emit(g_mat.first);
     else if (report && g_mat.count > 1) {
         char msg[1400];
-        snprintf(msg, sizeof msg, "%zu material files or textures could not be used; those materials keep their factors "
-                 "or the default grey (first: %.1200s)", g_mat.count, g_mat.first);
+        snprintf(msg, sizeof msg, "%zu material files, textures or glTF features could not be used; those materials keep "
+                 "their factors or the default grey, --verbose lists each (first: %.1200s)", g_mat.count, g_mat.first);
         emit(msg);
     }
     g_mat.active = 0;

@@ -100,6 +100,12 @@ int ms_alpha_build(const ms_scene *s, const ms_bvh *b, ms_alpha **out)
         const ms_texture *tx = finite ? &s->textures[tex] : NULL;
         if (!tx || !tx->rgba || tx->width < 1 || tx->height < 1) continue;   /* the factor alone decides */
         for (int c = 0; c < 6; c++) at->uv[c] = uv[c];
+        const ms_texture_sampling *sm = &m->base_color_sampling;   /* KHR_texture_transform: affine, per vertex */
+        for (int k = 0; k < 3 && sm->transformed && !grey; k++) {
+            const float *q = sm->transform, u0 = uv[2 * k], v0 = uv[2 * k + 1];
+            at->uv[2 * k] = q[0] * u0 + q[2] * v0 + q[4];
+            at->uv[2 * k + 1] = q[1] * u0 + q[3] * v0 + q[5];
+        }
         int32_t *mo = &map_of[2 * (size_t)tex + (size_t)grey];
         if (*mo < 0) {
             if (copy_map(tx, grey, &a->maps[a->n_maps])) { free(map_of); ms_alpha_free(a); return -1; }

@@ -63,6 +63,29 @@ static inline int ms_fuzz_exr(const uint8_t *data, size_t size)
     return rc;
 }
 
+/* A material texture (src/scene/texture.c: JPEG through TurboJPEG, and PNG and KTX2, told apart by content),
+ * from bytes; 0 if it decoded. Success means an image within the size limit with its pixels. The decoded
+ * budget is 16 MiB (2048x2048), not the scene's 1 GiB: a header can declare 16384x16384 in a few hundred
+ * bytes, and decoding that (libjpeg fills a truncated file's missing rows) costs seconds per input (a
+ * 1031x8197 one from 331 bytes once passed the 10 s timeout under ASan on a loaded machine,
+ * crashes/jpeg/); the size checks are the same code either way. */
+static inline int ms_fuzz_jpeg(const uint8_t *data, size_t size)
+{
+    const char *path = MS_FUZZ_MESH_PATH "jpg";
+    ms_texture t;
+    char err[1024] = "";
+    int rc = ms_texture_decode(data, size, path, 0, (size_t)16 << 20, &t, err, sizeof err);
+    if (rc) ms_fuzz_check_message(err, path);
+    else if (!t.rgba || t.width < 1 || t.height < 1 || (size_t)t.width * (size_t)t.height * 4 > ((size_t)16 << 20)) abort();
+    else {
+        volatile uint8_t sink = 0;
+        for (size_t i = 0; i < (size_t)t.width * (size_t)t.height * 4; i += 4093) sink ^= t.rgba[i];
+        (void)sink;
+    }
+    free(t.rgba);
+    return rc;
+}
+
 static inline void ms_fuzz_ignore_warning(void *user, const char *msg) { (void)user; (void)msg; }
 
 /* A scene file, from bytes, beside a directory holding one small valid mesh (a.obj); 0 if it loaded. */
