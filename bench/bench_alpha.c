@@ -17,8 +17,9 @@
 #include <x86intrin.h>
 #include "microshadow.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
-#include "shadow/alpha.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
 #include "raster/raster.h"
 #include "core/pattern.h"
 #include "core/vec.h"

@@ -9,6 +9,7 @@
 #include "camera/camera.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -7,7 +7,8 @@
  * instance; the shared scenes are skipped when absent. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/frustum_traverse.h"
+#include "primary/primary.h"
+#include "shadow/microraster/frustum_traverse.h"
 #include "raster/raster.h"
 #include "core/pattern.h"
 #include <stdio.h>

@@ -14,8 +14,10 @@
  *     with one line naming the file (exit 2 through the CLI). */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
-#include "shadow/hpc.h"
+#include "shadow/raytrace/raytrace.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "shadow/hpc/hpc.h"
 #include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>

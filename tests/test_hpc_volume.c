@@ -4,7 +4,7 @@
  * such a point is never culled. Also reports how tight the volume is: the share of sampled points inside
  * it that are shadowed from at least one of 64 light points. */
 #include "testutil.h"
-#include "shadow/hpc_volume.h"
+#include "shadow/hpc/hpc_volume.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>

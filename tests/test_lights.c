@@ -9,10 +9,11 @@
  *   - bad light JSON: exit 2 and one line naming the file and the problem. */
 #include "testutil.h"
 #include <OpenEXR/openexr.h>
-#include "../src/shadow/method.h"
-#include "../src/shadow/receiver.h"
-#include "../src/core/pattern.h"
-#include "../src/accel/bvh.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "core/pattern.h"
+#include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

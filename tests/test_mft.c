@@ -6,10 +6,12 @@
  * account for every triangle-frustum pair. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
+#include "shadow/raytrace/raytrace.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
 #include "accel/bvh.h"
 #include "core/pattern.h"
-#include "shadow/block_traverse.h"
+#include "shadow/microraster/block_traverse.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -4,7 +4,8 @@
  * too; the Quad scene against its exact V; an open quad shadows from both sides. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
 #include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>

@@ -10,6 +10,7 @@
  *   - progress reaches 1 and cancellation stops the call; bad input gets MS_ERR_* and a message. */
 #include "testutil.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include "core/pattern.h"
 #include <math.h>
 #include <omp.h>

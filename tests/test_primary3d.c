@@ -23,7 +23,8 @@
 #include "testutil.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
-#include "shadow/edge3d.h"
+#include "primary/primary.h"
+#include "primary/edge3d.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

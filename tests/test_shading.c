@@ -10,7 +10,7 @@
 #include "testutil.h"
 #include "render/ltc.h"
 #include "render/shade.h"
-#include "shadow/receiver.h"
+#include "visibility/receiver.h"
 #include "core/pattern.h"
 #include "camera/camera.h"
 #include <math.h>

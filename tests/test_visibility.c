@@ -8,7 +8,9 @@
  *     the light minus the occluder's projection onto it). */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
+#include "shadow/raytrace/raytrace.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
 #include "core/pattern.h"
 #include <math.h>
 #include <stdio.h>

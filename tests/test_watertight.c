@@ -35,6 +35,7 @@
 #include "testutil.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include "raster/raster.h"
 #include <math.h>
 #include <stdio.h>

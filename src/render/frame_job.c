@@ -11,10 +11,11 @@
  * state for the job's life (set-ups such as hpc's light hierarchy and the frusta are per light), so that
  * any call can render any tile for every light. */
 #include "microshadow.h"
-#include "../core/pattern.h"
-#include "../shadow/method.h"
-#include "../shadow/receiver.h"
-#include "../shadow/alpha.h"
+#include "core/pattern.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
 #include "frame_job.h"
 #include "shadow_frame.h"
 #include "shade.h"

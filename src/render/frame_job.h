@@ -3,7 +3,8 @@
 #define MS_FRAME_JOB_H
 #include <stddef.h>
 #include "microshadow.h"
-#include "../shadow/method.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
 #include "shade.h"
 
 /* Shading (render.c): f->rgb from the hits, their surfaces (surf: per pixel, or NULL for the Lambertian

@@ -7,7 +7,7 @@
 #include "ltc.h"
 #include "microshadow.h"
 #include "ltc_table.h"
-#include "../core/vec.h"
+#include "core/vec.h"
 #include <math.h>
 
 /* Bilinear Minv (normalised by its (1,1) element) and magnitude at (roughness, cos theta_v). */

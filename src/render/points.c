@@ -5,10 +5,10 @@
  * visible masks, V and S from ms_resolve_vs. A point's sample pattern is keyed like a pixel, so the same
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"
-#include "../core/pattern.h"
-#include "../shadow/method.h"
-#include "../shadow/receiver.h"
-#include "../shadow/alpha.h"
+#include "core/pattern.h"
+#include "shadow/method.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>

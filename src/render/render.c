@@ -2,7 +2,8 @@
  * light, each phase timed on its own and run over 16x16 pixel tiles by OpenMP, dynamic scheduling: shadow
  * cost varies wildly across a frame) with every tile in one call; the shading of a finished frame is here. */
 #include "microshadow.h"
-#include "../shadow/receiver.h"
+#include "visibility/receiver.h"
+#include "primary/primary.h"
 #include "frame_job.h"
 #include <math.h>
 #include <omp.h>

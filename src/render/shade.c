@@ -1,10 +1,11 @@
 /* Materials at hit points, the specular shadow factor and the shaded radiance (shade.h). */
 #include "shade.h"
+#include "primary/primary.h"
 #include "brdf_ggx.h"
 #include "ltc.h"
-#include "../core/pattern.h"
-#include "../core/vec.h"
-#include "../shadow/receiver.h"
+#include "core/pattern.h"
+#include "core/vec.h"
+#include "visibility/receiver.h"
 #include <math.h>
 #include <string.h>
 

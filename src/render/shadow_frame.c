@@ -1,8 +1,9 @@
 /* The whole-frame shadow phase (shadow_frame.h): the same front masks and the same V/S resolution as the
  * tiled phase of frame_job.c, around one call of the method's frame-level entry. */
 #include "shadow_frame.h"
-#include "../core/pattern.h"
-#include "../shadow/receiver.h"
+#include "primary/primary.h"
+#include "core/pattern.h"
+#include "visibility/receiver.h"
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,5 +1,7 @@
 #include "testutil.h"
-#include "shadow/receiver.h"
+#include "primary/primary.h"
+#include "shadow/method.h"
+#include "visibility/receiver.h"
 #include <OpenEXR/openexr.h>
 #include <dirent.h>
 #include <errno.h>
