@@ -16,7 +16,7 @@
 #include "primary/primary.h"
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
-#include "frame_job.h"
+#include "frame_shade.h"
 #include "shadow_frame.h"
 #include "shade.h"
 #include "render_materialise.h"
