@@ -1,18 +1,11 @@
 /* 3D edge functions: set-up, tile culling and screen bounds (edge3d.h). */
 #include "edge3d.h"
+#include "core/vec.h"
 #include <math.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static inline double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static inline void cross3(double r[3], const double a[3], const double b[3])
-{
-    r[0] = a[1] * b[2] - a[2] * b[1];
-    r[1] = a[2] * b[0] - a[0] * b[2];
-    r[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 void ms_e3_cam_init(ms_e3_cam *c, const ms_camera_basis *b)
 {
@@ -47,9 +40,9 @@ void ms_e3_setup(const ms_e3_cam *c, const float tri[9], ms_e3_tri *T)
             u[k] = (c->w ? (double)b[k] : 0.0) - c->e[k];
             v[k] = (double)a[k] - (double)b[k];
         }
-        cross3(m, u, v);
+        d3_cross(m, u, v);
         double kk = 0.0;
-        if (!c->w) { const double ad[3] = { a[0], a[1], a[2] }; kk = -dot3(m, ad); }
+        if (!c->w) { const double ad[3] = { a[0], a[1], a[2] }; kk = -d3_dot(m, ad); }
         /* s: the cyclic direction (exact negation keeps |V| identical for both triangles of the edge) */
         for (int k = 0; k < 3; k++) M[i][k] = s * m[k];
         K[i] = s * kk;
@@ -57,14 +50,14 @@ void ms_e3_setup(const ms_e3_cam *c, const float tri[9], ms_e3_tri *T)
     /* sigma: the orientation, edge 0's function at vertex 2 (the tetrahedron's D_123E) */
     double q2[3];
     for (int k = 0; k < 3; k++) q2[k] = (double)tri[6 + k] - (c->w ? c->e[k] : 0.0);
-    const double vol = K[0] + dot3(M[0], q2);
+    const double vol = K[0] + d3_dot(M[0], q2);
     T->ok = vol != 0.0 && isfinite(vol);
     const double sigma = vol > 0.0 ? 1.0 : -1.0;
     for (int i = 0; i < 3; i++) {
         for (int k = 0; k < 3; k++) T->m[i][k] = sigma * M[i][k];
         T->k[i] = sigma * K[i];
         /* the top-left rule in 3D: the ray perturbed by eps right + eps^2 down + eps^3 forward */
-        const double r = dot3(T->m[i], c->right), dn = dot3(T->m[i], c->down), f = dot3(T->m[i], c->forward);
+        const double r = d3_dot(T->m[i], c->right), dn = d3_dot(T->m[i], c->down), f = d3_dot(T->m[i], c->forward);
         T->tie[i] = r > 0.0 || (r == 0.0 && (dn > 0.0 || (dn == 0.0 && f > 0.0)));
     }
     double e1[3], e2[3];
@@ -73,7 +66,7 @@ void ms_e3_setup(const ms_e3_cam *c, const float tri[9], ms_e3_tri *T)
         e1[k] = (double)tri[3 + k] - (double)tri[k];
         e2[k] = (double)tri[6 + k] - (double)tri[k];
     }
-    cross3(T->n, e1, e2);
+    d3_cross(T->n, e1, e2);
 }
 
 /* Rounding margin of the culling tests: the rays the per-pixel test scores are float (ms_camera_ray), a
@@ -87,10 +80,10 @@ int ms_e3_tile_planar(const ms_e3_tri *T, const double q[4][3], double qmag)
         const double *m = T->m[i];
         double hi = -INFINITY;
         for (int c = 0; c < 4; c++) {
-            const double v = T->k[i] + dot3(m, q[c]);
+            const double v = T->k[i] + d3_dot(m, q[c]);
             hi = v > hi ? v : hi;
         }
-        const double mm = sqrt(dot3(m, m));
+        const double mm = sqrt(d3_dot(m, m));
         if (hi < -E3_REL * (mm * qmag + fabs(T->k[i]))) return 0;
     }
     return 1;
@@ -109,9 +102,9 @@ int ms_e3_tile_cone(const ms_e3_tri *T, const double a[3], double alpha)
     const double lim = -sin(alpha + E3_REL);
     for (int i = 0; i < 3; i++) {
         const double *m = T->m[i];
-        const double mm = sqrt(dot3(m, m));
+        const double mm = sqrt(d3_dot(m, m));
         if (!(mm > 0.0)) return 0;
-        if (dot3(m, a) < lim * mm) return 0;
+        if (d3_dot(m, a) < lim * mm) return 0;
     }
     return 1;
 }
@@ -155,12 +148,12 @@ static int bounds_curved(const ms_camera_basis *b, const float tri[9], ms_e3_box
         if (!(l > 0.0) || !isfinite(l)) return whole(b, box);
         for (int k = 0; k < 3; k++) { u[v][k] /= l; c[k] += u[v][k]; }
     }
-    const double cl = sqrt(dot3(c, c));
+    const double cl = sqrt(d3_dot(c, c));
     if (!(cl > 1e-3)) return whole(b, box);
     for (int k = 0; k < 3; k++) c[k] /= cl;
     double r = 0.0;
     for (int v = 0; v < 3; v++) {
-        double d = dot3(c, u[v]);
+        double d = d3_dot(c, u[v]);
         d = d > 1.0 ? 1.0 : d < -1.0 ? -1.0 : d;
         const double a = acos(d);
         r = a > r ? a : r;
@@ -175,9 +168,9 @@ static int bounds_curved(const ms_camera_basis *b, const float tri[9], ms_e3_box
         B[k] = latlong ? b->forward[k] : b->right[k];
         C[k] = latlong ? b->right[k] : b->up[k];
     }
-    double ca = dot3(c, A);
+    double ca = d3_dot(c, A);
     ca = ca > 1.0 ? 1.0 : ca < -1.0 ? -1.0 : ca;
-    const double thc = acos(ca), phc = atan2(dot3(c, C), dot3(c, B));
+    const double thc = acos(ca), phc = atan2(d3_dot(c, C), d3_dot(c, B));
     double th0 = thc - r, th1 = thc + r, dphi = M_PI;
     const int full = th0 <= 0.0 || th1 >= M_PI;
     if (th0 < 0.0) th0 = 0.0;
@@ -246,10 +239,10 @@ int ms_e3_bounds(const ms_camera_basis *b, const float tri[9], ms_e3_box box[2])
         for (int k = 0; k < 3; k++) p[k] = (double)tri[3 * v + k] - (double)b->eye[k];
         const double f[3] = { b->forward[0], b->forward[1], b->forward[2] };
         const double rr[3] = { b->right[0], b->right[1], b->right[2] }, uu[3] = { b->up[0], b->up[1], b->up[2] };
-        z[v] = dot3(p, f); a[v] = dot3(p, rr); c[v] = dot3(p, uu);
+        z[v] = d3_dot(p, f); a[v] = d3_dot(p, rr); c[v] = d3_dot(p, uu);
         zmax = z[v] > zmax ? z[v] : zmax;
         zmin = z[v] < zmin ? z[v] : zmin;
-        const double l = sqrt(dot3(p, p));
+        const double l = sqrt(d3_dot(p, p));
         len = l > len ? l : len;
     }
     if (!isfinite(len)) return whole(b, box);

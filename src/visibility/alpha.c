@@ -1,5 +1,6 @@
 /* The alpha test of alpha-tested occluders (alpha.h). */
 #include "alpha.h"
+#include "core/vec.h"
 #include "core/pattern.h"
 #include <math.h>
 #include <stdlib.h>
@@ -14,13 +15,6 @@ void ms_alpha_free(ms_alpha *a)
     free(a->slot);
     free(a->tri);
     free(a);
-}
-
-static void d3cross(double r[3], const double a[3], const double b[3])
-{
-    r[0] = a[1] * b[2] - a[2] * b[1];
-    r[1] = a[2] * b[0] - a[0] * b[2];
-    r[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 /* The alpha map of scene texture t: its alpha channel, or (grey = 1, an MTL map_d) its red channel when the
@@ -79,10 +73,10 @@ int ms_alpha_build(const ms_scene *s, const ms_bvh *b, ms_alpha **out)
             e1[c] = (double)v[3 + c] - (double)v[c];
             e2[c] = (double)v[6 + c] - (double)v[c];
         }
-        d3cross(at->n, e1, e2);
+        d3_cross(at->n, e1, e2);
         const double nn = at->n[0] * at->n[0] + at->n[1] * at->n[1] + at->n[2] * at->n[2];
-        d3cross(at->g1, e2, at->n);
-        d3cross(at->g2, at->n, e1);
+        d3_cross(at->g1, e2, at->n);
+        d3_cross(at->g2, at->n, e1);
         for (int c = 0; c < 3; c++) {   /* a degenerate triangle (nn = 0): g = 0, and ms_alpha_value sees N = 0 */
             at->g1[c] = nn > 0.0 ? at->g1[c] / nn : 0.0;
             at->g2[c] = nn > 0.0 ? at->g2[c] / nn : 0.0;

@@ -28,8 +28,9 @@
  *
  * Departures, and why:
  *  - the hard-shadow test of a sample (L70) is the reference tracer's watertight ray/triangle test from the
- *    receiver to the sample (raytrace_impl.h, packet_triangle, lane for lane: the same shear axis of the
- *    16-sample packet, the same float operations, the same double fall-back on a zero edge function). Its
+ *    receiver to the sample (ms_wt_segment_sheared in accel/ray_triangle.h, the scalar form of raytrace's
+ *    lane loop: the same shear axis of the 16-sample packet, the same float operations, the same double
+ *    fall-back on a zero edge function). Its
  *    three edge functions are the signed volumes of the sample, the receiver and each triangle edge, i.e.
  *    the receiver against the three planes of V_li through the sample and the edges, and its t range is
  *    the fourth plane, the triangle's, moved to the near/far range of the visibility definition. Evaluated
@@ -317,18 +318,12 @@ static void slot_setup(const shared *sh, chunk *c, int32_t s, const ms_shadow_qu
     const int k = sh->k;
     int8_t *kz = slot_kz(sh, c, s);
     for (int pk = 0; pk < sh->npk; pk++) {
-        float d[LANES][3];
+        float d[3][LANES];
         for (int l = 0; l < LANES; l++) {
             const int smp = pk * LANES + l, i = smp % k, j = smp / k;
-            for (int a = 0; a < 3; a++) d[l][a] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
+            for (int a = 0; a < 3; a++) d[a][l] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
         }
-        const int z = ms_wt_max_axis(d[0]);
-        int ok = 1;
-        for (int l = 0; l < LANES; l++) {
-            const float m = ms_maxf(fabsf(d[l][0]), ms_maxf(fabsf(d[l][1]), fabsf(d[l][2])));
-            ok &= 2.0f * fabsf(d[l][z]) >= m && m > 0.0f;
-        }
-        kz[pk] = (int8_t)(ok ? z : -1);
+        kz[pk] = (int8_t)ms_wt_packet_axis(d[0], d[1], d[2], LANES, NULL);
     }
     if (sh->scanline) {
         ms_raster_frame *f = slot_frame(sh, c, s);
@@ -439,36 +434,16 @@ static void build_group_volumes(const shared *sh, chunk *c, const tri_job *t)
     c->cnt[C_GROUP_VOLUMES_BUILT]++;
 }
 
-/* The reference tracer's lane test (raytrace_impl.h, packet_triangle) for one sample: 1 if the triangle
- * blocks the segment from the receiver o to o + d at a parameter in [near, far]. A, B, C: the vertices
- * minus o; num: ms_wt_offset(o, tri, N). */
+/* The reference tracer's lane test for one sample (ray_triangle.h, as raytrace's packets): 1 if the
+ * triangle blocks the segment from the receiver o to o + d at a parameter in [near, far]. A, B, C: the
+ * vertices minus o; num: ms_wt_offset(o, tri, N). */
 static int sample_blocked(const float o[3], const float d[3], int kz, const float *tri, const float N[3],
                           const float A[3], const float B[3], const float C[3], float num, float tmin, float tmax)
 {
-    if (kz < 0) {
-        ms_wt_ray w;
-        float t, u, v;
-        ms_wt_prepare(&w, o, d);
-        return ms_wt_intersect(&w, tri, N, tmin, tmax, &t, &u, &v);
-    }
+    if (kz < 0) return ms_wt_segment(o, d, tri, N, tmin, tmax);
     const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
     const float inv = 1.0f / d[kz];
-    const float sx = d[kx] * inv, sy = d[ky] * inv;
-    const float Ax = A[kx], Ay = A[ky], Az = A[kz], Bx = B[kx], By = B[ky], Bz = B[kz];
-    const float Cx = C[kx], Cy = C[ky], Cz = C[kz];
-    const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
-    const float cx = Cx - sx * Cz, cy = Cy - sy * Cz;
-    float u = ms_wt_edge(cx, cy, bx, by), v = ms_wt_edge(ax, ay, cx, cy), w = ms_wt_edge(bx, by, ax, ay);
-    if (u == 0.0f || v == 0.0f || w == 0.0f) {
-        u = ms_wt_edge_d(cx, cy, bx, by);
-        v = ms_wt_edge_d(ax, ay, cx, cy);
-        w = ms_wt_edge_d(bx, by, ax, ay);
-    }
-    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return 0;
-    const float det = u + v + w;
-    const float den = d[0] * N[0] + d[1] * N[1] + d[2] * N[2];
-    const float ns = den < 0.0f ? -num : num, aden = fabsf(den);
-    return det != 0.0f && aden > 0.0f && ns >= tmin * aden && ns <= tmax * aden;
+    return ms_wt_segment_sheared(A, B, C, kz, d[kx] * inv, d[ky] * inv, d, N, num, tmin, tmax);
 }
 
 /* Alpha-tested triangle t (alpha.h) at sample (i, j) of q's grid: 1 where it occludes. The sample point is the

@@ -11,17 +11,9 @@
  * size, and the tests allow the caller's margin eps (hpc.c derives it from the rounding of the exact
  * per-sample test), so that a relation the reference ray test calls blocked is never culled here. */
 #include "hpc_volume.h"
+#include "core/vec.h"
 #include <math.h>
 #include <string.h>
-
-static void d_sub(double r[3], const double a[3], const double b[3]) { for (int i = 0; i < 3; i++) r[i] = a[i] - b[i]; }
-static double d_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static void d_cross(double r[3], const double a[3], const double b[3])
-{
-    r[0] = a[1] * b[2] - a[2] * b[1];
-    r[1] = a[2] * b[0] - a[0] * b[2];
-    r[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 /* Adds the plane through e0, e1 and v if it separates the polygon (on its non-positive side) from the
  * triangle; oriented so that the triangle's side is positive. */
@@ -29,21 +21,21 @@ static void try_plane(hpc_volume *v, const double e0[3], const double e1[3], con
                       int np, const double tv[3][3], double tol)
 {
     double a[3], b[3], n[3];
-    d_sub(a, e1, e0);
-    d_sub(b, w, e0);
-    d_cross(n, a, b);
-    const double len = sqrt(d_dot(n, n));
+    d3_sub(a, e1, e0);
+    d3_sub(b, w, e0);
+    d3_cross(n, a, b);
+    const double len = sqrt(d3_dot(n, n));
     if (!(len > 0.0)) return;
     for (int i = 0; i < 3; i++) n[i] /= len;
-    const double d = -d_dot(n, e0);
+    const double d = -d3_dot(n, e0);
     double pmin = INFINITY, pmax = -INFINITY, tmin = INFINITY, tmax = -INFINITY;
     for (int i = 0; i < np; i++) {
-        const double s = d_dot(n, poly + 3 * i) + d;
+        const double s = d3_dot(n, poly + 3 * i) + d;
         pmin = fmin(pmin, s);
         pmax = fmax(pmax, s);
     }
     for (int i = 0; i < 3; i++) {
-        const double s = d_dot(n, tv[i]) + d;
+        const double s = d3_dot(n, tv[i]) + d;
         tmin = fmin(tmin, s);
         tmax = fmax(tmax, s);
     }
@@ -76,16 +68,16 @@ int hpc_volume_build(hpc_volume *v, const double *poly, int np, const float tri[
         for (int i = 0; i < 3; i++) try_plane(v, poly + 3 * e, poly + 3 * ((e + 1) % np), tv[i], poly, np, tv, tol);
     /* The cap: the triangle's plane, when the polygon lies strictly on one side of it. */
     double a[3], b[3], n[3];
-    d_sub(a, tv[1], tv[0]);
-    d_sub(b, tv[2], tv[0]);
-    d_cross(n, a, b);
-    const double len = sqrt(d_dot(n, n));
+    d3_sub(a, tv[1], tv[0]);
+    d3_sub(b, tv[2], tv[0]);
+    d3_cross(n, a, b);
+    const double len = sqrt(d3_dot(n, n));
     if (len > 0.0) {
         for (int i = 0; i < 3; i++) n[i] /= len;
-        const double d = -d_dot(n, tv[0]);
+        const double d = -d3_dot(n, tv[0]);
         double pmin = INFINITY, pmax = -INFINITY;
         for (int i = 0; i < np; i++) {
-            const double s = d_dot(n, poly + 3 * i) + d;
+            const double s = d3_dot(n, poly + 3 * i) + d;
             pmin = fmin(pmin, s);
             pmax = fmax(pmax, s);
         }

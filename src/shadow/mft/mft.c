@@ -63,15 +63,6 @@ void ms_mft_corners(const ms_mft_frame *f, const float c[3], const int r[4], flo
             d[q][x] = (float)(f->lp[x] + a[q & 1] * f->ls[x] + b[q >> 1] * f->lt[x] - c[x]);
 }
 
-static double d3_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static double d3_len(const double a[3]) { return sqrt(d3_dot(a, a)); }
-static void d3_cross(double o[3], const double a[3], const double b[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static void mft_frame_light(ms_mft_frame *f, const ms_light *l);
 
 static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
@@ -133,16 +124,9 @@ void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
     ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, base, 16, pts);
     for (int l = 0; l < 16; l++)
         for (int a = 0; a < 3; a++) L->d[a][base + l] = pts[3 * l + a] - L->c[a];
-    /* raytrace_impl.h, packet_shear: lane 0's largest axis if every lane has |d[kz]| >= max|d| / 2, else
-     * -1 (tested one by one); sx = d[kx] * (1 / d[kz]). */
-    const float d0[3] = { L->d[0][base], L->d[1][base], L->d[2][base] };
-    const int kz = ms_wt_max_axis(d0);
-    int ok = 1;
-    for (int l = base; l < base + 16; l++) {
-        const float m = ms_maxf(fabsf(L->d[0][l]), ms_maxf(fabsf(L->d[1][l]), fabsf(L->d[2][l])));
-        ok &= 2.0f * fabsf(L->d[kz][l]) >= m && m > 0.0f;
-    }
-    L->kz[ch] = (signed char)(ok ? kz : -1);
+    /* The shear axis raytrace shares over a packet (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]). */
+    int kz;
+    L->kz[ch] = (signed char)ms_wt_packet_axis(L->d[0] + base, L->d[1] + base, L->d[2] + base, 16, &kz);
     const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
     for (int l = base; l < base + 16; l++) {
         const float inv = 1.0f / L->d[kz][l];

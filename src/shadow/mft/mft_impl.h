@@ -180,10 +180,7 @@ static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const fl
         for (unsigned m = bits; m; m &= m - 1) {
             const int l = __builtin_ctz(m);
             const float d[3] = { L->d[0][base + l], L->d[1][base + l], L->d[2][base + l] };
-            ms_wt_ray w;
-            float t, u, v;
-            ms_wt_prepare(&w, L->c, d);
-            if (ms_wt_intersect(&w, tri, N, near, far, &t, &u, &v)) hit |= 1u << l;
+            if (ms_wt_segment(L->c, d, tri, N, near, far)) hit |= 1u << l;
         }
         return hit;
     }
@@ -208,20 +205,11 @@ static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const fl
     const l16 ns = l16_select(l16_lt(den, zero), l16_set1(-num), l16_set1(num)), aden = l16_abs(den);
     hit = bits & ~z & ~mixed & l16_gt(l16_abs(det), zero) & l16_gt(aden, zero) & l16_le(l16_mul(l16_set1(near), aden), ns) &
           l16_le(ns, l16_mul(l16_set1(far), aden));
-    /* An edge function exactly 0: redone in double, as raytrace does (rare). */
+    /* An edge function exactly 0: redone by the scalar test (in double), as raytrace does (rare). */
     for (unsigned m = bits & z; m; m &= m - 1) {
         const int l = __builtin_ctz(m), i = base + l;
-        const float lsx = L->sx[i], lsy = L->sy[i];
-        const float fax = V[0][kx] - lsx * V[0][kz], fay = V[0][ky] - lsy * V[0][kz];
-        const float fbx = V[1][kx] - lsx * V[1][kz], fby = V[1][ky] - lsy * V[1][kz];
-        const float fcx = V[2][kx] - lsx * V[2][kz], fcy = V[2][ky] - lsy * V[2][kz];
-        const float du = ms_wt_edge_d(fcx, fcy, fbx, fby), dv = ms_wt_edge_d(fax, fay, fcx, fcy);
-        const float dw = ms_wt_edge_d(fbx, fby, fax, fay);
-        if ((du < 0.0f || dv < 0.0f || dw < 0.0f) && (du > 0.0f || dv > 0.0f || dw > 0.0f)) continue;
-        const float ddet = du + dv + dw;
-        const float dd = L->d[0][i] * N[0] + L->d[1][i] * N[1] + L->d[2][i] * N[2];
-        const float dns = dd < 0.0f ? -num : num, dad = fabsf(dd);
-        if (ddet != 0.0f && dad > 0.0f && dns >= near * dad && dns <= far * dad) hit |= 1u << l;
+        const float d[3] = { L->d[0][i], L->d[1][i], L->d[2][i] };
+        if (ms_wt_segment_sheared(V[0], V[1], V[2], kz, L->sx[i], L->sy[i], d, N, num, near, far)) hit |= 1u << l;
     }
     return hit;
 }

@@ -31,23 +31,13 @@ typedef struct packet {
     float o_lo[3], o_hi[3]; /* the origin shifted by the box margin (ms_wt_box_origins), set by trace_packet */
 } packet;
 
-/* The packet's shear. Any kz with d[kz] != 0 keeps the test watertight (the per-ray choice of the
- * largest |d| only bounds the shear); the rays of a packet point at one small light, so one axis
- * usually serves all lanes: lane 0's largest, provided every lane has |d[kz]| >= max|d| / 2 (|Sx|,
- * |Sy| <= 2: as accurate as the per-ray choice within a factor of 2); else kz = -1 and the lanes are
- * tested one by one. Sx = d[kx] * (1/d[kz]) with the lane's 1/d of the slab test (the paper divides;
- * any shear that maps the ray onto the z axis serves; Sz is not needed, t comes from the plane). The winding swap of the paper is not
- * needed: the test is two-sided. */
+/* The packet's shear: the axis its lanes share (ms_wt_packet_axis; kz = -1: the lanes are tested one by
+ * one) and per lane Sx = d[kx] * (1/d[kz]) with the lane's 1/d of the slab test (the paper divides; any
+ * shear that maps the ray onto the z axis serves). */
 static void packet_shear(packet *pk)
 {
-    const float d0[3] = { pk->d[0][0], pk->d[1][0], pk->d[2][0] };
-    const int kz = ms_wt_max_axis(d0);
-    int ok = 1;
-    for (int l = 0; l < LANES; l++) {
-        const float m = ms_maxf(fabsf(pk->d[0][l]), ms_maxf(fabsf(pk->d[1][l]), fabsf(pk->d[2][l])));
-        ok &= 2.0f * fabsf(pk->d[kz][l]) >= m && m > 0.0f;
-    }
-    pk->kz = ok ? kz : -1;
+    int kz;
+    pk->kz = ms_wt_packet_axis(pk->d[0], pk->d[1], pk->d[2], LANES, &kz);
     pk->kx = kz + 1 == 3 ? 0 : kz + 1;
     pk->ky = pk->kx + 1 == 3 ? 0 : pk->kx + 1;
     for (int l = 0; l < LANES; l++) {
@@ -99,10 +89,7 @@ static void packet_triangle(packet *pk, const float *tri, const float N[3])
         for (int l = 0; l < LANES; l++) {
             if (!pk->live[l]) continue;
             const float d[3] = { pk->d[0][l], pk->d[1][l], pk->d[2][l] };
-            ms_wt_ray w;
-            float t, u, v;
-            ms_wt_prepare(&w, pk->o, d);
-            pk->live[l] = !ms_wt_intersect(&w, tri, N, pk->tmin, pk->tmax, &t, &u, &v);
+            pk->live[l] = !ms_wt_segment(pk->o, d, tri, N, pk->tmin, pk->tmax);
         }
         return;
     }
@@ -128,7 +115,7 @@ static void packet_triangle(packet *pk, const float *tri, const float N[3])
         zero |= z & pk->live[l];
         pk->live[l] &= !hit;
     }
-    if (zero)
+    if (zero)   /* the lanes with an edge function exactly 0, redone by the scalar test (in double) */
         for (int l = 0; l < LANES; l++) {
             const float sx = pk->sx[l], sy = pk->sy[l];
             const float ax = Ax - sx * Az, ay = Ay - sy * Az, bx = Bx - sx * Bz, by = By - sy * Bz;
@@ -136,12 +123,8 @@ static void packet_triangle(packet *pk, const float *tri, const float N[3])
             if (!pk->live[l] || (ms_wt_edge(cx, cy, bx, by) != 0.0f && ms_wt_edge(ax, ay, cx, cy) != 0.0f &&
                                  ms_wt_edge(bx, by, ax, ay) != 0.0f))
                 continue;
-            const float u = ms_wt_edge_d(cx, cy, bx, by), v = ms_wt_edge_d(ax, ay, cx, cy), w = ms_wt_edge_d(bx, by, ax, ay);
-            if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) continue;
-            const float det = u + v + w;
-            const float den = pk->d[0][l] * N[0] + pk->d[1][l] * N[1] + pk->d[2][l] * N[2];
-            const float ns = den < 0.0f ? -num : num, aden = fabsf(den);
-            if (det != 0.0f && aden > 0.0f && ns >= tmin * aden && ns <= tmax * aden) pk->live[l] = 0;
+            const float d[3] = { pk->d[0][l], pk->d[1][l], pk->d[2][l] };
+            if (ms_wt_segment_sheared(A, B, C, kz, sx, sy, d, N, num, tmin, tmax)) pk->live[l] = 0;
         }
 }
 
