@@ -397,12 +397,7 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     const int samples = o->points.samples > 0 ? o->points.samples : MS_SAMPLES_DEFAULT;
     ms_render_ctx tctx;   /* for the textured lights' mean texels: the points' pattern (points.c) */
-    memset(&tctx, 0, sizeof tctx);
-    tctx.pattern = o->points.pattern;
-    tctx.k = ms_samples_to_k(samples);
-    tctx.samples = tctx.k * tctx.k;
-    tctx.mask_words = tctx.samples / 64;
-    tctx.seed = o->points.seed;
+    ms_render_ctx_init(&tctx, NULL, NULL, NULL, o->points.pattern, ms_samples_to_k(samples), o->points.seed, 0);
     float *lum = malloc((nt ? nt : 1) * sizeof *lum);
     if (!lum) { snprintf(err, errlen, "out of memory for a %dx%d lightmap", size, size); return MS_ERR_NO_MEMORY; }
     const int threads = o->points.threads > 0 ? o->points.threads : omp_get_num_procs();

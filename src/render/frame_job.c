@@ -28,8 +28,6 @@
 #include <time.h>
 
 #define TILE MS_TILE_SIZE
-#define MS_NEAR 1e-4f        /* segment parameter: occluders closer than this to the receiver are ignored */
-#define MS_FAR (1.0f - 1e-4f)/* ... and this close to the light plane (a light set into a ceiling) */
 
 struct ms_frame_job {
     ms_scene soup;                /* a procedural scene materialised for a method that does not stream */
@@ -154,6 +152,8 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         goto fail;
     }
     ms_render_ctx *ctx = &j->ctx;
+    ms_render_ctx_init(ctx, scene, streamed ? NULL : &j->bvh, &j->lights[0], opt->pattern, ms_samples_to_k(samples),
+                       opt->seed, j->threads);
     if (ms_camera_basis_init(&ctx->cam, &scene->camera, W, H)) {
         snprintf(err, errlen, "camera is degenerate (eye = target, up parallel to the view, or a field of view, extent or type out of range)");
         goto fail;
@@ -161,17 +161,6 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); goto fail; }
     if (!streamed && ms_alpha_build(scene, &j->bvh, &j->alpha)) { snprintf(err, errlen, "out of memory for the alpha-tested triangles"); goto fail; }
     ctx->alpha = j->alpha;
-    ctx->scene = scene;
-    ctx->bvh = streamed ? NULL : &j->bvh;
-    ctx->light = j->lights[0];
-    ctx->pattern = opt->pattern;
-    ctx->k = ms_samples_to_k(samples);
-    ctx->samples = spp;
-    ctx->mask_words = (spp + 63) / 64;   /* bits past spp stay 0 */
-    ctx->seed = opt->seed;
-    ctx->near = MS_NEAR;
-    ctx->far = MS_FAR;
-    ctx->threads = j->threads;
     ctx->isa_cap = opt->isa;
     ctx->no_occlusion_cull = opt->no_occlusion_cull;
     ctx->no_child_order = opt->no_child_order;

@@ -16,10 +16,6 @@
 #include <string.h>
 
 #define BATCH 256              /* points per visibility call: a frame tile's 16 x 16 */
-/* The occluding range of the segment parameter: the same as ms_render's (render.c); test_points
- * compares points with frames bit for bit, so the two cannot drift apart unnoticed. */
-#define MS_POINTS_NEAR 1e-4f
-#define MS_POINTS_FAR (1.0f - 1e-4f)
 
 struct ms_accel {
     ms_bvh bvh;
@@ -233,20 +229,9 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
             memcpy(scene_tri + 9 * (size_t)a->bvh.tri_source[i], a->bvh.tri + 9 * (size_t)i, 9 * sizeof *scene_tri);
         view.tri = scene_tri;
     }
-    ms_render_ctx ctx;
-    memset(&ctx, 0, sizeof ctx);
-    ctx.scene = &view;
-    ctx.bvh = &a->bvh;
+    ms_render_ctx ctx;   /* the frames' context (ms_render_ctx_init), so points answer as frames do */
+    ms_render_ctx_init(&ctx, &view, &a->bvh, light, opt->pattern, k, opt->seed, threads);
     ctx.alpha = a->alpha;
-    ctx.light = *light;
-    ctx.pattern = opt->pattern;
-    ctx.k = k;
-    ctx.samples = k * k;
-    ctx.mask_words = k * k / 64;
-    ctx.seed = opt->seed;
-    ctx.near = MS_POINTS_NEAR;
-    ctx.far = MS_POINTS_FAR;
-    ctx.threads = threads;
     ctx.isa_cap = opt->isa;
     ctx.embree_mode = opt->embree_mode;
     ctx.embree_filter = opt->embree_filter;

@@ -50,4 +50,18 @@ typedef struct ms_shadow_query {
     uint32_t px, py;
 } ms_shadow_query;
 
+/* The occluding range of the segment parameter from the hit point (0) to the light sample (1): occluders
+ * closer than MS_SEGMENT_NEAR to the receiver are ignored (its own surface, whichever side rounding left
+ * the hit point on), and those within 1 - MS_SEGMENT_FAR of the light's plane (a light set into a
+ * ceiling). Frames, points and bakes use the same, so that they agree bit for bit (test_points). */
+#define MS_SEGMENT_NEAR 1e-4f
+#define MS_SEGMENT_FAR (1.0f - 1e-4f)
+
+/* The one way to fill a render context: zero, then the scene, its BVH (NULL: a streamed scene), the light,
+ * (NULL: set by the caller), the pattern with k samples per side (samples per point and mask words follow from the pattern), the
+ * seed, the threads and the segment range; the instruction-set cap MS_ISA_AUTO. The camera, the alpha
+ * table and the methods' switches are the caller's to set afterwards. */
+void ms_render_ctx_init(ms_render_ctx *ctx, const ms_scene *scene, const ms_bvh *bvh, const ms_light *light,
+                        ms_pattern pattern, int k, uint32_t seed, int threads);
+
 #endif

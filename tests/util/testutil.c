@@ -149,18 +149,8 @@ void tu_query_from_hit(ms_shadow_query *q, const ms_hit *h, int x, int y)
 
 void tu_ctx_init(ms_render_ctx *ctx, const ms_scene *sc, const ms_bvh *bvh, int W, int H, int k)
 {
-    memset(ctx, 0, sizeof *ctx);
+    ms_render_ctx_init(ctx, sc, bvh, &sc->light, MS_PATTERN_GRID, k, 0, 1);
     assert_int_equal(ms_camera_basis_init(&ctx->cam, &sc->camera, W, H), 0);
-    ctx->scene = sc;
-    ctx->bvh = bvh;
-    ctx->light = sc->light;
-    ctx->pattern = MS_PATTERN_GRID;
-    ctx->k = k;
-    ctx->samples = k * k;
-    ctx->mask_words = k * k / 64;
-    ctx->near = 1e-4f;
-    ctx->far = 1.0f - 1e-4f;
-    ctx->threads = 1;
     ctx->isa_cap = tu_isa_cap();
 }
 
