@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The folders of src/ depend on each other only downward (docs/design.md, "Layers"):
-#   core <- {accel, camera, raster, image} <- scene <- visibility <- {primary, shadow} <- render <- cli
+#   core <- light <- {accel, camera, raster, image} <- scene <- visibility <- {primary, shadow} <- render <- cli
 # A subfolder (src/shadow/mft/, ...) belongs to its top-level folder's layer: it may include its own
 # layer's headers (the layer's interface and, sideways, another family's shared part) and lower layers'.
 # Includes across folders are written from src/ ("core/vec.h"; "../core/vec.h" is read the same way),
@@ -9,8 +9,8 @@
 # or sideways between layers, and on any cycle between folders (subfolders counted as folders).
 set -euo pipefail
 src=${1:?usage: check_layers.sh SRC_DIR}
-declare -A rank=([core]=0 [accel]=1 [camera]=1 [raster]=1 [image]=1 [scene]=2 [visibility]=3 [primary]=4
-                 [shadow]=4 [render]=5 [cli]=6)
+declare -A rank=([core]=0 [light]=1 [accel]=2 [camera]=2 [raster]=2 [image]=2 [scene]=3 [visibility]=4
+                 [primary]=5 [shadow]=5 [render]=6 [cli]=7)
 bad=0
 edges=""
 while IFS= read -r -d '' f; do

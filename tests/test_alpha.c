@@ -17,7 +17,7 @@
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
 #include "accel/bvh.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

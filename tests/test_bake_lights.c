@@ -8,7 +8,7 @@
  *     0, --shadow as EXR has every light. */
 #include "testutil.h"
 #include <OpenEXR/openexr.h>
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

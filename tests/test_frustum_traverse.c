@@ -10,7 +10,7 @@
 #include "primary/primary.h"
 #include "shadow/microraster/frustum_traverse.h"
 #include "raster/raster.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -19,7 +19,7 @@
  * under ASan, twice that at 256x256); the paper's frames are 1024x1024. */
 #include "testutil.h"
 #include "primary/primary.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "render/interleave_filter.h"
 #include <math.h>
 #include <stdio.h>

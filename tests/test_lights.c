@@ -12,7 +12,7 @@
 #include "shadow/method.h"
 #include "primary/primary.h"
 #include "visibility/receiver.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>

@@ -10,7 +10,7 @@
 #include "primary/primary.h"
 #include "visibility/receiver.h"
 #include "accel/bvh.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "shadow/microraster/block_traverse.h"
 #include <stdio.h>
 #include <stdlib.h>

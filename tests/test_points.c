@@ -11,7 +11,7 @@
 #include "testutil.h"
 #include "shadow/method.h"
 #include "primary/primary.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>

@@ -11,7 +11,7 @@
 #include "render/ltc.h"
 #include "render/shade.h"
 #include "visibility/receiver.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "camera/camera.h"
 #include <math.h>
 #include <png.h>

@@ -11,7 +11,7 @@
 #include "shadow/raytrace/raytrace.h"
 #include "primary/primary.h"
 #include "visibility/receiver.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -13,7 +13,7 @@
 #define MS_RASTER_H
 #include <stdint.h>
 #include "microshadow.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 
 typedef struct ms_raster_frame {
     float m[3][3];      /* light-index coords of world point X: m * (X - c) */

@@ -4,7 +4,7 @@
  * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
 #include "microshadow.h"
 #include "lightmap_unwrap.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "visibility/receiver.h"
 #include <math.h>
 #include <omp.h>

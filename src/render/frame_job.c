@@ -11,7 +11,7 @@
  * state for the job's life (set-ups such as hpc's light hierarchy and the frusta are per light), so that
  * any call can render any tile for every light. */
 #include "microshadow.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "shadow/method.h"
 #include "primary/primary.h"
 #include "visibility/receiver.h"

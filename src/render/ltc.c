@@ -8,6 +8,7 @@
 #include "microshadow.h"
 #include "ltc_table.h"
 #include "core/vec.h"
+#include "light/light_frame.h"
 #include <math.h>
 
 /* Bilinear Minv (normalised by its (1,1) element) and magnitude at (roughness, cos theta_v). */
@@ -49,11 +50,10 @@ static int light_polygon(const ms_light *l0, const float p[3], float q[DISK_SIDE
         if (ms_light_sphere_outline(l0, p, &disk)) return 0;   /* inside the sphere */
         l = &disk;
     }
-    const float C[3] = { l->corner.x, l->corner.y, l->corner.z };
-    const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
-    const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    float ln[3], rel[3];
-    v3_cross(ln, S, T);
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    const float *C = F.corner, *S = F.edge_s, *T = F.edge_t, *ln = F.normal;
+    float rel[3];
     v3_sub(rel, p, C);
     if (!(v3_dot(rel, ln) > 0.0f)) return 0;   /* behind the emitting side */
     if (l->shape == MS_LIGHT_RECT) {

@@ -5,7 +5,8 @@
  * visible masks, V and S from ms_resolve_vs. A point's sample pattern is keyed like a pixel, so the same
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
+#include "light/light_frame.h"
 #include "shadow/method.h"
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
@@ -134,13 +135,10 @@ static int light_ok(const ms_light *l)
     if (l->shape == MS_LIGHT_SPHERE)   /* centre and radius; the parallelogram fields are unused */
         return isfinite(l->center.x) && isfinite(l->center.y) && isfinite(l->center.z) && isfinite(l->radius) &&
                l->radius > 0.0f;
-    const float v[9] = { l->corner.x, l->corner.y, l->corner.z, l->edge_s.x, l->edge_s.y, l->edge_s.z,
-                         l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    for (int i = 0; i < 9; i++) if (!isfinite(v[i])) return 0;
-    const float nx = l->edge_s.y * l->edge_t.z - l->edge_s.z * l->edge_t.y;
-    const float ny = l->edge_s.z * l->edge_t.x - l->edge_s.x * l->edge_t.z;
-    const float nz = l->edge_s.x * l->edge_t.y - l->edge_s.y * l->edge_t.x;
-    return nx * nx + ny * ny + nz * nz > 0.0f;
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    if (!v3_finite(F.corner) || !v3_finite(F.edge_s) || !v3_finite(F.edge_t)) return 0;
+    return v3_dot(F.normal, F.normal) > 0.0f;
 }
 
 /* Checks the arguments that do not need the method; MS_OK or MS_ERR_INVALID with a message. */

@@ -2,7 +2,7 @@
  * tiled phase of frame_job.c, around one call of the method's frame-level entry. */
 #include "shadow_frame.h"
 #include "primary/primary.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "visibility/receiver.h"
 #include <omp.h>
 #include <stdlib.h>

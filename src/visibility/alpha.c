@@ -1,7 +1,7 @@
 /* The alpha test of alpha-tested occluders (alpha.h). */
 #include "alpha.h"
 #include "core/vec.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

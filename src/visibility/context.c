@@ -1,6 +1,6 @@
 /* Filling the render context (context.h). */
 #include "context.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <string.h>
 
 void ms_render_ctx_init(ms_render_ctx *ctx, const ms_scene *scene, const ms_bvh *bvh, const ms_light *light,

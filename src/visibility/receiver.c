@@ -1,6 +1,7 @@
 /* Front masks and the resolution of V and S (receiver.h). */
 #include "receiver.h"
 #include "core/vec.h"
+#include "light/light_frame.h"
 #include "raster/raster.h"
 #include "core/cpu.h"
 #include <math.h>
@@ -8,9 +9,9 @@
 
 int ms_mask_count(const uint64_t *m, int n)
 {
-    /* Exact on every instance, so no cap applies: the best the CPU has (a portable popcount is a libgcc
-     * call per word, which made counting the masks cost more than the weights). */
-    switch (ms_cpu_isa()) {
+    /* Exact on every instance, so no cap applies (MS_ISA_AUTO): the best the CPU has (a portable popcount
+     * is a libgcc call per word, which made counting the masks cost more than the weights). */
+    switch (ms_isa_select(MS_ISA_AUTO, MS_ISA_ALL)) {
     case MS_ISA_AVX512: return ms_mask_count_avx512(m, n);
     case MS_ISA_AVX2: return ms_mask_count_avx2(m, n);
     default: return ms_mask_count_scalar(m, n);
@@ -83,10 +84,10 @@ static void textured_sums(const ms_render_ctx *ctx, const ms_shadow_query *q, co
                           const uint64_t *vis, float *wf, float *wv, float *rgb)
 {
     const ms_light *L = &ctx->light;
-    const float es[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, et[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
-    float nl[3];
-    v3_cross(nl, es, et);
-    v3_normalize(nl, nl);
+    ms_light_frame F;
+    ms_light_frame_of(L, &F);
+    float nl[3];   /* the light's unit normal */
+    v3_normalize(nl, F.normal);
     float own[3 * MS_SAMPLES_MAX], st[2 * MS_SAMPLES_MAX];
     if (!pts) { ms_pattern_points(ctx->pattern, L, ctx->k, q->px, q->py, ctx->seed, own); pts = own; }
     ms_pattern_st(ctx->pattern, ctx->k, q->px, q->py, ctx->seed, st);
@@ -136,10 +137,10 @@ int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
         *s = wf > 0.0f ? wv / wf : *v;
         return 1;
     }
-    const float es[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, et[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
-    float nl[3];
-    v3_cross(nl, es, et);
-    v3_normalize(nl, nl);
+    ms_light_frame F;
+    ms_light_frame_of(L, &F);
+    float nl[3];   /* the light's unit normal */
+    v3_normalize(nl, F.normal);
     float wf = 0.0f, wv = 0.0f;
     if (pts) {
         for (int i = 0; i < ctx->samples; i++) {
@@ -157,14 +158,14 @@ int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
         ms_grid_for_pixel(L, k, q->px, q->py, ctx->seed, &g);
         ms_horizon_edge(&g, q->p, q->n, h);
         v3_sub(rel0, g.p0, q->p);
-        /* The instance of the capped ISA (the probe is cached: a load and a compare per call). */
+        /* The instance of the capped ISA (ms_isa_select; the probe is cached: a few loads and compares). */
         static const grid_weights_fn by_isa[] = {
             [MS_ISA_SCALAR] = ms_grid_weights_scalar,
             [MS_ISA_AVX2] = ms_grid_weights_avx2,
             [MS_ISA_AVX512] = ms_grid_weights_avx512,
         };
         if (-v3_dot(rel0, nl) > 0.0f)   /* else every cos theta_l <= 0: all weights 0 */
-            by_isa[ms_isa_capped(ctx->isa_cap)](&g, rel0, h, k, front, vis, &wf, &wv);
+            by_isa[ms_isa_select(ctx->isa_cap, MS_ISA_ALL)](&g, rel0, h, k, front, vis, &wf, &wv);
     }
     *s = wf > 0.0f ? wv / wf : *v;
     return 1;

@@ -17,7 +17,7 @@
 #define MS_RECEIVER_H
 #include <stdint.h>
 #include "visibility/context.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
 #error "sample masks alias the k x k scanline buffers as a little-endian bit stream"

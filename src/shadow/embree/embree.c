@@ -28,8 +28,9 @@
 #include "shadow/method.h"
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "core/vec.h"
+#include "light/light_frame.h"
 #include "visibility/embree_scene.h"
 #include <math.h>
 #include <stdio.h>
@@ -56,8 +57,9 @@ static int eb_needs_filter(const ms_render_ctx *ctx, const ms_shadow_query *q)
      * before near/2 (outside the occluding range with a margin) when a > 2 below / near. The height is
      * affine on the light, so its four corners bound every sample's. */
     const ms_light *L = &ctx->light;
-    const float c0[3] = { L->corner.x, L->corner.y, L->corner.z };
-    const float es[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, et[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
+    ms_light_frame F;
+    ms_light_frame_of(L, &F);
+    const float *c0 = F.corner, *es = F.edge_s, *et = F.edge_t;
     float rel[3];
     v3_sub(rel, c0, q->p);
     const float a0 = v3_dot(rel, q->n), as = v3_dot(es, q->n), at = v3_dot(et, q->n);

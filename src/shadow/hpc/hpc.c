@@ -61,7 +61,7 @@
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
 #include "accel/ray_triangle.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "core/vec.h"
 #include "raster/raster.h"
 #include <math.h>

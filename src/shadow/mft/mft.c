@@ -12,7 +12,7 @@
 #include "shadow/method.h"
 #include "mft.h"
 #include "visibility/receiver.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "shadow/microraster/block_group.h"
 #include "core/vec.h"
 #include "accel/ray_triangle.h"
@@ -49,9 +49,10 @@ ms_mft_fn ms_mft_isa(ms_isa isa)
 
 ms_mft_fn ms_mft_select(ms_isa cap, ms_isa *chosen)
 {
-    const ms_isa isa = ms_isa_capped(cap);
-    if (chosen) *chosen = isa;
-    return ms_mft_isa(isa);
+    const ms_isa isa = ms_isa_select(cap, MS_ISA_ALL);
+    const ms_mft_fn fn = isa == MS_ISA_AUTO ? NULL : ms_mft_isa(isa);
+    if (fn && chosen) *chosen = isa;
+    return fn;
 }
 
 void ms_mft_corners(const ms_mft_frame *f, const float c[3], const int r[4], float d[4][3])

@@ -48,7 +48,7 @@
 #include "visibility/lanes16.h"
 #include "core/perk.h"
 #include "accel/ray_triangle.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "visibility/alpha.h"
 
 #define MFT_REL 1e-5f

@@ -15,7 +15,7 @@ ms_block_raster_fn ms_block_raster_isa(int k, ms_isa isa)
 
 ms_block_raster_fn ms_block_raster_select(int k, ms_isa cap, ms_isa *chosen)
 {
-    const ms_isa isa = ms_isa_capped(cap);
+    const ms_isa isa = ms_isa_select(cap, MS_ISA_ALL);
     const ms_block_raster_fn fn = ms_block_raster_isa(k, isa);
     if (fn && chosen) *chosen = isa;
     return fn;

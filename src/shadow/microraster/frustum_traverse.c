@@ -16,7 +16,7 @@ ms_frustum_trace_fn ms_frustum_trace_isa(int k, ms_isa isa)
 ms_frustum_trace_fn ms_frustum_trace_select(int k, ms_isa cap, ms_isa *chosen)
 {
     /* Every level has an instance, so the capped level is the one. */
-    const ms_isa isa = ms_isa_capped(cap);
+    const ms_isa isa = ms_isa_select(cap, MS_ISA_ALL);
     const ms_frustum_trace_fn fn = ms_frustum_trace_isa(k, isa);
     if (fn && chosen) *chosen = isa;
     return fn;

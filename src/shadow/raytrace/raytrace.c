@@ -16,7 +16,7 @@ ms_raytrace_fn ms_raytrace_select(ms_isa cap, ms_isa *chosen)
         [MS_ISA_AVX2] = ms_raytrace_samples_avx2,
         [MS_ISA_AVX512] = ms_raytrace_samples_avx512,
     };
-    const ms_isa isa = ms_isa_capped(cap);   /* every level has an instance */
+    const ms_isa isa = ms_isa_select(cap, MS_ISA_ALL);   /* every level has an instance: never AUTO */
     if (chosen) *chosen = isa;
     return table[isa];
 }

@@ -7,7 +7,7 @@
 #include "raytrace.h"
 #include "visibility/alpha.h"
 #include "core/perk.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "core/vec.h"
 #include "accel/ray_triangle.h"
 #include <math.h>

@@ -2,7 +2,8 @@
  * parameters (s,t) of the light's parallelogram, so every pattern, every method and the weights stay those
  * of the parallelogram, and a disk costs one more mask per receiver (ms_shape_mask, pattern.c). */
 #include "microshadow.h"
-#include "vec.h"
+#include "core/vec.h"
+#include "light_frame.h"
 #include <math.h>
 #include <string.h>
 
@@ -65,10 +66,9 @@ int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk)
 float ms_light_area(const ms_light *l)
 {
     if (l->shape == MS_LIGHT_SPHERE) return 4.0f * (float)M_PI * l->radius * l->radius;
-    const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z }, T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    float n[3];
-    v3_cross(n, S, T);
-    const float a = v3_len(n);
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    const float a = v3_len(F.normal);
     return l->shape == MS_LIGHT_DISK ? a * (float)(M_PI / 4.0) : a;
 }
 

@@ -1,5 +1,6 @@
 #include "pattern.h"
-#include "vec.h"
+#include "light_frame.h"
+#include "core/vec.h"
 #include <math.h>
 #include <string.h>
 
@@ -107,9 +108,9 @@ static void stratified_st(int k, uint32_t px, uint32_t py, uint32_t seed, int n,
 
 void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed, ms_grid *g)
 {
-    const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
-    const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    const float *S = F.edge_s, *T = F.edge_t, *P = F.corner;
     uint32_t h = ms_hash3(px, py, seed);
     float u = ms_hash_unit(h), v = ms_hash_unit(ms_hash3(h, 0x51ED270Bu, seed));
     float kf = (float)k, k2 = kf * kf;
@@ -137,9 +138,9 @@ void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px
         return;
     }
     if (p == MS_PATTERN_INTERLEAVED) {
-        const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
-        const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
-        const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
+        ms_light_frame F;
+        ms_light_frame_of(l, &F);
+        const float *S = F.edge_s, *T = F.edge_t, *P = F.corner;
         const int n = k * k / 16;
         uint32_t u[256], v[256];   /* n <= 4096 / 16 */
         ms_interleaved_uv(k * k, ms_interleaved_set(px, py), seed, u, v);
@@ -152,9 +153,9 @@ void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px
         }
         return;
     }
-    const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
-    const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    const float *S = F.edge_s, *T = F.edge_t, *P = F.corner;
     for (int n = first; n < first + count; n++) {
         float s, t;
         stratified_st(k, px, py, seed, n, &s, &t);

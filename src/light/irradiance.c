@@ -12,7 +12,8 @@
  * the shape with its area (half-diameters scaled by sqrt((2pi/N)/sin(2pi/N))): an approximation, within
  * 1e-4 relative of numerical integration (tests/test_lights.c). */
 #include "microshadow.h"
-#include "vec.h"
+#include "core/vec.h"
+#include "light_frame.h"
 #include <math.h>
 
 #define DISK_POLY 256
@@ -92,11 +93,10 @@ static double sphere_irradiance(const ms_light *l, const float p[3], const float
 float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3])
 {
     if (l->shape == MS_LIGHT_SPHERE) return (float)sphere_irradiance(l, p, n);
-    const float P[3] = { l->corner.x, l->corner.y, l->corner.z };
-    const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
-    const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    float ln[3], rel[3];
-    v3_cross(ln, S, T);
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    const float *P = F.corner, *S = F.edge_s, *T = F.edge_t, *ln = F.normal;
+    float rel[3];
     v3_sub(rel, p, P);
     if (!(v3_dot(rel, ln) > 0.0f)) return 0.0f;   /* behind the emitting side */
 
