@@ -5,6 +5,7 @@
 #include "microshadow.h"
 #include "lightmap_unwrap.h"
 #include "light/pattern.h"
+#include "light/light_shape.h"
 #include "visibility/receiver.h"
 #include <math.h>
 #include <omp.h>
@@ -408,7 +409,8 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
         float c[3] = { 0, 0, 0 }, y = 0.0f;
         for (size_t l = 0; l < nl; l++) {
             ms_light L = lights[l];
-            if (L.texture && L.shape != MS_LIGHT_SPHERE) {
+            const ms_light_shape_ops *shape = ms_light_shape_of(L.shape);
+            if (L.texture && shape && shape->textured) {
                 ms_render_ctx ctx = tctx;
                 ctx.light = L;
                 ms_shadow_query q;

@@ -12,6 +12,7 @@
  * any call can render any tile for every light. */
 #include "microshadow.h"
 #include "light/pattern.h"
+#include "light/light_shape.h"
 #include "shadow/method.h"
 #include "primary/primary.h"
 #include "visibility/receiver.h"
@@ -326,8 +327,9 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
      * it sets up per frame (mft re-derives its light frame per call; hpc sets up its light per call, so
      * a sphere costs it a pass over every triangle per receiver); frame-level entries are not used. The
      * price is the block traversal's coherence: groups of one. */
-    const int sphere = ctx.light.shape == MS_LIGHT_SPHERE;
-    const int shadow_tiles = sm->visibility_all && !sphere ? 0 : n;   /* a frame-level method: shadow_frame.c */
+    const ms_light_shape_ops *shape = ms_light_shape_of(ctx.light.shape);
+    const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
+    const int shadow_tiles = sm->visibility_all && !outlined ? 0 : n;   /* a frame-level method: shadow_frame.c */
 #pragma omp parallel num_threads(j->threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
@@ -356,7 +358,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     q[nq].prim = h->prim;
                     q[nq].px = (uint32_t)x;
                     q[nq].py = (uint32_t)y;
-                    if (sphere && ms_light_sphere_outline(&ctx.light, q[nq].p, &qc.light)) {
+                    if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                         vis[i] = shadow[i] = spec[i] = 0.0f;   /* inside the sphere: no sample counts */
                         fr[i] = 0;
                         local_visible++;
@@ -368,16 +370,16 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     local_segments += (uint64_t)nf;
                     where[nq++] = i;
                 }
-            if (!sphere) {
+            if (!outlined) {
                 if (nq && ok && sm->visibility(sstate, &ctx, q, nq, front, vmask, local)) ok = 0;
             } else
                 for (int i = 0; i < nq && ok; i++) {
-                    ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                    shape->outline(&ctx.light, q[i].p, &qc.light);
                     if (sm->visibility(sstate, &qc, &q[i], 1, front + (size_t)i * mw, vmask + (size_t)i * mw, local)) ok = 0;
                 }
             const double tr = omp_get_wtime();
             for (int i = 0; i < nq && ok; i++) {
-                if (sphere) ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                if (outlined) shape->outline(&ctx.light, q[i].p, &qc.light);
                 if (pts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
                 local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[i], pts, front + (size_t)i * mw,
                                                           vmask + (size_t)i * mw, &vis[where[i]],
@@ -403,7 +405,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
             failed |= !ok;
         }
     }
-    if (sm->visibility_all && !sphere && !failed) {
+    if (sm->visibility_all && !outlined && !failed) {
         size_t *pixels = NULL, np = 0;
         if (!whole) {   /* the listed tiles' pixels, tile after tile */
             pixels = malloc((size_t)n * TILE * TILE * sizeof *pixels);

@@ -6,6 +6,7 @@
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"
 #include "light/pattern.h"
+#include "light/light_shape.h"
 #include "light/light_frame.h"
 #include "shadow/method.h"
 #include "visibility/receiver.h"
@@ -234,7 +235,8 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     ctx.embree_mode = opt->embree_mode;
     ctx.embree_filter = opt->embree_filter;
     ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
-    const int sphere = light->shape == MS_LIGHT_SPHERE;
+    const ms_light_shape_ops *shape = ms_light_shape_of(light->shape);
+    const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
 
     const size_t n = pts->n;
     /* Proximity order: Morton codes in the points' bounding box, ties by index (a total order). */
@@ -304,7 +306,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
             for (int j = 0; j < m; j++) {
                 const size_t i = order[i0 + j].index;
                 make_query(a, pts, i, &q[nq]);
-                if (sphere && ms_light_sphere_outline(&ctx.light, q[nq].p, &qc.light)) {
+                if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                     if (front_out) front_out[i] = 0;
                     if (vis) vis[i] = 0.0f;
                     if (shadow) shadow[i] = 0.0f;
@@ -317,10 +319,10 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
                 where[nq++] = i;
             }
             int vfail = 0;
-            if (!sphere) vfail = nq && sm->visibility(sstate, &ctx, q, nq, fm, vm, local);
+            if (!outlined) vfail = nq && sm->visibility(sstate, &ctx, q, nq, fm, vm, local);
             else
                 for (int j = 0; j < nq && !vfail; j++) {
-                    ms_light_sphere_outline(&ctx.light, q[j].p, &qc.light);
+                    shape->outline(&ctx.light, q[j].p, &qc.light);
                     vfail = sm->visibility(sstate, &qc, &q[j], 1, fm + (size_t)j * mw, vm + (size_t)j * mw, local);
                 }
             if (vfail) {
@@ -333,7 +335,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
             for (int j = 0; j < nq; j++) {
                 const size_t i = where[j];
                 float v, s;
-                if (sphere) ms_light_sphere_outline(&ctx.light, q[j].p, &qc.light);
+                if (outlined) shape->outline(&ctx.light, q[j].p, &qc.light);
                 if (spts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
                 local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[j], spts, fm + (size_t)j * mw, vm + (size_t)j * mw, &v, &s);
                 if (vis) vis[i] = v;
