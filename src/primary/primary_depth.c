@@ -6,8 +6,8 @@
  * same watertight ray/triangle test and the same rays as the BVH
  * primary (ms_camera_ray, ms_wt_intersect with the triangle's ms_wt_normal, t in [0, inf)), keeping the
  * nearest; ties go to the smaller triangle index (the BVH keeps the last one it tests, so the two may
- * differ only at exact ties). The hit is finished as ms_hit_finish does (point o + t d, normal of the
- * triangle's two edges from vertex 0 facing the eye). The whole pass runs in create; trace copies.
+ * differ only at exact ties). The hit is finished by ms_hit_finish_tri, as every primary finishes it. The
+ * whole pass runs in create; trace copies.
  * Threads split the image into row bands, each band sees every triangle of a batch: no locks. */
 #include "primary.h"
 #include "accel/ray_triangle.h"
@@ -127,16 +127,7 @@ static void depth_triangle(const ms_render_ctx *ctx, depth_state *s, const float
             if (!ms_wt_intersect(&w, tri, N, 0.0f, s->t[i], &t, &u, &v)) continue;
             if (t == s->t[i] && s->hits[i].prim < id) continue;
             s->t[i] = t;
-            ms_hit *h = &s->hits[i];
-            float e1[3], e2[3], n[3];
-            v3_sub(e1, tri + 3, tri);
-            v3_sub(e2, tri + 6, tri);
-            v3_cross(n, e1, e2);
-            v3_normalize(n, n);
-            if (v3_dot(n, d) > 0.0f) v3_scale(n, n, -1.0f);
-            v3_madd(h->p, o, d, t);
-            memcpy(h->n, n, sizeof n);
-            h->prim = id;
+            ms_hit_finish_tri(tri, o, d, t, id, &s->hits[i]);
         }
 }
 
