@@ -21,7 +21,7 @@
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
 #include "raster/raster.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "core/vec.h"
 
 static inline uint64_t tsc(void)
