@@ -30,12 +30,12 @@
  *  - the hard-shadow test of a sample (L70) is the reference tracer's watertight ray/triangle test from the
  *    receiver to the sample (ms_wt_segment_sheared in accel/ray_triangle.h, the scalar form of raytrace's
  *    lane loop: the same shear axis of the 16-sample packet, the same float operations, the same double
- *    fall-back on a zero edge function). Its
- *    three edge functions are the signed volumes of the sample, the receiver and each triangle edge, i.e.
- *    the receiver against the three planes of V_li through the sample and the edges, and its t range is
- *    the fourth plane, the triangle's, moved to the near/far range of the visibility definition. Evaluated
- *    this way the answer equals raytrace bit for bit; the plane form rounds differently at the edges. The
- *    per-point part of "constructing V_li" (the packet shear axes) is made lazily with the point's mask.
+ *    fall-back on a zero edge function). Its three edge functions are the signed volumes of the sample,
+ *    the receiver and each triangle edge, i.e. the receiver against the three planes of V_li through the
+ *    sample and the edges, and its t range is the fourth plane, the triangle's, moved to the near/far
+ *    range of the visibility definition. Evaluated this way the answer equals raytrace bit for bit; the
+ *    plane form rounds differently at the edges. The per-point part of "constructing V_li" (the packet
+ *    shear axes, ms_wt_packet_axis) is made lazily with the point's mask.
  *  - the penumbra volumes cull with a margin (hpc_volume.h) that covers the rounding of that exact test:
  *    the error of a float test is magnified behind the triangle by (distance to the light) / (triangle's
  *    distance from the light, bounded below on separating axes), so the margin grows with it
