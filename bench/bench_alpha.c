@@ -1,4 +1,4 @@
-/* What an alpha-tested triangle costs the micro-rasterizer (src/shadow/alpha.c, ms_alpha_raster), in TSC cycles:
+/* What an alpha-tested triangle costs the micro-rasterizer (src/visibility/alpha.c, ms_alpha_raster), in TSC cycles:
  * for every (visible point, alpha-tested triangle) pair of a frame whose triangle covers some of the point's
  * visible samples, the Scanline kernel alone into the point's buffer (what an opaque triangle costs) against
  * ms_alpha_raster (the kernel into a scratch buffer, the merge, one alpha lookup per covered visible sample);

@@ -1,7 +1,7 @@
 /* Visibility at caller-given points (microshadow.h, "Visibility at any points"): the driver ms_render
  * is for frames, without the camera. Points are grouped by proximity (30-bit Morton codes of their
  * positions in the points' bounding box) into batches of BATCH, and each batch goes through the shadow
- * method interface exactly as a frame tile does in render.c: front masks (receiver.c), the method's
+ * method interface exactly as a frame tile does in frame_job.c: front masks (receiver.c), the method's
  * visible masks, V and S from ms_resolve_vs. A point's sample pattern is keyed like a pixel, so the same
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"

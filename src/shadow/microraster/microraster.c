@@ -15,7 +15,7 @@
  * kernels' boxes do. Such points are answered by the reference per-sample tracer instead, on the same
  * samples; they are counted (pixels_traced_edge_on) and are few: the light barely reaches them.
  *
- * The render context's switches (method.h) cap the kernels' and the traversal's instruction set and
+ * The render context's switches (visibility/context.h) cap the kernels' and the traversal's instruction set and
  * switch off the coverage test and the near-first child order; the library reads no environment. */
 #include "shadow/method.h"
 #include "shadow/raytrace/raytrace.h"
