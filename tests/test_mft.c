@@ -24,10 +24,7 @@ static void render_ok(const ms_scene *sc, const char *method, ms_pattern pat, in
     o.pattern = pat;
     o.samples = samples;
     o.width = o.height = size;
-    char err[512];
-    int rc = ms_render(sc, &o, f, err, sizeof err);
-    if (rc) fprintf(stderr, "render %s: %s\n", method, err);
-    assert_int_equal(rc, 0);
+    tu_render_ok(sc, &o, f);
 }
 
 /* mft equals raytrace, V and S, at every pixel, for the three patterns (interleaved: filtered, so the
