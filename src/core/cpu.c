@@ -61,13 +61,6 @@ ms_isa ms_isa_capped(ms_isa cap)
     return cap == MS_ISA_AUTO || cap > best ? best : cap;
 }
 
-ms_isa ms_isa_select(ms_isa cap, unsigned have)
-{
-    for (ms_isa isa = ms_isa_capped(cap); isa >= MS_ISA_SCALAR; isa = (ms_isa)(isa - 1))
-        if (have >> isa & 1u) return isa;
-    return MS_ISA_AUTO;
-}
-
 const char *ms_isa_name(ms_isa isa)
 {
     switch (isa) {

@@ -40,6 +40,12 @@ ms_isa ms_isa_capped(ms_isa cap);
  * never above the cap or the probe. MS_ISA_AUTO when no level at or below has one: the dispatcher then
  * returns NULL and leaves its *chosen untouched. */
 #define MS_ISA_ALL ((1u << MS_ISA_SCALAR) | (1u << MS_ISA_AVX2) | (1u << MS_ISA_AVX512))
-ms_isa ms_isa_select(ms_isa cap, unsigned have);
+static inline ms_isa ms_isa_select(ms_isa cap, unsigned have)
+{
+    /* Inline: the S weights and the mask popcount select per receiver. */
+    for (ms_isa isa = ms_isa_capped(cap); isa >= MS_ISA_SCALAR; isa = (ms_isa)(isa - 1))
+        if (have >> isa & 1u) return isa;
+    return MS_ISA_AUTO;
+}
 
 #endif
