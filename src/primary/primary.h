@@ -34,4 +34,14 @@ void ms_hit_finish(const ms_render_ctx *ctx, const float o[3], const float d[3],
 /* The same from the triangle's 9 floats (for passes without a BVH). */
 void ms_hit_finish_tri(const float *tri, const float o[3], const float d[3], float t, uint32_t prim, ms_hit *h);
 
+/* The shadow query of a primary hit at pixel (x, y): the hit point, its normal and triangle (the one way
+ * frames, their shading and the tests turn a hit into a receiver). */
+static inline void ms_query_from_hit(ms_shadow_query *q, const ms_hit *h, uint32_t x, uint32_t y)
+{
+    for (int a = 0; a < 3; a++) { q->p[a] = h->p[a]; q->n[a] = h->n[a]; }
+    q->prim = h->prim;
+    q->px = x;
+    q->py = y;
+}
+
 #endif

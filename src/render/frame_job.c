@@ -353,11 +353,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     size_t i = (size_t)y * W + x;
                     const ms_hit *h = &hits[i];
                     if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
-                    memcpy(q[nq].p, h->p, sizeof h->p);
-                    memcpy(q[nq].n, h->n, sizeof h->n);
-                    q[nq].prim = h->prim;
-                    q[nq].px = (uint32_t)x;
-                    q[nq].py = (uint32_t)y;
+                    ms_query_from_hit(&q[nq], h, (uint32_t)x, (uint32_t)y);
                     if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                         vis[i] = shadow[i] = spec[i] = 0.0f;   /* inside the sphere: no sample counts */
                         fr[i] = 0;

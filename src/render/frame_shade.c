@@ -34,11 +34,7 @@ static int texture_means(const ms_render_ctx *ctx0, const ms_light *lights, size
         for (size_t i = 0; i < npix; i++) {
             if (hits[i].prim == UINT32_MAX) continue;
             ms_shadow_query q;
-            memcpy(q.p, hits[i].p, sizeof q.p);
-            memcpy(q.n, hits[i].n, sizeof q.n);
-            q.prim = hits[i].prim;
-            q.px = (uint32_t)(i % (size_t)W);
-            q.py = (uint32_t)(i / (size_t)W);
+            ms_query_from_hit(&q, &hits[i], (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
             ms_light_texture_mean(&ctx, &q, tl + 3 * i);
         }
     }

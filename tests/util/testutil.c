@@ -140,11 +140,7 @@ tu_agreement tu_compare_frames(const ms_frame *a, const ms_frame *b)
 
 void tu_query_from_hit(ms_shadow_query *q, const ms_hit *h, int x, int y)
 {
-    memcpy(q->p, h->p, sizeof q->p);
-    memcpy(q->n, h->n, sizeof q->n);
-    q->prim = h->prim;
-    q->px = (uint32_t)x;
-    q->py = (uint32_t)y;
+    ms_query_from_hit(q, h, (uint32_t)x, (uint32_t)y);
 }
 
 void tu_ctx_init(ms_render_ctx *ctx, const ms_scene *sc, const ms_bvh *bvh, int W, int H, int k)

@@ -62,6 +62,7 @@
 #include "visibility/alpha.h"
 #include "accel/ray_triangle.h"
 #include "light/pattern.h"
+#include "light/light_frame.h"
 #include "core/vec.h"
 #include "raster/raster.h"
 #include <math.h>
@@ -703,14 +704,13 @@ int ms_hpc_cast(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster, con
     sh.kz_off = sh.frame_off + (scanline ? sizeof(ms_raster_frame) : 0);
     sh.slot_bytes = (sh.kz_off + (size_t)sh.npk + 63) / 64 * 64;
     {
-        const ms_light *L = &ctx->light;
-        const float c[4][3] = { { L->corner.x, L->corner.y, L->corner.z },
-                                { L->corner.x + L->edge_s.x, L->corner.y + L->edge_s.y, L->corner.z + L->edge_s.z },
-                                { L->corner.x + L->edge_t.x, L->corner.y + L->edge_t.y, L->corner.z + L->edge_t.z },
-                                { L->corner.x + L->edge_s.x + L->edge_t.x, L->corner.y + L->edge_s.y + L->edge_t.y,
-                                  L->corner.z + L->edge_s.z + L->edge_t.z } };
-        for (int v = 0; v < 4; v++)
-            for (int a = 0; a < 3; a++) sh.scale = ms_maxf(sh.scale, 2.0f * fabsf(c[v][a]));
+        ms_light_frame F;
+        ms_light_frame_of(&ctx->light, &F);
+        for (int a = 0; a < 3; a++) {   /* the light's four corners */
+            const float c[4] = { F.corner[a], F.corner[a] + F.edge_s[a], F.corner[a] + F.edge_t[a],
+                                 F.corner[a] + F.edge_s[a] + F.edge_t[a] };
+            for (int v = 0; v < 4; v++) sh.scale = ms_maxf(sh.scale, 2.0f * fabsf(c[v]));
+        }
     }
     for (size_t i = 0; i < n; i++)
         for (int a = 0; a < 3; a++) sh.scale = ms_maxf(sh.scale, fabsf(q[i].p[a]));

@@ -99,7 +99,7 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
 }
 
 /* The frame's light: corner, edges and the margin of the stored points. Per frame, or per call when the
- * context's light is not the frame's (a sphere light's per-receiver outline disk, render.c). */
+ * context's light is not the frame's (a sphere light's per-receiver outline disk, frame_job.c). */
 static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
 {
     const double P[3] = { l->corner.x, l->corner.y, l->corner.z }, S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
