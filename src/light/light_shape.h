@@ -1,7 +1,8 @@
 /* The light-shape table: one row per shape (microshadow.h's ms_light_shape), each in its own file
  * (light_rect.c, light_disk.c, light_sphere.c), over the light's precomputed frame (light_frame.h). A new
  * shape is one file with its row plus its entry in light_shape.c's table (CONTRIBUTING.md); the scene
- * file's parsing and validation of its keys stay in src/scene (scene_json.c, scene_validate.c).
+ * file's parsing of its keys stays in src/scene (scene_json.c), which checks a light with its row's
+ * validate (scene_validate.c).
  *
  * Every shape is a mask over the parameters (s,t) of a parallelogram, so every pattern, every method and
  * the weights stay those of the parallelogram; a shape that is not planar (the sphere) stands, for each
@@ -10,6 +11,7 @@
 #define MS_LIGHT_SHAPE_H
 #include "microshadow.h"
 #include "light_frame.h"
+#include <stddef.h>
 
 typedef struct ms_light_shape_ops {
     ms_light_shape shape;
@@ -28,6 +30,9 @@ typedef struct ms_light_shape_ops {
      * shapes as `sides` vertices inscribed and scaled to the shape's area; returns the vertex count (at most
      * max(4, sides)). */
     int (*polygon)(const ms_light_frame *F, const float p[3], int sides, float (*q)[3]);
+    /* The checks of the shape's own fields beyond the parallelogram's (a scene's lights, scene_validate.c):
+     * 0, or -1 with the problem in msg; coordinates must stay within +-max_coord. NULL: none. */
+    int (*validate)(const ms_light *l, float max_coord, char *msg, size_t n);
 } ms_light_shape_ops;
 
 /* The row of a shape; NULL for a value outside the enum (validation refuses those before they get here). */

@@ -3,6 +3,7 @@
 #include "light_shape.h"
 #include "core/vec.h"
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 int ms_light_sphere(ms_light *l, ms_vec3 c, float r)
@@ -62,6 +63,16 @@ static float sphere_irradiance_f(const ms_light *l, const ms_light_frame *F, con
     return (float)sphere_irradiance(l, p, n);
 }
 
+static int sphere_validate(const ms_light *l, float max_coord, char *msg, size_t n)
+{
+    const ms_vec3 c = l->center;
+    const int centre_ok = isfinite(c.x) && isfinite(c.y) && isfinite(c.z) && fabsf(c.x) <= max_coord &&
+                          fabsf(c.y) <= max_coord && fabsf(c.z) <= max_coord;
+    if (centre_ok && l->radius > 0.0f && l->radius <= max_coord && !l->texture) return 0;
+    snprintf(msg, n, "a sphere needs a finite center and a radius in (0, %g], and no texture", (double)max_coord);
+    return -1;
+}
+
 const ms_light_shape_ops ms_light_sphere_shape = {
     .shape = MS_LIGHT_SPHERE,
     .name = "sphere",
@@ -69,4 +80,5 @@ const ms_light_shape_ops ms_light_sphere_shape = {
     .area = sphere_area,
     .irradiance = sphere_irradiance_f,
     .outline = ms_light_sphere_outline,
+    .validate = sphere_validate,
 };

@@ -1,5 +1,6 @@
 #include "pattern.h"
 #include "light_frame.h"
+#include "light_shape.h"
 #include "core/vec.h"
 #include <math.h>
 #include <string.h>
@@ -235,11 +236,26 @@ void ms_shape_mask_reference(ms_pattern p, const ms_light *l, int k, uint32_t px
 void ms_shape_mask_apply(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                          uint64_t *mask)
 {
-    if (l->shape == MS_LIGHT_RECT) return;
+    const ms_light_shape_ops *shape = ms_light_shape_of(l->shape);
+    if (!shape || !shape->contains) return;   /* no mask: the whole parallelogram */
     const int spp = ms_pattern_spp(p, k);
+    if (p == MS_PATTERN_GRID && l->shape != MS_LIGHT_DISK) {
+        /* A shape without a row-span fast path: its samples one by one, (s, t) as grid_inside forms them. */
+        float u, v;
+        grid_shift(px, py, seed, &u, &v);
+        const float ik = 1.0f / (float)k;
+        for (int j = 0; j < k; j++)
+            for (int i = 0; i < k; i++) {
+                const float s = ((float)i + ((float)(k - 1 - j) + u) * ik) * ik, t = ((float)j + ((float)i + v) * ik) * ik;
+                const int n = j * k + i;
+                if (!shape->contains(s, t)) mask[n >> 6] &= ~(UINT64_C(1) << (n & 63));
+            }
+        return;
+    }
     if (p == MS_PATTERN_GRID) {
-        /* s_ij = (i + (k-1-j+u)/k)/k, t_ij = (j + (i+v)/k)/k, in this order of operations (the definition
-         * of the grid's parameters; the world positions are the affine p0 + i ds + j dt of the same). */
+        /* The disk, row by row (grid_row_span). s_ij = (i + (k-1-j+u)/k)/k, t_ij = (j + (i+v)/k)/k, in this
+         * order of operations (the definition of the grid's parameters; the world positions are the affine
+         * p0 + i ds + j dt of the same). */
         float u, v;
         grid_shift(px, py, seed, &u, &v);
         for (int j = 0; j < k; j++) {
