@@ -1,4 +1,4 @@
-/* What an alpha-tested triangle costs the micro-rasterizer (src/shadow/alpha.c, ms_alpha_raster), in TSC cycles:
+/* What an alpha-tested triangle costs the micro-rasterizer (src/visibility/alpha.c, ms_alpha_raster), in TSC cycles:
  * for every (visible point, alpha-tested triangle) pair of a frame whose triangle covers some of the point's
  * visible samples, the Scanline kernel alone into the point's buffer (what an opaque triangle costs) against
  * ms_alpha_raster (the kernel into a scratch buffer, the merge, one alpha lookup per covered visible sample);
@@ -17,10 +17,11 @@
 #include <x86intrin.h>
 #include "microshadow.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
-#include "shadow/alpha.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
 #include "raster/raster.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include "core/vec.h"
 
 static inline uint64_t tsc(void)
@@ -64,18 +65,8 @@ int main(int argc, char **argv)
     if (ms_bvh_build(&bvh, sc.tri, sc.n_tris, 0) || ms_alpha_build(&sc, &bvh, &alpha)) { fprintf(stderr, "out of memory\n"); return 1; }
     if (!alpha) { fprintf(stderr, "%s: no alpha-tested triangles\n", path); return 2; }
     ms_render_ctx ctx;
-    memset(&ctx, 0, sizeof ctx);
+    ms_render_ctx_init(&ctx, &sc, &bvh, sc.n_lights ? &sc.lights[0] : &sc.light, MS_PATTERN_GRID, k, 0, 1);
     if (ms_camera_basis_init(&ctx.cam, &sc.camera, size, size)) { fprintf(stderr, "bad camera\n"); return 2; }
-    ctx.scene = &sc;
-    ctx.bvh = &bvh;
-    ctx.light = sc.n_lights ? sc.lights[0] : sc.light;
-    ctx.pattern = MS_PATTERN_GRID;
-    ctx.k = k;
-    ctx.samples = k * k;
-    ctx.mask_words = k * k / 64;
-    ctx.near = 1e-4f;
-    ctx.far = 1.0f - 1e-4f;
-    ctx.threads = 1;
     ctx.alpha = alpha;
     ms_isa isa;
     const ms_raster_fn kernel = ms_raster_kernel(MS_KERNEL_SCANLINE, k, MS_ISA_AUTO, &isa);

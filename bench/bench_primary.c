@@ -17,6 +17,7 @@
 #include "microshadow.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include <omp.h>
 #include <stdint.h>
 #include <stdio.h>

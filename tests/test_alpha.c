@@ -13,10 +13,11 @@
  * against the oracle), and whole frames of every method equal raytrace's. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
-#include "shadow/alpha.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
 #include "accel/bvh.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -11,6 +11,7 @@
  *   - the CLI writes the EXR and the PNG together and refuses bad options with exit 2. */
 #include "testutil.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -7,8 +7,7 @@
  *   - the CLI: a two-light bake's EXR has S0, S1, V0, V1 equal to the API's planes, --vis as PFM is light
  *     0, --shadow as EXR has every light. */
 #include "testutil.h"
-#include <OpenEXR/openexr.h>
-#include "../src/core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -247,45 +246,6 @@ static void test_sphere_every_method(void **st)
     sphere_every_method(sphere_light(0.3f, 1.6f, 0.2f, 1.2f, (ms_vec3){ 1, 1, 1 }), 1);
 }
 
-/* Reads channel `name` of a one-part EXR (w x h) as floats into img; -1 if absent. */
-static int read_exr_channel(const char *path, const char *name, int w, int h, float *img)
-{
-    exr_context_t ctx = NULL;
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    assert_int_equal(exr_start_read(&ctx, path, &init), EXR_ERR_SUCCESS);
-    const exr_attr_chlist_t *chl = NULL;
-    assert_int_equal(exr_get_channels(ctx, 0, &chl), EXR_ERR_SUCCESS);
-    int want = -1;
-    for (int c = 0; c < chl->num_channels; c++)
-        if (!strcmp(chl->entries[c].name.str, name)) want = c;
-    if (want < 0) { exr_finish(&ctx); return -1; }
-    exr_attr_box2i_t dw;
-    assert_int_equal(exr_get_data_window(ctx, 0, &dw), EXR_ERR_SUCCESS);
-    assert_int_equal(dw.max.x - dw.min.x + 1, w);
-    assert_int_equal(dw.max.y - dw.min.y + 1, h);
-    int lines = 0;
-    assert_int_equal(exr_get_scanlines_per_chunk(ctx, 0, &lines), EXR_ERR_SUCCESS);
-    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
-    int dec_init = 0;
-    for (int y = dw.min.y; y <= dw.max.y; y += lines) {
-        exr_chunk_info_t ci;
-        assert_int_equal(exr_read_scanline_chunk_info(ctx, 0, y, &ci), EXR_ERR_SUCCESS);
-        if (!dec_init) assert_int_equal(exr_decoding_initialize(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
-        else assert_int_equal(exr_decoding_update(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
-        for (int c = 0; c < dec.channel_count; c++) dec.channels[c].decode_to_ptr = NULL;
-        dec.channels[want].decode_to_ptr = (uint8_t *)(img + (size_t)(ci.start_y - dw.min.y) * w);
-        dec.channels[want].user_pixel_stride = sizeof(float);
-        dec.channels[want].user_line_stride = (int32_t)sizeof(float) * w;
-        dec.channels[want].user_bytes_per_element = sizeof(float);
-        dec.channels[want].user_data_type = EXR_PIXEL_FLOAT;
-        if (!dec_init) { assert_int_equal(exr_decoding_choose_default_routines(ctx, 0, &dec), EXR_ERR_SUCCESS); dec_init = 1; }
-        assert_int_equal(exr_decoding_run(ctx, 0, &dec), EXR_ERR_SUCCESS);
-    }
-    exr_decoding_destroy(ctx, &dec);
-    exr_finish(&ctx);
-    return 0;
-}
-
 /* PFM (little-endian, rows bottom to top) into img. */
 static void read_pfm(const char *path, int w, int h, float *img)
 {
@@ -341,14 +301,14 @@ static void test_cli_channels(void **st)
     assert_non_null(img);
     static const char *const names[] = { "S0", "S1", "V0", "V1" };
     for (int c = 0; c < 4; c++) {
-        assert_int_equal(read_exr_channel(exr, names[c], size, size, img), 0);
+        assert_int_equal(tu_read_exr_channel(exr, names[c], size, size, img), 0);
         const float *want = (names[c][0] == 'S' ? lm.frame.shadow : lm.frame.vis) + (size_t)(names[c][1] - '0') * nt;
         assert_memory_equal(img, want, nt * sizeof *img);
     }
-    assert_int_equal(read_exr_channel(exr, "V", size, size, img), -1);   /* no plain V with several lights */
-    assert_int_equal(read_exr_channel(exr, "R", size, size, img), 0);
+    assert_int_equal(tu_read_exr_channel(exr, "V", size, size, img), -1);   /* no plain V with several lights */
+    assert_int_equal(tu_read_exr_channel(exr, "R", size, size, img), 0);
     for (size_t i = 0; i < nt; i++) assert_true(img[i] == lm.frame.rgb[3 * i]);
-    assert_int_equal(read_exr_channel(sh, "S1", size, size, img), 0);
+    assert_int_equal(tu_read_exr_channel(sh, "S1", size, size, img), 0);
     assert_memory_equal(img, lm.frame.shadow + nt, nt * sizeof *img);
     read_pfm(vis, size, size, img);
     assert_memory_equal(img, lm.frame.vis, nt * sizeof *img);

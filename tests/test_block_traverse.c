@@ -5,7 +5,8 @@
  * collapse of the deep one. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
 #include "accel/bvh.h"
 #include "core/cpu.h"
 #include <math.h>

@@ -9,6 +9,7 @@
 #include "camera/camera.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -624,9 +625,7 @@ static void render_ok(const ms_scene *sc, const char *method, int w, int h, ms_f
     o.width = w;
     o.height = h;
     o.seed = 3;
-    char err[512] = "";
-    const int rc = ms_render(sc, &o, f, err, sizeof err);
-    if (rc) fail_msg("ms_render(%s): %s", method, err);
+    tu_render_ok(sc, &o, f);
 }
 
 /* End to end, every type: whole frames of the built-in scene by the reference ray tracer and by the

@@ -8,8 +8,9 @@
  * Frames are small (48x48 to 128x128): raytrace is ~100x slower in a Debug+ASan build, and the whole
  * test must stay under about a minute there; the Release build runs it in a few seconds. */
 #include "testutil.h"
-#include "shadow/receiver.h"
+#include "visibility/receiver.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

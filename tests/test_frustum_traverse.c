@@ -7,9 +7,10 @@
  * instance; the shared scenes are skipped when absent. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/frustum_traverse.h"
+#include "primary/primary.h"
+#include "shadow/microraster/frustum_traverse.h"
 #include "raster/raster.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

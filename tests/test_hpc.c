@@ -1,4 +1,4 @@
-/* Hierarchical penumbra casting (methods hpc and hpc-scanline, src/shadow/hpc.c) against the reference ray
+/* Hierarchical penumbra casting (methods hpc and hpc-scanline, src/shadow/hpc/hpc.c) against the reference ray
  * tracer on identical samples:
  *   - hpc equals raytrace sample for sample: V and S bit for bit at every pixel (its per-sample decision is
  *     raytrace's own ray/triangle test; the volumes only cull, with a margin), on the built-in scene, the
@@ -14,8 +14,10 @@
  *     with one line naming the file (exit 2 through the CLI). */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
-#include "shadow/hpc.h"
+#include "shadow/raytrace/raytrace.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "shadow/hpc/hpc.h"
 #include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>
@@ -30,10 +32,7 @@ static void render_ok(const ms_scene *sc, const char *method, int samples, int s
     o.samples = samples;
     o.width = o.height = size;
     o.threads = threads;
-    char err[512];
-    int rc = ms_render(sc, &o, f, err, sizeof err);
-    if (rc) fprintf(stderr, "render %s: %s\n", method, err);
-    assert_int_equal(rc, 0);
+    tu_render_ok(sc, &o, f);
 }
 
 /* hpc bit for bit, hpc-scanline within ties. */

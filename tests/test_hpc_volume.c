@@ -1,10 +1,10 @@
-/* Penumbra volumes (src/shadow/hpc_volume.c, Laine & Aila 2005 sec. 3.2) against brute force: for random
+/* Penumbra volumes (src/shadow/hpc/hpc_volume.c, Laine & Aila 2005 sec. 3.2) against brute force: for random
  * light rectangles and triangles, every point that some segment from a point of the rectangle through the
  * triangle reaches (sampled densely, in double) lies inside the volume, with margin 0; and a box around
  * such a point is never culled. Also reports how tight the volume is: the share of sampled points inside
  * it that are shadowed from at least one of 64 light points. */
 #include "testutil.h"
-#include "shadow/hpc_volume.h"
+#include "shadow/hpc/hpc_volume.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>

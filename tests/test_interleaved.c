@@ -18,7 +18,8 @@
  * 192x192 (filtered 0.0029 vs 0.0060 for stratified 16; its 4096-sample raytrace reference costs ~10 s
  * under ASan, twice that at 256x256); the paper's frames are 1024x1024. */
 #include "testutil.h"
-#include "core/pattern.h"
+#include "primary/primary.h"
+#include "light/pattern.h"
 #include "render/interleave_filter.h"
 #include <math.h>
 #include <stdio.h>

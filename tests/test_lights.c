@@ -8,11 +8,11 @@
  *   - units: watts and lumens against hand-computed radiances;
  *   - bad light JSON: exit 2 and one line naming the file and the problem. */
 #include "testutil.h"
-#include <OpenEXR/openexr.h>
-#include "../src/shadow/method.h"
-#include "../src/shadow/receiver.h"
-#include "../src/core/pattern.h"
-#include "../src/accel/bvh.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "light/pattern.h"
+#include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -547,45 +547,6 @@ static void test_vis_outputs(void **st)
     ms_scene_free(&sc);
 }
 
-/* Reads channel `name` of a one-part float EXR of w x h into img; -1 if absent. */
-static int read_exr_channel(const char *path, const char *name, int w, int h, float *img)
-{
-    exr_context_t ctx = NULL;
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    assert_int_equal(exr_start_read(&ctx, path, &init), EXR_ERR_SUCCESS);
-    const exr_attr_chlist_t *chl = NULL;
-    assert_int_equal(exr_get_channels(ctx, 0, &chl), EXR_ERR_SUCCESS);
-    int want = -1;
-    for (int c = 0; c < chl->num_channels; c++)
-        if (!strcmp(chl->entries[c].name.str, name)) want = c;
-    if (want < 0) { exr_finish(&ctx); return -1; }
-    exr_attr_box2i_t dw;
-    assert_int_equal(exr_get_data_window(ctx, 0, &dw), EXR_ERR_SUCCESS);
-    assert_int_equal(dw.max.x - dw.min.x + 1, w);
-    assert_int_equal(dw.max.y - dw.min.y + 1, h);
-    int lines = 0;
-    assert_int_equal(exr_get_scanlines_per_chunk(ctx, 0, &lines), EXR_ERR_SUCCESS);
-    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
-    int dec_init = 0;
-    for (int y = dw.min.y; y <= dw.max.y; y += lines) {
-        exr_chunk_info_t ci;
-        assert_int_equal(exr_read_scanline_chunk_info(ctx, 0, y, &ci), EXR_ERR_SUCCESS);
-        if (!dec_init) assert_int_equal(exr_decoding_initialize(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
-        else assert_int_equal(exr_decoding_update(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
-        for (int c = 0; c < dec.channel_count; c++) dec.channels[c].decode_to_ptr = NULL;   /* skip the others */
-        dec.channels[want].decode_to_ptr = (uint8_t *)(img + (size_t)(ci.start_y - dw.min.y) * w);
-        dec.channels[want].user_pixel_stride = sizeof(float);
-        dec.channels[want].user_line_stride = (int32_t)sizeof(float) * w;
-        dec.channels[want].user_bytes_per_element = sizeof(float);
-        dec.channels[want].user_data_type = EXR_PIXEL_FLOAT;
-        if (!dec_init) { assert_int_equal(exr_decoding_choose_default_routines(ctx, 0, &dec), EXR_ERR_SUCCESS); dec_init = 1; }
-        assert_int_equal(exr_decoding_run(ctx, 0, &dec), EXR_ERR_SUCCESS);
-    }
-    exr_decoding_destroy(ctx, &dec);
-    exr_finish(&ctx);
-    return 0;
-}
-
 /* The per-light EXR channels hold the frame's planes: V0, V1 / S0, S1; no plain "V". */
 static void test_exr_channels_per_light(void **st)
 {
@@ -609,12 +570,12 @@ static void test_exr_channels_per_light(void **st)
     assert_non_null(img);
     const char *names[2][2] = { { "V0", "V1" }, { "S0", "S1" } };
     for (int l = 0; l < 2; l++) {
-        assert_int_equal(read_exr_channel(v, names[0][l], f.width, f.height, img), 0);
+        assert_int_equal(tu_read_exr_channel(v, names[0][l], f.width, f.height, img), 0);
         assert_memory_equal(img, f.vis + l * npix, npix * sizeof *img);
-        assert_int_equal(read_exr_channel(sh, names[1][l], f.width, f.height, img), 0);
+        assert_int_equal(tu_read_exr_channel(sh, names[1][l], f.width, f.height, img), 0);
         assert_memory_equal(img, f.shadow + l * npix, npix * sizeof *img);
     }
-    assert_int_equal(read_exr_channel(v, "V", f.width, f.height, img), -1);
+    assert_int_equal(tu_read_exr_channel(v, "V", f.width, f.height, img), -1);
     /* the two lights differ somewhere (the channels are not one plane twice) */
     long differ = 0;
     for (size_t i = 0; i < npix; i++) differ += f.vis[i] != f.vis[npix + i];

@@ -6,10 +6,12 @@
  * account for every triangle-frustum pair. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
+#include "shadow/raytrace/raytrace.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
 #include "accel/bvh.h"
-#include "core/pattern.h"
-#include "shadow/block_traverse.h"
+#include "light/pattern.h"
+#include "shadow/microraster/block_traverse.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,10 +24,7 @@ static void render_ok(const ms_scene *sc, const char *method, ms_pattern pat, in
     o.pattern = pat;
     o.samples = samples;
     o.width = o.height = size;
-    char err[512];
-    int rc = ms_render(sc, &o, f, err, sizeof err);
-    if (rc) fprintf(stderr, "render %s: %s\n", method, err);
-    assert_int_equal(rc, 0);
+    tu_render_ok(sc, &o, f);
 }
 
 /* mft equals raytrace, V and S, at every pixel, for the three patterns (interleaved: filtered, so the

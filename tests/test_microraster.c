@@ -4,7 +4,8 @@
  * too; the Quad scene against its exact V; an open quad shadows from both sides. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "shadow/receiver.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
 #include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>
@@ -32,10 +33,7 @@ static void render_ok(const ms_scene *sc, const char *method, int samples, int s
     o.method = method;
     o.samples = samples;
     o.width = o.height = size;
-    char err[512];
-    int rc = ms_render(sc, &o, f, err, sizeof err);
-    if (rc) fprintf(stderr, "render %s: %s\n", method, err);
-    assert_int_equal(rc, 0);
+    tu_render_ok(sc, &o, f);
 }
 
 /* Every kernel against raytrace on one scene, for the given sample counts. */

@@ -3,7 +3,7 @@
  * light axis; both patterns are deterministic for (pixel, seed) and differ across pixels and seeds.
  * Oracle: each point solved back to (s,t) in the light's (non-orthogonal) frame in double precision. */
 #include "testutil.h"
-#include "core/pattern.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

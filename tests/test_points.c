@@ -10,15 +10,17 @@
  *   - progress reaches 1 and cancellation stops the call; bad input gets MS_ERR_* and a message. */
 #include "testutil.h"
 #include "shadow/method.h"
-#include "core/pattern.h"
+#include "primary/primary.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const methods[] = { "raytrace", "scanline", "bounds", "hierarchical", "embree" };
-#define N_METHODS (sizeof methods / sizeof *methods)
+/* Every shadow method of the registry (ms_method_names: those compiled into this build), so that a new
+ * method is tested without touching this file. */
+#define methods (ms_method_names())
 
 /* Frame hits of the default scene at W x H by the BVH primary, as points with key and triangle. */
 typedef struct frame_points {
@@ -108,7 +110,7 @@ static void test_frame_agreement(void **st)
     uint16_t *f = malloc(sizeof(uint16_t) * fp.n);
     assert_true(v && s && f);
     for (int pat = 0; pat < 2; pat++)
-        for (size_t m = 0; m < N_METHODS; m++) {
+        for (size_t m = 0; methods[m]; m++) {
             const ms_shadow_method *sm = ms_find_shadow_method(methods[m]);
             if (!sm || strcmp(sm->primary, "bvh") != 0) continue;
             if (pat == MS_PATTERN_STRATIFIED && sm->needs_grid) continue;
@@ -294,7 +296,7 @@ static void test_points_in_the_air(void **st)
     }
     printf("%d points in the air: %ld partly lit\n", N, partial);
     assert_true(partial >= 3);
-    for (size_t m = 0; m < N_METHODS; m++) {
+    for (size_t m = 0; methods[m]; m++) {
         if (ms_method_available(methods[m]) != 1) continue;
         ms_points_options po;
         points_options(&po, methods[m], MS_PATTERN_GRID, 256);

@@ -23,7 +23,8 @@
 #include "testutil.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
-#include "shadow/edge3d.h"
+#include "primary/primary.h"
+#include "primary/edge3d.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -310,52 +311,10 @@ typedef struct mesh { float *tri; size_t n; } mesh;
  * bit-exact: each vertex is computed once and copied into every triangle that uses it). */
 static void icosphere(mesh *m, tu_rng *g, int levels, const double c[3], double r, double jitter)
 {
-    const double t = (1.0 + sqrt(5.0)) / 2.0;
-    const double iv[12][3] = { { -1, t, 0 }, { 1, t, 0 }, { -1, -t, 0 }, { 1, -t, 0 }, { 0, -1, t }, { 0, 1, t },
-                               { 0, -1, -t }, { 0, 1, -t }, { t, 0, -1 }, { t, 0, 1 }, { -t, 0, -1 }, { -t, 0, 1 } };
-    const int it[20][3] = { { 0, 11, 5 }, { 0, 5, 1 }, { 0, 1, 7 }, { 0, 7, 10 }, { 0, 10, 11 }, { 1, 5, 9 }, { 5, 11, 4 },
-                            { 11, 10, 2 }, { 10, 7, 6 }, { 7, 1, 8 }, { 3, 9, 4 }, { 3, 4, 2 }, { 3, 2, 6 }, { 3, 6, 8 },
-                            { 3, 8, 9 }, { 4, 9, 5 }, { 2, 4, 11 }, { 6, 2, 10 }, { 8, 6, 7 }, { 9, 8, 1 } };
-    size_t nt = 20, np = 12;
-    const size_t maxt = 20 * ((size_t)1 << (2 * levels)), maxp = 12 + 30 * ((size_t)1 << (2 * levels));
-    double *p = malloc(sizeof(double) * 3 * maxp);
-    int *tri = malloc(sizeof(int) * 3 * maxt), *nt2 = malloc(sizeof(int) * 3 * maxt);
-    assert_true(p && tri && nt2);
-    for (int i = 0; i < 12; i++) {
-        const double l = sqrt(iv[i][0] * iv[i][0] + iv[i][1] * iv[i][1] + iv[i][2] * iv[i][2]);
-        for (int a = 0; a < 3; a++) p[3 * i + a] = iv[i][a] / l;
-    }
-    memcpy(tri, it, sizeof it);
-    for (int lv = 0; lv < levels; lv++) {
-        const size_t hcap = 8 * nt * 3;
-        uint64_t *key = calloc(hcap, sizeof *key);
-        int *val = malloc(sizeof(int) * hcap);
-        assert_true(key && val);
-        for (size_t k = 0; k < nt; k++) {
-            const int v[3] = { tri[3 * k], tri[3 * k + 1], tri[3 * k + 2] };
-            int mid[3];
-            for (int e = 0; e < 3; e++) {
-                const int a = v[e], b = v[(e + 1) % 3];
-                const uint64_t kk = (a < b ? ((uint64_t)a << 32 | (uint64_t)b) : ((uint64_t)b << 32 | (uint64_t)a)) + 1;
-                size_t h = (size_t)(kk * 0x9E3779B97F4A7C15ull % hcap);
-                while (key[h] && key[h] != kk) h = (h + 1) % hcap;
-                if (!key[h]) {
-                    key[h] = kk;
-                    double q[3], l = 0;
-                    for (int x = 0; x < 3; x++) { q[x] = 0.5 * (p[3 * a + x] + p[3 * b + x]); l += q[x] * q[x]; }
-                    for (int x = 0; x < 3; x++) p[3 * np + x] = q[x] / sqrt(l);
-                    val[h] = (int)np++;
-                }
-                mid[e] = val[h];
-            }
-            const int nn[4][3] = { { v[0], mid[0], mid[2] }, { v[1], mid[1], mid[0] }, { v[2], mid[2], mid[1] }, { mid[0], mid[1], mid[2] } };
-            memcpy(nt2 + 12 * k, nn, sizeof nn);
-        }
-        memcpy(tri, nt2, sizeof(int) * 12 * nt);
-        nt *= 4;
-        free(key);
-        free(val);
-    }
+    double *p;
+    int *tri;
+    size_t np, nt;
+    tu_unit_icosphere(levels, &p, &np, &tri, &nt);
     float *vf = malloc(sizeof(float) * 3 * np);
     assert_non_null(vf);
     for (size_t i = 0; i < np; i++) {
@@ -367,7 +326,7 @@ static void icosphere(mesh *m, tu_rng *g, int levels, const double c[3], double 
     assert_non_null(m->tri);
     for (size_t k = 0; k < nt; k++)
         for (int v = 0; v < 3; v++) memcpy(m->tri + 9 * k + 3 * v, vf + 3 * tri[3 * k + v], 3 * sizeof(float));
-    free(p); free(tri); free(nt2); free(vf);
+    free(p); free(tri); free(vf);
 }
 
 /* Claims per pixel over every triangle with the edge test; checks parity and the inscribed ball. */

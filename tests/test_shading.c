@@ -10,8 +10,8 @@
 #include "testutil.h"
 #include "render/ltc.h"
 #include "render/shade.h"
-#include "shadow/receiver.h"
-#include "core/pattern.h"
+#include "visibility/receiver.h"
+#include "light/pattern.h"
 #include "camera/camera.h"
 #include <math.h>
 #include <png.h>

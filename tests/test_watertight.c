@@ -35,6 +35,7 @@
 #include "testutil.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
+#include "primary/primary.h"
 #include "raster/raster.h"
 #include <math.h>
 #include <stdio.h>
@@ -428,10 +429,7 @@ static void render_ok(const ms_scene *sc, const char *method, int samples, int w
     o.width = w;
     o.height = h;
     o.seed = 3;
-    char err[512] = "";
-    int rc = ms_render(sc, &o, f, err, sizeof err);
-    if (rc) print_message("ms_render(%s): %s\n", method, err);
-    assert_int_equal(rc, 0);
+    tu_render_ok(sc, &o, f);
 }
 
 /* The light-leak scene around centre c: ground y = c.y + 0 (a 2-triangle square), light 0.5 x 0.5
@@ -505,57 +503,10 @@ static void test_light_leak(void **st)
  * tangentially by up to `jitter` of the edge length; shared vertices (midpoints looked up per edge). */
 static void make_icosphere(mesh *m, tu_rng *g, int levels, const float c[3], float r, float jitter)
 {
-    const double t = (1.0 + sqrt(5.0)) / 2.0;
-    const double iv[12][3] = { { -1, t, 0 }, { 1, t, 0 }, { -1, -t, 0 }, { 1, -t, 0 }, { 0, -1, t }, { 0, 1, t },
-                               { 0, -1, -t }, { 0, 1, -t }, { t, 0, -1 }, { t, 0, 1 }, { -t, 0, -1 }, { -t, 0, 1 } };
-    const int it[20][3] = { { 0, 11, 5 }, { 0, 5, 1 }, { 0, 1, 7 }, { 0, 7, 10 }, { 0, 10, 11 }, { 1, 5, 9 }, { 5, 11, 4 },
-                            { 11, 10, 2 }, { 10, 7, 6 }, { 7, 1, 8 }, { 3, 9, 4 }, { 3, 4, 2 }, { 3, 2, 6 }, { 3, 6, 8 },
-                            { 3, 8, 9 }, { 4, 9, 5 }, { 2, 4, 11 }, { 6, 2, 10 }, { 8, 6, 7 }, { 9, 8, 1 } };
-    size_t cap = 12 + 30 * ((size_t)1 << (2 * levels));
-    double *p = malloc(sizeof(double) * 3 * cap);
-    size_t np = 12, nt = 20;
-    int *tri = malloc(sizeof(int) * 3 * 20 * ((size_t)1 << (2 * levels)));
-    assert_non_null(p);
-    assert_non_null(tri);
-    for (int i = 0; i < 12; i++) {
-        double l = sqrt(iv[i][0] * iv[i][0] + iv[i][1] * iv[i][1] + iv[i][2] * iv[i][2]);
-        for (int a = 0; a < 3; a++) p[3 * i + a] = iv[i][a] / l;
-    }
-    memcpy(tri, it, sizeof it);
-    for (int lv = 0; lv < levels; lv++) {
-        /* midpoint cache: a small open-addressing table keyed by the vertex pair */
-        size_t hcap = 8 * nt * 3;
-        uint64_t *key = calloc(hcap, sizeof *key);
-        int *val = malloc(sizeof(int) * hcap);
-        int *nt2 = malloc(sizeof(int) * 3 * 4 * nt);
-        assert_non_null(key);
-        assert_non_null(val);
-        assert_non_null(nt2);
-        for (size_t k = 0; k < nt; k++) {
-            int v[3] = { tri[3 * k], tri[3 * k + 1], tri[3 * k + 2] }, mid[3];
-            for (int e = 0; e < 3; e++) {
-                int a = v[e], b = v[(e + 1) % 3];
-                uint64_t kk = a < b ? ((uint64_t)a << 32 | (uint64_t)b) + 1 : ((uint64_t)b << 32 | (uint64_t)a) + 1;
-                size_t h = (size_t)(kk * 0x9E3779B97F4A7C15ull % hcap);
-                while (key[h] && key[h] != kk) h = (h + 1) % hcap;
-                if (!key[h]) {
-                    key[h] = kk;
-                    double q[3], l = 0;
-                    for (int x = 0; x < 3; x++) { q[x] = 0.5 * (p[3 * a + x] + p[3 * b + x]); l += q[x] * q[x]; }
-                    for (int x = 0; x < 3; x++) p[3 * np + x] = q[x] / sqrt(l);
-                    val[h] = (int)np++;
-                }
-                mid[e] = val[h];
-            }
-            const int nn[4][3] = { { v[0], mid[0], mid[2] }, { v[1], mid[1], mid[0] }, { v[2], mid[2], mid[1] }, { mid[0], mid[1], mid[2] } };
-            memcpy(nt2 + 12 * k, nn, sizeof nn);
-        }
-        memcpy(tri, nt2, sizeof(int) * 12 * nt);
-        nt *= 4;
-        free(key);
-        free(val);
-        free(nt2);
-    }
+    double *p;
+    int *tri;
+    size_t np, nt;
+    tu_unit_icosphere(levels, &p, &np, &tri, &nt);
     const double edge = 4.0 / sqrt((double)nt);   /* about the edge length on the unit sphere */
     for (size_t i = 0; i < np; i++) {
         double q[3];

@@ -3,7 +3,7 @@
  * leaves. Top levels run as OpenMP tasks so large scenes build on all cores. */
 #include "bvh.h"
 #include "ray_triangle.h"
-#include "../core/vec.h"
+#include "core/vec.h"
 #include <float.h>
 #include <math.h>
 #include <omp.h>

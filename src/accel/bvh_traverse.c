@@ -2,7 +2,7 @@
  * with the watertight triangle test and the box test widened to match it (ray_triangle.h). */
 #include "bvh.h"
 #include "ray_triangle.h"
-#include "../core/vec.h"
+#include "core/vec.h"
 #include <math.h>
 
 int ms_intersect_triangle(const float tri[9], const float o[3], const float d[3], float tmin, float tmax,

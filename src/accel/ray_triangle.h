@@ -1,6 +1,8 @@
 /* Watertight ray/triangle intersection (Woop, Benthin, Wald, "Watertight Ray/Triangle Intersection",
  * JCGT 2(1), 2013), shared by every ray test of ours: BVH closest and any hit (bvh_traverse.c), the
- * shadow packets (src/shadow/raytrace.c) and Embree's primary t (src/shadow/embree.c).
+ * shadow segments of raytrace, mft and hpc (src/shadow/raytrace/, mft/, hpc/: the scalar segment tests
+ * below, ms_wt_segment and ms_wt_segment_sheared, and their SIMD lane forms) and Embree's primary t
+ * (src/primary/primary_embree.c).
  *
  * Per ray (ms_wt_prepare): kz = the axis of largest |d|, kx, ky the next two (swapped when d[kz] < 0
  * to keep the winding), and the shear Sx = dx/dz, Sy = dy/dz, Sz = 1/dz that maps the ray onto the
@@ -26,9 +28,10 @@
  *  - the t range is decided on that t itself (the paper compares T with t_far * det), so a hit
  *    means exactly "t in [tmin, tmax]" for the t we report and the closest hit is the minimum over
  *    the triangles whatever order they are tested in, which the BVH tests compare bit for bit with
- *    brute force. The division happens only for rays that passed the edge tests. The shadow packets
- *    (raytrace.c), which need only the any-hit answer, compare the plane distance with tmin and tmax
- *    scaled by d . N, without a division or the clamp, and share one shear axis over 16 lanes;
+ *    brute force. The division happens only for rays that passed the edge tests. The shadow segments
+ *    (ms_wt_segment_sheared: raytrace, mft, hpc), which need only the any-hit answer, compare the plane
+ *    distance with tmin and tmax scaled by d . N, without a division or the clamp, and share one shear
+ *    axis over 16 lanes (ms_wt_packet_axis);
  *  - u, v are the weights of vertices 1 and 2 (V / det, W / det), as Moller-Trumbore's were.
  *
  * Zero-area triangles need no special case: a repeated vertex gives U = V = W = 0 or mixed signs, so
@@ -38,6 +41,7 @@
 #ifndef MS_RAY_TRIANGLE_H
 #define MS_RAY_TRIANGLE_H
 #include <math.h>
+#include "core/vec.h"   /* ms_maxf */
 
 #ifdef __clang__
 #pragma STDC FP_CONTRACT OFF
@@ -156,6 +160,65 @@ static inline int ms_wt_intersect(const ms_wt_ray *r, const float tri[9], const 
     *u = e.v / e.det;
     *v = e.w / e.det;
     return 1;
+}
+
+/* ---- shadow segments: any hit, t in [tmin, tmax], the receiver's 16-sample packets ---- */
+
+/* The shear axis one packet of n rays shares (raytrace, mft and hpc choose it alike, so that their
+ * answers agree bit for bit). Any kz with d[kz] != 0 keeps the test watertight (the per-ray choice of the
+ * largest |d| only bounds the shear); the rays of a packet point at one small light, so one axis usually
+ * serves all lanes: lane 0's largest, provided every lane has |d[kz]| >= max|d| / 2 (|Sx|, |Sy| <= 2: as
+ * accurate as the per-ray choice within a factor of 2); else -1, and the lanes are tested one by one
+ * (ms_wt_segment). dx, dy, dz: the lanes' direction components. *kz0: lane 0's largest axis either way. */
+static inline int ms_wt_packet_axis(const float *dx, const float *dy, const float *dz, int n, int *kz0)
+{
+    const float d0[3] = { dx[0], dy[0], dz[0] };
+    const float *const d[3] = { dx, dy, dz };
+    const int kz = ms_wt_max_axis(d0);
+    int ok = 1;
+    for (int l = 0; l < n; l++) {
+        const float m = ms_maxf(fabsf(dx[l]), ms_maxf(fabsf(dy[l]), fabsf(dz[l])));
+        ok &= 2.0f * fabsf(d[kz][l]) >= m && m > 0.0f;
+    }
+    if (kz0) *kz0 = kz;
+    return ok ? kz : -1;
+}
+
+/* 1 if the triangle blocks the segment from o to o + d at a parameter in [tmin, tmax], with the ray's own
+ * shear (the lanes of a packet without a shared axis). n: the triangle's ms_wt_normal. */
+static inline int ms_wt_segment(const float o[3], const float d[3], const float tri[9], const float n[3], float tmin,
+                                float tmax)
+{
+    ms_wt_ray w;
+    float t, u, v;
+    ms_wt_prepare(&w, o, d);
+    return ms_wt_intersect(&w, tri, n, tmin, tmax, &t, &u, &v);
+}
+
+/* The same with the packet's shared axis kz (ms_wt_packet_axis, >= 0) and this lane's shear sx = d[kx] /
+ * d[kz], sy = d[ky] / d[kz] (kx, ky: the next two axes, cyclic; the winding swap of the paper is not
+ * needed: the test is two-sided; Sz is not needed, t comes from the plane). A, B, C: the vertices minus
+ * o; num: ms_wt_offset(o, tri, n). The t range is tested on the plane distance num against tmin and tmax
+ * scaled by d . n (sign adjusted), without a division: only the any-hit answer is needed. The edge
+ * functions are redone in double when any is exactly 0 (as ms_wt_evaluate does). This is the scalar form;
+ * the packet tracers' SIMD lane loops compute the very same operations (raytrace_impl.h, mft_impl.h). */
+static inline int ms_wt_segment_sheared(const float A[3], const float B[3], const float C[3], int kz, float sx,
+                                        float sy, const float d[3], const float n[3], float num, float tmin, float tmax)
+{
+    const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+    const float ax = A[kx] - sx * A[kz], ay = A[ky] - sy * A[kz], bx = B[kx] - sx * B[kz], by = B[ky] - sy * B[kz];
+    const float cx = C[kx] - sx * C[kz], cy = C[ky] - sy * C[kz];
+    float u = ms_wt_edge(cx, cy, bx, by), v = ms_wt_edge(ax, ay, cx, cy), w = ms_wt_edge(bx, by, ax, ay);
+    if (u == 0.0f || v == 0.0f || w == 0.0f) {
+        u = ms_wt_edge_d(cx, cy, bx, by);
+        v = ms_wt_edge_d(ax, ay, cx, cy);
+        w = ms_wt_edge_d(bx, by, ax, ay);
+    }
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return 0;
+    const float det = u + v + w;
+    const float den = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    const float ns = den < 0.0f ? -num : num, aden = fabsf(den);
+    return det != 0.0f && aden > 0.0f && ns >= tmin * aden && ns <= tmax * aden;
 }
 
 /* Conservative box test to match (sec. 4 and Ize, "Robust BVH Ray Traversal", JCGT 2013): the

@@ -1,5 +1,5 @@
 #include "camera.h"
-#include "../core/vec.h"
+#include "core/vec.h"
 #include <math.h>
 
 int ms_camera_basis_init(ms_camera_basis *b, const ms_camera *c, int width, int height)

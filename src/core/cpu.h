@@ -33,4 +33,19 @@ ms_isa ms_cpu_isa(void);
 /* The level to run under a cap: the CPU's best, or the cap when it is lower (MS_ISA_AUTO: no cap). */
 ms_isa ms_isa_capped(ms_isa cap);
 
+/* The one ISA selector every dispatcher uses (kernels, traversals, packet tracers, weights). A family has
+ * instances at the levels of `have` (bit 1 << level; MS_ISA_ALL: every level, as every family has today).
+ * The level run is the capped one (ms_isa_capped: the caller's cap, the CPU probe); the documented
+ * fallback when the family has no instance there is downward, to the next lower level that has one,
+ * never above the cap or the probe. MS_ISA_AUTO when no level at or below has one: the dispatcher then
+ * returns NULL and leaves its *chosen untouched. */
+#define MS_ISA_ALL ((1u << MS_ISA_SCALAR) | (1u << MS_ISA_AVX2) | (1u << MS_ISA_AVX512))
+static inline ms_isa ms_isa_select(ms_isa cap, unsigned have)
+{
+    /* Inline: the S weights and the mask popcount select per receiver. */
+    for (ms_isa isa = ms_isa_capped(cap); isa >= MS_ISA_SCALAR; isa = (ms_isa)(isa - 1))
+        if (have >> isa & 1u) return isa;
+    return MS_ISA_AUTO;
+}
+
 #endif

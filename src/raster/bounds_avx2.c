@@ -6,4 +6,4 @@
 #include "raster_internal.h"
 
 #define MS_PERK_IMPL "raster/bounds_impl.h"
-#include "../core/perk_each.h"
+#include "core/perk_each.h"

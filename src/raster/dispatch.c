@@ -26,13 +26,11 @@ ms_raster_fn ms_raster_kernel_isa(ms_kernel_id id, int k, ms_isa isa)
 
 ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k, ms_isa cap, ms_isa *chosen)
 {
-    /* From the capped level down to scalar, the first variant there is (today every kernel has all). */
-    for (ms_isa isa = ms_isa_capped(cap); isa >= MS_ISA_SCALAR; isa = (ms_isa)(isa - 1)) {
-        const ms_raster_fn fn = ms_raster_kernel_isa(id, k, isa);
-        if (fn) {
-            if (chosen) *chosen = isa;
-            return fn;
-        }
-    }
-    return NULL;
+    unsigned have = 0;   /* the levels with a variant (today every kernel has all) */
+    for (ms_isa isa = MS_ISA_SCALAR; isa <= MS_ISA_AVX512; isa = (ms_isa)(isa + 1))
+        if (ms_raster_kernel_isa(id, k, isa)) have |= 1u << isa;
+    const ms_isa isa = ms_isa_select(cap, have);
+    if (isa == MS_ISA_AUTO) return NULL;
+    if (chosen) *chosen = isa;
+    return ms_raster_kernel_isa(id, k, isa);
 }

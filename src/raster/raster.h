@@ -13,7 +13,7 @@
 #define MS_RASTER_H
 #include <stdint.h>
 #include "microshadow.h"
-#include "../core/pattern.h"
+#include "light/pattern.h"
 
 typedef struct ms_raster_frame {
     float m[3][3];      /* light-index coords of world point X: m * (X - c) */
@@ -22,7 +22,7 @@ typedef struct ms_raster_frame {
     float near, far;    /* segment parameter range that occludes */
     int k;
     int cull_backfaces; /* 1: discard triangles facing away from C (closed meshes only) */
-    const void *alpha;  /* the caller's alpha-test context (src/shadow/alpha.h), NULL (ms_raster_frame_init):
+    const void *alpha;  /* the caller's alpha-test context (src/visibility/alpha.h), NULL (ms_raster_frame_init):
                          * every triangle opaque. The kernels never read it. */
 } ms_raster_frame;
 

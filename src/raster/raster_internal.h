@@ -10,8 +10,8 @@
 #include <math.h>
 #include <stdint.h>
 #include "raster.h"
-#include "../core/perk.h"
-#include "../core/vec.h"
+#include "core/perk.h"
+#include "core/vec.h"
 
 typedef struct ms_tri_setup {
     float e[5][3]; /* active edges: U, V, W always, then N and/or F when the triangle reaches a clip plane */

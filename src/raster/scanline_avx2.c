@@ -3,4 +3,4 @@
 #include "raster_internal.h"
 
 #define MS_PERK_IMPL "raster/scanline_simd_impl.h"
-#include "../core/perk_each.h"
+#include "core/perk_each.h"

@@ -4,8 +4,9 @@
  * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
 #include "microshadow.h"
 #include "lightmap_unwrap.h"
-#include "../core/pattern.h"
-#include "../shadow/receiver.h"
+#include "light/pattern.h"
+#include "light/light_shape.h"
+#include "visibility/receiver.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -397,12 +398,7 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     const int samples = o->points.samples > 0 ? o->points.samples : MS_SAMPLES_DEFAULT;
     ms_render_ctx tctx;   /* for the textured lights' mean texels: the points' pattern (points.c) */
-    memset(&tctx, 0, sizeof tctx);
-    tctx.pattern = o->points.pattern;
-    tctx.k = ms_samples_to_k(samples);
-    tctx.samples = tctx.k * tctx.k;
-    tctx.mask_words = tctx.samples / 64;
-    tctx.seed = o->points.seed;
+    ms_render_ctx_init(&tctx, NULL, NULL, NULL, o->points.pattern, ms_samples_to_k(samples), o->points.seed, 0);
     float *lum = malloc((nt ? nt : 1) * sizeof *lum);
     if (!lum) { snprintf(err, errlen, "out of memory for a %dx%d lightmap", size, size); return MS_ERR_NO_MEMORY; }
     const int threads = o->points.threads > 0 ? o->points.threads : omp_get_num_procs();
@@ -413,7 +409,8 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
         float c[3] = { 0, 0, 0 }, y = 0.0f;
         for (size_t l = 0; l < nl; l++) {
             ms_light L = lights[l];
-            if (L.texture && L.shape != MS_LIGHT_SPHERE) {
+            const ms_light_shape_ops *shape = ms_light_shape_of(L.shape);
+            if (L.texture && shape && shape->textured) {
                 ms_render_ctx ctx = tctx;
                 ctx.light = L;
                 ms_shadow_query q;

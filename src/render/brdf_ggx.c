@@ -1,6 +1,6 @@
 /* GGX with height-correlated Smith G2 (brdf_ggx.h). */
 #include "brdf_ggx.h"
-#include "../core/vec.h"
+#include "core/vec.h"
 #include <math.h>
 
 float ms_ggx_alpha(float roughness)

@@ -11,11 +11,13 @@
  * state for the job's life (set-ups such as hpc's light hierarchy and the frusta are per light), so that
  * any call can render any tile for every light. */
 #include "microshadow.h"
-#include "../core/pattern.h"
-#include "../shadow/method.h"
-#include "../shadow/receiver.h"
-#include "../shadow/alpha.h"
-#include "frame_job.h"
+#include "light/pattern.h"
+#include "light/light_shape.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
+#include "frame_shade.h"
 #include "shadow_frame.h"
 #include "shade.h"
 #include "render_materialise.h"
@@ -27,8 +29,6 @@
 #include <time.h>
 
 #define TILE MS_TILE_SIZE
-#define MS_NEAR 1e-4f        /* segment parameter: occluders closer than this to the receiver are ignored */
-#define MS_FAR (1.0f - 1e-4f)/* ... and this close to the light plane (a light set into a ceiling) */
 
 struct ms_frame_job {
     ms_scene soup;                /* a procedural scene materialised for a method that does not stream */
@@ -162,6 +162,8 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         goto fail;
     }
     ms_render_ctx *ctx = &j->ctx;
+    ms_render_ctx_init(ctx, scene, streamed ? NULL : &j->bvh, &j->lights[0], opt->pattern, ms_samples_to_k(samples),
+                       opt->seed, j->threads);
     if (ms_camera_basis_init(&ctx->cam, &scene->camera, W, H)) {
         snprintf(err, errlen, "camera is degenerate (eye = target, up parallel to the view, or a field of view, extent or type out of range)");
         goto fail;
@@ -169,17 +171,6 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); goto fail; }
     if (!streamed && ms_alpha_build(scene, &j->bvh, &j->alpha)) { snprintf(err, errlen, "out of memory for the alpha-tested triangles"); goto fail; }
     ctx->alpha = j->alpha;
-    ctx->scene = scene;
-    ctx->bvh = streamed ? NULL : &j->bvh;
-    ctx->light = j->lights[0];
-    ctx->pattern = opt->pattern;
-    ctx->k = ms_samples_to_k(samples);
-    ctx->samples = spp;
-    ctx->mask_words = (spp + 63) / 64;   /* bits past spp stay 0 */
-    ctx->seed = opt->seed;
-    ctx->near = MS_NEAR;
-    ctx->far = MS_FAR;
-    ctx->threads = j->threads;
     ctx->isa_cap = opt->isa;
     ctx->no_occlusion_cull = opt->no_occlusion_cull;
     ctx->no_child_order = opt->no_child_order;
@@ -345,8 +336,9 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
      * it sets up per frame (mft re-derives its light frame per call; hpc sets up its light per call, so
      * a sphere costs it a pass over every triangle per receiver); frame-level entries are not used. The
      * price is the block traversal's coherence: groups of one. */
-    const int sphere = ctx.light.shape == MS_LIGHT_SPHERE;
-    const int shadow_tiles = sm->visibility_all && !sphere ? 0 : n;   /* a frame-level method: shadow_frame.c */
+    const ms_light_shape_ops *shape = ms_light_shape_of(ctx.light.shape);
+    const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
+    const int shadow_tiles = sm->visibility_all && !outlined ? 0 : n;   /* a frame-level method: shadow_frame.c */
 #pragma omp parallel num_threads(j->threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
@@ -370,12 +362,8 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     size_t i = (size_t)y * W + x;
                     const ms_hit *h = &hits[i];
                     if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
-                    memcpy(q[nq].p, h->p, sizeof h->p);
-                    memcpy(q[nq].n, h->n, sizeof h->n);
-                    q[nq].prim = h->prim;
-                    q[nq].px = (uint32_t)x;
-                    q[nq].py = (uint32_t)y;
-                    if (sphere && ms_light_sphere_outline(&ctx.light, q[nq].p, &qc.light)) {
+                    ms_query_from_hit(&q[nq], h, (uint32_t)x, (uint32_t)y);
+                    if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                         vis[i] = shadow[i] = spec[i] = 0.0f;   /* inside the sphere: no sample counts */
                         fr[i] = 0;
                         local_visible++;
@@ -387,16 +375,16 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     local_segments += (uint64_t)nf;
                     where[nq++] = i;
                 }
-            if (!sphere) {
+            if (!outlined) {
                 if (nq && ok && sm->visibility(sstate, &ctx, q, nq, front, vmask, local)) ok = 0;
             } else
                 for (int i = 0; i < nq && ok; i++) {
-                    ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                    shape->outline(&ctx.light, q[i].p, &qc.light);
                     if (sm->visibility(sstate, &qc, &q[i], 1, front + (size_t)i * mw, vmask + (size_t)i * mw, local)) ok = 0;
                 }
             const double tr = omp_get_wtime();
             for (int i = 0; i < nq && ok; i++) {
-                if (sphere) ms_light_sphere_outline(&ctx.light, q[i].p, &qc.light);
+                if (outlined) shape->outline(&ctx.light, q[i].p, &qc.light);
                 if (pts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[i].px, q[i].py, ctx.seed, pts);
                 local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[i], pts, front + (size_t)i * mw,
                                                           vmask + (size_t)i * mw, &vis[where[i]],
@@ -422,7 +410,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
             failed |= !ok;
         }
     }
-    if (sm->visibility_all && !sphere && !failed) {
+    if (sm->visibility_all && !outlined && !failed) {
         size_t *pixels = NULL, np = 0;
         if (!whole) {   /* the listed tiles' pixels, tile after tile */
             pixels = malloc((size_t)n * TILE * TILE * sizeof *pixels);

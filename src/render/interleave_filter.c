@@ -29,6 +29,7 @@
  * penumbra; on scenes full of them the filtered error exceeds the raw one at low resolution
  * (docs/design.md, docs/scenes.md). */
 #include "interleave_filter.h"
+#include "primary/primary.h"
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>

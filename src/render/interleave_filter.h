@@ -4,7 +4,8 @@
 #ifndef MS_INTERLEAVE_FILTER_H
 #define MS_INTERLEAVE_FILTER_H
 #include <stdint.h>
-#include "../shadow/method.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
 
 /* A neighbour is left out when its hit point lies off the pixel's tangent plane by more than this share
  * of its distance from the pixel (about 0.6 degrees) ... */

@@ -7,7 +7,8 @@
 #include "ltc.h"
 #include "microshadow.h"
 #include "ltc_table.h"
-#include "../core/vec.h"
+#include "core/vec.h"
+#include "light/light_shape.h"
 #include <math.h>
 
 /* Bilinear Minv (normalised by its (1,1) element) and magnitude at (roughness, cos theta_v). */
@@ -38,35 +39,25 @@ static void lookup(float roughness, float cos_v, double minv[9], double *mag)
 #define DISK_SIDES 32
 
 /* The light's outline as a convex polygon (relative to p) into q[][3]; returns the vertex count, 0 when p
- * sees no emitting side. A disk (and a sphere's outline disk seen from p) is the regular DISK_SIDES-gon
- * inscribed in its ellipse, scaled to the ellipse's area (an approximation: the specular of a disk by a
- * polygon of equal area, off by less than the 32-gon's shape, 0.3% of the radius). */
+ * sees no emitting side. The shape's own polygon (light_shape.h): a disk (and a sphere's outline disk seen
+ * from p) is the regular DISK_SIDES-gon inscribed in its ellipse, scaled to the ellipse's area. */
 static int light_polygon(const ms_light *l0, const float p[3], float q[DISK_SIDES][3])
 {
-    ms_light disk;
+    ms_light planar;
     const ms_light *l = l0;
-    if (l0->shape == MS_LIGHT_SPHERE) {
-        if (ms_light_sphere_outline(l0, p, &disk)) return 0;   /* inside the sphere */
-        l = &disk;
+    const ms_light_shape_ops *shape = ms_light_shape_of(l0->shape);
+    if (!shape) shape = ms_light_shape_of(MS_LIGHT_RECT);
+    if (shape->outline) {
+        if (shape->outline(l0, p, &planar)) return 0;   /* inside the shape */
+        l = &planar;
+        shape = ms_light_shape_of(l->shape);
     }
-    const float C[3] = { l->corner.x, l->corner.y, l->corner.z };
-    const float S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
-    const float T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    float ln[3], rel[3];
-    v3_cross(ln, S, T);
-    v3_sub(rel, p, C);
-    if (!(v3_dot(rel, ln) > 0.0f)) return 0;   /* behind the emitting side */
-    if (l->shape == MS_LIGHT_RECT) {
-        for (int c = 0; c < 4; c++)
-            for (int i = 0; i < 3; i++) q[c][i] = C[i] + ((c == 1 || c == 2) ? S[i] : 0.0f) + ((c >= 2) ? T[i] : 0.0f) - p[i];
-        return 4;
-    }
-    const double scale = sqrt(M_PI / (0.5 * DISK_SIDES * sin(2.0 * M_PI / DISK_SIDES)));
-    for (int c = 0; c < DISK_SIDES; c++) {
-        const double a = 2.0 * M_PI * c / DISK_SIDES, cs = 0.5 * scale * cos(a), sn = 0.5 * scale * sin(a);
-        for (int i = 0; i < 3; i++) q[c][i] = (float)(C[i] + 0.5 * (S[i] + T[i]) + cs * S[i] + sn * T[i] - p[i]);
-    }
-    return DISK_SIDES;
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    float rel[3];
+    v3_sub(rel, p, F.corner);
+    if (!(v3_dot(rel, F.normal) > 0.0f)) return 0;   /* behind the emitting side */
+    return shape->polygon(&F, p, DISK_SIDES, q);
 }
 
 float ms_ltc_ggx(const ms_light *l, const float p[3], const float n[3], const float v[3], float roughness)

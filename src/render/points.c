@@ -1,14 +1,16 @@
 /* Visibility at caller-given points (microshadow.h, "Visibility at any points"): the driver ms_render
  * is for frames, without the camera. Points are grouped by proximity (30-bit Morton codes of their
  * positions in the points' bounding box) into batches of BATCH, and each batch goes through the shadow
- * method interface exactly as a frame tile does in render.c: front masks (receiver.c), the method's
+ * method interface exactly as a frame tile does in frame_job.c: front masks (receiver.c), the method's
  * visible masks, V and S from ms_resolve_vs. A point's sample pattern is keyed like a pixel, so the same
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"
-#include "../core/pattern.h"
-#include "../shadow/method.h"
-#include "../shadow/receiver.h"
-#include "../shadow/alpha.h"
+#include "light/pattern.h"
+#include "light/light_shape.h"
+#include "light/light_frame.h"
+#include "shadow/method.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -16,10 +18,6 @@
 #include <string.h>
 
 #define BATCH 256              /* points per visibility call: a frame tile's 16 x 16 */
-/* The occluding range of the segment parameter: the same as ms_render's (render.c); test_points
- * compares points with frames bit for bit, so the two cannot drift apart unnoticed. */
-#define MS_POINTS_NEAR 1e-4f
-#define MS_POINTS_FAR (1.0f - 1e-4f)
 
 struct ms_accel {
     ms_bvh bvh;
@@ -138,13 +136,10 @@ static int light_ok(const ms_light *l)
     if (l->shape == MS_LIGHT_SPHERE)   /* centre and radius; the parallelogram fields are unused */
         return isfinite(l->center.x) && isfinite(l->center.y) && isfinite(l->center.z) && isfinite(l->radius) &&
                l->radius > 0.0f;
-    const float v[9] = { l->corner.x, l->corner.y, l->corner.z, l->edge_s.x, l->edge_s.y, l->edge_s.z,
-                         l->edge_t.x, l->edge_t.y, l->edge_t.z };
-    for (int i = 0; i < 9; i++) if (!isfinite(v[i])) return 0;
-    const float nx = l->edge_s.y * l->edge_t.z - l->edge_s.z * l->edge_t.y;
-    const float ny = l->edge_s.z * l->edge_t.x - l->edge_s.x * l->edge_t.z;
-    const float nz = l->edge_s.x * l->edge_t.y - l->edge_s.y * l->edge_t.x;
-    return nx * nx + ny * ny + nz * nz > 0.0f;
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    if (!v3_finite(F.corner) || !v3_finite(F.edge_s) || !v3_finite(F.edge_t)) return 0;
+    return v3_dot(F.normal, F.normal) > 0.0f;
 }
 
 /* Checks the arguments that do not need the method; MS_OK or MS_ERR_INVALID with a message. */
@@ -233,25 +228,15 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
             memcpy(scene_tri + 9 * (size_t)a->bvh.tri_source[i], a->bvh.tri + 9 * (size_t)i, 9 * sizeof *scene_tri);
         view.tri = scene_tri;
     }
-    ms_render_ctx ctx;
-    memset(&ctx, 0, sizeof ctx);
-    ctx.scene = &view;
-    ctx.bvh = &a->bvh;
+    ms_render_ctx ctx;   /* the frames' context (ms_render_ctx_init), so points answer as frames do */
+    ms_render_ctx_init(&ctx, &view, &a->bvh, light, opt->pattern, k, opt->seed, threads);
     ctx.alpha = a->alpha;
-    ctx.light = *light;
-    ctx.pattern = opt->pattern;
-    ctx.k = k;
-    ctx.samples = k * k;
-    ctx.mask_words = k * k / 64;
-    ctx.seed = opt->seed;
-    ctx.near = MS_POINTS_NEAR;
-    ctx.far = MS_POINTS_FAR;
-    ctx.threads = threads;
     ctx.isa_cap = opt->isa;
     ctx.embree_mode = opt->embree_mode;
     ctx.embree_filter = opt->embree_filter;
     ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
-    const int sphere = light->shape == MS_LIGHT_SPHERE;
+    const ms_light_shape_ops *shape = ms_light_shape_of(light->shape);
+    const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
 
     const size_t n = pts->n;
     /* Proximity order: Morton codes in the points' bounding box, ties by index (a total order). */
@@ -321,7 +306,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
             for (int j = 0; j < m; j++) {
                 const size_t i = order[i0 + j].index;
                 make_query(a, pts, i, &q[nq]);
-                if (sphere && ms_light_sphere_outline(&ctx.light, q[nq].p, &qc.light)) {
+                if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                     if (front_out) front_out[i] = 0;
                     if (vis) vis[i] = 0.0f;
                     if (shadow) shadow[i] = 0.0f;
@@ -334,10 +319,10 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
                 where[nq++] = i;
             }
             int vfail = 0;
-            if (!sphere) vfail = nq && sm->visibility(sstate, &ctx, q, nq, fm, vm, local);
+            if (!outlined) vfail = nq && sm->visibility(sstate, &ctx, q, nq, fm, vm, local);
             else
                 for (int j = 0; j < nq && !vfail; j++) {
-                    ms_light_sphere_outline(&ctx.light, q[j].p, &qc.light);
+                    shape->outline(&ctx.light, q[j].p, &qc.light);
                     vfail = sm->visibility(sstate, &qc, &q[j], 1, fm + (size_t)j * mw, vm + (size_t)j * mw, local);
                 }
             if (vfail) {
@@ -350,7 +335,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
             for (int j = 0; j < nq; j++) {
                 const size_t i = where[j];
                 float v, s;
-                if (sphere) ms_light_sphere_outline(&ctx.light, q[j].p, &qc.light);
+                if (outlined) shape->outline(&ctx.light, q[j].p, &qc.light);
                 if (spts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
                 local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[j], spts, fm + (size_t)j * mw, vm + (size_t)j * mw, &v, &s);
                 if (vis) vis[i] = v;

@@ -1,10 +1,12 @@
 /* Materials at hit points, the specular shadow factor and the shaded radiance (shade.h). */
 #include "shade.h"
+#include "primary/primary.h"
 #include "brdf_ggx.h"
 #include "ltc.h"
-#include "../core/pattern.h"
-#include "../core/vec.h"
-#include "../shadow/receiver.h"
+#include "light/pattern.h"
+#include "core/vec.h"
+#include "light/light_frame.h"
+#include "visibility/receiver.h"
 #include <math.h>
 #include <string.h>
 
@@ -207,10 +209,10 @@ float ms_resolve_spec(const ms_render_ctx *ctx, const ms_shadow_query *q, const 
     const float v = nf ? (float)nv / (float)nf : 0.0f;
     if (nv == 0 || nv == nf) return v;   /* exact: the light wholly hidden or wholly visible */
     const ms_light *L = &ctx->light;
-    const float es[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, et[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
-    float nl[3];
-    v3_cross(nl, es, et);
-    v3_normalize(nl, nl);
+    ms_light_frame F;
+    ms_light_frame_of(L, &F);
+    float nl[3];   /* the light's unit normal */
+    v3_normalize(nl, F.normal);
     /* The lobe weight of ms_ggx_f_cos with what is constant per pixel taken out: D G2 / (4 n.v) with
      * n.h^2 = (n.l + n.v)^2 / |v + l|^2 (no normalisation of h) and Lambda(v) once. */
     const float alpha = ms_ggx_alpha(sf->roughness), a2 = alpha * alpha;

@@ -8,7 +8,8 @@
 #ifndef MS_SHADE_H
 #define MS_SHADE_H
 #include "microshadow.h"
-#include "../shadow/method.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
 
 #define MS_DEFAULT_ALBEDO 0.8f
 

@@ -1,8 +1,9 @@
 /* The whole-frame shadow phase (shadow_frame.h): the same front masks and the same V/S resolution as the
  * tiled phase of frame_job.c, around one call of the method's frame-level entry. */
 #include "shadow_frame.h"
-#include "../core/pattern.h"
-#include "../shadow/receiver.h"
+#include "primary/primary.h"
+#include "light/pattern.h"
+#include "visibility/receiver.h"
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,11 +29,7 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
         const size_t i = pixels ? pixels[j] : j;
         const ms_hit *h = &hits[i];
         if (h->prim == UINT32_MAX) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; continue; }
-        memcpy(q[n].p, h->p, sizeof h->p);
-        memcpy(q[n].n, h->n, sizeof h->n);
-        q[n].prim = h->prim;
-        q[n].px = (uint32_t)(i % (size_t)W);
-        q[n].py = (uint32_t)(i / (size_t)W);
+        ms_query_from_hit(&q[n], h, (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
         where[n++] = i;
     }
     int failed = 0;

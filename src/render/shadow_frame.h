@@ -3,7 +3,8 @@
 #define MS_SHADOW_FRAME_H
 #include <stdint.h>
 #include "microshadow.h"
-#include "../shadow/method.h"
+#include "shadow/method.h"
+#include "primary/primary.h"
 #include "shade.h"
 
 /* Gathers every visible pixel of hits (W x H) as a query with its front mask, calls the method once, and

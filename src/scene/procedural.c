@@ -5,7 +5,7 @@
  * petals clustered at its top. Triangle i depends only on (seed, i), so any range can be generated on its
  * own, in parallel, as often as needed. */
 #include "microshadow.h"
-#include "../core/pattern.h"
+#include "../light/pattern.h"
 #include <math.h>
 #include <string.h>
 

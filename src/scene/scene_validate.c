@@ -2,6 +2,7 @@
 #include "scene_internal.h"
 #include "../camera/camera.h"
 #include "../core/vec.h"
+#include "../light/light_shape.h"
 #include <math.h>
 #include <stdio.h>
 
@@ -21,13 +22,13 @@ static int validate_light(const ms_light *l, const char *name, const char *what,
         snprintf(err, errlen, "%s: %s has a NaN or infinite value", what, name);
         return -1;
     }
-    if (l->shape == MS_LIGHT_SPHERE && (!vec_ok(l->center) || !in_range(l->center) || !(l->radius > 0.0f) ||
-                                        !(l->radius <= MS_MAX_COORD) || l->texture)) {
-        snprintf(err, errlen, "%s: %s: a sphere needs a finite center and a radius in (0, %g], and no texture", what,
-                 name, (double)MS_MAX_COORD);
+    const ms_light_shape_ops *shape = ms_light_shape_of(l->shape);
+    char msg[256];
+    if (shape && shape->validate && shape->validate(l, MS_MAX_COORD, msg, sizeof msg)) {
+        snprintf(err, errlen, "%s: %s: %s", what, name, msg);
         return -1;
     }
-    if ((unsigned)l->shape > MS_LIGHT_SPHERE) {
+    if (!shape) {
         snprintf(err, errlen, "%s: %s has an unknown shape %d", what, name, (int)l->shape);
         return -1;
     }

@@ -1,4 +1,4 @@
-/* The methods microshadow knows. A method not compiled into this build is still named, so that
+/* The shadow methods microshadow knows. A method not compiled into this build is still named, so that
  * asking for it says "not compiled in" rather than "unknown". */
 #include "method.h"
 #include <string.h>
@@ -6,12 +6,8 @@
 extern const ms_shadow_method ms_shadow_raytrace, ms_shadow_mft;
 extern const ms_shadow_method ms_shadow_scanline, ms_shadow_bounds, ms_shadow_hierarchical;
 extern const ms_shadow_method ms_shadow_hpc, ms_shadow_hpc_scanline;
-extern const ms_primary_method ms_primary_bvh, ms_primary_depth;
-extern const ms_primary_method ms_primary_3dr_bb, ms_primary_3dr_bin, ms_primary_3dr_fc, ms_primary_3dr_fs,
-    ms_primary_3dr_full;
 #ifdef MS_HAVE_EMBREE
 extern const ms_shadow_method ms_shadow_embree;
-extern const ms_primary_method ms_primary_embree;
 #endif
 
 static const ms_shadow_method *const shadow_methods[] = {
@@ -32,20 +28,6 @@ const ms_shadow_method *ms_find_shadow_method(const char *name)
 {
     for (size_t i = 0; i < sizeof shadow_methods / sizeof *shadow_methods; i++)
         if (strcmp(shadow_methods[i]->name, name) == 0) return shadow_methods[i];
-    return NULL;
-}
-
-const ms_primary_method *ms_find_primary_method(const char *name)
-{
-    static const ms_primary_method *const primaries[] = {
-        &ms_primary_bvh, &ms_primary_depth, &ms_primary_3dr_bb, &ms_primary_3dr_bin, &ms_primary_3dr_fc,
-        &ms_primary_3dr_fs, &ms_primary_3dr_full,
-#ifdef MS_HAVE_EMBREE
-        &ms_primary_embree,
-#endif
-    };
-    for (size_t i = 0; i < sizeof primaries / sizeof *primaries; i++)
-        if (strcmp(primaries[i]->name, name) == 0) return primaries[i];
     return NULL;
 }
 

@@ -1,5 +1,7 @@
 #include "testutil.h"
-#include "shadow/receiver.h"
+#include "primary/primary.h"
+#include "shadow/method.h"
+#include "visibility/receiver.h"
 #include <OpenEXR/openexr.h>
 #include <dirent.h>
 #include <errno.h>
@@ -138,27 +140,13 @@ tu_agreement tu_compare_frames(const ms_frame *a, const ms_frame *b)
 
 void tu_query_from_hit(ms_shadow_query *q, const ms_hit *h, int x, int y)
 {
-    memcpy(q->p, h->p, sizeof q->p);
-    memcpy(q->n, h->n, sizeof q->n);
-    q->prim = h->prim;
-    q->px = (uint32_t)x;
-    q->py = (uint32_t)y;
+    ms_query_from_hit(q, h, (uint32_t)x, (uint32_t)y);
 }
 
 void tu_ctx_init(ms_render_ctx *ctx, const ms_scene *sc, const ms_bvh *bvh, int W, int H, int k)
 {
-    memset(ctx, 0, sizeof *ctx);
+    ms_render_ctx_init(ctx, sc, bvh, &sc->light, MS_PATTERN_GRID, k, 0, 1);
     assert_int_equal(ms_camera_basis_init(&ctx->cam, &sc->camera, W, H), 0);
-    ctx->scene = sc;
-    ctx->bvh = bvh;
-    ctx->light = sc->light;
-    ctx->pattern = MS_PATTERN_GRID;
-    ctx->k = k;
-    ctx->samples = k * k;
-    ctx->mask_words = k * k / 64;
-    ctx->near = 1e-4f;
-    ctx->far = 1.0f - 1e-4f;
-    ctx->threads = 1;
     ctx->isa_cap = tu_isa_cap();
 }
 
@@ -348,4 +336,105 @@ int tu_write_exr(const char *path, int w, int h, int nch, const char *const *nam
 out:
     for (int c = 0; c < 16; c++) free(hp[c]);
     return rc;
+}
+
+/* Reads channel `name` of a one-part EXR (w x h) as floats into img; -1 if absent. */
+int tu_read_exr_channel(const char *path, const char *name, int w, int h, float *img)
+{
+    exr_context_t ctx = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    assert_int_equal(exr_start_read(&ctx, path, &init), EXR_ERR_SUCCESS);
+    const exr_attr_chlist_t *chl = NULL;
+    assert_int_equal(exr_get_channels(ctx, 0, &chl), EXR_ERR_SUCCESS);
+    int want = -1;
+    for (int c = 0; c < chl->num_channels; c++)
+        if (!strcmp(chl->entries[c].name.str, name)) want = c;
+    if (want < 0) { exr_finish(&ctx); return -1; }
+    exr_attr_box2i_t dw;
+    assert_int_equal(exr_get_data_window(ctx, 0, &dw), EXR_ERR_SUCCESS);
+    assert_int_equal(dw.max.x - dw.min.x + 1, w);
+    assert_int_equal(dw.max.y - dw.min.y + 1, h);
+    int lines = 0;
+    assert_int_equal(exr_get_scanlines_per_chunk(ctx, 0, &lines), EXR_ERR_SUCCESS);
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    int dec_init = 0;
+    for (int y = dw.min.y; y <= dw.max.y; y += lines) {
+        exr_chunk_info_t ci;
+        assert_int_equal(exr_read_scanline_chunk_info(ctx, 0, y, &ci), EXR_ERR_SUCCESS);
+        if (!dec_init) assert_int_equal(exr_decoding_initialize(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
+        else assert_int_equal(exr_decoding_update(ctx, 0, &ci, &dec), EXR_ERR_SUCCESS);
+        for (int c = 0; c < dec.channel_count; c++) dec.channels[c].decode_to_ptr = NULL;
+        dec.channels[want].decode_to_ptr = (uint8_t *)(img + (size_t)(ci.start_y - dw.min.y) * w);
+        dec.channels[want].user_pixel_stride = sizeof(float);
+        dec.channels[want].user_line_stride = (int32_t)sizeof(float) * w;
+        dec.channels[want].user_bytes_per_element = sizeof(float);
+        dec.channels[want].user_data_type = EXR_PIXEL_FLOAT;
+        if (!dec_init) { assert_int_equal(exr_decoding_choose_default_routines(ctx, 0, &dec), EXR_ERR_SUCCESS); dec_init = 1; }
+        assert_int_equal(exr_decoding_run(ctx, 0, &dec), EXR_ERR_SUCCESS);
+    }
+    exr_decoding_destroy(ctx, &dec);
+    exr_finish(&ctx);
+    return 0;
+}
+
+void tu_render_ok(const ms_scene *sc, const ms_render_options *o, ms_frame *f)
+{
+    char err[512] = "";
+    if (ms_render(sc, o, f, err, sizeof err)) fail_msg("ms_render(%s): %s", o->method ? o->method : MS_DEFAULT_METHOD, err);
+}
+
+void tu_unit_icosphere(int levels, double **verts, size_t *n_verts, int **tris, size_t *n_tris)
+{
+    const double t = (1.0 + sqrt(5.0)) / 2.0;
+    const double iv[12][3] = { { -1, t, 0 }, { 1, t, 0 }, { -1, -t, 0 }, { 1, -t, 0 }, { 0, -1, t }, { 0, 1, t },
+                               { 0, -1, -t }, { 0, 1, -t }, { t, 0, -1 }, { t, 0, 1 }, { -t, 0, -1 }, { -t, 0, 1 } };
+    const int it[20][3] = { { 0, 11, 5 }, { 0, 5, 1 }, { 0, 1, 7 }, { 0, 7, 10 }, { 0, 10, 11 }, { 1, 5, 9 }, { 5, 11, 4 },
+                            { 11, 10, 2 }, { 10, 7, 6 }, { 7, 1, 8 }, { 3, 9, 4 }, { 3, 4, 2 }, { 3, 2, 6 }, { 3, 6, 8 },
+                            { 3, 8, 9 }, { 4, 9, 5 }, { 2, 4, 11 }, { 6, 2, 10 }, { 8, 6, 7 }, { 9, 8, 1 } };
+    size_t nt = 20, np = 12;
+    const size_t maxt = 20 * ((size_t)1 << (2 * levels)), maxp = 12 + 30 * ((size_t)1 << (2 * levels));
+    double *p = malloc(sizeof(double) * 3 * maxp);
+    int *tri = malloc(sizeof(int) * 3 * maxt), *nt2 = malloc(sizeof(int) * 3 * maxt);
+    assert_true(p && tri && nt2);
+    for (int i = 0; i < 12; i++) {
+        const double l = sqrt(iv[i][0] * iv[i][0] + iv[i][1] * iv[i][1] + iv[i][2] * iv[i][2]);
+        for (int a = 0; a < 3; a++) p[3 * i + a] = iv[i][a] / l;
+    }
+    memcpy(tri, it, sizeof it);
+    for (int lv = 0; lv < levels; lv++) {
+        /* midpoint cache: a small open-addressing table keyed by the vertex pair */
+        const size_t hcap = 8 * nt * 3;
+        uint64_t *key = calloc(hcap, sizeof *key);
+        int *val = malloc(sizeof(int) * hcap);
+        assert_true(key && val);
+        for (size_t k = 0; k < nt; k++) {
+            const int v[3] = { tri[3 * k], tri[3 * k + 1], tri[3 * k + 2] };
+            int mid[3];
+            for (int e = 0; e < 3; e++) {
+                const int a = v[e], b = v[(e + 1) % 3];
+                const uint64_t kk = (a < b ? ((uint64_t)a << 32 | (uint64_t)b) : ((uint64_t)b << 32 | (uint64_t)a)) + 1;
+                size_t h = (size_t)(kk * 0x9E3779B97F4A7C15ull % hcap);
+                while (key[h] && key[h] != kk) h = (h + 1) % hcap;
+                if (!key[h]) {
+                    key[h] = kk;
+                    double q[3], l = 0;
+                    for (int x = 0; x < 3; x++) { q[x] = 0.5 * (p[3 * a + x] + p[3 * b + x]); l += q[x] * q[x]; }
+                    for (int x = 0; x < 3; x++) p[3 * np + x] = q[x] / sqrt(l);
+                    val[h] = (int)np++;
+                }
+                mid[e] = val[h];
+            }
+            const int nn[4][3] = { { v[0], mid[0], mid[2] }, { v[1], mid[1], mid[0] }, { v[2], mid[2], mid[1] }, { mid[0], mid[1], mid[2] } };
+            memcpy(nt2 + 12 * k, nn, sizeof nn);
+        }
+        memcpy(tri, nt2, sizeof(int) * 12 * nt);
+        nt *= 4;
+        free(key);
+        free(val);
+    }
+    free(nt2);
+    *verts = p;
+    *n_verts = np;
+    *tris = tri;
+    *n_tris = nt;
 }

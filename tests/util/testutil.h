@@ -13,6 +13,9 @@ const char *tu_tmpdir(const char *test_name);
 /* Path buf = dir/name. */
 const char *tu_path(char *buf, size_t n, const char *dir, const char *name);
 int tu_write_file(const char *path, const char *text);
+/* Reads channel `name` of a one-part scanline EXR of w x h pixels as floats into img (rows top to
+ * bottom); -1 when it has no such channel. */
+int tu_read_exr_channel(const char *path, const char *name, int w, int h, float *img);
 /* Writes a one-part scanline EXR of w x h with nch channels (names[c], plane[c]: w*h floats, row 0 first),
  * each stored as half (half != 0; the values must be exact halves) or float, with the given compression
  * (an exr_compression_t). 0, or -1. */
@@ -88,5 +91,13 @@ static inline uint64_t tu_rng_next(tu_rng *r)
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return z ^ (z >> 31);
 }
+
+/* ms_render with o into f, failing the test with its message. */
+void tu_render_ok(const ms_scene *sc, const ms_render_options *o, ms_frame *f);
+
+/* The unit icosphere subdivided `levels` times: n_verts vertices on the unit sphere (3 doubles each; shared
+ * vertices once, midpoints looked up per edge) and n_tris triangles (3 vertex indices each); the caller
+ * jitters, scales and frees both. */
+void tu_unit_icosphere(int levels, double **verts, size_t *n_verts, int **tris, size_t *n_tris);
 
 #endif

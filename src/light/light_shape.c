@@ -1,0 +1,38 @@
+/* The light-shape table (light_shape.h) and the public per-shape entry points that read it. */
+#include "light_shape.h"
+#include <string.h>
+
+extern const ms_light_shape_ops ms_light_rect, ms_light_disk_shape, ms_light_sphere_shape;
+
+/* Indexed by ms_light_shape. */
+static const ms_light_shape_ops *const shapes[] = {
+    [MS_LIGHT_RECT] = &ms_light_rect,
+    [MS_LIGHT_DISK] = &ms_light_disk_shape,
+    [MS_LIGHT_SPHERE] = &ms_light_sphere_shape,
+};
+
+const ms_light_shape_ops *ms_light_shape_of(ms_light_shape shape)
+{
+    return (unsigned)shape < sizeof shapes / sizeof *shapes ? shapes[shape] : NULL;
+}
+
+const ms_light_shape_ops *ms_light_shape_named(const char *name)
+{
+    for (size_t i = 0; i < sizeof shapes / sizeof *shapes; i++)
+        if (strcmp(shapes[i]->name, name) == 0) return shapes[i];
+    return NULL;
+}
+
+int ms_light_shape_contains(ms_light_shape shape, float s, float t)
+{
+    const ms_light_shape_ops *o = ms_light_shape_of(shape);
+    return !o || !o->contains || o->contains(s, t);
+}
+
+float ms_light_area(const ms_light *l)
+{
+    const ms_light_shape_ops *o = ms_light_shape_of(l->shape);
+    ms_light_frame F;
+    ms_light_frame_of(l, &F);
+    return o ? o->area(l, &F) : v3_len(F.normal);
+}

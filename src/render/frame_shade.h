@@ -1,0 +1,17 @@
+/* The shading of a finished frame, the last step of the tile-by-tile frame (frame_job.c). */
+#ifndef MS_FRAME_SHADE_H
+#define MS_FRAME_SHADE_H
+#include <stddef.h>
+#include "microshadow.h"
+#include "visibility/context.h"
+#include "primary/primary.h"
+#include "shade.h"
+
+/* Shading: f->rgb from the hits, their surfaces (surf: per pixel, or NULL for the Lambertian
+ * grey everywhere) and every light's shadow and shadow_spec planes (lights[0..nlights), ctx: the frame's,
+ * for the textured lights' mean texels), and f->exposure (the 99th percentile of the unshadowed radiance
+ * over the visible pixels). 0, or -1 out of memory for the textured lights. */
+int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_light *lights, size_t nlights,
+                   const ms_hit *hits, const ms_surface *surf, int threads, ms_frame *f);
+
+#endif

@@ -1,5 +1,0 @@
-/* AVX2 instances (two 8-lane halves) of the micro-rasterization methods' multi-frusta traversal (block_raster_impl.h). */
-#include "block_raster.h"
-
-#define MS_PERK_IMPL "shadow/block_raster_impl.h"
-#include "../core/perk_each.h"

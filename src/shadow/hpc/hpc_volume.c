@@ -1,0 +1,129 @@
+/* Penumbra volumes (hpc_volume.h; Laine & Aila 2005, sec. 3.2, "MAKE-PENUMBRA-VOLUME").
+ *
+ * As the paper: every vertex-edge pair between the polygon and the triangle spans a candidate plane; the
+ * candidates with all polygon vertices on one side and all triangle vertices on the other are kept, and
+ * the triangle's plane caps the volume when the whole polygon lies on one side of it. Each kept plane is
+ * a valid bound on its own (a point x = l + s (t - l), s >= 1, with l on the polygon and t on the
+ * triangle, lies on t's side of a plane separating them), so keeping a subset when degenerate duplicates
+ * overflow HPC_MAX_PLANES is still conservative.
+ *
+ * Departure: the planes are found in double and classified with a tolerance of 1e-9 of the geometry's
+ * size, and the tests allow the caller's margin eps (hpc.c derives it from the rounding of the exact
+ * per-sample test), so that a relation the reference ray test calls blocked is never culled here. */
+#include "hpc_volume.h"
+#include "core/vec.h"
+#include <math.h>
+#include <string.h>
+
+/* Adds the plane through e0, e1 and v if it separates the polygon (on its non-positive side) from the
+ * triangle; oriented so that the triangle's side is positive. */
+static void try_plane(hpc_volume *v, const double e0[3], const double e1[3], const double w[3], const double *poly,
+                      int np, const double tv[3][3], double tol)
+{
+    double a[3], b[3], n[3];
+    d3_sub(a, e1, e0);
+    d3_sub(b, w, e0);
+    d3_cross(n, a, b);
+    const double len = sqrt(d3_dot(n, n));
+    if (!(len > 0.0)) return;
+    for (int i = 0; i < 3; i++) n[i] /= len;
+    const double d = -d3_dot(n, e0);
+    double pmin = INFINITY, pmax = -INFINITY, tmin = INFINITY, tmax = -INFINITY;
+    for (int i = 0; i < np; i++) {
+        const double s = d3_dot(n, poly + 3 * i) + d;
+        pmin = fmin(pmin, s);
+        pmax = fmax(pmax, s);
+    }
+    for (int i = 0; i < 3; i++) {
+        const double s = d3_dot(n, tv[i]) + d;
+        tmin = fmin(tmin, s);
+        tmax = fmax(tmax, s);
+    }
+    double sign;
+    if (pmax <= tol && tmin >= -tol) sign = 1.0;
+    else if (pmin >= -tol && tmax <= tol) sign = -1.0;
+    else return;
+    /* Everything on the plane: it separates nothing. */
+    if (fmax(fmax(fabs(pmin), fabs(pmax)), fmax(fabs(tmin), fabs(tmax))) <= tol) return;
+    if (v->n >= HPC_MAX_PLANES - 1) return;   /* one slot kept for the cap */
+    float *p = v->pl[v->n++];
+    for (int i = 0; i < 3; i++) p[i] = (float)(sign * n[i]);
+    p[3] = (float)(sign * d);
+}
+
+int hpc_volume_build(hpc_volume *v, const double *poly, int np, const float tri[9], float eps)
+{
+    memset(v, 0, sizeof *v);
+    v->eps = eps;
+    if (!isfinite(eps)) { v->unbounded = 1; return 0; }
+    double tv[3][3], size = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) { tv[i][a] = tri[3 * i + a]; size = fmax(size, fabs(tv[i][a])); }
+    for (int i = 0; i < 3 * np; i++) size = fmax(size, fabs(poly[i]));
+    const double tol = 1e-9 * size;
+    /* Triangle edge x polygon vertex, polygon edge x triangle vertex (every vertex-edge pair). */
+    for (int e = 0; e < 3; e++)
+        for (int i = 0; i < np; i++) try_plane(v, tv[e], tv[(e + 1) % 3], poly + 3 * i, poly, np, tv, tol);
+    for (int e = 0; e < np; e++)
+        for (int i = 0; i < 3; i++) try_plane(v, poly + 3 * e, poly + 3 * ((e + 1) % np), tv[i], poly, np, tv, tol);
+    /* The cap: the triangle's plane, when the polygon lies strictly on one side of it. */
+    double a[3], b[3], n[3];
+    d3_sub(a, tv[1], tv[0]);
+    d3_sub(b, tv[2], tv[0]);
+    d3_cross(n, a, b);
+    const double len = sqrt(d3_dot(n, n));
+    if (len > 0.0) {
+        for (int i = 0; i < 3; i++) n[i] /= len;
+        const double d = -d3_dot(n, tv[0]);
+        double pmin = INFINITY, pmax = -INFINITY;
+        for (int i = 0; i < np; i++) {
+            const double s = d3_dot(n, poly + 3 * i) + d;
+            pmin = fmin(pmin, s);
+            pmax = fmax(pmax, s);
+        }
+        const double sign = pmin > tol ? -1.0 : pmax < -tol ? 1.0 : 0.0;   /* inside: away from the polygon */
+        if (sign != 0.0) {
+            float *p = v->pl[v->n++];
+            for (int i = 0; i < 3; i++) p[i] = (float)(sign * n[i]);
+            p[3] = (float)(sign * d);
+        }
+    }
+    if (v->n == 0) v->unbounded = 1;
+    return v->n;
+}
+
+int hpc_volume_box(const hpc_volume *v, uint32_t act, const float lo[3], const float hi[3], uint32_t *out,
+                   uint64_t *tests)
+{
+    act &= v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u;
+    uint32_t keep = act;
+    while (act) {
+        const int i = __builtin_ctz(act);
+        act &= act - 1u;
+        const float *p = v->pl[i];
+        float mx = p[3], mn = p[3];
+        for (int a = 0; a < 3; a++) {
+            const float x = p[a] * lo[a], y = p[a] * hi[a];
+            mx += x > y ? x : y;
+            mn += x > y ? y : x;
+        }
+        ++*tests;
+        if (mx < -v->eps) return 0;
+        if (mn >= v->eps) keep &= ~(UINT32_C(1) << i);   /* wholly inside, with room for rounding */
+    }
+    *out = keep;
+    return 1;
+}
+
+int hpc_volume_point(const hpc_volume *v, uint32_t act, const float p[3], uint64_t *tests)
+{
+    act &= v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u;
+    while (act) {
+        const int i = __builtin_ctz(act);
+        act &= act - 1u;
+        const float *q = v->pl[i];
+        ++*tests;
+        if (q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] < -v->eps) return 0;
+    }
+    return 1;
+}

@@ -1,0 +1,251 @@
+/* Method "mft": multi-frusta tracing (Benthin & Wald 2009, "Efficient Ray Traced Soft Shadows using
+ * Multi-Frusta Tracing", HPG 2009). Pixels are taken in 4x4 blocks; the shadow frusta of a block (hit
+ * point -> the pixel's light samples) traverse a shallow BVH together, one frustum per SIMD lane, and in a
+ * leaf each triangle is culled for all sixteen by the frusta's corner rays before the surviving frusta
+ * test their live rays against it, 16 rays per operation, one bit per ray (mft_impl.h, per ISA).
+ *
+ * This file: the method's frame set-up, the grouping of the driver's queries into blocks, and each
+ * block's rays. The rays are the light samples of the shared patterns (ms_pattern_points: the points
+ * method raytrace traces) and are formed exactly as raytrace forms them (raytrace_impl.h: d = P - C,
+ * the shear of each 16-sample packet), so that mft and raytrace decide every ray alike; see mft_impl.h
+ * for what departs from the paper. */
+#include "shadow/method.h"
+#include "mft.h"
+#include "visibility/receiver.h"
+#include "light/pattern.h"
+#include "shadow/microraster/block_group.h"
+#include "core/vec.h"
+#include "accel/ray_triangle.h"
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Largest leaf of the shallow BVH (accel/bvh.h: subtrees of at most this many triangles collapsed into
+ * one leaf). Measured (docs/design.md, "mft"): 2, 4 and 8 within 3% of each other on the shared scenes
+ * (the leaf culling absorbs the difference); 16 was the slowest on the big light. */
+#ifndef MFT_SHALLOW_LEAF
+#define MFT_SHALLOW_LEAF 4
+#endif
+
+typedef struct mft_method {
+    ms_mft_fn block;
+    ms_isa isa;
+    ms_bvh_shallow sh;
+    ms_mft_frame f;
+} mft_method;
+
+ms_mft_fn ms_mft_isa(ms_isa isa)
+{
+    static const ms_mft_fn table[] = {
+        [MS_ISA_SCALAR] = ms_mft_block_scalar,
+        [MS_ISA_AVX2] = ms_mft_block_avx2,
+        [MS_ISA_AVX512] = ms_mft_block_avx512,
+    };
+    if (isa < MS_ISA_SCALAR || isa > MS_ISA_AVX512 || ms_cpu_isa() < isa) return NULL;
+    return table[isa];
+}
+
+ms_mft_fn ms_mft_select(ms_isa cap, ms_isa *chosen)
+{
+    const ms_isa isa = ms_isa_select(cap, MS_ISA_ALL);
+    const ms_mft_fn fn = isa == MS_ISA_AUTO ? NULL : ms_mft_isa(isa);
+    if (fn && chosen) *chosen = isa;
+    return fn;
+}
+
+void ms_mft_corners(const ms_mft_frame *f, const float c[3], const int r[4], float d[4][3])
+{
+    const double a[2] = { (r[0] - f->margin) / f->k, (r[1] + 1 + f->margin) / f->k };
+    const double b[2] = { (r[2] - f->margin) / f->k, (r[3] + 1 + f->margin) / f->k };
+    for (int q = 0; q < 4; q++)
+        for (int x = 0; x < 3; x++)
+            d[q][x] = (float)(f->lp[x] + a[q & 1] * f->ls[x] + b[q >> 1] * f->lt[x] - c[x]);
+}
+
+static void mft_frame_light(ms_mft_frame *f, const ms_light *l);
+
+static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
+{
+    mft_method *s = calloc(1, sizeof *s);
+    if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
+    s->block = ms_mft_select(ctx->isa_cap, &s->isa);
+    if (!s->block || ms_bvh_shallow_build(&s->sh, ctx->bvh, MFT_SHALLOW_LEAF)) {
+        free(s);
+        snprintf(err, errlen, "out of memory for the shallow BVH");
+        return -1;
+    }
+    ms_mft_frame *f = &s->f;
+    f->k = ctx->k;
+    f->samples = ctx->samples;
+    f->mask_words = ctx->mask_words;
+    f->near = ctx->near;
+    f->far = ctx->far;
+    mft_frame_light(f, &ctx->light);
+    f->pattern = ctx->pattern;
+    f->seed = ctx->seed;
+    f->alpha = ctx->alpha;
+    f->flags = (ctx->no_child_order ? 0 : MS_MFT_ORDER) | (ctx->frustum_shrink ? MS_MFT_FS : 0);
+    /* The paper's own mode: each pixel of a 4x4 block its own set of N/16 points (pattern.c), tested
+     * packet by packet against the whole light's frustum (footprints and CR need samples in cells). */
+    f->cells = ctx->pattern != MS_PATTERN_INTERLEAVED;
+    if (!f->cells) f->flags |= MS_MFT_NO_FOOTPRINT;
+#ifdef MFT_NO_FOOTPRINT
+    f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
+#endif
+    *state = s;
+    return 0;
+}
+
+/* The frame's light: corner, edges and the margin of the stored points. Per frame, or per call when the
+ * context's light is not the frame's (a sphere light's per-receiver outline disk, frame_job.c). */
+static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
+{
+    const double P[3] = { l->corner.x, l->corner.y, l->corner.z }, S[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z };
+    const double T[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
+    memcpy(f->lp, P, sizeof P);
+    memcpy(f->ls, S, sizeof S);
+    memcpy(f->lt, T, sizeof T);
+    /* The stored points are P + s S + t T (or the grid's p0 + i ds + j dt) rounded to float: a few ulps
+     * of |P| + |S| + |T| per coordinate. In cells of the light (height |S x T| / max(|S|, |T|) over k),
+     * 64 ulps of that, plus 1/100 of a cell. */
+    double n[3], mag = 0.0;
+    d3_cross(n, S, T);
+    for (int a = 0; a < 3; a++) mag += fabs(P[a]) + fabs(S[a]) + fabs(T[a]);
+    const double h = d3_len(n) / fmax(d3_len(S), d3_len(T));
+    f->margin = 0.01 + (h > 0.0 ? 64.0 * FLT_EPSILON * mag * f->k / h : 0.0);
+    f->light = *l;
+}
+
+void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
+{
+    const int base = ch * 16;
+    float pts[3 * 16];
+    ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, base, 16, pts);
+    for (int l = 0; l < 16; l++)
+        for (int a = 0; a < 3; a++) L->d[a][base + l] = pts[3 * l + a] - L->c[a];
+    /* The shear axis raytrace shares over a packet (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]). */
+    int kz;
+    L->kz[ch] = (signed char)ms_wt_packet_axis(L->d[0] + base, L->d[1] + base, L->d[2] + base, 16, &kz);
+    const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+    for (int l = base; l < base + 16; l++) {
+        const float inv = 1.0f / L->d[kz][l];
+        L->sx[l] = L->d[kx][l] * inv;
+        L->sy[l] = L->d[ky][l] * inv;
+    }
+    L->ready[ch >> 6] |= UINT64_C(1) << (ch & 63);
+}
+
+/* Lane L for pixel q: its rays are formed when first tested (ms_mft_rays). Its cell projection for the
+ * footprints: the inverse of the columns S/k, T/k, P - C (in double, then rounded), and the footprint's
+ * slack: the rounding of the stored points (the frame's margin) and an angle of 1e-4 around each ray,
+ * far above the watertight test's few ulps. */
+static void mft_lane_setup(const ms_mft_frame *f, const ms_shadow_query *q, ms_mft_lane *L)
+{
+    memcpy(L->c, q->p, sizeof L->c);
+    memcpy(L->n, q->n, sizeof L->n);
+    L->skip = q->prim;
+    L->px = q->px;
+    L->py = q->py;
+    memset(L->ready, 0, sizeof L->ready);
+    double u[3], v[3], w[3], vw[3], wu[3], uv[3];
+    for (int a = 0; a < 3; a++) {
+        u[a] = f->ls[a] / f->k;
+        v[a] = f->lt[a] / f->k;
+        w[a] = f->lp[a] - (double)q->p[a];
+    }
+    d3_cross(vw, v, w);
+    d3_cross(wu, w, u);
+    d3_cross(uv, u, v);
+    const double det = d3_dot(u, vw);
+    L->has_m = fabs(det) > 1e-6 * d3_len(u) * d3_len(v) * d3_len(w);
+    if (!L->has_m) return;
+    double m[3][3];
+    for (int a = 0; a < 3; a++) {
+        m[0][a] = vw[a] / det;
+        m[1][a] = wu[a] / det;
+        m[2][a] = uv[a] / det;
+    }
+    for (int r = 0; r < 3; r++) {
+        L->m_l1[r] = (float)(fabs(m[r][0]) + fabs(m[r][1]) + fabs(m[r][2]));
+        for (int a = 0; a < 3; a++) L->m[r][a] = (float)m[r][a];
+    }
+    L->foot_slack = (float)(f->margin + 0.02 + 1e-4 * d3_len(w) * (fmax(d3_len(m[0]), d3_len(m[1])) + f->k * d3_len(m[2])));
+}
+
+static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                          const uint64_t *front, uint64_t *vis, uint64_t *cnt)
+{
+    const mft_method *s = state;
+    const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
+    int *order = malloc((size_t)nq * sizeof *order);
+    float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
+    signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
+    if (!order || !rayf || !kzs) { free(order); free(rayf); free(kzs); return -1; }
+    ms_block_order(ctx, q, nq, order);
+    /* A light other than the frame's (a sphere's outline disk): the frame re-derived for it. */
+    const ms_mft_frame *f = &s->f;
+    ms_mft_frame own;
+    const ms_light *cl = &ctx->light, *fl = &s->f.light;
+    if (memcmp(&cl->corner, &fl->corner, sizeof cl->corner) || memcmp(&cl->edge_s, &fl->edge_s, sizeof cl->edge_s) ||
+        memcmp(&cl->edge_t, &fl->edge_t, sizeof cl->edge_t) || cl->shape != fl->shape) {
+        own = s->f;
+        mft_frame_light(&own, cl);
+        f = &own;
+    }
+    ms_mft_block blk;
+    for (int l = 0; l < MS_BLOCK_LANES; l++) {
+        float *base = rayf + (size_t)l * 5 * ns;
+        for (int a = 0; a < 3; a++) blk.lane[l].d[a] = base + (size_t)a * ns;
+        blk.lane[l].sx = base + 3 * ns;
+        blk.lane[l].sy = base + 4 * ns;
+        blk.lane[l].kz = kzs + (size_t)l * (ns / 16);
+    }
+    for (int g = 0; g < nq;) {
+        blk.n = 0;
+        const int end = ms_block_group_end(ctx, q, order, nq, g);
+        for (int e = g; e < end; e++) {
+            const int i = order[e];
+            uint64_t *m = vis + (size_t)i * mw;
+            memcpy(m, front + (size_t)i * mw, mw * sizeof *m);   /* the front mask is the starting set */
+            if (ms_mask_count(m, (int)mw) == 0) continue;
+            ms_mft_lane *L = &blk.lane[blk.n++];
+            L->mask = m;
+            mft_lane_setup(f, &q[i], L);
+        }
+        if (blk.n) s->block(f, &blk, ctx->bvh, &s->sh, cnt);
+        g = end;
+    }
+    free(order);
+    free(rayf);
+    free(kzs);
+    return 0;
+}
+
+static void mft_destroy(void *state)
+{
+    mft_method *s = state;
+    ms_bvh_shallow_free(&s->sh);
+    free(s);
+}
+
+static void mft_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
+{
+    const mft_method *s = state;
+    *kernel = *traversal = s->isa;
+}
+
+const ms_shadow_method ms_shadow_mft = {
+    .name = "mft",
+    .primary = "bvh",
+    .needs_grid = 0,
+    .n_counters = MS_MFT_COUNTERS,
+    .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",
+                       "leaf_frusta_culled", "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",
+                       "culled_footprint", "pairs_tested", "isec_tests16", "frusta_early_out", "rect_shrinks" },
+    .create = mft_create,
+    .visibility = mft_visibility,
+    .destroy = mft_destroy,
+    .isa_used = mft_isa_used,
+};

@@ -1,0 +1,50 @@
+/* The micro-rasterization methods over the multi-frusta traversal (block_traverse.h): the 4x4 pixel
+ * block's frusta traverse the shallow BVH together, and in a leaf each triangle is first tested for all
+ * sixteen pixels at once (lane = pixel) against what the kernel's own set-up would decide: the depth
+ * range, the receiver's horizon and the sample rectangle of the pixel's still-visible samples; then, per
+ * pixel that remains, against the visible samples of its buffer under the triangle's box (the coverage
+ * test); only then is it rasterized by the kernel. The rectangle shrinks as samples are occluded (the
+ * paper's corner-ray recomputation, "CR"), a pixel whose buffer empties leaves the block, and the block
+ * stops when none is left. The buffers equal those of the per-pixel traversal: every test is
+ * conservative with respect to the kernel (see block_raster_impl.h). */
+#ifndef MS_BLOCK_RASTER_H
+#define MS_BLOCK_RASTER_H
+#include <stdint.h>
+#include "block_traverse.h"
+#include "raster/raster.h"
+#include "core/perk.h"
+
+/* The block as the caller hands it over: up to 16 pixels, each with its frame, its buffer (the front
+ * mask on entry, the visible mask on return) and its hit triangle. */
+typedef struct ms_block_input {
+    int n;
+    const ms_raster_frame *frame[MS_BLOCK_LANES];
+    void *buf[MS_BLOCK_LANES];
+    uint32_t skip[MS_BLOCK_LANES];
+} ms_block_input;
+
+enum {
+    MS_BR_LEAF_LANES_CULLED = MS_BT_COUNTERS, /* pixels dropped at a leaf by their own frustum */
+    MS_BR_TRI_LANES,                   /* (triangle, pixel) pairs reaching the leaf tests */
+    MS_BR_CULLED_DEPTH, MS_BR_CULLED_RECT, MS_BR_CULLED_CORNER, MS_BR_CULLED_COVERAGE,
+    MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS, MS_BR_COUNTERS
+};
+
+/* Flags: MS_BR_FRUSTUM_SHRINK also narrows a pixel's traversal frustum to its rectangle (the paper's
+ * "FS"); MS_BR_ORDER visits nearer children first. */
+enum { MS_BR_ORDER = 1, MS_BR_FRUSTUM_SHRINK = 2 };
+
+typedef void (*ms_block_raster_fn)(const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh,
+                                   ms_raster_fn raster, float near, float far, uint64_t *cnt, int flags);
+
+ms_block_raster_fn ms_block_raster_select(int k, ms_isa cap, ms_isa *chosen);
+ms_block_raster_fn ms_block_raster_isa(int k, ms_isa isa);
+
+#define MS_BR_PARAMS                                                                                   \
+    (const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh, ms_raster_fn raster, float near, \
+     float far, uint64_t *cnt, int flags)
+MS_PERK_DECLARE(void, ms_block_raster, scalar, MS_BR_PARAMS);
+MS_PERK_DECLARE(void, ms_block_raster, avx2, MS_BR_PARAMS);
+MS_PERK_DECLARE(void, ms_block_raster, avx512, MS_BR_PARAMS);
+
+#endif

@@ -1,0 +1,5 @@
+/* AVX-512 instances (one 16-lane register) of the micro-rasterization methods' multi-frusta traversal (block_raster_impl.h). */
+#include "block_raster.h"
+
+#define MS_PERK_IMPL "shadow/microraster/block_raster_impl.h"
+#include "core/perk_each.h"

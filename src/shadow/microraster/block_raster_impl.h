@@ -1,0 +1,357 @@
+/* The micro-rasterization methods' multi-frusta traversal (block_raster.h), instantiated per k through
+ * core/perk_each.h (MS_K, MS_WORD) for each ISA (block_raster_{scalar,avx2,avx512}.c); the loop is
+ * block_traverse_loop.h, the lanes lanes16.h.
+ *
+ * Exactness: the per-pixel traversal hands every triangle of a surviving leaf to the kernel; here a
+ * triangle is dropped for a pixel only where the kernel would change nothing in its buffer:
+ *   - depth: the kernel's own test, recomputed with its arithmetic operation for operation
+ *     (raster_internal.h, ms_tri_setup_run: light-index vertices m (P - C) summed left to right, the same
+ *     error bound MS_Z_REL), so the decision is the kernel's;
+ *   - rectangle: when the kernel would bound the triangle by its projected box (its zmin > 0), that box,
+ *     again recomputed as the kernel computes it (x * (1/z), the same slack, clamp and rounding to
+ *     sample indices), against the rectangle of the buffer's visible samples: the kernel clears only
+ *     samples inside its box, and outside the rectangle there is nothing left to clear;
+ *   - coverage: the same box against the visible samples of the rows it spans.
+ * The horizon needs no test of its own: it is rasterized into the buffer before the traversal (the
+ * front mask), so the rectangle and the coverage tests already exclude the samples behind the receiver
+ * (a separate per-vertex plane test was measured to drop only 2% of the triangle-pixel pairs on the
+ * bunny, for more than it saved).
+ * Before the triangles, a leaf's box is tested the same way for all sixteen pixels (br_leaf_lanes):
+ * against each pixel's rectangle frustum and, projected, against its visible samples (the per-pixel
+ * traversal's node tests, frustum_traverse_impl.h), so that a pixel skips a leaf it cannot change.
+ * The paper's corner rays are here the rays through the rectangle's corners (the pixel's light-index
+ * space makes them the corners of a box of sample indices): the rectangle test is the frustum's side
+ * planes against the triangle, the corner-ray test (large rectangles only) the triangle's edge planes
+ * against the corner rays, and the paper's shrinking (CR) is the rectangle recomputed after a leaf in
+ * which the pixel rasterized. */
+#include <string.h>
+#include "block_raster.h"
+#include "visibility/lanes16.h"
+#include "raster/raster_internal.h"
+#include "frustum_traverse.h"   /* MS_TRAV_SIDE_SLACK; alpha.h */
+
+#ifndef MS_BR_COMMON
+#define MS_BR_COMMON
+/* A leaf's triangles that are some pixel's own (never occluding): few, usually none. */
+#define BR_MAX_SKIP MS_BLOCK_LANES
+/* Smallest rectangle (in samples) for which the corner-ray test runs. */
+#define BR_CORNER_AREA 16.0f
+typedef struct br_state {
+    ms_block_frusta *fr;
+    uint64_t *bt_cnt;
+    const ms_bvh *b;
+    const ms_block_input *in;
+    ms_raster_fn raster;
+    int flags;
+    float m[3][3][MS_BLOCK_LANES];   /* lane frames' m[r][a] */
+    float mabs2[3][MS_BLOCK_LANES];  /* |m[2][a]| */
+    float rx0[MS_BLOCK_LANES], rx1[MS_BLOCK_LANES], ry0[MS_BLOCK_LANES], ry1[MS_BLOCK_LANES];
+    int rect[MS_BLOCK_LANES][4];
+} br_state;
+
+/* The four corner directions of lane rectangle r (columns r[0]..r[1], rows r[2]..r[3]) from C: sample
+ * (i, j) is C + mt[2] + i mt[0] + j mt[1] (raster.h). */
+static inline void br_corner_dirs(const ms_raster_frame *f, const int r[4], float d[4][3])
+{
+    for (int c = 0; c < 4; c++) {
+        const float i = (float)r[c & 1], j = (float)r[2 + (c >> 1)];
+        for (int a = 0; a < 3; a++) d[c][a] = f->mt[2][a] + i * f->mt[0][a] + j * f->mt[1][a];
+    }
+}
+#endif
+
+/* The rectangle of the visible samples of a buffer within rows j0..j1 (the others known empty):
+ * columns r[0]..r[1], rows r[2]..r[3]; 0 if none. */
+static inline int MS_KFN(br_live_rect)(const MS_WORD *buf, int j0, int j1, int r[4])
+{
+    /* Branch-free (the rows' emptiness is data, and mispredicted here it cost 10% of the traversal). */
+    MS_WORD any = 0;
+    uint64_t rows = 0;
+    for (int j = j0; j <= j1; j++) { any |= buf[j]; rows |= (uint64_t)(buf[j] != 0) << j; }
+    if (!any) return 0;
+    const uint64_t a = (uint64_t)any;
+    r[0] = __builtin_ctzll(a);
+    r[1] = 63 - __builtin_clzll(a);
+    r[2] = __builtin_ctzll(rows);
+    r[3] = 63 - __builtin_clzll(rows);
+    return 1;
+}
+
+/* Lane l's rectangle from its buffer (0: the buffer is empty), and its traversal frustum from the
+ * rectangle when `frustum` is set. Rectangles only shrink: rows outside the current one are not read
+ * (`first`: there is none yet). */
+static inline int MS_KFN(br_update_lane)(br_state *s, int l, int frustum, int first)
+{
+    int r[4];
+    const int j0 = first ? 0 : s->rect[l][2], j1 = first ? MS_K - 1 : s->rect[l][3];
+    if (!MS_KFN(br_live_rect)((const MS_WORD *)s->in->buf[l], j0, j1, r)) return 0;
+    memcpy(s->rect[l], r, sizeof r);
+    s->rx0[l] = (float)r[0]; s->rx1[l] = (float)r[1];
+    s->ry0[l] = (float)r[2]; s->ry1[l] = (float)r[3];
+    if (frustum) {
+        float d[4][3];
+        br_corner_dirs(s->in->frame[l], r, d);
+        ms_block_frusta_set_lane(s->fr, l, s->in->frame[l]->c, d, 1e-5f);
+    }
+    return 1;
+}
+
+
+/* 1 if a visible sample lies in columns x0..x1 of rows y0..y1. */
+static inline int MS_KFN(br_covers)(const MS_WORD *buf, int x0, int x1, int y0, int y1)
+{
+    const MS_WORD ones = (MS_WORD)~(MS_WORD)0;   /* cast after ~: uint16_t promotes to int */
+    const MS_WORD mask = (MS_WORD)((MS_WORD)(ones >> (MS_K - 1 - (x1 - x0))) << x0);
+    MS_WORD any = 0;
+    for (int j = y0; j <= y1; j++) any |= buf[j];
+    return (any & mask) != 0;
+}
+
+/* The lanes of mask whose rectangle frustum (light-index space: i in [rx0, rx1], j in [ry0, ry1] on the
+ * plane z = 1, segment parameter in [near, far]) may meet the box of leaf n: the per-pixel traversal's
+ * node test (frustum_traverse_impl.h, the same slack) for all sixteen pixels at once, against each
+ * pixel's rectangle rather than the whole buffer. All eight corners outside one plane through C (or
+ * beyond near or far) cull: the box, hence every triangle in it, then lies wholly outside the frustum
+ * of the visible samples. */
+static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_node *n, unsigned mask,
+                                             const l16 m[3][3], const l16 c[3])
+{
+    l16 base[3], col[3][3];
+    l16 rel[3];
+    for (int a = 0; a < 3; a++) rel[a] = l16_sub(l16_set1(n->bmin[a]), c[a]);
+    for (int r = 0; r < 3; r++) {
+        base[r] = l16_add(l16_add(l16_mul(m[r][0], rel[0]), l16_mul(m[r][1], rel[1])), l16_mul(m[r][2], rel[2]));
+        for (int a = 0; a < 3; a++) col[a][r] = l16_mul(m[r][a], l16_set1(n->bmax[a] - n->bmin[a]));
+    }
+    const l16 sl = l16_set1(MS_TRAV_SIDE_SLACK);
+    const l16 x0 = l16_sub(l16_load(s->rx0), sl), x1 = l16_add(l16_load(s->rx1), sl);
+    const l16 y0 = l16_sub(l16_load(s->ry0), sl), y1 = l16_add(l16_load(s->ry1), sl);
+    const l16 near = l16_set1(s->fr->near), far = l16_set1(s->fr->far);
+    unsigned out_xl = 0xFFFF, out_xh = 0xFFFF, out_yl = 0xFFFF, out_yh = 0xFFFF, out_n = 0xFFFF, out_f = 0xFFFF;
+    unsigned front = 0xFFFF;
+    const l16 inf = l16_set1(INFINITY), zero = l16_set1(0.0f), one = l16_set1(1.0f);
+    l16 px0 = inf, py0 = inf, px1 = l16_sub(zero, inf), py1 = l16_sub(zero, inf);
+    for (int corner = 0; corner < 8; corner++) {
+        l16 p[3];
+        for (int r = 0; r < 3; r++) {
+            p[r] = base[r];
+            if (corner & 1) p[r] = l16_add(p[r], col[0][r]);
+            if (corner & 2) p[r] = l16_add(p[r], col[1][r]);
+            if (corner & 4) p[r] = l16_add(p[r], col[2][r]);
+        }
+        /* Side planes x = x0 z etc.: through C, so the tests hold whatever the sign of z. */
+        out_xl &= l16_lt(p[0], l16_mul(x0, p[2]));
+        out_xh &= l16_gt(p[0], l16_mul(x1, p[2]));
+        out_yl &= l16_lt(p[1], l16_mul(y0, p[2]));
+        out_yh &= l16_gt(p[1], l16_mul(y1, p[2]));
+        out_n &= l16_lt(p[2], near);
+        out_f &= l16_gt(p[2], far);
+        front &= l16_gt(p[2], zero);
+        const l16 iz = l16_div(one, p[2]);
+        const l16 qx = l16_mul(p[0], iz), qy = l16_mul(p[1], iz);
+        px0 = l16_min(px0, qx); px1 = l16_max(px1, qx);
+        py0 = l16_min(py0, qy); py1 = l16_max(py1, qy);
+    }
+    unsigned keep = mask & ~(out_xl | out_xh | out_yl | out_yh | out_n | out_f);
+    /* Coverage (the per-pixel traversal's occlusion cull): in front of C the box projects inside the hull
+     * of its corners' projections; if that holds no visible sample, nothing in the leaf changes the
+     * buffer. */
+    unsigned cand = keep & front;
+    if (cand) {
+        float bx0[MS_BLOCK_LANES], bx1[MS_BLOCK_LANES], by0[MS_BLOCK_LANES], by1[MS_BLOCK_LANES];
+        l16_store(bx0, px0); l16_store(bx1, px1); l16_store(by0, py0); l16_store(by1, py1);
+        for (; cand; cand &= cand - 1) {
+            const int l = __builtin_ctz(cand);
+            const int *r = s->rect[l];
+            const float kmax = (float)(MS_K - 1);
+            const int ix0 = ms_ceil_i(ms_clampf(bx0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int ix1 = ms_floor_i(ms_clampf(bx1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int iy0 = ms_ceil_i(ms_clampf(by0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int iy1 = ms_floor_i(ms_clampf(by1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
+            const int xa = ix0 > r[0] ? ix0 : r[0], xb = ix1 < r[1] ? ix1 : r[1];
+            const int ya = iy0 > r[2] ? iy0 : r[2], yb = iy1 < r[3] ? iy1 : r[3];
+            if (xa > xb || ya > yb || !MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa, xb, ya, yb)) keep &= ~(1u << l);
+        }
+    }
+    return keep;
+}
+
+static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
+{
+    ms_block_frusta *fr = s->fr;
+    uint64_t *cnt = s->bt_cnt;
+    const ms_block_input *in = s->in;
+    /* The pixels whose own triangle is in this leaf. */
+    uint32_t skip_tri[BR_MAX_SKIP];
+    unsigned skip_lane[BR_MAX_SKIP];
+    int nskip = 0;
+    for (unsigned m = mask; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        if (in->skip[l] - n->first < n->count) { skip_tri[nskip] = in->skip[l]; skip_lane[nskip++] = 1u << l; }
+    }
+    const l16 near = l16_set1(fr->near), far = l16_set1(fr->far), zero = l16_set1(0.0f);
+    const l16 zrel = l16_set1(MS_Z_REL), slack = l16_set1(MS_BOX_SLACK), one = l16_set1(1.0f);
+    const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+    l16 m[3][3], ma[3], c[3];
+    for (int a = 0; a < 3; a++) {
+        c[a] = l16_load(fr->c[a]);
+        ma[a] = l16_load(s->mabs2[a]);
+        for (int r = 0; r < 3; r++) m[r][a] = l16_load(s->m[r][a]);
+    }
+    const l16 rx0 = l16_load(s->rx0), rx1 = l16_load(s->rx1), ry0 = l16_load(s->ry0), ry1 = l16_load(s->ry1);
+    const unsigned before = mask & fr->live;
+    mask = MS_KFN(br_leaf_lanes)(s, n, before, m, c);
+    cnt[MS_BR_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
+    if (!mask) return;
+    unsigned rasterized = 0;
+    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_corner = 0, c_cov = 0, c_rast = 0;
+    for (uint32_t t = n->first; t < n->first + n->count; t++) {
+        unsigned lanes = mask & fr->live;
+        if (!lanes) break;
+        for (int q = 0; q < nskip; q++)
+            if (skip_tri[q] == t) lanes &= ~skip_lane[q];
+        if (!lanes) continue;
+        tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
+        const float *tri = s->b->tri + 9 * (size_t)t;
+        l16 x[3], y[3], z[3], zlo[3], zhi[3];
+        for (int v = 0; v < 3; v++) {
+            l16 a[3], aa[3];
+            for (int k = 0; k < 3; k++) { a[k] = l16_sub(l16_set1(tri[3 * v + k]), c[k]); aa[k] = l16_abs(a[k]); }
+            x[v] = l16_add(l16_add(l16_mul(m[0][0], a[0]), l16_mul(m[0][1], a[1])), l16_mul(m[0][2], a[2]));
+            y[v] = l16_add(l16_add(l16_mul(m[1][0], a[0]), l16_mul(m[1][1], a[1])), l16_mul(m[1][2], a[2]));
+            z[v] = l16_add(l16_add(l16_mul(m[2][0], a[0]), l16_mul(m[2][1], a[1])), l16_mul(m[2][2], a[2]));
+            const l16 zerr = l16_mul(l16_add(l16_add(l16_mul(ma[0], aa[0]), l16_mul(ma[1], aa[1])), l16_mul(ma[2], aa[2])), zrel);
+            zlo[v] = l16_sub(z[v], zerr);
+            zhi[v] = l16_add(z[v], zerr);
+        }
+        const l16 zmin = l16_min(l16_min(zlo[0], zlo[1]), zlo[2]);
+        const l16 zmax = l16_max(l16_max(zhi[0], zhi[1]), zhi[2]);
+        const unsigned depth_ok = l16_le(near, zmax) & l16_le(zmin, far);
+        const unsigned front = l16_gt(zmin, zero);
+        l16 xs[3], ys[3];
+        for (int v = 0; v < 3; v++) {
+            const l16 inv = l16_div(one, z[v]);
+            xs[v] = l16_mul(x[v], inv);
+            ys[v] = l16_mul(y[v], inv);
+        }
+        /* The kernel's box: its slack, its clamp, its rounding to sample indices; then within the
+         * rectangle. */
+        const l16 xlo = l16_sub(l16_min(l16_min(xs[0], xs[1]), xs[2]), slack);
+        const l16 xhi = l16_add(l16_max(l16_max(xs[0], xs[1]), xs[2]), slack);
+        const l16 ylo = l16_sub(l16_min(l16_min(ys[0], ys[1]), ys[2]), slack);
+        const l16 yhi = l16_add(l16_max(l16_max(ys[0], ys[1]), ys[2]), slack);
+        const l16 bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), rx0);
+        const l16 bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), rx1);
+        const l16 by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), ry0);
+        const l16 by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), ry1);
+        const unsigned miss = front & (l16_gt(bx0, bx1) | l16_gt(by0, by1));
+        const unsigned l_depth = lanes & ~depth_ok, l_rect = lanes & depth_ok & miss;
+        c_depth += (uint64_t)ms_bt_popcount16(l_depth);
+        c_rect += (uint64_t)ms_bt_popcount16(l_rect);
+        unsigned pass = lanes & depth_ok & ~miss;
+        if (!pass) continue;
+        /* Corner rays (the paper's corner-ray culling, in light-index space): a triangle whose box holds
+         * visible samples may still miss the whole rectangle box x rows (a long thin triangle across
+         * it). Its three edge planes through C, oriented towards the opposite vertex: if the four
+         * corners of the rectangle lie outside one of them, no sample inside does (convexity). Worth
+         * its cost only for large rectangles, where the kernel call it saves is dear and the miss likely;
+         * a margin of 1e-5 of the terms' magnitudes leaves any doubt to the kernel. */
+        const l16 cx0 = l16_select(front, bx0, rx0), cx1 = l16_select(front, bx1, rx1);
+        const l16 cy0 = l16_select(front, by0, ry0), cy1 = l16_select(front, by1, ry1);
+        const l16 area = l16_mul(l16_add(l16_sub(cx1, cx0), one), l16_add(l16_sub(cy1, cy0), one));
+        if (pass & l16_gt(area, l16_set1(BR_CORNER_AREA))) {
+            l16 n1[3];
+            for (int v = 0; v < 3; v++) n1[v] = l16_add(l16_add(l16_abs(x[v]), l16_abs(y[v])), l16_abs(z[v]));
+            const l16 pmax = l16_add(l16_add(cx1, cy1), one);   /* |i| + |j| + 1 at any corner */
+            unsigned out = 0;
+            for (int e = 0; e < 3; e++) {
+                const int va = (e + 1) % 3, vb = (e + 2) % 3;
+                const l16 ex = l16_sub(l16_mul(y[va], z[vb]), l16_mul(z[va], y[vb]));
+                const l16 ey = l16_sub(l16_mul(z[va], x[vb]), l16_mul(x[va], z[vb]));
+                const l16 ez = l16_sub(l16_mul(x[va], y[vb]), l16_mul(y[va], x[vb]));
+                const l16 tol = l16_mul(l16_mul(n1[va], n1[vb]), l16_set1(1e-5f));
+                const l16 side = l16_add(l16_add(l16_mul(ex, x[e]), l16_mul(ey, y[e])), l16_mul(ez, z[e]));
+                const l16 tc = l16_mul(tol, n1[e]);
+                const unsigned pos = l16_gt(side, tc), neg = l16_lt(side, l16_sub(zero, tc));
+                const l16 tp = l16_mul(tol, pmax), ntp = l16_sub(zero, tp);
+                unsigned pos_out = pos, neg_out = neg;
+                for (int corner = 0; corner < 4; corner++) {
+                    const l16 pi = (corner & 1) ? cx1 : cx0, pj = (corner & 2) ? cy1 : cy0;
+                    const l16 val = l16_add(l16_add(l16_mul(ex, pi), l16_mul(ey, pj)), ez);
+                    pos_out &= l16_lt(val, ntp);   /* inside is positive: the corner is outside */
+                    neg_out &= l16_gt(val, tp);
+                }
+                out |= pos_out | neg_out;
+            }
+            out &= pass;
+            c_corner += (uint64_t)ms_bt_popcount16(out);
+            pass &= ~out;
+            if (!pass) continue;
+        }
+        int32_t ix0[MS_BLOCK_LANES], ix1[MS_BLOCK_LANES], iy0[MS_BLOCK_LANES], iy1[MS_BLOCK_LANES];
+        l16_store_int(ix0, bx0); l16_store_int(ix1, bx1); l16_store_int(iy0, by0); l16_store_int(iy1, by1);
+        for (; pass; pass &= pass - 1) {
+            const int l = __builtin_ctz(pass);
+            /* Behind C somewhere (front clear): the kernel scans its whole rectangle, which holds visible
+             * samples by construction. */
+            if ((front >> l & 1) && !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], ix0[l], ix1[l], iy0[l], iy1[l])) { c_cov++; continue; }
+            /* An alpha-tested triangle clears only its opaque samples (alpha.h): the rectangle, coverage and
+             * early-out tests that read the buffer afterwards see only what it really occludes. */
+            ms_raster_or_alpha(in->frame[l], s->raster, tri, t, in->buf[l]);
+            rasterized |= 1u << l;
+            c_rast++;
+        }
+    }
+    cnt[MS_BR_TRI_LANES] += tri_lanes;
+    cnt[MS_BR_CULLED_DEPTH] += c_depth;
+    cnt[MS_BR_CULLED_RECT] += c_rect;
+    cnt[MS_BR_CULLED_CORNER] += c_corner;
+    cnt[MS_BR_CULLED_COVERAGE] += c_cov;
+    cnt[MS_BR_RASTERIZED] += c_rast;
+    /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */
+    const int fs = s->flags & MS_BR_FRUSTUM_SHRINK;
+    for (; rasterized; rasterized &= rasterized - 1) {
+        const int l = __builtin_ctz(rasterized);
+        int old[4];
+        memcpy(old, s->rect[l], sizeof old);
+        if (!MS_KFN(br_update_lane)(s, l, fs, 0)) { fr->live &= ~(1u << l); cnt[MS_BR_PIXELS_EARLY_OUT]++; continue; }
+        cnt[MS_BR_RECT_SHRINKS] += memcmp(old, s->rect[l], sizeof old) != 0;
+    }
+}
+
+#define BT_STATE br_state
+#define BT_LEAF(s, n, mask) MS_KFN(br_leaf)(s, n, mask)
+#define BT_FN MS_KFN(br_traverse)
+#include "block_traverse_loop.h"
+#undef BT_STATE
+#undef BT_LEAF
+#undef BT_FN
+
+void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh, ms_raster_fn raster,
+                             float near, float far, uint64_t *cnt, int flags)
+{
+    ms_block_frusta fr;
+    br_state s;
+    ms_block_frusta_init(&fr, &sh->nodes[0], near, far);
+    s.fr = &fr;
+    s.bt_cnt = cnt;
+    s.b = b;
+    s.in = in;
+    s.raster = raster;
+    s.flags = flags;
+    memset(s.m, 0, sizeof s.m);
+    memset(s.mabs2, 0, sizeof s.mabs2);
+    for (int l = 0; l < MS_BLOCK_LANES; l++) {
+        s.rx0[l] = s.ry0[l] = 1.0f;
+        s.rx1[l] = s.ry1[l] = 0.0f;
+    }
+    for (int l = 0; l < in->n; l++) {
+        const ms_raster_frame *f = in->frame[l];
+        for (int r = 0; r < 3; r++)
+            for (int a = 0; a < 3; a++) s.m[r][a][l] = f->m[r][a];
+        for (int a = 0; a < 3; a++) s.mabs2[a][l] = fabsf(f->m[2][a]);
+        /* The starting frustum bounds the front samples (the horizon already cleared the rest). */
+        MS_KFN(br_update_lane)(&s, l, 1, 1);
+    }
+    MS_KFN(br_traverse)(&s, sh, flags & MS_BR_ORDER);
+}

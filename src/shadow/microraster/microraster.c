@@ -1,0 +1,207 @@
+/* Methods "scanline", "bounds", "hierarchical": soft shadows by micro-rasterization (Woop 2010,
+ * sec. 6). For every visible point C the frustum spanned by C and the light finds the triangles between
+ * them, each of which is rasterized into the pixel's k x k occlusion buffer with the method's kernel
+ * (src/raster); the buffer starts as the pixel's front mask (the receiver's horizon rasterized by the
+ * Scanline row loop, receiver.c) and what is left is the visible mask. The pixel's 3x3 light-space
+ * transform is set up once and shared by all its triangles. Two traversals give the same buffers: by
+ * default the frusta of a 4x4 pixel block together through the shallow BVH (Benthin & Wald 2009,
+ * block_raster_impl.h), or each pixel's alone through the deep BVH (Woop's, frustum_traverse_impl.h;
+ * ms_render_options.traversal).
+ *
+ * Departure from the paper: a point that sees the light nearly edge-on (closer to the light's plane than
+ * 1e-3 of its distance to the light) makes the light-space transform near-singular (light-space
+ * coordinates of 1e6 were seen on Sponza). The kernels' edge equations no longer depend on it (they are
+ * world cross products carried by M^T, raster_internal.h), but the traversal's node projections and the
+ * kernels' boxes do. Such points are answered by the reference per-sample tracer instead, on the same
+ * samples; they are counted (pixels_traced_edge_on) and are few: the light barely reaches them.
+ *
+ * The render context's switches (visibility/context.h) cap the kernels' and the traversal's instruction set and
+ * switch off the coverage test and the near-first child order; the library reads no environment. */
+#include "shadow/method.h"
+#include "shadow/raytrace/raytrace.h"
+#include "frustum_traverse.h"
+#include "block_raster.h"
+#include "block_group.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
+#include <math.h>
+#include "core/vec.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define EDGE_ON 1e-3f
+
+/* Largest leaf of the shallow BVH of the block traversal (accel/bvh.h): measured on the shared scenes
+ * (docs/scenes.md); leaves this size cost a few 16-lane triangle tests and save two levels of nodes. */
+#define MR_SHALLOW_LEAF 8
+
+typedef struct mr_state {
+    ms_raster_fn raster;
+    ms_frustum_trace_fn trace;
+    ms_block_raster_fn block;       /* NULL: per-pixel traversal */
+    ms_bvh_shallow shallow;
+    int flags, block_flags;
+    ms_isa kernel_isa, trace_isa; /* what ran, for ms_stats */
+} mr_state;
+
+static const char *const block_counter_names[] = {
+    "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "leaf_pixels_culled", "tri_pixel_tests",
+    "culled_depth", "culled_rect", "culled_corner_rays", "culled_coverage", "triangles_rasterized",
+    "pixels_early_out", "rect_shrinks", "pixels_traced_edge_on"
+};
+enum { MR_BLOCK_EDGE_ON = MS_BR_COUNTERS, MR_BLOCK_COUNTERS };
+
+static int mr_create_kernel(ms_kernel_id id, const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
+{
+    mr_state *s = calloc(1, sizeof *s);
+    if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
+    s->raster = ms_raster_kernel(id, ctx->k, ctx->isa_cap, &s->kernel_isa);
+    if (ctx->traversal == MS_TRAVERSAL_PIXEL) s->trace = ms_frustum_trace_select(ctx->k, ctx->isa_cap, &s->trace_isa);
+    else s->block = ms_block_raster_select(ctx->k, ctx->isa_cap, &s->trace_isa);
+    if (!s->raster || !(s->trace || s->block)) {
+        free(s);
+        snprintf(err, errlen, "no %s kernel for %d samples", ms_kernel_name(id), ctx->samples);
+        return -1;
+    }
+    s->flags = (ctx->no_occlusion_cull ? 0 : MS_FT_CULL_OCCLUDED) | (ctx->no_child_order ? 0 : MS_FT_ORDER_CHILDREN);
+    s->block_flags = (ctx->no_child_order ? 0 : MS_BR_ORDER) | (ctx->frustum_shrink ? MS_BR_FRUSTUM_SHRINK : 0);
+    if (s->block && ms_bvh_shallow_build(&s->shallow, ctx->bvh, MR_SHALLOW_LEAF)) {
+        free(s);
+        snprintf(err, errlen, "out of memory for the shallow BVH");
+        return -1;
+    }
+    *state = s;
+    return 0;
+}
+
+static int mr_create_scanline(const ms_render_ctx *c, void **s, char *e, size_t n) { return mr_create_kernel(MS_KERNEL_SCANLINE, c, s, e, n); }
+static int mr_create_bounds(const ms_render_ctx *c, void **s, char *e, size_t n) { return mr_create_kernel(MS_KERNEL_BOUNDS, c, s, e, n); }
+static int mr_create_hier(const ms_render_ctx *c, void **s, char *e, size_t n) { return mr_create_kernel(MS_KERNEL_HIERARCHICAL, c, s, e, n); }
+
+/* Starts query q's buffer as its front mask (the horizon is already rasterized, so samples behind count
+ * as neither visible nor occluded and the all-zero early-out means "every front sample occluded") and
+ * sets up its frame. Returns 1 when the frame is to be traversed, 0 when the buffer is final: no front
+ * sample, or an edge-on point, traced per sample (counted in *edge_on), or -1 when out of memory. */
+static int mr_start(const ms_render_ctx *ctx, const ms_shadow_query *q, const uint64_t *fm, uint64_t *buf,
+                    ms_raster_frame *f, ms_alpha_pixel *ap, float **pts, uint64_t *edge_on)
+{
+    const size_t mw = (size_t)ctx->mask_words;
+    memcpy(buf, fm, mw * sizeof *buf);
+    if (ms_mask_count(fm, (int)mw) == 0) return 0;
+    ms_grid g;
+    ms_grid_for_pixel(&ctx->light, ctx->k, q->px, q->py, ctx->seed, &g);
+    float n[3], rel[3];
+    v3_cross(n, g.ds, g.dt);
+    v3_sub(rel, g.p0, q->p);
+    float h = fabsf(v3_dot(n, rel)), d = v3_len(n) * v3_len(rel);
+    if (!(h > EDGE_ON * d) || ms_raster_frame_init(f, q->p, &g, ctx->near, ctx->far, 0) != 0) {
+        uint64_t rt_counters[MS_MAX_COUNTERS] = { 0 };
+        if (!*pts && !(*pts = malloc((size_t)ctx->samples * 3 * sizeof(float)))) return -1;
+        ms_raytrace_visible_samples(ctx, q, *pts, fm, buf, rt_counters);
+        ++*edge_on;
+        return 0;
+    }
+    /* Alpha-tested triangles need the query to find their samples (alpha.h); opaque scenes: NULL. */
+    ap->ctx = ctx;
+    ap->q = q;
+    f->alpha = ctx->alpha ? ap : NULL;
+    return 1;
+}
+
+static int mr_visibility_pixel(const mr_state *s, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                               const uint64_t *front, uint64_t *vis, uint64_t *cnt)
+{
+    const size_t mw = (size_t)ctx->mask_words;
+    float *pts = NULL;
+    for (int qi = 0; qi < nq; qi++) {
+        ms_raster_frame f;
+        ms_alpha_pixel ap;
+        uint64_t *buf = vis + qi * mw;   /* the k x k occlusion buffer itself (receiver.h) */
+        const int go = mr_start(ctx, &q[qi], front + qi * mw, buf, &f, &ap, &pts, &cnt[MS_FT_TRACED_EDGE_ON]);
+        if (go < 0) { free(pts); return -1; }
+        if (!go) continue;
+        cnt[MS_FT_FRUSTA]++;
+        s->trace(ctx->bvh, &f, s->raster, q[qi].prim, buf, cnt, s->flags);
+    }
+    free(pts);
+    return 0;
+}
+
+/* The queries grouped by 4x4 pixel block (at most 16 to a group), or 16 consecutive ones when they come
+ * in proximity order (the points API), each group traversed together. */
+static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                               const uint64_t *front, uint64_t *vis, uint64_t *cnt)
+{
+    const size_t mw = (size_t)ctx->mask_words;
+    float *pts = NULL;
+    int *order = malloc((size_t)nq * sizeof *order);
+    if (!order) return -1;
+    ms_block_order(ctx, q, nq, order);
+    int rc = 0;
+    for (int g = 0; g < nq && !rc;) {
+        ms_block_input in;
+        ms_raster_frame frames[MS_BLOCK_LANES];
+        ms_alpha_pixel aps[MS_BLOCK_LANES];
+        in.n = 0;
+        const int end = ms_block_group_end(ctx, q, order, nq, g);
+        for (int e = g; e < end; e++) {
+            const int i = order[e];
+            uint64_t *buf = vis + (size_t)i * mw;
+            const int go = mr_start(ctx, &q[i], front + (size_t)i * mw, buf, &frames[in.n], &aps[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
+            if (go < 0) { rc = -1; break; }
+            if (!go) continue;
+            in.frame[in.n] = &frames[in.n];
+            in.buf[in.n] = buf;
+            in.skip[in.n] = q[i].prim;
+            in.n++;
+        }
+        if (!rc && in.n) s->block(&in, ctx->bvh, &s->shallow, s->raster, ctx->near, ctx->far, cnt, s->block_flags);
+        g = end;
+    }
+    free(order);
+    free(pts);
+    return rc;
+}
+
+static int mr_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
+                         const uint64_t *front, uint64_t *vis, uint64_t *cnt)
+{
+    const mr_state *s = state;
+    return s->block ? mr_visibility_block(s, ctx, q, nq, front, vis, cnt)
+                    : mr_visibility_pixel(s, ctx, q, nq, front, vis, cnt);
+}
+
+static int mr_counters_used(const void *state, const char *const **names)
+{
+    const mr_state *s = state;
+    if (!s->block) return -1;
+    *names = block_counter_names;
+    return MR_BLOCK_COUNTERS;
+}
+
+static void mr_destroy(void *state)
+{
+    mr_state *s = state;
+    ms_bvh_shallow_free(&s->shallow);
+    free(s);
+}
+
+static void mr_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
+{
+    const mr_state *s = state;
+    *kernel = s->kernel_isa;
+    *traversal = s->trace_isa;
+}
+
+#define MICRORASTER_METHOD(ident, mname, create_fn)                                                   \
+    const ms_shadow_method ident = {                                                                  \
+        .name = mname, .primary = "bvh", .needs_grid = 1, .n_counters = MS_FT_COUNTERS,               \
+        .counter_names = { "frusta", "nodes_visited", "nodes_culled_frustum", "nodes_culled_occluded", \
+                           "triangles_rasterized", "pixels_early_out", "pixels_traced_edge_on" },    \
+        .create = create_fn, .visibility = mr_visibility, .destroy = mr_destroy, .isa_used = mr_isa_used, \
+        .counters_used = mr_counters_used }
+
+MICRORASTER_METHOD(ms_shadow_scanline, "scanline", mr_create_scanline);
+MICRORASTER_METHOD(ms_shadow_bounds, "bounds", mr_create_bounds);
+MICRORASTER_METHOD(ms_shadow_hierarchical, "hierarchical", mr_create_hier);
