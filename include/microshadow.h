@@ -235,8 +235,8 @@ void ms_procedural_triangles(const ms_scene *s, size_t first, size_t count, floa
  * default they are printed to stderr as "microshadow: warning: ...". NULL restores the default. */
 typedef void (*ms_warning_fn)(void *user, const char *message);
 void ms_set_warning_handler(ms_warning_fn fn, void *user);
-/* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, JPEG, an
- * absolute path) are one warning per ms_scene_load: that warning, or "N material files or textures could not
+/* Material files and textures a scene's meshes name but that cannot be used (missing, unreadable, JPEG) are
+ * one warning per ms_scene_load: that warning, or "N material files or textures could not
  * be used ... (first: ...)". With verbose non-zero (process-wide, like the handler) each is its own warning. */
 void ms_set_warning_verbose(int verbose);
 
@@ -244,6 +244,17 @@ void ms_set_warning_verbose(int verbose);
  * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
  * unknown keys warnings. */
 int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
+/* Options of ms_scene_load_ex; zero (or NULL) means ms_scene_load's behaviour. */
+typedef struct ms_scene_load_options {
+    /* Files that meshes name - glTF buffer and image URIs, OBJ mtllib files, MTL maps (map_Kd, map_d) - are
+     * read only from inside the folder of the file naming them: an absolute path, `..` leading out of that
+     * folder, or a symbolic link resolving outside it is an error naming the file and the path (a downloaded
+     * asset reads only its own files). Non-zero reads them anyway, for trusted assets, as the scene file's
+     * "allow_outside_paths": true does (either one allows). Mesh and texture paths in the scene file itself
+     * are the scene author's and are not restricted. */
+    int allow_outside_paths;
+} ms_scene_load_options;
+int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light. */
 int ms_scene_default(ms_scene *out);
 /* Checks camera, light and geometry for NaN/inf and degenerate cases. `what` names the source. */

@@ -112,30 +112,35 @@ int ms_mesh_assimp(const char *buf, size_t len, const char *ext, const char *pat
         copy = malloc(len + 1);
         if (!copy) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
         memcpy(copy, buf, len + 1);
-        /* ... and the MTL files are read here instead (mtl.c), relative to the OBJ. */
-        const char *slash = strrchr(path, '/');
-        const int dl = slash ? (int)(slash - path + 1) : 0;
-        for (size_t i = 0; i + 6 <= len; i++)
-            if ((i == 0 || copy[i - 1] == '\n' || copy[i - 1] == '\r') && !memcmp(copy + i, "mtllib", 6) &&
-                (copy[i + 6] == ' ' || copy[i + 6] == '\t')) {
-                copy[i] = '#';
-                size_t a = i + 7, e = a;
-                while (a < len && (copy[a] == ' ' || copy[a] == '\t')) a++;
-                for (e = a; e < len && copy[e] != '\n' && copy[e] != '\r'; e++) {}
-                while (e > a && (copy[e - 1] == ' ' || copy[e - 1] == '\t')) e--;
-                char mpath[4096];
-                if (e == a) continue;
-                if (copy[a] == '/' || snprintf(mpath, sizeof mpath, "%.*s%.*s", dl, path, (int)(e - a), copy + a) >= (int)sizeof mpath) {
-                    ms_warn_material("%s: mtllib '%.*s': only relative paths are read: materials ignored", path, (int)(e - a > 200 ? 200 : e - a), copy + a);
-                    continue;
-                }
-                if (ms_mtl_load(mpath, soup, &mtl)) {
-                    snprintf(err, errlen, "%s: out of memory reading its materials", path);
-                    ms_mtl_lib_free(&mtl);
-                    free(copy);
-                    return -1;
-                }
+        /* ... and the MTL files are read here instead (mtl.c), relative to the OBJ. assimp's line ends are
+         * \r, \n and \f, and it skips blanks at a line's start and takes any of them (or \0) after the
+         * keyword: "\f  mtllib\f/x" is an mtllib line to it (the fuzzers' mtllib-absolute-leak input). */
+        for (size_t i = 0; i + 6 <= len; i++) {
+            size_t b = i;
+            while (b > 0 && (copy[b - 1] == ' ' || copy[b - 1] == '\t')) b--;
+            if (!((b == 0 || copy[b - 1] == '\n' || copy[b - 1] == '\r' || copy[b - 1] == '\f') && !memcmp(copy + i, "mtllib", 6) &&
+                  (i + 6 == len || strchr(" \t\r\n\f", copy[i + 6]))))
+                continue;
+            copy[i] = '#';
+            size_t a = i + 6, e = a;
+            while (a < len && (copy[a] == ' ' || copy[a] == '\t')) a++;
+            for (e = a; e < len && copy[e] != '\n' && copy[e] != '\r' && copy[e] != '\f'; e++) {}
+            while (e > a && (copy[e - 1] == ' ' || copy[e - 1] == '\t')) e--;
+            if (e == a) continue;
+            char ref[4096];
+            if (e - a >= sizeof ref) {
+                snprintf(err, errlen, "%s: an mtllib path of more than %zu bytes", path, sizeof ref - 1);
+                ms_mtl_lib_free(&mtl);
+                free(copy);
+                return -1;
             }
+            snprintf(ref, sizeof ref, "%.*s", (int)(e - a), copy + a);
+            if (ms_mtl_load(path, ref, soup, &mtl, err, errlen)) {
+                ms_mtl_lib_free(&mtl);
+                free(copy);
+                return -1;
+            }
+        }
         buf = copy;
     }
     /* From memory, so that assimp reads exactly the bytes that were checked; the hint picks the one
