@@ -3,8 +3,8 @@
  * loads (they are valid files of each format), every kept crash input in tests/fuzz/crashes is refused
  * with one line naming the file, and none crashes, hangs or leaks (ASan/UBSan/LSan). Each input runs in a
  * child process, so that an input that aborts or crashes (assimp's assertions call abort()) is reported as
- * a failure naming the file and the signal, and the others are still replayed; under LeakSanitizer the
- * child checks for leaks before it exits.
+ * a failure naming the file and the signal, and the others are still replayed; one still running after
+ * 20 s is a hang (SIGALRM); under LeakSanitizer the child checks for leaks before it exits.
  *
  * Seeds named by their SHA-1 (40 hex digits: what libFuzzer's -merge=1 adds, scripts/fuzz.sh) are inputs that
  * reached new coverage: they must load or be refused with one line, like any input; the named seeds are
@@ -67,6 +67,7 @@ static int run_one(const char *target, const char *p)
     const pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
+        alarm(20);   /* a hang (libFuzzer's -timeout is 10 s) dies of SIGALRM, reported as such */
         size_t n = 0;
         uint8_t *b = slurp(p, &n);
         if (!b) _exit(99);
