@@ -138,7 +138,7 @@ static void test_seeds_load(void **st)
 {
     (void)st;
     int n = replay("corpus", 1);
-    print_message("%d seed inputs loaded\n", n);
+    print_message("%d corpus inputs replayed (seeds loaded, merged ones loaded or refused with one line)\n", n);
     assert_true(n >= 6);
 }
 
