@@ -297,6 +297,7 @@ static void render_finite(ms_scene *sc, int keep_view, const char *what, int *re
     o.samples = 256;
     o.threads = 2;
     ms_frame f;
+    if (getenv("TF_DEBUG")) fprintf(stderr, "render %s\n", what);   /* which input, when a sanitizer ends the test */
     if (ms_render(sc, &o, &f, err, sizeof err)) fail_msg("%s: render failed: %s", what, err);
     if (!all_finite(&f, why, sizeof why)) fail_msg("%s: %s", what, why);
     ms_frame_free(&f);
