@@ -136,6 +136,22 @@ typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPH
  * at s = 0). Its texels weight the samples in S (docs/design.md: w_i times the texel's luminance) and
  * the shading; V stays the unweighted fraction. The caller owns the texels (ms_scene_free frees a loaded
  * scene's). */
+/* Bounds on what a light emits, so that every output stays finite in single precision: a light texture's
+ * texels lie in [0, MS_MAX_LIGHT_TEXEL] and a light's radiance (after "power" or "lumens" are divided by
+ * pi times its area) in [-MS_MAX_RADIANCE, MS_MAX_RADIANCE] per channel; ms_scene_validate refuses more, and
+ * the EXR reader refuses such a texel naming it. Why these suffice: a pixel's radiance is a sum over at most
+ * 64 lights of albedo/pi * E * S * t plus a specular term, where the unshadowed irradiance E <= pi L (the
+ * projected solid angle of the receiver's hemisphere is pi), S <= 1, the mean texel t <= 1e6 and the
+ * specular term (LTC-integrated GGX: directional albedo <= 1) <= L t. So a pixel is at most
+ * 64 * 2 * 1e20 * 1e6 = 1.3e28, a baked irradiance at most 64 * pi * 1e26 = 2e28, and S's texel-weighted
+ * sums (at most 4096 weights times a luminance <= 1e6, summed in double) stay as far from overflow: ten
+ * orders of magnitude below FLT_MAX = 3.4e38, room for the intermediate products. 1e6 is beyond any light
+ * profile's useful dynamic range (scale the emission instead); 1e20 is 1e11 times the sun's luminance in
+ * nits. What geometry alone can make infinite (the form-factor weight of a receiver touching the light)
+ * is caught by the last check before outputs are written (ms_outputs_write, ms_bake, ms_visibility_points). */
+#define MS_MAX_LIGHT_TEXEL 1e6f
+#define MS_MAX_RADIANCE 1e20f
+
 typedef struct ms_light {
     ms_vec3 corner, edge_s, edge_t;
     ms_vec3 emission;
@@ -304,6 +320,17 @@ MS_API void ms_set_warning_verbose(int verbose);
  * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
  * unknown keys warnings. */
 MS_API int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
+/* Options of ms_scene_load_ex; zero (or NULL) means ms_scene_load's behaviour. */
+typedef struct ms_scene_load_options {
+    /* Files that meshes name - glTF buffer and image URIs, OBJ mtllib files, MTL maps (map_Kd, map_d) - are
+     * read only from inside the folder of the file naming them: an absolute path, `..` leading out of that
+     * folder, or a symbolic link resolving outside it is an error naming the file and the path (a downloaded
+     * asset reads only its own files). Non-zero reads them anyway, for trusted assets, as the scene file's
+     * "allow_outside_paths": true does (either one allows). Mesh and texture paths in the scene file itself
+     * are the scene author's and are not restricted. */
+    int allow_outside_paths;
+} ms_scene_load_options;
+MS_API int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light. */
 MS_API int ms_scene_default(ms_scene *out);
 /* Checks camera, light and geometry for NaN/inf and degenerate cases. `what` names the source. */
@@ -507,7 +534,12 @@ typedef struct ms_output {
 } ms_output;
 #define MS_MAX_OUTPUTS 8
 MS_API int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
+/* Before writing anything it checks the frame (ms_frame_check_finite): a NaN or infinite value is an error
+ * naming the first output's path and the pixel, and no file is written. */
 MS_API int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
+/* 0 when every value of the frame or lightmap (rgb, each light's vis, shadow, shadow_spec; the NULL ones
+ * skipped) and, with rgb, the exposure are finite; else -1 with one line "what: ... at pixel (x, y) is NaN". */
+MS_API int ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen);
 MS_API void ms_outputs_cleanup_on_signals(void);
 /* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name; with several lights the EXR has
  * one channel per light, V0, V1, ... resp. S0, S1, ..., and the PFM light 0); the stats as JSON. */
@@ -603,6 +635,8 @@ typedef struct ms_points_options {
  * the first light of the scene the accel was built from (ms_accel_lights lists them all). A sphere light
  * is sampled per point on its outline disk as in frames; a point inside the sphere gets V = S = 0. Stats (timing, counters, no image fields) into
  * stats when non-NULL. */
+/* A V or S that came out NaN or infinite is MS_ERR_INVALID naming the first such point (the arrays are then
+ * not to be used). */
 MS_API ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
                                const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
                                ms_stats *stats, char *err, size_t errlen);

@@ -83,6 +83,8 @@ static void build_node(build_ctx *c, uint32_t ni, uint32_t first, uint32_t count
         float ext = cb.hi[a] - cb.lo[a];
         if (!(ext > 0.0f)) continue;
         float scale = (float)BINS / ext;
+        /* a subnormal extent (centroids 1e-45 apart) makes the scale infinite and 0 * inf a NaN bin */
+        if (!isfinite(scale)) continue;
         box bb[BINS];
         uint32_t bn[BINS] = { 0 };
         for (int k = 0; k < BINS; k++) box_empty(&bb[k]);

@@ -3,6 +3,7 @@
  * file cannot make OpenEXR read elsewhere, and OpenEXR's own size limits are set to ours so that its
  * header checks refuse huge windows before anything is allocated for them. */
 #include "exr_read.h"
+#include "microshadow.h"
 #include <math.h>
 #include <openexr.h>
 #include <stdint.h>
@@ -151,6 +152,12 @@ int ms_exr_decode_linear(const char *name, const void *bytes, size_t len, int ma
             if (!(out[3 * i + k] >= 0.0f) || !isfinite(out[3 * i + k])) {
                 snprintf(err, errlen, "%s: texel (%zu, %zu) is negative, NaN or infinite (%g)", name, i % (size_t)W,
                          i / (size_t)W, (double)out[3 * i + k]);
+                goto done;
+            } else if (out[3 * i + k] > MS_MAX_LIGHT_TEXEL) {
+                /* beyond it, emission sums could overflow float (microshadow.h: MS_MAX_LIGHT_TEXEL) */
+                snprintf(err, errlen, "%s: texel (%zu, %zu) is %g, above the limit of %g for a light texture (scale the "
+                         "light's emission instead)", name, i % (size_t)W, i / (size_t)W, (double)out[3 * i + k],
+                         (double)MS_MAX_LIGHT_TEXEL);
                 goto done;
             }
     }

@@ -1,5 +1,6 @@
 #include "microshadow.h"
 #include <errno.h>
+#include <math.h>
 #include <fcntl.h>
 #include <libgen.h>
 #include <limits.h>
@@ -240,11 +241,54 @@ int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
     return 0;
 }
 
+/* The first non-finite value of plane p (w*h values of `per` floats each, `planes` planes), or 0. */
+static int first_bad(const float *p, int w, int h, int per, int planes, const char *name, const char *what, char *err,
+                     size_t errlen)
+{
+    if (!p) return 0;
+    const size_t n = (size_t)w * (size_t)h;
+    for (int l = 0; l < planes; l++)
+        for (size_t i = 0; i < n * (size_t)per; i++) {
+            const float v = p[(size_t)l * n * (size_t)per + i];
+            if (isfinite(v)) continue;
+            char plane[32] = "";
+            if (per == 3) snprintf(plane, sizeof plane, " %c", "RGB"[i % 3]);
+            else if (planes > 1) snprintf(plane, sizeof plane, " of light %d", l);
+            snprintf(err, errlen, "%s: %s%s at pixel (%zu, %zu) is %s: no output written (a NaN or infinite result is "
+                     "an error, never a file)", what, name, plane, i / (size_t)per % (size_t)w, i / (size_t)per / (size_t)w,
+                     isnan(v) ? "NaN" : "infinite");
+            return -1;
+        }
+    return 0;
+}
+
+int ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen)
+{
+    const int planes = f->n_lights > 0 ? f->n_lights : 1;
+    if (first_bad(f->rgb, f->width, f->height, 3, 1, "the image's radiance", what, err, errlen) ||
+        first_bad(f->vis, f->width, f->height, 1, planes, "V", what, err, errlen) ||
+        first_bad(f->shadow, f->width, f->height, 1, planes, "S", what, err, errlen) ||
+        first_bad(f->shadow_spec, f->width, f->height, 1, planes, "S_spec", what, err, errlen))
+        return -1;
+    if (f->rgb && !isfinite(f->exposure)) {
+        snprintf(err, errlen, "%s: the image's exposure is %g: no output written (the radiance is too small or too "
+                 "large to scale)", what, (double)f->exposure);
+        return -1;
+    }
+    return 0;
+}
+
 int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen)
 {
     int slot[MS_MAX_OUTPUTS];
     int rc = 0, k;
     if (n > MS_MAX_OUTPUTS) { snprintf(err, errlen, "too many outputs"); return -1; }
+    /* The last guard: a frame or lightmap with a NaN or infinite value is an error, before any file exists. */
+    for (k = 0; k < n; k++)
+        if (outs[k].path) {
+            if (ms_frame_check_finite(f, outs[k].path, err, errlen)) return -1;
+            break;
+        }
     for (k = 0; k < n; k++) slot[k] = -1;
     for (k = 0; k < n && !rc; k++) {
         if (!outs[k].path) continue;

@@ -445,6 +445,8 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     free(lum);
     if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); return MS_ERR_NO_MEMORY; }
+    /* A NaN or infinite texel is an error, never a lightmap (microshadow.h: MS_MAX_RADIANCE). */
+    if (ms_frame_check_finite(f, "the lightmap", err, errlen)) return MS_ERR_INVALID;
     f->stats.width = f->stats.height = size;
     f->stats.triangles = scene->n_tris;
     f->stats.load_s = scene->load_s;

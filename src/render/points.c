@@ -374,6 +374,13 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     free(scene_tri);
     if (failed) { snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
     if (cancelled) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
+    /* A NaN or infinite V or S (geometry the form-factor weights overflow on) is an error naming the point. */
+    for (size_t i = 0; i < n; i++)
+        if ((vis && !isfinite(vis[i])) || (shadow && !isfinite(shadow[i]))) {
+            snprintf(err, errlen, "point %zu: %s is %s (a NaN or infinite result is an error)", i,
+                     vis && !isfinite(vis[i]) ? "V" : "S", isnan(vis && !isfinite(vis[i]) ? vis[i] : shadow[i]) ? "NaN" : "infinite");
+            return MS_ERR_INVALID;
+        }
     if (stats) {
         stats->triangles = a->view.n_tris;
         stats->build_s = a->bvh.build_s;

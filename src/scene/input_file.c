@@ -77,3 +77,68 @@ int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char *
     *len = n;
     return 0;
 }
+
+/* ---- Paths a file names (docs/design.md, "Hostile input": a downloaded asset reads only its own files) ---- */
+
+/* 1 when the components of rel never climb above its first folder ("a/../b" stays, "a/../../b" leaves). */
+static int stays_below(const char *rel)
+{
+    long depth = 0;
+    for (const char *c = rel; *c;) {
+        const char *e = strchr(c, '/');
+        const size_t n = e ? (size_t)(e - c) : strlen(c);
+        if (n == 2 && c[0] == '.' && c[1] == '.') {
+            if (--depth < 0) return 0;
+        } else if (n && !(n == 1 && c[0] == '.')) {
+            depth++;
+        }
+        c += n;
+        while (*c == '/') c++;
+    }
+    return 1;
+}
+
+int ms_resolve_inside(const char *owner, const char *ref, int allow, const char *what, char *out, size_t n, char *err,
+                      size_t errlen)
+{
+    const char *slash = strrchr(owner, '/');
+    const int dl = slash ? (int)(slash - owner + 1) : 0;
+    /* Messages show at most 200 bytes of the reference, made one line by the callers (ms_one_line). */
+    const int rl = (int)(strlen(ref) > 200 ? 200 : strlen(ref));
+    const char *hint = "only files inside the asset's folder are read; a trusted scene may say \"allow_outside_paths\": true";
+    if (ref[0] == '/' && !allow) {
+        snprintf(err, errlen, "%s: %s '%.*s' is an absolute path (%s)", owner, what, rl, ref, hint);
+        return -1;
+    }
+    const int k = ref[0] == '/' ? snprintf(out, n, "%s", ref) : snprintf(out, n, "%.*s%s", dl, owner, ref);
+    if (k < 0 || (size_t)k >= n) {
+        snprintf(err, errlen, "%s: %s '%.*s': the path is longer than %zu bytes", owner, what, rl, ref, n - 1);
+        return -1;
+    }
+    if (allow) return 0;
+    if (!stays_below(ref)) {
+        snprintf(err, errlen, "%s: %s '%.*s' leads outside the folder of the file naming it (%s)", owner, what, rl, ref, hint);
+        return -1;
+    }
+    /* Symbolic links: the file, resolved, must lie inside the naming file's folder, resolved. A file that
+     * does not resolve (missing, a dangling link) is left to the open, which fails and says so. Checked
+     * before the open, by name: a link swapped in between the two by someone who can write into the
+     * asset's folder is not caught (openat2's RESOLVE_BENEATH would; the asset's files are not expected to
+     * change while they are read). */
+    char dir[4096];
+    if (snprintf(dir, sizeof dir, "%.*s", dl ? dl : 1, dl ? owner : ".") >= (int)sizeof dir) return 0;
+    char *rdir = realpath(dir, NULL), *rfile = rdir ? realpath(out, NULL) : NULL;
+    int rc = 0;
+    if (rdir && rfile) {
+        const size_t m = strlen(rdir);
+        const int inside = !strcmp(rdir, "/") || (!strncmp(rfile, rdir, m) && (rfile[m] == '/' || rfile[m] == 0));
+        if (!inside) {
+            snprintf(err, errlen, "%s: %s '%.*s' is a symbolic link (or passes through one) leading outside the folder of the "
+                     "file naming it, to %.200s (%s)", owner, what, rl, ref, rfile, hint);
+            rc = -1;
+        }
+    }
+    free(rdir);
+    free(rfile);
+    return rc;
+}

@@ -41,7 +41,7 @@ static cgltf_result read_buffer_file(const struct cgltf_memory_options *mo, cons
     if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_MESH, &buf, &len, g->why, sizeof g->why))
         return cgltf_result_file_not_found;
     if (len < *size) {
-        snprintf(g->why, sizeof g->why, "%s: holds %zu bytes, fewer than the %zu the glTF declares", path, len, (size_t)*size);
+        snprintf(g->why, sizeof g->why, "%.400s: holds %zu bytes, fewer than the %zu the glTF declares", path, len, (size_t)*size);
         free(buf);
         return cgltf_result_data_too_short;
     }
@@ -231,6 +231,48 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
     return 0;
 }
 
+/* A buffer's or image's file URI, percent-decoded, resolved inside the folder of the glTF `path` (as cgltf
+ * resolves buffers: the glTF's folder and the decoded URI) unless allow; -1 with one line otherwise. */
+static int resolve_uri(const char *path, const char *uri, int allow, const char *what, char *out, size_t n, char *err,
+                       size_t errlen)
+{
+    char *dec = strdup(uri);
+    if (!dec) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    cgltf_decode_uri(dec);
+    char name[320];   /* messages name the URI as written, and decoded when that differs */
+    if (strcmp(dec, uri)) snprintf(name, sizeof name, "%s uri '%.200s', percent-decoded,", what, uri);
+    else snprintf(name, sizeof name, "%s uri", what);
+    const int rc = ms_resolve_inside(path, dec, allow, name, out, n, err, errlen);
+    free(dec);
+    return rc;
+}
+
+/* Every external buffer and image URI inside the glTF's folder, before any file is opened; then the
+ * external buffers read from the paths resolved here (cgltf_load_buffers skips buffers with data; its own
+ * resolution would put the folder before an allowed absolute path). */
+static int load_uris(cgltf_data *d, const cgltf_options *opt, const char *path, int allow, char *err, size_t errlen)
+{
+    char out[4096], what[64];
+    for (int pass = 0; pass < 2; pass++)
+        for (size_t i = 0; i < d->buffers_count + (pass ? 0 : d->images_count); i++) {
+            const int buf = i < d->buffers_count;
+            const char *uri = buf ? d->buffers[i].uri : d->images[i - d->buffers_count].uri;
+            if (!uri || !strncmp(uri, "data:", 5) || strstr(uri, "://")) continue;   /* never opened as files */
+            snprintf(what, sizeof what, "%s %zu", buf ? "buffer" : "image", buf ? i : i - d->buffers_count);
+            if (resolve_uri(path, uri, allow, what, out, sizeof out, err, errlen)) return -1;
+            if (!pass || d->buffers[i].data) continue;
+            cgltf_size size = d->buffers[i].size;
+            void *data = NULL;
+            if (read_buffer_file(&opt->memory, &opt->file, out, &size, &data) != cgltf_result_success) {
+                snprintf(err, errlen, "%s: buffer %s", path, ((const gltf_ctx *)opt->file.user_data)->why);
+                return -1;
+            }
+            d->buffers[i].data = data;
+            d->buffers[i].data_free_method = cgltf_data_free_method_file_release;
+        }
+    return 0;
+}
+
 /* Image i of the glTF as a soup texture: from its buffer view, a data: URI or a file beside the glTF. */
 static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, const char *path, ms_tri_soup *soup,
                        char *err, size_t errlen)
@@ -267,16 +309,11 @@ static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, 
         opt->memory.free_func(opt->memory.user_data, data);
         return r;
     }
-    /* A relative file: beside the glTF (percent-decoded as glTF URIs are). */
-    if (im->uri[0] == '/' || strstr(im->uri, "://")) { snprintf(err, errlen, "%s: only relative image paths are read", full); return -1; }
-    const char *slash = strrchr(path, '/');
-    const int dl = slash ? (int)(slash - path + 1) : 0;
+    /* A file (percent-decoded as glTF URIs are) inside the glTF's folder: checked with the buffers' URIs
+     * before anything was read (check_uris). */
+    if (strstr(im->uri, "://")) { snprintf(err, errlen, "%s: only relative image paths are read", full); return -1; }
     char file[4096];
-    if (snprintf(file, sizeof file, "%.*s%s", dl, path, im->uri) >= (int)sizeof file) {
-        snprintf(err, errlen, "%s: the image path is too long", full);
-        return -1;
-    }
-    cgltf_decode_uri(file + dl);
+    if (resolve_uri(path, im->uri, soup->allow_outside_paths, what, file, sizeof file, err, errlen)) return -1;
     return ms_soup_add_texture_file(soup, file, 0, err, errlen);
 }
 
@@ -543,6 +580,7 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
             goto out;
         }
     }
+    if (load_uris(d, &opt, path, soup->allow_outside_paths, err, errlen)) goto out;
     r = cgltf_load_buffers(&opt, d, path);
     if (r != cgltf_result_success) {
         if (g.why[0]) snprintf(err, errlen, "%s: buffer %s", path, g.why);

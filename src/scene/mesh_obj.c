@@ -42,20 +42,18 @@ static long obj_index(const char *s, size_t n, uint64_t so_far, uint64_t total)
 
 static const char *index_problem(long r) { return r == -1 ? "is not an integer" : "is not"; }
 
-/* The MTL files of the mtllib lines, read relative to the OBJ before the faces (mtl.c). An absolute
- * path is a warning (the materials are left out). */
-static int obj_mtllib(const char *rb, const char *re, const char *path, ms_tri_soup *soup, ms_mtl_lib *mtl)
+/* The MTL files of the mtllib lines, read relative to the OBJ before the faces (mtl.c). A path leading
+ * outside the OBJ's folder is an error unless outside paths are allowed (ms_scene_load_options); a
+ * missing or unreadable MTL file is a warning (the materials are left out). */
+static int obj_mtllib(const char *rb, const char *re, const char *path, ms_tri_soup *soup, ms_mtl_lib *mtl, char *err,
+                      size_t errlen)
 {
     if (re == rb) return 0;
-    const char *slash = strrchr(path, '/');
-    const int dl = slash ? (int)(slash - path + 1) : 0;
-    char mpath[4096];
-    if (*rb == '/' || snprintf(mpath, sizeof mpath, "%.*s%.*s", dl, path, (int)(re - rb), rb) >= (int)sizeof mpath) {
-        ms_warn_material("%s: mtllib '%.*s': only relative paths are read: materials ignored", path,
-                         (int)(re - rb > 200 ? 200 : re - rb), rb);
-        return 0;
-    }
-    return ms_mtl_load(mpath, soup, mtl);
+    char ref[4096];
+    if ((size_t)(re - rb) >= sizeof ref) MS_FAIL("%s: an mtllib path of more than %zu bytes", path, sizeof ref - 1);
+    snprintf(ref, sizeof ref, "%.*s", (int)(re - rb), rb);
+    /* mtl.c resolves it inside the OBJ's folder (or refuses it: a downloaded asset reads only its own files) */
+    return ms_mtl_load(path, ref, soup, mtl, err, errlen);
 }
 
 /* Joins continuation lines ('\' at the end of a line) in a copy: the backslash becomes a blank and the
@@ -240,7 +238,7 @@ static int obj_read(const char *buf, size_t len, const char *path, ms_tri_soup *
             } else if (ms_tok_is(tb, tn, "mtllib")) {
                 const char *rb, *re;
                 rest_of_line(p, e, &rb, &re);
-                if (pass == 0 && obj_mtllib(rb, re, path, soup, mtl)) MS_FAIL("%s: out of memory reading its materials", path);
+                if (pass == 0 && obj_mtllib(rb, re, path, soup, mtl, err, errlen)) return -1;
             } else if (ms_tok_is(tb, tn, "cstype")) {
                 in_cstype = 1;
                 if (pass == 2 && !s->warned_cstype)

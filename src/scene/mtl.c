@@ -95,16 +95,26 @@ static int flush(pending *p, ms_tri_soup *soup, ms_mtl_lib *lib)
     return 0;
 }
 
-int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
+int ms_mtl_load(const char *owner, const char *ref, ms_tri_soup *soup, ms_mtl_lib *lib, char *err, size_t errlen)
 {
-    char *buf, err[1024];
+    /* The MTL file, then each map it names, must stay inside the folder of the file naming it. */
+    char path[4096], why[1024];
+    if (ms_resolve_inside(owner, ref, soup->allow_outside_paths, "mtllib", path, sizeof path, err, errlen)) return -1;
+    char *buf;
     size_t len;
-    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_AUX, &buf, &len, err, sizeof err)) {
-        ms_warn_material("%s: materials ignored", err);
+    if (ms_read_input(path, MS_MAX_MESH_BYTES, MS_INPUT_AUX, &buf, &len, why, sizeof why)) {
+        ms_warn_material("%s: materials ignored", why);
         return 0;
     }
-    const char *slash = strrchr(path, '/');
-    const int dl = slash ? (int)(slash - path + 1) : 0;
+    const int rc = ms_mtl_load_memory(buf, len, path, soup, lib, err, errlen);
+    free(buf);
+    return rc;
+}
+
+int ms_mtl_load_memory(char *buf, size_t len, const char *path, ms_tri_soup *soup, ms_mtl_lib *lib, char *err,
+                       size_t errlen)
+{
+    (void)len;   /* buf[len] == 0; a NUL before it ends the file */
     pending p;
     memset(&p, 0, sizeof p);
     int rc = 0;
@@ -152,8 +162,10 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
             if (tab && (!file || tab > file)) file = tab;
             file = file ? file + 1 : arg;
             char full[4096];
-            if (file[0] == '/' || snprintf(full, sizeof full, "%.*s%s", dl, path, file) >= (int)sizeof full) {
-                ms_warn_material("%s: %s '%s': only relative paths are read: texture ignored", path, is_d ? "map_d" : "map_Kd", file);
+            if (ms_resolve_inside(path, file, soup->allow_outside_paths, is_d ? "map_d" : "map_Kd", full, sizeof full,
+                                  err, errlen)) {
+                rc = -2;
+                break;
             } else {
                 const long t = texture(lib, soup, full);
                 if (t == -2) { rc = -1; break; }
@@ -167,6 +179,7 @@ int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib)
         line = next;
     }
     if (!rc) rc = flush(&p, soup, lib);
-    free(buf);
-    return rc;
+    if (rc == -1) snprintf(err, errlen, "%s: out of memory reading its materials", path);
+    if (rc) ms_one_line(err);
+    return rc ? -1 : 0;
 }

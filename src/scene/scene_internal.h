@@ -40,6 +40,7 @@ typedef struct ms_tri_soup {
      * [0, tangent_n), NaN where none; NULL until a primitive has them. */
     float *tangent;
     size_t tangent_n;
+    int allow_outside_paths;   /* files named by the meshes may lie outside their folders (ms_resolve_inside) */
 } ms_tri_soup;
 /* Tangents t12 (12 floats per triangle) of triangles [first, first + count); 0, or -1 out of memory. */
 int ms_soup_set_tangents(ms_tri_soup *soup, size_t first, size_t count, const float *t12);
@@ -82,9 +83,14 @@ typedef struct ms_mtl_lib {
     long *tex_id;
     size_t n_tex;
 } ms_mtl_lib;
-/* Reads one MTL file (newmtl, Kd, d, map_Kd, Pr, Pm, Ns) into lib and the soup. A file that cannot be read
- * and a texture that cannot be used are warnings; 0, or -1 when out of memory. */
-int ms_mtl_load(const char *path, ms_tri_soup *soup, ms_mtl_lib *lib);
+/* Reads the MTL file `ref` that the mesh file `owner` names (an OBJ's mtllib argument, relative to its folder)
+ * - newmtl, Kd, d, map_Kd, Pr, Pm, Ns - into lib and the soup. ref and its maps must stay inside their
+ * folders unless soup->allow_outside_paths (ms_resolve_inside). A file that cannot be read and a texture that
+ * cannot be used are warnings; 0, or -1 with one line in err (a path leading outside, out of memory). */
+int ms_mtl_load(const char *owner, const char *ref, ms_tri_soup *soup, ms_mtl_lib *lib, char *err, size_t errlen);
+/* The same from the bytes of MTL file `path` (buf[len] == 0; the lines are cut in place): the fuzzers' entry. */
+int ms_mtl_load_memory(char *buf, size_t len, const char *path, ms_tri_soup *soup, ms_mtl_lib *lib, char *err,
+                       size_t errlen);
 /* The soup material named `name`, or MS_NO_MATERIAL. The last definition of a name wins. */
 uint32_t ms_mtl_find(const ms_mtl_lib *lib, const char *name);
 void ms_mtl_lib_free(ms_mtl_lib *lib);
@@ -96,6 +102,13 @@ typedef enum ms_input_kind { MS_INPUT_SCENE, MS_INPUT_MESH, MS_INPUT_AUX, MS_INP
  * blocking) into a malloc'ed, NUL-terminated buffer. */
 int ms_read_input(const char *path, size_t max_bytes, ms_input_kind kind, char **out, size_t *len, char *err,
                   size_t errlen);
+/* A path named by a file (a glTF buffer or image URI, percent-decoded; an OBJ's mtllib; an MTL map), resolved
+ * against the folder of that file, `owner`, into out[n]. Unless allow (the scene's "allow_outside_paths",
+ * ms_scene_load_options), refused with one line naming owner, `what` ("mtllib", "buffer 0 uri") and ref:
+ * an absolute ref, `..` components climbing out of the folder, or a file that resolves (symbolic links
+ * followed, realpath) outside the folder's own resolved path. 0, or -1. */
+int ms_resolve_inside(const char *owner, const char *ref, int allow, const char *what, char *out, size_t n, char *err,
+                      size_t errlen);
 
 /* Appends the triangles of a mesh file (OBJ, PLY, OFF, STL through microshadow's own readers;
  * glTF 2.0 through cgltf), triangulated, node transforms applied. Fails with one line naming the file. */

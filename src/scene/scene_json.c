@@ -25,7 +25,8 @@ static int line_of(const char *text, size_t off)
 }
 
 /* Known keys, per object, for the unknown-key warnings. */
-static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "lights", "render", NULL };
+static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "lights", "render",
+                                        "allow_outside_paths", NULL };
 static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
 /* The camera's keys depend on camera.type (docs/cameras.md): each type reads the common ones and its own. */
 #define CAMERA_COMMON_KEYS "type", "eye", "target", "up", "width", "height"
@@ -389,26 +390,41 @@ static int parse_lights(const cJSON *root, ms_scene *out, const char *path, char
     return 0;
 }
 
-int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen)
+static int parse_with(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
+                      ms_scene *out, char *err, size_t errlen);
+
+int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     char *text;
     size_t len;
     if (ms_read_input(json_path, MS_MAX_SCENE_BYTES, MS_INPUT_SCENE, &text, &len, err, errlen)) { ms_one_line(err); return -1; }
-    int rc = ms_scene_parse(text, len, json_path, out, err, errlen);
+    int rc = parse_with(text, len, json_path, opt, out, err, errlen);
     free(text);
     return rc;
 }
 
-static int scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen);
+int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen)
+{
+    return ms_scene_load_ex(json_path, NULL, out, err, errlen);
+}
+
+static int scene_parse(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
+                       ms_scene *out, char *err, size_t errlen);
 
 int ms_scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen)
+{
+    return parse_with(text, len, json_path, NULL, out, err, errlen);
+}
+
+static int parse_with(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
+                      ms_scene *out, char *err, size_t errlen)
 {
     warn_list w;
     w.n = 0;
     g_warnings = &w;
     ms_material_warnings_begin();
-    int rc = scene_parse(text, len, json_path, out, err, errlen);
+    int rc = scene_parse(text, len, json_path, opt, out, err, errlen);
     g_warnings = NULL;
     if (rc) ms_one_line(err);
     else
@@ -417,7 +433,8 @@ int ms_scene_parse(const char *text, size_t len, const char *json_path, ms_scene
     return rc;
 }
 
-static int scene_parse(const char *text, size_t len, const char *json_path, ms_scene *out, char *err, size_t errlen)
+static int scene_parse(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
+                       ms_scene *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     struct timespec t0, t1;
@@ -537,6 +554,15 @@ static int scene_parse(const char *text, size_t len, const char *json_path, ms_s
     if (!dircopy) { snprintf(err, errlen, "%s: out of memory", json_path); goto done; }
     const char *dir = dirname(dircopy);
     ms_tri_soup soup = { 0 };
+    /* Files the meshes name (glTF buffers and images, MTL files and maps) stay inside the meshes' folders
+     * unless the scene file or the caller trusts the assets (ms_resolve_inside). */
+    const cJSON *allow = cJSON_GetObjectItemCaseSensitive(root, "allow_outside_paths");
+    if (allow && !cJSON_IsBool(allow)) {
+        snprintf(err, errlen, "%s: \"allow_outside_paths\" must be true or false", json_path);
+        free(dircopy);
+        goto done;
+    }
+    soup.allow_outside_paths = (allow && cJSON_IsTrue(allow)) || (opt && opt->allow_outside_paths);
     int i = 0;
     const cJSON *m;
     /* Per entry: its triangles [from, to) and transform, applied once every file is read; a file listed

@@ -28,6 +28,27 @@ static int validate_light(const ms_light *l, const char *name, const char *what,
         snprintf(err, errlen, "%s: %s: %s", what, name, msg);
         return -1;
     }
+    const float e[3] = { l->emission.x, l->emission.y, l->emission.z };
+    for (int c = 0; c < 3; c++)
+        if (!(fabsf(e[c]) <= MS_MAX_RADIANCE)) {
+            snprintf(err, errlen, "%s: %s emits radiance %g, beyond the limit of %g (emission, or power or lumens over "
+                     "pi times the area: a tiny light with a large flux)", what, name, (double)e[c], (double)MS_MAX_RADIANCE);
+            return -1;
+        }
+    if (l->texture) {
+        if (l->texture_width < 1 || l->texture_height < 1) {
+            snprintf(err, errlen, "%s: %s has a texture of %dx%d texels", what, name, l->texture_width, l->texture_height);
+            return -1;
+        }
+        const size_t n = 3 * (size_t)l->texture_width * (size_t)l->texture_height;
+        for (size_t i = 0; i < n; i++)
+            if (!(l->texture[i] >= 0.0f && l->texture[i] <= MS_MAX_LIGHT_TEXEL)) {
+                snprintf(err, errlen, "%s: %s: texel (%zu, %zu) is %g, outside [0, %g]", what, name,
+                         i / 3 % (size_t)l->texture_width, i / 3 / (size_t)l->texture_width, (double)l->texture[i],
+                         (double)MS_MAX_LIGHT_TEXEL);
+                return -1;
+            }
+    }
     if (!shape) {
         snprintf(err, errlen, "%s: %s has an unknown shape %d", what, name, (int)l->shape);
         return -1;

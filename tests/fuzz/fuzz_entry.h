@@ -7,6 +7,8 @@
 #include "microshadow.h"
 #include "scene/scene_internal.h"
 #include "image/exr_read.h"
+#include "image/png_read.h"
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,7 +35,7 @@ static inline int ms_fuzz_mesh(const char *ext, const uint8_t *data, size_t size
     if (!buf) return 0;
     memcpy(buf, data, size);
     buf[size] = 0;
-    char path[64], err[1024] = "";
+    char path[320], err[1024] = "";
     snprintf(path, sizeof path, "%s%s", MS_FUZZ_MESH_PATH, ext);
     ms_tri_soup soup = { 0 };
     int rc = ms_mesh_load_memory(buf, size, ext, path, &soup, err, sizeof err);
@@ -45,7 +47,7 @@ static inline int ms_fuzz_mesh(const char *ext, const uint8_t *data, size_t size
 }
 
 /* A light's emission texture as an EXR file, from bytes (the decoder the scene loader calls for one);
- * 0 if it decoded. Success means texels within the size limit, each finite and not negative. */
+ * 0 if it decoded. Success means texels within the size limit, each in [0, MS_MAX_LIGHT_TEXEL]. */
 static inline int ms_fuzz_exr(const uint8_t *data, size_t size)
 {
     const char *path = MS_FUZZ_MESH_PATH "exr";
@@ -57,7 +59,7 @@ static inline int ms_fuzz_exr(const uint8_t *data, size_t size)
     else {
         if (w < 1 || h < 1 || w > MS_MAX_LIGHT_TEXTURE || h > MS_MAX_LIGHT_TEXTURE) abort();
         for (size_t i = 0; i < (size_t)w * (size_t)h * 3; i++)
-            if (!(rgb[i] >= 0.0f) || rgb[i] > 3.4e38f) abort();
+            if (!(rgb[i] >= 0.0f) || !(rgb[i] <= MS_MAX_LIGHT_TEXEL)) abort();
     }
     free(rgb);
     return rc;
@@ -87,6 +89,68 @@ static inline int ms_fuzz_jpeg(const uint8_t *data, size_t size)
 }
 
 static inline void ms_fuzz_ignore_warning(void *user, const char *msg) { (void)user; (void)msg; }
+
+/* A PNG texture, from bytes, through both decoders: a light's emission texture (src/image/png_read.c, linear
+ * floats) and a material's base-colour texture (src/scene/texture.c, RGBA8); 0 if both decoded. Success means
+ * the size within the limits and, for the light, texels in [0, 1]. */
+static inline int ms_fuzz_png(const uint8_t *data, size_t size)
+{
+    const char *path = MS_FUZZ_MESH_PATH "png";
+    float *rgb = NULL;
+    int w = 0, h = 0;
+    char err[1024] = "";
+    int rc = ms_png_decode_linear(path, data, size, MS_MAX_LIGHT_TEXTURE, &rgb, &w, &h, err, sizeof err);
+    if (rc) ms_fuzz_check_message(err, path);
+    else {
+        if (w < 1 || h < 1 || w > MS_MAX_LIGHT_TEXTURE || h > MS_MAX_LIGHT_TEXTURE) abort();
+        for (size_t i = 0; i < (size_t)w * (size_t)h * 3; i++)
+            if (!(rgb[i] >= 0.0f && rgb[i] <= 1.0f)) abort();
+    }
+    free(rgb);
+    ms_tri_soup soup = { 0 };
+    err[0] = 0;
+    const long t = ms_soup_add_texture_memory(&soup, data, size, path, (int)(size & 1), err, sizeof err);
+    if (t < 0) ms_fuzz_check_message(err, path);
+    else if (t != 0 || soup.n_tex != 1 || soup.tex[0].width < 1 || soup.tex[0].height < 1 ||
+             soup.tex[0].width > MS_MAX_TEXTURE_SIDE || soup.tex[0].height > MS_MAX_TEXTURE_SIDE)
+        abort();
+    ms_soup_free(&soup);
+    return rc || t < 0;
+}
+
+/* An MTL file, from bytes (mtl.c, as an OBJ's mtllib reads it; its maps name files that do not exist, or
+ * absolute paths and paths leading out, which are refused); 0 if it loaded. Success means every material's
+ * factors in [0, 1] and its texture indices valid or -1. */
+static inline int ms_fuzz_mtl(const uint8_t *data, size_t size)
+{
+    const char *path = MS_FUZZ_MESH_PATH "mtl";
+    char *buf = malloc(size + 1);
+    if (!buf) return 0;
+    memcpy(buf, data, size);
+    buf[size] = 0;
+    ms_tri_soup soup = { 0 };
+    ms_mtl_lib lib;
+    memset(&lib, 0, sizeof lib);
+    char err[1024] = "";
+    ms_material_warnings_begin();   /* the maps that cannot be read: counted, then dropped */
+    int rc = ms_mtl_load_memory(buf, size, path, &soup, &lib, err, sizeof err);
+    ms_material_warnings_end(0);
+    if (rc) ms_fuzz_check_message(err, path);
+    else {
+        if (lib.n != soup.n_mats) abort();
+        for (size_t i = 0; i < soup.n_mats; i++) {
+            const ms_material *m = &soup.mats[i];
+            for (int c = 0; c < 4; c++)
+                if (!(m->base_color[c] >= 0.0f && m->base_color[c] <= 1.0f)) abort();
+            if (!(m->metallic >= 0.0f && m->metallic <= 1.0f) || !(m->roughness >= 0.0f && m->roughness <= 1.0f)) abort();
+            if (m->base_color_texture >= (int32_t)soup.n_tex || m->alpha_texture >= (int32_t)soup.n_tex) abort();
+        }
+    }
+    ms_mtl_lib_free(&lib);
+    ms_soup_free(&soup);
+    free(buf);
+    return rc;
+}
 
 /* A scene file, from bytes, beside a directory holding one small valid mesh (a.obj); 0 if it loaded. */
 static inline int ms_fuzz_scene(const char *dir, const uint8_t *data, size_t size)
