@@ -458,10 +458,16 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
         }
         /* Emission: emissiveFactor x KHR_materials_emissive_strength (x emissiveTexture), linear radiance. */
         const float strength = cm->has_emissive_strength ? cm->emissive_strength.emissive_strength : 1.0f;
+        int bad_emission = 0;
         for (int c = 0; c < 3; c++) {
+            /* bounded like lights' radiance (MS_MAX_RADIANCE), so that sums of shaded radiance stay finite */
             const float e = cm->emissive_factor[c] * strength;
-            m.emissive[c] = e >= 0.0f && e <= 1e30f ? e : 0.0f;
+            bad_emission |= !(e >= 0.0f && e <= MS_MAX_RADIANCE);
+            m.emissive[c] = e >= 0.0f && e <= MS_MAX_RADIANCE ? e : 0.0f;
         }
+        if (bad_emission)
+            ms_warn_material("%s: material %zu: emission (emissiveFactor x emissive strength) negative, NaN or above %g: "
+                             "left out", path, i, (double)MS_MAX_RADIANCE);
         if ((m.emissive[0] > 0.0f || m.emissive[1] > 0.0f || m.emissive[2] > 0.0f) &&
             (t = texture_of(d, opt, &cm->emissive_texture, path, i, "emissiveTexture", soup, tex_of, &set,
                             &m.emissive_sampling)) >= 0) {
