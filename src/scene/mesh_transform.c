@@ -115,6 +115,17 @@ int ms_mesh_transform_parse(const cJSON *t, const char *objname, const char *pat
     return 0;
 }
 
+/* v (3 floats) := a v (a 3x3, row-major) scaled back to v's length, times sign; NaN stays NaN. */
+static void direction_transform(const double a[9], double sign, float *v)
+{
+    const double x = v[0], y = v[1], z = v[2];
+    double o[3];
+    for (int r = 0; r < 3; r++) o[r] = a[3 * r] * x + a[3 * r + 1] * y + a[3 * r + 2] * z;
+    const double l0 = sqrt(x * x + y * y + z * z), l1 = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+    const double f = l1 > 0 && isfinite(l1) ? sign * l0 / l1 : 0;
+    for (int r = 0; r < 3; r++) v[r] = (float)(o[r] * f);
+}
+
 void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m[12])
 {
     /* Normals by the cofactor matrix (the inverse transpose times the determinant), times the sign of the
@@ -127,6 +138,7 @@ void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m
         }
     const double det = m[0] * cof[0] + m[1] * cof[1] + m[2] * cof[2];
     const int flip = det < 0;
+    const double lin[9] = { m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10] };   /* m without translation */
     for (size_t t = from; t < to; t++) {
         float *v = soup->tri + 9 * t;
         for (int k = 0; k < 3; k++) {
@@ -135,25 +147,13 @@ void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m
         }
         float *nv = soup->normal ? soup->normal + 9 * t : NULL;
         if (nv)
-            for (int k = 0; k < 3; k++) {
-                const double x = nv[3 * k], y = nv[3 * k + 1], z = nv[3 * k + 2];
-                double o[3];
-                for (int r = 0; r < 3; r++) o[r] = cof[3 * r] * x + cof[3 * r + 1] * y + cof[3 * r + 2] * z;
-                const double l0 = sqrt(x * x + y * y + z * z), l1 = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
-                const double f = l1 > 0 && isfinite(l1) ? (flip ? -l0 : l0) / l1 : 0;
-                for (int r = 0; r < 3; r++) nv[3 * k + r] = (float)(o[r] * f);   /* NaN stays NaN */
-            }
+            for (int k = 0; k < 3; k++) direction_transform(cof, flip ? -1.0 : 1.0, nv + 3 * k);
         /* Normal-map tangents (x, y, z, w per corner) are directions along the surface: by m itself, each
          * keeping its length; w (the bitangent's handedness) turns with a mirror. */
         float *tv = t < soup->tangent_n ? soup->tangent + 12 * t : NULL;
         if (tv)
             for (int k = 0; k < 3; k++) {
-                const double x = tv[4 * k], y = tv[4 * k + 1], z = tv[4 * k + 2];
-                double o[3];
-                for (int r = 0; r < 3; r++) o[r] = m[4 * r] * x + m[4 * r + 1] * y + m[4 * r + 2] * z;
-                const double l0 = sqrt(x * x + y * y + z * z), l1 = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
-                const double f = l1 > 0 && isfinite(l1) ? l0 / l1 : 0;
-                for (int r = 0; r < 3; r++) tv[4 * k + r] = (float)(o[r] * f);   /* NaN stays NaN */
+                direction_transform(lin, 1.0, tv + 4 * k);
                 if (flip) tv[4 * k + 3] = -tv[4 * k + 3];
             }
         if (!flip) continue;
