@@ -133,6 +133,7 @@ _Frame = _mirror("ms_frame", [("width", ctypes.c_int), ("height", ctypes.c_int),
 _PROGRESS = ctypes.CFUNCTYPE(None, _p, ctypes.c_double)
 _PROGRESS_CANCEL = ctypes.CFUNCTYPE(ctypes.c_int, _p, ctypes.c_double)
 
+_LoadOptions = _mirror("ms_scene_load_options", [("allow_outside_paths", ctypes.c_int)])
 _RenderOptions = _mirror("ms_render_options", [
     ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("width", ctypes.c_int),
     ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS),
@@ -152,7 +153,8 @@ _BakeOptions = _mirror("ms_bake_options", [("points", _PointsOptions), ("size", 
                                            ("dilate", ctypes.c_int), ("padding", ctypes.c_int)])
 
 _ERR = ctypes.c_char_p
-_scene_load = _sig("ms_scene_load", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_Scene), _ERR, _size)
+_scene_load = _sig("ms_scene_load_ex", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_LoadOptions),
+                   ctypes.POINTER(_Scene), _ERR, _size)
 _scene_default = _sig("ms_scene_default", ctypes.c_int, ctypes.POINTER(_Scene))
 _scene_free = _sig("ms_scene_free", None, ctypes.POINTER(_Scene))
 _accel_build = _sig("ms_accel_build", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.c_int, ctypes.POINTER(_p), _ERR, _size)
@@ -343,10 +345,14 @@ class Scene:
         return self.lights[0]
 
 
-def load(path):
-    """Loads a scene JSON file (meshes relative to it). Raises Error with the library's message."""
+def load(path, allow_outside_paths=False):
+    """Loads a scene JSON file (meshes relative to it). Raises Error with the library's message. Files that
+    the meshes name (glTF buffers and images, MTL files and maps) must lie inside the folder of the file
+    naming them, unless allow_outside_paths (for trusted assets) or the scene file says so."""
     s, err = _Scene(), _errbuf()
-    if _scene_load(os.fsencode(path), ctypes.byref(s), err, len(err)) != 0:
+    opt = _LoadOptions()
+    opt.allow_outside_paths = 1 if allow_outside_paths else 0
+    if _scene_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(s), err, len(err)) != 0:
         raise Error(-1, err.value.decode(errors="replace"))
     return Scene(s)
 

@@ -371,6 +371,22 @@ class StrictTest(unittest.TestCase):
             self.assertEqual(ms._layout(cname.encode(), None, None, ctypes.byref(size)), 0)
             self.assertEqual(ctypes.sizeof(mirror), size.value, cname)
 
+    def test_outside_paths(self):
+        # an OBJ whose mtllib leads out of its folder: refused, unless allowed
+        with tempfile.TemporaryDirectory() as d:
+            os.mkdir(os.path.join(d, "asset"))
+            with open(os.path.join(d, "outside.mtl"), "w") as f:
+                f.write("newmtl m\nKd 1 0 0\n")
+            with open(os.path.join(d, "asset", "m.obj"), "w") as f:
+                f.write("mtllib ../outside.mtl\nusemtl m\n" + OBJ)
+            path = os.path.join(d, "asset", "s.json")
+            with open(path, "w") as f:
+                f.write(JSON.replace("quad.obj", "m.obj"))
+            with self.assertRaises(ms.Error) as cm:
+                ms.load(path)
+            self.assertIn("../outside.mtl", str(cm.exception))
+            self.assertEqual(ms.load(path, allow_outside_paths=True).n_triangles, 4)
+
     def test_version(self):
         self.assertRegex(ms.__version__, r"^\d+\.\d+\.\d+$")
 
