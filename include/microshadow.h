@@ -365,7 +365,10 @@ MS_API int ms_isa_from_name(const char *name, ms_isa *out);
 /* The best level this CPU (and OS: saved register state) runs. */
 MS_API ms_isa ms_cpu_isa(void);
 
-typedef void (*ms_progress_fn)(void *user, double fraction_done);
+/* Progress with cancellation (like Embree's progress monitor), for frames, points and bakes: called with the
+ * fraction done, from one thread at a time (never concurrently for one call), fractions growing to 1; return 0
+ * to go on, non-zero to cancel the call, which then returns MS_ERR_CANCELLED soon after without results. */
+typedef int (*ms_progress_cancel_fn)(void *user, double fraction_done);
 
 /* How the embree method hands rays to Embree (docs/embree.md). */
 typedef enum ms_embree_mode {
@@ -396,7 +399,7 @@ typedef struct ms_render_options {
     int width, height;      /* 0: the scene camera's */
     int threads;            /* 0: all cores; the host's OpenMP settings are left alone */
     uint32_t seed;
-    ms_progress_fn progress;/* may be NULL; called one thread at a time (any thread), fractions growing to 1 */
+    ms_progress_cancel_fn progress;   /* may be NULL; non-zero from it cancels the frame */
     void *progress_user;
     ms_isa isa;             /* cap on the instruction set of kernels and traversal; MS_ISA_AUTO: the CPU's best */
     /* Switches to measure what a part buys; leave them 0. */
@@ -476,6 +479,8 @@ typedef struct ms_frame {
     int n_lights;
 } ms_frame;
 
+/* A frame: 0, or non-zero with a message in err and *out zeroed: MS_ERR_CANCELLED (3) when the progress
+ * callback cancelled it, -1 otherwise. */
 MS_API int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
               char *err, size_t errlen);
 MS_API void ms_frame_free(ms_frame *f);
@@ -507,7 +512,8 @@ MS_API int ms_frame_job_tiles(const ms_frame_job *job, int *tiles_x, int *tiles_
 MS_API int ms_frame_job_splittable(const ms_frame_job *job);
 /* Primary hits, and V, S, S_spec and front for every light, of the n tiles listed (tiles NULL: all of them, n = the number of tiles) into
  * the job's frame, the stats' visible_pixels, shadow_rays, penumbra_pixels, counters and seconds (primary_s,
- * shadow_s, shadow_cpu_s, and shadow_factor_s in thread-seconds until finish) summed over calls. 0, or -1 with a message. */
+ * shadow_s, shadow_cpu_s, and shadow_factor_s in thread-seconds until finish) summed over calls. 0, or -1 with a message
+ * (MS_ERR_CANCELLED when the options' progress callback cancelled: the job's frame is then incomplete). */
 MS_API int ms_frame_job_render(ms_frame_job *job, const int *tiles, int n, char *err, size_t errlen);
 /* The frame being assembled (full size, n_lights planes; only the rendered tiles' pixels are set;
  * vis, shadow and shadow_spec unfiltered).
@@ -589,10 +595,6 @@ typedef enum ms_status {
 /* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o". */
 MS_API const char *ms_status_name(ms_status s);
 
-/* Progress with cancellation (like Embree's progress monitor): called with the fraction done, from one
- * thread at a time (never concurrently for one call); return 0 to go on, non-zero to cancel the call,
- * which then returns MS_ERR_CANCELLED soon after without results. */
-typedef int (*ms_progress_cancel_fn)(void *user, double fraction_done);
 
 typedef struct ms_accel ms_accel;
 /* Builds the acceleration structure of the scene's triangles (copied: the scene may be freed after).

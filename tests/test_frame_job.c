@@ -230,6 +230,52 @@ static void test_refusals(void **state)
     ms_scene_free(&sc);
 }
 
+/* Progress and cancellation of frames: fractions that only grow, to 1; a non-zero return stops the frame
+ * soon after (tiles not begun are skipped) with MS_ERR_CANCELLED and no frame. */
+typedef struct progress_log { int calls, cancel_at; double last; int grew; } progress_log;
+
+static int log_progress(void *user, double f)
+{
+    progress_log *p = user;
+    p->grew &= f > p->last;
+    p->last = f;
+    return ++p->calls == p->cancel_at;
+}
+
+static void test_progress_cancel(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.method = "raytrace";
+    o.samples = 256;
+    o.width = 96;
+    o.height = 64;
+    char err[512];
+    ms_frame f;
+    progress_log full = { 0, -1, 0.0, 1 };
+    o.progress = log_progress;
+    o.progress_user = &full;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+    assert_true(full.grew);
+    assert_true(full.last == 1.0);
+    assert_true(full.calls > 4);
+    ms_frame_free(&f);
+    for (int at = 1; at <= 3; at++) {
+        progress_log stop = { 0, at, 0.0, 1 };
+        o.progress_user = &stop;
+        o.threads = 1;   /* one thread: no tile is under way when it cancels, so no further call */
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), MS_ERR_CANCELLED);
+        assert_non_null(strstr(err, "cancelled"));
+        assert_int_equal(stop.calls, at);
+        assert_null(f.vis);
+        assert_null(f.rgb);
+    }
+    ms_scene_free(&sc);
+}
+
 static void test_split_bake(void **state)
 {
     (void)state;
@@ -282,6 +328,7 @@ int main(void)
         cmocka_unit_test(test_split_frames),
         cmocka_unit_test(test_split_lights_materials),
         cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_progress_cancel),
         cmocka_unit_test(test_split_bake),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

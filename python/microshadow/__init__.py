@@ -130,13 +130,12 @@ _Frame = _mirror("ms_frame", [("width", ctypes.c_int), ("height", ctypes.c_int),
                               ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats),
                               ("shadow_spec", ctypes.POINTER(_f)), ("n_lights", ctypes.c_int)])
 
-_PROGRESS = ctypes.CFUNCTYPE(None, _p, ctypes.c_double)
-_PROGRESS_CANCEL = ctypes.CFUNCTYPE(ctypes.c_int, _p, ctypes.c_double)
 
 _LoadOptions = _mirror("ms_scene_load_options", [("allow_outside_paths", ctypes.c_int)])
+_PROGRESS_CANCEL = ctypes.CFUNCTYPE(ctypes.c_int, _p, ctypes.c_double)
 _RenderOptions = _mirror("ms_render_options", [
     ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("width", ctypes.c_int),
-    ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS),
+    ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS_CANCEL),
     ("progress_user", _p), ("isa", ctypes.c_int), ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
     ("traversal", ctypes.c_int), ("no_filter", ctypes.c_int), ("primary", ctypes.c_char_p),
     ("consistent_primary", ctypes.c_int)])
@@ -461,7 +460,7 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
     (H, W) uint16 (all of light 0), rgb (H, W, 3) linear radiance summed over the lights, exposure, stats
     (a dict), and lights: one dict per light of the scene with its vis, shadow, shadow_spec and front
     (H, W). primary: the primary visibility method (docs/primary.md; None: the method's pairing).
-    progress: fn(fraction), called from one thread (frames cannot be cancelled yet)."""
+    progress: fn(fraction) -> truthy to cancel (Error with status 3)."""
     if not isinstance(scene, Scene):
         raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
     opt = _RenderOptions()
@@ -471,11 +470,12 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
     opt.pattern = _choice("pattern", pattern, _PATTERNS)
     opt.samples, opt.width, opt.height, opt.threads, opt.seed = int(samples), int(width), int(height), int(threads), int(seed)
     opt.isa = _choice("isa", isa, _ISAS)
-    cb = _PROGRESS() if progress is None else _PROGRESS(lambda user, frac: progress(frac) and None)
+    cb = _progress_cancel(progress)
     opt.progress = cb
     fr, err = _Frame(), _errbuf()
-    if _render(ctypes.byref(scene._s), ctypes.byref(opt), ctypes.byref(fr), err, len(err)) != 0:
-        raise Error(-1, err.value.decode(errors="replace"))
+    rc = _render(ctypes.byref(scene._s), ctypes.byref(opt), ctypes.byref(fr), err, len(err))
+    if rc != 0:
+        raise Error(rc if rc > 0 else -1, err.value.decode(errors="replace"))
     try:
         W, H, nl = fr.width, fr.height, max(1, fr.n_lights)
         vis, shadow = _planes(fr.vis, nl, H, W), _planes(fr.shadow, nl, H, W)

@@ -58,11 +58,11 @@ static void usage(FILE *f)
         "  --help, --version\n");
 }
 
-static void progress_bar(void *user, double frac)
+static int progress_bar(void *user, double frac)
 {
     int *last = user;
     int pct = (int)(frac * 100.0);
-    if (pct == *last) return;
+    if (pct == *last) return 0;
     *last = pct;
     int filled = pct * 40 / 100;
     char bar[41];
@@ -71,6 +71,7 @@ static void progress_bar(void *user, double frac)
     fprintf(stderr, "\r[%s] %3d%%", bar, pct);
     if (pct >= 100) fputc('\n', stderr);
     fflush(stderr);
+    return 0;
 }
 
 static int cli_main(int argc, char **argv)

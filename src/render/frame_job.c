@@ -52,6 +52,7 @@ struct ms_frame_job {
     double t_start;
     long done, total;             /* progress: tiles over the primary phase and every light's shadow phase */
     long reported;                /* the largest `done` handed to the progress callback */
+    int cancelled;                /* the callback asked to stop: the remaining tiles are skipped */
 };
 
 /* CPU seconds of all the process's threads: on a shared machine, where wall time depends on the
@@ -73,10 +74,22 @@ static void progress_tick(ms_frame_job *j)
     d = ++j->done;
     if (!j->opt.progress) return;
 #pragma omp critical(ms_frame_progress)
-    if (d > j->reported) {
+    if (d > j->reported && !j->cancelled) {
         j->reported = d;
-        j->opt.progress(j->opt.progress_user, (double)d / (double)j->total);
+        if (j->opt.progress(j->opt.progress_user, (double)d / (double)j->total)) {
+#pragma omp atomic write
+            j->cancelled = 1;
+        }
     }
+}
+
+/* 1 once the progress callback cancelled the frame: a tile not begun is skipped. */
+static int cancelled(ms_frame_job *j)
+{
+    int c;
+#pragma omp atomic read
+    c = j->cancelled;
+    return c;
 }
 
 void ms_frame_job_free(ms_frame_job *j)
@@ -271,6 +284,7 @@ static void trace_tiles(ms_frame_job *j, const int *tiles, int n, int tick)
 {
 #pragma omp parallel for schedule(dynamic, 1) num_threads(j->threads)
     for (int i = 0; i < n; i++) {
+        if (tick && cancelled(j)) continue;
         const int t = tiles ? tiles[i] : i;
         int x0, y0, x1, y1;
         tile_rect(j, t, &x0, &y0, &x1, &y1);
@@ -351,6 +365,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
         int ok = front && vmask && (pts || !stratified);
 #pragma omp for schedule(dynamic, 1)
         for (int ti = 0; ti < shadow_tiles; ti++) {
+            if (cancelled(j)) continue;
             int x0, y0, x1, y1;
             tile_rect(j, tiles ? tiles[ti] : ti, &x0, &y0, &x1, &y1);
             ms_shadow_query q[TILE * TILE];
@@ -450,6 +465,7 @@ int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, siz
     ms_stats *st = &j->frame.stats;
     const double t0 = omp_get_wtime();
     trace_tiles(j, tiles, n, 1);
+    if (cancelled(j)) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
     const double t1 = omp_get_wtime();
     const double c1 = process_cpu_s();
 
@@ -459,7 +475,8 @@ int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, siz
     pass_sums p;
     memset(&p, 0, sizeof p);
     int failed = 0;
-    for (size_t l = 0; l < j->nlights && !failed; l++) failed = shadow_pass(j, l, tiles, n, whole, &p) != 0;
+    for (size_t l = 0; l < j->nlights && !failed && !cancelled(j); l++) failed = shadow_pass(j, l, tiles, n, whole, &p) != 0;
+    if (cancelled(j)) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
     if (failed) {
         snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);
         return -1;

@@ -313,6 +313,12 @@ class LightsTest(unittest.TestCase):
         self.assertGreater(len(seen), 1)
         self.assertEqual(seen[-1], 1.0)
         self.assertTrue(all(a <= b for a, b in zip(seen, seen[1:])))
+        # cancelled at the first report: status 3, and no frame
+        seen.clear()
+        with self.assertRaises(ms.Error) as cm:
+            ms.render(self.scenes["all"], samples=256, threads=1, progress=lambda f: seen.append(f) or True)
+        self.assertEqual(cm.exception.status, 3)
+        self.assertEqual(len(seen), 1)
 
 
 class StrictTest(unittest.TestCase):
