@@ -20,7 +20,10 @@ static int render_chunk(void *user, int first, int count, char *err, size_t errl
     return ms_frame_job_render(w->job, w->tiles, count, err, errlen);
 }
 
-_Static_assert(sizeof(ms_material) == 7 * sizeof(float) + 4 * sizeof(int32_t), "ms_material is hashed as bytes: no padding");
+_Static_assert(sizeof(ms_texture_sampling) == 4 * sizeof(int32_t) + 6 * sizeof(float),
+               "ms_texture_sampling is hashed as bytes (in ms_material): no padding");
+_Static_assert(sizeof(ms_material) == 11 * sizeof(float) + 13 * sizeof(int32_t) + 4 * sizeof(ms_texture_sampling),
+               "ms_material is hashed as bytes: no padding");
 _Static_assert(sizeof(ms_camera) == 3 * sizeof(ms_vec3) + 3 * sizeof(float) + 2 * sizeof(int) + sizeof(ms_camera_type),
                "ms_camera is hashed as bytes: no padding");
 
