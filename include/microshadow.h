@@ -418,6 +418,11 @@ typedef struct ms_render_options {
     const char *primary;
     int consistent_primary; /* bvh primary: decide each ray with the 3D rasterizers' consistent edge test
                              * (ties by the top-left rule, t ties to the smaller id): the same hits as 3dr-* */
+    int closed_cull;        /* leave out of every light's occluders the triangles of closed meshes that face away
+                             * from the whole light: the same V and S (docs/culling.md), measured slower on dense
+                             * meshes (the kept far side projects smaller); off by default, to measure */
+    int no_interior;        /* micro-raster methods: no interior boxes (virtual occluders inside closed meshes,
+                             * docs/culling.md: the same V and S); to measure what they buy */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
@@ -457,6 +462,10 @@ typedef struct ms_stats {
     /* Its counters where it has them (the 3D rasterizers, the consistent bvh caster; Dachsbacher et al.'s
      * Table 1): triangle set-ups, edge-function evaluations, BVH nodes visited; 0 otherwise. */
     uint64_t primary_setups, primary_edge_evals, primary_nodes;
+    /* Triangles of closed components left out of the lights' occluders (ms_render_options.closed_cull),
+     * and interior boxes rasterized before the triangles (micro-raster methods), summed over the lights
+     * (docs/culling.md). */
+    uint64_t occluders_culled, interior_boxes;
 } ms_stats;
 
 typedef struct ms_frame {

@@ -47,6 +47,9 @@ static void usage(FILE *f)
         "  --primary P         primary visibility: bvh, embree, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full,\n"
         "                      depth (default: the method's pairing; docs/primary.md)\n"
         "  --consistent        bvh primary: the 3D rasterizers' consistent edge test (same hits as 3dr-*)\n"
+        "  --closed-cull       leave out the side of closed meshes facing away from the light (the same\n"
+        "                      answer, docs/culling.md; slower on dense meshes, to measure)\n"
+        "  --no-interior       micro-raster methods: no interior boxes (docs/culling.md; to measure)\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture, which\n"
         "                      are otherwise one line per scene: their number and the first)\n"
@@ -79,7 +82,7 @@ static int cli_main(int argc, char **argv)
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
-           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT };
+           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -92,6 +95,8 @@ static int cli_main(int argc, char **argv)
         { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
         { "exposure", required_argument, 0, O_EXPOSURE }, { "primary", required_argument, 0, O_PRIMARY },
         { "consistent", no_argument, 0, O_CONSISTENT },
+        { "closed-cull", no_argument, 0, O_CLOSED_CULL },
+        { "no-interior", no_argument, 0, O_NO_INTERIOR },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -175,6 +180,8 @@ static int cli_main(int argc, char **argv)
         case O_NO_FILTER: opt.no_filter = 1; break;
         case O_PRIMARY: opt.primary = optarg; break;
         case O_CONSISTENT: opt.consistent_primary = 1; break;
+        case O_CLOSED_CULL: opt.closed_cull = 1; break;
+        case O_NO_INTERIOR: opt.no_interior = 1; break;
         case O_EXPOSURE: {
             char *end;
             errno = 0;
