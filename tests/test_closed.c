@@ -10,9 +10,9 @@
  *
  * Interior boxes (src/accel/interior.c): every point sampled in every box lies inside its component by a
  * ray-parity count written here, and at least the clearance from each of its triangles (point-triangle
- * distance, double); open meshes get none. Frames of a dense sphere over a ground: scanline with the boxes,
- * without them, raytrace and the per-pixel traversal give the same V bit for bit, for a light apart from the
- * sphere (boxes used) and one inside its box (none used). */
+ * distance, double); open meshes get none. Frames of a dense sphere over a ground: scanline with the boxes
+ * and the cull (its default), without either, per pixel, hierarchical, raytrace with and without the cull
+ * give the same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none). */
 #include "testutil.h"
 #include "accel/closed.h"
 #include "accel/interior.h"
@@ -501,13 +501,15 @@ static void test_interior_boxes(void **st)
 }
 
 /* V of a frame by method with the options' switches (vis copied out, the stats kept). */
-static float *frame_vis(const ms_scene *sc, const char *method, ms_traversal trav, int no_interior, ms_stats *stats)
+static float *frame_vis(const ms_scene *sc, const char *method, ms_traversal trav, int no_interior, ms_closed_cull_mode cull,
+                        ms_stats *stats)
 {
     ms_render_options o;
     ms_render_options_default(&o);
     o.method = method;
     o.traversal = trav;
     o.no_interior = no_interior;
+    o.closed_cull = cull;
     o.threads = 2;
     o.isa = tu_isa_cap();
     ms_frame f;
@@ -552,11 +554,18 @@ static void test_interior_frames(void **st)
     for (int light = 0; light < 2; light++) {
         if (light == 1) sc.light.corner = (ms_vec3){ 1.2f, 2.4f, 0.6f };   /* beside the sphere, within its box: no boxes */
         ms_stats s_int, s_rt;
-        float *v_int = frame_vis(&sc, "scanline", MS_TRAVERSAL_BLOCK, 0, &s_int);
-        float *v_no = frame_vis(&sc, "scanline", MS_TRAVERSAL_BLOCK, 1, NULL);
-        float *v_pix = frame_vis(&sc, "scanline", MS_TRAVERSAL_PIXEL, 0, NULL);
-        float *v_hier = frame_vis(&sc, "hierarchical", MS_TRAVERSAL_BLOCK, 0, NULL);
-        float *v_rt = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, &s_rt);
+        float *v_int = frame_vis(&sc, "scanline", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_DEFAULT, &s_int);
+        float *v_no = frame_vis(&sc, "scanline", MS_TRAVERSAL_BLOCK, 1, MS_CLOSED_CULL_OFF, NULL);
+        float *v_pix = frame_vis(&sc, "scanline", MS_TRAVERSAL_PIXEL, 0, MS_CLOSED_CULL_DEFAULT, NULL);
+        float *v_hier = frame_vis(&sc, "hierarchical", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_OFF, NULL);
+        float *v_rt = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_DEFAULT, &s_rt);
+        ms_stats s_rtc;
+        float *v_rtc = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_ON, &s_rtc);
+        /* the default: the micro-raster methods cull, raytrace does not; nothing for the light within the
+         * sphere's box */
+        assert_int_equal(s_rt.occluders_culled, 0);
+        assert_true(light == 0 ? s_int.occluders_culled > 0 && s_rtc.occluders_culled > 0
+                               : s_int.occluders_culled == 0 && s_rtc.occluders_culled == 0);
         if (light == 0) {
             assert_true(s_int.interior_boxes > 0);
             assert_true(counter(&s_int, "interior_rasterized") > 0);
@@ -572,7 +581,8 @@ static void test_interior_frames(void **st)
         assert_memory_equal(v_int, v_pix, npix * sizeof *v_int);
         assert_memory_equal(v_int, v_hier, npix * sizeof *v_int);
         assert_memory_equal(v_int, v_rt, npix * sizeof *v_int);
-        free(v_int); free(v_no); free(v_pix); free(v_hier); free(v_rt);
+        assert_memory_equal(v_int, v_rtc, npix * sizeof *v_int);
+        free(v_int); free(v_no); free(v_pix); free(v_hier); free(v_rt); free(v_rtc);
     }
     ms_scene_free(&sc);
 }

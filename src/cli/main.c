@@ -47,8 +47,8 @@ static void usage(FILE *f)
         "  --primary P         primary visibility: bvh, embree, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full,\n"
         "                      depth (default: the method's pairing; docs/primary.md)\n"
         "  --consistent        bvh primary: the 3D rasterizers' consistent edge test (same hits as 3dr-*)\n"
-        "  --closed-cull       leave out the side of closed meshes facing away from the light (the same\n"
-        "                      answer, docs/culling.md; slower on dense meshes, to measure)\n"
+        "  --closed-cull on|off  leave out the side of closed meshes facing away from the light (the same\n"
+        "                      answer, docs/culling.md); default: on for the micro-raster methods\n"
         "  --no-interior       micro-raster methods: no interior boxes (docs/culling.md; to measure)\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture, which\n"
@@ -95,7 +95,7 @@ static int cli_main(int argc, char **argv)
         { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
         { "exposure", required_argument, 0, O_EXPOSURE }, { "primary", required_argument, 0, O_PRIMARY },
         { "consistent", no_argument, 0, O_CONSISTENT },
-        { "closed-cull", no_argument, 0, O_CLOSED_CULL },
+        { "closed-cull", required_argument, 0, O_CLOSED_CULL },
         { "no-interior", no_argument, 0, O_NO_INTERIOR },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
@@ -180,7 +180,11 @@ static int cli_main(int argc, char **argv)
         case O_NO_FILTER: opt.no_filter = 1; break;
         case O_PRIMARY: opt.primary = optarg; break;
         case O_CONSISTENT: opt.consistent_primary = 1; break;
-        case O_CLOSED_CULL: opt.closed_cull = 1; break;
+        case O_CLOSED_CULL:
+            if (!strcmp(optarg, "on")) opt.closed_cull = MS_CLOSED_CULL_ON;
+            else if (!strcmp(optarg, "off")) opt.closed_cull = MS_CLOSED_CULL_OFF;
+            else { fprintf(stderr, "microshadow: --closed-cull: '%s' is not on or off\n", optarg); return EXIT_BAD_INPUT; }
+            break;
         case O_NO_INTERIOR: opt.no_interior = 1; break;
         case O_EXPOSURE: {
             char *end;

@@ -275,7 +275,10 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->pstate = pstate;
     f->stats.primary_s = omp_get_wtime() - t_primary;
     const double t_setup = omp_get_wtime();
-    const int occ_what = sm->occluders & (opt->closed_cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0);
+    if ((unsigned)opt->closed_cull > MS_CLOSED_CULL_OFF) { snprintf(err, errlen, "unknown closed_cull %d", (int)opt->closed_cull); goto fail; }
+    const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
+                     (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
+    const int occ_what = sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0);
     if (occ_what && !streamed && occluders_build(j, occ_what, &f->stats)) {
         snprintf(err, errlen, "out of memory for the lights' occluders");
         goto fail;

@@ -39,7 +39,7 @@ typedef struct ms_occluders {
 #define MS_INTERIOR_MIN_TRIS 256
 
 /* What a light's occluders are built with (ms_shadow_method.occluders). */
-enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2 };
+enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4 };
 
 /* The occluders of light l (every shape: its hull is its parallelogram, or a sphere's box) for the scene
  * whose BVH is `scene_bvh` and closed components `closed` (found over scene->tri), with alpha-tested
