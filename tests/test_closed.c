@@ -427,16 +427,16 @@ done:;
     return sqrt(dot3(d, d));
 }
 
-/* Every box of in: corners, centre and random points inside their component (odd crossings along two
- * directions) and at least eps from each of its triangles. The component's triangles are m's triangles
- * with that component number. Returns the boxes checked. */
-static size_t check_boxes(const mesh *m, const ms_closed *c, const ms_interior *in, double eps)
+/* Every box of in: corners, centre and random points inside their cycle (odd crossings along two
+ * directions) and at least eps from each of its triangles. The cycle's triangles are those of m's first n
+ * with that cycle number. Returns the boxes checked. */
+static size_t check_boxes(const mesh *m, size_t n, const ms_closed *c, const ms_interior *in, double eps)
 {
     unsigned seed = 5;
     for (size_t b = 0; b < in->n_boxes; b++) {
         mesh comp = { 0 };
-        for (size_t t = 0; t < m->n; t++)
-            if (c->component[t] == in->component[b]) {
+        for (size_t t = 0; t < n; t++)
+            if (c->cycle[t] == in->component[b]) {
                 const float *f = m->tri + 9 * t;
                 const double p0[3] = { f[0], f[1], f[2] }, p1[3] = { f[3], f[4], f[5] }, p2[3] = { f[6], f[7], f[8] };
                 add_tri(&comp, p0, p1, p2);
@@ -479,22 +479,36 @@ static void test_interior_boxes(void **st)
     assert_int_equal(c.n_components, 4);
     ms_interior in;
     assert_int_equal(ms_interior_find(m.tri, m.n, &c, 24, 0, eps, 2, &in), 0);
+    assert_int_equal(c.n_cycles, 4);   /* every closed component is a cycle */
     int per[4] = { 0 };
     for (size_t b = 0; b < in.n_boxes; b++) per[in.component[b]]++;
     for (int k = 0; k < 4; k++) assert_true(per[k] > 0);
-    assert_int_equal(check_boxes(&m, &c, &in, eps), in.n_boxes);
+    assert_int_equal(check_boxes(&m, m.n, &c, &in, eps), in.n_boxes);
     /* min_tris leaves out the small ones */
     ms_interior_free(&in);
     assert_int_equal(ms_interior_find(m.tri, m.n, &c, 24, 2000, eps, 2, &in), 0);
-    for (size_t b = 0; b < in.n_boxes; b++) assert_int_equal(c.component[0], in.component[b]);
+    for (size_t b = 0; b < in.n_boxes; b++) assert_int_equal(c.cycle[0], in.component[b]);
     assert_true(in.n_boxes > 0);
     ms_interior_free(&in);
     ms_closed_free(&c);
     /* open: the sphere less one triangle has no inside */
     assert_int_equal(ms_closed_find(m.tri, 5119, &c), 0);
     assert_int_equal(ms_interior_find(m.tri, 5119, &c, 24, 0, eps, 2, &in), 0);
-    for (size_t b = 0; b < in.n_boxes; b++) assert_true(in.component[b] != c.component[0] || c.component[0] == MS_OPEN_COMPONENT);
-    for (size_t t = 0; t < 5119; t++) assert_int_equal(c.component[t], MS_OPEN_COMPONENT);
+    assert_int_equal(c.n_cycles, 0);
+    assert_int_equal(in.n_boxes, 0);
+    ms_interior_free(&in);
+    ms_closed_free(&c);
+    /* a flipped triangle: no closed component any more, still a cycle with an inside */
+    float tmp[3];
+    memcpy(tmp, m.tri + 3, sizeof tmp);
+    memcpy(m.tri + 3, m.tri + 6, sizeof tmp);
+    memcpy(m.tri + 6, tmp, sizeof tmp);
+    assert_int_equal(ms_closed_find(m.tri, 5120, &c), 0);
+    assert_int_equal(c.n_components, 0);
+    assert_int_equal(c.n_cycles, 1);
+    assert_int_equal(ms_interior_find(m.tri, 5120, &c, 24, 0, eps, 2, &in), 0);
+    assert_true(in.n_boxes > 0);
+    assert_int_equal(check_boxes(&m, 5120, &c, &in, eps), in.n_boxes);
     ms_interior_free(&in);
     ms_closed_free(&c);
     free(m.tri);

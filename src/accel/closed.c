@@ -63,9 +63,12 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     uint32_t *id = malloc(3 * n * sizeof *id);          /* welded vertex of each corner */
     edge_slot *e = calloc(em, sizeof *e);
     uint32_t *parent = malloc(n * sizeof *parent);
+    uint32_t *cparent = malloc(n * sizeof *cparent);    /* the mod-2 cycles: any shared edge unites */
     uint8_t *bad = calloc(n, 1);                        /* on a boundary, fin, flipped or degenerate edge */
+    uint8_t *odd = calloc(n, 1);                        /* on an edge used an odd number of times */
     out->component = malloc(n * sizeof *out->component);
-    if (!vslot || !id || !e || !parent || !bad || !out->component) goto oom;
+    out->cycle = malloc(n * sizeof *out->cycle);
+    if (!vslot || !id || !e || !parent || !cparent || !bad || !odd || !out->component || !out->cycle) goto oom;
     memset(vslot, 0, vm * sizeof *vslot);
     /* Weld: corners with bitwise-equal positions (-0 as +0) share a vertex, numbered by first corner. */
     for (size_t c = 0; c < 3 * n; c++) {
@@ -83,7 +86,7 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     free(vslot);
     vslot = NULL;
     for (size_t t = 0; t < n; t++) {
-        parent[t] = (uint32_t)t;
+        parent[t] = cparent[t] = (uint32_t)t;
         for (int k = 0; k < 3; k++) {
             const uint32_t a = id[3 * t + (size_t)k], b = id[3 * t + (size_t)(k + 1) % 3];
             if (a == b) { bad[t] = 1; continue; }   /* a repeated vertex: no solid has such a face */
@@ -91,6 +94,7 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
             size_t h = (size_t)mix64((uint64_t)lo << 32 | hi) & (em - 1);
             while (e[h].count && (e[h].lo != lo || e[h].hi != hi)) h = (h + 1) & (em - 1);
             edge_slot *s = &e[h];
+            if (s->count) unite(cparent, (uint32_t)t, s->tri[0]);
             if (s->count < 2) {
                 s->lo = lo; s->hi = hi;
                 s->tri[s->count] = (uint32_t)t;
@@ -110,6 +114,7 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
         if (s->count == 2 && s->dir[0] != s->dir[1]) unite(parent, s->tri[0], s->tri[1]);
         else if (s->count == 1) bad[s->tri[0]] = 1;
         else if (s->count >= 2) bad[s->tri[0]] = bad[s->tri[1]] = 1;
+        if (s->count & 1) odd[s->tri[0]] = 1;
     }
     free(e);
     e = NULL;
@@ -127,10 +132,48 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
         if (bad[r]) out->component[t] = MS_OPEN_COMPONENT;
         else out->component[t] = r == t ? (uint32_t)nc++ : out->component[r];
     }
+    /* The mod-2 cycles the same way: open when any of their edges is used an odd number of times. */
+    for (size_t t = 0; t < n; t++) {
+        const uint32_t r = find_root(cparent, (uint32_t)t);
+        if (odd[t]) odd[r] = 1;
+    }
+    size_t ncy = 0;
+    for (size_t t = 0; t < n; t++) {
+        const uint32_t r = find_root(cparent, (uint32_t)t);
+        if (odd[r]) out->cycle[t] = MS_OPEN_COMPONENT;
+        else out->cycle[t] = r == t ? (uint32_t)ncy++ : out->cycle[r];
+    }
+    out->n_cycles = ncy;
+    if (ncy) {
+        out->cycle_box = malloc(ncy * sizeof *out->cycle_box);
+        uint8_t *seen = calloc(ncy, 1);
+        if (!out->cycle_box || !seen) { free(seen); goto oom; }
+        for (size_t t = 0; t < n; t++) {
+            const uint32_t c = out->cycle[t];
+            if (c == MS_OPEN_COMPONENT) continue;
+            const float *p = tri + 9 * t;
+            out->cycle_tris++;
+            if (!seen[c]) {
+                seen[c] = 1;
+                for (int k = 0; k < 3; k++) out->cycle_box[c][k] = out->cycle_box[c][3 + k] = p[k];
+            }
+            for (int q = 0; q < 3; q++)
+                for (int k = 0; k < 3; k++) {
+                    const float x = p[3 * q + k];
+                    if (x < out->cycle_box[c][k]) out->cycle_box[c][k] = x;
+                    if (x > out->cycle_box[c][3 + k]) out->cycle_box[c][3 + k] = x;
+                }
+        }
+        free(seen);
+    }
     free(parent);
     parent = NULL;
+    free(cparent);
+    cparent = NULL;
     free(bad);
     bad = NULL;
+    free(odd);
+    odd = NULL;
     out->n_components = nc;
     if (nc) {
         out->box = malloc(nc * sizeof *out->box);
@@ -173,7 +216,9 @@ oom:
     free(id);
     free(e);
     free(parent);
+    free(cparent);
     free(bad);
+    free(odd);
     ms_closed_free(out);
     return -1;
 }
@@ -183,6 +228,8 @@ void ms_closed_free(ms_closed *c)
     free(c->component);
     free(c->box);
     free(c->outward);
+    free(c->cycle);
+    free(c->cycle_box);
     memset(c, 0, sizeof *c);
 }
 

@@ -1,4 +1,4 @@
-/* Interior boxes of closed components (interior.h). */
+/* Interior boxes of closed surfaces (interior.h). */
 #include "interior.h"
 #include <math.h>
 #include <stdlib.h>
@@ -6,7 +6,7 @@
 
 enum { CELL_FREE = 0, CELL_MARKED = 1, CELL_OUTSIDE = 2, CELL_SEEN = 3, CELL_INSIDE = 4, CELL_USED = 5 };
 
-/* Groups of unmarked cells not reached from outside, tested by winding number: at most this many per
+/* Groups of unmarked cells not reached from outside, tested by ray parity: at most this many per
  * component (largest first matters little: a statue has one big group and few pockets). */
 #define MAX_GROUPS 64
 #define MIN_GROUP_CELLS 8
@@ -19,24 +19,51 @@ typedef struct grid {
 
 static size_t gidx(const grid *g, int x, int y, int z) { return ((size_t)z * (size_t)g->ny + (size_t)y) * (size_t)g->nx + (size_t)x; }
 
-/* The winding number of the component's surface around p (solid angles, Van Oosterom & Strackee 1983). */
-static double winding(const float *tri, const uint32_t *ids, size_t n, const double p[3], int threads)
+/* The parity of the crossings of the ray p + t d (t > 0) with the cycle's triangles (Moller-Trumbore in
+ * double): 1 odd, 0 even, -1 when the ray passes too close to an edge, a vertex or a plane to be sure (the
+ * caller tries another direction). p is at least half a cell from every triangle, so t > 0 is clear. */
+static int ray_parity(const float *tri, const uint32_t *ids, size_t n, const double p[3], const double d[3], int threads)
 {
-    double sum = 0.0;
-#pragma omp parallel for reduction(+ : sum) schedule(static) num_threads(threads) if (n > 4096)
+    int odd = 0, unsure = 0;
+#pragma omp parallel for reduction(^ : odd) reduction(| : unsure) schedule(static) num_threads(threads) if (n > 4096)
     for (size_t k = 0; k < n; k++) {
         const float *t = tri + 9 * (size_t)ids[k];
-        double a[3], b[3], c[3];
-        for (int i = 0; i < 3; i++) { a[i] = t[i] - p[i]; b[i] = t[3 + i] - p[i]; c[i] = t[6 + i] - p[i]; }
-        const double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-        const double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-        const double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-        const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2], ac = a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
-        const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
-        sum += 2.0 * atan2(det, la * lb * lc + ab * lc + ac * lb + bc * la);
+        double e1[3], e2[3], s[3], h[3], q[3];
+        for (int a = 0; a < 3; a++) { e1[a] = (double)t[3 + a] - t[a]; e2[a] = (double)t[6 + a] - t[a]; s[a] = p[a] - t[a]; }
+        h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
+        const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+        const double scale = sqrt((e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]) * (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]));
+        if (fabs(det) <= 1e-9 * scale) {
+            /* parallel to the plane: a crossing is impossible unless the ray lies in it */
+            const double n0 = e1[1] * e2[2] - e1[2] * e2[1], n1 = e1[2] * e2[0] - e1[0] * e2[2], n2 = e1[0] * e2[1] - e1[1] * e2[0];
+            const double off = n0 * s[0] + n1 * s[1] + n2 * s[2];
+            if (fabs(off) <= 1e-9 * sqrt(n0 * n0 + n1 * n1 + n2 * n2) * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])) unsure = 1;
+            continue;
+        }
+        const double u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) / det;
+        q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
+        const double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+        const double w = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+        const double tol = 1e-7;
+        if (w <= 0.0) continue;
+        if (u < -tol || v < -tol || u + v > 1.0 + tol) continue;
+        if (u <= tol || v <= tol || u + v >= 1.0 - tol) { unsure = 1; continue; }   /* near an edge or vertex */
+        odd ^= 1;
     }
-    return sum / (4.0 * 3.14159265358979323846);
+    return unsure ? -1 : odd;
+}
+
+/* Whether p is inside the cycle (odd crossings), by rays along fixed directions in turn until one is sure;
+ * 0 when none is (the cells then stay out: always right). */
+static int inside_cycle(const float *tri, const uint32_t *ids, size_t n, const double p[3], int threads)
+{
+    static const double dirs[6][3] = { { 0.5773, 0.6181, 0.5331 }, { -0.3119, 0.8423, -0.4397 }, { 0.7071, -0.1234, 0.6963 },
+                                       { -0.6513, -0.4455, 0.6142 }, { 0.1291, -0.9178, -0.3755 }, { -0.8236, 0.2468, -0.5107 } };
+    for (int i = 0; i < 6; i++) {
+        const int r = ray_parity(tri, ids, n, p, dirs[i], threads);
+        if (r >= 0) return r;
+    }
+    return 0;
 }
 
 /* Flood fill from cell s over cells of value `from`, setting them to `to` (26-connected); stack: scratch
@@ -81,7 +108,7 @@ static int push_box(ms_interior *out, size_t *cap, const float b[6], uint32_t co
     return 0;
 }
 
-/* One component: its triangles ids[0..n), its box cbox. */
+/* One cycle: its triangles ids[0..n), its box cbox. */
 static int component_boxes(const float *tri, const uint32_t *ids, size_t n, const float cbox[6], uint32_t comp,
                            int res, double eps, int threads, ms_interior *out, size_t *cap)
 {
@@ -122,15 +149,15 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
     }
     /* Outside: reached from the border (which no triangle reaches: the box is a cell inside it). */
     flood(&g, 0, CELL_FREE, CELL_OUTSIDE, stack);
-    /* The other groups: inside or outside as a whole, by the winding number at one cell's centre. */
+    /* The other groups: inside or outside as a whole, by the parity of a ray from one cell's centre. */
     int groups = 0;
     for (size_t c = 0; c < nc && groups < MAX_GROUPS; c++) {
         if (g.cell[c] != CELL_FREE) continue;
         const int x = (int)(c % (size_t)g.nx), y = (int)(c / (size_t)g.nx % (size_t)g.ny), z = (int)(c / ((size_t)g.nx * (size_t)g.ny));
-        /* A pocket of a few cells would give a box or two: not worth the winding number's pass. */
+        /* A pocket of a few cells would give a box or two: not worth the ray's pass. */
         if (flood(&g, c, CELL_FREE, CELL_SEEN, stack) < MIN_GROUP_CELLS) continue;
         const double p[3] = { g.o[0] + (x + 0.5) * g.h, g.o[1] + (y + 0.5) * g.h, g.o[2] + (z + 0.5) * g.h };
-        if (fabs(winding(tri, ids, n, p, threads)) > 0.5) flood(&g, c, CELL_SEEN, CELL_INSIDE, stack);
+        if (inside_cycle(tri, ids, n, p, threads)) flood(&g, c, CELL_SEEN, CELL_INSIDE, stack);
         groups++;
     }
     free(stack);
@@ -175,26 +202,26 @@ int ms_interior_find(const float *tri, size_t n, const ms_closed *c, int res, si
                      int threads, ms_interior *out)
 {
     memset(out, 0, sizeof *out);
-    if (!c->n_components || c->n_tris != n) return 0;
-    /* The triangles of each component, contiguous. */
-    size_t *start = calloc(c->n_components + 1, sizeof *start);
-    uint32_t *ids = malloc((c->closed_tris ? c->closed_tris : 1) * sizeof *ids);
+    if (!c->n_cycles || c->n_tris != n) return 0;
+    /* The triangles of each cycle, contiguous. */
+    size_t *start = calloc(c->n_cycles + 1, sizeof *start);
+    uint32_t *ids = malloc((c->cycle_tris ? c->cycle_tris : 1) * sizeof *ids);
     if (!start || !ids) { free(start); free(ids); return -1; }
     for (size_t t = 0; t < n; t++)
-        if (c->component[t] != MS_OPEN_COMPONENT) start[c->component[t] + 1]++;
-    for (size_t k = 0; k < c->n_components; k++) start[k + 1] += start[k];
-    size_t *fill = malloc((c->n_components ? c->n_components : 1) * sizeof *fill);
+        if (c->cycle[t] != MS_OPEN_COMPONENT) start[c->cycle[t] + 1]++;
+    for (size_t k = 0; k < c->n_cycles; k++) start[k + 1] += start[k];
+    size_t *fill = malloc(c->n_cycles * sizeof *fill);
     if (!fill) { free(start); free(ids); return -1; }
-    memcpy(fill, start, c->n_components * sizeof *fill);
+    memcpy(fill, start, c->n_cycles * sizeof *fill);
     for (size_t t = 0; t < n; t++)
-        if (c->component[t] != MS_OPEN_COMPONENT) ids[fill[c->component[t]]++] = (uint32_t)t;
+        if (c->cycle[t] != MS_OPEN_COMPONENT) ids[fill[c->cycle[t]]++] = (uint32_t)t;
     free(fill);
     size_t cap = 0;
     int rc = 0;
-    for (size_t k = 0; k < c->n_components && !rc; k++) {
+    for (size_t k = 0; k < c->n_cycles && !rc; k++) {
         const size_t m = start[k + 1] - start[k];
         if (m < min_tris) continue;
-        rc = component_boxes(tri, ids + start[k], m, c->box[k], (uint32_t)k, res, eps, threads, out, &cap);
+        rc = component_boxes(tri, ids + start[k], m, c->cycle_box[k], (uint32_t)k, res, eps, threads, out, &cap);
     }
     free(start);
     free(ids);

@@ -135,7 +135,7 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
     ms_interior interior = { 0 };
     if (ms_closed_find(j->scene->tri, j->scene->n_tris, &closed)) return -1;
     int rc = 0;
-    if (closed.n_components) {
+    if (closed.n_cycles) {
         const double eps = ms_interior_clearance(&j->bvh, j->lights, j->nlights);
         if (what & MS_OCC_INTERIOR)
             rc = ms_interior_find(j->scene->tri, j->scene->n_tris, &closed, MS_INTERIOR_RES, MS_INTERIOR_MIN_TRIS, eps, j->threads, &interior);

@@ -73,22 +73,24 @@ double ms_interior_clearance(const ms_bvh *scene_bvh, const ms_light *lights, si
     return 2.5 * (double)MS_SEGMENT_NEAR * d;
 }
 
-/* Per closed component: 1 when it holds an alpha-tested triangle (its surface is porous: neither the cull
- * nor the interior boxes hold), or NULL when the scene is opaque. */
-static uint8_t *porous_components(const ms_closed *closed, const ms_bvh *scene_bvh, const struct ms_alpha *alpha, int *oom)
+/* Per closed component (cycle: per mod-2 cycle): 1 when it holds an alpha-tested triangle (its surface is
+ * porous: neither the cull nor the interior boxes hold), or NULL when the scene is opaque. */
+static uint8_t *porous_of(const ms_closed *closed, int cycle, const ms_bvh *scene_bvh, const struct ms_alpha *alpha, int *oom)
 {
     *oom = 0;
-    if (!alpha || !alpha->n_alpha) return NULL;
-    uint8_t *porous = calloc(closed->n_components, 1);
+    const size_t n = cycle ? closed->n_cycles : closed->n_components;
+    const uint32_t *of = cycle ? closed->cycle : closed->component;
+    if (!alpha || !alpha->n_alpha || !n) return NULL;
+    uint8_t *porous = calloc(n, 1);
     if (!porous) { *oom = 1; return NULL; }
     for (uint32_t i = 0; i < scene_bvh->n_tris; i++) {
-        const uint32_t c = closed->component[scene_bvh->tri_source[i]];
+        const uint32_t c = of[scene_bvh->tri_source[i]];
         if (ms_alpha_tested(alpha, i) && c != MS_OPEN_COMPONENT) porous[c] = 1;
     }
     return porous;
 }
 
-/* The interior boxes whose component is apart from the light by `margin`, as 12 triangles each. */
+/* The interior boxes whose cycle is apart from the light by `margin`, as 12 triangles each. */
 static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_interior *in, const uint8_t *porous,
                           const float lbox[6], double margin, int threads)
 {
@@ -98,7 +100,7 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
     for (size_t i = 0; i < in->n_boxes; i++) {
         const uint32_t k = in->component[i];
         if (porous && porous[k]) continue;
-        const float *cb = closed->box[k];
+        const float *cb = closed->cycle_box[k];
         int sep = 0;
         for (int a = 0; a < 3; a++)
             sep |= (double)lbox[a] > (double)cb[3 + a] + margin || (double)lbox[3 + a] < (double)cb[a] - margin;
@@ -182,7 +184,7 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
 {
     memset(o, 0, sizeof *o);
     const size_t n = scene->n_tris;
-    if (!closed->n_components || closed->n_tris != n || !scene_bvh->n_nodes) return 0;
+    if (!closed->n_cycles || closed->n_tris != n || !scene_bvh->n_nodes) return 0;
     float pts[8][3], lbox[6], sbox[6];
     const int np = light_hull(l, pts, lbox);
     for (int i = 0; i < 6; i++)
@@ -192,16 +194,19 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
      * diagonal of the scene's and the light's boxes together; doubled for the rounding of the boxes. */
     const double diag = joint_diag(sbox, lbox);
     const double margin = 2.0 * (1.0 - (double)MS_SEGMENT_FAR) * diag;
-    int oom;
-    uint8_t *porous = porous_components(closed, scene_bvh, scene_alpha, &oom);
-    if (oom) return -1;
-    int rc = 0;
+    int rc = 0, oom;
     /* Interior boxes hold for this light when their clearance covers the near range of its longest
      * segment (docs/culling.md). */
-    if ((what & MS_OCC_INTERIOR) && interior && interior->n_boxes && interior_eps >= 2.0 * (double)MS_SEGMENT_NEAR * diag)
-        rc = interior_build(o, closed, interior, porous, lbox, margin, threads);
-    if (!rc && (what & MS_OCC_CULL)) rc = cull_build(o, scene, scene_bvh, closed, porous, (const float (*)[3])pts, np, lbox, margin, scene_alpha, threads);
-    free(porous);
+    if ((what & MS_OCC_INTERIOR) && interior && interior->n_boxes && interior_eps >= 2.0 * (double)MS_SEGMENT_NEAR * diag) {
+        uint8_t *porous = porous_of(closed, 1, scene_bvh, scene_alpha, &oom);
+        rc = oom ? -1 : interior_build(o, closed, interior, porous, lbox, margin, threads);
+        free(porous);
+    }
+    if (!rc && (what & MS_OCC_CULL) && closed->n_components) {
+        uint8_t *porous = porous_of(closed, 0, scene_bvh, scene_alpha, &oom);
+        rc = oom ? -1 : cull_build(o, scene, scene_bvh, closed, porous, (const float (*)[3])pts, np, lbox, margin, scene_alpha, threads);
+        free(porous);
+    }
     if (rc) ms_occluders_free(o);
     return rc;
 }
