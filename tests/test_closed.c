@@ -12,7 +12,8 @@
  * ray-parity count written here, and at least the clearance from each of its triangles (point-triangle
  * distance, double); open meshes get none. Frames of a dense sphere over a ground: scanline with the boxes
  * and the cull (its default), without either, per pixel, hierarchical, raytrace with and without the cull
- * give the same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none). */
+ * give the same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none);
+ * the points API with the boxes equals raytrace point for point. */
 #include "testutil.h"
 #include "accel/closed.h"
 #include "accel/interior.h"
@@ -601,6 +602,72 @@ static void test_interior_frames(void **st)
     ms_scene_free(&sc);
 }
 
+/* The points API (a bake's path) with the boxes: the same V as raytrace, point for point, on the ground
+ * under the sphere and on the sphere itself. */
+static void test_interior_points(void **st)
+{
+    (void)st;
+    mesh m = { 0 };
+    const double g[4][3] = { { -10, 0, -10 }, { 10, 0, 10 }, { 10, 0, -10 }, { -10, 0, 10 } };
+    add_tri(&m, g[0], g[1], g[2]);
+    add_tri(&m, g[0], g[3], g[1]);
+    const double c[3] = { 0.3, 1.6, -0.2 };
+    icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
+    ms_scene sc;
+    tu_make_quad(&sc);
+    free(sc.tri);
+    sc.tri = m.tri;
+    sc.n_tris = m.n;
+    ms_accel *acc;
+    char err[256];
+    assert_int_equal(ms_accel_build(&sc, 2, &acc, err, sizeof err), MS_OK);
+    /* 2000 points: on the ground within 3 of the sphere's foot (triangle 0 or 1), and the sphere's
+     * triangles' centroids (their own triangle) */
+    const size_t n = 2000;
+    float *pos = malloc(n * 3 * sizeof *pos), *nrm = malloc(n * 3 * sizeof *nrm);
+    uint32_t *tri = malloc(n * sizeof *tri);
+    unsigned seed = 77;
+    for (size_t i = 0; i < n; i++) {
+        if (i % 2) {
+            const double x = -2.7 + 6.0 * urand(&seed), z = -3.2 + 6.0 * urand(&seed);
+            pos[3 * i] = (float)x; pos[3 * i + 1] = 0.0f; pos[3 * i + 2] = (float)z;
+            nrm[3 * i] = 0.0f; nrm[3 * i + 1] = 1.0f; nrm[3 * i + 2] = 0.0f;
+            tri[i] = 0;   /* x, z on either ground triangle: both lie in the plane y = 0; 0 keeps its own out */
+        } else {
+            const uint32_t t = 2 + (uint32_t)(urand(&seed) * 5120.0) % 5120;
+            const float *p = m.tri + 9 * (size_t)t;
+            double e1[3], e2[3];
+            for (int a = 0; a < 3; a++) {
+                pos[3 * i + (size_t)a] = (p[a] + p[3 + a] + p[6 + a]) / 3.0f;
+                e1[a] = (double)p[3 + a] - p[a];
+                e2[a] = (double)p[6 + a] - p[a];
+            }
+            nrm[3 * i] = (float)(e1[1] * e2[2] - e1[2] * e2[1]);
+            nrm[3 * i + 1] = (float)(e1[2] * e2[0] - e1[0] * e2[2]);
+            nrm[3 * i + 2] = (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+            tri[i] = t;
+        }
+    }
+    const ms_points pts = { n, pos, nrm, tri, NULL };
+    float *v_sl = malloc(n * sizeof *v_sl), *v_rt = malloc(n * sizeof *v_rt);
+    ms_points_options o = { 0 };
+    o.threads = 2;
+    o.isa = tu_isa_cap();
+    ms_stats s_sl;
+    o.method = "scanline";
+    assert_int_equal(ms_visibility_points(acc, &sc.light, &pts, &o, v_sl, NULL, NULL, &s_sl, err, sizeof err), MS_OK);
+    o.method = "raytrace";
+    assert_int_equal(ms_visibility_points(acc, &sc.light, &pts, &o, v_rt, NULL, NULL, NULL, err, sizeof err), MS_OK);
+    assert_true(s_sl.interior_boxes > 0);
+    int shadowed = 0;
+    for (size_t i = 0; i < n; i++) shadowed += v_rt[i] >= 0.0f && v_rt[i] < 1.0f;
+    assert_true(shadowed > 200);
+    assert_memory_equal(v_sl, v_rt, n * sizeof *v_sl);
+    free(v_sl); free(v_rt); free(pos); free(nrm); free(tri);
+    ms_accel_free(acc);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -609,6 +676,7 @@ int main(void)
         cmocka_unit_test(test_cull_guards),
         cmocka_unit_test(test_interior_boxes),
         cmocka_unit_test(test_interior_frames),
+        cmocka_unit_test(test_interior_points),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
