@@ -199,7 +199,7 @@ int main(int argc, char **argv)
      * run the defaults. */
     const char *methods[MAX_METHODS] = { "raytrace", "embree:packet16", "embree:stream", "mft", "bounds", "hierarchical",
                                          "scanline:pixel", "scanline" };
-    int n_methods = 8, quality_only = 0;
+    int n_methods = 8, quality_only = 0, no_quality = 0;
     /* The command line as given, for the header (strtok below cuts the lists). */
     char cmdline[1024] = "";
     for (int i = 1; i < argc; i++) {
@@ -212,6 +212,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) out_md = argv[++i];
         else if (!strcmp(argv[i], "--quality-only")) quality_only = 1;
+        else if (!strcmp(argv[i], "--no-quality")) no_quality = 1;
         else if (!strcmp(argv[i], "--samples") && i + 1 < argc) {
             n_samples = 0;
             for (char *t = strtok(argv[++i], ","); t && n_samples < 4; t = strtok(NULL, ",")) samples[n_samples++] = atoi(t);
@@ -403,7 +404,7 @@ int main(int argc, char **argv)
         memset(log_scan, 0, sizeof log_scan); memset(log_emb, 0, sizeof log_emb);
         memset(n_scan, 0, sizeof n_scan); memset(n_emb, 0, sizeof n_emb);
     }
-    FILE *mem = open_memstream(&sec, &sec_len);
+    FILE *mem = no_quality ? NULL : open_memstream(&sec, &sec_len);
     if (mem) {
         quality_table(mem, scenes, n_scenes, size, threads, date, cmd);
         fclose(mem);

@@ -559,6 +559,9 @@ static void test_interior_frames(void **st)
     add_tri(&m, g[0], g[3], g[1]);
     const double c[3] = { 0.3, 1.6, -0.2 };
     icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
+    /* and a thin closed bar (12 triangles: no interior boxes, so the micro-raster methods cull its back) */
+    const double blo[3] = { -2.5, 0.8, 1.3 }, bhi[3] = { 2.5, 0.9, 1.4 };
+    box(&m, blo, bhi, 0);
     free(sc.tri);
     sc.tri = m.tri;
     sc.n_tris = m.n;
@@ -576,11 +579,12 @@ static void test_interior_frames(void **st)
         float *v_rt = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_DEFAULT, &s_rt);
         ms_stats s_rtc;
         float *v_rtc = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_ON, &s_rtc);
-        /* the default: the micro-raster methods cull, raytrace does not; nothing for the light within the
-         * sphere's box */
+        /* the default: the micro-raster methods cull what has no interior boxes (the bar's bottom and a
+         * side, not the sphere), raytrace nothing; asked to, raytrace culls the sphere's back too; for the
+         * light within the sphere's box, only the bar */
         assert_int_equal(s_rt.occluders_culled, 0);
-        assert_true(light == 0 ? s_int.occluders_culled > 0 && s_rtc.occluders_culled > 0
-                               : s_int.occluders_culled == 0 && s_rtc.occluders_culled == 0);
+        assert_true(s_int.occluders_culled > 0 && s_int.occluders_culled <= 12);
+        assert_true(light == 0 ? s_rtc.occluders_culled > 1000 : s_rtc.occluders_culled <= 12);
         if (light == 0) {
             assert_true(s_int.interior_boxes > 0);
             assert_true(counter(&s_int, "interior_rasterized") > 0);

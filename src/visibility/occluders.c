@@ -92,7 +92,7 @@ static uint8_t *porous_of(const ms_closed *closed, int cycle, const ms_bvh *scen
 
 /* The interior boxes whose cycle is apart from the light by `margin`, as 12 triangles each. */
 static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_interior *in, const uint8_t *porous,
-                          const float lbox[6], double margin, int threads)
+                          const float lbox[6], double margin, uint8_t *boxed, int threads)
 {
     float *tri = malloc((in->n_boxes ? in->n_boxes : 1) * 12 * 9 * sizeof *tri);
     if (!tri) return -1;
@@ -105,6 +105,7 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
         for (int a = 0; a < 3; a++)
             sep |= (double)lbox[a] > (double)cb[3 + a] + margin || (double)lbox[3 + a] < (double)cb[a] - margin;
         if (!sep) continue;
+        boxed[k] = 1;
         const float *b = in->box[i];
         float v[8][3];
         for (int c = 0; c < 8; c++)
@@ -131,13 +132,19 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
 
 /* The cull (docs/culling.md) into o->bvh, o->alpha, o->prim_map; o->active = 0 when nothing is culled. */
 static int cull_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const ms_closed *closed,
-                      const uint8_t *porous, const float (*pts)[3], int np, const float lbox[6], double margin,
-                      const struct ms_alpha *scene_alpha, int threads)
+                      const uint8_t *porous, const uint8_t *boxed, const float (*pts)[3], int np, const float lbox[6],
+                      double margin, const struct ms_alpha *scene_alpha, int threads)
 {
     const size_t n = scene->n_tris;
     uint8_t *keep = malloc(n ? n : 1);
     if (!keep) return -1;
     size_t culled = ms_closed_cull(closed, scene->tri, pts, np, lbox, margin, keep);
+    /* Components with interior boxes for this light keep both sides: there the cull was measured neutral
+     * (the boxes already fill the umbra the near side used to), and it would cost a BVH of its own
+     * (docs/culling.md); it pays on thin closed parts, which get no boxes. A closed component is its own
+     * mod-2 cycle. */
+    for (size_t t = 0; boxed && culled && t < n; t++)
+        if (!keep[t] && boxed[closed->cycle[t]]) { keep[t] = 1; culled--; }
     /* Condition 2 of the proof: an alpha-tested triangle makes its component porous; keep the whole
      * component two-sided. */
     for (size_t t = 0; porous && culled && t < n; t++) {
@@ -195,18 +202,21 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
     const double diag = joint_diag(sbox, lbox);
     const double margin = 2.0 * (1.0 - (double)MS_SEGMENT_FAR) * diag;
     int rc = 0, oom;
+    uint8_t *boxed = NULL;   /* per cycle: 1 when it has interior boxes for this light */
     /* Interior boxes hold for this light when their clearance covers the near range of its longest
      * segment (docs/culling.md). */
     if ((what & MS_OCC_INTERIOR) && interior && interior->n_boxes && interior_eps >= 2.0 * (double)MS_SEGMENT_NEAR * diag) {
         uint8_t *porous = porous_of(closed, 1, scene_bvh, scene_alpha, &oom);
-        rc = oom ? -1 : interior_build(o, closed, interior, porous, lbox, margin, threads);
+        boxed = oom ? NULL : calloc(closed->n_cycles, 1);
+        rc = !boxed ? -1 : interior_build(o, closed, interior, porous, lbox, margin, boxed, threads);
         free(porous);
     }
     if (!rc && (what & MS_OCC_CULL) && closed->n_components) {
         uint8_t *porous = porous_of(closed, 0, scene_bvh, scene_alpha, &oom);
-        rc = oom ? -1 : cull_build(o, scene, scene_bvh, closed, porous, (const float (*)[3])pts, np, lbox, margin, scene_alpha, threads);
+        rc = oom ? -1 : cull_build(o, scene, scene_bvh, closed, porous, boxed, (const float (*)[3])pts, np, lbox, margin, scene_alpha, threads);
         free(porous);
     }
+    free(boxed);
     if (rc) ms_occluders_free(o);
     return rc;
 }
