@@ -345,6 +345,12 @@ typedef struct ms_scene_load_options {
 MS_API int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light. */
 MS_API int ms_scene_default(ms_scene *out);
+/* Puts a scene built in world coordinates (tri, camera, lights as floats; origin usually 0) into the frame
+ * ms_scene_load would choose for it (see ms_scene): tri, the camera's eye and target and the lights' corners
+ * and centres moved, origin set. The detail a float lost far from the origin is not recovered, but every
+ * method then works at the scene's own magnitudes (bounds as tight, time as at home). Nothing changes for a
+ * scene about the origin, a procedural scene, or one already in its frame. 0, or -1 when out of memory. */
+MS_API int ms_scene_localize(ms_scene *s);
 /* Checks camera, light and geometry for NaN/inf and degenerate cases. `what` names the source. */
 MS_API int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen);
 MS_API void ms_scene_free(ms_scene *s);

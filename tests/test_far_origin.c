@@ -12,7 +12,8 @@
  *    (exactly representable there) get the V and S of d = 0;
  *  - test_leak_far, test_cracks_far: the light-leak and primary-crack scenes of test_watertight.c (smaller)
  *    at every offset: every method V == 0 inside the closed pillow, no pixel without a hit inside the
- *    closed icosphere. */
+ *    closed icosphere;
+ *  - test_localize: a scene built in world floats far out, put into its frame by ms_scene_localize. */
 #include "testutil.h"
 #include <math.h>
 #include <stdio.h>
@@ -448,6 +449,59 @@ static void test_cracks_far(void **st)
     gen_free(&m);
 }
 
+/* A scene built in world floats (the leak scene at (1e5, 5e4, -1e5)): ms_scene_localize moves it into its
+ * frame; still watertight in every method, and raytrace's traversal is that of a scene at home. */
+static void test_localize(void **st)
+{
+    (void)st;
+    gen m;
+    leak_scene(&m);
+    const double off[3] = { 1e5, 5e4, -1e5 };
+    ms_scene sc;
+    memset(&sc, 0, sizeof sc);
+    sc.n_tris = m.nt;
+    sc.tri = malloc(m.nt * 9 * sizeof *sc.tri);
+    assert_non_null(sc.tri);
+    for (size_t t = 0; t < m.nt; t++)
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++) sc.tri[9 * t + 3 * k + a] = (float)(m.v[3 * m.ix[3 * t + k] + a] + off[a]);
+    sc.camera = (ms_camera){ { (float)(m.eye[0] + off[0]), (float)(m.eye[1] + off[1]), (float)(m.eye[2] + off[2]) },
+                             { (float)(m.target[0] + off[0]), (float)(m.target[1] + off[1]), (float)(m.target[2] + off[2]) },
+                             { 0, 0, 1 }, m.fov, 64, 64, MS_CAMERA_PINHOLE, 0, 0 };
+    sc.light = (ms_light){ { (float)(m.corner[0] + off[0]), (float)(m.corner[1] + off[1]), (float)(m.corner[2] + off[2]) },
+                           { m.es[0], m.es[1], m.es[2] }, { m.et[0], m.et[1], m.et[2] }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0,
+                           { 0, 0, 0 }, 0 };
+    sc.samples = 256;
+    ms_frame before, after;
+    render(&sc, "raytrace", 24, &before);   /* small: in world floats nothing is culled (slow under ASan) */
+    assert_int_equal(ms_scene_localize(&sc), 0);
+    print_message("localized: origin (%.17g, %.17g, %.17g), eye (%g, %g, %g)\n", sc.origin[0], sc.origin[1], sc.origin[2],
+                  (double)sc.camera.eye.x, (double)sc.camera.eye.y, (double)sc.camera.eye.z);
+    for (int a = 0; a < 3; a++) assert_true(sc.origin[a] == off[a]);
+    const double o0[3] = { sc.origin[0], sc.origin[1], sc.origin[2] };
+    assert_int_equal(ms_scene_localize(&sc), 0);   /* already in its frame: nothing moves */
+    for (int a = 0; a < 3; a++) assert_true(sc.origin[a] == o0[a]);
+    long leaked = 0;
+    for (const char *const *n = ms_method_names(); *n; n++) {
+        ms_frame f;
+        render(&sc, *n, 48, &f);
+        for (int i = 0; i < 48 * 48; i++) {
+            assert_true(f.vis[i] >= 0.0f);
+            leaked += lroundf(f.vis[i] * 256.0f);
+        }
+        ms_frame_free(&f);
+    }
+    render(&sc, "raytrace", 24, &after);
+    print_message("raytrace %s: %.0f in world floats, %.0f localized\n", after.stats.counter_name[1],
+                  (double)before.stats.counter[1], (double)after.stats.counter[1]);
+    assert_true(4.0 * (double)after.stats.counter[1] < (double)before.stats.counter[1]);
+    ms_frame_free(&after);
+    assert_int_equal(leaked, 0);
+    ms_frame_free(&before);
+    ms_scene_free(&sc);
+    gen_free(&m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -456,6 +510,7 @@ int main(void)
         cmocka_unit_test(test_points_far),
         cmocka_unit_test(test_leak_far),
         cmocka_unit_test(test_cracks_far),
+        cmocka_unit_test(test_localize),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

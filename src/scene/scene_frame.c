@@ -5,8 +5,10 @@
  * scene, not of its distance from the world's origin: a float has the same absolute precision, and every
  * conservative bound derived from the coordinates (ray_triangle.h, the traversals) stays as tight, 100 km
  * out as at home. This file is the only place that chooses or applies it. */
+#include "microshadow.h"
 #include "scene_internal.h"
 #include <math.h>
+#include <stdlib.h>
 
 /* The origin: per axis, the centre c of the bounds rounded to a multiple of s, the smallest power of two
  * not below the half-extent e (the largest over the axes); zero on an axis where |c| <= s, i.e. where the
@@ -44,4 +46,40 @@ void ms_scene_frame_apply(float *tri, const double *tri_d, size_t n, const doubl
 void ms_scene_frame_point(const double p[3], const double origin[3], float out[3])
 {
     for (int a = 0; a < 3; a++) out[a] = (float)(p[a] - origin[a]);
+}
+
+/* ms_scene_localize: the same frame for a scene built in world floats (microshadow.h). */
+static void shift3(ms_vec3 *v, const double d[3])
+{
+    v->x = (float)((double)v->x + d[0]);
+    v->y = (float)((double)v->y + d[1]);
+    v->z = (float)((double)v->z + d[2]);
+}
+
+int ms_scene_localize(ms_scene *s)
+{
+    if (!s || !s->tri || !s->n_tris) return 0;   /* procedural scenes are generated about the origin */
+    const size_t n = 9 * s->n_tris;
+    double *w = malloc(n * sizeof *w);
+    if (!w) return -1;
+    for (size_t i = 0; i < n; i++) w[i] = (double)s->tri[i] + s->origin[i % 3];
+    double o[3];
+    ms_scene_frame_origin(w, s->n_tris, o);
+    const double d[3] = { s->origin[0] - o[0], s->origin[1] - o[1], s->origin[2] - o[2] };
+    if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) {
+        /* exact for the triangles: a float minus a multiple of a power of two above its spacing */
+        for (size_t i = 0; i < n; i++) s->tri[i] = (float)(w[i] - o[i % 3]);
+        shift3(&s->camera.eye, d);
+        shift3(&s->camera.target, d);
+        ms_light *l = s->n_lights && s->lights ? s->lights : &s->light;
+        const size_t nl = s->n_lights && s->lights ? s->n_lights : 1;
+        for (size_t i = 0; i < nl; i++) {
+            shift3(&l[i].corner, d);
+            if (l[i].shape == MS_LIGHT_SPHERE) shift3(&l[i].center, d);
+        }
+        if (s->n_lights && s->lights) s->light = s->lights[0];
+        for (int a = 0; a < 3; a++) s->origin[a] = o[a];
+    }
+    free(w);
+    return 0;
 }
