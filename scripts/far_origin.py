@@ -90,29 +90,38 @@ def read_pfm(path):
 
 
 def differing(a, b, tol=0.0):
+    """Pixels whose V or S differ (a, b: (V, S) pairs), as "V/S" counts."""
     if a is None or b is None:
         return None
-    return sum(1 for x, y in zip(a, b) if abs(x - y) > tol)
+    nv = sum(1 for x, y in zip(a[0], b[0]) if abs(x - y) > tol)
+    ns = sum(1 for x, y in zip(a[1], b[1]) if abs(x - y) > tol)
+    return "%d/%d" % (nv, ns)
 
 
 def bench(args):
-    bins = []
+    offsets = [float(x) for x in args.offsets.split(",")]
+    bins, only = [], {}
     for spec in args.bin or ["new=build/microshadow"]:
         n, _, p = spec.partition("=")
+        p, _, at = p.partition("@")   # NAME=PATH@0,1e4: that binary at those offsets only
         bins.append((n, p))
-    offsets = [float(x) for x in args.offsets.split(",")]
+        only[n] = [float(x) for x in at.split(",")] if at else offsets
     methods = args.methods.split(",") if args.methods else METHODS
     work = args.work or tempfile.mkdtemp(prefix="far-origin-")
     scenes = {d: translate(args.scene, d, os.path.join(work, "d%g" % d)) for d in offsets}
-    res = {}   # (bin, method, d) -> (seconds list or None, V)
-    for d in offsets:
-        for m in methods:
-            for rep in range(args.repeat):
+    res = {}   # (bin, method, d) -> (seconds list or None, (V, S))
+    # Method by method, each repetition running every offset and binary in turn: runs compared with each
+    # other are minutes apart at most, so that a load on a shared machine falls on both alike.
+    for m in methods:
+        for rep in range(args.repeat):
+            for d in offsets:
                 for bn, bp in bins:
+                    if d not in only[bn]:
+                        continue
                     out = os.path.join(work, "%s.%s.%g" % (bn, m, d))
                     cmd = [bp, scenes[d], "--method", m, "--width", str(args.size), "--height", str(args.size),
                            "--samples", str(args.samples), "--threads", str(args.threads), "--quiet",
-                           "--vis", out + ".vis.pfm", "--stats", out + ".json"]
+                           "--vis", out + ".vis.pfm", "--shadow", out + ".shadow.pfm", "--stats", out + ".json"]
                     key = (bn, m, d)
                     secs, vis = res.get(key, ([], None))
                     try:
@@ -123,38 +132,40 @@ def bench(args):
                         else:
                             with open(out + ".json") as f:
                                 secs.append(json.load(f)["shadow_s"])
-                            vis = read_pfm(out + ".vis.pfm")
+                            vis = (read_pfm(out + ".vis.pfm"), read_pfm(out + ".shadow.pfm"))
                     except subprocess.TimeoutExpired:
                         secs.append(None)
                     res[key] = (secs, vis)
                     print("%s %s d=%g: %s" % (bn, m, d, secs[-1]), file=sys.stderr, flush=True)
 
     def cell(bn, m, d):
+        if (bn, m, d) not in res:
+            return "-"
         secs, vis = res[(bn, m, d)]
         if any(s is None for s in secs):
             t = "> %g s" % args.timeout
         else:
             t = " / ".join("%.3g" % s for s in secs) + " s"
-        if d != offsets[0]:
+        if d != offsets[0] and (bn, m, offsets[0]) in res:
             n0 = differing(vis, res[(bn, m, offsets[0])][1])
             t += " (%s)" % ("-" if n0 is None else n0)
         return t
 
-    print("\nShadow seconds (--stats shadow_s), %dx%d, %d samples, %d threads; in brackets: pixels whose V differs "
+    print("\nShadow seconds (--stats shadow_s), %dx%d, %d samples, %d threads; in brackets: pixels whose V / S differ "
           "from the same binary's image at offset %g.\n" % (args.size, args.size, args.samples, args.threads, offsets[0]))
     for bn, _ in bins:
         print("**%s**\n" % bn)
         print("| d | " + " | ".join(methods) + " |")
         print("|---" * (len(methods) + 1) + "|")
-        for d in offsets:
+        for d in only[bn]:
             print("| %g | " % d + " | ".join(cell(bn, m, d) for m in methods) + " |")
         if "raytrace" in methods:
             row = []
-            for d in offsets:
+            for d in only[bn]:
                 ref = res[(bn, "raytrace", d)][1]
                 row.append("%g: " % d + ", ".join("%s %s" % (m, differing(res[(bn, m, d)][1], ref)) for m in methods
                                                  if m != "raytrace"))
-            print("\nPixels whose V differs from raytrace's at the same offset: " + "; ".join(row))
+            print("\nPixels whose V / S differ from raytrace's at the same offset: " + "; ".join(row))
         print()
     if not args.work:
         shutil.rmtree(work)

@@ -11,12 +11,14 @@
 #include <stdlib.h>
 
 /* The origin: per axis, the centre c of the bounds rounded to a multiple of s, the smallest power of two
- * not below the half-extent e (the largest over the axes); zero on an axis where |c| <= s, i.e. where the
- * scene already lies about the origin (centring would win at most two bits, and every scene that does not
- * lie far out keeps its floats bit for bit). Then every local coordinate is below 4e in magnitude
- * (|x| <= |c| + e <= 2s, or |x - o| <= e + s/2), whatever the distance. A multiple of a power of two
- * >= the spacing of the floats near the scene makes world -> local exact for float positions near the
- * geometry (ms_visibility_points) and local -> world exact in double. */
+ * not below the half-extent e (the largest over the axes); zero on an axis where |c| <= 16 s, i.e. where
+ * the scene lies within 16 of its sizes of the origin: there centring would win at most 5 bits and the
+ * bounds derived from coordinates are at most 2^-12 of the scene (ray_triangle.h), below a fine mesh's
+ * triangles, while a scene placed near the origin keeps its world coordinates (and its floats bit for bit).
+ * Then every local coordinate is below 34e in magnitude (|x| <= |c| + e <= 17s, or |x - o| <= e + s/2),
+ * whatever the distance. A multiple of a power of two >= the spacing of the floats near the scene makes
+ * world -> local exact for float positions near the geometry (ms_visibility_points) and local -> world
+ * exact in double. */
 void ms_scene_frame_origin(const double *tri_d, size_t n, double origin[3])
 {
     double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
@@ -33,7 +35,7 @@ void ms_scene_frame_origin(const double *tri_d, size_t n, double origin[3])
     const double s = ldexp(1.0, ex - 1) == e ? e : ldexp(1.0, ex);
     for (int a = 0; a < 3; a++) {
         const double c = 0.5 * (lo[a] + hi[a]);
-        if (fabs(c) > s) origin[a] = s * nearbyint(c / s);
+        if (fabs(c) > 16.0 * s) origin[a] = s * nearbyint(c / s);
     }
 }
 
