@@ -208,7 +208,16 @@ typedef struct ms_procedural {
 } ms_procedural;
 
 /* A triangle soup: tri[9*i .. 9*i+8] are the three vertices of triangle i. With a procedural source, tri is
- * NULL and n_tris counts the triangles it generates. */
+ * NULL and n_tris counts the triangles it generates.
+ * The scene's frame (docs/design.md, "The scene's frame"): every position of an ms_scene - tri, the camera's
+ * eye and target, the lights' corners and centres, and so ms_scene_lights and ms_accel_lights - is local,
+ * world = local + origin (in double). ms_scene_load puts a scene that lies far from the world's origin into a
+ * frame centred on its geometry, subtracting in double before rounding to float, so that a model 100 km out
+ * keeps the detail and the speed it has at home; a scene within 16 of its sizes of the origin keeps origin = 0
+ * and its floats as they were. Scenes built by the caller (zeroed origin; ms_scene_localize moves them), the
+ * built-in and the procedural scenes are in world coordinates (origin 0). Frames are images and need no conversion; ms_visibility_points takes world
+ * positions (converted with the origin of the accel's scene, ms_accel_origin); ms_lightmap.position is in
+ * the scene's frame (add origin for world coordinates). Directions (normals, edges, up) are the same in both. */
 typedef struct ms_scene {
     float *tri;
     size_t n_tris;
@@ -243,6 +252,9 @@ typedef struct ms_scene {
      * triangle i's three vertices, NaN where its mesh has none (glTF TANGENT, else MikkTSpace for primitives
      * with a normal map; w: the bitangent is w n x t). */
     float *tri_tangent;
+    /* The world position of the local frame's origin (see above): 0, 0, 0 unless ms_scene_load moved a
+     * distant scene. */
+    double origin[3];
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX
@@ -333,6 +345,12 @@ typedef struct ms_scene_load_options {
 MS_API int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light. */
 MS_API int ms_scene_default(ms_scene *out);
+/* Puts a scene built in world coordinates (tri, camera, lights as floats; origin usually 0) into the frame
+ * ms_scene_load would choose for it (see ms_scene): tri, the camera's eye and target and the lights' corners
+ * and centres moved, origin set. The detail a float lost far from the origin is not recovered, but every
+ * method then works at the scene's own magnitudes (bounds as tight, time as at home). Nothing changes for a
+ * scene about the origin, a procedural scene, or one already in its frame. 0, or -1 when out of memory. */
+MS_API int ms_scene_localize(ms_scene *s);
 /* Checks camera, light and geometry for NaN/inf and degenerate cases. `what` names the source. */
 MS_API int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen);
 MS_API void ms_scene_free(ms_scene *s);
@@ -623,12 +641,16 @@ MS_API size_t ms_accel_triangles(const ms_accel *a);
 /* The lights of the scene the accel was built from (its own copies, texels included: valid until
  * ms_accel_free); *n gets their number (ms_scene_lights of that scene). */
 MS_API const ms_light *ms_accel_lights(const ms_accel *a, size_t *n);
+/* The origin of the accel's scene's frame (ms_scene.origin) into origin[3]: world = local + origin. The lights
+ * of ms_accel_lights are local; the positions given to ms_visibility_points are world coordinates. */
+MS_API void ms_accel_origin(const ms_accel *a, double origin[3]);
 
 #define MS_NO_TRIANGLE UINT32_MAX
 
 typedef struct ms_points {
     size_t n;
-    const float *position;   /* 3n floats */
+    const float *position;   /* 3n floats, world coordinates (moved into the scene's frame inside: world - origin
+                              * in double, exact for points near the geometry; ms_accel_origin) */
     const float *normal;     /* 3n floats: the side of each receiver (need not be unit length, not zero) */
     const uint32_t *triangle;/* n or NULL: index of the scene triangle (ms_scene.tri) each point lies on,
                               * which never occludes it, or MS_NO_TRIANGLE; NULL: none. Without it a point
@@ -689,7 +711,8 @@ typedef struct ms_lightmap {
      * exposure and stats as for frames (visible_pixels: texels on triangles). The ms_output writers and
      * ms_exr_write_stream take &lightmap.frame. */
     ms_frame frame;
-    float *position, *normal;  /* 3 floats per texel: where it was evaluated; NaN off the triangles */
+    float *position, *normal;  /* 3 floats per texel: where it was evaluated, in the scene's frame (world =
+                                * position + ms_scene.origin); NaN off the triangles */
     uint32_t *triangle;        /* per texel: the scene triangle, MS_NO_TRIANGLE off the triangles */
     float *uv;                 /* 6 floats per scene triangle: the UVs baked into, in [0,1]^2; NaN if none */
     size_t n_tris;

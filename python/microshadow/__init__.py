@@ -115,7 +115,8 @@ _Light = _mirror("ms_light", [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _
 _Scene = _mirror("ms_scene", [("tri", ctypes.POINTER(_f)), ("n_tris", _size), ("camera", _Camera), ("light", _Light),
                               ("samples", ctypes.c_int), ("load_s", ctypes.c_double),
                               ("tri_mesh", ctypes.POINTER(ctypes.c_uint32)), ("tri_uv", ctypes.POINTER(_f) * MAX_UV_SETS),
-                              ("n_meshes", _size), ("lights", ctypes.POINTER(_Light)), ("n_lights", _size)])
+                              ("n_meshes", _size), ("lights", ctypes.POINTER(_Light)), ("n_lights", _size),
+                              ("origin", ctypes.c_double * 3)])
 _Stats = _mirror("ms_stats", [("triangles", _size)] +
                  [(n, ctypes.c_double) for n in ("load_s", "build_s", "setup_s", "primary_s", "shadow_s", "total_s")] +
                  [(n, ctypes.c_int) for n in ("samples", "threads", "width", "height", "samples_per_pixel")] +
@@ -303,7 +304,8 @@ def _light_struct(light, arg="light"):
 
 class Scene:
     """A loaded scene (ms_scene). .triangles is an (n, 3, 3) float32 copy; .lights a list of dicts (the
-    first is also .light)."""
+    first is also .light). Both are in the scene's frame: world = local + .origin (docs/design.md, "The scene's
+    frame"; (0, 0, 0) unless the scene lies far from the origin). visibility_points takes world positions."""
 
     def __init__(self, _s):
         self._s = _s
@@ -316,6 +318,11 @@ class Scene:
     @property
     def n_triangles(self):
         return int(self._s.n_tris)
+
+    @property
+    def origin(self):
+        """The world position of the scene's local frame (a float64 array of 3)."""
+        return np.array(list(self._s.origin), dtype=np.float64)
 
     @property
     def triangles(self):
@@ -517,7 +524,7 @@ def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed
          dilate=4, padding=2, accel=None, progress=None):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
     (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off
-    the triangles), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked
+    the triangles; position in the scene's frame: add scene.origin for world coordinates), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked
     into, lights: one dict per light with its vis, shadow and front, and counts and timings. uv: the UV
     set (0..3) or None for xatlas everywhere; dilate 0: none; progress: fn(fraction) -> truthy to cancel
     (Error with status 3)."""

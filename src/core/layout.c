@@ -24,7 +24,7 @@ static const layout_row rows[] = {
     FIELD(ms_light, center), FIELD(ms_light, radius),
     STRUCT(ms_scene), FIELD(ms_scene, tri), FIELD(ms_scene, n_tris), FIELD(ms_scene, camera), FIELD(ms_scene, light),
     FIELD(ms_scene, samples), FIELD(ms_scene, load_s), FIELD(ms_scene, tri_mesh), FIELD(ms_scene, tri_uv),
-    FIELD(ms_scene, n_meshes), FIELD(ms_scene, lights), FIELD(ms_scene, n_lights),
+    FIELD(ms_scene, n_meshes), FIELD(ms_scene, lights), FIELD(ms_scene, n_lights), FIELD(ms_scene, origin),
     STRUCT(ms_scene_load_options), FIELD(ms_scene_load_options, allow_outside_paths),
     STRUCT(ms_render_options), FIELD(ms_render_options, method), FIELD(ms_render_options, pattern),
     FIELD(ms_render_options, samples), FIELD(ms_render_options, width), FIELD(ms_render_options, height),

@@ -3,6 +3,7 @@
  * through ms_visibility_points (so every method bakes, on the frames' sample patterns keyed by texel),
  * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
 #include "microshadow.h"
+#include "points.h"
 #include "lightmap_unwrap.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -354,7 +355,7 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
             ms_stats one;
             memset(&one, 0, sizeof one);
             bp.light = l;
-            st = ms_visibility_points(accel, &lights[l], &pts, &po, vl + l * m, sl + l * m, fl + l * m, &one, err, errlen);
+            st = ms_visibility_points_local(accel, &lights[l], &pts, &po, vl + l * m, sl + l * m, fl + l * m, &one, err, errlen);
             if (!st) add_stats(&sum, &one, l == 0);
         }
         if (!st) {

@@ -5,6 +5,7 @@
  * visible masks, V and S from ms_resolve_vs. A point's sample pattern is keyed like a pixel, so the same
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"
+#include "points.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
 #include "light/light_frame.h"
@@ -194,9 +195,34 @@ static void make_query(const ms_accel *a, const ms_points *pts, size_t i, ms_sha
     else { q->px = (uint32_t)i; q->py = (uint32_t)((uint64_t)i >> 32); }
 }
 
+void ms_accel_origin(const ms_accel *a, double origin[3])
+{
+    for (int c = 0; c < 3; c++) origin[c] = a ? a->view.origin[c] : 0.0;
+}
+
 ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
-                               const ms_points_options *opt_in, float *vis, float *shadow, uint16_t *front_out,
+                               const ms_points_options *opt, float *vis, float *shadow, uint16_t *front_out,
                                ms_stats *stats, char *err, size_t errlen)
+{
+    /* World positions into the scene's frame (scene_frame.c): subtracted in double, which is exact for points
+     * near the geometry (the origin is a multiple of a power of two above the floats' spacing there). */
+    if (!a || !pts || !pts->position || !pts->n ||
+        (a->view.origin[0] == 0.0 && a->view.origin[1] == 0.0 && a->view.origin[2] == 0.0))
+        return ms_visibility_points_local(a, light, pts, opt, vis, shadow, front_out, stats, err, errlen);
+    if (stats) memset(stats, 0, sizeof *stats);
+    float *local = malloc(pts->n * 3 * sizeof *local);
+    if (!local) { snprintf(err, errlen, "out of memory for %zu points", pts->n); return MS_ERR_NO_MEMORY; }
+    for (size_t i = 0; i < 3 * pts->n; i++) local[i] = (float)((double)pts->position[i] - a->view.origin[i % 3]);
+    ms_points lp = *pts;
+    lp.position = local;
+    const ms_status st = ms_visibility_points_local(a, light, &lp, opt, vis, shadow, front_out, stats, err, errlen);
+    free(local);
+    return st;
+}
+
+ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, const ms_points *pts,
+                                     const ms_points_options *opt_in, float *vis, float *shadow, uint16_t *front_out,
+                                     ms_stats *stats, char *err, size_t errlen)
 {
     const double t_start = omp_get_wtime();
     ms_points_options zero;

@@ -188,6 +188,7 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
         else if (pr->type == cgltf_primitive_type_triangle_strip) { corner[0] = t; corner[1] = t + 1 + (t & 1); corner[2] = t + 2 - (t & 1); }
         else { corner[0] = t + 1; corner[1] = t + 2; corner[2] = 0; }
         float v[9], uv[MS_SOUP_UV_SETS][6], nv[9];
+        double vd[9];
         const float *uvp[MS_SOUP_UV_SETS] = { NULL };
         for (int k = 0; k < 3; k++) {
             size_t idx = ix ? cgltf_accessor_read_index(ix, corner[k]) : corner[k];
@@ -205,6 +206,10 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
             float p[3] = { 0, 0, 0 };
             cgltf_accessor_read_float(pos, idx, p, 3);
             for (int r = 0; r < 3; r++) v[3 * k + r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+            /* in double too: a node translation far from the origin (cgltf keeps it as a float) then leaves the
+             * mesh's own detail to the scene's frame (scene_frame.c) instead of rounding it away here */
+            for (int r = 0; r < 3; r++)
+                vd[3 * k + r] = (double)m[r] * p[0] + (double)m[4 + r] * p[1] + (double)m[8 + r] * p[2] + (double)m[12 + r];
             if (nrm) {
                 float q[3] = { 0, 0, 0 };
                 cgltf_accessor_read_float(nrm, idx, q, 3);
@@ -217,7 +222,7 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
                 uvp[st] = uv[st];
             }
         }
-        if (ms_soup_push_full(soup, v, uvp, material, nrm ? nv : NULL)) {
+        if (ms_soup_push_d(soup, v, vd, uvp, material, nrm ? nv : NULL)) {
             snprintf(err, errlen, "%s: out of memory", path);
             free(t12);
             return -1;

@@ -17,11 +17,20 @@ int ms_soup_push_uv(ms_tri_soup *soup, const float v[9], const float *const uv[M
 int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
                       uint32_t material, const float *normal9)
 {
+    return ms_soup_push_d(soup, v, NULL, uv, material, normal9);
+}
+
+int ms_soup_push_d(ms_tri_soup *soup, const float v[9], const double *vd, const float *const uv[MS_SOUP_UV_SETS],
+                   uint32_t material, const float *normal9)
+{
     if (soup->n == soup->cap) {
         size_t cap = soup->cap ? 2 * soup->cap : 1024;
         float *t = realloc(soup->tri, cap * 9 * sizeof(float));
         if (!t) return -1;
         soup->tri = t;
+        double *td = realloc(soup->tri_d, cap * 9 * sizeof(double));
+        if (!td) return -1;
+        soup->tri_d = td;
         uint32_t *m = realloc(soup->mesh, cap * sizeof *m);
         if (!m) return -1;
         soup->mesh = m;
@@ -69,6 +78,7 @@ int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv
         else for (int i = 0; i < 6; i++) soup->uv[s][6 * soup->n + i] = NAN;
     }
     memcpy(soup->tri + 9 * soup->n, v, 9 * sizeof(float));
+    for (int i = 0; i < 9; i++) soup->tri_d[9 * soup->n + i] = vd ? vd[i] : (double)v[i];
     soup->mesh[soup->n] = soup->cur_mesh;
     soup->n++;
     return 0;
@@ -79,6 +89,7 @@ int ms_soup_push(ms_tri_soup *soup, const float v[9]) { return ms_soup_push_uv(s
 void ms_soup_free(ms_tri_soup *soup)
 {
     free(soup->tri);
+    free(soup->tri_d);
     free(soup->mesh);
     for (int s = 0; s < MS_SOUP_UV_SETS; s++) free(soup->uv[s]);
     free(soup->material);

@@ -82,6 +82,7 @@ static char *join_continuations(const char *buf, size_t len, int *oom)
 
 typedef struct obj_state {
     float *v, *vt, *vn;
+    double *vd;   /* v in double (the scene's frame is subtracted from these: scene_frame.c) */
     uint64_t nv, nvt, nvn, tv, tvt, tvn;   /* defined so far; in the file */
     int warned_cstype;
 } obj_state;
@@ -98,6 +99,15 @@ static int parse_reals(const char **p, const char *e, float *out, int max, int *
         (*k)++;
     }
     return 0;
+}
+
+/* The same numbers in double (tokens parse_reals accepted). */
+static void parse_reals_d(const char *p, const char *e, double *out, int max)
+{
+    const char *tb;
+    size_t tn;
+    for (int k = 0; k < max && ms_text_token(&p, e, &tb, &tn); k++)
+        if (ms_parse_real_d(tb, tn, &out[k])) out[k] = 0.0;
 }
 
 /* One face: its triangles into the soup. */
@@ -148,16 +158,18 @@ static int obj_face(obj_state *s, const char *p, const char *e, const char *path
     const int nt = ms_triangulate(pos, n, tri);
     for (int t = 0; t < nt; t++) {
         float v[9], uv[6], nn[9];
+        double vd[9];
         int has_uv = 1, has_n = 1;
         for (int k = 0; k < 3; k++) {
             const int c = tri[t][k];
             memcpy(v + 3 * k, pos + 3 * c, 3 * sizeof(float));
+            memcpy(vd + 3 * k, s->vd + 3 * vi[c], 3 * sizeof(double));
             if (ti[c] < 0) has_uv = 0;
             else memcpy(uv + 2 * k, s->vt + 2 * ti[c], 2 * sizeof(float));
             if (ni[c] < 0) has_n = 0;
             else memcpy(nn + 3 * k, s->vn + 3 * ni[c], 3 * sizeof(float));
         }
-        if (ms_emit_tri(em, v, has_uv ? uv : NULL, has_n ? nn : NULL, material, err, errlen)) return -1;
+        if (ms_emit_tri(em, v, vd, has_uv ? uv : NULL, has_n ? nn : NULL, material, err, errlen)) return -1;
     }
     return 0;
 }
@@ -173,9 +185,10 @@ static int obj_read(const char *buf, size_t len, const char *path, ms_tri_soup *
         if (pass == 1) {
             /* Every such line takes at least 2 bytes: at most 6 floats per byte of file. */
             s->v = malloc((s->tv ? s->tv : 1) * 3 * sizeof(float));
+            s->vd = malloc((s->tv ? s->tv : 1) * 3 * sizeof(double));
             s->vt = malloc((s->tvt ? s->tvt : 1) * 2 * sizeof(float));
             s->vn = malloc((s->tvn ? s->tvn : 1) * 3 * sizeof(float));
-            if (!s->v || !s->vt || !s->vn) MS_FAIL("%s: out of memory", path);
+            if (!s->v || !s->vd || !s->vt || !s->vn) MS_FAIL("%s: out of memory", path);
         }
         /* Faces before any usemtl have assimp's default material name. */
         uint32_t material = mtl->n ? ms_mtl_find(mtl, "DefaultMaterial") : MS_NO_MATERIAL;
@@ -196,7 +209,9 @@ static int obj_read(const char *buf, size_t len, const char *path, ms_tri_soup *
                 if (pass == 0) { s->tv++; continue; }
                 if (pass == 2) { s->nv++; continue; }
                 float f[7];
+                double fd[4] = { 0, 0, 0, 1 };
                 int k;
+                parse_reals_d(p, ue, fd, 4);
                 if (parse_reals(&p, ue, f, 7, &k))
                     MS_FAIL("%s: line %zu: a vertex coordinate is not a number (malformed)", path, line);
                 if (k != 3 && k != 4 && k != 6 && k != 7)
@@ -204,7 +219,9 @@ static int obj_read(const char *buf, size_t len, const char *path, ms_tri_soup *
                 if (k == 4) {
                     if (f[3] == 0.0f) MS_FAIL("%s: line %zu: a homogeneous vertex with w = 0 (malformed)", path, line);
                     for (int i = 0; i < 3; i++) f[i] /= f[3];
+                    for (int i = 0; i < 3; i++) fd[i] /= fd[3];
                 }
+                memcpy(s->vd + 3 * s->nv, fd, 3 * sizeof(double));
                 memcpy(s->v + 3 * s->nv++, f, 3 * sizeof(float));
             } else if (ms_tok_is(tb, tn, "vt")) {
                 if (pass == 0) { s->tvt++; continue; }
@@ -268,6 +285,7 @@ int ms_mesh_obj(const char *buf, size_t len, const char *path, ms_tri_soup *soup
     int rc = obj_read(joined ? joined : buf, len, path, soup, &mtl, &s, &em, err, errlen);
     *added = em.added;
     free(s.v);
+    free(s.vd);
     free(s.vt);
     free(s.vn);
     free(joined);

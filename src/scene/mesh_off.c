@@ -80,20 +80,23 @@ int ms_mesh_off(const char *buf, size_t len, const char *path, ms_tri_soup *soup
                 (long long)cnt[0], (long long)cnt[1], rest);
     const size_t nv = (size_t)cnt[0];
     float *pos = malloc((nv ? nv : 1) * 3 * sizeof(float));
+    double *posd = malloc((nv ? nv : 1) * 3 * sizeof(double));   /* pos in double (scene_frame.c) */
     float *nor = nrm ? malloc((nv ? nv : 1) * 3 * sizeof(float)) : NULL;
     float *uvs = st ? malloc((nv ? nv : 1) * 2 * sizeof(float)) : NULL;
     int rc = -1;
-    if (!pos || (nrm && !nor) || (st && !uvs)) { snprintf(err, errlen, "%s: out of memory", path); goto done; }
+    if (!pos || !posd || (nrm && !nor) || (st && !uvs)) { snprintf(err, errlen, "%s: out of memory", path); goto done; }
 #define OFAIL(...) do { snprintf(err, errlen, __VA_ARGS__); goto done; } while (0)
     for (size_t v = 0; v < nv; v++) {
         if (!data_line(&c, &b, &e)) OFAIL("%s: the file ends after %zu of %zu vertices (malformed)", path, v, nv);
         float f[16];
+        double fd[4] = { 0, 0, 0, 1 };
         int n = 0;
         p = b;
         while (ms_text_token(&p, e, &tb, &tn)) {
             float x;
             if (ms_parse_real_f(tb, tn, &x)) OFAIL("%s: line %zu: '%.*s' is not a number (malformed)", path, c.line, MS_TOKQ(tn), tb);
             if (n < 16) f[n] = x;
+            if (n < 4 && ms_parse_real_d(tb, tn, &fd[n])) fd[n] = x;
             n++;
         }
         const int want = ncoord + 3 * nrm + 2 * st;
@@ -101,12 +104,15 @@ int ms_mesh_off(const char *buf, size_t len, const char *path, ms_tri_soup *soup
             OFAIL("%s: line %zu: a vertex of %d numbers where %d%s are expected (malformed)", path, c.line, n, want,
                   col ? " and a colour" : "");
         float xyz[3] = { 0, 0, 0 };
-        for (int i = 0; i < dim; i++) xyz[i] = f[i];
+        double xyzd[3] = { 0, 0, 0 };
+        for (int i = 0; i < dim; i++) { xyz[i] = f[i]; xyzd[i] = fd[i]; }
         if (hom) {
             if (f[dim] == 0.0f) OFAIL("%s: line %zu: a homogeneous vertex with w = 0 (malformed)", path, c.line);
             for (int i = 0; i < 3; i++) xyz[i] /= f[dim];
+            for (int i = 0; i < 3; i++) xyzd[i] /= fd[dim];
         }
         memcpy(pos + 3 * v, xyz, sizeof xyz);
+        memcpy(posd + 3 * v, xyzd, sizeof xyzd);
         if (nrm) memcpy(nor + 3 * v, f + ncoord, 3 * sizeof(float));
         if (st) memcpy(uvs + 2 * v, f + (n - 2 < 16 ? n - 2 : 14), 2 * sizeof(float));
     }
@@ -134,19 +140,22 @@ int ms_mesh_off(const char *buf, size_t len, const char *path, ms_tri_soup *soup
         const int nt = ms_triangulate(fp, (int)n, tri);
         for (int t = 0; t < nt; t++) {
             float v[9], uv[6], nn[9];
+            double vd[9];
             for (int q = 0; q < 3; q++) {
                 const size_t vi = (size_t)idx[tri[t][q]];
                 memcpy(v + 3 * q, pos + 3 * vi, 3 * sizeof(float));
+                memcpy(vd + 3 * q, posd + 3 * vi, 3 * sizeof(double));
                 if (nrm) memcpy(nn + 3 * q, nor + 3 * vi, 3 * sizeof(float));
                 if (st) memcpy(uv + 2 * q, uvs + 2 * vi, 2 * sizeof(float));
             }
-            if (ms_emit_tri(&em, v, st ? uv : NULL, nrm ? nn : NULL, MS_NO_MATERIAL, err, errlen)) { *added = em.added; goto done; }
+            if (ms_emit_tri(&em, v, vd, st ? uv : NULL, nrm ? nn : NULL, MS_NO_MATERIAL, err, errlen)) { *added = em.added; goto done; }
         }
     }
     *added = em.added;
     rc = 0;
 done:
     free(pos);
+    free(posd);
     free(nor);
     free(uvs);
     return rc;

@@ -44,6 +44,7 @@ typedef struct ply_body {
     const unsigned char *p, *end;
     int fmt;
     const char *path;
+    double precise;   /* the last value read, ASCII reals in double (positions: scene_frame.c) */
 } ply_body;
 
 /* One value: integers into *iv (and *dv), reals into *dv; -1 when truncated or malformed. */
@@ -61,11 +62,17 @@ static int read_value(ply_body *r, ply_type t, int64_t *iv, double *dv)
             float f;
             if (ms_parse_real_f(tb, tn, &f)) return -1;
             *dv = f;
+            if (ms_parse_real_d(tb, tn, &r->precise)) r->precise = f;
             return 0;
         }
-        if (t == T_F64) return ms_parse_real_d(tb, tn, dv);
+        if (t == T_F64) {
+            if (ms_parse_real_d(tb, tn, dv)) return -1;
+            r->precise = *dv;
+            return 0;
+        }
         if (ms_parse_int(tb, tn, iv)) return -1;
         *dv = (double)*iv;
+        r->precise = *dv;
         return 0;
     }
     const size_t n = (size_t)ply_size[t];
@@ -187,6 +194,7 @@ static int header(const char *buf, size_t len, const char *path, ply_elem *el, i
 
 typedef struct ply_data {
     float *pos, *nrm, *uv;
+    double *posd;           /* pos as exact as the file gives it (scene_frame.c) */
     uint64_t nv;
     uint32_t *idx;          /* face lists and strips as read: [count, i0, i1, ...] runs */
     size_t nidx, cap;
@@ -209,7 +217,7 @@ static int push_idx(ply_data *d, uint32_t v)
 static int body(const char *buf, size_t len, size_t off, const char *path, const ply_elem *el, int ne, int fmt,
                 ply_data *d, char *err, size_t errlen)
 {
-    ply_body r = { (const unsigned char *)buf + off, (const unsigned char *)buf + len, fmt, path };
+    ply_body r = { (const unsigned char *)buf + off, (const unsigned char *)buf + len, fmt, path, 0.0 };
     const uint64_t bytes = (uint64_t)(len - off);
     /* Counts against the bytes present: every instance takes at least its smallest size. */
     for (int i = 0; i < ne; i++) {
@@ -233,9 +241,10 @@ static int body(const char *buf, size_t len, size_t off, const char *path, const
             d->nv = E->count;
             const size_t n = E->count ? (size_t)E->count : 1;
             d->pos = malloc(n * 3 * sizeof(float));
+            d->posd = malloc(n * 3 * sizeof(double));
             if (d->has_n) d->nrm = malloc(n * 3 * sizeof(float));
             if (d->has_uv) d->uv = malloc(n * 2 * sizeof(float));
-            if (!d->pos || (d->has_n && !d->nrm) || (d->has_uv && !d->uv)) MS_FAIL("%s: out of memory", path);
+            if (!d->pos || !d->posd || (d->has_n && !d->nrm) || (d->has_uv && !d->uv)) MS_FAIL("%s: out of memory", path);
         }
         for (uint64_t k = 0; k < E->count; k++) {
             for (int j = 0; j < E->np; j++) {
@@ -247,7 +256,10 @@ static int body(const char *buf, size_t len, size_t off, const char *path, const
                         MS_FAIL("%s: %s %llu: truncated or malformed value", path, E->name, (unsigned long long)k);
                     const float f = (float)dv;
                     switch (pr->role) {
-                    case R_X: case R_Y: case R_Z: d->pos[3 * k + (size_t)(pr->role - R_X)] = f; break;
+                    case R_X: case R_Y: case R_Z:
+                        d->pos[3 * k + (size_t)(pr->role - R_X)] = f;
+                        d->posd[3 * k + (size_t)(pr->role - R_X)] = r.fmt == PLY_ASCII ? r.precise : dv;
+                        break;
                     case R_NX: case R_NY: case R_NZ: if (d->has_n) d->nrm[3 * k + (size_t)(pr->role - R_NX)] = f; break;
                     case R_U: case R_V: if (d->has_uv) d->uv[2 * k + (size_t)(pr->role - R_U)] = f; break;
                     default: break;
@@ -304,8 +316,10 @@ static int corner(const ply_data *d, uint32_t v, float *p, float *uv, float *n)
 static int emit(const ply_data *d, const uint32_t *c, ms_emit *em, char *err, size_t errlen)
 {
     float v[9], uv[6], n[9];
+    double vd[9];
     for (int k = 0; k < 3; k++) corner(d, c[k], v + 3 * k, uv + 2 * k, n + 3 * k);
-    return ms_emit_tri(em, v, d->has_uv ? uv : NULL, d->has_n ? n : NULL, MS_NO_MATERIAL, err, errlen);
+    for (int k = 0; k < 3; k++) memcpy(vd + 3 * k, d->posd + 3 * (size_t)c[k], 3 * sizeof(double));
+    return ms_emit_tri(em, v, vd, d->has_uv ? uv : NULL, d->has_n ? n : NULL, MS_NO_MATERIAL, err, errlen);
 }
 
 static int triangles(const ply_data *d, const char *path, ms_emit *em, char *err, size_t errlen)
@@ -365,6 +379,7 @@ int ms_mesh_ply(const char *buf, size_t len, const char *path, ms_tri_soup *soup
     }
     free(el);
     free(d.pos);
+    free(d.posd);
     free(d.nrm);
     free(d.uv);
     free(d.idx);

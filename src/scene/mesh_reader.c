@@ -294,8 +294,8 @@ void ms_emit_init(ms_emit *em, ms_tri_soup *soup, size_t len, const char *path)
     em->path = path;
 }
 
-int ms_emit_tri(ms_emit *em, const float v[9], const float *uv6, const float *n9, uint32_t material, char *err,
-                size_t errlen)
+int ms_emit_tri(ms_emit *em, const float v[9], const double *vd, const float *uv6, const float *n9, uint32_t material,
+                char *err, size_t errlen)
 {
     if (em->added == em->max)
         MS_FAIL("%s: the mesh expands to more than %zu triangles (%d per byte of file)", em->path, em->max,
@@ -316,7 +316,9 @@ int ms_emit_tri(ms_emit *em, const float v[9], const float *uv6, const float *n9
         }
     }
     const float *uvp[MS_SOUP_UV_SETS] = { uv6 };
-    if (ms_soup_push_full(em->soup, p, uvp, material, n9 ? nv : NULL)) MS_FAIL("%s: out of memory", em->path);
+    double pd[9];
+    for (int i = 0; i < 9; i++) pd[i] = vd ? vd[i] + 0.0 : (double)p[i];   /* + 0.0: a -0 becomes +0, as p */
+    if (ms_soup_push_d(em->soup, p, pd, uvp, material, n9 ? nv : NULL)) MS_FAIL("%s: out of memory", em->path);
     em->added++;
     return 0;
 }

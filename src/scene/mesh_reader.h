@@ -53,10 +53,11 @@ typedef struct ms_emit {
     const char *path;
 } ms_emit;
 void ms_emit_init(ms_emit *em, ms_tri_soup *soup, size_t len, const char *path);
-/* One triangle: positions (9 floats), UV set 0 (6 floats or NULL), vertex normals (9 or NULL), material.
+/* One triangle: positions (9 floats, and vd: the same 9 parsed in double, or NULL when the floats are
+ * exact), UV set 0 (6 floats or NULL), vertex normals (9 or NULL), material.
  * -1 with one line in err when out of memory or past the triangle limit. */
-int ms_emit_tri(ms_emit *em, const float v[9], const float *uv6, const float *n9, uint32_t material, char *err,
-                size_t errlen);
+int ms_emit_tri(ms_emit *em, const float v[9], const double *vd, const float *uv6, const float *n9, uint32_t material,
+                char *err, size_t errlen);
 
 int ms_mesh_obj(const char *buf, size_t len, const char *path, ms_tri_soup *soup, size_t *added, char *err,
                 size_t errlen);

@@ -48,7 +48,7 @@ static int binary(const unsigned char *b, uint32_t count, const char *path, ms_t
             memcpy(&x[k], &u, 4);
         }
         float n9[9];
-        if (ms_emit_tri(&em, x + 3, NULL, usable_normal(x, n9), MS_NO_MATERIAL, err, errlen)) { *added = em.added; return -1; }
+        if (ms_emit_tri(&em, x + 3, NULL, NULL, usable_normal(x, n9), MS_NO_MATERIAL, err, errlen)) { *added = em.added; return -1; }
     }
     *added = em.added;
     return 0;
@@ -86,6 +86,8 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
         SFAIL("%s: line %zu: expected '%s' (malformed ASCII STL)", path, s.line, w); } while (0)
 #define NUMBER(x) do { if (!tok(&s, &tb, &tn) || ms_parse_real_f(tb, tn, &(x))) \
         SFAIL("%s: line %zu: expected a number (malformed ASCII STL)", path, s.line); } while (0)
+    /* a position: also in double (the scene's frame is subtracted from it: scene_frame.c) */
+#define COORD(x, xd) do { NUMBER(x); if (ms_parse_real_d(tb, tn, &(xd))) (xd) = (x); } while (0)
     for (;;) {
         /* solid NAME: the name is the rest of the line */
         while (s.p < s.end && *s.p != '\n' && *s.p != '\r') s.p++;
@@ -97,6 +99,7 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
             }
             if (!kw(tb, tn, "facet")) SFAIL("%s: line %zu: expected 'facet' or 'endsolid' (malformed ASCII STL)", path, s.line);
             float nrm[3], pos[3 * MS_MAX_POLYGON];
+            double posd[3 * MS_MAX_POLYGON];
             EXPECT("normal");
             NUMBER(nrm[0]); NUMBER(nrm[1]); NUMBER(nrm[2]);
             EXPECT("outer");
@@ -107,7 +110,7 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
                 if (kw(tb, tn, "endloop")) break;
                 if (!kw(tb, tn, "vertex")) SFAIL("%s: line %zu: expected 'vertex' or 'endloop' (malformed ASCII STL)", path, s.line);
                 if (n == MS_MAX_POLYGON) SFAIL("%s: line %zu: a facet of more than %d vertices (over the limit)", path, s.line, MS_MAX_POLYGON);
-                NUMBER(pos[3 * n]); NUMBER(pos[3 * n + 1]); NUMBER(pos[3 * n + 2]);
+                COORD(pos[3 * n], posd[3 * n]); COORD(pos[3 * n + 1], posd[3 * n + 1]); COORD(pos[3 * n + 2], posd[3 * n + 2]);
                 n++;
             }
             EXPECT("endfacet");
@@ -116,8 +119,10 @@ int ms_mesh_stl(const char *buf, size_t len, const char *path, ms_tri_soup *soup
             const int nt = ms_triangulate(pos, n, tri);
             for (int t = 0; t < nt; t++) {
                 float v[9], n9[9];
+                double vd[9];
                 for (int k = 0; k < 3; k++) memcpy(v + 3 * k, pos + 3 * tri[t][k], 3 * sizeof(float));
-                if (ms_emit_tri(&em, v, NULL, usable_normal(nrm, n9), MS_NO_MATERIAL, err, errlen)) { *added = em.added; return -1; }
+                for (int k = 0; k < 3; k++) memcpy(vd + 3 * k, posd + 3 * tri[t][k], 3 * sizeof(double));
+                if (ms_emit_tri(&em, v, vd, NULL, usable_normal(nrm, n9), MS_NO_MATERIAL, err, errlen)) { *added = em.added; return -1; }
             }
         }
         if (!tok(&s, &tb, &tn)) break;

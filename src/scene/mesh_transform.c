@@ -141,9 +141,13 @@ void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m
     const double lin[9] = { m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10] };   /* m without translation */
     for (size_t t = from; t < to; t++) {
         float *v = soup->tri + 9 * t;
+        double *vd = soup->tri_d + 9 * t;
         for (int k = 0; k < 3; k++) {
             const double x = v[3 * k], y = v[3 * k + 1], z = v[3 * k + 2];
             for (int r = 0; r < 3; r++) v[3 * k + r] = (float)(m[4 * r] * x + m[4 * r + 1] * y + m[4 * r + 2] * z + m[4 * r + 3]);
+            /* the double positions stay double: a "translate" of 1e5 keeps the mesh's detail (scene_frame.c) */
+            const double xd = vd[3 * k], yd = vd[3 * k + 1], zd = vd[3 * k + 2];
+            for (int r = 0; r < 3; r++) vd[3 * k + r] = m[4 * r] * xd + m[4 * r + 1] * yd + m[4 * r + 2] * zd + m[4 * r + 3];
         }
         float *nv = soup->normal ? soup->normal + 9 * t : NULL;
         if (nv)
@@ -159,6 +163,8 @@ void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m
         if (!flip) continue;
         float tmp[4];
         memcpy(tmp, v + 3, 3 * sizeof *tmp); memcpy(v + 3, v + 6, 3 * sizeof *tmp); memcpy(v + 6, tmp, 3 * sizeof *tmp);
+        double tmpd[3];
+        memcpy(tmpd, vd + 3, sizeof tmpd); memcpy(vd + 3, vd + 6, sizeof tmpd); memcpy(vd + 6, tmpd, sizeof tmpd);
         if (nv) { memcpy(tmp, nv + 3, 3 * sizeof *tmp); memcpy(nv + 3, nv + 6, 3 * sizeof *tmp); memcpy(nv + 6, tmp, 3 * sizeof *tmp); }
         if (tv) { memcpy(tmp, tv + 4, sizeof tmp); memcpy(tv + 4, tv + 8, sizeof tmp); memcpy(tv + 8, tmp, sizeof tmp); }
         for (int s = 0; s < MS_SOUP_UV_SETS; s++) {
@@ -173,13 +179,15 @@ int ms_soup_copy_range(ms_tri_soup *soup, size_t from, size_t to)
 {
     for (size_t t = from; t < to; t++) {
         float v[9], n[9], uv[MS_SOUP_UV_SETS][6];
+        double vd[9];
         const float *uvp[MS_SOUP_UV_SETS] = { NULL };
         memcpy(v, soup->tri + 9 * t, sizeof v);
+        memcpy(vd, soup->tri_d + 9 * t, sizeof vd);
         if (soup->normal) memcpy(n, soup->normal + 9 * t, sizeof n);
         for (int s = 0; s < MS_SOUP_UV_SETS; s++)
             if (soup->uv[s]) { memcpy(uv[s], soup->uv[s] + 6 * t, sizeof uv[s]); uvp[s] = uv[s]; }
         const uint32_t mat = soup->material ? soup->material[t] : MS_NO_MATERIAL;
-        if (ms_soup_push_full(soup, v, uvp, mat, soup->normal ? n : NULL)) return -1;
+        if (ms_soup_push_d(soup, v, vd, uvp, mat, soup->normal ? n : NULL)) return -1;
         if (t < soup->tangent_n) {   /* copied first: setting them may move the array */
             float tg[12];
             memcpy(tg, soup->tangent + 12 * t, sizeof tg);

@@ -64,6 +64,7 @@ int ms_scene_default(ms_scene *out)
         ms_soup_free(&s);
         return -1;
     }
+    free(s.tri_d);   /* generated about the origin: the scene's frame is the world's */
     out->tri = s.tri;
     out->n_tris = s.n;
     out->tri_mesh = s.mesh;

@@ -23,6 +23,11 @@ int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n);
  * for those before and for triangles without it). */
 typedef struct ms_tri_soup {
     float *tri;
+    /* The same positions in double (9 per triangle), as exact as the file gives them: the scene's local frame
+     * (scene_frame.c) is subtracted from these before they are rounded to float, so that a model far from
+     * the origin keeps its detail. tri holds what the loaders always produced, used as it is when the
+     * frame is the identity (images of scenes near the origin unchanged bit for bit). */
+    double *tri_d;
     size_t n, cap;
     uint32_t *mesh;
     float *uv[MS_SOUP_UV_SETS];
@@ -53,6 +58,17 @@ void ms_soup_free(ms_tri_soup *soup);
 /* The same push with a material index (MS_NO_MATERIAL: none) and three vertex normals (or NULL). */
 int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
                       uint32_t material, const float *normal9);
+/* The same with the positions also in double (vd, 9; NULL: v widened), for tri_d. */
+int ms_soup_push_d(ms_tri_soup *soup, const float v[9], const double *vd, const float *const uv[MS_SOUP_UV_SETS],
+                   uint32_t material, const float *normal9);
+
+/* The scene's local frame (scene_frame.c, docs/design.md "The scene's frame"): the origin chosen from the
+ * bounds of the n triangles' double positions tri_d (all zero when the scene lies about the origin), and
+ * the positions tri moved into it: tri = (float)(tri_d - origin) when the origin is not zero. */
+void ms_scene_frame_origin(const double *tri_d, size_t n, double origin[3]);
+void ms_scene_frame_apply(float *tri, const double *tri_d, size_t n, const double origin[3]);
+/* A world position (double) in the frame: out = (float)(p - origin), each coordinate. */
+void ms_scene_frame_point(const double p[3], const double origin[3], float out[3]);
 /* Appends a material; its index, or -1 when out of memory or past MS_MAX_MATERIALS. */
 long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m);
 

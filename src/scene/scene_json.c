@@ -190,6 +190,17 @@ static int get_vec3(const cJSON *obj, const char *objname, const char *key, int 
     return 0;
 }
 
+/* The double values of a vec3 that get_vec3 accepted (a position: the scene's frame is subtracted from these
+ * before rounding, scene_frame.c). */
+static void vec3_d(const cJSON *obj, const char *key, double out[3])
+{
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(obj, key);
+    for (int i = 0; i < 3; i++) out[i] = a ? cJSON_GetArrayItem(a, i)->valuedouble : 0.0;
+}
+
+/* A light's position as the file gives it, and what re-derives the light from it in the scene's frame. */
+typedef struct light_pos { double p[3]; ms_vec3 normal; float radius; } light_pos;
+
 static int get_number(const cJSON *obj, const char *objname, const char *key, int required, double *out,
                       const char *path, char *err, size_t errlen)
 {
@@ -256,7 +267,8 @@ static int get_amount(const cJSON *obj, const char *objname, const char *key, ms
 
 /* One light object: "shape" ("rect", the default, "disk" or "sphere"), its geometry, and at most one of
  * "emission" (radiance), "power" (watts) or "lumens" (luminous flux), default emission 1. */
-static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const char *path, char *err, size_t errlen)
+static int parse_light(const cJSON *obj, const char *objname, ms_light *l, light_pos *lp, const char *path, char *err,
+                       size_t errlen)
 {
     if (!cJSON_IsObject(obj)) { snprintf(err, errlen, "%s: %s must be an object", path, objname); return -1; }
     warn_unknown(obj, objname, light_keys, path);
@@ -272,6 +284,7 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
             get_vec3(obj, objname, "edge_s", 1, &l->edge_s, path, err, errlen) ||
             get_vec3(obj, objname, "edge_t", 1, &l->edge_t, path, err, errlen))
             return -1;
+        vec3_d(obj, "corner", lp->p);
     } else if (!strcmp(sh, "disk")) {
         ms_vec3 c = { 0, 0, 0 }, m = { 0, 0, 0 };
         double r = 0;
@@ -287,6 +300,9 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
             snprintf(err, errlen, "%s: %s.normal must not be zero", path, objname);
             return -1;
         }
+        vec3_d(obj, "center", lp->p);
+        lp->normal = m;
+        lp->radius = (float)r;
     } else if (!strcmp(sh, "sphere")) {
         ms_vec3 c = { 0, 0, 0 };
         double r = 0;
@@ -302,6 +318,8 @@ static int parse_light(const cJSON *obj, const char *objname, ms_light *l, const
             return -1;
         }
         ms_light_sphere(l, c, (float)r);
+        vec3_d(obj, "center", lp->p);
+        lp->radius = (float)r;
     } else {
         snprintf(err, errlen, "%s: %s.shape must be \"rect\", \"disk\" or \"sphere\" (got \"%.40s\")", path, objname, sh);
         return -1;
@@ -363,14 +381,15 @@ int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n)
     return k < 0 || (size_t)k >= n ? -1 : 0;
 }
 
-static int parse_lights(const cJSON *root, ms_scene *out, const char *path, char *err, size_t errlen)
+/* lp: MS_MAX_LIGHTS positions as the file gives them (scene_frame.c). */
+static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, const char *path, char *err, size_t errlen)
 {
     const cJSON *one = cJSON_GetObjectItemCaseSensitive(root, "light");
     const cJSON *many = cJSON_GetObjectItemCaseSensitive(root, "lights");
     if (one && many) { snprintf(err, errlen, "%s: give either \"light\" or \"lights\", not both", path); return -1; }
     if (!many) {
         const cJSON *light = get_object(root, "light", path, err, errlen);
-        return light ? parse_light(light, "light", &out->light, path, err, errlen) : -1;
+        return light ? parse_light(light, "light", &out->light, lp, path, err, errlen) : -1;
     }
     const int n = cJSON_IsArray(many) ? cJSON_GetArraySize(many) : 0;
     if (n < 1 || n > MS_MAX_LIGHTS) {
@@ -383,7 +402,7 @@ static int parse_lights(const cJSON *root, ms_scene *out, const char *path, char
     for (int i = 0; i < n; i++) {
         char name[32];
         snprintf(name, sizeof name, "lights[%d]", i);
-        if (parse_light(cJSON_GetArrayItem(many, i), name, &out->lights[i], path, err, errlen)) return -1;
+        if (parse_light(cJSON_GetArrayItem(many, i), name, &out->lights[i], &lp[i], path, err, errlen)) return -1;
     }
     out->n_lights = (size_t)n;
     out->light = out->lights[0];
@@ -392,6 +411,32 @@ static int parse_lights(const cJSON *root, ms_scene *out, const char *path, char
 
 static int parse_with(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
                       ms_scene *out, char *err, size_t errlen);
+
+/* The camera's eye and target and the lights' positions in the scene's frame (out->origin), from the
+ * numbers of the file; nothing changes when the frame is the world's. */
+static void frame_camera_lights(const cJSON *cam, ms_scene *out, const light_pos *lp)
+{
+    const double *o = out->origin;
+    if (o[0] == 0.0 && o[1] == 0.0 && o[2] == 0.0) return;
+    double p[3];
+    float f[3];
+    vec3_d(cam, "eye", p);
+    ms_scene_frame_point(p, o, f);
+    out->camera.eye = (ms_vec3){ f[0], f[1], f[2] };
+    vec3_d(cam, "target", p);
+    ms_scene_frame_point(p, o, f);
+    out->camera.target = (ms_vec3){ f[0], f[1], f[2] };
+    const size_t n = out->n_lights ? out->n_lights : 1;
+    for (size_t i = 0; i < n; i++) {
+        ms_light *l = out->n_lights ? &out->lights[i] : &out->light;
+        ms_scene_frame_point(lp[i].p, o, f);
+        const ms_vec3 c = { f[0], f[1], f[2] };
+        if (l->shape == MS_LIGHT_DISK) ms_light_disk(l, c, lp[i].normal, lp[i].radius);
+        else if (l->shape == MS_LIGHT_SPHERE) ms_light_sphere(l, c, lp[i].radius);
+        else l->corner = c;
+    }
+    if (out->n_lights) out->light = out->lights[0];
+}
 
 int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen)
 {
@@ -505,7 +550,9 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         else c->fov = (float)v;
     }
 
-    if (parse_lights(root, out, json_path, err, errlen)) goto done;
+    light_pos lpos[MS_MAX_LIGHTS];
+    memset(lpos, 0, sizeof lpos);
+    if (parse_lights(root, out, lpos, json_path, err, errlen)) goto done;
 
     out->samples = 1024;
     const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
@@ -607,6 +654,13 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     }
     free(ent);
     free(dircopy);
+    /* The scene's frame (scene_frame.c): chosen from the triangles' double positions, applied to them, the
+     * camera and the lights, here and nowhere else. */
+    ms_scene_frame_origin(soup.tri_d, soup.n, out->origin);
+    ms_scene_frame_apply(soup.tri, soup.tri_d, soup.n, out->origin);
+    frame_camera_lights(cam, out, lpos);
+    free(soup.tri_d);
+    soup.tri_d = NULL;
     out->tri = soup.tri;
     out->n_tris = soup.n;
     out->tri_mesh = soup.mesh;

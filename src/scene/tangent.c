@@ -43,6 +43,8 @@ typedef struct mikk_user {
     size_t first;
     int count, set;
     float *out;
+    int far;        /* the primitive lies far from the origin: positions from tri_d - o (scene_frame.c) */
+    double o[3];
 } mikk_user;
 
 static int n_faces(const SMikkTSpaceContext *c) { return ((const mikk_user *)c->m_pUserData)->count; }
@@ -51,7 +53,9 @@ static int n_verts(const SMikkTSpaceContext *c, const int f) { (void)c; (void)f;
 static void get_pos(const SMikkTSpaceContext *c, float out[], const int f, const int v)
 {
     const mikk_user *u = c->m_pUserData;
-    memcpy(out, u->soup->tri + 9 * (u->first + (size_t)f) + 3 * v, 3 * sizeof(float));
+    const size_t i = 9 * (u->first + (size_t)f) + 3 * (size_t)v;
+    if (u->far) ms_scene_frame_point(u->soup->tri_d + i, u->o, out);
+    else memcpy(out, u->soup->tri + i, 3 * sizeof(float));
 }
 
 /* The vertex normal, or the face normal where the mesh has none (glTF: flat shading). */
@@ -61,7 +65,8 @@ static void get_normal(const SMikkTSpaceContext *c, float out[], const int f, co
     const size_t t = u->first + (size_t)f;
     const float *n = u->soup->normal ? u->soup->normal + 9 * t + 3 * v : NULL;
     if (n && isfinite(n[0]) && isfinite(n[1]) && isfinite(n[2])) { memcpy(out, n, 3 * sizeof(float)); return; }
-    const float *p = u->soup->tri + 9 * t;
+    float p[9];
+    for (int k = 0; k < 3; k++) get_pos(c, p + 3 * k, f, k);
     const float e1[3] = { p[3] - p[0], p[4] - p[1], p[5] - p[2] }, e2[3] = { p[6] - p[0], p[7] - p[1], p[8] - p[2] };
     out[0] = e1[1] * e2[2] - e1[2] * e2[1];
     out[1] = e1[2] * e2[0] - e1[0] * e2[2];
@@ -108,8 +113,14 @@ int ms_soup_mikktspace(ms_tri_soup *soup, size_t first, size_t count, int set)
         if (!(fabsf(soup->uv[set][i]) <= 1e18f)) return 0;
     for (size_t i = 9 * first; soup->normal && i < 9 * (first + count); i++)
         if (isinf(soup->normal[i])) return 0;
-    mikk_user u = { soup, first, (int)count, set, malloc(count * 12 * sizeof(float)) };
+    mikk_user u = { soup, first, (int)count, set, malloc(count * 12 * sizeof(float)), 0, { 0, 0, 0 } };
     if (!u.out) return -1;
+    /* Tangents depend on position differences: far from the origin, from the double positions in the
+     * primitive's own frame (the floats there are too coarse); else from the floats, as always. */
+    if (soup->tri_d) {
+        ms_scene_frame_origin(soup->tri_d + 9 * first, count, u.o);
+        u.far = u.o[0] != 0.0 || u.o[1] != 0.0 || u.o[2] != 0.0;
+    }
     for (size_t i = 0; i < 12 * count; i++) u.out[i] = NAN;
     SMikkTSpaceInterface mi = { n_faces, n_verts, get_pos, get_normal, get_uv, set_basic, NULL };
     SMikkTSpaceContext ctx = { &mi, &u };

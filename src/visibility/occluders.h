@@ -11,7 +11,11 @@
  * The light's interior boxes (accel/interior.h): the boxes inside closed components whose box is apart
  * from the light's (the same condition as the cull), as 12 triangles each in a BVH of their own, for the
  * micro-rasterization methods to rasterize before the scene's triangles. Their prim ids name nothing in
- * the scene: no receiver lies on them and none is alpha-tested. */
+ * the scene: no receiver lies on them and none is alpha-tested.
+ *
+ * Every bound here (the far margin, the clearance, the box separations) is computed from the scene's and
+ * the light's boxes in the scene's frame (docs/design.md, "The scene's frame"), so it is a fixed fraction
+ * of the scene wherever the world puts it. */
 #ifndef MS_OCCLUDERS_H
 #define MS_OCCLUDERS_H
 #include <stddef.h>

@@ -110,7 +110,8 @@ static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
     memcpy(f->lt, T, sizeof T);
     /* The stored points are P + s S + t T (or the grid's p0 + i ds + j dt) rounded to float: a few ulps
      * of |P| + |S| + |T| per coordinate. In cells of the light (height |S x T| / max(|S|, |T|) over k),
-     * 64 ulps of that, plus 1/100 of a cell. */
+     * 64 ulps of that, plus 1/100 of a cell. |P| is the scene frame's (scene_frame.c): of the scene's size,
+     * not of its distance from the world's origin, so the margin stays near 1/100 of a cell far out. */
     double n[3], mag = 0.0;
     d3_cross(n, S, T);
     for (int a = 0; a < 3; a++) mag += fabs(P[a]) + fabs(S[a]) + fabs(T[a]);

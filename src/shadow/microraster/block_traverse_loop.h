@@ -30,7 +30,9 @@ static inline unsigned MS_CAT(BT_FN, _node)(const ms_block_frusta *f, const ms_b
     }
     *tlo_out = tlo;
     /* Relative slack 2^-16 for the rounding of the products; an upper bound of -inf (overflow of an
-     * impossible constraint) gives NaN here and culls, as it should. */
+     * impossible constraint) gives NaN here and culls, as it should. t is the segment's parameter (0 at the
+     * receiver, 1 at the sample): relative to it, the slack is position- and scale-free; the coordinates'
+     * own rounding is the margin's (ms_block_frusta_init). */
     return l16_le(tlo, l16_add(thi, l16_mul(l16_abs(thi), l16_set1(1.0f / 65536.0f))));
 }
 

@@ -18,7 +18,8 @@ enum {
 
 enum { MS_FT_CULL_OCCLUDED = 1, MS_FT_ORDER_CHILDREN = 2 };
 
-/* Slack, in samples per unit depth, for rounding at the frustum's sides and in the projection. */
+/* Slack, in samples per unit depth, for rounding at the frustum's sides and in the projection (light space:
+ * position- and scale-free; the projected coordinates are the scene frame's, scene_frame.c). */
 #define MS_TRAV_SIDE_SLACK 0.01f
 
 /* Rasterizes every triangle (but `skip`) of the frustum from f->c to the light into buf (k x k, all
