@@ -124,7 +124,8 @@ _Stats = _mirror("ms_stats", [("triangles", _size)] +
                  [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
                   ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS),
                   ("shadow_cpu_s", ctypes.c_double), ("primary", ctypes.c_char_p)] +
-                 [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes")])
+                 [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes", "memory_need",
+                                                 "memory_budget")])
 _Frame = _mirror("ms_frame", [("width", ctypes.c_int), ("height", ctypes.c_int), ("vis", ctypes.POINTER(_f)),
                               ("shadow", ctypes.POINTER(_f)), ("front", ctypes.POINTER(ctypes.c_uint16)),
                               ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats),
@@ -138,12 +139,12 @@ _RenderOptions = _mirror("ms_render_options", [
     ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS_CANCEL),
     ("progress_user", _p), ("isa", ctypes.c_int), ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
     ("traversal", ctypes.c_int), ("no_filter", ctypes.c_int), ("primary", ctypes.c_char_p),
-    ("consistent_primary", ctypes.c_int)])
+    ("consistent_primary", ctypes.c_int), ("max_memory", ctypes.c_uint64)])
 _Points = _mirror("ms_points", [("n", _size), ("position", _p), ("normal", _p), ("triangle", _p), ("key", _p)])
 _PointsOptions = _mirror("ms_points_options", [
     ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("threads", ctypes.c_int),
     ("seed", ctypes.c_uint32), ("isa", ctypes.c_int), ("progress", _PROGRESS_CANCEL), ("progress_user", _p),
-    ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int)])
+    ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int), ("max_memory", ctypes.c_uint64)])
 _Lightmap = _mirror("ms_lightmap", [
     ("frame", _Frame), ("position", ctypes.POINTER(_f)), ("normal", ctypes.POINTER(_f)),
     ("triangle", ctypes.POINTER(ctypes.c_uint32)), ("uv", ctypes.POINTER(_f)), ("n_tris", _size), ("texels", _size),
