@@ -402,6 +402,13 @@ typedef enum ms_traversal {
 } ms_traversal;
 
 /* Every field's zero means its default, so a zeroed struct renders with the defaults. */
+/* Whether a light's occluders leave out the back of closed meshes (ms_render_options.closed_cull). */
+typedef enum ms_closed_cull_mode {
+    MS_CLOSED_CULL_DEFAULT = 0,   /* the method's measured choice */
+    MS_CLOSED_CULL_ON = 1,
+    MS_CLOSED_CULL_OFF = 2
+} ms_closed_cull_mode;
+
 typedef struct ms_render_options {
     const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
     ms_pattern pattern;
@@ -429,6 +436,13 @@ typedef struct ms_render_options {
     const char *primary;
     int consistent_primary; /* bvh primary: decide each ray with the 3D rasterizers' consistent edge test
                              * (ties by the top-left rule, t ties to the smaller id): the same hits as 3dr-* */
+    ms_closed_cull_mode closed_cull; /* leave out of every light's occluders the triangles of closed meshes that face
+                             * away from the whole light: the same V and S (docs/culling.md). Default: on for the
+                             * micro-raster methods (with their interior boxes it pays: thin closed parts halve),
+                             * off for raytrace and mft (on bulky meshes it costs them: the kept far side projects
+                             * smaller); embree and hpc never cull */
+    int no_interior;        /* micro-raster methods: no interior boxes (virtual occluders inside closed meshes,
+                             * docs/culling.md: the same V and S); to measure what they buy */
     uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
 } ms_render_options;
 
@@ -469,6 +483,10 @@ typedef struct ms_stats {
     /* Its counters where it has them (the 3D rasterizers, the consistent bvh caster; Dachsbacher et al.'s
      * Table 1): triangle set-ups, edge-function evaluations, BVH nodes visited; 0 otherwise. */
     uint64_t primary_setups, primary_edge_evals, primary_nodes;
+    /* Triangles of closed components left out of the lights' occluders (ms_render_options.closed_cull),
+     * and interior boxes rasterized before the triangles (micro-raster methods), summed over the lights
+     * (docs/culling.md). */
+    uint64_t occluders_culled, interior_boxes;
     uint64_t memory_need;          /* bytes the call estimated it would allocate, checked against its memory budget */
     uint64_t memory_budget;        /* that budget (max_memory, or the default: ms_memory_budget) */
 } ms_stats;

@@ -201,7 +201,7 @@ def bar(verts, faces, axis, u, y, t, span, segments):
             q0, q1 = p0 + 4, p1 + 4
             faces.append((p0, q0, q1) if axis == 0 else (p0, q1, q0))
             faces.append((p0, q1, p1) if axis == 0 else (p0, p1, q1))
-    for base, flip in ((b, axis == 0), (b + 4 * segments, axis != 0)):
+    for base, flip in ((b, axis != 0), (b + 4 * segments, axis == 0)):
         q = [base, base + 1, base + 2, base + 3]
         faces.extend([(q[0], q[2], q[1]), (q[0], q[3], q[2])] if flip else [(q[0], q[1], q[2]), (q[0], q[2], q[3])])
 

@@ -6,9 +6,17 @@
  * test, no BVH, no code of the library): for random solids, lights and receivers — outside the solids,
  * inside them, on them — every sample's occlusion by the kept triangles equals its occlusion by all
  * triangles. The cases that break the naive argument are shown to break it (the oracle finds leaks when
- * the guards are bypassed): a lamp inside a closed shade, and a room wound inwards with the sun outside. */
+ * the guards are bypassed): a lamp inside a closed shade, and a room wound inwards with the sun outside.
+ *
+ * Interior boxes (src/accel/interior.c): every point sampled in every box lies inside its component by a
+ * ray-parity count written here, and at least the clearance from each of its triangles (point-triangle
+ * distance, double); open meshes get none. Frames of a dense sphere over a ground: scanline with the boxes
+ * and the cull (its default), without either, per pixel, hierarchical, raytrace with and without the cull
+ * give the same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none);
+ * the points API with the boxes equals raytrace point for point. */
 #include "testutil.h"
 #include "accel/closed.h"
+#include "accel/interior.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -357,12 +365,318 @@ static void test_cull_guards(void **st)
     free(r.tri);
 }
 
+
+/* ---- interior boxes ---- */
+
+/* Crossings of the ray p + t d, t > 0, with the triangles (double Moller-Trumbore; d chosen irrational so
+ * that edges and vertices are not met in these cases). */
+static int ray_crossings(const mesh *m, const double p[3], const double d[3])
+{
+    int n = 0;
+    for (size_t i = 0; i < m->n; i++) {
+        const float *t = m->tri + 9 * i;
+        double e1[3], e2[3], s[3], h[3], q[3];
+        for (int a = 0; a < 3; a++) { e1[a] = (double)t[3 + a] - t[a]; e2[a] = (double)t[6 + a] - t[a]; s[a] = p[a] - t[a]; }
+        h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
+        const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+        if (det == 0.0) continue;
+        const double u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) / det;
+        if (u < 0.0 || u > 1.0) continue;
+        q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
+        const double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+        if (v < 0.0 || u + v > 1.0) continue;
+        n += (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det > 0.0;
+    }
+    return n;
+}
+
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Distance from p to triangle t (closest point by regions, Ericson's "Real-Time Collision Detection" 5.1.5). */
+static double point_tri_dist(const double p[3], const float *t)
+{
+    double a[3], b[3], c[3], ab[3], ac[3], ap[3], x[3];
+    for (int k = 0; k < 3; k++) {
+        a[k] = t[k]; b[k] = t[3 + k]; c[k] = t[6 + k];
+        ab[k] = b[k] - a[k]; ac[k] = c[k] - a[k]; ap[k] = p[k] - a[k];
+    }
+    const double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    if (d1 <= 0 && d2 <= 0) { memcpy(x, a, sizeof x); goto done; }
+    double bp[3], cp[3];
+    for (int k = 0; k < 3; k++) { bp[k] = p[k] - b[k]; cp[k] = p[k] - c[k]; }
+    const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+    if (d3 >= 0 && d4 <= d3) { memcpy(x, b, sizeof x); goto done; }
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) { for (int k = 0; k < 3; k++) x[k] = a[k] + d1 / (d1 - d3) * ab[k]; goto done; }
+    const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+    if (d6 >= 0 && d5 <= d6) { memcpy(x, c, sizeof x); goto done; }
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) { for (int k = 0; k < 3; k++) x[k] = a[k] + d2 / (d2 - d6) * ac[k]; goto done; }
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++) x[k] = b[k] + w * (c[k] - b[k]);
+        goto done;
+    }
+    {
+        const double den = 1.0 / (va + vb + vc), v = vb * den, w = vc * den;
+        for (int k = 0; k < 3; k++) x[k] = a[k] + ab[k] * v + ac[k] * w;
+    }
+done:;
+    double d[3];
+    for (int k = 0; k < 3; k++) d[k] = p[k] - x[k];
+    return sqrt(dot3(d, d));
+}
+
+/* Every box of in: corners, centre and random points inside their cycle (odd crossings along two
+ * directions) and at least eps from each of its triangles. The cycle's triangles are those of m's first n
+ * with that cycle number. Returns the boxes checked. */
+static size_t check_boxes(const mesh *m, size_t n, const ms_closed *c, const ms_interior *in, double eps)
+{
+    unsigned seed = 5;
+    for (size_t b = 0; b < in->n_boxes; b++) {
+        mesh comp = { 0 };
+        for (size_t t = 0; t < n; t++)
+            if (c->cycle[t] == in->component[b]) {
+                const float *f = m->tri + 9 * t;
+                const double p0[3] = { f[0], f[1], f[2] }, p1[3] = { f[3], f[4], f[5] }, p2[3] = { f[6], f[7], f[8] };
+                add_tri(&comp, p0, p1, p2);
+            }
+        const float *bx = in->box[b];
+        for (int a = 0; a < 3; a++) assert_true(bx[a] <= bx[3 + a]);
+        for (int sidx = 0; sidx < 12; sidx++) {
+            double p[3];
+            for (int a = 0; a < 3; a++) {
+                const double f = sidx < 8 ? (double)(sidx >> a & 1) : sidx == 8 ? 0.5 : urand(&seed);
+                p[a] = bx[a] + f * ((double)bx[3 + a] - bx[a]);
+            }
+            const double d1[3] = { 0.5773, 0.6181, 0.5331 }, d2[3] = { -0.3119, 0.8423, -0.4397 };
+            assert_int_equal(ray_crossings(&comp, p, d1) % 2, 1);
+            assert_int_equal(ray_crossings(&comp, p, d2) % 2, 1);
+            double dmin = INFINITY;
+            for (size_t t = 0; t < comp.n; t++) dmin = fmin(dmin, point_tri_dist(p, comp.tri + 9 * t));
+            assert_true(dmin >= eps);
+        }
+        free(comp.tri);
+    }
+    return in->n_boxes;
+}
+
+static void test_interior_boxes(void **st)
+{
+    (void)st;
+    const double eps = 2e-3;
+    /* a jittered sphere; a hollow shell (an outer sphere and an inner one wound inwards: two components,
+     * each with its own inside); a box */
+    mesh m = { 0 };
+    const double c0[3] = { 0, 0, 0 }, c1[3] = { 3, 0.5, -1 };
+    icosphere(&m, c0, 1.0, 4, 0, 0.1, 3);
+    icosphere(&m, c1, 1.0, 3, 0, 0.0, 0);
+    icosphere(&m, c1, 0.6, 3, 1, 0.0, 0);
+    const double lo[3] = { -2, -3, 1.5 }, hi[3] = { -1, -2.5, 3 };
+    box(&m, lo, hi, 0);
+    ms_closed c;
+    assert_int_equal(ms_closed_find(m.tri, m.n, &c), 0);
+    assert_int_equal(c.n_components, 4);
+    ms_interior in;
+    assert_int_equal(ms_interior_find(m.tri, m.n, &c, 24, 0, eps, 2, &in), 0);
+    assert_int_equal(c.n_cycles, 4);   /* every closed component is a cycle */
+    int per[4] = { 0 };
+    for (size_t b = 0; b < in.n_boxes; b++) per[in.component[b]]++;
+    for (int k = 0; k < 4; k++) assert_true(per[k] > 0);
+    assert_int_equal(check_boxes(&m, m.n, &c, &in, eps), in.n_boxes);
+    /* min_tris leaves out the small ones */
+    ms_interior_free(&in);
+    assert_int_equal(ms_interior_find(m.tri, m.n, &c, 24, 2000, eps, 2, &in), 0);
+    for (size_t b = 0; b < in.n_boxes; b++) assert_int_equal(c.cycle[0], in.component[b]);
+    assert_true(in.n_boxes > 0);
+    ms_interior_free(&in);
+    ms_closed_free(&c);
+    /* open: the sphere less one triangle has no inside */
+    assert_int_equal(ms_closed_find(m.tri, 5119, &c), 0);
+    assert_int_equal(ms_interior_find(m.tri, 5119, &c, 24, 0, eps, 2, &in), 0);
+    assert_int_equal(c.n_cycles, 0);
+    assert_int_equal(in.n_boxes, 0);
+    ms_interior_free(&in);
+    ms_closed_free(&c);
+    /* a flipped triangle: no closed component any more, still a cycle with an inside */
+    float tmp[3];
+    memcpy(tmp, m.tri + 3, sizeof tmp);
+    memcpy(m.tri + 3, m.tri + 6, sizeof tmp);
+    memcpy(m.tri + 6, tmp, sizeof tmp);
+    assert_int_equal(ms_closed_find(m.tri, 5120, &c), 0);
+    assert_int_equal(c.n_components, 0);
+    assert_int_equal(c.n_cycles, 1);
+    assert_int_equal(ms_interior_find(m.tri, 5120, &c, 24, 0, eps, 2, &in), 0);
+    assert_true(in.n_boxes > 0);
+    assert_int_equal(check_boxes(&m, 5120, &c, &in, eps), in.n_boxes);
+    ms_interior_free(&in);
+    ms_closed_free(&c);
+    free(m.tri);
+}
+
+/* V of a frame by method with the options' switches (vis copied out, the stats kept). */
+static float *frame_vis(const ms_scene *sc, const char *method, ms_traversal trav, int no_interior, ms_closed_cull_mode cull,
+                        ms_stats *stats)
+{
+    ms_render_options o;
+    ms_render_options_default(&o);
+    o.method = method;
+    o.traversal = trav;
+    o.no_interior = no_interior;
+    o.closed_cull = cull;
+    o.threads = 2;
+    o.isa = tu_isa_cap();
+    ms_frame f;
+    char err[256];
+    assert_int_equal(ms_render(sc, &o, &f, err, sizeof err), 0);
+    const size_t n = (size_t)f.width * f.height;
+    float *v = malloc(n * sizeof *v);
+    assert_non_null(v);
+    memcpy(v, f.vis, n * sizeof *v);
+    if (stats) *stats = f.stats;
+    ms_frame_free(&f);
+    return v;
+}
+
+static uint64_t counter(const ms_stats *s, const char *name)
+{
+    for (int i = 0; i < s->n_counters; i++)
+        if (!strcmp(s->counter_name[i], name)) return s->counter[i];
+    fail_msg("no counter %s", name);
+    return 0;
+}
+
+static void test_interior_frames(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    tu_make_quad(&sc);
+    /* the ground of the Quad, and a dense sphere (5120 triangles) instead of its occluder */
+    mesh m = { 0 };
+    const double g[4][3] = { { -10, 0, -10 }, { 10, 0, 10 }, { 10, 0, -10 }, { -10, 0, 10 } };
+    add_tri(&m, g[0], g[1], g[2]);
+    add_tri(&m, g[0], g[3], g[1]);
+    const double c[3] = { 0.3, 1.6, -0.2 };
+    icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
+    free(sc.tri);
+    sc.tri = m.tri;
+    sc.n_tris = m.n;
+    sc.camera.width = sc.camera.height = 64;
+    sc.camera.eye = (ms_vec3){ 1, 5, 5 };   /* closer than the Quad's: the sphere and its shadow fill the frame */
+    sc.camera.target = (ms_vec3){ 0, 0.5f, 0 };
+    const int npix = 64 * 64;
+    for (int light = 0; light < 2; light++) {
+        if (light == 1) sc.light.corner = (ms_vec3){ 1.2f, 2.4f, 0.6f };   /* beside the sphere, within its box: no boxes */
+        ms_stats s_int, s_rt;
+        float *v_int = frame_vis(&sc, "scanline", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_DEFAULT, &s_int);
+        float *v_no = frame_vis(&sc, "scanline", MS_TRAVERSAL_BLOCK, 1, MS_CLOSED_CULL_OFF, NULL);
+        float *v_pix = frame_vis(&sc, "scanline", MS_TRAVERSAL_PIXEL, 0, MS_CLOSED_CULL_DEFAULT, NULL);
+        float *v_hier = frame_vis(&sc, "hierarchical", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_OFF, NULL);
+        float *v_rt = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_DEFAULT, &s_rt);
+        ms_stats s_rtc;
+        float *v_rtc = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_ON, &s_rtc);
+        /* the default: the micro-raster methods cull, raytrace does not; nothing for the light within the
+         * sphere's box */
+        assert_int_equal(s_rt.occluders_culled, 0);
+        assert_true(light == 0 ? s_int.occluders_culled > 0 && s_rtc.occluders_culled > 0
+                               : s_int.occluders_culled == 0 && s_rtc.occluders_culled == 0);
+        if (light == 0) {
+            assert_true(s_int.interior_boxes > 0);
+            assert_true(counter(&s_int, "interior_rasterized") > 0);
+        } else {
+            assert_int_equal(s_int.interior_boxes, 0);
+        }
+        assert_int_equal(s_rt.interior_boxes, 0);   /* raytrace takes none: it is the reference here */
+        int shadowed = 0;
+        for (int i = 0; i < npix; i++) shadowed += v_rt[i] >= 0.0f && v_rt[i] < 1.0f;
+        print_message("light %d: %d shadowed pixels\n", light, shadowed);
+        assert_true(shadowed > npix / 10);
+        assert_memory_equal(v_int, v_no, npix * sizeof *v_int);
+        assert_memory_equal(v_int, v_pix, npix * sizeof *v_int);
+        assert_memory_equal(v_int, v_hier, npix * sizeof *v_int);
+        assert_memory_equal(v_int, v_rt, npix * sizeof *v_int);
+        assert_memory_equal(v_int, v_rtc, npix * sizeof *v_int);
+        free(v_int); free(v_no); free(v_pix); free(v_hier); free(v_rt); free(v_rtc);
+    }
+    ms_scene_free(&sc);
+}
+
+/* The points API (a bake's path) with the boxes: the same V as raytrace, point for point, on the ground
+ * under the sphere and on the sphere itself. */
+static void test_interior_points(void **st)
+{
+    (void)st;
+    mesh m = { 0 };
+    const double g[4][3] = { { -10, 0, -10 }, { 10, 0, 10 }, { 10, 0, -10 }, { -10, 0, 10 } };
+    add_tri(&m, g[0], g[1], g[2]);
+    add_tri(&m, g[0], g[3], g[1]);
+    const double c[3] = { 0.3, 1.6, -0.2 };
+    icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
+    ms_scene sc;
+    tu_make_quad(&sc);
+    free(sc.tri);
+    sc.tri = m.tri;
+    sc.n_tris = m.n;
+    ms_accel *acc;
+    char err[256];
+    assert_int_equal(ms_accel_build(&sc, 2, &acc, err, sizeof err), MS_OK);
+    /* 2000 points: on the ground within 3 of the sphere's foot (triangle 0 or 1), and the sphere's
+     * triangles' centroids (their own triangle) */
+    const size_t n = 2000;
+    float *pos = malloc(n * 3 * sizeof *pos), *nrm = malloc(n * 3 * sizeof *nrm);
+    uint32_t *tri = malloc(n * sizeof *tri);
+    unsigned seed = 77;
+    for (size_t i = 0; i < n; i++) {
+        if (i % 2) {
+            const double x = -2.7 + 6.0 * urand(&seed), z = -3.2 + 6.0 * urand(&seed);
+            pos[3 * i] = (float)x; pos[3 * i + 1] = 0.0f; pos[3 * i + 2] = (float)z;
+            nrm[3 * i] = 0.0f; nrm[3 * i + 1] = 1.0f; nrm[3 * i + 2] = 0.0f;
+            tri[i] = 0;   /* x, z on either ground triangle: both lie in the plane y = 0; 0 keeps its own out */
+        } else {
+            const uint32_t t = 2 + (uint32_t)(urand(&seed) * 5120.0) % 5120;
+            const float *p = m.tri + 9 * (size_t)t;
+            double e1[3], e2[3];
+            for (int a = 0; a < 3; a++) {
+                pos[3 * i + (size_t)a] = (p[a] + p[3 + a] + p[6 + a]) / 3.0f;
+                e1[a] = (double)p[3 + a] - p[a];
+                e2[a] = (double)p[6 + a] - p[a];
+            }
+            nrm[3 * i] = (float)(e1[1] * e2[2] - e1[2] * e2[1]);
+            nrm[3 * i + 1] = (float)(e1[2] * e2[0] - e1[0] * e2[2]);
+            nrm[3 * i + 2] = (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+            tri[i] = t;
+        }
+    }
+    const ms_points pts = { n, pos, nrm, tri, NULL };
+    float *v_sl = malloc(n * sizeof *v_sl), *v_rt = malloc(n * sizeof *v_rt);
+    ms_points_options o = { 0 };
+    o.threads = 2;
+    o.isa = tu_isa_cap();
+    ms_stats s_sl;
+    o.method = "scanline";
+    assert_int_equal(ms_visibility_points(acc, &sc.light, &pts, &o, v_sl, NULL, NULL, &s_sl, err, sizeof err), MS_OK);
+    o.method = "raytrace";
+    assert_int_equal(ms_visibility_points(acc, &sc.light, &pts, &o, v_rt, NULL, NULL, NULL, err, sizeof err), MS_OK);
+    assert_true(s_sl.interior_boxes > 0);
+    int shadowed = 0;
+    for (size_t i = 0; i < n; i++) shadowed += v_rt[i] >= 0.0f && v_rt[i] < 1.0f;
+    assert_true(shadowed > 200);
+    assert_memory_equal(v_sl, v_rt, n * sizeof *v_sl);
+    free(v_sl); free(v_rt); free(pos); free(nrm); free(tri);
+    ms_accel_free(acc);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_topology),
         cmocka_unit_test(test_cull_exact),
         cmocka_unit_test(test_cull_guards),
+        cmocka_unit_test(test_interior_boxes),
+        cmocka_unit_test(test_interior_frames),
+        cmocka_unit_test(test_interior_points),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,7 +6,7 @@
  *   - what the refusal says would fit does fit: rendered (baked) with the same budget, it runs;
  *   - just under the budget a frame runs, one byte under its estimate it is refused, and its peak RSS (the
  *     growth during the call, measured in a child with the peak reset) is at most the estimate and at least
- *     the estimate over the stated factor (1.5; 3 for hpc, whose masks on demand are counted at their worst case);
+ *     the estimate over the stated factor (2; 3 for hpc, whose masks on demand are counted at their worst case);
  *   - the CLI: --max-memory refuses with one line, exit code 2, no output file, and a small peak RSS; bad sizes
  *     are refused.
  * RSS figures are meaningless under the sanitizers (shadow memory, quarantine) and RLIMIT_AS cannot be set
@@ -34,7 +34,7 @@
 #define MiB (1024.0 * 1024.0)
 /* The stated factors: measured peak growth <= estimate <= factor x measured (docs/memory.md); hpc's masks on
  * demand are counted as if every receiver held one at once, which they never do. */
-#define FACTOR 1.5
+#define FACTOR 2.0
 #define FACTOR_HPC 3.0
 
 /* A field of /proc/self/status in kB ("VmRSS", "VmHWM", "VmSize"); -1 if absent. */

@@ -24,6 +24,13 @@ typedef struct ms_closed {
     int8_t *outward;       /* per closed component: +1 when the triangles' winding (cross(b - a, c - a))
                             * points out of the solid (positive signed volume), -1 when it points in */
     size_t closed_tris;    /* triangles in closed components */
+    /* Mod-2 cycles (the interior boxes need no more, accel/interior.h): triangles connected through shared
+     * edges, every edge used by an even number of them, whatever their orientation (a flipped triangle or a
+     * fin of four leaves a scan a cycle, not a closed component). Every closed component is a cycle. */
+    uint32_t *cycle;       /* per triangle: its cycle, or MS_OPEN_COMPONENT */
+    size_t n_cycles;
+    float (*cycle_box)[6];
+    size_t cycle_tris;
 } ms_closed;
 
 /* The closed components of n triangles (tri: 9 floats each). Work O(n log n), memory O(n). 0, or -1 when

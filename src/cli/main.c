@@ -47,6 +47,9 @@ static void usage(FILE *f)
         "  --primary P         primary visibility: bvh, embree, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full,\n"
         "                      depth (default: the method's pairing; docs/primary.md)\n"
         "  --consistent        bvh primary: the 3D rasterizers' consistent edge test (same hits as 3dr-*)\n"
+        "  --closed-cull on|off  leave out the side of closed meshes facing away from the light (the same\n"
+        "                      answer, docs/culling.md); default: on for the micro-raster methods\n"
+        "  --no-interior       micro-raster methods: no interior boxes (docs/culling.md; to measure)\n"
         "  --max-memory SIZE   memory budget (e.g. 512M, 8G; default %d%% of physical memory): a frame that\n"
         "                      would need more is refused before anything is allocated, naming what fits\n"
         "  --quiet             no progress or summary on stderr\n"
@@ -81,7 +84,7 @@ static int cli_main(int argc, char **argv)
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
-           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_MAX_MEMORY };
+           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR, O_MAX_MEMORY };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -93,7 +96,10 @@ static int cli_main(int argc, char **argv)
         { "traversal", required_argument, 0, O_TRAVERSAL }, { "frustum-shrink", no_argument, 0, O_FRUSTUM_SHRINK },
         { "no-filter", no_argument, 0, O_NO_FILTER }, { "help", no_argument, 0, O_HELP }, { "version", no_argument, 0, O_VERSION },
         { "exposure", required_argument, 0, O_EXPOSURE }, { "primary", required_argument, 0, O_PRIMARY },
-        { "consistent", no_argument, 0, O_CONSISTENT }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
+        { "consistent", no_argument, 0, O_CONSISTENT },
+        { "closed-cull", required_argument, 0, O_CLOSED_CULL },
+        { "no-interior", no_argument, 0, O_NO_INTERIOR },
+        { "max-memory", required_argument, 0, O_MAX_MEMORY },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -177,6 +183,12 @@ static int cli_main(int argc, char **argv)
         case O_NO_FILTER: opt.no_filter = 1; break;
         case O_PRIMARY: opt.primary = optarg; break;
         case O_CONSISTENT: opt.consistent_primary = 1; break;
+        case O_CLOSED_CULL:
+            if (!strcmp(optarg, "on")) opt.closed_cull = MS_CLOSED_CULL_ON;
+            else if (!strcmp(optarg, "off")) opt.closed_cull = MS_CLOSED_CULL_OFF;
+            else { fprintf(stderr, "microshadow: --closed-cull: '%s' is not on or off\n", optarg); return EXIT_BAD_INPUT; }
+            break;
+        case O_NO_INTERIOR: opt.no_interior = 1; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &opt.max_memory)) return EXIT_BAD_INPUT; break;
         case O_EXPOSURE: {
             char *end;

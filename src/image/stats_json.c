@@ -29,6 +29,8 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     cJSON_AddNumberToObject(o, "primary_setups", (double)s->primary_setups);
     cJSON_AddNumberToObject(o, "primary_edge_evals", (double)s->primary_edge_evals);
     cJSON_AddNumberToObject(o, "primary_nodes", (double)s->primary_nodes);
+    cJSON_AddNumberToObject(o, "occluders_culled", (double)s->occluders_culled);
+    cJSON_AddNumberToObject(o, "interior_boxes", (double)s->interior_boxes);
     cJSON_AddNumberToObject(o, "shadow_s", s->shadow_s);
     cJSON_AddNumberToObject(o, "shadow_cpu_s", s->shadow_cpu_s);
     cJSON_AddNumberToObject(o, "total_s", s->total_s);

@@ -35,6 +35,21 @@
  * receiver held one at once (the masks on demand's worst case: measured peaks are 1.4-2.2x below). */
 #define HPC_PER_RECEIVER (8u + 1u + 4u + 4u + 48u + 16u)
 #define HPC_RASTER_FRAME 112u
+/* Closed components (accel/closed.c, ms_closed_find) while they are found: two hash tables of a power of two
+ * >= 6n slots (vertex slots 4 bytes, edge slots 24), corner ids 12, unions 8, flags 2, components and cycles
+ * 8 per triangle (kept while the lights' occluders are built). */
+static uint64_t closed_find_bytes(uint64_t n)
+{
+    uint64_t m = 16;
+    while (m < 6 * n) m <<= 1;
+    return m * (4u + 24u) + n * (12u + 8u + 2u + 8u);
+}
+/* A light's occluders (visibility/occluders.c): a BVH over the kept triangles (at most all) and the map from
+ * the scene's prims (4); while one is built, its triangles, sources, flags and map (45) and the build's
+ * temporaries. */
+#define OCCLUDERS_PER_TRI (BVH_PER_TRI + 4u)
+#define OCCLUDERS_BUILD_PER_TRI (45u + BVH_BUILD_PER_TRI - BVH_PER_TRI)
+
 /* Thread-private buffers and what OpenMP and the allocator keep per thread. */
 #define PER_THREAD (256u * 1024u)
 /* The call's own small allocations (method states, tables). */
@@ -75,7 +90,12 @@ uint64_t ms_memory_budget(uint64_t max_memory)
 
 static uint64_t mul(uint64_t a, uint64_t b) { return a && b > UINT64_MAX / a ? UINT64_MAX : a * b; }
 
-uint64_t ms_bvh_need(size_t n_tris) { return mul(n_tris, BVH_BUILD_PER_TRI); }
+uint64_t ms_accel_need(size_t n_tris)
+{
+    /* points.c: the BVH, then the closed components found over it (kept: 8 per triangle), the leaf map 4. */
+    const uint64_t build = mul(n_tris, BVH_BUILD_PER_TRI), find = mul(n_tris, BVH_PER_TRI) + closed_find_bytes(n_tris);
+    return (build > find ? build : find) + mul(n_tris, 12u);
+}
 
 uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
 {
@@ -117,6 +137,12 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     if (s->whole_frame && shadow_pp > finish_pp) ms_need_add(need, "hpc receiver hierarchy and masks", mul(P, shadow_pp));
     else ms_need_add(need, "finishing (filter, exposure)", mul(P, finish_pp));
     ms_need_add(need, "threads", mul((uint64_t)(s->threads > 0 ? s->threads : 1), PER_THREAD + 512u * mw8) + FIXED);
+    /* The lights' occluders stay; the closed components' search, or the last light's build, come on top. */
+    if (s->bvh && s->occluders) {
+        ms_need_add(need, "per-light occluder BVHs", mul(mul(n, OCCLUDERS_PER_TRI), s->nl));
+        const uint64_t find = closed_find_bytes(n), build_occ = mul(n, 8u + OCCLUDERS_BUILD_PER_TRI);
+        ms_need_add(need, "closed components", find > build_occ ? find : build_occ);
+    }
     /* The peak is the larger phase: the build's temporaries are freed before the planes exist. */
     const uint64_t phase1 = soup + build + FIXED;
     if (phase1 > need->total) {
@@ -214,13 +240,9 @@ uint64_t ms_bake_need(const ms_bake_shape *s, ms_need *need)
     /* ms_bake_rows over every row: each texel's point (position, normal, triangle, key, place: 40), its
      * per-light V, S, front (10) and the points call's Morton order (16). */
     ms_need_add(need, "texel points", mul(P, 56u + 10u * (uint64_t)s->nl));
-    if (s->build_accel) ms_need_add(need, "BVH and triangles", mul(n, BVH_PER_TRI + 4u));
+    if (s->build_accel) ms_need_add(need, "BVH and triangles", ms_accel_need(n));
     ms_need_add(need, "per-call triangle copies", s->whole_tri_copy ? mul(n, TRI_BYTES + HPC_ORDER_PER_TRI) : 0);
     ms_need_add(need, "threads", mul((uint64_t)(s->threads > 0 ? s->threads : 1), PER_THREAD + 512u * mw8) + FIXED);
-    if (s->build_accel && mul(n, BVH_BUILD_PER_TRI) > mul(n, BVH_PER_TRI)) {
-        /* The build's temporaries overlap the layout (ms_bake builds the accel after laying out). */
-        ms_need_add(need, "BVH and triangles", mul(n, BVH_BUILD_PER_TRI - BVH_PER_TRI));
-    }
     return need->total;
 }
 

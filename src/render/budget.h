@@ -44,6 +44,7 @@ typedef struct ms_frame_shape {
     int primary_3dr_setups; /* 3dr-* on a triangle soup: one set-up per triangle */
     int filter;             /* the interleaved pattern's filter runs in finish */
     int textured;           /* some light is textured (finish keeps a mean texel per light and pixel) */
+    int occluders;          /* per-light occluders (visibility/occluders.h): closed components, culled BVHs */
     int threads;
 } ms_frame_shape;
 
@@ -73,7 +74,7 @@ uint64_t ms_points_need(size_t n, size_t n_tris, int whole_tri_copy, int mask_wo
 int ms_points_budget_check(size_t n, size_t n_tris, int whole_tri_copy, int mask_words, int threads, uint64_t budget,
                            char *err, size_t errlen);
 
-/* The BVH over n triangles at its build's peak (ms_accel_build). */
-uint64_t ms_bvh_need(size_t n_tris);
+/* ms_accel_build over n triangles at its peak: the BVH's build, or the closed components' search after it. */
+uint64_t ms_accel_need(size_t n_tris);
 
 #endif

@@ -17,6 +17,7 @@
 #include "primary/primary.h"
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
+#include "visibility/occluders.h"
 #include "frame_shade.h"
 #include "shadow_frame.h"
 #include "shade.h"
@@ -44,6 +45,7 @@ struct ms_frame_job {
     struct ms_alpha *alpha;       /* alpha-tested triangles (NULL: none), ctx.alpha */
     void *pstate;
     void **sstate;                /* per light */
+    ms_occluders *occ;            /* per light: its occluders (sm->culls_closed), else NULL */
     ms_render_options opt;
     int W, H, tx, ty, ntiles, samples, spp, threads, rendered_any, streamed;
     ms_hit *hits;
@@ -100,6 +102,8 @@ void ms_frame_job_free(ms_frame_job *j)
         if (j->sstate[l]) j->sm->destroy(j->sstate[l]);
     free(j->sstate);
     if (j->pm && j->pstate) j->pm->destroy(j->pstate);
+    for (size_t l = 0; j->occ && l < j->nlights; l++) ms_occluders_free(&j->occ[l]);
+    free(j->occ);
     ms_bvh_free(&j->bvh);
     ms_alpha_free(j->alpha);
     free(j->hits);
@@ -108,6 +112,45 @@ void ms_frame_job_free(ms_frame_job *j)
     ms_frame_free(&j->frame);
     if (j->own_soup) free(j->soup.tri);
     free(j);
+}
+
+/* Light l's context: the frame's, with its light and, when the method takes them, its occluders. */
+static void light_ctx(const ms_frame_job *j, size_t l, ms_render_ctx *c)
+{
+    *c = j->ctx;
+    c->light = j->lights[l];
+    if (j->occ && j->occ[l].active) {
+        c->bvh = &j->occ[l].bvh;
+        c->alpha = j->occ[l].alpha;
+        c->prim_map = j->occ[l].prim_map;
+    }
+    if (j->occ && j->occ[l].interior.n_tris) c->interior = &j->occ[l].interior;
+}
+
+/* Every light's occluders (occluders.h) with what the method takes and the options allow: the scene's
+ * closed components and interior boxes once, then per light; sums into the stats. 0, or -1 when out of
+ * memory. */
+static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
+{
+    ms_closed closed;
+    ms_interior interior = { 0 };
+    if (ms_closed_find(j->scene->tri, j->scene->n_tris, &closed)) return -1;
+    int rc = 0;
+    if (closed.n_cycles) {
+        const double eps = ms_interior_clearance(&j->bvh, j->lights, j->nlights);
+        if (what & MS_OCC_INTERIOR)
+            rc = ms_interior_find(j->scene->tri, j->scene->n_tris, &closed, MS_INTERIOR_RES, MS_INTERIOR_MIN_TRIS, eps, j->threads, &interior);
+        j->occ = rc ? NULL : calloc(j->nlights, sizeof *j->occ);
+        rc = j->occ ? 0 : -1;
+        for (size_t l = 0; l < j->nlights && !rc; l++) {
+            rc = ms_occluders_build(&j->occ[l], j->scene, &j->bvh, &closed, &interior, eps, j->alpha, &j->lights[l], what, j->threads);
+            st->occluders_culled += j->occ[l].culled;
+            st->interior_boxes += j->occ[l].interior_boxes;
+        }
+    }
+    ms_interior_free(&interior);
+    ms_closed_free(&closed);
+    return rc;
 }
 
 int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **out, char *err, size_t errlen)
@@ -194,6 +237,9 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         fs.filter = opt->pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter;
         for (size_t l = 0; l < j->nlights; l++) fs.textured |= j->lights[l].texture != NULL;
         fs.threads = j->threads;
+        const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
+                         (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
+        fs.occluders = (sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0)) != 0;
         const uint64_t budget = ms_memory_budget(opt->max_memory);
         if (ms_frame_budget_check(&fs, budget, err, errlen)) { rc = MS_ERR_BUDGET; goto fail; }
         j->frame.stats.memory_need = ms_frame_need(&fs, NULL);
@@ -265,9 +311,17 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->pstate = pstate;
     f->stats.primary_s = omp_get_wtime() - t_primary;
     const double t_setup = omp_get_wtime();
+    if ((unsigned)opt->closed_cull > MS_CLOSED_CULL_OFF) { snprintf(err, errlen, "unknown closed_cull %d", (int)opt->closed_cull); goto fail; }
+    const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
+                     (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
+    const int occ_what = sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0);
+    if (occ_what && !streamed && occluders_build(j, occ_what, &f->stats)) {
+        snprintf(err, errlen, "out of memory for the lights' occluders");
+        goto fail;
+    }
     for (size_t l = 0; l < nl; l++) {
-        ms_render_ctx lc = *ctx;
-        lc.light = j->lights[l];
+        ms_render_ctx lc;
+        light_ctx(j, l, &lc);
         if (sm->create(&lc, &j->sstate[l], err, errlen)) { j->sstate[l] = NULL; goto fail; }
     }
     ms_stats *st = &f->stats;
@@ -362,8 +416,8 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
 {
     const ms_shadow_method *sm = j->sm;
     void *const sstate = j->sstate[l];
-    ms_render_ctx lctx = j->ctx;
-    lctx.light = j->lights[l];
+    ms_render_ctx lctx;
+    light_ctx(j, l, &lctx);
     const ms_render_ctx ctx = lctx;
     const int W = j->W;
     const size_t npix = (size_t)W * j->H, mw = (size_t)ctx.mask_words;
@@ -411,6 +465,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     const ms_hit *h = &hits[i];
                     if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
                     ms_query_from_hit(&q[nq], h, (uint32_t)x, (uint32_t)y);
+                    q[nq].prim = ms_ctx_skip_prim(&ctx, h->prim);
                     if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                         vis[i] = shadow[i] = spec[i] = 0.0f;   /* inside the sphere: no sample counts */
                         fr[i] = 0;

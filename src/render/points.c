@@ -12,6 +12,7 @@
 #include "shadow/method.h"
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
+#include "visibility/occluders.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -28,6 +29,12 @@ struct ms_accel {
     ms_light *lights;          /* copies of the scene's lights, each with its own texels */
     size_t n_lights;
     int threads;
+    /* The scene's closed surfaces and their interior boxes (occluders.h), found once: each call keeps those
+     * its light allows, for the methods that take them (the closed-component cull, which needs a BVH of its
+     * own per light, is for frames only). */
+    ms_closed closed;
+    ms_interior interior;
+    double interior_eps;
 };
 
 const char *ms_status_name(ms_status s)
@@ -55,12 +62,12 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
     }
     if (scene->n_tris >= UINT32_MAX) { snprintf(err, errlen, "ms_accel_build: more than 2^32-2 triangles"); return MS_ERR_INVALID; }
     {   /* No options here: the default budget (ms_memory_budget). */
-        const uint64_t need = ms_bvh_need(scene->n_tris), budget = ms_memory_budget(0);
+        const uint64_t need = ms_accel_need(scene->n_tris), budget = ms_memory_budget(0);
         if (need > budget) {
             char nb[32], bb[32];
             ms_bytes_text(need, nb, sizeof nb);
             ms_bytes_text(budget, bb, sizeof bb);
-            snprintf(err, errlen, "the BVH over %zu triangles needs about %s but the default memory budget is %s (%d%% of "
+            snprintf(err, errlen, "the acceleration structure over %zu triangles needs about %s but the default memory budget is %s (%d%% of "
                      "physical memory)", scene->n_tris, nb, bb, MS_MEMORY_DEFAULT_PERCENT);
             return MS_ERR_BUDGET;
         }
@@ -98,6 +105,14 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
         a->lights[l].texture = t;
     }
     a->view.light = a->lights[0];
+    if (scene->n_tris && (ms_closed_find(scene->tri, scene->n_tris, &a->closed) ||
+                          ms_interior_find(scene->tri, scene->n_tris, &a->closed, MS_INTERIOR_RES, MS_INTERIOR_MIN_TRIS,
+                                           a->interior_eps = ms_interior_clearance(&a->bvh, a->lights, a->n_lights),
+                                           a->threads, &a->interior))) {
+        ms_accel_free(a);
+        snprintf(err, errlen, "out of memory");
+        return MS_ERR_NO_MEMORY;
+    }
     *out = a;
     return MS_OK;
 }
@@ -108,6 +123,8 @@ void ms_accel_free(ms_accel *a)
     ms_bvh_free(&a->bvh);
     ms_alpha_free(a->alpha);
     free(a->leaf_of);
+    ms_closed_free(&a->closed);
+    ms_interior_free(&a->interior);
     for (size_t l = 0; a->lights && l < a->n_lights; l++) free((void *)a->lights[l].texture);
     free(a->lights);
     free(a);
@@ -280,7 +297,19 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
 
     void *sstate = NULL;
     const double t_setup = omp_get_wtime();
-    if (sm->create(&ctx, &sstate, err, errlen)) { free(order); free(scene_tri); return MS_ERR_METHOD; }
+    ms_occluders occ = { 0 };
+    if ((sm->occluders & MS_OCC_INTERIOR) && a->interior.n_boxes) {
+        if (ms_occluders_build(&occ, &view, &a->bvh, &a->closed, &a->interior, a->interior_eps, a->alpha, light,
+                               MS_OCC_INTERIOR, threads)) {
+            free(order);
+            free(scene_tri);
+            snprintf(err, errlen, "out of memory for the interior boxes");
+            return MS_ERR_NO_MEMORY;
+        }
+        if (occ.interior.n_tris) ctx.interior = &occ.interior;
+    }
+    const uint64_t occ_boxes = occ.interior_boxes;
+    if (sm->create(&ctx, &sstate, err, errlen)) { ms_occluders_free(&occ); free(order); free(scene_tri); return MS_ERR_METHOD; }
     const double setup_s = omp_get_wtime() - t_setup;
 
     const long nbatch = (long)((n + BATCH - 1) / BATCH);
@@ -388,6 +417,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
     ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
     if (sm->isa_used) sm->isa_used(sstate, &kisa, &tisa);
     sm->destroy(sstate);
+    ms_occluders_free(&occ);
     free(scene_tri);
     if (failed) { snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
     if (cancelled) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
@@ -403,6 +433,7 @@ ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const m
         stats->build_s = a->bvh.build_s;
         stats->setup_s = setup_s;
         stats->shadow_s = t1 - t0;
+        stats->interior_boxes = occ_boxes;
         stats->samples = ctx.samples;
         stats->samples_per_pixel = ctx.samples;   /* every point gets all N (no interleaving here) */
         stats->threads = threads;

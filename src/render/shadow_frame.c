@@ -30,6 +30,7 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
         const ms_hit *h = &hits[i];
         if (h->prim == UINT32_MAX) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; continue; }
         ms_query_from_hit(&q[n], h, (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
+        q[n].prim = ms_ctx_skip_prim(ctx, h->prim);
         where[n++] = i;
     }
     int failed = 0;

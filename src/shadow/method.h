@@ -15,6 +15,12 @@ typedef struct ms_shadow_method {
     int needs_grid;               /* 1: only the grid pattern fits (micro-rasterization) */
     int streams;                  /* 1: reads the triangles once in batches, never all at once: a procedural
                                    * scene is streamed (primary "depth", no BVH), not materialised */
+    int occluders;                /* what it takes of a light's occluders (visibility/occluders.h, MS_OCC_*):
+                                   * MS_OCC_CULL: the culled BVH in ctx->bvh with ctx->prim_map (when the
+                                   * options ask for the cull; MS_OCC_CULL_BY_DEFAULT: unless they refuse it);
+                                   * MS_OCC_INTERIOR: ctx->interior. 0: the scene's
+                                   * BVH alone (streamed or own-indexed methods, and Embree, the baseline as
+                                   * its users run it) */
     int n_counters;
     const char *counter_names[MS_MAX_COUNTERS];
     /* Per-frame set-up (shared, read-only afterwards); 0 or -1 with a message in err. */

@@ -37,6 +37,13 @@ typedef struct ms_render_ctx {
     /* Alpha-tested triangles (alpha.h: ms_alpha_build), NULL when every triangle is opaque. A method that finds
      * a segment or ray meeting a flagged triangle asks ms_alpha_segment_occludes / ms_alpha_ray_occludes. */
     const struct ms_alpha *alpha;
+    /* With a light's occluders (occluders.h) in bvh and alpha: the occluder prim of each prim of the scene's
+     * BVH, whose ids the primary's hits carry (UINT32_MAX: culled); NULL: the same ids. Receivers' prim ids
+     * go through ms_ctx_skip_prim. */
+    const uint32_t *prim_map;
+    /* The light's interior boxes (occluders.h, accel/interior.h) as triangles, NULL: none. Every segment
+     * one of them meets is occluded; the micro-rasterization methods rasterize them first. */
+    const ms_bvh *interior;
     int consistent_primary;            /* bvh primary: the 3D edge-function test (edge3d.h) in its leaves */
 } ms_render_ctx;
 
@@ -49,6 +56,12 @@ typedef struct ms_shadow_query {
     uint32_t prim;
     uint32_t px, py;
 } ms_shadow_query;
+
+/* The prim id a shadow method skips for a receiver on the scene's triangle prim (ctx->prim_map). */
+static inline uint32_t ms_ctx_skip_prim(const ms_render_ctx *ctx, uint32_t prim)
+{
+    return ctx->prim_map && prim != UINT32_MAX ? ctx->prim_map[prim] : prim;
+}
 
 /* The occluding range of the segment parameter from the hit point (0) to the light sample (1): occluders
  * closer than MS_SEGMENT_NEAR to the receiver are ignored (its own surface, whichever side rounding left

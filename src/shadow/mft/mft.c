@@ -10,6 +10,7 @@
  * the shear of each 16-sample packet), so that mft and raytrace decide every ray alike; see mft_impl.h
  * for what departs from the paper. */
 #include "shadow/method.h"
+#include "visibility/occluders.h"
 #include "mft.h"
 #include "visibility/receiver.h"
 #include "light/pattern.h"
@@ -240,6 +241,7 @@ const ms_shadow_method ms_shadow_mft = {
     .name = "mft",
     .primary = "bvh",
     .needs_grid = 0,
+    .occluders = MS_OCC_CULL,
     .n_counters = MS_MFT_COUNTERS,
     .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",
                        "leaf_frusta_culled", "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",

@@ -6,6 +6,7 @@
  * ISA and chosen under the context's cap; the lane loops are plain C that each file's compiler vectorises
  * for its instruction set). */
 #include "raytrace.h"
+#include "visibility/occluders.h"
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -65,6 +66,7 @@ const ms_shadow_method ms_shadow_raytrace = {
     .name = "raytrace",
     .primary = "bvh",
     .needs_grid = 0,
+    .occluders = MS_OCC_CULL,
     .n_counters = 3,
     .counter_names = { "packets", "packet_node_visits", "packet_triangle_tests" },
     .create = rt_create,

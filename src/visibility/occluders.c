@@ -1,0 +1,212 @@
+/* A light's occluders (occluders.h): the closed-component cull of accel/closed.c applied to the scene, and
+ * a BVH over what is kept. */
+#include "occluders.h"
+#include "alpha.h"
+#include "context.h"
+#include "light/light_shape.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Points whose convex hull holds every point of the light (the proof's Λ), and their box: a planar
+ * shape's parallelogram (a disk inside its bounding square), a round shape's bounding box (every outline
+ * disk a receiver sees lies inside the sphere). Returns the number of points. */
+static int light_hull(const ms_light *l, float pts[8][3], float box[6])
+{
+    const ms_light_shape_ops *ops = ms_light_shape_of(l->shape);
+    int n;
+    if (ops && ops->outline) {
+        const float c[3] = { l->center.x, l->center.y, l->center.z }, r = l->radius;
+        for (n = 0; n < 8; n++)
+            for (int a = 0; a < 3; a++) pts[n][a] = c[a] + (n >> a & 1 ? r : -r);
+    } else {
+        const float c[3] = { l->corner.x, l->corner.y, l->corner.z };
+        const float s[3] = { l->edge_s.x, l->edge_s.y, l->edge_s.z }, t[3] = { l->edge_t.x, l->edge_t.y, l->edge_t.z };
+        for (n = 0; n < 4; n++)
+            for (int a = 0; a < 3; a++) pts[n][a] = c[a] + (n & 1 ? s[a] : 0.0f) + (n & 2 ? t[a] : 0.0f);
+    }
+    for (int a = 0; a < 3; a++) {
+        box[a] = box[3 + a] = pts[0][a];
+        for (int q = 1; q < n; q++) {
+            box[a] = fminf(box[a], pts[q][a]);
+            box[3 + a] = fmaxf(box[3 + a], pts[q][a]);
+        }
+    }
+    return n;
+}
+
+void ms_occluders_free(ms_occluders *o)
+{
+    ms_bvh_free(&o->bvh);
+    ms_alpha_free(o->alpha);
+    free(o->prim_map);
+    ms_bvh_free(&o->interior);
+    memset(o, 0, sizeof *o);
+}
+
+/* The diagonal of box b (6 floats) and the light's hull box together. */
+static double joint_diag(const float b[6], const float lbox[6])
+{
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        const double d = fmax((double)b[3 + a], lbox[3 + a]) - fmin((double)b[a], lbox[a]);
+        d2 += d * d;
+    }
+    return sqrt(d2);
+}
+
+static void root_box(const ms_bvh *b, float box[6])
+{
+    for (int a = 0; a < 3; a++) { box[a] = b->nodes[0].bmin[a]; box[3 + a] = b->nodes[0].bmax[a]; }
+}
+
+double ms_interior_clearance(const ms_bvh *scene_bvh, const ms_light *lights, size_t n_lights)
+{
+    float sbox[6];
+    root_box(scene_bvh, sbox);
+    double d = 0.0;
+    for (size_t l = 0; l < n_lights; l++) {
+        float pts[8][3], lbox[6];
+        light_hull(&lights[l], pts, lbox);
+        d = fmax(d, joint_diag(sbox, lbox));
+    }
+    return 2.5 * (double)MS_SEGMENT_NEAR * d;
+}
+
+/* Per closed component (cycle: per mod-2 cycle): 1 when it holds an alpha-tested triangle (its surface is
+ * porous: neither the cull nor the interior boxes hold), or NULL when the scene is opaque. */
+static uint8_t *porous_of(const ms_closed *closed, int cycle, const ms_bvh *scene_bvh, const struct ms_alpha *alpha, int *oom)
+{
+    *oom = 0;
+    const size_t n = cycle ? closed->n_cycles : closed->n_components;
+    const uint32_t *of = cycle ? closed->cycle : closed->component;
+    if (!alpha || !alpha->n_alpha || !n) return NULL;
+    uint8_t *porous = calloc(n, 1);
+    if (!porous) { *oom = 1; return NULL; }
+    for (uint32_t i = 0; i < scene_bvh->n_tris; i++) {
+        const uint32_t c = of[scene_bvh->tri_source[i]];
+        if (ms_alpha_tested(alpha, i) && c != MS_OPEN_COMPONENT) porous[c] = 1;
+    }
+    return porous;
+}
+
+/* The interior boxes whose cycle is apart from the light by `margin`, as 12 triangles each. */
+static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_interior *in, const uint8_t *porous,
+                          const float lbox[6], double margin, int threads)
+{
+    float *tri = malloc((in->n_boxes ? in->n_boxes : 1) * 12 * 9 * sizeof *tri);
+    if (!tri) return -1;
+    size_t nb = 0;
+    for (size_t i = 0; i < in->n_boxes; i++) {
+        const uint32_t k = in->component[i];
+        if (porous && porous[k]) continue;
+        const float *cb = closed->cycle_box[k];
+        int sep = 0;
+        for (int a = 0; a < 3; a++)
+            sep |= (double)lbox[a] > (double)cb[3 + a] + margin || (double)lbox[3 + a] < (double)cb[a] - margin;
+        if (!sep) continue;
+        const float *b = in->box[i];
+        float v[8][3];
+        for (int c = 0; c < 8; c++)
+            for (int a = 0; a < 3; a++) v[c][a] = b[(c >> a & 1) ? 3 + a : a];
+        /* The six faces (corner bits: x = 1, y = 2, z = 4), two triangles each; the winding does not matter
+         * (the kernels are two-sided). */
+        static const int face[6][4] = { { 0, 2, 6, 4 }, { 1, 3, 7, 5 }, { 0, 1, 5, 4 }, { 2, 3, 7, 6 }, { 0, 1, 3, 2 }, { 4, 5, 7, 6 } };
+        for (int f = 0; f < 6; f++) {
+            const int *q = face[f];
+            const int tv[2][3] = { { q[0], q[1], q[2] }, { q[0], q[2], q[3] } };
+            for (int t = 0; t < 2; t++)
+                for (int c = 0; c < 3; c++) memcpy(tri + 9 * (12 * nb + 2 * (size_t)f + (size_t)t) + 3 * c, v[tv[t][c]], 3 * sizeof(float));
+        }
+        nb++;
+    }
+    int rc = 0;
+    if (nb) {
+        rc = ms_bvh_build(&o->interior, tri, 12 * nb, threads);
+        o->interior_boxes = nb;
+    }
+    free(tri);
+    return rc;
+}
+
+/* The cull (docs/culling.md) into o->bvh, o->alpha, o->prim_map; o->active = 0 when nothing is culled. */
+static int cull_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const ms_closed *closed,
+                      const uint8_t *porous, const float (*pts)[3], int np, const float lbox[6], double margin,
+                      const struct ms_alpha *scene_alpha, int threads)
+{
+    const size_t n = scene->n_tris;
+    uint8_t *keep = malloc(n ? n : 1);
+    if (!keep) return -1;
+    size_t culled = ms_closed_cull(closed, scene->tri, pts, np, lbox, margin, keep);
+    /* Condition 2 of the proof: an alpha-tested triangle makes its component porous; keep the whole
+     * component two-sided. */
+    for (size_t t = 0; porous && culled && t < n; t++) {
+        const uint32_t c = closed->component[t];
+        if (!keep[t] && porous[c]) { keep[t] = 1; culled--; }
+    }
+    if (!culled || culled == n) { free(keep); return 0; }   /* all culled: only degenerate inputs; keep it simple */
+    const size_t nk = n - culled;
+    float *tri = malloc(nk * 9 * sizeof *tri);
+    uint32_t *src = malloc(nk * sizeof *src);
+    o->prim_map = malloc((size_t)scene_bvh->n_tris * sizeof *o->prim_map);
+    uint32_t *occ_of_tri = malloc(n * sizeof *occ_of_tri);
+    int rc = -1;
+    if (!tri || !src || !o->prim_map || !occ_of_tri) goto done;
+    size_t m = 0;
+    for (size_t t = 0; t < n; t++) {
+        if (!keep[t]) continue;
+        memcpy(tri + 9 * m, scene->tri + 9 * t, 9 * sizeof *tri);
+        src[m++] = (uint32_t)t;
+    }
+    if (ms_bvh_build(&o->bvh, tri, nk, threads)) goto done;
+    /* The occluder BVH's tri_source indexes the kept list: compose it back to the scene's triangles. */
+    for (size_t t = 0; t < n; t++) occ_of_tri[t] = UINT32_MAX;
+    for (uint32_t i = 0; i < o->bvh.n_tris; i++) {
+        o->bvh.tri_source[i] = src[o->bvh.tri_source[i]];
+        occ_of_tri[o->bvh.tri_source[i]] = i;
+    }
+    for (uint32_t i = 0; i < scene_bvh->n_tris; i++) o->prim_map[i] = occ_of_tri[scene_bvh->tri_source[i]];
+    if (scene_alpha && ms_alpha_build(scene, &o->bvh, &o->alpha)) goto done;
+    o->culled = culled;
+    o->active = 1;
+    rc = 0;
+done:
+    free(keep);
+    free(tri);
+    free(src);
+    free(occ_of_tri);
+    return rc;
+}
+
+int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const ms_closed *closed,
+                       const ms_interior *interior, double interior_eps, const struct ms_alpha *scene_alpha,
+                       const ms_light *l, int what, int threads)
+{
+    memset(o, 0, sizeof *o);
+    const size_t n = scene->n_tris;
+    if (!closed->n_cycles || closed->n_tris != n || !scene_bvh->n_nodes) return 0;
+    float pts[8][3], lbox[6], sbox[6];
+    const int np = light_hull(l, pts, lbox);
+    for (int i = 0; i < 6; i++)
+        if (!isfinite(lbox[i])) return 0;
+    root_box(scene_bvh, sbox);
+    /* The proof's margin: the far range (1 - MS_SEGMENT_FAR) times the longest segment, bounded by the
+     * diagonal of the scene's and the light's boxes together; doubled for the rounding of the boxes. */
+    const double diag = joint_diag(sbox, lbox);
+    const double margin = 2.0 * (1.0 - (double)MS_SEGMENT_FAR) * diag;
+    int rc = 0, oom;
+    /* Interior boxes hold for this light when their clearance covers the near range of its longest
+     * segment (docs/culling.md). */
+    if ((what & MS_OCC_INTERIOR) && interior && interior->n_boxes && interior_eps >= 2.0 * (double)MS_SEGMENT_NEAR * diag) {
+        uint8_t *porous = porous_of(closed, 1, scene_bvh, scene_alpha, &oom);
+        rc = oom ? -1 : interior_build(o, closed, interior, porous, lbox, margin, threads);
+        free(porous);
+    }
+    if (!rc && (what & MS_OCC_CULL) && closed->n_components) {
+        uint8_t *porous = porous_of(closed, 0, scene_bvh, scene_alpha, &oom);
+        rc = oom ? -1 : cull_build(o, scene, scene_bvh, closed, porous, (const float (*)[3])pts, np, lbox, margin, scene_alpha, threads);
+        free(porous);
+    }
+    if (rc) ms_occluders_free(o);
+    return rc;
+}

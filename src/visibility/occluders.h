@@ -1,0 +1,60 @@
+/* The occluders of one light: the scene's triangles less those of closed components that face away from
+ * the whole light (accel/closed.h, docs/culling.md: removing them changes no V and no S), with their own
+ * BVH, so that the methods that take it (ms_shadow_method.culls_closed) traverse and test only what can
+ * decide a segment. Built per light at a frame's set-up; the primary's BVH stays the scene's.
+ *
+ * Prim ids: the occluder BVH names its triangles in its own leaf order. Its tri_source is composed back
+ * to the scene's triangle index (as the scene's BVH's is), so that the alpha table (alpha.h) is built
+ * over it unchanged; prim_map turns a receiver's prim id (the scene BVH's leaf order, from the primary)
+ * into the occluder's (UINT32_MAX: culled, so nothing to skip).
+ *
+ * The light's interior boxes (accel/interior.h): the boxes inside closed components whose box is apart
+ * from the light's (the same condition as the cull), as 12 triangles each in a BVH of their own, for the
+ * micro-rasterization methods to rasterize before the scene's triangles. Their prim ids name nothing in
+ * the scene: no receiver lies on them and none is alpha-tested. */
+#ifndef MS_OCCLUDERS_H
+#define MS_OCCLUDERS_H
+#include <stddef.h>
+#include <stdint.h>
+#include "microshadow.h"
+#include "accel/bvh.h"
+#include "accel/closed.h"
+#include "accel/interior.h"
+
+struct ms_alpha;
+
+typedef struct ms_occluders {
+    ms_bvh bvh;                 /* the kept triangles */
+    struct ms_alpha *alpha;     /* their alpha table (NULL: all opaque) */
+    uint32_t *prim_map;         /* per prim of the scene's BVH: the occluder prim, or UINT32_MAX */
+    size_t culled;              /* triangles left out */
+    int active;                 /* 0: nothing culled, use the scene's BVH (the fields above empty) */
+    ms_bvh interior;            /* the interior boxes' triangles (n_tris 0: none) */
+    size_t interior_boxes;
+} ms_occluders;
+
+/* Interior boxes (accel/interior.h): grid cells along a component's longest side, and the smallest
+ * component that gets them (a few boxes cannot pay for a few triangles). */
+#define MS_INTERIOR_RES 32
+#define MS_INTERIOR_MIN_TRIS 256
+
+/* What a light's occluders are built with (ms_shadow_method.occluders). */
+enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4 };
+
+/* The occluders of light l (every shape: its hull is its parallelogram, or a sphere's box) for the scene
+ * whose BVH is `scene_bvh` and closed components `closed` (found over scene->tri), with alpha-tested
+ * components left as they are (`scene_alpha`: the scene BVH's alpha table, NULL when opaque): with
+ * MS_OCC_CULL in `what` the cull (o->active = 0 when nothing is culled), with MS_OCC_INTERIOR the boxes of
+ * `interior` (found with clearance interior_eps; none for a light so far that the clearance no longer
+ * covers the near range). 0, or -1 when out of memory. */
+int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const ms_closed *closed,
+                       const ms_interior *interior, double interior_eps, const struct ms_alpha *scene_alpha,
+                       const ms_light *l, int what, int threads);
+
+/* The clearance interior boxes need so that every light of the scene may use them (docs/culling.md):
+ * 2.5 times the near range (MS_SEGMENT_NEAR) times the longest segment, the diagonal of the scene's and
+ * the lights' boxes together. */
+double ms_interior_clearance(const ms_bvh *scene_bvh, const ms_light *lights, size_t n_lights);
+void ms_occluders_free(ms_occluders *o);
+
+#endif
