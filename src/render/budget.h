@@ -9,7 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define MS_NEED_PARTS 8
+#define MS_NEED_PARTS 16
 
 typedef struct ms_need {
     const char *name[MS_NEED_PARTS];
