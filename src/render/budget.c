@@ -19,7 +19,7 @@
 #define BVH_BUILD_PER_TRI 124u
 /* A built BVH: triangles, sources, normals, nodes. */
 #define BVH_PER_TRI 84u
-/* A shallow view per light (bvh_shallow.c, leaves of 8: 0.32-0.36 nodes per triangle measured, counted as
+/* A shallow view per light (bvh_shallow.c; with leaves of 8 it had 0.32-0.36 nodes per triangle, counted as
  * 0.5): nodes 16, and the build's ranges (8 per BVH node) while it runs. */
 #define SHALLOW_PER_TRI 24u
 /* hpc on a soup (hpc_method.c, hpc_sort.c): area order 4, leaf map 4, buckets 1. */
