@@ -88,6 +88,17 @@ MS_API int ms_layout(const char *structure, const char *field, size_t *offset, s
 #define MS_SAMPLES_MAX 4096
 #define MS_DEFAULT_METHOD "scanline"
 
+/* Memory budget (docs/memory.md). Frames, bakes and point queries estimate what each phase will allocate
+ * (frame planes, per-light planes, the BVH and its triangles, a procedural scene materialised, hpc's receiver
+ * hierarchy and masks, lightmap atlases) before allocating it, and refuse with MS_ERR_BUDGET and one line
+ * naming the need, the budget and what would fit when the sum exceeds the budget. The budget is the options'
+ * max_memory in bytes, or when that is 0 MS_MEMORY_DEFAULT_PERCENT percent of the physical memory. It bounds
+ * what the call allocates beyond the scene it is given (the loaders bound that by the files' sizes).
+ * ms_accel_build, which takes no options, uses the default. */
+#define MS_MEMORY_DEFAULT_PERCENT 75
+/* The budget in effect for max_memory: max_memory itself, or the default when it is 0. */
+MS_API uint64_t ms_memory_budget(uint64_t max_memory);
+
 typedef struct ms_vec3 { float x, y, z; } ms_vec3;
 
 /* Camera projections (scene file: camera.type; docs/cameras.md). The view frame is forward =
@@ -450,6 +461,7 @@ typedef struct ms_render_options {
                              * smaller); embree and hpc never cull */
     int no_interior;        /* micro-raster methods: no interior boxes (virtual occluders inside closed meshes,
                              * docs/culling.md: the same V and S); to measure what they buy */
+    uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
@@ -493,6 +505,8 @@ typedef struct ms_stats {
      * and interior boxes rasterized before the triangles (micro-raster methods), summed over the lights
      * (docs/culling.md). */
     uint64_t occluders_culled, interior_boxes;
+    uint64_t memory_need;          /* bytes the call estimated it would allocate, checked against its memory budget */
+    uint64_t memory_budget;        /* that budget (max_memory, or the default: ms_memory_budget) */
 } ms_stats;
 
 typedef struct ms_frame {
@@ -516,7 +530,8 @@ typedef struct ms_frame {
 } ms_frame;
 
 /* A frame: 0, or non-zero with a message in err and *out zeroed: MS_ERR_CANCELLED (3) when the progress
- * callback cancelled it, -1 otherwise. */
+ * callback cancelled it, MS_ERR_BUDGET (6) when it would need more memory than the budget (nothing was
+ * allocated for it then), -1 otherwise. */
 MS_API int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
               char *err, size_t errlen);
 MS_API void ms_frame_free(ms_frame *f);
@@ -536,8 +551,8 @@ MS_API void ms_frame_free(ms_frame *f);
 #define MS_TILE_SIZE 16
 typedef struct ms_frame_job ms_frame_job;
 /* Checks the options, builds the acceleration structure and sets up the methods, the shadow method once per
- * light, kept until ms_frame_job_free (what ms_render does first, with its messages). 0 and *job, or -1 with
- * *job = NULL. */
+ * light, kept until ms_frame_job_free (what ms_render does first, with its messages). 0 and *job, or -1 (MS_ERR_BUDGET
+ * over the memory budget, before allocating) with *job = NULL. */
 MS_API int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **job, char *err,
                         size_t errlen);
 /* The number of tiles; tiles_x and tiles_y (may be NULL) get the frame's tiles per row and per column. */
@@ -626,9 +641,11 @@ typedef enum ms_status {
     MS_ERR_NO_MEMORY = 2,
     MS_ERR_CANCELLED = 3,   /* the progress callback returned non-zero */
     MS_ERR_METHOD = 4,      /* unknown method, not compiled in, or its set-up failed */
-    MS_ERR_IO = 5           /* reading or writing a file failed */
+    MS_ERR_IO = 5,          /* reading or writing a file failed */
+    MS_ERR_BUDGET = 6       /* the call would need more memory than its budget (max_memory): refused before
+                             * allocating; the message names the need, the budget and what would fit */
 } ms_status;
-/* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o". */
+/* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o", "over the memory budget". */
 MS_API const char *ms_status_name(ms_status s);
 
 
@@ -671,6 +688,8 @@ typedef struct ms_points_options {
     void *progress_user;
     ms_embree_mode embree_mode;
     ms_embree_filter embree_filter;
+    uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default. Bakes: this field of
+                             * ms_bake_options.points */
 } ms_points_options;
 
 /* V, S and the front count of each point (any output may be NULL; each has n entries). light: NULL for

@@ -26,7 +26,7 @@ NO_TRIANGLE = 0xFFFFFFFF
 
 class Error(RuntimeError):
     """A failed call: .status is the library's ms_status code (0 ok, 1 invalid, 2 memory, 3 cancelled,
-    4 method, 5 i/o; -1 for the frame and scene functions, which return only pass/fail)."""
+    4 method, 5 i/o, 6 over the memory budget; -1 for the other failures of the frame and scene functions)."""
 
     def __init__(self, status, message):
         super().__init__(message)
@@ -125,7 +125,8 @@ _Stats = _mirror("ms_stats", [("triangles", _size)] +
                  [("shadow_factor_s", ctypes.c_double), ("filter_s", ctypes.c_double), ("n_counters", ctypes.c_int),
                   ("counter_name", ctypes.c_char_p * MAX_COUNTERS), ("counter", ctypes.c_uint64 * MAX_COUNTERS),
                   ("shadow_cpu_s", ctypes.c_double), ("primary", ctypes.c_char_p)] +
-                 [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes")])
+                 [(n, ctypes.c_uint64) for n in ("primary_setups", "primary_edge_evals", "primary_nodes", "memory_need",
+                                                 "memory_budget")])
 _Frame = _mirror("ms_frame", [("width", ctypes.c_int), ("height", ctypes.c_int), ("vis", ctypes.POINTER(_f)),
                               ("shadow", ctypes.POINTER(_f)), ("front", ctypes.POINTER(ctypes.c_uint16)),
                               ("rgb", ctypes.POINTER(_f)), ("exposure", _f), ("stats", _Stats),
@@ -139,12 +140,12 @@ _RenderOptions = _mirror("ms_render_options", [
     ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS_CANCEL),
     ("progress_user", _p), ("isa", ctypes.c_int), ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
     ("traversal", ctypes.c_int), ("no_filter", ctypes.c_int), ("primary", ctypes.c_char_p),
-    ("consistent_primary", ctypes.c_int)])
+    ("consistent_primary", ctypes.c_int), ("max_memory", ctypes.c_uint64)])
 _Points = _mirror("ms_points", [("n", _size), ("position", _p), ("normal", _p), ("triangle", _p), ("key", _p)])
 _PointsOptions = _mirror("ms_points_options", [
     ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("threads", ctypes.c_int),
     ("seed", ctypes.c_uint32), ("isa", ctypes.c_int), ("progress", _PROGRESS_CANCEL), ("progress_user", _p),
-    ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int)])
+    ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int), ("max_memory", ctypes.c_uint64)])
 _Lightmap = _mirror("ms_lightmap", [
     ("frame", _Frame), ("position", ctypes.POINTER(_f)), ("normal", ctypes.POINTER(_f)),
     ("triangle", ctypes.POINTER(ctypes.c_uint32)), ("uv", ctypes.POINTER(_f)), ("n_tris", _size), ("texels", _size),
@@ -227,6 +228,12 @@ def _array(arg, a, cols, kind, n=None):
             raise ValueError("%s: values must lie in [0, 2**32)" % arg)
         return np.ascontiguousarray(arr, dtype=np.uint32)
     return np.ascontiguousarray(arr, dtype=np.float32)
+
+
+def _max_memory(v):
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v < 2 ** 64:
+        raise ValueError("max_memory: expected a number of bytes >= 0 (0: the default budget), got %r" % (v,))
+    return int(v)
 
 
 def _vec3(arg, v):
@@ -403,7 +410,7 @@ def _progress_cancel(fn):
 
 def visibility_points(scene, positions, normals, triangles=None, keys=None, method=None, samples=1024,
                       pattern="grid", seed=0, threads=0, light=None, isa="auto", progress=None,
-                      return_front=False):
+                      return_front=False, max_memory=0):
     """V and S at n points (microshadow.h, "Visibility at any points").
 
     scene: a Scene or an Accel (reused); positions, normals: (n, 3); triangles: (n,) scene triangle
@@ -430,6 +437,7 @@ def visibility_points(scene, positions, normals, triangles=None, keys=None, meth
     opt.method = method.encode() if method else None
     opt.pattern, opt.isa = _choice("pattern", pattern, _PATTERNS), _choice("isa", isa, _ISAS)
     opt.samples, opt.threads, opt.seed = int(samples), int(threads), int(seed)
+    opt.max_memory = _max_memory(max_memory)
     opt.progress = cb
     keep = None
     if light is None:
@@ -462,12 +470,13 @@ def _planes(ptr, n_lights, h, w, shape=None):
 
 
 def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto",
-           primary=None, consistent_primary=False, progress=None):
+           primary=None, consistent_primary=False, progress=None, max_memory=0):
     """A frame (ms_render): dict of vis, shadow (H, W) float32 (-1 where the primary ray missed), front
     (H, W) uint16 (all of light 0), rgb (H, W, 3) linear radiance summed over the lights, exposure, stats
     (a dict), and lights: one dict per light of the scene with its vis, shadow, shadow_spec and front
     (H, W). primary: the primary visibility method (docs/primary.md; None: the method's pairing).
-    progress: fn(fraction) -> truthy to cancel (Error with status 3)."""
+    progress: fn(fraction) -> truthy to cancel (Error with status 3). max_memory: the memory budget in bytes
+    (0: the library's default); a frame over it is refused before allocating (Error with status 6)."""
     if not isinstance(scene, Scene):
         raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
     opt = _RenderOptions()
@@ -477,6 +486,7 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
     opt.pattern = _choice("pattern", pattern, _PATTERNS)
     opt.samples, opt.width, opt.height, opt.threads, opt.seed = int(samples), int(width), int(height), int(threads), int(seed)
     opt.isa = _choice("isa", isa, _ISAS)
+    opt.max_memory = _max_memory(max_memory)
     cb = _progress_cancel(progress)
     opt.progress = cb
     fr, err = _Frame(), _errbuf()
@@ -521,7 +531,7 @@ def light_irradiance(light, point, normal):
 
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
-         dilate=4, padding=2, accel=None, progress=None):
+         dilate=4, padding=2, accel=None, progress=None, max_memory=0):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
     (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off
     the triangles; position in the scene's frame: add scene.origin for world coordinates), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked
@@ -540,6 +550,7 @@ def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed
     o.points.pattern, o.points.isa = _choice("pattern", pattern, _PATTERNS), _choice("isa", isa, _ISAS)
     o.points.samples, o.points.threads, o.points.seed = int(samples), int(threads), int(seed)
     o.points.progress = cb
+    o.points.max_memory = _max_memory(max_memory)
     o.size = int(size)
     o.uv_set = -1 if uv is None else int(uv)
     o.dilate = -1 if dilate == 0 else int(dilate)

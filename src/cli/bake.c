@@ -33,7 +33,7 @@ static void usage(FILE *f)
         "  --stats OUT.json    timings and counters\n"
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
         "  --padding N         texels between xatlas charts (default 2)\n"
-        "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I   as for frames\n"
+        "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I, --max-memory SIZE   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture)\n"
 #ifdef MS_HAVE_MPI
@@ -59,7 +59,7 @@ static int progress_bar(void *user, double frac)
 int ms_cli_bake(int argc, char **argv)
 {
     enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE };
+           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -69,7 +69,7 @@ int ms_cli_bake(int argc, char **argv)
         { "samples", required_argument, 0, O_SAMPLES }, { "seed", required_argument, 0, O_SEED },
         { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
         { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
-        { "verbose", no_argument, 0, O_VERBOSE },
+        { "verbose", no_argument, 0, O_VERBOSE }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -135,6 +135,7 @@ int ms_cli_bake(int argc, char **argv)
         case O_VIS: outs[3].path = optarg; break;
         case O_SHADOW: outs[4].path = optarg; break;
         case O_QUIET: quiet = 1; break;
+        case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &bo.points.max_memory)) return EXIT_BAD_INPUT; break;
         case O_VERBOSE: ms_set_warning_verbose(1); break;
 #ifdef MS_HAVE_MPI
         case O_MPI_SCHEDULE:

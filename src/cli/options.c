@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 void ms_cli_parser_init(ms_cli_parser *p, const char *prog, const struct option *longopts)
 {
@@ -93,4 +94,29 @@ int ms_cli_check_method(const ms_cli_parser *p, const char *method)
     else fprintf(stderr, "%s: --method: '%s' is not a known method (did you mean %s? see --help)\n", p->prog, method,
                  ms_nearest_name(method, ms_method_names(), NULL));
     return -1;
+}
+
+int ms_cli_parse_size(const ms_cli_parser *p, const char *opt, const char *s, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    const double v = strtod(s, &end);
+    double scale = 1.0;
+    /* A unit: K, M, G or T (powers of 1024), with an optional "i" and "B"; a bare "B" or nothing: bytes. */
+    static const char units[] = "KMGT";
+    const char *u = *end && (end[0] & ~0x20) ? strchr(units, end[0] & ~0x20) : NULL;
+    const char *rest = end;
+    if (u) {
+        for (const char *q = units; q <= u; q++) scale *= 1024.0;
+        rest = end + 1;
+        if (*rest == 'i') rest++;
+    }
+    if (*rest == 'B' || *rest == 'b') rest++;
+    if (errno || end == s || *rest || !(v > 0.0) || !(v * scale < 9.2e18) || v * scale < 1.0) {
+        fprintf(stderr, "%s: %s: '%s' is not a size in bytes (a number, optionally with K, M, G or T: e.g. 512M, 1.5G)\n",
+                p->prog, opt, s);
+        return -1;
+    }
+    *out = (uint64_t)(v * scale);
+    return 0;
 }

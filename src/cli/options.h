@@ -4,6 +4,7 @@
 #ifndef MS_CLI_OPTIONS_H
 #define MS_CLI_OPTIONS_H
 #include <getopt.h>
+#include <stdint.h>
 
 #define EXIT_BAD_INPUT 2
 #define MS_CLI_MAX_OPTIONS 64
@@ -21,6 +22,9 @@ void ms_cli_parser_init(ms_cli_parser *p, const char *prog, const struct option 
 int ms_cli_next(ms_cli_parser *p, int argc, char **argv);
 /* An integer value in [lo, hi] of option opt; -1 after printing one line. */
 int ms_cli_parse_long(const ms_cli_parser *p, const char *opt, const char *s, long lo, long hi, long *out);
+/* A size in bytes of option opt: a positive number with an optional unit K, M, G, T (powers of 1024; "Ki",
+ * "KiB", "KB" alike); -1 after printing one line. */
+int ms_cli_parse_size(const ms_cli_parser *p, const char *opt, const char *s, uint64_t *out);
 /* 0 when method is compiled in; otherwise -1 after one line (not compiled in, or unknown with the nearest
  * known method suggested). */
 int ms_cli_check_method(const ms_cli_parser *p, const char *method);

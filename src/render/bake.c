@@ -5,9 +5,11 @@
 #include "microshadow.h"
 #include "points.h"
 #include "lightmap_unwrap.h"
+#include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
 #include "visibility/receiver.h"
+#include "shadow/method.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -223,6 +225,27 @@ static int dilate(ms_frame *f, int passes)
     return 0;
 }
 
+/* The memory budget of a bake (budget.h) with its size and lights, building the accel here or not; the
+ * estimate into *need when not NULL. */
+static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, int size, int build_accel, uint64_t *need,
+                             char *err, size_t errlen)
+{
+    ms_bake_shape bs;
+    memset(&bs, 0, sizeof bs);
+    bs.size = size;
+    ms_scene_lights(scene, &bs.nl);
+    bs.n_tris = scene->n_tris;
+    bs.build_accel = build_accel;
+    bs.unwrap = o->uv_set < 0 || !scene->tri_uv[o->uv_set];
+    const int samples = o->points.samples > 0 ? o->points.samples : MS_SAMPLES_DEFAULT;
+    bs.mask_words = (samples + 63) / 64;
+    bs.threads = o->points.threads > 0 ? o->points.threads : omp_get_num_procs();
+    const ms_shadow_method *sm = ms_find_shadow_method(o->points.method ? o->points.method : MS_DEFAULT_METHOD);
+    bs.whole_tri_copy = sm && sm->visibility_all;
+    if (need) *need = ms_bake_need(&bs, NULL);
+    return ms_bake_budget_check(&bs, ms_memory_budget(o->points.max_memory), err, errlen) ? MS_ERR_BUDGET : MS_OK;
+}
+
 /* The layout of the lightmap (ms_bake_layout): checks, UVs, texel rasterization, the frame's arrays. */
 ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *out, char *err, size_t errlen)
 {
@@ -242,6 +265,8 @@ ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, m
         snprintf(err, errlen, "UV set must be in [0, %d], or -1 for xatlas", MS_MAX_UV_SETS - 1);
         return MS_ERR_INVALID;
     }
+    ms_status bst = bake_budget(scene, o, size, 0, NULL, err, errlen);
+    if (bst) return bst;
     const int padding = o->padding > 0 ? o->padding : 2;
     ms_status st = choose_uvs(scene, o, size, padding, out, err, errlen);
     const double t_raster = omp_get_wtime();
@@ -460,6 +485,17 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
                   char *err, size_t errlen)
 {
     const double t_start = omp_get_wtime();
+    if (out) memset(out, 0, sizeof *out);
+    ms_bake_options zero;
+    memset(&zero, 0, sizeof zero);
+    const ms_bake_options *o = opt_in ? opt_in : &zero;
+    const int size = o->size ? o->size : 1024;
+    uint64_t need = 0;
+    if (scene && (scene->tri || !scene->n_tris) && size >= 1 && size <= MS_MAX_IMAGE_SIZE && o->uv_set >= -1 &&
+        o->uv_set < MS_MAX_UV_SETS) {   /* with the accel built here; ms_bake_layout checks the rest */
+        ms_status bst = bake_budget(scene, o, size, !accel, &need, err, errlen);
+        if (bst) return bst;
+    }
     ms_status st = ms_bake_layout(scene, opt_in, out, err, errlen);
     if (st) return st;
     ms_accel *own = NULL;
@@ -472,5 +508,7 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
     ms_accel_free(own);
     if (st) { ms_lightmap_free(out); return st; }
     out->frame.stats.total_s = omp_get_wtime() - t_start + scene->load_s;
+    out->frame.stats.memory_need = need;
+    out->frame.stats.memory_budget = ms_memory_budget(o->points.max_memory);
     return MS_OK;
 }

@@ -23,6 +23,7 @@
 #include "shade.h"
 #include "render_materialise.h"
 #include "interleave_filter.h"
+#include "budget.h"
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -184,18 +185,13 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         free(j);
         return -1;
     }
-    /* A procedural scene: streamed when the shadow method and the primary can (no BVH), else materialised. */
-    int streamed = procedural;
-    if (streamed && !(sm->streams && pm->streams)) {
-        if (ms_scene_materialise(scene, j->threads, &j->soup, err, errlen)) { free(j); return -1; }
-        j->own_soup = 1;
-        scene = &j->soup;
-        streamed = 0;
-        j->t_start = omp_get_wtime();   /* the generation counts as loading (soup.load_s) */
-    }
-    j->scene = scene;
+    /* A procedural scene: streamed when the shadow method and the primary can (no BVH), else materialised
+     * (below, once the options are checked and the budget allows it). */
+    const int streamed = procedural && sm->streams && pm->streams;
     j->streamed = streamed;
+    j->scene = scene;
     j->lights = ms_scene_lights(scene, &j->nlights);
+    int rc = -1;
     const int samples = opt->samples > 0 ? opt->samples : scene->samples;
     if ((unsigned)opt->pattern > MS_PATTERN_INTERLEAVED) { snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern); goto fail; }
     if ((unsigned)opt->traversal > MS_TRAVERSAL_PIXEL) { snprintf(err, errlen, "unknown traversal %d", (int)opt->traversal); goto fail; }
@@ -216,6 +212,46 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     if (W < 1 || H < 1 || W > MS_MAX_IMAGE_SIZE || H > MS_MAX_IMAGE_SIZE) {
         snprintf(err, errlen, "width and height must be in [1, %d]", MS_MAX_IMAGE_SIZE);
         goto fail;
+    }
+    /* The memory budget, before anything proportional to the frame or the scene is allocated. */
+    {
+        ms_frame_shape fs;
+        memset(&fs, 0, sizeof fs);
+        fs.W = W;
+        fs.H = H;
+        fs.nl = j->nlights;
+        fs.n_tris = scene->n_tris;
+        fs.materialise = procedural && !streamed;
+        fs.bvh = !streamed;
+        fs.surf = !streamed && (scene->tri_material || scene->tri_normal);
+        fs.mask_words = (spp + 63) / 64;
+        fs.npk = spp / 16;
+        fs.whole_frame = sm->visibility_all != NULL;
+        fs.scanline_slots = strcmp(sm->name, "hpc-scanline") == 0;
+        fs.shallow_per_light = (sm->needs_grid && opt->traversal != MS_TRAVERSAL_PIXEL) || strcmp(sm->name, "mft") == 0;
+        fs.hpc_order = sm->visibility_all != NULL && !streamed;
+        fs.embree = strcmp(sm->name, "embree") == 0 || strcmp(pm->name, "embree") == 0;
+        fs.primary_depth = strcmp(pm->name, "depth") == 0;
+        fs.primary_3dr = strncmp(pm->name, "3dr", 3) == 0;
+        fs.primary_3dr_setups = fs.primary_3dr && !streamed;
+        fs.filter = opt->pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter;
+        for (size_t l = 0; l < j->nlights; l++) fs.textured |= j->lights[l].texture != NULL;
+        fs.threads = j->threads;
+        const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
+                         (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
+        fs.occluders = (sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0)) != 0;
+        const uint64_t budget = ms_memory_budget(opt->max_memory);
+        if (ms_frame_budget_check(&fs, budget, err, errlen)) { rc = MS_ERR_BUDGET; goto fail; }
+        j->frame.stats.memory_need = ms_frame_need(&fs, NULL);
+        j->frame.stats.memory_budget = budget;
+    }
+    if (procedural && !streamed) {
+        if (ms_scene_materialise(scene, j->threads, &j->soup, err, errlen)) goto fail;
+        j->own_soup = 1;
+        scene = &j->soup;
+        j->scene = scene;
+        j->lights = ms_scene_lights(scene, &j->nlights);
+        j->t_start = omp_get_wtime();   /* the generation counts as loading (soup.load_s) */
     }
     ms_render_ctx *ctx = &j->ctx;
     ms_render_ctx_init(ctx, scene, streamed ? NULL : &j->bvh, &j->lights[0], opt->pattern, ms_samples_to_k(samples),
@@ -305,7 +341,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     return 0;
 fail:
     ms_frame_job_free(j);
-    return -1;
+    return rc;
 }
 
 int ms_frame_job_tiles(const ms_frame_job *j, int *tiles_x, int *tiles_y)

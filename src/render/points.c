@@ -6,6 +6,7 @@
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"
 #include "points.h"
+#include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
 #include "light/light_frame.h"
@@ -46,6 +47,7 @@ const char *ms_status_name(ms_status s)
     case MS_ERR_CANCELLED: return "cancelled";
     case MS_ERR_METHOD: return "method";
     case MS_ERR_IO: return "i/o";
+    case MS_ERR_BUDGET: return "over the memory budget";
     }
     return "unknown status";
 }
@@ -60,6 +62,17 @@ ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, cha
         return MS_ERR_INVALID;
     }
     if (scene->n_tris >= UINT32_MAX) { snprintf(err, errlen, "ms_accel_build: more than 2^32-2 triangles"); return MS_ERR_INVALID; }
+    {   /* No options here: the default budget (ms_memory_budget). */
+        const uint64_t need = ms_accel_need(scene->n_tris), budget = ms_memory_budget(0);
+        if (need > budget) {
+            char nb[32], bb[32];
+            ms_bytes_text(need, nb, sizeof nb);
+            ms_bytes_text(budget, bb, sizeof bb);
+            snprintf(err, errlen, "the acceleration structure over %zu triangles needs about %s but the default memory budget is %s (%d%% of "
+                     "physical memory)", scene->n_tris, nb, bb, MS_MEMORY_DEFAULT_PERCENT);
+            return MS_ERR_BUDGET;
+        }
+    }
     ms_accel *a = calloc(1, sizeof *a);
     if (!a) { snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
     a->threads = threads > 0 ? threads : omp_get_num_procs();
@@ -259,6 +272,10 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
         return MS_ERR_INVALID;
     }
     const int threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
+    const uint64_t budget = ms_memory_budget(opt->max_memory);
+    if (ms_points_budget_check(pts->n, a->view.n_tris, sm->visibility_all != NULL, (k * k + 63) / 64, threads, budget, err,
+                               errlen))
+        return MS_ERR_BUDGET;
 
     /* The hpc methods (those with a frame-level entry) read the scene's triangles in scene order
      * (hpc_method.c), which the accel keeps only in the BVH's leaf order: a scene-order copy for this call. */
@@ -456,6 +473,8 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
         stats->shadow_factor_s = resolve_thread_s / threads;
         stats->n_counters = sm->n_counters;
         for (int c = 0; c < sm->n_counters; c++) { stats->counter_name[c] = sm->counter_names[c]; stats->counter[c] = counters[c]; }
+        stats->memory_need = ms_points_need(n, a->view.n_tris, sm->visibility_all != NULL, (int)mw, threads, NULL);
+        stats->memory_budget = budget;
         stats->total_s = omp_get_wtime() - t_start;
     }
     return MS_OK;

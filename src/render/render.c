@@ -9,7 +9,8 @@ int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out
 {
     memset(out, 0, sizeof *out);
     ms_frame_job *job;
-    if (ms_frame_job_create(scene, opt, &job, err, errlen)) return -1;
+    const int crc = ms_frame_job_create(scene, opt, &job, err, errlen);
+    if (crc) return crc == MS_ERR_BUDGET ? MS_ERR_BUDGET : -1;
     int rc = ms_frame_job_render(job, NULL, ms_frame_job_tiles(job, NULL, NULL), err, errlen);
     if (rc == 0) rc = ms_frame_job_finish(job, out, err, errlen) ? -1 : 0;
     else if (rc != MS_ERR_CANCELLED) rc = -1;

@@ -131,6 +131,23 @@ class QuadTest(unittest.TestCase):
         ms.visibility_points(self.scene, pos, nor, progress=lambda f: seen.append(f) and False)
         self.assertEqual(seen[-1], 1.0)
 
+    def test_memory_budget(self):
+        sc = ms.default_scene()
+        # over the budget: status 6 and the one line naming need, budget and what would fit; within it: runs
+        with self.assertRaises(ms.Error) as cm:
+            ms.render(sc, samples=256, width=4096, height=4096, max_memory=16 << 20)
+        self.assertEqual(cm.exception.status, 6)
+        self.assertIn("but the memory budget is 16.0 MiB", str(cm.exception))
+        self.assertIn("would fit", str(cm.exception))
+        f = ms.render(sc, samples=256, width=64, height=64, max_memory=16 << 20)
+        self.assertLessEqual(f["stats"]["memory_need"], 16 << 20)
+        self.assertEqual(f["stats"]["memory_budget"], 16 << 20)
+        with self.assertRaises(ms.Error) as cm:
+            ms.bake(sc, size=4096, uv=None, samples=256, max_memory=8 << 20)
+        self.assertEqual(cm.exception.status, 6)
+        with self.assertRaises(ValueError):
+            ms.render(sc, max_memory=-1)
+
     def test_render(self):
         a = ms.render(self.scene, method="scanline", samples=256)
         b = ms.render(self.scene, method="raytrace", samples=256)
