@@ -89,6 +89,8 @@ int hpc_volume_build(hpc_volume *v, const double *poly, int np, const float tri[
         }
     }
     if (v->n == 0) v->unbounded = 1;
+    for (int i = 0; i < v->n; i++)
+        for (int a = 0; a < 4; a++) v->soa[a][i] = v->pl[i][a];
     return v->n;
 }
 
