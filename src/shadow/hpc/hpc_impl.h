@@ -519,33 +519,48 @@ static unsigned group_block16(const shared *sh, const ms_shadow_query *q, const 
                               int j0, int w, unsigned live, const tri_job *t, const float A[3], const float B[3],
                               const float C[3], float num)
 {
-    const int k = sh->k;
-    float fi[LANES], fj[LANES];
+    /* Lane l's column and row offsets in the block, w = 4 or 8 columns (small integers: exact in float). */
+    static const float off[2][2][LANES] = {
+        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+    const int k = sh->k, wi = w == 8, rows = LANES / w;
+    /* A group lies within one 16-sample packet per row: the row's packet gives its lanes' shear axis. */
     unsigned m0 = 0, m1 = 0, mneg = 0;
-    for (int l = 0; l < LANES; l++) {
-        const int i = i0 + (l & (w - 1)), j = j0 + l / w, z = kz[(j * k + i) / LANES];
-        fi[l] = (float)i;
-        fj[l] = (float)j;
-        m0 |= (unsigned)(z == 0) << l;
-        m1 |= (unsigned)(z == 1) << l;
-        mneg |= (unsigned)(z < 0) << l;
+    const unsigned rowbits = (1u << w) - 1u;
+    int z0 = kz[(j0 * k + i0) / LANES], uniform = z0 >= 0;
+    for (int r = 0; r < rows; r++) {
+        const int z = kz[((j0 + r) * k + i0) / LANES];
+        uniform &= z == z0;
+        m0 |= (z == 0 ? rowbits : 0u) << (r * w);
+        m1 |= (z == 1 ? rowbits : 0u) << (r * w);
+        mneg |= (z < 0 ? rowbits : 0u) << (r * w);
     }
-    const l16 li = l16_load(fi), lj = l16_load(fj);
+    const l16 li = l16_add(l16_set1((float)i0), l16_load(off[wi][0])), lj = l16_add(l16_set1((float)j0), l16_load(off[wi][1]));
     l16 d[3];
     for (int a = 0; a < 3; a++)
         d[a] = l16_sub(l16_add(l16_add(l16_set1(g->p0[a]), l16_mul(li, l16_set1(g->ds[a]))), l16_mul(lj, l16_set1(g->dt[a]))),
                        l16_set1(q->p[a]));
-    /* kz = 0: kx = 1, ky = 2; kz = 1: kx = 2, ky = 0; kz = 2: kx = 0, ky = 1. */
-    const l16 dz = sel3(m0, m1, d[0], d[1], d[2]), dx = sel3(m0, m1, d[1], d[2], d[0]), dy = sel3(m0, m1, d[2], d[0], d[1]);
-    const l16 inv = l16_div(l16_set1(1.0f), dz), sx = l16_mul(dx, inv), sy = l16_mul(dy, inv);
+    /* kz = 0: kx = 1, ky = 2; kz = 1: kx = 2, ky = 0; kz = 2: kx = 0, ky = 1. One axis for every lane (the
+     * rule): no per-lane selection. */
+    l16 dz, dx, dy, Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz;
+    if (uniform) {
+        const int zx = z0 + 1 == 3 ? 0 : z0 + 1, zy = zx + 1 == 3 ? 0 : zx + 1;
+        dz = d[z0]; dx = d[zx]; dy = d[zy];
+        Ax = l16_set1(A[zx]); Ay = l16_set1(A[zy]); Az = l16_set1(A[z0]);
+        Bx = l16_set1(B[zx]); By = l16_set1(B[zy]); Bz = l16_set1(B[z0]);
+        Cx = l16_set1(C[zx]); Cy = l16_set1(C[zy]); Cz = l16_set1(C[z0]);
+    } else {
+        dz = sel3(m0, m1, d[0], d[1], d[2]); dx = sel3(m0, m1, d[1], d[2], d[0]); dy = sel3(m0, m1, d[2], d[0], d[1]);
 #define HPC_VCOMP(V, x, y, zz)                                                                                 \
-    const l16 x = sel3(m0, m1, l16_set1(V[1]), l16_set1(V[2]), l16_set1(V[0]));                                \
-    const l16 y = sel3(m0, m1, l16_set1(V[2]), l16_set1(V[0]), l16_set1(V[1]));                                \
-    const l16 zz = sel3(m0, m1, l16_set1(V[0]), l16_set1(V[1]), l16_set1(V[2]))
-    HPC_VCOMP(A, Ax, Ay, Az);
-    HPC_VCOMP(B, Bx, By, Bz);
-    HPC_VCOMP(C, Cx, Cy, Cz);
+        x = sel3(m0, m1, l16_set1(V[1]), l16_set1(V[2]), l16_set1(V[0]));                                      \
+        y = sel3(m0, m1, l16_set1(V[2]), l16_set1(V[0]), l16_set1(V[1]));                                      \
+        zz = sel3(m0, m1, l16_set1(V[0]), l16_set1(V[1]), l16_set1(V[2]))
+        HPC_VCOMP(A, Ax, Ay, Az);
+        HPC_VCOMP(B, Bx, By, Bz);
+        HPC_VCOMP(C, Cx, Cy, Cz);
 #undef HPC_VCOMP
+    }
+    const l16 inv = l16_div(l16_set1(1.0f), dz), sx = l16_mul(dx, inv), sy = l16_mul(dy, inv);
     const l16 ax = l16_sub(Ax, l16_mul(sx, Az)), ay = l16_sub(Ay, l16_mul(sy, Az));
     const l16 bx = l16_sub(Bx, l16_mul(sx, Bz)), by = l16_sub(By, l16_mul(sy, Bz));
     const l16 cx = l16_sub(Cx, l16_mul(sx, Cz)), cy = l16_sub(Cy, l16_mul(sy, Cz));
@@ -663,10 +678,12 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     if (sh->full[r] || q->prim == t->self) return;
     c->cnt[C_POINT_TESTS]++;
     if (!vol_point(sh, &t->vl, pl, q->p, &c->cnt[C_PLANE_TESTS])) return;
-    ms_grid g;
-    ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g);
+    ms_grid g;   /* the point's samples, formed when first needed */
+    int have_g = 0;
+#define HPC_GRID() (have_g ? (void)0 : (ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g), (void)(have_g = 1)))
     int32_t s = sh->slot[r];
     if (s < 0) {
+        HPC_GRID();
         if ((s = slot_get(sh, c)) < 0) { c->failed = 1; return; }
         sh->slot[r] = s;
         memcpy(slot_mask(sh, c, s), sh->front + (size_t)r * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
@@ -703,11 +720,13 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
             if (gu >> gk & 1u) continue;
             c->cnt[C_GROUP_POINT_TESTS]++;
             if (!vol_point(sh, &c->gvol[gk], ag[i].planes, q->p, &c->cnt[C_PLANE_TESTS])) continue;
+            HPC_GRID();
             const int done = sh->sw & MS_HPC_OFF_SIMD_SAMPLES ? cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
                                                               : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num);
             if (done) gu |= UINT64_C(1) << gk;
         }
     }
+#undef HPC_GRID
     if (sh->sw & MS_HPC_OFF_UMBRA) return;   /* A off: umbra found by casting is not recorded */
     sh->gumbra[r] = gu;
     if (gu == sh->all_groups) {
