@@ -199,7 +199,7 @@ int main(int argc, char **argv)
      * run the defaults. */
     const char *methods[MAX_METHODS] = { "raytrace", "embree:packet16", "embree:stream", "mft", "bounds", "hierarchical",
                                          "scanline:pixel", "scanline" };
-    int n_methods = 8, quality_only = 0;
+    int n_methods = 8, quality_only = 0, no_quality = 0;
     ms_pattern pattern = MS_PATTERN_GRID;   /* --pattern: the main table's samples (interleaved: filtered, as rendered) */
     const char *pattern_name = "grid";
     /* The command line as given, for the header (strtok below cuts the lists). */
@@ -214,6 +214,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) out_md = argv[++i];
         else if (!strcmp(argv[i], "--quality-only")) quality_only = 1;
+        else if (!strcmp(argv[i], "--no-quality")) no_quality = 1;
         else if (!strcmp(argv[i], "--pattern") && i + 1 < argc) {
             const char *pn = argv[++i];
             if (!strcmp(pn, "grid")) pattern = MS_PATTERN_GRID;
@@ -231,7 +232,7 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr, "usage: bench_scenes [--scenes DIR] [--samples 256,1024,4096] [--size S] [--threads T] "
                             "[--methods raytrace,embree:packet16,embree:stream,mft,bounds,hierarchical,scanline:pixel,scanline] "
-                            "[--pattern grid|interleaved|stratified] [--quality-only] "
+                            "[--pattern grid|interleaved|stratified] [--quality-only | --no-quality] "
                             "[--out FILE.md]\n");
             return 2;
         }
@@ -415,7 +416,7 @@ int main(int argc, char **argv)
         memset(log_scan, 0, sizeof log_scan); memset(log_emb, 0, sizeof log_emb);
         memset(n_scan, 0, sizeof n_scan); memset(n_emb, 0, sizeof n_emb);
     }
-    FILE *mem = open_memstream(&sec, &sec_len);
+    FILE *mem = no_quality ? NULL : open_memstream(&sec, &sec_len);
     if (mem) {
         quality_table(mem, scenes, n_scenes, size, threads, date, cmd);
         fclose(mem);

@@ -349,6 +349,9 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     mask = mft_leaf_lanes(s, n, before);
     /* Interleaved: each live packet's rays against the leaf's box (mft_ray_box). */
     uint16_t enter[MS_BLOCK_LANES][MFT_MAX_IPK];
+    uint16_t genter[MS_BLOCK_LANES][256];   /* grid: packets' rays entering the leaf, computed when first needed */
+    uint64_t gdone[MS_BLOCK_LANES][4];
+    if (f->cells) memset(gdone, 0, sizeof gdone);
     if (!f->cells)
         for (unsigned m = mask; m; m &= m - 1) {
             const int l = __builtin_ctz(m);
@@ -507,9 +510,17 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                     const int clo = (x0 > col0 ? x0 : col0) - col0, chi = (x1 < col0 + 15 ? x1 : col0 + 15) - col0;
                     const unsigned cols = (0xFFFFu >> (15 - (chi - clo))) << clo;
                     const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
-                    const unsigned bits = all & cols & (f->cells ? 0xFFFFu : (unsigned)enter[l][ch]);
+                    unsigned bits = all & cols & (f->cells ? 0xFFFFu : (unsigned)enter[l][ch]);
                     if (!bits) continue;
                     if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
+                    if (f->cells) {   /* the packet's rays against the leaf's box, once per leaf */
+                        if (!(gdone[l][ch >> 6] >> (ch & 63) & 1)) {
+                            genter[l][ch] = (uint16_t)mft_ray_box(s, l, ch, n);
+                            gdone[l][ch >> 6] |= UINT64_C(1) << (ch & 63);
+                        }
+                        bits &= genter[l][ch];
+                        if (!bits) continue;
+                    }
                     isec++;
                     unsigned hit = mft_packet(L, ch, bits, tri, N, V, numv[l], f->near, f->far);
                     /* Any hit: an alpha-tested triangle keeps only the rays where it is opaque (alpha.h, the
