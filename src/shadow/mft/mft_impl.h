@@ -31,7 +31,7 @@
  *  - rays are not generated from delta vectors at every test but formed once per pixel and 16-sample
  *    packet, when the packet is first tested (mft.c, ms_mft_rays), and kept for the block: the exact
  *    agreement with raytrace needs its shear (one division per ray), which generating rays at every
- *    test would repeat; 16 pixels x N x 5 floats (320 KB at N = 1024) stay in the L2 cache;
+ *    test would repeat; 16 pixels x N x 8 floats (with the reciprocals of mft_ray_box; 512 KB at N = 1024) stay in the L2 cache;
  *  - the paper tests a frustum's 16 rays (its interleaved set) in one operation; with N up to 4096 rays
  *    per frustum, we test N/16 packets, only those the triangle's footprint reaches (16 rays need no
  *    footprint);
@@ -41,7 +41,10 @@
  *    ray-AABB tests, Table 2) did not pay on Larrabee; this one tests the 16 frusta at once and removes
  *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
- *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept). */
+ *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept);
+ *  - at a leaf, each packet's rays take raytrace's box test before the triangles (mft_ray_box: the paper's
+ *    "Ray-AABB", which did not pay on Larrabee): needed in the interleaved mode, whose frusta span the
+ *    whole light, and a small gain on the grid (docs/design.md, "mft"). */
 #include <math.h>
 #include <string.h>
 #include "mft.h"
