@@ -42,9 +42,10 @@
  *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
  *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept);
- *  - at a leaf, each packet's rays take raytrace's box test before the triangles (mft_ray_box: the paper's
- *    "Ray-AABB", which did not pay on Larrabee): needed in the interleaved mode, whose frusta span the
- *    whole light, and a small gain on the grid (docs/design.md, "mft"). */
+ *  - in the interleaved mode, at a leaf, each packet's rays take raytrace's box test before the triangles
+ *    (mft_ray_box: the paper's "Ray-AABB", which did not pay on Larrabee): its frusta span the whole light.
+ *    On the grid the same test (once per leaf and packet) cut the 16-ray tests 1.3-3.6x but not the time
+ *    (big-light Sponza -7%, GRIDS-like bars and ogre +4-7% CPU): not kept (docs/design.md, "mft"). */
 #include <math.h>
 #include <string.h>
 #include "mft.h"
@@ -352,9 +353,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     mask = mft_leaf_lanes(s, n, before);
     /* Interleaved: each live packet's rays against the leaf's box (mft_ray_box). */
     uint16_t enter[MS_BLOCK_LANES][MFT_MAX_IPK];
-    uint16_t genter[MS_BLOCK_LANES][256];   /* grid: packets' rays entering the leaf, computed when first needed */
-    uint64_t gdone[MS_BLOCK_LANES][4];
-    if (f->cells) memset(gdone, 0, sizeof gdone);
     if (!f->cells)
         for (unsigned m = mask; m; m &= m - 1) {
             const int l = __builtin_ctz(m);
@@ -538,14 +536,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                 unsigned bits = all & ccols[ci] & (f->cells ? 0xFFFFu : (unsigned)enter[l][ch]);
                 if (!bits) continue;
                 if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
-                if (f->cells) {   /* the packet's rays against the leaf's box, once per leaf */
-                    if (!(gdone[l][ch >> 6] >> (ch & 63) & 1)) {
-                        genter[l][ch] = (uint16_t)mft_ray_box(s, l, ch, n);
-                        gdone[l][ch >> 6] |= UINT64_C(1) << (ch & 63);
-                    }
-                    bits &= genter[l][ch];
-                    if (!bits) continue;
-                }
                 isec++;
                 unsigned hit = mft_packet(L, ch, bits, tri, N, V, numv[l], f->near, f->far);
                 /* Any hit: an alpha-tested triangle keeps only the rays where it is opaque (alpha.h, the
