@@ -533,7 +533,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             for (int ci = 0; ci < nc; ci++) {
                 const int ch = cand[ci], w = ch >> 6, sh = (ch & 3) * 16;
                 const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
-                unsigned bits = all & ccols[ci] & (f->cells ? 0xFFFFu : (unsigned)enter[l][ch]);
+                unsigned bits = all & ccols[ci];
+                if (!f->cells) bits &= enter[l][ch];
                 if (!bits) continue;
                 if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
                 isec++;
