@@ -12,8 +12,12 @@
  * --light-scale F: the light's edges times F about its centre (2: the paper's 4x light).
  * --no-reference: leave out raytrace and scanline (their columns read "-").
  * --cpu: the methods' totals in CPU seconds of all threads (ms_stats.shadow_cpu_s) instead of wall seconds,
- *        for a machine shared with other work; hpc's phase columns stay wall seconds. */
+ *        for a machine shared with other work; hpc's phase columns stay wall seconds.
+ * --methods LIST: only these of raytrace, scanline, hpc, hpc-scanline (hpc always runs; absent columns "-").
+ * --off LIST: hpc with parts turned off (ms_hpc_switches, src/shadow/hpc/hpc.h), to measure each alone:
+ *        umbra (A), planesets (B), lazy (C), ondemand (D), sort, simdsamples, simdplanes. */
 #include "microshadow.h"
+#include "shadow/hpc/hpc.h"
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -76,7 +80,7 @@ int main(int argc, char **argv)
     int samples[4] = { 256 }, nsamples = 1, threads = 0, sizes[8] = { 512, 1024, 2048 }, nsizes = 3, reference = 1;
     float scales[4] = { 1.0f };
     int nscales = 1;
-    int first = 1;
+    int first = 1, run[NM] = { 1, 1, 1, 1 };
     for (; first < argc && argv[first][0] == '-'; first += 2) {
         if (!strcmp(argv[first], "--no-reference")) { reference = 0; first--; continue; }
         if (!strcmp(argv[first], "--cpu")) { g_cpu = 1; first--; continue; }
@@ -85,7 +89,19 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[first], "--threads")) threads = atoi(argv[first + 1]);
         else if (!strcmp(argv[first], "--sizes")) nsizes = parse_list(argv[first + 1], sizes, 8);
         else if (!strcmp(argv[first], "--light-scale")) nscales = parse_flist(argv[first + 1], scales, 4);
-        else { fprintf(stderr, "bench_hpc: unknown option %s\n", argv[first]); return 2; }
+        else if (!strcmp(argv[first], "--methods")) {
+            for (int m = 0; m < NM; m++) run[m] = m == HPC;
+            for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ","))
+                for (int m = 0; m < NM; m++) run[m] |= !strcmp(t, methods[m]);
+        } else if (!strcmp(argv[first], "--off")) {
+            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes" };
+            for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ",")) {
+                int found = 0;
+                for (int b = 0; b < 7; b++)
+                    if (!strcmp(t, names[b])) { ms_hpc_switches |= 1 << b; found = 1; }
+                if (!found) { fprintf(stderr, "bench_hpc: --off: unknown part %s\n", t); return 2; }
+            }
+        } else { fprintf(stderr, "bench_hpc: unknown option %s\n", argv[first]); return 2; }
     }
     if (first >= argc || !nsamples || !nsizes || !nscales) {
         fprintf(stderr, "usage: bench_hpc [--samples a,b] [--sizes a,b,c] [--light-scale 1,2] [--threads T] [--no-reference] [--cpu] SCENE.json|builtin ...\n");
@@ -111,7 +127,7 @@ int main(int argc, char **argv)
                     ms_frame f[NM];
                     int have[NM] = { 0 };
                     for (int m = 0; m < NM; m++) {
-                        if (!reference && m < HPC) continue;
+                        if ((!reference && m < HPC) || !run[m]) continue;
                         ms_render_options o;
                         ms_render_options_default(&o);
                         o.method = methods[m];
@@ -133,14 +149,15 @@ int main(int argc, char **argv)
                     for (int d = 0; d < 2; d++) snprintf(diff[d], sizeof diff[d], "-");
                     if (have[RT]) {
                         snprintf(ratio[0], sizeof ratio[0], "%.2f", total_s(&f[RT], RT) / total_s(&f[HPC], HPC));
-                        snprintf(ratio[1], sizeof ratio[1], "%.2f", total_s(&f[RT], RT) / total_s(&f[HPCS], HPCS));
+                        if (have[HPCS]) snprintf(ratio[1], sizeof ratio[1], "%.2f", total_s(&f[RT], RT) / total_s(&f[HPCS], HPCS));
                         for (int d = 0; d < 2; d++) {
+                            if (!have[HPC + d]) continue;
                             long c = 0;
                             for (size_t i = 0; i < np; i++) c += f[HPC + d].vis[i] != f[RT].vis[i];
                             snprintf(diff[d], sizeof diff[d], "%ld", c);
                         }
                     }
-                    if (have[SL]) snprintf(ratio[2], sizeof ratio[2], "%.2f", total_s(&f[SL], SL) / total_s(&f[HPCS], HPCS));
+                    if (have[SL] && have[HPCS]) snprintf(ratio[2], sizeof ratio[2], "%.2f", total_s(&f[SL], SL) / total_s(&f[HPCS], HPCS));
                     const ms_frame *h = &f[HPC];
                     printf("| %s | x%g | %d | %d | %s | %s | %.3f | %.3f | %.3f | %s | %s | %s | %s | %s | %.1f | %.1f | %.1f | %s | %s "
                            "| %llu | %llu | %llu | %llu |\n",

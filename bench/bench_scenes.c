@@ -200,6 +200,8 @@ int main(int argc, char **argv)
     const char *methods[MAX_METHODS] = { "raytrace", "embree:packet16", "embree:stream", "mft", "bounds", "hierarchical",
                                          "scanline:pixel", "scanline" };
     int n_methods = 8, quality_only = 0, no_quality = 0;
+    ms_pattern pattern = MS_PATTERN_GRID;   /* --pattern: the main table's samples (interleaved: filtered, as rendered) */
+    const char *pattern_name = "grid";
     /* The command line as given, for the header (strtok below cuts the lists). */
     char cmdline[1024] = "";
     for (int i = 1; i < argc; i++) {
@@ -213,6 +215,14 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) out_md = argv[++i];
         else if (!strcmp(argv[i], "--quality-only")) quality_only = 1;
         else if (!strcmp(argv[i], "--no-quality")) no_quality = 1;
+        else if (!strcmp(argv[i], "--pattern") && i + 1 < argc) {
+            const char *pn = argv[++i];
+            if (!strcmp(pn, "grid")) pattern = MS_PATTERN_GRID;
+            else if (!strcmp(pn, "interleaved")) pattern = MS_PATTERN_INTERLEAVED;
+            else if (!strcmp(pn, "stratified")) pattern = MS_PATTERN_STRATIFIED;
+            else { fprintf(stderr, "bench_scenes: unknown pattern %s\n", pn); return 2; }
+            pattern_name = pn;
+        }
         else if (!strcmp(argv[i], "--samples") && i + 1 < argc) {
             n_samples = 0;
             for (char *t = strtok(argv[++i], ","); t && n_samples < 4; t = strtok(NULL, ",")) samples[n_samples++] = atoi(t);
@@ -221,7 +231,8 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[++i], ","); t && n_methods < MAX_METHODS; t = strtok(NULL, ",")) methods[n_methods++] = t;
         } else {
             fprintf(stderr, "usage: bench_scenes [--scenes DIR] [--samples 256,1024,4096] [--size S] [--threads T] "
-                            "[--methods raytrace,embree:packet16,embree:stream,mft,bounds,hierarchical,scanline:pixel,scanline] [--quality-only] "
+                            "[--methods raytrace,embree:packet16,embree:stream,mft,bounds,hierarchical,scanline:pixel,scanline] "
+                            "[--pattern grid|interleaved|stratified] [--quality-only | --no-quality] "
                             "[--out FILE.md]\n");
             return 2;
         }
@@ -266,8 +277,8 @@ int main(int argc, char **argv)
     for (int o = 0; o < 2; o++) {
         if (!outs[o]) continue;
         fprintf(outs[o], "Shadow seconds per method (primary visibility, shading and BVH build excluded), %dx%d, "
-                "grid pattern, seed 0, threads %s, measured %s by `build/bench_scenes",
-                size, size, threads ? "as given" : "= all cores", date);
+                "%s pattern, seed 0, threads %s, measured %s by `build/bench_scenes",
+                size, size, pattern_name, threads ? "as given" : "= all cores", date);
         fprintf(outs[o], "%s`. What the figures mean and how they moved: docs/scenes-notes.md (by hand; this file is "
                 "regenerated).\n\n", cmdline);
     }
@@ -310,6 +321,7 @@ int main(int argc, char **argv)
                 if (variant && !strcmp(variant + 1, "packet16")) opt.embree_mode = MS_EMBREE_PACKET16;
                 if (variant && !strcmp(variant + 1, "stream")) opt.embree_mode = MS_EMBREE_STREAM;
                 opt.samples = N;
+                opt.pattern = pattern;
                 opt.width = opt.height = size;
                 opt.threads = threads;
                 ms_frame f;

@@ -191,6 +191,80 @@ static void test_order_and_threads(void **st)
     ms_scene_free(&sc);
 }
 
+/* The engine's ISA instances (hpc_impl.h compiled per ISA) give the same masks, equal to raytrace's, and the same
+ * counters, at k = 16, 32 and 64 (64: groups of 8 x 8, four 16-lane blocks each); and every measuring switch
+ * (ms_hpc_switches: each optimisation of sec. 3.3 and each SIMD form off) changes the work, not the answer. */
+static void test_isa_instances_and_switches(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    const int W = 40, H = 40;
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
+    const size_t nt = bvh.n_tris;
+    uint32_t *area = ms_hpc_area_order(bvh.tri, nt);
+    assert_non_null(area);
+    for (int k = 16; k <= 64; k *= 2) {
+        ms_render_ctx ctx;
+        tu_ctx_init(&ctx, &sc, &bvh, W, H, k);
+        const ms_primary_method *pm = ms_find_primary_method("bvh");
+        void *ps = NULL;
+        char err[256];
+        assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
+        ms_hit *hits = malloc((size_t)W * H * sizeof *hits);
+        pm->trace(ps, &ctx, 0, 0, W, H, hits);
+        pm->destroy(ps);
+        ms_shadow_query *q = malloc((size_t)W * H * sizeof *q);
+        size_t n = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                if (hits[y * W + x].prim != UINT32_MAX) tu_query_from_hit(&q[n++], &hits[y * W + x], x, y);
+        const size_t mw = (size_t)ctx.mask_words;
+        uint64_t *front = malloc(n * mw * sizeof *front), *ref = malloc(n * mw * sizeof *ref);
+        uint64_t *vis = malloc(n * mw * sizeof *vis);
+        float *pts = malloc((size_t)ctx.samples * 3 * sizeof *pts);
+        uint64_t rc[MS_MAX_COUNTERS] = { 0 }, cnt0[MS_MAX_COUNTERS] = { 0 };
+        for (size_t i = 0; i < n; i++) {
+            ms_front_mask(&ctx, &q[i], NULL, front + i * mw);
+            ms_raytrace_visible_samples(&ctx, &q[i], pts, front + i * mw, ref + i * mw, rc);
+        }
+        int ran = 0;
+        for (int isa = MS_ISA_SCALAR; isa <= MS_ISA_AVX512; isa++) {
+            const ms_hpc_cast_fn fn = ms_hpc_cast_isa((ms_isa)isa);
+            if (!fn || (ctx.isa_cap != MS_ISA_AUTO && isa > (int)ctx.isa_cap)) continue;
+            perm_source ps2 = { &bvh, area, nt, 0 };
+            const hpc_source src = { &ps2, perm_rewind, perm_next };
+            uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+            memset(vis, 0xA5, n * mw * sizeof *vis);
+            assert_int_equal(fn(&ctx, 0, NULL, q, n, front, vis, &src, cnt), 0);
+            assert_memory_equal(vis, ref, n * mw * sizeof *vis);
+            /* Counters but the wall-clock ones (sort, build, rebuild, cast: microseconds). */
+            cnt[16] = cnt[17] = cnt[18] = cnt[19] = 0;
+            if (!ran) memcpy(cnt0, cnt, sizeof cnt);
+            else assert_memory_equal(cnt, cnt0, sizeof cnt);
+            ran++;
+        }
+        assert_true(ran >= 1);
+        for (int sw = 1; sw <= MS_HPC_OFF_SIMD_PLANES; sw <<= 1) {
+            perm_source ps2 = { &bvh, area, nt, 0 };
+            const hpc_source src = { &ps2, perm_rewind, perm_next };
+            uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+            ms_hpc_switches = sw;
+            const int rc2 = ms_hpc_cast(&ctx, 0, NULL, q, n, front, vis, &src, cnt);
+            ms_hpc_switches = 0;
+            assert_int_equal(rc2, 0);
+            assert_memory_equal(vis, ref, n * mw * sizeof *vis);
+        }
+        printf("k=%d: %zu points, %d ISA instances equal to raytrace and to each other (masks, counters: %llu sample "
+               "tests); 7 switches equal\n", k, n, ran, (unsigned long long)cnt0[9]);
+        free(front); free(ref); free(vis); free(pts); free(q); free(hits);
+    }
+    free(area);
+    ms_bvh_free(&bvh);
+    ms_scene_free(&sc);
+}
+
 /* The scene's own triangle array shuffled: the render still equals raytrace on it, on 1 and 2 threads. */
 static void test_shuffled_scene(void **st)
 {
@@ -313,6 +387,7 @@ int main(void)
         cmocka_unit_test(test_sibenik),
         cmocka_unit_test(test_sponza),
         cmocka_unit_test(test_order_and_threads),
+        cmocka_unit_test(test_isa_instances_and_switches),
         cmocka_unit_test(test_shuffled_scene),
         cmocka_unit_test(test_streamed_flowers),
         cmocka_unit_test(test_procedural_bad_input),

@@ -213,10 +213,6 @@ static void test_plane_cuts_light(void **st)
             const ms_shadow_method *sm = ms_find_shadow_method(methods[m]);
             if (!sm) { printf("%s not compiled in\n", methods[m]); continue; }
             if (sm->needs_grid && cfg[c].pat != MS_PATTERN_GRID) continue;
-            /* KNOWN BUG, skipped until fixed: mft with 16 samples (k = 4, stratified) does not give raytrace's
-             * V (one point in 200 here; frames of the built-in scene differ too). Found when this test took
-             * its methods from the registry (#22); the same before the layout change (base binary). */
-            if (!strcmp(methods[m], "mft") && k < 16) { printf("  mft          k=%d skipped: known bug\n", k); continue; }
             void *state = NULL;
             char err[256];
             assert_int_equal(sm->create(&ctx, &state, err, sizeof err), 0);

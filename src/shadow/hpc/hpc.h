@@ -1,11 +1,13 @@
 /* Hierarchical penumbra casting (Laine & Aila 2005), the engine shared by methods "hpc" and
- * "hpc-scanline" (hpc.c; the methods in hpc_method.c). */
+ * "hpc-scanline" (hpc_impl.h, compiled per ISA: hpc_scalar.c, hpc_avx2.c, hpc_avx512.c; the choice in
+ * hpc.c; the methods in hpc_method.c). */
 #ifndef MS_HPC_H
 #define MS_HPC_H
 #include <stddef.h>
 #include <stdint.h>
 #include "shadow/method.h"
 #include "raster/raster.h"
+#include "core/cpu.h"
 
 /* Where the blocker triangles come from: batches in any order, each triangle once. next writes up to max
  * triangles (9 floats each) and their ids (the prim id a receiver on that triangle carries, so that its own
@@ -26,6 +28,34 @@ typedef struct hpc_source {
  * source fails. */
 int ms_hpc_cast(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster, const ms_shadow_query *q, size_t n,
                 const uint64_t *front, uint64_t *vis, const hpc_source *src, uint64_t *counters);
+
+/* The engine's instances (hpc_impl.h): the same masks and counters on every ISA. ms_hpc_cast runs the one
+ * ms_hpc_cast_select picks under ctx->isa_cap. */
+typedef int (*ms_hpc_cast_fn)(const ms_render_ctx *, int, ms_raster_fn, const ms_shadow_query *, size_t,
+                              const uint64_t *, uint64_t *, const hpc_source *, uint64_t *);
+int ms_hpc_cast_scalar(const ms_render_ctx *, int, ms_raster_fn, const ms_shadow_query *, size_t, const uint64_t *,
+                       uint64_t *, const hpc_source *, uint64_t *);
+int ms_hpc_cast_avx2(const ms_render_ctx *, int, ms_raster_fn, const ms_shadow_query *, size_t, const uint64_t *,
+                     uint64_t *, const hpc_source *, uint64_t *);
+int ms_hpc_cast_avx512(const ms_render_ctx *, int, ms_raster_fn, const ms_shadow_query *, size_t, const uint64_t *,
+                       uint64_t *, const hpc_source *, uint64_t *);
+/* The instance for isa (NULL if this CPU lacks it) and the one for a cap (*chosen set when found). */
+ms_hpc_cast_fn ms_hpc_cast_isa(ms_isa isa);
+ms_hpc_cast_fn ms_hpc_cast_select(ms_isa cap, ms_isa *chosen);
+
+/* Measuring switches (bench_hpc --off), each turning one part of the engine off; 0, the default, is the
+ * engine as designed. Process-wide and read when a cast starts: set it before rendering, never during.
+ * Answers do not change, only the work. The letters are the paper's (sec. 3.3, Fig. 3). */
+enum {
+    MS_HPC_OFF_UMBRA = 1,        /* A: umbra bits (and the rebuild) */
+    MS_HPC_OFF_PLANE_SETS = 2,   /* B: active plane sets: every plane of a volume tested at every node */
+    MS_HPC_OFF_LAZY = 4,         /* C: lazy volumes: V_Gk built for every triangle, before the traversal */
+    MS_HPC_OFF_ON_DEMAND = 8,    /* D: on-demand masks: every receiver gets its mask before the first triangle */
+    MS_HPC_OFF_SORT = 16,        /* coarse blocker sorting: the scene's order (hpc_method.c) */
+    MS_HPC_OFF_SIMD_SAMPLES = 32,/* the 16-lane sample test: one sample at a time (the scalar form) */
+    MS_HPC_OFF_SIMD_PLANES = 64  /* the 16-lane volume tests: one plane at a time */
+};
+extern int ms_hpc_switches;
 
 /* Coarse blocker sorting (sec. 3.3): the order of n triangles (9 floats each) bucketed by area, largest
  * bucket first, stable within a bucket, in two linear passes (a histogram of log2 areas, then placement).

@@ -16,6 +16,7 @@ typedef struct hpc_state {
     int scanline;
     ms_raster_fn raster;
     ms_isa kernel_isa;
+    ms_isa cast_isa;      /* the engine's instance (hpc.c) */
     uint32_t *order;      /* scene triangles in area order */
     uint32_t *leaf_of;    /* scene index -> prim id (BVH leaf order) */
     double sort_s;        /* the coarse sort of the scene's triangles, done once in create */
@@ -46,6 +47,8 @@ static size_t procedural_next(void *user, float *tri, uint32_t *ids, size_t max)
     for (size_t c = 0; c < n; c += 1024) ms_procedural_triangles(sc, src->pos + c, n - c < 1024 ? n - c : 1024, raw + 9 * c);
     const double t0 = omp_get_wtime();
     uint32_t *order = ms_hpc_area_order(raw, n);
+    if (order && (ms_hpc_switches & MS_HPC_OFF_SORT))
+        for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
     src->sort_s += omp_get_wtime() - t0;
     if (!order) { free(raw); return (size_t)-1; }
     for (size_t i = 0; i < n; i++) {
@@ -76,6 +79,7 @@ static int hpc_create_common(const ms_render_ctx *ctx, void **state, char *err, 
     hpc_state *s = calloc(1, sizeof *s);
     if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
     s->scanline = scanline;
+    if (!ms_hpc_cast_select(ctx->isa_cap, &s->cast_isa)) s->cast_isa = MS_ISA_AUTO;
     if (scanline && !(s->raster = ms_raster_kernel(MS_KERNEL_SCANLINE, ctx->k, ctx->isa_cap, &s->kernel_isa))) {
         free(s);
         snprintf(err, errlen, "no Scanline kernel for %d samples", ctx->samples);
@@ -85,6 +89,8 @@ static int hpc_create_common(const ms_render_ctx *ctx, void **state, char *err, 
     const size_t n = ctx->scene->n_tris;
     const double t0 = omp_get_wtime();
     s->order = ms_hpc_area_order(ctx->scene->tri, n);
+    if (s->order && (ms_hpc_switches & MS_HPC_OFF_SORT))   /* measuring: the scene's own order */
+        for (size_t i = 0; i < n; i++) s->order[i] = (uint32_t)i;
     s->sort_s = omp_get_wtime() - t0;
     s->leaf_of = malloc((n ? n : 1) * sizeof *s->leaf_of);
     if (!s->order || !s->leaf_of) {
@@ -142,8 +148,8 @@ static void hpc_destroy(void *state)
 static void hpc_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
 {
     const hpc_state *s = state;
-    *kernel = s->scanline ? s->kernel_isa : MS_ISA_AUTO;
-    *traversal = MS_ISA_AUTO;
+    *kernel = s->scanline ? s->kernel_isa : s->cast_isa;
+    *traversal = s->cast_isa;
 }
 
 #define HPC_COUNTER_NAMES                                                                              \

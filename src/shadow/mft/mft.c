@@ -126,7 +126,10 @@ void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
     float pts[3 * 16];
     ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, base, 16, pts);
     for (int l = 0; l < 16; l++)
-        for (int a = 0; a < 3; a++) L->d[a][base + l] = pts[3 * l + a] - L->c[a];
+        for (int a = 0; a < 3; a++) {
+            L->d[a][base + l] = pts[3 * l + a] - L->c[a];
+            L->inv[a][base + l] = 1.0f / L->d[a][base + l];
+        }
     /* The shear axis raytrace shares over a packet (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]). */
     int kz;
     L->kz[ch] = (signed char)ms_wt_packet_axis(L->d[0] + base, L->d[1] + base, L->d[2] + base, 16, &kz);
@@ -182,7 +185,7 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     const mft_method *s = state;
     const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
     int *order = malloc((size_t)nq * sizeof *order);
-    float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
+    float *rayf = malloc(MS_BLOCK_LANES * 8 * ns * sizeof *rayf);
     signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
     if (!order || !rayf || !kzs) { free(order); free(rayf); free(kzs); return -1; }
     ms_block_order(ctx, q, nq, order);
@@ -198,8 +201,9 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     }
     ms_mft_block blk;
     for (int l = 0; l < MS_BLOCK_LANES; l++) {
-        float *base = rayf + (size_t)l * 5 * ns;
+        float *base = rayf + (size_t)l * 8 * ns;
         for (int a = 0; a < 3; a++) blk.lane[l].d[a] = base + (size_t)a * ns;
+        for (int a = 0; a < 3; a++) blk.lane[l].inv[a] = base + (size_t)(5 + a) * ns;
         blk.lane[l].sx = base + 3 * ns;
         blk.lane[l].sy = base + 4 * ns;
         blk.lane[l].kz = kzs + (size_t)l * (ns / 16);

@@ -43,6 +43,7 @@ typedef struct ms_mft_lane {
     uint64_t *mask;               /* mask_words words: live rays */
     /* Its rays, formed per 16-sample packet when first tested (ms_mft_rays; ready: one bit per packet). */
     float *d[3], *sx, *sy;        /* per sample */
+    float *inv[3];                /* per sample: 1 / d, for the rays' own box test (interleaved, mft_impl.h) */
     signed char *kz;              /* per packet: the shear axis, -1: lanes tested one by one */
     uint64_t ready[4];
     float m[3][3];                /* rows: X - C -> (cell a, cell b, c) with X = C + c (P - C) + a S/k + b T/k */

@@ -1,0 +1,1039 @@
+/* Methods "hpc" and "hpc-scanline": hierarchical penumbra casting (Laine & Aila, "Hierarchical Penumbra
+ * Casting", EGSR 2005, sec. 3), the transpose of ray tracing: for each triangle, find every (light sample ->
+ * receiver point) relation it blocks, with a hierarchy over the receiver points and a three-level hierarchy
+ * over the light samples, never a hierarchy over the scene. The triangles are read once, in any order, in
+ * batches (hpc_source), so they need not be in memory together.
+ *
+ * What is the paper's (sec. 3.1-3.3, the pseudocode of its Fig. 3, line numbers L..):
+ *  - the receiver points (the frame's visible hit points) in a BVH of axis-aligned boxes: nodes of more
+ *    than 1K points split at the middle of the box, smaller ones by surface area (build_tree);
+ *  - the light: the whole polygon Delta_L, groups G_k of gs x gs neighbouring samples with bounding
+ *    polygons Delta_Gk, the samples; per triangle the penumbra volumes V_L and V_Gk (separating planes of
+ *    every vertex-edge pair, hpc_volume.c) and the samples' hard-shadow tests;
+ *  - the recursive traversal with the list of active groups and their active plane sets (B, L36-L45);
+ *  - A, umbra bits: group-umbra and full-umbra bits per point and per node, ANDed upwards (L50-L54,
+ *    L72-L80), ending the traversal at full-umbra nodes and dropping umbra groups (L35, L39, L57, L66),
+ *    and the rebuild of the receiver hierarchy without the full-umbra points when they exceed a quarter
+ *    of the points it holds (L29);
+ *  - C, lazy volumes: V_Gk and the per-point sample data are made only when a point inside V_L that is
+ *    not in umbra is reached (L31, L40-L44, L60-L64);
+ *  - D, on-demand bit masks: a point gets its mask when a triangle first may block it and gives it back
+ *    when it reaches full umbra (L59, L75);
+ *  - coarse blocker sorting: triangles bucketed by area, largest first, in linear time (hpc_sort.c).
+ *
+ * Multiple sample sets (sec. 3.4): each receiver uses its own pixel's samples (the per-pixel rotated and
+ * shifted grid, pattern.h), so hpc answers sample for sample like every other method. The group polygons
+ * bound their samples over all pixels: with the grid every sample (i, j) lies in cell (i, j) of the light
+ * (pattern.h), so a group's polygon is the union of its cells, widened by 1e-3 of a cell for rounding.
+ *
+ * Departures, and why:
+ *  - the hard-shadow test of a sample (L70) is the reference tracer's watertight ray/triangle test from the
+ *    receiver to the sample (ms_wt_segment_sheared in accel/ray_triangle.h, the scalar form of raytrace's
+ *    lane loop: the same shear axis of the 16-sample packet, the same float operations, the same double
+ *    fall-back on a zero edge function). Its three edge functions are the signed volumes of the sample,
+ *    the receiver and each triangle edge, i.e. the receiver against the three planes of V_li through the
+ *    sample and the edges, and its t range is the fourth plane, the triangle's, moved to the near/far
+ *    range of the visibility definition. Evaluated this way the answer equals raytrace bit for bit; the
+ *    plane form rounds differently at the edges. The per-point part of "constructing V_li" (the packet
+ *    shear axes, ms_wt_packet_axis) is made lazily with the point's mask.
+ *  - the penumbra volumes cull with a margin (hpc_volume.h) that covers the rounding of that exact test:
+ *    the error of a float test is magnified behind the triangle by (distance to the light) / (triangle's
+ *    distance from the light, bounded below on separating axes), so the margin grows with it
+ *    (tri_margin); a triangle that may touch the light gets no volume (nothing culled, every relation
+ *    tested).
+ *  - below 1K points the split is a 16-bin SAH (count-weighted, the paper's "total surface area of the
+ *    children" unweighted would split off single points), and leaves hold up to 8 points.
+ *  - the light samples behind a receiver's plane (the horizon) count as blocked from the start, so umbra
+ *    bits mean "no front sample left open"; a receiver's hit triangle never blocks it.
+ *  - hpc-scanline: the leaf rasterizes the triangle into the receiver's k x k buffer with the Scanline
+ *    kernel (Woop 2010; src/raster) once some active group's volume holds the point, instead of testing
+ *    the samples one by one (points that see the light nearly edge-on are tested per sample, as
+ *    microraster.c hands them to the tracer). Its answers are Scanline's: equal to raytrace up to ties.
+ *
+ * One source per ISA (CONTRIBUTING.md, "An ISA kernel"): this file is compiled as hpc_scalar.c, hpc_avx2.c and
+ * hpc_avx512.c, each defining ms_hpc_cast_<isa>; hpc.c picks one under the context's cap. What the ISA
+ * changes is the 16-lane code of lanes16.h (IEEE operations per lane, no FMA), so every instance gives the
+ * same masks and counters (test_hpc checks it):
+ *  - the hard-shadow test (L70) runs over 16 samples of a group at once (group_block16): a group of 4 x 4
+ *    samples (k = 16, 32) is one call, one of 8 x 8 (k = 64) four calls of 2 rows. Each lane forms its
+ *    sample, its direction and its shear exactly as the scalar form (and raytrace) does: the per-lane
+ *    shear axis of its 16-sample packet (selected per lane; lanes whose packet has none are tested one by
+ *    one, as raytrace does), sx = d[kx] * (1 / d[kz]), the same edge functions, the same double fall-back
+ *    on a zero edge, the same plane-distance range. The paper tests the four planes of V_li with SSE,
+ *    one sample at a time; here the SIMD width goes to the samples instead;
+ *  - the box- and point-in-volume tests (INTERSECTS, POINT-IN-VOLUME) evaluate all the planes of a volume
+ *    in one 16-lane operation (hpc_volume.h keeps them by component) and then keep the active ones: the
+ *    scalar form's arithmetic per plane, without its early exit (the counter counts every active plane).
+ * Measuring switches (ms_hpc_switches, hpc.h) turn off each optimisation of sec. 3.3 and each SIMD form.
+ *
+ * Threads: the receiver points are split into spatially coherent chunks (the top of a middle-split
+ * hierarchy, about 4 per thread), each with its own hierarchy, masks and umbra bits; every batch of
+ * triangles is read once, its V_L made once in parallel, and then every chunk processes the whole batch,
+ * chunks scheduled dynamically over the threads. No point is shared between chunks, so there are no
+ * locks, and the answer (an OR over triangles per relation) does not depend on the split. */
+#include "hpc.h"
+#include "hpc_volume.h"
+#include "shadow/method.h"
+#include "visibility/receiver.h"
+#include "visibility/alpha.h"
+#include "accel/ray_triangle.h"
+#include "light/pattern.h"
+#include "light/light_frame.h"
+#include "core/vec.h"
+#include "raster/raster.h"
+#include "core/perk.h"
+#include "visibility/lanes16.h"
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LEAF_POINTS 8
+#define MIDDLE_SPLIT_ABOVE 1024   /* the paper's 1K */
+#define SAH_BINS 16
+#define MEDIAN_BELOW_DEPTH 40     /* median splits from here: depth at most 40 + log2(points) */
+#define BATCH 16384               /* triangles read and prepared together */
+#define EDGE_ON 1e-3f             /* as microraster.c */
+#define LANES 16                  /* the reference tracer's packet width (raytrace_impl.h) */
+
+enum {
+    C_TRIANGLES, C_TRI_CHUNK_PASSES, C_NODE_VISITS, C_NODES_OUTSIDE_VL, C_UMBRA_NODE_SKIPS, C_PLANE_TESTS,
+    C_GROUP_VOLUMES_BUILT, C_POINT_TESTS, C_GROUP_POINT_TESTS, C_SAMPLE_TESTS, C_SAMPLES_BLOCKED,
+    C_MASKS_ALLOCATED, C_MASKS_PEAK, C_REBUILDS, C_FULL_UMBRA_POINTS, C_RASTER_CALLS,
+    /* The paper's Table 2 breakdown: phase times (microseconds; the sort is the source's, hpc_method.c) and
+     * memory by kind (bytes allocated at the peak). */
+    C_SORT_US, C_BUILD_US, C_REBUILD_THREAD_US, C_CAST_US, C_SAMPLE_BYTES, C_HIERARCHY_BYTES, C_MASK_BYTES,
+    C_COUNT
+};
+_Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
+_Static_assert(C_SORT_US == HPC_COUNTER_SORT_US, "hpc.h names the sort counter");
+
+typedef struct hnode {
+    float lo[3], hi[3];
+    uint32_t first, count;   /* interior: count 0, children first and first + 1; leaf: points idx[first..] */
+    uint64_t gumbra;
+    int full;
+} hnode;
+
+typedef struct tri_job {
+    float v[9], N[3];
+    uint32_t self;           /* the triangle's id: receivers on it are not blocked by it */
+    hpc_volume vl;
+} tri_job;
+
+typedef struct act_group { uint32_t k, planes; } act_group;
+
+/* Per frame, read-only while the triangles are cast. */
+typedef struct shared {
+    const ms_render_ctx *ctx;
+    int sw;                          /* ms_hpc_switches when the cast started */
+    int scanline;
+    ms_raster_fn raster;
+    int k, mw, gs, G, npk;
+    uint64_t all_groups;
+    uint64_t *gmask;                 /* G x mw: the samples of each group */
+    double light_poly[12];
+    double group_poly[64][12];
+    float light_lo[3], light_hi[3], scale;
+    float reach;                     /* farthest distance from the light's box to the receivers' box */
+    size_t n;
+    const ms_shadow_query *q;
+    const uint64_t *front;
+    uint64_t *gumbra;                /* per receiver */
+    uint8_t *full;
+    int32_t *slot;
+    size_t slot_bytes, frame_off, kz_off;
+} shared;
+
+/* One chunk of receivers with its own hierarchy and mask pool (one thread at a time). */
+typedef struct chunk {
+    uint32_t *idx;
+    uint32_t n;                      /* points in the hierarchy (full-umbra ones leave at a rebuild) */
+    uint32_t umbra_in_tree;
+    hnode *nodes;
+    uint32_t n_nodes;
+    size_t node_bytes_peak;          /* the largest node array this chunk held (Table 2 memory) */
+    uint8_t *pool;
+    int32_t n_slots, cap_slots, n_free, live, peak;
+    int32_t *free_list;
+    hpc_volume gvol[64];
+    int gvol_built;
+    uint64_t cnt[C_COUNT];
+    int failed;
+} chunk;
+
+/* ---- receiver hierarchy ---- */
+
+static void bounds_of(const shared *sh, const uint32_t *idx, uint32_t n, float lo[3], float hi[3])
+{
+    for (int a = 0; a < 3; a++) { lo[a] = INFINITY; hi[a] = -INFINITY; }
+    for (uint32_t i = 0; i < n; i++) {
+        const float *p = sh->q[idx[i]].p;
+        for (int a = 0; a < 3; a++) { lo[a] = ms_minf(lo[a], p[a]); hi[a] = ms_maxf(hi[a], p[a]); }
+    }
+}
+
+static float half_area(const float lo[3], const float hi[3])
+{
+    const float x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+    return x * y + y * z + z * x;
+}
+
+/* Partition idx[0..n) by p[axis] < split; returns the count below. */
+static uint32_t partition(const shared *sh, uint32_t *idx, uint32_t n, int axis, float split)
+{
+    uint32_t i = 0, j = n;
+    while (i < j) {
+        if (sh->q[idx[i]].p[axis] < split) i++;
+        else { const uint32_t t = idx[i]; idx[i] = idx[--j]; idx[j] = t; }
+    }
+    return i;
+}
+
+static int cmp_key(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* Where to split idx[0..n): the middle of the longest axis above MIDDLE_SPLIT_ABOVE points, else a binned
+ * SAH; the median when a side would be empty (coincident points) or when asked (deep in the tree: points
+ * spaced exponentially would otherwise peel off one per level, and the traversal recurses). Returns the
+ * left count. */
+static uint32_t split_points(const shared *sh, uint32_t *idx, uint32_t n, const float lo[3], const float hi[3],
+                             int median)
+{
+    const float ext[3] = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
+    int axis = ext[0] >= ext[1] ? (ext[0] >= ext[2] ? 0 : 2) : (ext[1] >= ext[2] ? 1 : 2);
+    float split = lo[axis] + 0.5f * ext[axis];
+    if (n <= MIDDLE_SPLIT_ABOVE) {
+        float best = INFINITY;
+        for (int a = 0; a < 3; a++) {
+            if (!(ext[a] > 0.0f)) continue;
+            uint32_t cnt[SAH_BINS] = { 0 };
+            float blo[SAH_BINS][3], bhi[SAH_BINS][3];
+            for (int b = 0; b < SAH_BINS; b++)
+                for (int c = 0; c < 3; c++) { blo[b][c] = INFINITY; bhi[b][c] = -INFINITY; }
+            const float sc = (float)SAH_BINS / ext[a];
+            for (uint32_t i = 0; i < n; i++) {
+                const float *p = sh->q[idx[i]].p;
+                int b = (int)((p[a] - lo[a]) * sc);
+                b = b < 0 ? 0 : b >= SAH_BINS ? SAH_BINS - 1 : b;
+                cnt[b]++;
+                for (int c = 0; c < 3; c++) { blo[b][c] = ms_minf(blo[b][c], p[c]); bhi[b][c] = ms_maxf(bhi[b][c], p[c]); }
+            }
+            float rarea[SAH_BINS];
+            uint32_t rcnt[SAH_BINS];
+            float l[3] = { INFINITY, INFINITY, INFINITY }, h[3] = { -INFINITY, -INFINITY, -INFINITY };
+            uint32_t c = 0;
+            for (int b = SAH_BINS - 1; b > 0; b--) {
+                for (int d = 0; d < 3; d++) { l[d] = ms_minf(l[d], blo[b][d]); h[d] = ms_maxf(h[d], bhi[b][d]); }
+                c += cnt[b];
+                rcnt[b] = c;
+                rarea[b] = c ? half_area(l, h) : 0.0f;
+            }
+            for (int d = 0; d < 3; d++) { l[d] = INFINITY; h[d] = -INFINITY; }
+            c = 0;
+            for (int b = 0; b < SAH_BINS - 1; b++) {
+                for (int d = 0; d < 3; d++) { l[d] = ms_minf(l[d], blo[b][d]); h[d] = ms_maxf(h[d], bhi[b][d]); }
+                c += cnt[b];
+                if (!c || !rcnt[b + 1]) continue;
+                const float cost = half_area(l, h) * (float)c + rarea[b + 1] * (float)rcnt[b + 1];
+                if (cost < best) { best = cost; axis = a; split = lo[a] + (float)(b + 1) / sc; }
+            }
+        }
+    }
+    uint32_t m = median ? 0 : partition(sh, idx, n, axis, split);
+    if (m == 0 || m == n) {
+        /* Median by sorting keys (rare: points bunched in one bin or coincident). */
+        float *key = malloc((size_t)n * 2 * sizeof *key);
+        if (!key) return n / 2;   /* any split is correct; only balance suffers */
+        for (uint32_t i = 0; i < n; i++) { key[2 * i] = sh->q[idx[i]].p[axis]; memcpy(&key[2 * i + 1], &idx[i], 4); }
+        qsort(key, n, 2 * sizeof *key, cmp_key);
+        for (uint32_t i = 0; i < n; i++) memcpy(&idx[i], &key[2 * i + 1], 4);
+        free(key);
+        m = n / 2;
+    }
+    return m;
+}
+
+static void node_bits_from_points(const shared *sh, const chunk *c, hnode *N)
+{
+    uint64_t g = sh->all_groups;
+    int full = 1;
+    for (uint32_t i = N->first; i < N->first + N->count; i++) {
+        g &= sh->gumbra[c->idx[i]];
+        full &= sh->full[c->idx[i]];
+    }
+    N->gumbra = g;
+    N->full = full;
+}
+
+/* (Re)builds the chunk's hierarchy over its points that are not in full umbra. 0, or -1 out of memory. */
+static int build_tree(const shared *sh, chunk *c)
+{
+    uint32_t live = 0;
+    for (uint32_t i = 0; i < c->n; i++)
+        if (!sh->full[c->idx[i]]) c->idx[live++] = c->idx[i];
+    c->n = live;
+    c->umbra_in_tree = 0;
+    free(c->nodes);
+    c->nodes = NULL;
+    c->n_nodes = 0;
+    if (!live) return 0;
+    c->nodes = malloc((size_t)(2 * live) * sizeof *c->nodes);
+    if ((size_t)(2 * live) * sizeof *c->nodes > c->node_bytes_peak) c->node_bytes_peak = (size_t)(2 * live) * sizeof *c->nodes;
+    uint32_t *stack = malloc((size_t)(2 * live + 64) * 2 * sizeof *stack);   /* node, depth */
+    if (!c->nodes || !stack) { free(stack); return -1; }
+    c->n_nodes = 1;
+    c->nodes[0].first = 0;
+    c->nodes[0].count = live;
+    int sp = 0;
+    stack[sp++] = 0;
+    stack[sp++] = 0;
+    while (sp) {
+        const uint32_t depth = stack[--sp];
+        hnode *N = &c->nodes[stack[--sp]];
+        bounds_of(sh, c->idx + N->first, N->count, N->lo, N->hi);
+        if (N->count <= LEAF_POINTS) continue;
+        const uint32_t m = split_points(sh, c->idx + N->first, N->count, N->lo, N->hi, depth >= MEDIAN_BELOW_DEPTH);
+        const uint32_t l = c->n_nodes;
+        c->n_nodes += 2;
+        c->nodes[l].first = N->first;
+        c->nodes[l].count = m;
+        c->nodes[l + 1].first = N->first + m;
+        c->nodes[l + 1].count = N->count - m;
+        N->first = l;
+        N->count = 0;
+        stack[sp++] = l + 1;
+        stack[sp++] = depth + 1;
+        stack[sp++] = l;
+        stack[sp++] = depth + 1;
+    }
+    free(stack);
+    /* Children follow their parents: umbra bits bottom-up in reverse order. */
+    for (uint32_t i = c->n_nodes; i-- > 0;) {
+        hnode *N = &c->nodes[i];
+        if (N->count) node_bits_from_points(sh, c, N);
+        else {
+            N->gumbra = c->nodes[N->first].gumbra & c->nodes[N->first + 1].gumbra;
+            N->full = c->nodes[N->first].full & c->nodes[N->first + 1].full;
+        }
+    }
+    return 0;
+}
+
+/* ---- masks on demand (D) ---- */
+
+static uint64_t *slot_mask(const shared *sh, const chunk *c, int32_t s) { return (uint64_t *)(c->pool + (size_t)s * sh->slot_bytes); }
+static ms_raster_frame *slot_frame(const shared *sh, const chunk *c, int32_t s) { return (ms_raster_frame *)(c->pool + (size_t)s * sh->slot_bytes + sh->frame_off); }
+static int8_t *slot_kz(const shared *sh, const chunk *c, int32_t s) { return (int8_t *)(c->pool + (size_t)s * sh->slot_bytes + sh->kz_off); }
+
+/* The shear axis of each 16-sample packet exactly as the reference tracer chooses it (packet_shear), or -1
+ * (lane by lane); for hpc-scanline also the Scanline frame, or -2 in kz[0]'s place for edge-on points. */
+static void slot_setup(const shared *sh, chunk *c, int32_t s, const ms_shadow_query *q, const ms_grid *g)
+{
+    const ms_render_ctx *ctx = sh->ctx;
+    const int k = sh->k;
+    int8_t *kz = slot_kz(sh, c, s);
+    for (int pk = 0; pk < sh->npk; pk++) {
+        float d[3][LANES];
+        for (int l = 0; l < LANES; l++) {
+            const int smp = pk * LANES + l, i = smp % k, j = smp / k;
+            for (int a = 0; a < 3; a++) d[a][l] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
+        }
+        kz[pk] = (int8_t)ms_wt_packet_axis(d[0], d[1], d[2], LANES, NULL);
+    }
+    if (sh->scanline) {
+        ms_raster_frame *f = slot_frame(sh, c, s);
+        float n[3], rel[3];
+        v3_cross(n, g->ds, g->dt);
+        v3_sub(rel, g->p0, q->p);
+        const float h = fabsf(v3_dot(n, rel)), dd = v3_len(n) * v3_len(rel);
+        if (!(h > EDGE_ON * dd) || ms_raster_frame_init(f, q->p, g, ctx->near, ctx->far, 0) != 0) f->k = 0;   /* edge-on */
+    }
+}
+
+static int32_t slot_get(const shared *sh, chunk *c)
+{
+    int32_t s;
+    if (c->n_free) s = c->free_list[--c->n_free];
+    else {
+        if (c->n_slots == c->cap_slots) {
+            const int32_t cap = c->cap_slots ? 2 * c->cap_slots : 256;
+            uint8_t *p = realloc(c->pool, (size_t)cap * sh->slot_bytes);
+            int32_t *fl = realloc(c->free_list, (size_t)cap * sizeof *fl);
+            if (p) c->pool = p;
+            if (fl) c->free_list = fl;
+            if (!p || !fl) return -1;
+            c->cap_slots = cap;
+        }
+        s = c->n_slots++;
+    }
+    c->live++;
+    if (c->live > c->peak) c->peak = c->live;
+    c->cnt[C_MASKS_ALLOCATED]++;
+    return s;
+}
+
+static void slot_put(chunk *c, int32_t s)
+{
+    c->free_list[c->n_free++] = s;
+    c->live--;
+}
+
+/* ---- per triangle ---- */
+
+/* A lower bound on the distance between the triangle and the light: the largest gap between their
+ * projections on the separating axes of two convex polygons (the box axes, both normals, and the cross
+ * products of their edges); a projection never lengthens a distance. 0 when they may touch. */
+static double tri_light_gap(const shared *sh, const float v[9])
+{
+    double T[3][3], L[4][3], ax[14][3];
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) T[i][a] = v[3 * i + a];
+    for (int i = 0; i < 4; i++)
+        for (int a = 0; a < 3; a++) L[i][a] = sh->light_poly[3 * i + a];
+    int n = 0;
+    for (int a = 0; a < 3; a++) { ax[n][0] = a == 0; ax[n][1] = a == 1; ax[n][2] = a == 2; n++; }
+    double te[3][3], le[2][3];
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) te[i][a] = T[(i + 1) % 3][a] - T[i][a];
+    for (int a = 0; a < 3; a++) { le[0][a] = L[1][a] - L[0][a]; le[1][a] = L[3][a] - L[0][a]; }
+#define CROSS(r, x, y) (r[0] = x[1] * y[2] - x[2] * y[1], r[1] = x[2] * y[0] - x[0] * y[2], r[2] = x[0] * y[1] - x[1] * y[0])
+    CROSS(ax[n], te[0], te[1]); n++;
+    CROSS(ax[n], le[0], le[1]); n++;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 2; j++) { CROSS(ax[n], te[i], le[j]); n++; }
+#undef CROSS
+    double gap = 0.0;
+    for (int k = 0; k < n; k++) {
+        const double len = sqrt(ax[k][0] * ax[k][0] + ax[k][1] * ax[k][1] + ax[k][2] * ax[k][2]);
+        if (!(len > 0.0)) continue;
+        double tmin = INFINITY, tmax = -INFINITY, lmin = INFINITY, lmax = -INFINITY;
+        for (int i = 0; i < 3; i++) {
+            const double d = (T[i][0] * ax[k][0] + T[i][1] * ax[k][1] + T[i][2] * ax[k][2]) / len;
+            tmin = fmin(tmin, d); tmax = fmax(tmax, d);
+        }
+        for (int i = 0; i < 4; i++) {
+            const double d = (L[i][0] * ax[k][0] + L[i][1] * ax[k][1] + L[i][2] * ax[k][2]) / len;
+            lmin = fmin(lmin, d); lmax = fmax(lmax, d);
+        }
+        gap = fmax(gap, fmax(lmin - tmax, tmin - lmax));
+    }
+    return gap;
+}
+
+/* The culling margin for a triangle (see the departures above). The exact test rounds the vertices and the
+ * sample relative to the receiver, by ulps of their distance to it (at most sh->reach, the farthest
+ * distance from the light's box to the receivers' box); a ray from a sample through the triangle passes it
+ * at least D from the sample (D: the larger of tri_light_gap and the gap between the bounding boxes, less
+ * a relative 1e-6 for their rounding), so an error at
+ * the triangle moves the shadow at the receiver by up to reach / D. The samples' own rounding is absorbed
+ * by the polygons (setup_light), the plane evaluation's by ulps of the coordinates. 256 ulps of each for
+ * safety; a triangle that may touch the light: infinite (no culling). The coordinates (sc, sh->scale) are
+ * the scene frame's (scene_frame.c), within 34 half-extents of the geometry at any distance from the
+ * world's origin, so the margin and the volumes' planes cull as they do at home. */
+static float tri_margin(const shared *sh, const float v[9])
+{
+    float sc = sh->scale, box2 = 0.0f;
+    for (int a = 0; a < 3; a++) {   /* the gap between the bounding boxes, another lower bound */
+        const float lo = ms_minf(v[a], ms_minf(v[3 + a], v[6 + a])), hi = ms_maxf(v[a], ms_maxf(v[3 + a], v[6 + a]));
+        const float g = ms_maxf(sh->light_lo[a] - hi, lo - sh->light_hi[a]);
+        if (g > 0.0f) box2 += g * g;
+        sc = ms_maxf(sc, ms_maxf(fabsf(lo), fabsf(hi)));
+    }
+    const float D = (float)(fmax(tri_light_gap(sh, v), sqrt((double)box2)) - 1e-6 * sc);
+    if (!(D > 1e-6f * sc)) return INFINITY;
+    return 256.0f * 1.1920929e-07f * (sc + sh->reach * (1.0f + 4.0f * sh->reach / D));
+}
+
+static void build_group_volumes(const shared *sh, chunk *c, const tri_job *t)
+{
+    for (int g = 0; g < sh->G; g++) hpc_volume_build(&c->gvol[g], sh->group_poly[g], 4, t->v, t->vl.eps);
+    c->gvol_built = 1;
+    c->cnt[C_GROUP_VOLUMES_BUILT]++;
+}
+
+/* The reference tracer's lane test for one sample (ray_triangle.h, as raytrace's packets): 1 if the
+ * triangle blocks the segment from the receiver o to o + d at a parameter in [near, far]. A, B, C: the
+ * vertices minus o; num: ms_wt_offset(o, tri, N). */
+static int sample_blocked(const float o[3], const float d[3], int kz, const float *tri, const float N[3],
+                          const float A[3], const float B[3], const float C[3], float num, float tmin, float tmax)
+{
+    if (kz < 0) return ms_wt_segment(o, d, tri, N, tmin, tmax);
+    const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+    const float inv = 1.0f / d[kz];
+    return ms_wt_segment_sheared(A, B, C, kz, d[kx] * inv, d[ky] * inv, d, N, num, tmin, tmax);
+}
+
+/* Alpha-tested triangle t (alpha.h) at sample (i, j) of q's grid: 1 where it occludes. The sample point is the
+ * pattern's float, formed as ms_pattern_points_range forms it. */
+static int alpha_opaque(const shared *sh, const tri_job *t, const ms_shadow_query *q, const ms_grid *g, int i, int j)
+{
+    float L[3];
+    for (int a = 0; a < 3; a++) L[a] = g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a];
+    return ms_alpha_segment_occludes(sh->ctx->alpha, t->self, q->p, L);
+}
+
+/* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
+ * alpha-tested triangle blocks a sample only where it is opaque (any hit, alpha.h). */
+static int cast_group(const shared *sh, chunk *c, uint64_t *open, const int8_t *kz, int gk, const ms_shadow_query *q,
+                      const ms_grid *g, const tri_job *t, const float A[3], const float B[3], const float C[3], float num)
+{
+    const int k = sh->k, gs = sh->gs, gpr = k / gs;
+    const int i0 = (gk % gpr) * gs, j0 = (gk / gpr) * gs;
+    const uint64_t seg = (UINT64_C(1) << gs) - 1u;   /* gs <= 8 */
+    const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
+    int left = 0;
+    for (int j = j0; j < j0 + gs; j++) {
+        const int s0 = j * k + i0, w = s0 >> 6, b = s0 & 63;
+        uint64_t bits = open[w] >> b & seg;
+        while (bits) {
+            const int di = __builtin_ctzll(bits);
+            bits &= bits - 1u;
+            const int i = i0 + di, s = s0 + di;
+            float d[3];
+            for (int a = 0; a < 3; a++) d[a] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
+            c->cnt[C_SAMPLE_TESTS]++;
+            if (sample_blocked(q->p, d, kz[s / LANES], t->v, t->N, A, B, C, num, sh->ctx->near, sh->ctx->far) &&
+                !(alpha && !alpha_opaque(sh, t, q, g, i, j))) {
+                open[w] &= ~(UINT64_C(1) << (b + di));
+                c->cnt[C_SAMPLES_BLOCKED]++;
+            }
+        }
+        left |= (open[w] >> b & seg) != 0;
+    }
+    return !left;
+}
+
+/* sel3(m0, m1, x0, x1, x2): per lane x0 where m0, x1 where m1, else x2 (a lane's component by its axis). */
+static inline l16 sel3(unsigned m0, unsigned m1, l16 x0, l16 x1, l16 x2) { return l16_select(m0, x0, l16_select(m1, x1, x2)); }
+
+/* The hard-shadow test of 16 samples of receiver q at once (L70): lane l is sample (i0 + l % w, j0 + l / w) of
+ * its grid g (w = 4 or 8 columns); live: the lanes to test. Returns the lanes triangle t blocks. Every lane
+ * computes what sample_blocked computes for its sample, in the same order: its point and direction, the
+ * shear with its packet's axis kz (one packet = 16 consecutive samples of a row, raytrace's), the edge
+ * functions of the vertices A, B, C (relative to q), the plane-distance range with num. Lanes with an edge
+ * function exactly 0, or whose packet has no shared axis, go to the scalar form (as raytrace's lanes do). */
+static unsigned group_block16(const shared *sh, const ms_shadow_query *q, const ms_grid *g, const int8_t *kz, int i0,
+                              int j0, int w, unsigned live, const tri_job *t, const float A[3], const float B[3],
+                              const float C[3], float num)
+{
+    /* Lane l's column and row offsets in the block, w = 4 or 8 columns (small integers: exact in float). */
+    static const float off[2][2][LANES] = {
+        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+    const int k = sh->k, wi = w == 8, rows = LANES / w;
+    /* A group lies within one 16-sample packet per row: the row's packet gives its lanes' shear axis. */
+    unsigned m0 = 0, m1 = 0, mneg = 0;
+    const unsigned rowbits = (1u << w) - 1u;
+    int z0 = kz[(j0 * k + i0) / LANES], uniform = z0 >= 0;
+    for (int r = 0; r < rows; r++) {
+        const int z = kz[((j0 + r) * k + i0) / LANES];
+        uniform &= z == z0;
+        m0 |= (z == 0 ? rowbits : 0u) << (r * w);
+        m1 |= (z == 1 ? rowbits : 0u) << (r * w);
+        mneg |= (z < 0 ? rowbits : 0u) << (r * w);
+    }
+    const l16 li = l16_add(l16_set1((float)i0), l16_load(off[wi][0])), lj = l16_add(l16_set1((float)j0), l16_load(off[wi][1]));
+    l16 d[3];
+    for (int a = 0; a < 3; a++)
+        d[a] = l16_sub(l16_add(l16_add(l16_set1(g->p0[a]), l16_mul(li, l16_set1(g->ds[a]))), l16_mul(lj, l16_set1(g->dt[a]))),
+                       l16_set1(q->p[a]));
+    /* kz = 0: kx = 1, ky = 2; kz = 1: kx = 2, ky = 0; kz = 2: kx = 0, ky = 1. One axis for every lane (the
+     * rule): no per-lane selection. */
+    l16 dz, dx, dy, Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz;
+    if (uniform) {
+        const int zx = z0 + 1 == 3 ? 0 : z0 + 1, zy = zx + 1 == 3 ? 0 : zx + 1;
+        dz = d[z0]; dx = d[zx]; dy = d[zy];
+        Ax = l16_set1(A[zx]); Ay = l16_set1(A[zy]); Az = l16_set1(A[z0]);
+        Bx = l16_set1(B[zx]); By = l16_set1(B[zy]); Bz = l16_set1(B[z0]);
+        Cx = l16_set1(C[zx]); Cy = l16_set1(C[zy]); Cz = l16_set1(C[z0]);
+    } else {
+        dz = sel3(m0, m1, d[0], d[1], d[2]); dx = sel3(m0, m1, d[1], d[2], d[0]); dy = sel3(m0, m1, d[2], d[0], d[1]);
+#define HPC_VCOMP(V, x, y, zz)                                                                                 \
+        x = sel3(m0, m1, l16_set1(V[1]), l16_set1(V[2]), l16_set1(V[0]));                                      \
+        y = sel3(m0, m1, l16_set1(V[2]), l16_set1(V[0]), l16_set1(V[1]));                                      \
+        zz = sel3(m0, m1, l16_set1(V[0]), l16_set1(V[1]), l16_set1(V[2]))
+        HPC_VCOMP(A, Ax, Ay, Az);
+        HPC_VCOMP(B, Bx, By, Bz);
+        HPC_VCOMP(C, Cx, Cy, Cz);
+#undef HPC_VCOMP
+    }
+    const l16 inv = l16_div(l16_set1(1.0f), dz), sx = l16_mul(dx, inv), sy = l16_mul(dy, inv);
+    const l16 ax = l16_sub(Ax, l16_mul(sx, Az)), ay = l16_sub(Ay, l16_mul(sy, Az));
+    const l16 bx = l16_sub(Bx, l16_mul(sx, Bz)), by = l16_sub(By, l16_mul(sy, Bz));
+    const l16 cx = l16_sub(Cx, l16_mul(sx, Cz)), cy = l16_sub(Cy, l16_mul(sy, Cz));
+    const l16 u = l16_sub(l16_mul(cx, by), l16_mul(cy, bx));
+    const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
+    const l16 ww = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
+    const l16 zero = l16_set1(0.0f);
+    /* As mft_packet: some edge exactly 0 iff the least |edge| is 0; mixed signs iff the least < 0 < the largest. */
+    const unsigned z = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(ww)), zero);
+    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), ww), zero) & l16_gt(l16_max(l16_max(u, v), ww), zero);
+    const l16 det = l16_add(l16_add(u, v), ww);
+    const float *N = t->N, near = sh->ctx->near, far = sh->ctx->far;
+    const l16 den = l16_add(l16_add(l16_mul(d[0], l16_set1(N[0])), l16_mul(d[1], l16_set1(N[1]))), l16_mul(d[2], l16_set1(N[2])));
+    const l16 ns = l16_select(l16_lt(den, zero), l16_set1(-num), l16_set1(num)), aden = l16_abs(den);
+    unsigned hit = live & ~mneg & ~z & ~mixed & l16_gt(l16_abs(det), zero) & l16_gt(aden, zero) &
+                   l16_le(l16_mul(l16_set1(near), aden), ns) & l16_le(ns, l16_mul(l16_set1(far), aden));
+    const unsigned rest = live & (mneg | z);
+    if (rest) {
+        float dv[3][LANES], sxv[LANES], syv[LANES];
+        for (int a = 0; a < 3; a++) l16_store(dv[a], d[a]);
+        l16_store(sxv, sx);
+        l16_store(syv, sy);
+        for (unsigned m = rest; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            const float dl[3] = { dv[0][l], dv[1][l], dv[2][l] };
+            const int kl = (mneg >> l & 1) ? -1 : (m0 >> l & 1) ? 0 : (m1 >> l & 1) ? 1 : 2;
+            const int b = kl < 0 ? ms_wt_segment(q->p, dl, t->v, N, near, far)
+                                 : ms_wt_segment_sheared(A, B, C, kl, sxv[l], syv[l], dl, N, num, near, far);
+            hit |= (unsigned)b << l;
+        }
+    }
+    return hit;
+}
+
+/* cast_group with the 16-lane test: the group's open samples 16 at a time. */
+static int cast_group16(const shared *sh, chunk *c, uint64_t *open, const int8_t *kz, int gk, const ms_shadow_query *q,
+                        const ms_grid *g, const tri_job *t, const float A[3], const float B[3], const float C[3], float num)
+{
+    const int k = sh->k, gs = sh->gs, gpr = k / gs, rows = LANES / gs;
+    const int i0 = (gk % gpr) * gs, j0 = (gk / gpr) * gs;
+    const uint64_t seg = (UINT64_C(1) << gs) - 1u;
+    const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
+    int left = 0;
+    for (int jb = j0; jb < j0 + gs; jb += rows) {
+        unsigned live = 0;
+        for (int r = 0; r < rows; r++) {
+            const int s0 = (jb + r) * k + i0;
+            live |= (unsigned)(open[s0 >> 6] >> (s0 & 63) & seg) << (r * gs);
+        }
+        if (!live) continue;
+        c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
+        unsigned hit = group_block16(sh, q, g, kz, i0, jb, gs, live, t, A, B, C, num);
+        if (hit && alpha)
+            for (unsigned m = hit; m; m &= m - 1) {
+                const int l = __builtin_ctz(m);
+                if (!alpha_opaque(sh, t, q, g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
+            }
+        c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
+        for (int r = 0; r < rows; r++) {
+            const int s0 = (jb + r) * k + i0;
+            open[s0 >> 6] &= ~((uint64_t)(hit >> (r * gs) & seg) << (s0 & 63));
+        }
+    }
+    for (int j = j0; j < j0 + gs && !left; j++) {
+        const int s0 = j * k + i0;
+        left |= (open[s0 >> 6] >> (s0 & 63) & seg) != 0;
+    }
+    return !left;
+}
+
+/* INTERSECTS (hpc_volume_box) over all planes at once: per plane the scalar form's arithmetic. */
+static int vol_box(const shared *sh, const hpc_volume *v, uint32_t act, const float lo[3], const float hi[3],
+                   uint32_t *out, uint64_t *tests)
+{
+    if (sh->sw & MS_HPC_OFF_SIMD_PLANES) return hpc_volume_box(v, act, lo, hi, out, tests);
+    act &= v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u;
+    if (!act) { *out = 0; return 1; }
+    l16 mx = l16_load(v->soa[3]), mn = mx;
+    for (int a = 0; a < 3; a++) {
+        const l16 n = l16_load(v->soa[a]), x = l16_mul(n, l16_set1(lo[a])), y = l16_mul(n, l16_set1(hi[a]));
+        mx = l16_add(mx, l16_max(x, y));
+        mn = l16_add(mn, l16_min(y, x));
+    }
+    *tests += (uint64_t)__builtin_popcount(act);
+    if (l16_lt(mx, l16_set1(-v->eps)) & act) return 0;
+    *out = act & ~l16_le(l16_set1(v->eps), mn);   /* wholly inside, with room for rounding */
+    return 1;
+}
+
+/* POINT-IN-VOLUME (hpc_volume_point) over all planes at once. */
+static int vol_point(const shared *sh, const hpc_volume *v, uint32_t act, const float p[3], uint64_t *tests)
+{
+    if (sh->sw & MS_HPC_OFF_SIMD_PLANES) return hpc_volume_point(v, act, p, tests);
+    act &= v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u;
+    if (!act) return 1;
+    const l16 s = l16_add(l16_add(l16_add(l16_mul(l16_load(v->soa[0]), l16_set1(p[0])), l16_mul(l16_load(v->soa[1]), l16_set1(p[1]))),
+                                  l16_mul(l16_load(v->soa[2]), l16_set1(p[2]))),
+                          l16_load(v->soa[3]));
+    *tests += (uint64_t)__builtin_popcount(act);
+    return !(l16_lt(s, l16_set1(-v->eps)) & act);
+}
+
+static int group_done(const shared *sh, const uint64_t *open, int gk)
+{
+    const uint64_t *m = sh->gmask + (size_t)gk * sh->mw;
+    for (int w = 0; w < sh->mw; w++)
+        if (open[w] & m[w]) return 0;
+    return 1;
+}
+
+/* One receiver of a leaf against the triangle (L56-L75). */
+static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t, uint32_t pl, const act_group *ag, int nag)
+{
+    const ms_shadow_query *q = &sh->q[r];
+    if (sh->full[r] || q->prim == t->self) return;
+    c->cnt[C_POINT_TESTS]++;
+    if (!vol_point(sh, &t->vl, pl, q->p, &c->cnt[C_PLANE_TESTS])) return;
+    ms_grid g;   /* the point's samples, formed when first needed */
+    int have_g = 0;
+#define HPC_GRID() (have_g ? (void)0 : (ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g), (void)(have_g = 1)))
+    int32_t s = sh->slot[r];
+    if (s < 0) {
+        HPC_GRID();
+        if ((s = slot_get(sh, c)) < 0) { c->failed = 1; return; }
+        sh->slot[r] = s;
+        memcpy(slot_mask(sh, c, s), sh->front + (size_t)r * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
+        slot_setup(sh, c, s, q, &g);
+    }
+    if (!c->gvol_built) build_group_volumes(sh, c, t);
+    uint64_t *open = slot_mask(sh, c, s);
+    const int8_t *kz = slot_kz(sh, c, s);
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
+    const float num = ms_wt_offset(q->p, t->v, t->N);
+    uint64_t gu = sh->gumbra[r];
+    if (sh->scanline && slot_frame(sh, c, s)->k) {
+        int any = 0;
+        for (int i = 0; i < nag && !any; i++) {
+            if (gu >> ag[i].k & 1u) continue;
+            c->cnt[C_GROUP_POINT_TESTS]++;
+            any = vol_point(sh, &c->gvol[ag[i].k], ag[i].planes, q->p, &c->cnt[C_PLANE_TESTS]);
+        }
+        if (any) {
+            c->cnt[C_RASTER_CALLS]++;
+            if (ms_alpha_tested(sh->ctx->alpha, t->self)) {   /* its opaque samples only (alpha.h) */
+                const ms_alpha_pixel ap = { sh->ctx, q };
+                ms_alpha_raster(&ap, slot_frame(sh, c, s), sh->raster, t->v, t->self, open);
+            } else {
+                sh->raster(slot_frame(sh, c, s), t->v, open);
+            }
+            for (int gk = 0; gk < sh->G; gk++)
+                if (!(gu >> gk & 1u) && group_done(sh, open, gk)) gu |= UINT64_C(1) << gk;
+        }
+    } else {
+        for (int i = 0; i < nag; i++) {
+            const int gk = (int)ag[i].k;
+            if (gu >> gk & 1u) continue;
+            c->cnt[C_GROUP_POINT_TESTS]++;
+            if (!vol_point(sh, &c->gvol[gk], ag[i].planes, q->p, &c->cnt[C_PLANE_TESTS])) continue;
+            HPC_GRID();
+            const int done = sh->sw & MS_HPC_OFF_SIMD_SAMPLES ? cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
+                                                              : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num);
+            if (done) gu |= UINT64_C(1) << gk;
+        }
+    }
+#undef HPC_GRID
+    if (sh->sw & MS_HPC_OFF_UMBRA) return;   /* A off: umbra found by casting is not recorded */
+    sh->gumbra[r] = gu;
+    if (gu == sh->all_groups) {
+        sh->full[r] = 1;
+        if (!(sh->sw & MS_HPC_OFF_ON_DEMAND)) {   /* D: the mask goes back (L75) */
+            slot_put(c, s);
+            sh->slot[r] = -1;
+        }
+        c->umbra_in_tree++;
+        c->cnt[C_FULL_UMBRA_POINTS]++;
+    }
+}
+
+/* PROCESS-RECURSIVE (L35-L81). */
+static void cast_node(const shared *sh, chunk *c, uint32_t ni, const tri_job *t, uint32_t pl, const act_group *ag, int nag)
+{
+    hnode *N = &c->nodes[ni];
+    c->cnt[C_NODE_VISITS]++;
+    if (N->full) { c->cnt[C_UMBRA_NODE_SKIPS]++; return; }
+    uint32_t pl2;
+    if (!vol_box(sh, &t->vl, pl, N->lo, N->hi, &pl2, &c->cnt[C_PLANE_TESTS])) { c->cnt[C_NODES_OUTSIDE_VL]++; return; }
+    const int sets = !(sh->sw & MS_HPC_OFF_PLANE_SETS);
+    if (!sets) pl2 = HPC_ALL_PLANES;
+    act_group ag2[64];
+    int n2 = 0;
+    for (int i = 0; i < nag; i++) {
+        if (N->gumbra >> ag[i].k & 1u) continue;
+        if (c->gvol_built) {
+            uint32_t p2;
+            if (vol_box(sh, &c->gvol[ag[i].k], ag[i].planes, N->lo, N->hi, &p2, &c->cnt[C_PLANE_TESTS]))
+                ag2[n2++] = (act_group){ ag[i].k, sets ? p2 : HPC_ALL_PLANES };
+        } else ag2[n2++] = (act_group){ ag[i].k, HPC_ALL_PLANES };
+    }
+    if (!n2) return;
+    if (!N->count) {
+        const uint32_t l = N->first;
+        cast_node(sh, c, l, t, pl2, ag2, n2);
+        cast_node(sh, c, l + 1, t, pl2, ag2, n2);
+        N->gumbra = c->nodes[l].gumbra & c->nodes[l + 1].gumbra;
+        N->full = c->nodes[l].full & c->nodes[l + 1].full;
+    } else {
+        for (uint32_t i = N->first; i < N->first + N->count; i++) cast_point(sh, c, c->idx[i], t, pl2, ag2, n2);
+        node_bits_from_points(sh, c, N);
+    }
+}
+
+/* PROCESS-BLOCKER-OPTIMIZED (L29-L34). */
+static void cast_triangle(const shared *sh, chunk *c, const tri_job *t)
+{
+    if (c->failed || !c->n_nodes) return;
+    if (c->umbra_in_tree > 64 && 4 * c->umbra_in_tree > c->n) {
+        c->cnt[C_REBUILDS]++;
+        const double t0 = omp_get_wtime();
+        const int bad = build_tree(sh, c);
+        c->cnt[C_REBUILD_THREAD_US] += (uint64_t)((omp_get_wtime() - t0) * 1e6);
+        if (bad) { c->failed = 1; return; }
+        if (!c->n_nodes) return;
+    }
+    c->cnt[C_TRI_CHUNK_PASSES]++;
+    c->gvol_built = 0;
+    if (sh->sw & MS_HPC_OFF_LAZY) build_group_volumes(sh, c, t);   /* C off: before the traversal */
+    act_group ag[64];
+    for (int g = 0; g < sh->G; g++) ag[g] = (act_group){ (uint32_t)g, HPC_ALL_PLANES };
+    cast_node(sh, c, 0, t, HPC_ALL_PLANES, ag, sh->G);
+}
+
+/* ---- the frame ---- */
+
+/* Splits the receivers into chunks of at most `target` points by middle splits; returns the count. */
+static int make_chunks(const shared *sh, uint32_t *idx, uint32_t n, uint32_t target, chunk *out, int cap)
+{
+    typedef struct { uint32_t b, n; } range;
+    range *st = malloc((size_t)(2 * cap + 64) * sizeof *st);
+    if (!st) return -1;
+    int sp = 0, nc = 0;
+    st[sp++] = (range){ 0, n };
+    while (sp) {
+        const range r = st[--sp];
+        if (r.n <= target || nc + sp + 2 > cap) {
+            out[nc].idx = idx + r.b;
+            out[nc].n = r.n;
+            nc++;
+            continue;
+        }
+        float lo[3], hi[3];
+        bounds_of(sh, idx + r.b, r.n, lo, hi);
+        const float ext[3] = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
+        const int axis = ext[0] >= ext[1] ? (ext[0] >= ext[2] ? 0 : 2) : (ext[1] >= ext[2] ? 1 : 2);
+        uint32_t m = partition(sh, idx + r.b, r.n, axis, lo[axis] + 0.5f * ext[axis]);
+        if (m == 0 || m == r.n) m = r.n / 2;   /* coincident points: any split */
+        st[sp++] = (range){ r.b + m, r.n - m };
+        st[sp++] = (range){ r.b, m };
+    }
+    free(st);
+    return nc;
+}
+
+static void prepare_batch(const shared *sh, tri_job *jobs, const float *tri, const uint32_t *ids, size_t n)
+{
+#pragma omp parallel for schedule(static) num_threads(sh->ctx->threads)
+    for (size_t i = 0; i < n; i++) {
+        tri_job *t = &jobs[i];
+        memcpy(t->v, tri + 9 * i, sizeof t->v);
+        ms_wt_normal(t->v, t->N);
+        t->self = ids[i];
+        hpc_volume_build(&t->vl, sh->light_poly, 4, t->v, tri_margin(sh, t->v));
+    }
+}
+
+static void setup_light(shared *sh)
+{
+    const ms_light *L = &sh->ctx->light;
+    const double P[3] = { L->corner.x, L->corner.y, L->corner.z };
+    const double S[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, T[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
+    const int k = sh->k, gpr = k / sh->gs;
+    /* Widened by 1e-3 of a cell and by 16 ulps of the frame's coordinates (sh->scale, set by the caller):
+     * the float samples round off their cells by ulps of their coordinates, which the polygons absorb so
+     * that the culling margin need not magnify them. */
+    const double ls = fmin(sqrt(S[0] * S[0] + S[1] * S[1] + S[2] * S[2]), sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2]));
+    const double w = 1e-3 / k + (ls > 0.0 ? 16.0 * 1.1920929e-07 * sh->scale / ls : 0.0);
+    const double corners[4][2] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } };
+    for (int v = 0; v < 4; v++) {
+        const double s = corners[v][0] * (1 + 2 * w) - w, t = corners[v][1] * (1 + 2 * w) - w;
+        for (int a = 0; a < 3; a++) sh->light_poly[3 * v + a] = P[a] + s * S[a] + t * T[a];
+    }
+    for (int g = 0; g < sh->G; g++) {
+        const double s0 = (double)(g % gpr * sh->gs) / k, t0 = (double)(g / gpr * sh->gs) / k, e = (double)sh->gs / k;
+        for (int v = 0; v < 4; v++) {
+            const double s = s0 - w + corners[v][0] * (e + 2 * w), t = t0 - w + corners[v][1] * (e + 2 * w);
+            for (int a = 0; a < 3; a++) sh->group_poly[g][3 * v + a] = P[a] + s * S[a] + t * T[a];
+        }
+    }
+    for (int a = 0; a < 3; a++) {
+        sh->light_lo[a] = INFINITY;
+        sh->light_hi[a] = -INFINITY;
+        for (int v = 0; v < 4; v++) {
+            sh->light_lo[a] = ms_minf(sh->light_lo[a], (float)sh->light_poly[3 * v + a]);
+            sh->light_hi[a] = ms_maxf(sh->light_hi[a], (float)sh->light_poly[3 * v + a]);
+        }
+    }
+}
+
+int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, ms_raster_fn raster,
+                                        const ms_shadow_query *q, size_t n, const uint64_t *front, uint64_t *vis,
+                                        const hpc_source *src, uint64_t *counters)
+{
+    const int k = ctx->k, mw = ctx->mask_words;
+    shared sh;
+    memset(&sh, 0, sizeof sh);
+    sh.ctx = ctx;
+    sh.sw = ms_hpc_switches;
+    sh.scanline = scanline;
+    sh.raster = raster;
+    sh.k = k;
+    sh.mw = mw;
+    sh.gs = k >= 64 ? 8 : 4;     /* 16, 64, 64 groups for k = 16, 32, 64 (a group-umbra word; 2x2 groups at
+                                  * k = 16 tripled the box-plane tests and the time on a flowers scene) */
+    sh.G = (k / sh.gs) * (k / sh.gs);
+    sh.all_groups = sh.G == 64 ? UINT64_MAX : (UINT64_C(1) << sh.G) - 1u;
+    sh.npk = k * k / LANES;
+    sh.n = n;
+    sh.q = q;
+    sh.front = front;
+    sh.frame_off = (size_t)mw * sizeof(uint64_t);
+    sh.kz_off = sh.frame_off + (scanline ? sizeof(ms_raster_frame) : 0);
+    sh.slot_bytes = (sh.kz_off + (size_t)sh.npk + 63) / 64 * 64;
+    {
+        ms_light_frame F;
+        ms_light_frame_of(&ctx->light, &F);
+        for (int a = 0; a < 3; a++) {   /* the light's four corners */
+            const float c[4] = { F.corner[a], F.corner[a] + F.edge_s[a], F.corner[a] + F.edge_t[a],
+                                 F.corner[a] + F.edge_s[a] + F.edge_t[a] };
+            for (int v = 0; v < 4; v++) sh.scale = ms_maxf(sh.scale, 2.0f * fabsf(c[v]));
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) sh.scale = ms_maxf(sh.scale, fabsf(q[i].p[a]));
+    setup_light(&sh);
+    float rlo[3] = { INFINITY, INFINITY, INFINITY }, rhi[3] = { -INFINITY, -INFINITY, -INFINITY }, reach2 = 0.0f;
+    for (size_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) {
+            rlo[a] = ms_minf(rlo[a], q[i].p[a]);
+            rhi[a] = ms_maxf(rhi[a], q[i].p[a]);
+        }
+    for (int a = 0; a < 3 && n; a++) {
+        const float e = ms_maxf(fabsf(rhi[a] - sh.light_lo[a]), fabsf(sh.light_hi[a] - rlo[a]));
+        reach2 += e * e;
+    }
+    sh.reach = sqrtf(reach2);
+
+    int rc = -1, nchunks = 0;
+    const int threads = ctx->threads > 0 ? ctx->threads : 1;
+    const int cap = 4 * threads;
+    sh.gmask = calloc((size_t)sh.G * mw, sizeof *sh.gmask);
+    sh.gumbra = malloc(n * sizeof *sh.gumbra);
+    sh.full = malloc(n);
+    sh.slot = malloc(n * sizeof *sh.slot);
+    uint32_t *idx = malloc(n * sizeof *idx);
+    chunk *ch = calloc((size_t)cap, sizeof *ch);
+    tri_job *jobs = malloc(BATCH * sizeof *jobs);
+    float *tri = malloc(BATCH * 9 * sizeof *tri);
+    uint32_t *ids = malloc(BATCH * sizeof *ids);
+    if (!sh.gmask || !sh.gumbra || !sh.full || !sh.slot || !idx || !ch || !jobs || !tri || !ids) goto done;
+    for (int g = 0; g < sh.G; g++) {
+        const int gpr = k / sh.gs, i0 = g % gpr * sh.gs, j0 = g / gpr * sh.gs;
+        for (int j = j0; j < j0 + sh.gs; j++)
+            for (int i = i0; i < i0 + sh.gs; i++) {
+                const int s = j * k + i;
+                sh.gmask[(size_t)g * mw + (s >> 6)] |= UINT64_C(1) << (s & 63);
+            }
+    }
+    /* Samples behind the horizon count as blocked from the start (umbra bits: nothing open). */
+    uint32_t nlive = 0;
+    for (size_t r = 0; r < n; r++) {
+        uint64_t gu = 0;
+        const uint64_t *f = front + r * mw;
+        for (int g = 0; g < sh.G; g++) {
+            int open = 0;
+            for (int w = 0; w < mw; w++) open |= (f[w] & sh.gmask[(size_t)g * mw + w]) != 0;
+            if (!open) gu |= UINT64_C(1) << g;
+        }
+        sh.gumbra[r] = gu;
+        sh.full[r] = gu == sh.all_groups;
+        sh.slot[r] = -1;
+        if (!sh.full[r]) idx[nlive++] = (uint32_t)r;
+    }
+    const uint32_t target = (uint32_t)((nlive + cap - 1) / cap) > 1024u ? (uint32_t)((nlive + cap - 1) / cap) : 1024u;
+    nchunks = nlive ? make_chunks(&sh, idx, nlive, target, ch, cap) : 0;
+    if (nchunks < 0) goto done;
+    int failed = 0;
+    double t0 = omp_get_wtime();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(| : failed)
+    for (int i = 0; i < nchunks; i++) failed |= build_tree(&sh, &ch[i]) != 0;
+    counters[C_BUILD_US] += (uint64_t)((omp_get_wtime() - t0) * 1e6);
+    if (failed) goto done;
+    if (sh.sw & MS_HPC_OFF_ON_DEMAND) {   /* D off: every receiver's mask and sample data before any triangle */
+        for (int i = 0; i < nchunks; i++)
+            for (uint32_t j = 0; j < ch[i].n; j++) {
+                const uint32_t r = ch[i].idx[j];
+                const int32_t s = slot_get(&sh, &ch[i]);
+                if (s < 0) goto done;
+                ms_grid g;
+                ms_grid_for_pixel(&ctx->light, k, q[r].px, q[r].py, ctx->seed, &g);
+                sh.slot[r] = s;
+                memcpy(slot_mask(&sh, &ch[i], s), front + (size_t)r * mw, (size_t)mw * sizeof(uint64_t));
+                slot_setup(&sh, &ch[i], s, &q[r], &g);
+            }
+    }
+    t0 = omp_get_wtime();
+
+    if (src->rewind && src->rewind(src->user)) goto done;
+    for (;;) {
+        const size_t got = src->next(src->user, tri, ids, BATCH);
+        if (got == (size_t)-1) goto done;
+        if (!got) break;
+        prepare_batch(&sh, jobs, tri, ids, got);
+        counters[C_TRIANGLES] += got;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+        for (int i = 0; i < nchunks; i++)
+            for (size_t t = 0; t < got; t++) cast_triangle(&sh, &ch[i], &jobs[t]);
+        for (int i = 0; i < nchunks; i++)
+            if (ch[i].failed) goto done;
+    }
+    counters[C_CAST_US] += (uint64_t)((omp_get_wtime() - t0) * 1e6);
+    /* The visible masks: front where no triangle came near, nothing in full umbra, else what is open. */
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (size_t r = 0; r < n; r++) {
+        uint64_t *v = vis + r * mw;
+        if (sh.full[r]) memset(v, 0, (size_t)mw * sizeof *v);
+        else memcpy(v, front + r * mw, (size_t)mw * sizeof *v);
+    }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int i = 0; i < nchunks; i++) {
+        chunk *c = &ch[i];
+        for (uint32_t j = 0; j < c->n; j++) {
+            const uint32_t r = c->idx[j];
+            if (!sh.full[r] && sh.slot[r] >= 0) memcpy(vis + (size_t)r * mw, slot_mask(&sh, c, sh.slot[r]), (size_t)mw * sizeof *vis);
+        }
+    }
+    rc = 0;
+done:
+    for (int i = 0; i < (nchunks > 0 ? nchunks : 0); i++) {
+        for (int c = 0; c < C_COUNT; c++)
+            if (c != C_TRIANGLES && c != C_MASKS_PEAK) counters[c] += ch[i].cnt[c];
+        counters[C_MASKS_PEAK] += (uint64_t)ch[i].peak;
+        /* The pool as allocated (it only grows): each slot's mask, and its per-point sample data (the
+         * packets' shear axes, the Scanline frame). */
+        counters[C_MASK_BYTES] += (uint64_t)ch[i].cap_slots * (uint64_t)mw * 8u;
+        counters[C_SAMPLE_BYTES] += (uint64_t)ch[i].cap_slots * (uint64_t)(sh.slot_bytes - (size_t)mw * 8u);
+        counters[C_HIERARCHY_BYTES] += ch[i].node_bytes_peak;
+        free(ch[i].nodes);
+        free(ch[i].pool);
+        free(ch[i].free_list);
+    }
+    /* The hierarchy's per-point arrays: indices, umbra bits, full flags, slot numbers; the groups' masks. */
+    counters[C_HIERARCHY_BYTES] += (uint64_t)n * (sizeof *idx + sizeof *sh.gumbra + 1u + sizeof *sh.slot);
+    counters[C_SAMPLE_BYTES] += (uint64_t)sh.G * (uint64_t)mw * 8u;
+    free(ch);
+    free(idx);
+    free(jobs);
+    free(tri);
+    free(ids);
+    free(sh.gmask);
+    free(sh.gumbra);
+    free(sh.full);
+    free(sh.slot);
+    return rc;
+}

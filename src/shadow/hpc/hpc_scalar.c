@@ -1,0 +1,2 @@
+/* The portable instance of the hierarchical penumbra casting engine (hpc_impl.h). */
+#include "hpc_impl.h"
