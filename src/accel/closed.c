@@ -37,6 +37,25 @@ static void unite(uint32_t *parent, uint32_t a, uint32_t b)
     if (a != b) parent[a < b ? b : a] = a < b ? a : b;
 }
 
+/* Numbers the sets of the union-find `parent` over n triangles into label (0, 1, ... in order of their
+ * smallest member), a set with any flagged triangle MS_OPEN_COMPONENT; returns the number of sets kept.
+ * flag is overwritten (a set's flag gathers at its root). */
+static size_t label_sets(uint32_t *parent, uint8_t *flag, size_t n, uint32_t *label)
+{
+    for (size_t t = 0; t < n; t++) {
+        const uint32_t r = find_root(parent, (uint32_t)t);
+        if (flag[t]) flag[r] = 1;
+    }
+    /* Roots are their set's smallest index (unite), so a root is numbered before its members. */
+    size_t k = 0;
+    for (size_t t = 0; t < n; t++) {
+        const uint32_t r = find_root(parent, (uint32_t)t);
+        if (flag[r]) label[t] = MS_OPEN_COMPONENT;
+        else label[t] = r == t ? (uint32_t)k++ : label[r];
+    }
+    return k;
+}
+
 static uint32_t float_key(float f)
 {
     f += 0.0f;   /* -0 and +0 are one position */
@@ -127,29 +146,8 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     etri = NULL;
     free(id);
     id = NULL;
-    /* A component is closed when none of its triangles is bad; roots are the smallest index. */
-    for (size_t t = 0; t < n; t++) {
-        const uint32_t r = find_root(parent, (uint32_t)t);
-        if (bad[t]) bad[r] = 1;
-    }
-    /* Roots are their set's smallest index (unite), so a root is numbered before its members. */
-    size_t nc = 0;
-    for (size_t t = 0; t < n; t++) {
-        const uint32_t r = find_root(parent, (uint32_t)t);
-        if (bad[r]) out->component[t] = MS_OPEN_COMPONENT;
-        else out->component[t] = r == t ? (uint32_t)nc++ : out->component[r];
-    }
-    /* The mod-2 cycles the same way: open when any of their edges is used an odd number of times. */
-    for (size_t t = 0; t < n; t++) {
-        const uint32_t r = find_root(cparent, (uint32_t)t);
-        if (odd[t]) odd[r] = 1;
-    }
-    size_t ncy = 0;
-    for (size_t t = 0; t < n; t++) {
-        const uint32_t r = find_root(cparent, (uint32_t)t);
-        if (odd[r]) out->cycle[t] = MS_OPEN_COMPONENT;
-        else out->cycle[t] = r == t ? (uint32_t)ncy++ : out->cycle[r];
-    }
+    const size_t nc = label_sets(parent, bad, n, out->component);   /* closed components */
+    const size_t ncy = label_sets(cparent, odd, n, out->cycle);      /* mod-2 cycles */
     out->n_cycles = ncy;
     if (ncy) {
         out->cycle_box = malloc(ncy * sizeof *out->cycle_box);
