@@ -461,6 +461,9 @@ typedef struct ms_render_options {
                              * smaller); embree and hpc never cull */
     int no_interior;        /* micro-raster methods: no interior boxes (virtual occluders inside closed meshes,
                              * docs/culling.md: the same V and S); to measure what they buy */
+    int no_merge;           /* micro-raster methods: occluders as given, without merging the two halves of
+                             * axis-aligned rectangles and rectangles sharing a side into one (docs/culling.md:
+                             * the same points, so the same V and S up to ties on the rectangles' sides) */
     uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
 } ms_render_options;
 
@@ -505,6 +508,9 @@ typedef struct ms_stats {
      * and interior boxes rasterized before the triangles (micro-raster methods), summed over the lights
      * (docs/culling.md). */
     uint64_t occluders_culled, interior_boxes;
+    uint64_t occluders_merged;     /* triangles saved by merging coplanar rectangles, summed over the lights */
+    uint64_t receivers_on_merged;  /* visible points on a merged face, answered on the scene's own triangles by
+                                    * the reference tracer (docs/culling.md), summed over the lights */
     uint64_t memory_need;          /* bytes the call estimated it would allocate, checked against its memory budget */
     uint64_t memory_budget;        /* that budget (max_memory, or the default: ms_memory_budget) */
 } ms_stats;

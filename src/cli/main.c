@@ -50,6 +50,7 @@ static void usage(FILE *f)
         "  --closed-cull on|off  leave out the side of closed meshes facing away from the light (the same\n"
         "                      answer, docs/culling.md); default: on for the micro-raster methods\n"
         "  --no-interior       micro-raster methods: no interior boxes (docs/culling.md; to measure)\n"
+        "  --no-merge          micro-raster methods: do not merge coplanar rectangles (docs/culling.md)\n"
         "  --max-memory SIZE   memory budget (e.g. 512M, 8G; default %d%% of physical memory): a frame that\n"
         "                      would need more is refused before anything is allocated, naming what fits\n"
         "  --quiet             no progress or summary on stderr\n"
@@ -84,7 +85,7 @@ static int cli_main(int argc, char **argv)
     if (argc > 1 && strcmp(argv[1], "bake") == 0) return ms_cli_bake(argc - 1, argv + 1);
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
-           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR, O_MAX_MEMORY };
+           O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR, O_NO_MERGE, O_MAX_MEMORY };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -99,6 +100,7 @@ static int cli_main(int argc, char **argv)
         { "consistent", no_argument, 0, O_CONSISTENT },
         { "closed-cull", required_argument, 0, O_CLOSED_CULL },
         { "no-interior", no_argument, 0, O_NO_INTERIOR },
+        { "no-merge", no_argument, 0, O_NO_MERGE },
         { "max-memory", required_argument, 0, O_MAX_MEMORY },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
@@ -189,6 +191,7 @@ static int cli_main(int argc, char **argv)
             else { fprintf(stderr, "microshadow: --closed-cull: '%s' is not on or off\n", optarg); return EXIT_BAD_INPUT; }
             break;
         case O_NO_INTERIOR: opt.no_interior = 1; break;
+        case O_NO_MERGE: opt.no_merge = 1; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &opt.max_memory)) return EXIT_BAD_INPUT; break;
         case O_EXPOSURE: {
             char *end;

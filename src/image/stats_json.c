@@ -31,6 +31,8 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     cJSON_AddNumberToObject(o, "primary_nodes", (double)s->primary_nodes);
     cJSON_AddNumberToObject(o, "occluders_culled", (double)s->occluders_culled);
     cJSON_AddNumberToObject(o, "interior_boxes", (double)s->interior_boxes);
+    cJSON_AddNumberToObject(o, "occluders_merged", (double)s->occluders_merged);
+    cJSON_AddNumberToObject(o, "receivers_on_merged", (double)s->receivers_on_merged);
     cJSON_AddNumberToObject(o, "shadow_s", s->shadow_s);
     cJSON_AddNumberToObject(o, "shadow_cpu_s", s->shadow_cpu_s);
     cJSON_AddNumberToObject(o, "total_s", s->total_s);

@@ -14,6 +14,7 @@
 #include "light/pattern.h"
 #include "light/light_shape.h"
 #include "shadow/method.h"
+#include "shadow/raytrace/raytrace.h"
 #include "primary/primary.h"
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
@@ -123,6 +124,7 @@ static void light_ctx(const ms_frame_job *j, size_t l, ms_render_ctx *c)
         c->bvh = &j->occ[l].bvh;
         c->alpha = j->occ[l].alpha;
         c->prim_map = j->occ[l].prim_map;
+        c->prim_merged = j->occ[l].prim_merged;
     }
     if (j->occ && j->occ[l].interior.n_tris) c->interior = &j->occ[l].interior;
 }
@@ -136,9 +138,9 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
     ms_interior interior = { 0 };
     if (ms_closed_find(j->scene->tri, j->scene->n_tris, &closed)) return -1;
     int rc = 0;
-    if (closed.n_cycles) {
+    if (closed.n_cycles || (what & MS_OCC_MERGE)) {
         const double eps = ms_interior_clearance(&j->bvh, j->lights, j->nlights);
-        if (what & MS_OCC_INTERIOR)
+        if ((what & MS_OCC_INTERIOR) && closed.n_cycles)
             rc = ms_interior_find(j->scene->tri, j->scene->n_tris, &closed, MS_INTERIOR_RES, MS_INTERIOR_MIN_TRIS, eps, j->threads, &interior);
         j->occ = rc ? NULL : calloc(j->nlights, sizeof *j->occ);
         rc = j->occ ? 0 : -1;
@@ -146,6 +148,7 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
             rc = ms_occluders_build(&j->occ[l], j->scene, &j->bvh, &closed, &interior, eps, j->alpha, &j->lights[l], what, j->threads);
             st->occluders_culled += j->occ[l].culled;
             st->interior_boxes += j->occ[l].interior_boxes;
+            st->occluders_merged += j->occ[l].merged;
         }
     }
     ms_interior_free(&interior);
@@ -314,7 +317,8 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     if ((unsigned)opt->closed_cull > MS_CLOSED_CULL_OFF) { snprintf(err, errlen, "unknown closed_cull %d", (int)opt->closed_cull); goto fail; }
     const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
                      (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
-    const int occ_what = sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0);
+    const int occ_what = sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0) &
+                         (opt->no_merge ? ~MS_OCC_MERGE : ~0);
     if (occ_what && !streamed && occluders_build(j, occ_what, &f->stats)) {
         snprintf(err, errlen, "out of memory for the lights' occluders");
         goto fail;
@@ -405,9 +409,34 @@ static void surface_tiles(ms_frame_job *j, const int *tiles, int n)
 /* Sums of the shadow passes of one call. */
 typedef struct pass_sums {
     uint64_t counters[MS_MAX_COUNTERS];
-    uint64_t visible, penumbra, segments;
+    uint64_t visible, penumbra, segments, on_merged;
     double resolve_thread_s;
 } pass_sums;
+
+/* Moves the queries whose receiver lies on a merged coplanar face (ctx->prim_merged; own: their prims in
+ * the scene's BVH b) where the merged faces could answer otherwise than the scene's own triangles
+ * (ms_merged_receiver_ok: a grazing segment meeting its own plane beyond the near range) after the others,
+ * with their front masks and pixels; returns how many come first. */
+static int merged_last(const ms_render_ctx *ctx, const ms_bvh *b, const float (*hull)[3], int n_hull, ms_shadow_query *q,
+                       size_t *where, uint32_t *own, uint64_t *front, size_t mw, int nq)
+{
+    int w = 0;
+    for (int i = 0; i < nq; i++) {
+        if (ctx->prim_merged[own[i]] && !ms_merged_receiver_ok(b->tri + 9 * (size_t)own[i], q[i].p, hull, n_hull)) continue;
+        if (w != i) {
+            const ms_shadow_query tq = q[w]; q[w] = q[i]; q[i] = tq;
+            const size_t tw = where[w]; where[w] = where[i]; where[i] = tw;
+            const uint32_t to = own[w]; own[w] = own[i]; own[i] = to;
+            for (size_t k = 0; k < mw; k++) {
+                const uint64_t tf = front[(size_t)w * mw + k];
+                front[(size_t)w * mw + k] = front[(size_t)i * mw + k];
+                front[(size_t)i * mw + k] = tf;
+            }
+        }
+        w++;
+    }
+    return w;
+}
 
 /* The shadow phase of light l over tiles[0..n) (tiles == NULL: 0..n-1; whole: the frame's first and only
  * call): front masks, the method's visible masks, V, S and S_spec into light l's planes, over 16x16 tiles
@@ -427,7 +456,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     uint16_t *const fr = out->front + l * npix;
     const ms_surface *const surf = j->surf;
     const ms_hit *const hits = j->hits;
-    uint64_t visible = 0, penumbra = 0, segments = 0;
+    uint64_t visible = 0, penumbra = 0, segments = 0, on_merged = 0;
     double resolve_thread_s = 0.0;
     int failed = 0;
     const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
@@ -443,13 +472,18 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
 #pragma omp parallel num_threads(j->threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
-        uint64_t local_visible = 0, local_penumbra = 0, local_segments = 0;
+        uint64_t local_visible = 0, local_penumbra = 0, local_segments = 0, local_on_merged = 0;
         double local_resolve = 0.0;
         /* Per thread: the tile's front and visible masks, and the stratified pattern's points. */
         uint64_t *front = aligned_alloc(64, TILE * TILE * mw * sizeof *front);
         uint64_t *vmask = aligned_alloc(64, TILE * TILE * mw * sizeof *vmask);
         float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
-        int ok = front && vmask && (pts || !stratified);
+        /* Receivers on merged coplanar faces (occluders.h): answered here by the reference tracer on the
+         * scene's own triangles, with scratch for its sample points. */
+        float *rt_pts = ctx.prim_merged ? malloc((size_t)ctx.samples * 3 * sizeof *rt_pts) : NULL;
+        float hull[8][3], hull_box[6];
+        const int n_hull = ms_light_hull(&ctx.light, hull, hull_box);
+        int ok = front && vmask && (pts || !stratified) && (rt_pts || !ctx.prim_merged);
 #pragma omp for schedule(dynamic, 1)
         for (int ti = 0; ti < shadow_tiles; ti++) {
             if (cancelled(j)) continue;
@@ -457,6 +491,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
             tile_rect(j, tiles ? tiles[ti] : ti, &x0, &y0, &x1, &y1);
             ms_shadow_query q[TILE * TILE];
             size_t where[TILE * TILE];
+            uint32_t own[TILE * TILE];   /* the receivers' prims in the scene's BVH */
             ms_render_ctx qc = ctx;   /* the query's context: the frame's, or with a sphere's outline disk */
             int nq = 0;
             for (int y = y0; y < y1 && ok; y++)
@@ -466,6 +501,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
                     ms_query_from_hit(&q[nq], h, (uint32_t)x, (uint32_t)y);
                     q[nq].prim = ms_ctx_skip_prim(&ctx, h->prim);
+                    own[nq] = h->prim;
                     if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                         vis[i] = shadow[i] = spec[i] = 0.0f;   /* inside the sphere: no sample counts */
                         fr[i] = 0;
@@ -478,13 +514,28 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     local_segments += (uint64_t)nf;
                     where[nq++] = i;
                 }
+            const int nm = ctx.prim_merged && ok ? merged_last(&ctx, &j->bvh, (const float (*)[3])hull, n_hull, q, where, own, front, mw, nq) : nq;
             if (!outlined) {
-                if (nq && ok && sm->visibility(sstate, &ctx, q, nq, front, vmask, local)) ok = 0;
+                if (nm && ok && sm->visibility(sstate, &ctx, q, nm, front, vmask, local)) ok = 0;
             } else
-                for (int i = 0; i < nq && ok; i++) {
+                for (int i = 0; i < nm && ok; i++) {
                     shape->outline(&ctx.light, q[i].p, &qc.light);
                     if (sm->visibility(sstate, &qc, &q[i], 1, front + (size_t)i * mw, vmask + (size_t)i * mw, local)) ok = 0;
                 }
+            for (int i = nm; i < nq && ok; i++) {
+                ms_render_ctx rc = ctx;
+                if (outlined) shape->outline(&ctx.light, q[i].p, &rc.light);
+                rc.bvh = &j->bvh;
+                rc.alpha = j->alpha;
+                rc.prim_map = NULL;
+                rc.prim_merged = NULL;
+                rc.interior = NULL;
+                ms_shadow_query qq = q[i];
+                qq.prim = own[i];
+                uint64_t rt_cnt[MS_MAX_COUNTERS] = { 0 };
+                ms_raytrace_visible_samples(&rc, &qq, rt_pts, front + (size_t)i * mw, vmask + (size_t)i * mw, rt_cnt);
+                local_on_merged++;
+            }
             const double tr = omp_get_wtime();
             for (int i = 0; i < nq && ok; i++) {
                 if (outlined) shape->outline(&ctx.light, q[i].p, &qc.light);
@@ -503,12 +554,14 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
         free(front);
         free(vmask);
         free(pts);
+        free(rt_pts);
 #pragma omp critical(ms_counters)
         {
             for (int c = 0; c < MS_MAX_COUNTERS; c++) p->counters[c] += local[c];
             visible += local_visible;
             penumbra += local_penumbra;
             segments += local_segments;
+            on_merged += local_on_merged;
             resolve_thread_s += local_resolve;
             failed |= !ok;
         }
@@ -533,6 +586,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     p->visible += visible;
     p->penumbra += penumbra;
     p->segments += segments;
+    p->on_merged += on_merged;
     p->resolve_thread_s += resolve_thread_s;
     return failed ? -1 : 0;
 }
@@ -575,6 +629,7 @@ int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, siz
     for (int c = 0; c < MS_MAX_COUNTERS; c++) st->counter[c] += p.counters[c];
     st->visible_pixels += p.visible / j->nlights;   /* every light's pass counts each visible pixel once */
     st->penumbra_pixels += p.penumbra;
+    st->receivers_on_merged += p.on_merged;
     st->shadow_rays += p.segments;
     st->shadow_factor_s += p.resolve_thread_s;
     return 0;

@@ -18,7 +18,8 @@ typedef struct ms_shadow_method {
     int occluders;                /* what it takes of a light's occluders (visibility/occluders.h, MS_OCC_*):
                                    * MS_OCC_CULL: the culled BVH in ctx->bvh with ctx->prim_map (when the
                                    * options ask for the cull; MS_OCC_CULL_BY_DEFAULT: unless they refuse it);
-                                   * MS_OCC_INTERIOR: ctx->interior. 0: the scene's
+                                   * MS_OCC_INTERIOR: ctx->interior; MS_OCC_MERGE: coplanar rectangles merged
+                                   * in that BVH (ties may move). 0: the scene's
                                    * BVH alone (streamed or own-indexed methods, and Embree, the baseline as
                                    * its users run it) */
     int n_counters;

@@ -41,6 +41,9 @@ typedef struct ms_render_ctx {
      * BVH, whose ids the primary's hits carry (UINT32_MAX: culled); NULL: the same ids. Receivers' prim ids
      * go through ms_ctx_skip_prim. */
     const uint32_t *prim_map;
+    /* With merged coplanar faces in bvh (occluders.h): per prim of the scene's BVH, 1 when a receiver on it
+     * is to be answered by the driver on the scene's own triangles; NULL: none. */
+    const uint8_t *prim_merged;
     /* The light's interior boxes (occluders.h, accel/interior.h) as triangles, NULL: none. Every segment
      * one of them meets is occluded; the micro-rasterization methods rasterize them first. */
     const ms_bvh *interior;

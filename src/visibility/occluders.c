@@ -4,6 +4,7 @@
 #include "alpha.h"
 #include "context.h"
 #include "light/light_shape.h"
+#include "accel/coplanar.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,7 +12,7 @@
 /* Points whose convex hull holds every point of the light (the proof's Λ), and their box: a planar
  * shape's parallelogram (a disk inside its bounding square), a round shape's bounding box (every outline
  * disk a receiver sees lies inside the sphere). Returns the number of points. */
-static int light_hull(const ms_light *l, float pts[8][3], float box[6])
+int ms_light_hull(const ms_light *l, float pts[8][3], float box[6])
 {
     const ms_light_shape_ops *ops = ms_light_shape_of(l->shape);
     int n;
@@ -40,6 +41,7 @@ void ms_occluders_free(ms_occluders *o)
     ms_bvh_free(&o->bvh);
     ms_alpha_free(o->alpha);
     free(o->prim_map);
+    free(o->prim_merged);
     ms_bvh_free(&o->interior);
     memset(o, 0, sizeof *o);
 }
@@ -67,7 +69,7 @@ double ms_interior_clearance(const ms_bvh *scene_bvh, const ms_light *lights, si
     double d = 0.0;
     for (size_t l = 0; l < n_lights; l++) {
         float pts[8][3], lbox[6];
-        light_hull(&lights[l], pts, lbox);
+        ms_light_hull(&lights[l], pts, lbox);
         d = fmax(d, joint_diag(sbox, lbox));
     }
     return 2.5 * (double)MS_SEGMENT_NEAR * d;
@@ -130,12 +132,98 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
     return rc;
 }
 
-/* The cull (docs/culling.md) into o->bvh, o->alpha, o->prim_map; o->active = 0 when nothing is culled. */
-static int cull_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const ms_closed *closed,
-                      const uint8_t *porous, const uint8_t *boxed, const float (*pts)[3], int np, const float lbox[6],
-                      double margin, const struct ms_alpha *scene_alpha, int threads)
+/* The triangles kept by the cull (keep NULL: all), with coplanar rectangles merged when `merge` (alpha-tested
+ * triangles left alone), into o->bvh, o->alpha, o->prim_map; o->active = 0 when that changes nothing. */
+static int set_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const uint8_t *keep, size_t culled,
+                     int merge, const struct ms_alpha *scene_alpha, int threads)
 {
     const size_t n = scene->n_tris;
+    if (culled == n || (!culled && !merge)) return 0;   /* all culled: only degenerate inputs; keep it simple */
+    const size_t nk = n - culled;
+    float *tri = malloc(nk * 9 * sizeof *tri), *mtri = NULL;
+    uint32_t *src = malloc(nk * sizeof *src), *of_kept = NULL, *msrc = NULL;
+    uint8_t *mflag = NULL;
+    uint32_t *occ_of_tri = malloc(n * sizeof *occ_of_tri);
+    uint8_t *opaque = merge ? malloc(nk ? nk : 1) : NULL;
+    uint32_t *leaf_of = scene_alpha && merge ? malloc(n * sizeof *leaf_of) : NULL;
+    int rc = -1;
+    if (!tri || !src || !occ_of_tri || (merge && !opaque) || (scene_alpha && merge && !leaf_of)) goto done;
+    for (uint32_t i = 0; leaf_of && i < scene_bvh->n_tris; i++) leaf_of[scene_bvh->tri_source[i]] = i;
+    size_t m = 0;
+    for (size_t t = 0; t < n; t++) {
+        if (keep && !keep[t]) continue;
+        memcpy(tri + 9 * m, scene->tri + 9 * t, 9 * sizeof *tri);
+        if (opaque) opaque[m] = !(leaf_of && ms_alpha_tested(scene_alpha, leaf_of[t]));
+        src[m++] = (uint32_t)t;
+    }
+    size_t nb = nk;
+    const float *btri = tri;
+    if (merge) {
+        if (ms_coplanar_merge(tri, nk, opaque, &mtri, &nb, &of_kept, &msrc, &mflag)) goto done;
+        if (!culled && nb == nk) { rc = 0; goto done; }   /* nothing merged, nothing culled */
+        btri = mtri;
+        o->merged = nk - nb;
+    }
+    o->prim_map = malloc((size_t)scene_bvh->n_tris * sizeof *o->prim_map);
+    if (!o->prim_map || ms_bvh_build(&o->bvh, btri, nb, threads)) goto done;
+    /* The occluder BVH's tri_source indexes its input list: composed back to the scene's triangles (a
+     * merged rectangle names one of its halves), and each scene triangle's occluder prim (a merged one:
+     * its rectangle's first triangle; the near range keeps a receiver off the coplanar second). */
+    uint32_t *leaf_of_set = malloc((nb ? nb : 1) * sizeof *leaf_of_set);
+    if (!leaf_of_set) goto done;
+    for (uint32_t i = 0; i < o->bvh.n_tris; i++) {
+        const uint32_t in = o->bvh.tri_source[i];
+        leaf_of_set[in] = i;
+        o->bvh.tri_source[i] = src[merge ? msrc[in] : in];
+    }
+    for (size_t t = 0; t < n; t++) occ_of_tri[t] = UINT32_MAX;
+    for (size_t k = 0; k < nk; k++) occ_of_tri[src[k]] = leaf_of_set[merge ? of_kept[k] : k];
+    free(leaf_of_set);
+    for (uint32_t i = 0; i < scene_bvh->n_tris; i++) o->prim_map[i] = occ_of_tri[scene_bvh->tri_source[i]];
+    if (o->merged) {
+        /* Receivers on merged faces (coplanar.h) are answered on the scene's own triangles. */
+        uint8_t *on = calloc(n ? n : 1, 1);
+        o->prim_merged = malloc((size_t)scene_bvh->n_tris);
+        if (!on || !o->prim_merged) { free(on); goto done; }
+        for (size_t k = 0; k < nk; k++) on[src[k]] = mflag[k];
+        for (uint32_t i = 0; i < scene_bvh->n_tris; i++) o->prim_merged[i] = on[scene_bvh->tri_source[i]];
+        free(on);
+    }
+    if (scene_alpha && ms_alpha_build(scene, &o->bvh, &o->alpha)) goto done;
+    o->culled = culled;
+    o->active = 1;
+    rc = 0;
+done:
+    free(tri);
+    free(src);
+    free(occ_of_tri);
+    free(opaque);
+    free(leaf_of);
+    free(mtri);
+    free(of_kept);
+    free(msrc);
+    free(mflag);
+    if (rc || !o->active) {
+        ms_bvh_free(&o->bvh);
+        ms_alpha_free(o->alpha);
+        free(o->prim_map);
+        free(o->prim_merged);
+        o->alpha = NULL;
+        o->prim_map = NULL;
+        o->prim_merged = NULL;
+        o->merged = o->culled = 0;
+        o->active = 0;
+    }
+    return rc;
+}
+
+/* The cull's keep flags (docs/culling.md); returns the triangles culled (0 with *keep NULL when nothing). */
+static int cull_keep(const ms_scene *scene, const ms_closed *closed, const uint8_t *porous, const uint8_t *boxed,
+                     const float (*pts)[3], int np, const float lbox[6], double margin, uint8_t **keep_out, size_t *culled_out)
+{
+    const size_t n = scene->n_tris;
+    *keep_out = NULL;
+    *culled_out = 0;
     uint8_t *keep = malloc(n ? n : 1);
     if (!keep) return -1;
     size_t culled = ms_closed_cull(closed, scene->tri, pts, np, lbox, margin, keep);
@@ -151,38 +239,10 @@ static int cull_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scen
         const uint32_t c = closed->component[t];
         if (!keep[t] && porous[c]) { keep[t] = 1; culled--; }
     }
-    if (!culled || culled == n) { free(keep); return 0; }   /* all culled: only degenerate inputs; keep it simple */
-    const size_t nk = n - culled;
-    float *tri = malloc(nk * 9 * sizeof *tri);
-    uint32_t *src = malloc(nk * sizeof *src);
-    o->prim_map = malloc((size_t)scene_bvh->n_tris * sizeof *o->prim_map);
-    uint32_t *occ_of_tri = malloc(n * sizeof *occ_of_tri);
-    int rc = -1;
-    if (!tri || !src || !o->prim_map || !occ_of_tri) goto done;
-    size_t m = 0;
-    for (size_t t = 0; t < n; t++) {
-        if (!keep[t]) continue;
-        memcpy(tri + 9 * m, scene->tri + 9 * t, 9 * sizeof *tri);
-        src[m++] = (uint32_t)t;
-    }
-    if (ms_bvh_build(&o->bvh, tri, nk, threads)) goto done;
-    /* The occluder BVH's tri_source indexes the kept list: compose it back to the scene's triangles. */
-    for (size_t t = 0; t < n; t++) occ_of_tri[t] = UINT32_MAX;
-    for (uint32_t i = 0; i < o->bvh.n_tris; i++) {
-        o->bvh.tri_source[i] = src[o->bvh.tri_source[i]];
-        occ_of_tri[o->bvh.tri_source[i]] = i;
-    }
-    for (uint32_t i = 0; i < scene_bvh->n_tris; i++) o->prim_map[i] = occ_of_tri[scene_bvh->tri_source[i]];
-    if (scene_alpha && ms_alpha_build(scene, &o->bvh, &o->alpha)) goto done;
-    o->culled = culled;
-    o->active = 1;
-    rc = 0;
-done:
-    free(keep);
-    free(tri);
-    free(src);
-    free(occ_of_tri);
-    return rc;
+    if (!culled) { free(keep); return 0; }
+    *keep_out = keep;
+    *culled_out = culled;
+    return 0;
 }
 
 int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const ms_closed *closed,
@@ -191,9 +251,9 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
 {
     memset(o, 0, sizeof *o);
     const size_t n = scene->n_tris;
-    if (!closed->n_cycles || closed->n_tris != n || !scene_bvh->n_nodes) return 0;
+    if (closed->n_tris != n || !scene_bvh->n_nodes || (!closed->n_cycles && !(what & MS_OCC_MERGE))) return 0;
     float pts[8][3], lbox[6], sbox[6];
-    const int np = light_hull(l, pts, lbox);
+    const int np = ms_light_hull(l, pts, lbox);
     for (int i = 0; i < 6; i++)
         if (!isfinite(lbox[i])) return 0;
     root_box(scene_bvh, sbox);
@@ -211,12 +271,35 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
         rc = !boxed ? -1 : interior_build(o, closed, interior, porous, lbox, margin, boxed, threads);
         free(porous);
     }
+    uint8_t *keep = NULL;
+    size_t culled = 0;
     if (!rc && (what & MS_OCC_CULL) && closed->n_components) {
         uint8_t *porous = porous_of(closed, 0, scene_bvh, scene_alpha, &oom);
-        rc = oom ? -1 : cull_build(o, scene, scene_bvh, closed, porous, boxed, (const float (*)[3])pts, np, lbox, margin, scene_alpha, threads);
+        rc = oom ? -1 : cull_keep(scene, closed, porous, boxed, (const float (*)[3])pts, np, lbox, margin, &keep, &culled);
         free(porous);
     }
+    if (!rc && (culled || (what & MS_OCC_MERGE)))
+        rc = set_build(o, scene, scene_bvh, keep, culled, (what & MS_OCC_MERGE) != 0, scene_alpha, threads);
+    free(keep);
     free(boxed);
     if (rc) ms_occluders_free(o);
     return rc;
+}
+
+int ms_merged_receiver_ok(const float tri[9], const float p[3], const float (*hull)[3], int n_hull)
+{
+    int a = -1;
+    for (int k = 0; k < 3 && a < 0; k++)
+        if (tri[k] == tri[3 + k] && tri[k] == tri[6 + k]) a = k;
+    if (a < 0) return 1;   /* not on an axis-aligned face: never merged */
+    const double c = tri[a], d = fabs((double)p[a] - c);
+    double lmin = INFINITY;
+    int above = 0, below = 0;
+    for (int q = 0; q < n_hull; q++) {
+        const double e = (double)hull[q][a] - c;
+        above |= e > 0.0;
+        below |= e < 0.0;
+        lmin = fmin(lmin, fabs(e));
+    }
+    return !(above && below) && lmin > 0.0 && d < 0.5 * (double)MS_SEGMENT_NEAR * lmin;
 }

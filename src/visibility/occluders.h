@@ -1,6 +1,6 @@
 /* The occluders of one light: the scene's triangles less those of closed components that face away from
- * the whole light (accel/closed.h, docs/culling.md: removing them changes no V and no S), with their own
- * BVH, so that the methods that take it (ms_shadow_method.culls_closed) traverse and test only what can
+ * the whole light (accel/closed.h, docs/culling.md: removing them changes no V and no S), with axis-aligned
+ * coplanar rectangles merged (accel/coplanar.h: the same points, ties aside), with their own BVH, so that the methods that take it (ms_shadow_method.culls_closed) traverse and test only what can
  * decide a segment. Built per light at a frame's set-up; the primary's BVH stays the scene's.
  *
  * Prim ids: the occluder BVH names its triangles in its own leaf order. Its tri_source is composed back
@@ -32,6 +32,9 @@ typedef struct ms_occluders {
     struct ms_alpha *alpha;     /* their alpha table (NULL: all opaque) */
     uint32_t *prim_map;         /* per prim of the scene's BVH: the occluder prim, or UINT32_MAX */
     size_t culled;              /* triangles left out */
+    size_t merged;              /* triangles saved by merging coplanar rectangles (accel/coplanar.h) */
+    uint8_t *prim_merged;       /* per prim of the scene's BVH: 1 when its triangle is part of a merged face,
+                                 * whose receivers are answered on the scene's own triangles; NULL: none */
     int active;                 /* 0: nothing culled, use the scene's BVH (the fields above empty) */
     ms_bvh interior;            /* the interior boxes' triangles (n_tris 0: none) */
     size_t interior_boxes;
@@ -43,17 +46,28 @@ typedef struct ms_occluders {
 #define MS_INTERIOR_MIN_TRIS 256
 
 /* What a light's occluders are built with (ms_shadow_method.occluders). */
-enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4 };
+enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4, MS_OCC_MERGE = 8 };
 
 /* The occluders of light l (every shape: its hull is its parallelogram, or a sphere's box) for the scene
  * whose BVH is `scene_bvh` and closed components `closed` (found over scene->tri), with alpha-tested
  * components left as they are (`scene_alpha`: the scene BVH's alpha table, NULL when opaque): with
- * MS_OCC_CULL in `what` the cull (o->active = 0 when nothing is culled), with MS_OCC_INTERIOR the boxes of
+ * MS_OCC_CULL in `what` the cull, with MS_OCC_MERGE the merge (o->active = 0 when neither changes anything:
+ * the scene's BVH serves), with MS_OCC_INTERIOR the boxes of
  * `interior` (found with clearance interior_eps; none for a light so far that the clearance no longer
  * covers the near range). 0, or -1 when out of memory. */
 int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const ms_closed *closed,
                        const ms_interior *interior, double interior_eps, const struct ms_alpha *scene_alpha,
                        const ms_light *l, int what, int threads);
+
+/* Points whose convex hull holds every point of light l (a planar shape's parallelogram, a round shape's
+ * bounding box) and their box; returns their number (4 or 8). */
+int ms_light_hull(const ms_light *l, float pts[8][3], float box[6]);
+
+/* 1 when a receiver at p on triangle tri (9 floats) may be answered with merged coplanar faces (coplanar.h):
+ * tri is not axis-aligned, or p is so close to tri's plane x_a = c, and every light point so far on one
+ * side of it, that no segment from p to the light meets that plane at a parameter of 0.5 near or more
+ * (|p_a - c| < 0.5 near |L_a - c|): then neither tiling of the face is ever met beyond the near range. */
+int ms_merged_receiver_ok(const float tri[9], const float p[3], const float (*hull)[3], int n_hull);
 
 /* The clearance interior boxes need so that every light of the scene may use them (docs/culling.md):
  * 2.5 times the near range (MS_SEGMENT_NEAR) times the longest segment, the diagonal of the scene's and

@@ -240,7 +240,7 @@ static void mr_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
 
 #define MICRORASTER_METHOD(ident, mname, create_fn)                                                   \
     const ms_shadow_method ident = {                                                                  \
-        .name = mname, .primary = "bvh", .needs_grid = 1, .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_INTERIOR, .n_counters = MS_FT_COUNTERS, \
+        .name = mname, .primary = "bvh", .needs_grid = 1, .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_INTERIOR | MS_OCC_MERGE, .n_counters = MS_FT_COUNTERS, \
         .counter_names = { "frusta", "nodes_visited", "nodes_culled_frustum", "nodes_culled_occluded", \
                            "triangles_rasterized", "pixels_early_out", "pixels_traced_edge_on" },    \
         .create = create_fn, .visibility = mr_visibility, .destroy = mr_destroy, .isa_used = mr_isa_used, \

@@ -1,0 +1,233 @@
+/* Merged coplanar rectangles (src/accel/coplanar.c) for the micro-raster methods' occluders.
+ *
+ * The merge against an oracle written here: random points of each plane are covered by the merged
+ * triangles exactly when they are covered by the input ones (point in triangle in double, points kept off
+ * the edges), strips of segments become one rectangle, rectangles of one pair and triangles that are not
+ * rectangle halves pass through unchanged. Frames of segmented bars over a tiled ground: scanline with the
+ * merge, without it, and raytrace agree within the tie tolerance of the other method tests (at most a
+ * sample on a few pixels), receivers on merged faces seen at grazing angles included (answered on the
+ * scene's own triangles, counted). */
+#include "testutil.h"
+#include "accel/coplanar.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct soup { float *t; size_t n, cap; } soup;
+
+static void add(soup *s, const float a[3], const float b[3], const float c[3])
+{
+    if (s->n == s->cap) {
+        s->cap = s->cap ? 2 * s->cap : 64;
+        s->t = realloc(s->t, s->cap * 9 * sizeof(float));
+        assert_non_null(s->t);
+    }
+    float *t = s->t + 9 * s->n++;
+    memcpy(t, a, 3 * sizeof(float));
+    memcpy(t + 3, b, 3 * sizeof(float));
+    memcpy(t + 6, c, 3 * sizeof(float));
+}
+
+/* A box [lo, hi] whose faces along x are cut into `seg` strips (two triangles each); the end caps whole. */
+static void bar(soup *s, const float lo[3], const float hi[3], int seg)
+{
+    for (int k = 0; k < seg; k++) {
+        const float x0 = lo[0] + (hi[0] - lo[0]) * (float)k / (float)seg;
+        const float x1 = k + 1 == seg ? hi[0] : lo[0] + (hi[0] - lo[0]) * (float)(k + 1) / (float)seg;
+        const float y[4] = { lo[1], hi[1], hi[1], lo[1] }, z[4] = { lo[2], lo[2], hi[2], hi[2] };
+        for (int f = 0; f < 4; f++) {
+            const int g = (f + 1) % 4;
+            const float a[3] = { x0, y[f], z[f] }, b[3] = { x1, y[f], z[f] }, c[3] = { x1, y[g], z[g] }, d[3] = { x0, y[g], z[g] };
+            add(s, a, b, c);
+            add(s, a, c, d);
+        }
+    }
+    for (int e = 0; e < 2; e++) {
+        const float x = e ? hi[0] : lo[0];
+        const float a[3] = { x, lo[1], lo[2] }, b[3] = { x, hi[1], lo[2] }, c[3] = { x, hi[1], hi[2] }, d[3] = { x, lo[1], hi[2] };
+        add(s, a, b, c);
+        add(s, a, c, d);
+    }
+}
+
+/* A ground y = 0 over [-w, w]^2 in n x n tiles (two triangles each, diagonals alternating). */
+static void ground(soup *s, float w, int n)
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            const float x0 = -w + 2 * w * (float)i / (float)n, x1 = -w + 2 * w * (float)(i + 1) / (float)n;
+            const float z0 = -w + 2 * w * (float)j / (float)n, z1 = -w + 2 * w * (float)(j + 1) / (float)n;
+            const float a[3] = { x0, 0, z0 }, b[3] = { x1, 0, z0 }, c[3] = { x1, 0, z1 }, d[3] = { x0, 0, z1 };
+            if ((i + j) & 1) { add(s, a, b, c); add(s, a, c, d); }
+            else { add(s, a, b, d); add(s, b, c, d); }
+        }
+}
+
+static double urand(unsigned *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return (double)(*s >> 8) / 16777216.0;
+}
+
+/* Is (u, v) inside triangle t projected on the plane x_a = c (in double); *edge when within 1e-9 of a side. */
+static int in_tri(const float *t, int a, double u, double v, int *edge)
+{
+    const int au = (a + 1) % 3, av = (a + 2) % 3;
+    double s[3];
+    for (int k = 0; k < 3; k++) {
+        const float *p = t + 3 * k, *q = t + 3 * ((k + 1) % 3);
+        s[k] = ((double)q[au] - p[au]) * (v - p[av]) - ((double)q[av] - p[av]) * (u - p[au]);
+    }
+    const double m = fmax(fabs(s[0]), fmax(fabs(s[1]), fabs(s[2])));
+    for (int k = 0; k < 3; k++)
+        if (fabs(s[k]) <= 1e-9 * (m + 1.0)) *edge = 1;
+    return (s[0] >= 0 && s[1] >= 0 && s[2] >= 0) || (s[0] <= 0 && s[1] <= 0 && s[2] <= 0);
+}
+
+static int covered(const float *tri, size_t n, int a, float c, double u, double v, int *edge)
+{
+    int in = 0;
+    for (size_t i = 0; i < n; i++) {
+        const float *t = tri + 9 * i;
+        if (t[a] != c || t[3 + a] != c || t[6 + a] != c) continue;
+        in |= in_tri(t, a, u, v, edge);
+    }
+    return in;
+}
+
+static void test_merge(void **st)
+{
+    (void)st;
+    soup s = { 0 };
+    const float lo[3] = { -3, 1, -0.2f }, hi[3] = { 3, 1.1f, -0.1f };
+    bar(&s, lo, hi, 32);                 /* 4 x 64 strip triangles + 4 cap triangles */
+    ground(&s, 4, 6);                    /* 72 tile triangles: rows of rectangles */
+    const float a[3] = { 0, 2, 0 }, b[3] = { 1, 2.5f, 0 }, c[3] = { 0, 2, 1 };
+    add(&s, a, b, c);                    /* not axis-aligned: passes through */
+    const size_t n = s.n;
+    float *out;
+    size_t no;
+    uint32_t *of, *src;
+    uint8_t *merged;
+    assert_int_equal(ms_coplanar_merge(s.t, n, NULL, &out, &no, &of, &src, &merged), 0);
+    /* the bar's four faces: one rectangle each (2 triangles); the caps are single pairs (unchanged); the
+     * ground one rectangle; the tilted triangle */
+    assert_int_equal(no, 4 * 2 + 4 + 2 + 1);
+    for (size_t i = 0; i < 4 * 64; i++) assert_int_equal(merged[i], 1);
+    for (size_t i = 256; i < 260; i++) assert_int_equal(merged[i], 0);
+    assert_int_equal(merged[n - 1], 0);
+    assert_memory_equal(out + 9 * of[n - 1], s.t + 9 * (n - 1), 9 * sizeof(float));
+    for (size_t i = 256; i < 260; i++) assert_memory_equal(out + 9 * of[i], s.t + 9 * i, 9 * sizeof(float));
+    for (size_t i = 0; i < n; i++) assert_true(of[i] < no);
+    for (size_t o = 0; o < no; o++) assert_true(src[o] < n);
+    /* the same points covered, plane by plane */
+    unsigned seed = 3;
+    struct { int a; float c; double u0, u1, v0, v1; } planes[] = {
+        { 1, 1.0f, -0.3, 0.0, -3.5, 3.5 }, { 1, 1.1f, -0.3, 0.0, -3.5, 3.5 }, { 2, -0.2f, -3.5, 3.5, 0.9, 1.2 },
+        { 2, -0.1f, -3.5, 3.5, 0.9, 1.2 }, { 0, -3.0f, 0.9, 1.2, -0.3, 0.0 }, { 1, 0.0f, -4.5, 4.5, -4.5, 4.5 } };
+    int tested = 0, inside = 0;
+    for (size_t p = 0; p < sizeof planes / sizeof *planes; p++)
+        for (int k = 0; k < 4000; k++) {
+            const double u = planes[p].u0 + (planes[p].u1 - planes[p].u0) * urand(&seed);
+            const double v = planes[p].v0 + (planes[p].v1 - planes[p].v0) * urand(&seed);
+            int edge = 0;
+            const int want = covered(s.t, n, planes[p].a, planes[p].c, u, v, &edge);
+            const int got = covered(out, no, planes[p].a, planes[p].c, u, v, &edge);
+            if (edge) continue;
+            tested++;
+            inside += want;
+            assert_int_equal(got, want);
+        }
+    assert_true(tested > 20000 && inside > 5000);
+    free(out); free(of); free(src); free(merged);
+    /* eligible: nothing merged where nothing may be */
+    uint8_t *none = calloc(n, 1);
+    assert_int_equal(ms_coplanar_merge(s.t, n, none, &out, &no, &of, &src, &merged), 0);
+    assert_int_equal(no, n);
+    assert_memory_equal(out, s.t, n * 9 * sizeof(float));
+    free(none); free(out); free(of); free(src); free(merged);
+    free(s.t);
+}
+
+static float *vis_of(const ms_scene *sc, const char *method, int no_merge, ms_stats *stats)
+{
+    ms_render_options o;
+    ms_render_options_default(&o);
+    o.method = method;
+    o.no_merge = no_merge;
+    o.threads = 2;
+    o.isa = tu_isa_cap();
+    ms_frame f;
+    char err[256];
+    assert_int_equal(ms_render(sc, &o, &f, err, sizeof err), 0);
+    const size_t np = (size_t)f.width * f.height;
+    float *v = malloc(np * sizeof *v);
+    assert_non_null(v);
+    memcpy(v, f.vis, np * sizeof *v);
+    *stats = f.stats;
+    ms_frame_free(&f);
+    return v;
+}
+
+/* Pixels where a and b differ, and the largest difference in samples (of 1024). */
+static int differ(const float *a, const float *b, int np, double *max_samples)
+{
+    int d = 0;
+    *max_samples = 0;
+    for (int i = 0; i < np; i++)
+        if (a[i] != b[i]) {
+            d++;
+            *max_samples = fmax(*max_samples, fabs((double)a[i] - b[i]) * 1024.0);
+        }
+    return d;
+}
+
+static void test_merged_frames(void **st)
+{
+    (void)st;
+    soup s = { 0 };
+    ground(&s, 4, 8);
+    for (int i = 0; i < 6; i++) {
+        const float lo[3] = { -3, 1.0f + 0.3f * (float)(i & 1), -1.6f + 0.55f * (float)i };
+        const float hi[3] = { 3, lo[1] + 0.08f, lo[2] + 0.08f };
+        bar(&s, lo, hi, 24);
+    }
+    ms_scene sc;
+    tu_make_quad(&sc);
+    free(sc.tri);
+    sc.tri = s.t;
+    sc.n_tris = s.n;
+    sc.camera.width = sc.camera.height = 64;
+    /* low over the bars: their side faces are receivers, some seen at grazing angles from the light */
+    sc.camera.eye = (ms_vec3){ 3.5f, 2.2f, 4.5f };
+    sc.camera.target = (ms_vec3){ 0, 0.8f, 0 };
+    sc.light = (ms_light){ { -1.5f, 4, -1.5f }, { 3, 0, 0 }, { 0, 0, 3 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
+    const int np = 64 * 64;
+    ms_stats sm, sn, sr;
+    float *vm = vis_of(&sc, "scanline", 0, &sm), *vn = vis_of(&sc, "scanline", 1, &sn), *vr = vis_of(&sc, "raytrace", 0, &sr);
+    assert_true(sm.occluders_merged > 0);
+    assert_true(sm.receivers_on_merged > 0);
+    assert_int_equal(sn.occluders_merged, 0);
+    assert_int_equal(sr.occluders_merged, 0);
+    int shadowed = 0;
+    for (int i = 0; i < np; i++) shadowed += vr[i] >= 0 && vr[i] < 1;
+    assert_true(shadowed > np / 10);
+    double dm, dn;
+    const int pm = differ(vm, vr, np, &dm), pn = differ(vn, vr, np, &dn);
+    print_message("merged: %d pixels off raytrace (max %.1f samples); unmerged: %d (max %.1f); %llu receivers on merged faces\n",
+                  pm, dm, pn, dn, (unsigned long long)sm.receivers_on_merged);
+    /* the tie tolerance of the method tests: at most a sample, on under 1% of the pixels */
+    assert_true(dm <= 1.0 && pm <= np / 100);
+    assert_true(dn <= 1.0 && pn <= np / 100);
+    free(vm); free(vn); free(vr);
+    ms_scene_free(&sc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_merge),
+        cmocka_unit_test(test_merged_frames),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
