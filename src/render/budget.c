@@ -46,11 +46,12 @@ static uint64_t closed_find_bytes(uint64_t n)
     while (m < 6 * n) m <<= 1;
     return m * 4u + n * (12u + 36u + 8u + 2u + 8u);
 }
-/* A light's occluders (visibility/occluders.c): a BVH over the kept triangles (at most all) and the map from
- * the scene's prims (4); while one is built, its triangles, sources, flags and map (45) and the build's
- * temporaries. */
-#define OCCLUDERS_PER_TRI (BVH_PER_TRI + 4u)
-#define OCCLUDERS_BUILD_PER_TRI (45u + BVH_BUILD_PER_TRI - BVH_PER_TRI)
+/* A light's occluders (visibility/occluders.c): a BVH over the kept triangles (at most all), the map from
+ * the scene's prims (4) and the merged-face flags (1); while one is built, the kept triangles, sources,
+ * map, flags and alpha leaf map (49), the merged copy with its maps and flags (45), and the build's
+ * temporaries (the merge's own, 84 per triangle, are freed before the build and stay below them). */
+#define OCCLUDERS_PER_TRI (BVH_PER_TRI + 5u)
+#define OCCLUDERS_BUILD_PER_TRI (94u + BVH_BUILD_PER_TRI - BVH_PER_TRI)
 
 /* Thread-private buffers and what OpenMP and the allocator keep per thread. */
 #define PER_THREAD (256u * 1024u)
