@@ -15,6 +15,11 @@
  * kernels' boxes do. Such points are answered by the reference per-sample tracer instead, on the same
  * samples; they are counted (pixels_traced_edge_on) and are few: the light barely reaches them.
  *
+ * Before the triangles, a light's interior boxes (ctx->interior, visibility/occluders.h, docs/culling.md):
+ * virtual occluders inside closed surfaces, which empty most umbra buffers in a few kernel calls; the
+ * triangles themselves come from the light's occluder set (the cull of closed parts without boxes, merged
+ * coplanar rectangles), all with the same V and S.
+ *
  * The render context's switches (visibility/context.h) cap the kernels' and the traversal's instruction set and
  * switch off the coverage test and the near-first child order; the library reads no environment. */
 #include "shadow/method.h"
