@@ -46,7 +46,7 @@ struct ms_frame_job {
     struct ms_alpha *alpha;       /* alpha-tested triangles (NULL: none), ctx.alpha */
     void *pstate;
     void **sstate;                /* per light */
-    ms_occluders *occ;            /* per light: its occluders (sm->culls_closed), else NULL */
+    ms_occluders *occ;            /* per light: its occluders (sm->occluders, occluder_what), else NULL */
     ms_render_options opt;
     int W, H, tx, ty, ntiles, samples, spp, threads, rendered_any, streamed;
     ms_hit *hits;
@@ -113,6 +113,15 @@ void ms_frame_job_free(ms_frame_job *j)
     ms_frame_free(&j->frame);
     if (j->own_soup) free(j->soup.tri);
     free(j);
+}
+
+/* What the lights' occluder sets hold for method sm under the options (MS_OCC_*; 0: the scene's BVH). */
+static int occluder_what(const ms_shadow_method *sm, const ms_render_options *opt)
+{
+    const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
+                     (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
+    return sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0) &
+           (opt->no_merge ? ~MS_OCC_MERGE : ~0);
 }
 
 /* Light l's context: the frame's, with its light and, when the method takes them, its occluders. */
@@ -198,6 +207,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     const int samples = opt->samples > 0 ? opt->samples : scene->samples;
     if ((unsigned)opt->pattern > MS_PATTERN_INTERLEAVED) { snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern); goto fail; }
     if ((unsigned)opt->traversal > MS_TRAVERSAL_PIXEL) { snprintf(err, errlen, "unknown traversal %d", (int)opt->traversal); goto fail; }
+    if ((unsigned)opt->closed_cull > MS_CLOSED_CULL_OFF) { snprintf(err, errlen, "unknown closed_cull %d", (int)opt->closed_cull); goto fail; }
     /* Samples per pixel: N, or N/16 for interleaved; always a multiple of 16 (full ray packets). */
     const int spp = ms_pattern_samples_per_pixel(opt->pattern, samples);
     if (!spp) {
@@ -240,9 +250,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         fs.filter = opt->pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter;
         for (size_t l = 0; l < j->nlights; l++) fs.textured |= j->lights[l].texture != NULL;
         fs.threads = j->threads;
-        const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
-                         (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
-        fs.occluders = (sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0)) != 0;
+        fs.occluders = occluder_what(sm, opt) != 0;
         const uint64_t budget = ms_memory_budget(opt->max_memory);
         if (ms_frame_budget_check(&fs, budget, err, errlen)) { rc = MS_ERR_BUDGET; goto fail; }
         j->frame.stats.memory_need = ms_frame_need(&fs, NULL);
@@ -314,11 +322,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->pstate = pstate;
     f->stats.primary_s = omp_get_wtime() - t_primary;
     const double t_setup = omp_get_wtime();
-    if ((unsigned)opt->closed_cull > MS_CLOSED_CULL_OFF) { snprintf(err, errlen, "unknown closed_cull %d", (int)opt->closed_cull); goto fail; }
-    const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
-                     (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
-    const int occ_what = sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0) &
-                         (opt->no_merge ? ~MS_OCC_MERGE : ~0);
+    const int occ_what = occluder_what(sm, opt);
     if (occ_what && !streamed && occluders_build(j, occ_what, &f->stats)) {
         snprintf(err, errlen, "out of memory for the lights' occluders");
         goto fail;
