@@ -520,23 +520,13 @@ static float *frame_vis(const ms_scene *sc, const char *method, ms_traversal tra
                         ms_stats *stats)
 {
     ms_render_options o;
-    ms_render_options_default(&o);
+    tu_render_options_default(&o);
     o.method = method;
     o.traversal = trav;
     o.no_interior = no_interior;
     o.closed_cull = cull;
     o.threads = 2;
-    o.isa = tu_isa_cap();
-    ms_frame f;
-    char err[256];
-    assert_int_equal(ms_render(sc, &o, &f, err, sizeof err), 0);
-    const size_t n = (size_t)f.width * f.height;
-    float *v = malloc(n * sizeof *v);
-    assert_non_null(v);
-    memcpy(v, f.vis, n * sizeof *v);
-    if (stats) *stats = f.stats;
-    ms_frame_free(&f);
-    return v;
+    return tu_render_vis(sc, &o, stats);
 }
 
 static uint64_t counter(const ms_stats *s, const char *name)

@@ -152,21 +152,11 @@ static void test_merge(void **st)
 static float *vis_of(const ms_scene *sc, const char *method, int no_merge, ms_stats *stats)
 {
     ms_render_options o;
-    ms_render_options_default(&o);
+    tu_render_options_default(&o);
     o.method = method;
     o.no_merge = no_merge;
     o.threads = 2;
-    o.isa = tu_isa_cap();
-    ms_frame f;
-    char err[256];
-    assert_int_equal(ms_render(sc, &o, &f, err, sizeof err), 0);
-    const size_t np = (size_t)f.width * f.height;
-    float *v = malloc(np * sizeof *v);
-    assert_non_null(v);
-    memcpy(v, f.vis, np * sizeof *v);
-    *stats = f.stats;
-    ms_frame_free(&f);
-    return v;
+    return tu_render_vis(sc, &o, stats);
 }
 
 /* Pixels where a and b differ, and the largest difference in samples (of 1024). */

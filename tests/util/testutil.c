@@ -383,6 +383,19 @@ void tu_render_ok(const ms_scene *sc, const ms_render_options *o, ms_frame *f)
     if (ms_render(sc, o, f, err, sizeof err)) fail_msg("ms_render(%s): %s", o->method ? o->method : MS_DEFAULT_METHOD, err);
 }
 
+float *tu_render_vis(const ms_scene *sc, const ms_render_options *o, ms_stats *stats)
+{
+    ms_frame f;
+    tu_render_ok(sc, o, &f);
+    const size_t n = (size_t)f.width * f.height;
+    float *v = malloc(n * sizeof *v);
+    assert_non_null(v);
+    memcpy(v, f.vis, n * sizeof *v);
+    if (stats) *stats = f.stats;
+    ms_frame_free(&f);
+    return v;
+}
+
 void tu_unit_icosphere(int levels, double **verts, size_t *n_verts, int **tris, size_t *n_tris)
 {
     const double t = (1.0 + sqrt(5.0)) / 2.0;

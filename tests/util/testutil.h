@@ -94,6 +94,9 @@ static inline uint64_t tu_rng_next(tu_rng *r)
 
 /* ms_render with o into f, failing the test with its message. */
 void tu_render_ok(const ms_scene *sc, const ms_render_options *o, ms_frame *f);
+/* ms_render with o, returning a copy of the frame's V (width x height floats; the caller frees it) and its
+ * stats into *stats (NULL: not wanted); the frame itself freed. */
+float *tu_render_vis(const ms_scene *sc, const ms_render_options *o, ms_stats *stats);
 
 /* The unit icosphere subdivided `levels` times: n_verts vertices on the unit sphere (3 doubles each; shared
  * vertices once, midpoints looked up per edge) and n_tris triangles (3 vertex indices each); the caller
