@@ -1,5 +1,6 @@
 /* Closed components of a triangle soup and the light-facing cull they allow (closed.h, docs/culling.md). */
 #include "closed.h"
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -54,6 +55,27 @@ static size_t label_sets(uint32_t *parent, uint8_t *flag, size_t n, uint32_t *la
         else label[t] = r == t ? (uint32_t)k++ : label[r];
     }
     return k;
+}
+
+/* The boxes of the k labelled sets (label: per triangle, MS_OPEN_COMPONENT for none); returns the number of
+ * labelled triangles. */
+static size_t set_boxes(const float *tri, size_t n, const uint32_t *label, size_t k, float (*box)[6])
+{
+    for (size_t c = 0; c < k; c++)
+        for (int a = 0; a < 3; a++) { box[c][a] = INFINITY; box[c][3 + a] = -INFINITY; }
+    size_t m = 0;
+    for (size_t t = 0; t < n; t++) {
+        const uint32_t c = label[t];
+        if (c == MS_OPEN_COMPONENT) continue;
+        m++;
+        for (int q = 0; q < 3; q++)
+            for (int a = 0; a < 3; a++) {
+                const float x = tri[9 * t + 3 * (size_t)q + (size_t)a];
+                if (x < box[c][a]) box[c][a] = x;
+                if (x > box[c][3 + a]) box[c][3 + a] = x;
+            }
+    }
+    return m;
 }
 
 static uint32_t float_key(float f)
@@ -151,25 +173,8 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     out->n_cycles = ncy;
     if (ncy) {
         out->cycle_box = malloc(ncy * sizeof *out->cycle_box);
-        uint8_t *seen = calloc(ncy, 1);
-        if (!out->cycle_box || !seen) { free(seen); goto oom; }
-        for (size_t t = 0; t < n; t++) {
-            const uint32_t c = out->cycle[t];
-            if (c == MS_OPEN_COMPONENT) continue;
-            const float *p = tri + 9 * t;
-            out->cycle_tris++;
-            if (!seen[c]) {
-                seen[c] = 1;
-                for (int k = 0; k < 3; k++) out->cycle_box[c][k] = out->cycle_box[c][3 + k] = p[k];
-            }
-            for (int q = 0; q < 3; q++)
-                for (int k = 0; k < 3; k++) {
-                    const float x = p[3 * q + k];
-                    if (x < out->cycle_box[c][k]) out->cycle_box[c][k] = x;
-                    if (x > out->cycle_box[c][3 + k]) out->cycle_box[c][3 + k] = x;
-                }
-        }
-        free(seen);
+        if (!out->cycle_box) goto oom;
+        out->cycle_tris = set_boxes(tri, n, out->cycle, ncy, out->cycle_box);
     }
     free(parent);
     parent = NULL;
@@ -183,28 +188,18 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     if (nc) {
         out->box = malloc(nc * sizeof *out->box);
         out->outward = malloc(nc);
-        double *vol = calloc(nc, sizeof *vol), (*ref)[3] = malloc(nc * sizeof *ref);
-        uint8_t *seen = calloc(nc, 1);
-        if (!out->box || !out->outward || !vol || !ref || !seen) { free(vol); free(ref); free(seen); goto oom; }
+        double *vol = calloc(nc, sizeof *vol);
+        if (!out->box || !out->outward || !vol) { free(vol); goto oom; }
+        out->closed_tris = set_boxes(tri, n, out->component, nc, out->box);
         for (size_t t = 0; t < n; t++) {
             const uint32_t c = out->component[t];
             if (c == MS_OPEN_COMPONENT) continue;
-            const float *p = tri + 9 * t;
-            out->closed_tris++;
-            if (!seen[c]) {
-                seen[c] = 1;
-                for (int k = 0; k < 3; k++) { out->box[c][k] = out->box[c][3 + k] = p[k]; ref[c][k] = p[k]; }
-            }
+            const float *p = tri + 9 * t, *ref = out->box[c];   /* any point will do: the box's low corner, near */
             double a[3], b[3], d[3];
             for (int k = 0; k < 3; k++) {
-                for (int q = 0; q < 3; q++) {
-                    const float x = p[3 * q + k];
-                    if (x < out->box[c][k]) out->box[c][k] = x;
-                    if (x > out->box[c][3 + k]) out->box[c][3 + k] = x;
-                }
-                a[k] = (double)p[k] - ref[c][k];
-                b[k] = (double)p[3 + k] - ref[c][k];
-                d[k] = (double)p[6 + k] - ref[c][k];
+                a[k] = (double)p[k] - ref[k];
+                b[k] = (double)p[3 + k] - ref[k];
+                d[k] = (double)p[6 + k] - ref[k];
             }
             /* six times the signed volume of the tetrahedron (ref, a, b, c): summed over a closed surface,
              * positive when its winding points outwards */
@@ -212,8 +207,6 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
         }
         for (size_t c = 0; c < nc; c++) out->outward[c] = vol[c] >= 0.0 ? 1 : -1;
         free(vol);
-        free(ref);
-        free(seen);
     }
     return 0;
 oom:
