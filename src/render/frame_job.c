@@ -185,6 +185,8 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     *out = NULL;
     const double t_start = omp_get_wtime();
     const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;   /* zeroed options: defaults */
+    const int auto_pick = strcmp(method, MS_AUTO_METHOD) == 0;
+    if (auto_pick) method = ms_auto_method(opt->pattern);
     const ms_shadow_method *sm = ms_find_shadow_method(method);
     if (!sm) {
         if (ms_method_available(method) < 0) snprintf(err, errlen, "method '%s' is not compiled into this build", method);
@@ -267,7 +269,17 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         fs.threads = j->threads;
         fs.occluders = occluder_what(sm, opt) != 0;
         const uint64_t budget = ms_memory_budget(opt->max_memory);
-        if (ms_frame_budget_check(&fs, budget, err, errlen)) { rc = MS_ERR_BUDGET; goto fail; }
+        if (ms_frame_budget_check(&fs, budget, err, errlen)) {
+            if (auto_pick && fs.materialise && opt->pattern == MS_PATTERN_GRID && !opt->primary) {
+                /* "auto": a procedural scene that does not fit materialised is streamed by hpc. */
+                ms_frame_job_free(j);
+                ms_render_options streamed_opt = *opt;
+                streamed_opt.method = "hpc";
+                return ms_frame_job_create(scene, &streamed_opt, out, err, errlen);
+            }
+            rc = MS_ERR_BUDGET;
+            goto fail;
+        }
         j->frame.stats.memory_need = ms_frame_need(&fs, NULL);
         j->frame.stats.memory_budget = budget;
     }
