@@ -47,6 +47,8 @@ struct ms_frame_job {
     void **sstate;                /* per light */
     void **own_sstate;            /* per light whose occluders merge coplanar faces: the method over the scene's
                                    * own triangles, for the receivers on merged faces (merged_last) */
+    void **interior_sstate;       /* per light with interior boxes, for a method with MS_OCC_INTERIOR_PASS: the
+                                   * method over the boxes' triangles, run before the scene's */
     ms_occluders *occ;            /* per light: its occluders (sm->occluders, occluder_what), else NULL */
     ms_render_options opt;
     int W, H, tx, ty, ntiles, samples, spp, threads, rendered_any, streamed;
@@ -106,6 +108,9 @@ void ms_frame_job_free(ms_frame_job *j)
     for (size_t l = 0; j->own_sstate && l < j->nlights; l++)
         if (j->own_sstate[l]) j->sm->destroy(j->own_sstate[l]);
     free(j->own_sstate);
+    for (size_t l = 0; j->interior_sstate && l < j->nlights; l++)
+        if (j->interior_sstate[l]) j->sm->destroy(j->interior_sstate[l]);
+    free(j->interior_sstate);
     if (j->pm && j->pstate) j->pm->destroy(j->pstate);
     for (size_t l = 0; j->occ && l < j->nlights; l++) ms_occluders_free(&j->occ[l]);
     free(j->occ);
@@ -124,7 +129,7 @@ static int occluder_what(const ms_shadow_method *sm, const ms_render_options *op
 {
     const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
                      (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
-    return sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~MS_OCC_INTERIOR : ~0) &
+    return sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~(MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS) : ~0) &
            (opt->no_merge ? ~MS_OCC_MERGE : ~0);
 }
 
@@ -149,6 +154,18 @@ static void light_own_ctx(const ms_frame_job *j, size_t l, ms_render_ctx *c)
     light_ctx(j, l, c);
     c->bvh = &j->bvh;
     c->alpha = j->alpha;
+    c->prim_map = NULL;
+    c->prim_merged = NULL;
+}
+
+/* Light l's context over its interior boxes alone, for a method that takes them as occluders of its own
+ * (MS_OCC_INTERIOR_PASS): no receiver lies on them, none is alpha-tested. */
+static void light_interior_ctx(const ms_frame_job *j, size_t l, ms_render_ctx *c)
+{
+    light_ctx(j, l, c);
+    c->bvh = c->interior;
+    c->interior = NULL;
+    c->alpha = NULL;
     c->prim_map = NULL;
     c->prim_merged = NULL;
 }
@@ -323,6 +340,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->traced = calloc((size_t)j->ntiles, 1);
     j->sstate = calloc(nl, sizeof *j->sstate);
     j->own_sstate = calloc(nl, sizeof *j->own_sstate);
+    j->interior_sstate = calloc(nl, sizeof *j->interior_sstate);
     ms_frame *f = &j->frame;
     f->vis = malloc(nl * npix * sizeof(float));
     f->shadow = malloc(nl * npix * sizeof(float));
@@ -330,7 +348,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     f->front = calloc(nl * npix, sizeof *f->front);
     f->rgb = malloc(npix * 3 * sizeof(float));
     f->n_lights = (int)nl;
-    if (!j->hits || !j->traced || !j->sstate || !j->own_sstate || !f->vis || !f->shadow || !f->shadow_spec || !f->front || !f->rgb) {
+    if (!j->hits || !j->traced || !j->sstate || !j->own_sstate || !j->interior_sstate || !f->vis || !f->shadow || !f->shadow_spec || !f->front || !f->rgb) {
         snprintf(err, errlen, "out of memory for a %dx%d frame", W, H);
         goto fail;
     }
@@ -362,6 +380,11 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         if (lc.prim_merged) {
             light_own_ctx(j, l, &lc);
             if (sm->create(&lc, &j->own_sstate[l], err, errlen)) { j->own_sstate[l] = NULL; goto fail; }
+        }
+        light_ctx(j, l, &lc);
+        if ((sm->occluders & MS_OCC_INTERIOR_PASS) && lc.interior) {
+            light_interior_ctx(j, l, &lc);
+            if (sm->create(&lc, &j->interior_sstate[l], err, errlen)) { j->interior_sstate[l] = NULL; goto fail; }
         }
     }
     ms_stats *st = &f->stats;
@@ -482,6 +505,9 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     const ms_shadow_method *sm = j->sm;
     void *const sstate = j->sstate[l];
     void *const own_state = j->own_sstate[l];
+    void *const interior_state = j->interior_sstate[l];
+    ms_render_ctx ictx;
+    if (interior_state) light_interior_ctx(j, l, &ictx);
     ms_render_ctx lctx;
     light_ctx(j, l, &lctx);
     const ms_render_ctx ctx = lctx;
@@ -514,10 +540,12 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
         /* Per thread: the tile's front and visible masks, and the stratified pattern's points. */
         uint64_t *front = aligned_alloc(64, TILE * TILE * mw * sizeof *front);
         uint64_t *vmask = aligned_alloc(64, TILE * TILE * mw * sizeof *vmask);
+        /* The samples the interior boxes leave (MS_OCC_INTERIOR_PASS). */
+        uint64_t *imask = interior_state ? aligned_alloc(64, TILE * TILE * mw * sizeof *imask) : NULL;
         float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
         float hull[8][3], hull_box[6];
         const int n_hull = ms_light_hull(&ctx.light, hull, hull_box);
-        int ok = front && vmask && (pts || !stratified);
+        int ok = front && vmask && (pts || !stratified) && (imask || !interior_state);
 #pragma omp for schedule(dynamic, 1)
         for (int ti = 0; ti < shadow_tiles; ti++) {
             if (cancelled(j)) continue;
@@ -549,7 +577,15 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     where[nq++] = i;
                 }
             const int nm = ctx.prim_merged && ok ? merged_last(&ctx, &j->bvh, (const float (*)[3])hull, n_hull, q, where, own, front, mw, nq) : nq;
-            if (!outlined) {
+            if (!outlined && interior_state && nm && ok) {
+                /* The interior boxes first (no receiver on them: no prim to skip), then the triangles
+                 * with the samples they left. */
+                uint32_t prim[TILE * TILE];
+                for (int i = 0; i < nm; i++) { prim[i] = q[i].prim; q[i].prim = UINT32_MAX; }
+                if (sm->visibility(interior_state, &ictx, q, nm, front, imask, local)) ok = 0;
+                for (int i = 0; i < nm; i++) q[i].prim = prim[i];
+                if (ok && sm->visibility(sstate, &ctx, q, nm, imask, vmask, local)) ok = 0;
+            } else if (!outlined) {
                 if (nm && ok && sm->visibility(sstate, &ctx, q, nm, front, vmask, local)) ok = 0;
             } else
                 for (int i = 0; i < nm && ok; i++) {
@@ -589,6 +625,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
         }
         free(front);
         free(vmask);
+        free(imask);
         free(pts);
 #pragma omp critical(ms_counters)
         {
