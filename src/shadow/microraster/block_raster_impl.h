@@ -313,19 +313,20 @@ static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_nod
      * buffer. */
     unsigned cand = keep & front;
     if (cand) {
-        float bx0[MS_BLOCK_LANES], bx1[MS_BLOCK_LANES], by0[MS_BLOCK_LANES], by1[MS_BLOCK_LANES];
-        l16_store(bx0, px0); l16_store(bx1, px1); l16_store(by0, py0); l16_store(by1, py1);
+        /* The projected box in sample indices (slack, clamp, rounding), within each lane's rectangle. */
+        const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+        const l16 ax0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(px0, sl), lo1), hi1)), l16_load(s->rx0));
+        const l16 ax1 = l16_min(l16_floor(l16_min(l16_max(l16_add(px1, sl), lo1), hi1)), l16_load(s->rx1));
+        const l16 ay0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(py0, sl), lo1), hi1)), l16_load(s->ry0));
+        const l16 ay1 = l16_min(l16_floor(l16_min(l16_max(l16_add(py1, sl), lo1), hi1)), l16_load(s->ry1));
+        const unsigned empty = cand & (l16_gt(ax0, ax1) | l16_gt(ay0, ay1));
+        keep &= ~empty;
+        cand &= ~empty;
+        int32_t xa[MS_BLOCK_LANES], xb[MS_BLOCK_LANES], ya[MS_BLOCK_LANES], yb[MS_BLOCK_LANES];
+        l16_store_int(xa, ax0); l16_store_int(xb, ax1); l16_store_int(ya, ay0); l16_store_int(yb, ay1);
         for (; cand; cand &= cand - 1) {
             const int l = __builtin_ctz(cand);
-            const int *r = s->rect[l];
-            const float kmax = (float)(MS_K - 1);
-            const int ix0 = ms_ceil_i(ms_clampf(bx0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int ix1 = ms_floor_i(ms_clampf(bx1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int iy0 = ms_ceil_i(ms_clampf(by0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int iy1 = ms_floor_i(ms_clampf(by1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int xa = ix0 > r[0] ? ix0 : r[0], xb = ix1 < r[1] ? ix1 : r[1];
-            const int ya = iy0 > r[2] ? iy0 : r[2], yb = iy1 < r[3] ? iy1 : r[3];
-            if (xa > xb || ya > yb || !MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa, xb, ya, yb)) keep &= ~(1u << l);
+            if (!MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa[l], xb[l], ya[l], yb[l])) keep &= ~(1u << l);
         }
     }
     return keep;
