@@ -25,6 +25,7 @@
 #include "render_materialise.h"
 #include "interleave_filter.h"
 #include "budget.h"
+#include "frame_stream.h"
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -49,6 +50,9 @@ struct ms_frame_job {
     ms_occluders *occ;            /* per light: its occluders (sm->occluders, occluder_what), else NULL */
     ms_render_options opt;
     int W, H, tx, ty, ntiles, samples, spp, threads, rendered_any, streamed;
+    /* The rows the planes (hits, surf, the frame's) hold: y_base .. y_base + rows_held; the whole frame, or
+     * a band of band_rows at most when the outputs are streamed (frame_stream.c). */
+    int y_base, rows_held, band_rows;
     ms_hit *hits;
     ms_surface *surf;             /* per pixel, only for scenes with materials or normals (shade.h) */
     uint8_t *traced;              /* per tile: primary hits (and surfaces) are in hits (and surf) */
@@ -165,7 +169,10 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
     return rc;
 }
 
-int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **out, char *err, size_t errlen)
+/* stream: MS_STREAM_OFF (the whole frame), MS_STREAM_ON (bands), or MS_STREAM_AUTO (bands when only they fit the
+ * budget). */
+static int job_create(const ms_scene *scene, const ms_render_options *opt, int stream, ms_frame_job **out, char *err,
+                      size_t errlen)
 {
     *out = NULL;
     const double t_start = omp_get_wtime();
@@ -251,7 +258,22 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         for (size_t l = 0; l < j->nlights; l++) fs.textured |= j->lights[l].texture != NULL;
         fs.threads = j->threads;
         fs.occluders = occluder_what(sm, opt) != 0;
+        /* Streamed outputs: bands of whole tile rows, enough tiles for every thread many times over. Not
+         * for frame-level methods (their receivers are the whole frame) nor the interleaved filter (it reads
+         * two rows beyond a band: not done yet). */
+        const int tiles_x = (W + TILE - 1) / TILE, want = 16 * j->threads;
+        const int streamable = !sm->visibility_all && !fs.filter;
+        fs.stream_rows = streamable ? TILE * ((want + tiles_x - 1) / tiles_x) : 0;
         const uint64_t budget = ms_memory_budget(opt->max_memory);
+        if (stream == MS_STREAM_ON && !streamable) {
+            snprintf(err, errlen, "streamed outputs: %s", sm->visibility_all ? "the method takes the whole frame at once (its receivers are all of the frame's pixels)"
+                     : "the interleaved pattern's filter reads rows beyond a band (--no-filter, or not streamed)");
+            goto fail;
+        }
+        if (stream == MS_STREAM_ON || (stream == MS_STREAM_AUTO && streamable && ms_frame_need(&fs, NULL) > budget)) {
+            fs.band_rows = fs.stream_rows;
+            j->band_rows = fs.band_rows < H ? fs.band_rows : H;
+        }
         if (ms_frame_budget_check(&fs, budget, err, errlen)) { rc = MS_ERR_BUDGET; goto fail; }
         j->frame.stats.memory_need = ms_frame_need(&fs, NULL);
         j->frame.stats.memory_budget = budget;
@@ -291,7 +313,8 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->ntiles = j->tx * j->ty;
     j->total = (long)(1 + j->nlights) * j->ntiles;
 
-    const size_t npix = (size_t)W * H, nl = j->nlights;
+    j->rows_held = j->band_rows ? j->band_rows : H;
+    const size_t npix = (size_t)W * j->rows_held, nl = j->nlights;
     j->hits = malloc(npix * sizeof *j->hits);
     j->traced = calloc((size_t)j->ntiles, 1);
     j->sstate = calloc(nl, sizeof *j->sstate);
@@ -312,7 +335,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         if (!j->surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); goto fail; }
     }
     f->width = W;
-    f->height = H;
+    f->height = j->rows_held;
     /* The primary's create is timed as primary visibility: the rasterizing primaries (3dr-*, depth) do
      * their whole pass there. */
     const double t_primary = omp_get_wtime();
@@ -352,6 +375,19 @@ fail:
     return rc;
 }
 
+int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **out, char *err, size_t errlen)
+{
+    return job_create(scene, opt, MS_STREAM_OFF, out, err, errlen);
+}
+
+int ms_frame_job_create_stream(const ms_scene *scene, const ms_render_options *opt, int stream, ms_frame_job **out,
+                               int *band_rows, char *err, size_t errlen)
+{
+    const int rc = job_create(scene, opt, stream, out, err, errlen);
+    *band_rows = rc ? 0 : (*out)->band_rows;
+    return rc;
+}
+
 int ms_frame_job_tiles(const ms_frame_job *j, int *tiles_x, int *tiles_y)
 {
     if (tiles_x) *tiles_x = j->tx;
@@ -386,7 +422,7 @@ static void trace_tiles(ms_frame_job *j, const int *tiles, int n, int tick)
         ms_hit tile[TILE * TILE];
         j->pm->trace(j->pstate, &j->ctx, x0, y0, x1, y1, tile);
         for (int y = y0; y < y1; y++)
-            memcpy(&j->hits[(size_t)y * j->W + x0], &tile[(y - y0) * (x1 - x0)], (size_t)(x1 - x0) * sizeof *tile);
+            memcpy(&j->hits[(size_t)(y - j->y_base) * j->W + x0], &tile[(y - y0) * (x1 - x0)], (size_t)(x1 - x0) * sizeof *tile);
         j->traced[t] = 1;
         if (tick) progress_tick(j);
     }
@@ -402,7 +438,7 @@ static void surface_tiles(ms_frame_job *j, const int *tiles, int n)
         tile_rect(j, tiles ? tiles[i] : i, &x0, &y0, &x1, &y1);
         for (int y = y0; y < y1; y++)
             for (int x = x0; x < x1; x++) {
-                const size_t p = (size_t)y * j->W + x;
+                const size_t p = (size_t)(y - j->y_base) * j->W + x;
                 float viewer[3];   /* the eye, or up the pixel's own ray for an orthographic camera */
                 ms_camera_viewer(&j->ctx.cam, j->hits[p].p, viewer);
                 ms_surface_at(j->scene, &j->bvh, &j->hits[p], viewer, &j->surf[p]);
@@ -453,7 +489,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     light_ctx(j, l, &lctx);
     const ms_render_ctx ctx = lctx;
     const int W = j->W;
-    const size_t npix = (size_t)W * j->H, mw = (size_t)ctx.mask_words;
+    const size_t npix = (size_t)W * j->rows_held, mw = (size_t)ctx.mask_words;
     ms_frame *const out = &j->frame;
     float *const vis = out->vis + l * npix, *const shadow = out->shadow + l * npix;
     float *const spec = out->shadow_spec + l * npix;   /* S_spec (shade.h) where surf has a specular lobe, else S */
@@ -500,7 +536,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
             int nq = 0;
             for (int y = y0; y < y1 && ok; y++)
                 for (int x = x0; x < x1; x++) {
-                    size_t i = (size_t)y * W + x;
+                    size_t i = (size_t)(y - j->y_base) * W + x;
                     const ms_hit *h = &hits[i];
                     if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
                     ms_query_from_hit(&q[nq], h, (uint32_t)x, (uint32_t)y);
@@ -639,8 +675,38 @@ int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, siz
     return 0;
 }
 
+/* The frame's stats once every tile is rendered (finish, or a streamed frame's last band). */
+static void job_stats(ms_frame_job *j, ms_stats *st)
+{
+    const size_t nl = j->nlights;
+    st->triangles = j->scene->n_tris;
+    st->load_s = j->scene->load_s;
+    st->samples = j->samples;
+    st->samples_per_pixel = j->spp;
+    st->threads = j->threads;
+    st->width = j->W;
+    st->height = j->H;
+    st->method = j->sm->name;
+    st->primary = j->pm->name;
+    if (j->pm->counters) {
+        uint64_t c[3];
+        j->pm->counters(j->pstate, c);
+        st->primary_setups = c[0];
+        st->primary_edge_evals = c[1];
+        st->primary_nodes = c[2];
+    }
+    ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
+    if (j->sm->isa_used) j->sm->isa_used(j->sstate[nl - 1], &kisa, &tisa);
+    st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
+    st->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
+    st->pattern = ms_pattern_name(j->opt.pattern);
+    st->shadow_factor_s /= j->threads;   /* thread-seconds to seconds */
+    st->total_s = omp_get_wtime() - j->t_start + j->scene->load_s;
+}
+
 int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen)
 {
+    if (j->band_rows) { snprintf(err, errlen, "ms_frame_job_finish: a streamed job's frame is written band by band"); return -1; }
     memset(out, 0, sizeof *out);
     ms_frame *f = &j->frame;
     ms_stats *st = &f->stats;
@@ -680,35 +746,48 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
         st->shadow_s += st->filter_s;
         st->shadow_cpu_s += process_cpu_s() - cf;
     }
-    if (ms_frame_shade(j->scene, &j->ctx, j->lights, nl, j->hits, j->surf, j->threads, f)) {
+    if (ms_frame_shade(j->scene, &j->ctx, j->lights, nl, j->hits, j->surf, j->threads, 0, f, NULL)) {
         snprintf(err, errlen, "out of memory for the textured lights of a %dx%d frame", W, H);
         return -1;
     }
 
-    st->triangles = j->scene->n_tris;
-    st->load_s = j->scene->load_s;
-    st->samples = j->samples;
-    st->samples_per_pixel = j->spp;
-    st->threads = j->threads;
-    st->width = W;
-    st->height = H;
-    st->method = j->sm->name;
-    st->primary = j->pm->name;
-    if (j->pm->counters) {
-        uint64_t c[3];
-        j->pm->counters(j->pstate, c);
-        st->primary_setups = c[0];
-        st->primary_edge_evals = c[1];
-        st->primary_nodes = c[2];
-    }
-    ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
-    if (j->sm->isa_used) j->sm->isa_used(j->sstate[nl - 1], &kisa, &tisa);
-    st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
-    st->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
-    st->pattern = ms_pattern_name(j->opt.pattern);
-    st->shadow_factor_s /= j->threads;   /* thread-seconds to seconds */
-    st->total_s = omp_get_wtime() - j->t_start + j->scene->load_s;
+    job_stats(j, st);
     *out = *f;
     memset(f, 0, sizeof *f);
     return 0;
+}
+
+int ms_frame_job_band(ms_frame_job *j, int y0, int rows, ms_frame *band, float *lum, char *err, size_t errlen)
+{
+    memset(band, 0, sizeof *band);
+    if (!j->band_rows || y0 % TILE || rows < 1 || rows > j->band_rows || (rows % TILE && y0 + rows != j->H) || y0 + rows > j->H) {
+        snprintf(err, errlen, "ms_frame_job_band: rows %d..%d are not a band of whole tile rows", y0, y0 + rows);
+        return -1;
+    }
+    /* The planes now hold rows y0 .. y0 + rows, light l's plane at l * W * rows, as in a frame of that height. */
+    j->y_base = y0;
+    j->rows_held = rows;
+    const int ty0 = y0 / TILE, ty1 = (y0 + rows + TILE - 1) / TILE, n = (ty1 - ty0) * j->tx;
+    int *tiles = malloc((size_t)n * sizeof *tiles);
+    if (!tiles) { snprintf(err, errlen, "out of memory"); return -1; }
+    for (int i = 0; i < n; i++) tiles[i] = ty0 * j->tx + i;
+    const int rc = ms_frame_job_render(j, tiles, n, err, errlen);
+    free(tiles);
+    if (rc) return rc;
+    ms_frame *f = &j->frame;
+    f->height = rows;
+    if (ms_frame_shade(j->scene, &j->ctx, j->lights, j->nlights, j->hits, j->surf, j->threads, y0, f, lum)) {
+        snprintf(err, errlen, "out of memory for the textured lights of a %dx%d band", j->W, rows);
+        return -1;
+    }
+    *band = *f;
+    if (y0 + rows == j->H) job_stats(j, &f->stats);
+    band->stats = f->stats;
+    return 0;
+}
+
+void ms_frame_job_size(const ms_frame_job *j, int *W, int *H)
+{
+    *W = j->W;
+    *H = j->H;
 }
