@@ -473,6 +473,8 @@ typedef struct ms_render_options {
                              * the same points, so the same V and S up to ties on the rectangles' sides) */
     uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
     ms_stream_mode stream;  /* ms_render_outputs only (ms_render always holds the whole frame) */
+    int stream_rows;        /* streamed: rows per band, a multiple of MS_TILE_SIZE; 0: about 512 tiles' worth, fewer
+                             * (down to one tile row) when the budget needs */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */

@@ -14,7 +14,7 @@
 #include <string.h>
 
 #define W 150
-#define H 250  /* with 2 threads: bands of 64 rows (32 tiles of 10 per row want 4 tile rows), the last of 58 */
+#define H 250  /* bands of 64 rows (options: stream_rows), the last of 58 */
 
 static char *slurp(const char *path, size_t *n)
 {
@@ -61,6 +61,7 @@ static void options(ms_render_options *o)
     o->height = H;
     o->threads = 2;
     o->samples = 256;
+    o->stream_rows = 64;   /* several bands at this size (the default band would hold it all) */
 }
 
 /* Renders sc into dir/<tag>.png (or .exr), <tag>-vis.exr / .pfm, <tag>-shadow.pfm / .exr. */
@@ -172,16 +173,22 @@ static void test_refusals(void **state)
     char err[1024];
     ms_stats st;
     o.stream = MS_STREAM_ON;
+    o.stream_rows = MS_TILE_SIZE;   /* the smallest band: under its need nothing streamed fits */
     assert_int_equal(render_to(&sc, &o, dir, "a", 0, &st, err, sizeof err), 0);
     const uint64_t need = st.memory_need;
     assert_int_equal(tu_count_entries(dir), 3);
-    /* Even streamed it does not fit: refused, naming the streamed frame, and nothing written. */
+    /* Even streamed it does not fit: refused, saying what streaming would need, and nothing written; forced to
+     * stream, the refusal is the streamed frame's. */
     const char *sub = tu_tmpdir("test_stream_refuse_none");
     o.stream = MS_STREAM_AUTO;
     o.max_memory = need - 1;
     assert_int_equal(render_to(&sc, &o, sub, "b", 0, &st, err, sizeof err), MS_ERR_BUDGET);
-    assert_non_null(strstr(err, "frame streamed"));
     assert_non_null(strstr(err, "--max-memory"));
+    assert_non_null(strstr(err, "--stream writes the outputs as the rows finish (about"));
+    assert_null(strstr(err, "which fits"));
+    o.stream = MS_STREAM_ON;
+    assert_int_equal(render_to(&sc, &o, sub, "b", 0, &st, err, sizeof err), MS_ERR_BUDGET);
+    assert_non_null(strstr(err, "frame streamed"));
     assert_int_equal(tu_count_entries(sub), 0);
     /* Not streamed, the refusal says that streaming would fit. */
     o.stream = MS_STREAM_OFF;
@@ -218,7 +225,7 @@ static void test_cli(void **state)
     const char *whole[] = { "--width", "600", "--height", "400", "--samples", "256", "--threads", "2", "--no-stream",
                             "-o", a[0], "--vis", a[1], "--shadow", a[2], "--quiet", NULL };
     assert_int_equal(tu_run_cli(whole, line, sizeof line), 0);
-    /* 600x400 needs about 16.5 MiB whole, 4.9 MiB streamed (bands of 16 rows). */
+    /* 600x400 needs about 16.5 MiB whole; streamed, bands of 16 rows fit 8 MiB (the budget picks them). */
     const char *streamed[] = { "--width", "600", "--height", "400", "--samples", "256", "--threads", "2",
                                "--max-memory", "8M", "-o", b[0], "--vis", b[1], "--shadow", b[2], NULL };
     assert_int_equal(tu_run_cli(streamed, line, sizeof line), 0);

@@ -165,6 +165,14 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     return need->total;
 }
 
+int ms_frame_band_rows(const ms_frame_shape *s, int rows, uint64_t budget)
+{
+    ms_frame_shape t = *s;
+    for (t.band_rows = rows; t.band_rows > MS_TILE_SIZE; t.band_rows = t.band_rows / 2 / MS_TILE_SIZE * MS_TILE_SIZE)
+        if (ms_frame_need(&t, NULL) <= budget) return t.band_rows;
+    return MS_TILE_SIZE;
+}
+
 /* One line of the parts, largest first: "frame planes 9.0 GiB, per-light planes 3.5 GiB". */
 static void parts_text(const ms_need *n, char *buf, size_t len)
 {
@@ -236,7 +244,7 @@ int ms_frame_budget_check(const ms_frame_shape *s, uint64_t budget, char *err, s
     /* The outputs written as the rows finish. */
     if (!s->band_rows && s->stream_rows > 0 && at < sizeof hints) {
         t = *s;
-        t.band_rows = s->stream_rows;
+        t.band_rows = ms_frame_band_rows(s, s->stream_rows, budget);
         char sb[32];
         const uint64_t h = ms_frame_need(&t, NULL);
         ms_bytes_text(h, sb, sizeof sb);

@@ -52,6 +52,10 @@ typedef struct ms_frame_shape {
     int band_rows, stream_rows;
 } ms_frame_shape;
 
+/* Streamed: the largest band of rows (rows, then halves of it, each a multiple of MS_TILE_SIZE) whose frame fits
+ * budget, or MS_TILE_SIZE when none does. */
+int ms_frame_band_rows(const ms_frame_shape *s, int rows, uint64_t budget);
+
 /* The frame's estimated peak in bytes, its parts into need (may be NULL). */
 uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need);
 

@@ -258,21 +258,33 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         for (size_t l = 0; l < j->nlights; l++) fs.textured |= j->lights[l].texture != NULL;
         fs.threads = j->threads;
         fs.occluders = occluder_what(sm, opt) != 0;
-        /* Streamed outputs: bands of whole tile rows, enough tiles for every thread many times over. Not
-         * for frame-level methods (their receivers are the whole frame) nor the interleaved filter (it reads
-         * two rows beyond a band: not done yet). */
-        const int tiles_x = (W + TILE - 1) / TILE, want = 16 * j->threads;
+        /* Streamed outputs: bands of whole tile rows, by default about 512 tiles (and 16 per thread): a parallel
+         * region per band and light costs a barrier, which on a loaded machine means waiting for a time slice
+         * (bands of 128 tiles at 2048 wide took twice as long as the whole frame with the load at 11 on 2
+         * cores); fewer rows when the budget needs. Not for frame-level methods (their receivers are the
+         * whole frame) nor the interleaved filter (it reads two rows beyond a band: not done yet). */
+        const int tiles_x = (W + TILE - 1) / TILE, want = 16 * j->threads > 512 ? 16 * j->threads : 512;
         const int streamable = !sm->visibility_all && !fs.filter;
-        fs.stream_rows = streamable ? TILE * ((want + tiles_x - 1) / tiles_x) : 0;
+        if (opt->stream_rows < 0 || opt->stream_rows % TILE) {
+            snprintf(err, errlen, "stream_rows %d is not a multiple of %d", opt->stream_rows, TILE);
+            goto fail;
+        }
+        fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : TILE * ((want + tiles_x - 1) / tiles_x);
         const uint64_t budget = ms_memory_budget(opt->max_memory);
         if (stream == MS_STREAM_ON && !streamable) {
             snprintf(err, errlen, "streamed outputs: %s", sm->visibility_all ? "the method takes the whole frame at once (its receivers are all of the frame's pixels)"
                      : "the interleaved pattern's filter reads rows beyond a band (--no-filter, or not streamed)");
             goto fail;
         }
+        /* AUTO streams only when that fits where the whole frame does not: else the whole frame's refusal names
+         * what would fit (--stream among it, with its need). */
         if (stream == MS_STREAM_ON || (stream == MS_STREAM_AUTO && streamable && ms_frame_need(&fs, NULL) > budget)) {
-            fs.band_rows = fs.stream_rows;
-            j->band_rows = fs.band_rows < H ? fs.band_rows : H;
+            ms_frame_shape t = fs;
+            t.band_rows = opt->stream_rows ? opt->stream_rows : ms_frame_band_rows(&fs, fs.stream_rows, budget);
+            if (stream == MS_STREAM_ON || ms_frame_need(&t, NULL) <= budget) {
+                fs = t;
+                j->band_rows = fs.band_rows < H ? fs.band_rows : H;
+            }
         }
         if (ms_frame_budget_check(&fs, budget, err, errlen)) { rc = MS_ERR_BUDGET; goto fail; }
         j->frame.stats.memory_need = ms_frame_need(&fs, NULL);
