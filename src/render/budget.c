@@ -107,7 +107,10 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     memset(need, 0, sizeof *need);
     const uint64_t P = (uint64_t)s->W * (uint64_t)s->H, n = s->n_tris, mw8 = (uint64_t)s->mask_words * 8u;
     /* The pixels the frame's planes hold at once: all, or a band's (streamed outputs, frame_stream.c). */
-    const uint64_t PB = s->band_rows > 0 && (uint64_t)s->band_rows < (uint64_t)s->H ? (uint64_t)s->W * (uint64_t)s->band_rows : P;
+    /* With the interleaved filter a band is kept until two rows of the next are rendered: 2 bands + 2 rows. */
+    const uint64_t rows_held = s->band_rows > 0 ? (uint64_t)s->band_rows * (s->filter ? 2u : 1u) + (s->filter ? 2u : 0u) : 0;
+    const uint64_t PB = rows_held && rows_held < (uint64_t)s->H ? (uint64_t)s->W * rows_held : P;
+    const uint64_t band_px = s->band_rows > 0 && (uint64_t)s->band_rows < (uint64_t)s->H ? (uint64_t)s->W * (uint64_t)s->band_rows : P;
     /* Phase 1 (frame_job.c, before the planes): the materialised scene and the BVH's build. */
     const uint64_t soup = s->materialise ? mul(n, TRI_BYTES) : 0;
     const uint64_t build = s->bvh ? mul(n, BVH_BUILD_PER_TRI) : 0;
@@ -140,12 +143,13 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     uint64_t finish_pp = 8u + (s->textured ? mul(12u, s->nl) : 0);
     if (s->filter && finish_pp < 8u + (s->surf ? 4u : 0)) finish_pp = 8u + (s->surf ? 4u : 0);
     if (s->whole_frame && shadow_pp > finish_pp) ms_need_add(need, "hpc receiver hierarchy and masks", mul(P, shadow_pp));
-    else if (PB < P) {
+    else if (s->band_rows > 0) {
         /* A band: its luminances (4), the PNG's scratch records (16) and the band it writes from them (rgb and
-         * the miss test, 16), textured lights' mean texels; the writers' buffers (frame_stream.c): an EXR's
+         * the miss test, 16), textured lights' mean texels, the filtered V, S, S_spec per light; the writers' buffers (frame_stream.c): an EXR's
          * 16-row block of every channel (at most R, G, B and V, S twice per light over the outputs) as given,
          * packed and compressed, and the exposure's 65536-bucket histogram. */
-        ms_need_add(need, "finishing (filter, exposure)", mul(PB, 36u + (s->textured ? mul(12u, s->nl) : 0)));
+        ms_need_add(need, "finishing (filter, exposure)", mul(band_px, 36u + (s->textured ? mul(12u, s->nl) : 0) +
+                                                                 (s->filter ? mul(12u, s->nl) : 0)));
         ms_need_add(need, "streamed outputs", mul(mul((uint64_t)s->W, 16u * 4u * 3u), 3u + 4u * (uint64_t)s->nl) + (1u << 20));
     } else
         ms_need_add(need, "finishing (filter, exposure)", mul(P, finish_pp));

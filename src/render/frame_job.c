@@ -53,6 +53,11 @@ struct ms_frame_job {
     /* The rows the planes (hits, surf, the frame's) hold: y_base .. y_base + rows_held; the whole frame, or
      * a band of band_rows at most when the outputs are streamed (frame_stream.c). */
     int y_base, rows_held, band_rows;
+    /* Streamed: rows 0 .. rendered_to are rendered, 0 .. emitted_to handed out. With the interleaved filter
+     * (band_filter) a band is handed out once two rows of the next are rendered: the planes then hold a window
+     * of 2 band_rows + 2 rows from y_base, and the filtered band goes to band_vis, band_shadow, band_spec. */
+    int rendered_to, emitted_to, band_filter;
+    float *band_vis, *band_shadow, *band_spec;
     ms_hit *hits;
     ms_surface *surf;             /* per pixel, only for scenes with materials or normals (shade.h) */
     uint8_t *traced;              /* per tile: primary hits (and surfaces) are in hits (and surf) */
@@ -114,6 +119,9 @@ void ms_frame_job_free(ms_frame_job *j)
     free(j->hits);
     free(j->surf);
     free(j->traced);
+    free(j->band_vis);
+    free(j->band_shadow);
+    free(j->band_spec);
     ms_frame_free(&j->frame);
     if (j->own_soup) free(j->soup.tri);
     free(j);
@@ -264,7 +272,7 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
          * cores); fewer rows when the budget needs. Not for frame-level methods (their receivers are the
          * whole frame) nor the interleaved filter (it reads two rows beyond a band: not done yet). */
         const int tiles_x = (W + TILE - 1) / TILE, want = 16 * j->threads > 512 ? 16 * j->threads : 512;
-        const int streamable = !sm->visibility_all && !fs.filter;
+        const int streamable = !sm->visibility_all;
         if (opt->stream_rows < 0 || opt->stream_rows % TILE) {
             snprintf(err, errlen, "stream_rows %d is not a multiple of %d", opt->stream_rows, TILE);
             goto fail;
@@ -272,8 +280,7 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : TILE * ((want + tiles_x - 1) / tiles_x);
         const uint64_t budget = ms_memory_budget(opt->max_memory);
         if (stream == MS_STREAM_ON && !streamable) {
-            snprintf(err, errlen, "streamed outputs: %s", sm->visibility_all ? "the method takes the whole frame at once (its receivers are all of the frame's pixels)"
-                     : "the interleaved pattern's filter reads rows beyond a band (--no-filter, or not streamed)");
+            snprintf(err, errlen, "streamed outputs: the method takes the whole frame at once (its receivers are all of the frame's pixels)");
             goto fail;
         }
         /* AUTO streams only when that fits where the whole frame does not: else the whole frame's refusal names
@@ -325,8 +332,16 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     j->ntiles = j->tx * j->ty;
     j->total = (long)(1 + j->nlights) * j->ntiles;
 
-    j->rows_held = j->band_rows ? j->band_rows : H;
+    j->band_filter = j->band_rows && opt->pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter;
+    j->rows_held = !j->band_rows ? H : j->band_filter ? (2 * j->band_rows + 2 < H ? 2 * j->band_rows + 2 : H) : j->band_rows;
     const size_t npix = (size_t)W * j->rows_held, nl = j->nlights;
+    if (j->band_filter) {
+        const size_t nb = nl * (size_t)W * (size_t)j->band_rows;
+        j->band_vis = malloc(nb * sizeof(float));
+        j->band_shadow = malloc(nb * sizeof(float));
+        j->band_spec = malloc(nb * sizeof(float));
+        if (!j->band_vis || !j->band_shadow || !j->band_spec) { snprintf(err, errlen, "out of memory for a %dx%d band", W, j->band_rows); goto fail; }
+    }
     j->hits = malloc(npix * sizeof *j->hits);
     j->traced = calloc((size_t)j->ntiles, 1);
     j->sstate = calloc(nl, sizeof *j->sstate);
@@ -769,33 +784,85 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
     return 0;
 }
 
-int ms_frame_job_band(ms_frame_job *j, int y0, int rows, ms_frame *band, float *lum, char *err, size_t errlen)
+int ms_frame_job_band_render(ms_frame_job *j, int y0, int rows, char *err, size_t errlen)
 {
-    memset(band, 0, sizeof *band);
-    if (!j->band_rows || y0 % TILE || rows < 1 || rows > j->band_rows || (rows % TILE && y0 + rows != j->H) || y0 + rows > j->H) {
-        snprintf(err, errlen, "ms_frame_job_band: rows %d..%d are not a band of whole tile rows", y0, y0 + rows);
+    if (!j->band_rows || y0 != j->rendered_to || y0 % TILE || rows < 1 || rows > j->band_rows || (rows % TILE && y0 + rows != j->H) ||
+        y0 + rows > j->H) {
+        snprintf(err, errlen, "ms_frame_job_band_render: rows %d..%d are not the next band of whole tile rows", y0, y0 + rows);
         return -1;
     }
-    /* The planes now hold rows y0 .. y0 + rows, light l's plane at l * W * rows, as in a frame of that height. */
-    j->y_base = y0;
-    j->rows_held = rows;
+    /* Without the filter the planes hold this band alone (light l's plane at l * W * rows, as in a frame of that
+     * height); with it they keep the window from y_base (shifted in ms_frame_job_band_take). */
+    if (!j->band_filter) {
+        j->y_base = y0;
+        j->rows_held = rows;
+    }
     const int ty0 = y0 / TILE, ty1 = (y0 + rows + TILE - 1) / TILE, n = (ty1 - ty0) * j->tx;
     int *tiles = malloc((size_t)n * sizeof *tiles);
     if (!tiles) { snprintf(err, errlen, "out of memory"); return -1; }
     for (int i = 0; i < n; i++) tiles[i] = ty0 * j->tx + i;
     const int rc = ms_frame_job_render(j, tiles, n, err, errlen);
     free(tiles);
-    if (rc) return rc;
+    if (!rc) j->rendered_to = y0 + rows;
+    return rc;
+}
+
+/* Moves rows from .. rendered_to of every plane of the window to its start. */
+static void window_shift(ms_frame_job *j, int from)
+{
+    const size_t W = (size_t)j->W, cap = W * (size_t)j->rows_held, off = (size_t)(from - j->y_base) * W;
+    const size_t keep = (size_t)(j->rendered_to - from) * W;
+    memmove(j->hits, j->hits + off, keep * sizeof *j->hits);
+    if (j->surf) memmove(j->surf, j->surf + off, keep * sizeof *j->surf);
     ms_frame *f = &j->frame;
-    f->height = rows;
-    if (ms_frame_shade(j->scene, &j->ctx, j->lights, j->nlights, j->hits, j->surf, j->threads, y0, f, lum)) {
-        snprintf(err, errlen, "out of memory for the textured lights of a %dx%d band", j->W, rows);
+    for (size_t l = 0; l < j->nlights; l++) {
+        memmove(f->vis + l * cap, f->vis + l * cap + off, keep * sizeof *f->vis);
+        memmove(f->shadow + l * cap, f->shadow + l * cap + off, keep * sizeof *f->shadow);
+        memmove(f->shadow_spec + l * cap, f->shadow_spec + l * cap + off, keep * sizeof *f->shadow_spec);
+        memmove(f->front + l * cap, f->front + l * cap + off, keep * sizeof *f->front);
+    }
+    j->y_base = from;
+}
+
+int ms_frame_job_band_take(ms_frame_job *j, ms_frame *band, int *y0, float *lum, char *err, size_t errlen)
+{
+    const int a = j->emitted_to, W = j->W;
+    int b = j->band_filter ? a + j->band_rows : j->rendered_to;
+    if (b > j->H) b = j->H;
+    /* The filter reads two rows below the band: ready once they are rendered (or the frame ends there). */
+    if (a >= j->rendered_to || (j->band_filter && j->rendered_to < (b + 2 < j->H ? b + 2 : j->H))) return 0;
+    ms_frame *f = &j->frame, bf = *f;
+    bf.height = b - a;
+    const size_t off = (size_t)(a - j->y_base) * (size_t)W;
+    if (j->band_filter) {
+        const size_t cap = (size_t)W * (size_t)j->rows_held, bn = (size_t)W * (size_t)(b - a);
+        const double tf = omp_get_wtime();
+        for (size_t l = 0; l < j->nlights; l++) {
+            ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow + l * cap, j->y_base,
+                                      j->rows_held, a, b, j->band_vis + l * bn, j->band_shadow + l * bn, j->threads);
+            ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow_spec + l * cap,
+                                      j->y_base, j->rows_held, a, b, NULL, j->band_spec + l * bn, j->threads);
+        }
+        const double dt = omp_get_wtime() - tf;
+        f->stats.filter_s += dt;
+        f->stats.shadow_s += dt;
+        bf.vis = j->band_vis;
+        bf.shadow = j->band_shadow;
+        bf.shadow_spec = j->band_spec;
+        bf.front = NULL;   /* not handed out: the window's */
+    }
+    if (ms_frame_shade(j->scene, &j->ctx, j->lights, j->nlights, j->hits + off, j->surf ? j->surf + off : NULL, j->threads, a,
+                       &bf, lum)) {
+        snprintf(err, errlen, "out of memory for the textured lights of a %dx%d band", W, b - a);
         return -1;
     }
-    *band = *f;
-    if (y0 + rows == j->H) job_stats(j, &f->stats);
-    band->stats = f->stats;
-    return 0;
+    j->emitted_to = b;
+    if (j->band_filter && b < j->H) window_shift(j, b - 2);   /* the next band's filter reads rows b - 2, b - 1 */
+    if (b == j->H) job_stats(j, &f->stats);
+    bf.stats = f->stats;
+    *band = bf;
+    *y0 = a;
+    return 1;
 }
 
 void ms_frame_job_size(const ms_frame_job *j, int *W, int *H)

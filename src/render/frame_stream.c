@@ -164,11 +164,15 @@ static int stream_frame(ms_frame_job *job, int band_rows, double exposure_ev, co
     memset(&band, 0, sizeof band);
     for (int y0 = 0; y0 < H && !rc; y0 += band_rows) {
         const int rows = H - y0 < band_rows ? H - y0 : band_rows;
-        rc = ms_frame_job_band(job, y0, rows, &band, lum, err, errlen);
+        rc = ms_frame_job_band_render(job, y0, rows, err, errlen);
         if (rc) rc = rc == MS_ERR_CANCELLED ? MS_ERR_CANCELLED : -1;
-        else if (first && ms_band_check_finite(&band, y0, first, err, errlen)) rc = MS_ERR_IO;
-        else if (ms_outputs_stream_rows(os, &band, y0, 0, err, errlen)) rc = MS_ERR_IO;
-        else if (png && spill_band(&sp, &band, lum, y0, err, errlen)) rc = MS_ERR_IO;
+        int by0, got;
+        while (!rc && (got = ms_frame_job_band_take(job, &band, &by0, lum, err, errlen)) != 0) {
+            if (got < 0) rc = -1;
+            else if (first && ms_band_check_finite(&band, by0, first, err, errlen)) rc = MS_ERR_IO;
+            else if (ms_outputs_stream_rows(os, &band, by0, 0, err, errlen)) rc = MS_ERR_IO;
+            else if (png && spill_band(&sp, &band, lum, by0, err, errlen)) rc = MS_ERR_IO;
+        }
     }
     ms_frame meta;   /* what the end needs of the frame: its stats, and its exposure for the check */
     memset(&meta, 0, sizeof meta);

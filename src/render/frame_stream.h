@@ -11,11 +11,16 @@ int ms_frame_job_create_stream(const ms_scene *scene, const ms_render_options *o
                                int *band_rows, char *err, size_t errlen);
 /* The frame's size. */
 void ms_frame_job_size(const ms_frame_job *job, int *W, int *H);
-/* A banded job: renders rows y0 .. y0 + rows (y0 a multiple of MS_TILE_SIZE, rows at most the band's and a
- * multiple of MS_TILE_SIZE unless the frame ends there) for every light, shades them, and points *band at them
- * (width W, height rows; valid until the next call); lum (W * rows floats, may be NULL) gets each pixel's
- * unshadowed luminance (-INFINITY on misses) for the exposure. After the last band, band->stats are the
- * frame's. 0, or -1 / MS_ERR_CANCELLED with a message. */
-int ms_frame_job_band(ms_frame_job *job, int y0, int rows, ms_frame *band, float *lum, char *err, size_t errlen);
+/* A banded job: renders rows y0 .. y0 + rows (the rows after those rendered before; y0 a multiple of
+ * MS_TILE_SIZE, rows at most the band's and a multiple of MS_TILE_SIZE unless the frame ends there) for every
+ * light. 0, or -1 / MS_ERR_CANCELLED with a message. */
+int ms_frame_job_band_render(ms_frame_job *job, int y0, int rows, char *err, size_t errlen);
+/* The next finished band, in order: 1 with *band (width W, height its rows: filtered V, S, S_spec per light,
+ * shaded rgb; valid until the next call) and its first row *y0, when it is ready (with the interleaved filter
+ * a band is ready once two rows of the next are rendered, or the frame ends); 0 when none is (*band left as it
+ * was); -1 with a
+ * message. lum (W * band rows floats, may be NULL) gets each pixel's unshadowed luminance (-INFINITY on misses)
+ * for the exposure. With the last band, band->stats are the frame's. */
+int ms_frame_job_band_take(ms_frame_job *job, ms_frame *band, int *y0, float *lum, char *err, size_t errlen);
 
 #endif
