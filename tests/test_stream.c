@@ -8,7 +8,8 @@
  *     ms_render's planes: an oracle that does not go through the writers);
  *   - a budget below even the streamed estimate is refused (MS_ERR_BUDGET, "streamed" in the message) and
  *     leaves no file; frame-level methods are refused when streaming is forced;
- *   - the CLI: --max-memory below the whole frame streams and says so; the files equal --no-stream's. */
+ *   - the CLI: --max-memory below the whole frame streams and says so; the files equal --no-stream's; the
+ *     largest frame under a budget below even its streamed need is refused in one line, nothing written. */
 #include "testutil.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -238,6 +239,18 @@ static void test_cli(void **state)
     assert_int_equal(tu_run_cli(streamed, line, sizeof line), 0);
     if (!strstr(line, "written as the rows finished")) fail_msg("no word of streaming: %s", line);
     for (int k = 0; k < 3; k++) assert_same_file(a[k], b[k]);
+    /* The largest frame: streamed it needs about 46 MiB (one tile row of 16384 pixels at a time), over 16 MiB:
+     * refused before allocating, one line naming the streamed need, nothing written. */
+    const char *sub = tu_tmpdir("test_stream_cli_big");
+    tu_path(a[0], sizeof a[0], sub, "big.png");
+    const char *big[] = { "--width", "16384", "--height", "16384", "--max-memory", "16M", "--quiet", "-o", a[0], NULL };
+    char all[2048];
+    tu_run_result res;
+    assert_int_equal(tu_run_cli_ex(big, NULL, all, sizeof all, &res), 2);
+    assert_int_equal(res.lines, 1);
+    if (!strstr(all, "--stream writes the outputs as the rows finish (about")) fail_msg("no streamed need: %s", all);
+    assert_null(strstr(all, "which fits"));
+    assert_int_equal(tu_count_entries(sub), 0);
 }
 
 int main(void)
