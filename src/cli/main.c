@@ -25,7 +25,8 @@ static void usage(FILE *f)
         "  --method M          shadow method:");
     for (const char *const *m = ms_method_names(); *m; m++) fprintf(f, " %s", *m);
     fprintf(f,
-        " (default scanline)\n"
+        " (default scanline),\n"
+        "                      or auto: the one measured fastest for the pattern and scene (docs/methods.md)\n"
         "  --pattern P         light samples: grid (default), stratified, or interleaved (N/16 per pixel\n"
         "                      of a 4x4 block, then a 4x4 depth- and normal-aware filter; ray tracers only)\n"
         "  --samples N         256, 1024 or 4096 light samples (default: the scene's); stratified also 16, 64\n"
