@@ -252,8 +252,9 @@ int ms_frame_budget_check(const ms_frame_shape *s, uint64_t budget, char *err, s
         char sb[32];
         const uint64_t h = ms_frame_need(&t, NULL);
         ms_bytes_text(h, sb, sizeof sb);
-        at += (size_t)snprintf(hints + at, sizeof hints - at, "%s--stream writes the outputs as the rows finish (about %s%s)",
-                               at ? "; or " : "", sb, h <= budget ? ", which fits" : "");
+        if (h <= budget || h <= total / 2)   /* said when it fits or saves much (not for a scene-bound need) */
+            at += (size_t)snprintf(hints + at, sizeof hints - at, "%s--stream writes the outputs as the rows finish (about %s%s)",
+                                   at ? "; or " : "", sb, h <= budget ? ", which fits" : "");
     }
     if (!hints[0]) snprintf(hints, sizeof hints, "no frame size fits: the scene alone needs more");
     snprintf(err, errlen, "a %dx%d frame%s with %zu light%s and %zu triangles needs about %s (%s) but the memory budget is "
