@@ -258,6 +258,8 @@ static int cli_main(int argc, char **argv)
         /* Every rank renders its share; rank 0 alone writes (mpi_frame.c). */
         ms_frame frame;
         if (!chunk) chunk = opt.threads > 0 ? opt.threads : 4;
+        if (opt.stream == MS_STREAM_ON && ms_mpi_rank() == 0)
+            fprintf(stderr, "microshadow: warning: --stream is not done under mpirun (rank 0 assembles the whole frame)\n");
         outs[OUT_STATS].write = ms_mpi_stats_write_stream;
         const int mrc = ms_mpi_frame(&scene, what, &opt, schedule, chunk, &frame, err, sizeof err);
         if (mrc || ms_mpi_rank() != 0) {
