@@ -431,6 +431,13 @@ typedef enum ms_closed_cull_mode {
     MS_CLOSED_CULL_OFF = 2
 } ms_closed_cull_mode;
 
+/* Whether ms_render_outputs writes the outputs as the rows finish (ms_render_options.stream; docs/memory.md). */
+typedef enum ms_stream_mode {
+    MS_STREAM_AUTO = 0,   /* only when the whole frame would exceed the memory budget and a streamed one fits */
+    MS_STREAM_ON = 1,     /* always (refused for frame-level methods and the interleaved filter) */
+    MS_STREAM_OFF = 2     /* never: the whole frame in memory, then the outputs */
+} ms_stream_mode;
+
 typedef struct ms_render_options {
     const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
     ms_pattern pattern;
@@ -469,6 +476,9 @@ typedef struct ms_render_options {
                              * axis-aligned rectangles and rectangles sharing a side into one (docs/culling.md:
                              * the same points, so the same V and S up to ties on the rectangles' sides) */
     uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
+    ms_stream_mode stream;  /* ms_render_outputs only (ms_render always holds the whole frame) */
+    int stream_rows;        /* streamed: rows per band, a multiple of MS_TILE_SIZE; 0: about 512 tiles' worth, fewer
+                             * (down to one tile row) when the budget needs */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
@@ -517,6 +527,7 @@ typedef struct ms_stats {
                                     * the reference tracer (docs/culling.md), summed over the lights */
     uint64_t memory_need;          /* bytes the call estimated it would allocate, checked against its memory budget */
     uint64_t memory_budget;        /* that budget (max_memory, or the default: ms_memory_budget) */
+    int stream_rows;               /* ms_render_outputs: the rows of a band when the outputs were streamed, else 0 */
 } ms_stats;
 
 typedef struct ms_frame {
@@ -615,6 +626,18 @@ MS_API int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, c
 MS_API int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 MS_API int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 extern const char *const ms_float_image_suffixes[];   /* ".pfm", ".exr" */
+
+/* A frame rendered and written to outs[0..n) (ms_outputs_check them first), all or nothing: the whole frame in
+ * memory, then ms_outputs_write; or, streamed (opt->stream, docs/memory.md), band by band of MS_TILE_SIZE-row
+ * tile rows, each image output (the writers above) taking a band's rows as they finish, so that memory holds
+ * one band of the frame's planes instead of all of them; the PNG last, from the band's radiance spilled to an
+ * unlinked scratch file beside it, once its exposure (the exact 99th percentile, from a histogram gathered as the
+ * bands finish and one pass over the spill) is known. Byte for byte the same files either way. exposure_ev:
+ * stops added to the PNG's automatic exposure. stats (may be NULL) gets the frame's stats. 0; MS_ERR_BUDGET,
+ * MS_ERR_CANCELLED or -1 when the frame failed (nothing written); MS_ERR_IO when an output failed (nothing
+ * written either); each with a message. */
+MS_API int ms_render_outputs(const ms_scene *scene, const ms_render_options *opt, double exposure_ev, const ms_output *outs,
+                             int n, ms_stats *stats, char *err, size_t errlen);
 
 /* One output alone, all or nothing (checked, staged and renamed). */
 MS_API int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */

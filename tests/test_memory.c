@@ -368,14 +368,16 @@ static void test_cli(void **state)
     tu_path(out, sizeof out, dir, "out.png");
     tu_path(exr, sizeof exr, dir, "lightmap.exr");
     tu_path(vis, sizeof vis, dir, "v.pfm");
-    const char *const big[] = { "--width", "16384", "--height", "16384", "--max-memory", "64M", "--quiet", "-o", out,
-                                "--vis", vis, NULL };
+    /* --no-stream: streamed, this frame fits 64 MiB (test_stream) */
+    const char *const big[] = { "--width", "16384", "--height", "16384", "--max-memory", "64M", "--no-stream", "--quiet",
+                                "-o", out, "--vis", vis, NULL };
     tu_run_result res;
     assert_int_equal(tu_run_cli_ex(big, NULL, err, sizeof err, &res), 2);
     assert_int_equal(res.lines, 1);
     assert_non_null(strstr(err, "needs about"));
     assert_non_null(strstr(err, "but the memory budget is 64.0 MiB (--max-memory)"));
     assert_non_null(strstr(err, "would fit"));
+    assert_non_null(strstr(err, "--stream writes the outputs as the rows finish"));
     assert_int_equal(tu_count_entries(dir), 0);
     /* Refused before allocating: the process stays near its own size (a sanitized one has its runtime's). */
     assert_true(res.max_rss_mb < (SANITIZED ? 400.0 : 64.0));

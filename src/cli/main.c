@@ -57,6 +57,9 @@ static void usage(FILE *f)
         "                      always, none (to measure only: the receiver then shadows itself)\n"
         "  --max-memory SIZE   memory budget (e.g. 512M, 8G; default %d%% of physical memory): a frame that\n"
         "                      would need more is refused before anything is allocated, naming what fits\n"
+        "  --stream            write the outputs as the rows finish, holding one band of rows in memory (the\n"
+        "                      default when only that fits the memory budget; docs/memory.md)\n"
+        "  --no-stream         hold the whole frame, never stream\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture, which\n"
         "                      are otherwise one line per scene: their number and the first)\n"
@@ -90,7 +93,7 @@ static int cli_main(int argc, char **argv)
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
            O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR, O_NO_MERGE, O_MAX_MEMORY,
-           O_EMBREE_MODE, O_EMBREE_FILTER };
+           O_EMBREE_MODE, O_EMBREE_FILTER, O_STREAM, O_NO_STREAM };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -108,6 +111,7 @@ static int cli_main(int argc, char **argv)
         { "no-merge", no_argument, 0, O_NO_MERGE },
         { "max-memory", required_argument, 0, O_MAX_MEMORY },
         { "embree-mode", required_argument, 0, O_EMBREE_MODE }, { "embree-filter", required_argument, 0, O_EMBREE_FILTER },
+        { "stream", no_argument, 0, O_STREAM }, { "no-stream", no_argument, 0, O_NO_STREAM },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -196,6 +200,8 @@ static int cli_main(int argc, char **argv)
             else if (!strcmp(optarg, "none")) opt.embree_filter = MS_EMBREE_FILTER_NONE;
             else { fprintf(stderr, "microshadow: --embree-filter: '%s' is not plane, always or none\n", optarg); return EXIT_BAD_INPUT; }
             break;
+        case O_STREAM: opt.stream = MS_STREAM_ON; break;
+        case O_NO_STREAM: opt.stream = MS_STREAM_OFF; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &opt.max_memory)) return EXIT_BAD_INPUT; break;
         case O_EXPOSURE: {
             char *end;
@@ -247,43 +253,61 @@ static int cli_main(int argc, char **argv)
         return 1;
     }
     int last = -1;
-    ms_frame frame;
+    ms_stats stats;
+    const char *what = scene_path ? scene_path : "built-in scene";
 #ifdef MS_HAVE_MPI
     if (ms_mpi_active()) {
         /* Every rank renders its share; rank 0 alone writes (mpi_frame.c). */
+        ms_frame frame;
         if (!chunk) chunk = opt.threads > 0 ? opt.threads : 4;
+        if (opt.stream == MS_STREAM_ON && ms_mpi_rank() == 0)
+            fprintf(stderr, "microshadow: warning: --stream is not done under mpirun (rank 0 assembles the whole frame)\n");
         outs[OUT_STATS].write = ms_mpi_stats_write_stream;
-        const int mrc = ms_mpi_frame(&scene, scene_path ? scene_path : "built-in scene", &opt, schedule, chunk, &frame, err,
-                                     sizeof err);
+        const int mrc = ms_mpi_frame(&scene, what, &opt, schedule, chunk, &frame, err, sizeof err);
         if (mrc || ms_mpi_rank() != 0) {
             ms_frame_free(&frame);
             ms_scene_free(&scene);
             return mrc ? EXIT_BAD_INPUT : 0;
         }
+        frame.exposure *= (float)exp2(exposure_ev);
+        const int wrc = ms_outputs_write(&frame, outs, N_OUTS, err, sizeof err);
+        stats = frame.stats;
+        ms_frame_free(&frame);
+        if (wrc) {
+            fprintf(stderr, "microshadow: %s\n", err);
+            ms_scene_free(&scene);
+            return EXIT_BAD_INPUT;
+        }
     } else
 #endif
     {
         if (!quiet && isatty(STDERR_FILENO)) { opt.progress = progress_bar; opt.progress_user = &last; }
-        if (ms_render(&scene, &opt, &frame, err, sizeof err)) {
-            fprintf(stderr, "microshadow: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
+        /* Rendered and written together: streamed band by band when asked, or when only that fits the budget. */
+        const int rrc = ms_render_outputs(&scene, &opt, exposure_ev, outs, N_OUTS, &stats, err, sizeof err);
+        if (rrc == MS_ERR_IO) fprintf(stderr, "microshadow: %s\n", err);
+        else if (rrc) fprintf(stderr, "microshadow: %s: %s\n", what, err);
+        if (rrc) {
             ms_scene_free(&scene);
             return EXIT_BAD_INPUT;
         }
     }
-    frame.exposure *= (float)exp2(exposure_ev);
-    int rc = ms_outputs_write(&frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
-    if (rc) fprintf(stderr, "microshadow: %s\n", err);
-    if (!quiet && rc == 0) {
-        const ms_stats *s = &frame.stats;
+    if (!quiet && stats.stream_rows && opt.stream == MS_STREAM_AUTO) {
+        char nb[32], bb[32];
+        snprintf(nb, sizeof nb, "%.1f MiB", (double)stats.memory_need / 1048576.0);
+        snprintf(bb, sizeof bb, "%.1f MiB", (double)stats.memory_budget / 1048576.0);
+        fprintf(stderr, "microshadow: the whole frame exceeds the memory budget (%s): the outputs were written as the rows "
+                "finished, %d rows at a time (about %s)\n", bb, stats.stream_rows, nb);
+    }
+    if (!quiet) {
+        const ms_stats *s = &stats;
         fprintf(stderr, "%s: %zu triangles, %dx%d, %d samples (%s), method %s, %d threads: build %.3fs, setup %.3fs, primary %.3fs, "
                 "shadow %.3fs (%.1f M shadow rays/s), total %.3fs -> %s\n",
-                scene_path ? scene_path : "built-in scene", s->triangles, s->width, s->height, s->samples, s->pattern, s->method,
+                what, s->triangles, s->width, s->height, s->samples, s->pattern, s->method,
                 s->threads, s->build_s, s->setup_s, s->primary_s, s->shadow_s,
                 s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s * 1e-6 : 0.0, s->total_s, outs[OUT_PNG].path);
     }
-    ms_frame_free(&frame);
     ms_scene_free(&scene);
-    return rc;
+    return 0;
 }
 
 int main(int argc, char **argv)

@@ -1,4 +1,6 @@
 #include "microshadow.h"
+#include "image_rows.h"
+#include "output_stream.h"
 #include <errno.h>
 #include <math.h>
 #include <fcntl.h>
@@ -114,7 +116,7 @@ static const char *base_of(const char *path)
 /* Creates a staging file in the target's directory: a short fixed-length name, so that any target
  * name the filesystem accepts can be staged; mode 0666 less the umask, as any new file. Returns the
  * slot (path in g_stage) or -1. */
-static int stage_create(const char *target, int *fd_out, char *err, size_t errlen)
+static int stage_create_rw(const char *target, int *fd_out, int access, char *err, size_t errlen)
 {
     char dir[PATH_MAX];
     dir_of(target, dir, sizeof dir);
@@ -133,7 +135,7 @@ static int stage_create(const char *target, int *fd_out, char *err, size_t errle
             snprintf(err, errlen, "%s: cannot write: the directory's path is too long", target);
             return -1;
         }
-        int fd = open(g_stage[slot], O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        int fd = open(g_stage[slot], access | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (fd >= 0) g_live[slot] = 1;
         int e = errno;
         unblock(&old);
@@ -142,6 +144,11 @@ static int stage_create(const char *target, int *fd_out, char *err, size_t errle
     }
     snprintf(err, errlen, "%s: cannot write: no free staging name", target);
     return -1;
+}
+
+static int stage_create(const char *target, int *fd_out, char *err, size_t errlen)
+{
+    return stage_create_rw(target, fd_out, O_WRONLY, err, errlen);
 }
 
 static void stage_remove(int slot)
@@ -242,8 +249,8 @@ int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
 }
 
 /* The first non-finite value of plane p (w*h values of `per` floats each, `planes` planes), or 0. */
-static int first_bad(const float *p, int w, int h, int per, int planes, const char *name, const char *what, char *err,
-                     size_t errlen)
+static int first_bad(const float *p, int w, int h, int y0, int per, int planes, const char *name, const char *what,
+                     char *err, size_t errlen)
 {
     if (!p) return 0;
     const size_t n = (size_t)w * (size_t)h;
@@ -255,7 +262,7 @@ static int first_bad(const float *p, int w, int h, int per, int planes, const ch
             if (per == 3) snprintf(plane, sizeof plane, " %c", "RGB"[i % 3]);
             else if (planes > 1) snprintf(plane, sizeof plane, " of light %d", l);
             snprintf(err, errlen, "%s: %s%s at pixel (%zu, %zu) is %s: no output written (a NaN or infinite result is "
-                     "an error, never a file)", what, name, plane, i / (size_t)per % (size_t)w, i / (size_t)per / (size_t)w,
+                     "an error, never a file)", what, name, plane, i / (size_t)per % (size_t)w, i / (size_t)per / (size_t)w + (size_t)y0,
                      isnan(v) ? "NaN" : "infinite");
             return -1;
         }
@@ -264,11 +271,16 @@ static int first_bad(const float *p, int w, int h, int per, int planes, const ch
 
 int ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen)
 {
+    return ms_band_check_finite(f, 0, what, err, errlen);
+}
+
+int ms_band_check_finite(const ms_frame *f, int y0, const char *what, char *err, size_t errlen)
+{
     const int planes = f->n_lights > 0 ? f->n_lights : 1;
-    if (first_bad(f->rgb, f->width, f->height, 3, 1, "the image's radiance", what, err, errlen) ||
-        first_bad(f->vis, f->width, f->height, 1, planes, "V", what, err, errlen) ||
-        first_bad(f->shadow, f->width, f->height, 1, planes, "S", what, err, errlen) ||
-        first_bad(f->shadow_spec, f->width, f->height, 1, planes, "S_spec", what, err, errlen))
+    if (first_bad(f->rgb, f->width, f->height, y0, 3, 1, "the image's radiance", what, err, errlen) ||
+        first_bad(f->vis, f->width, f->height, y0, 1, planes, "V", what, err, errlen) ||
+        first_bad(f->shadow, f->width, f->height, y0, 1, planes, "S", what, err, errlen) ||
+        first_bad(f->shadow_spec, f->width, f->height, y0, 1, planes, "S_spec", what, err, errlen))
         return -1;
     if (f->rgb && !isfinite(f->exposure)) {
         snprintf(err, errlen, "%s: the image's exposure is %g: no output written (the radiance is too small or too "
@@ -276,6 +288,49 @@ int ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t
         return -1;
     }
     return 0;
+}
+
+/* Flushes, syncs and closes fp (the staging file of output path); 0, or -1 with a message unless rc was set. */
+static int close_staged(FILE *fp, const char *path, int rc, char *err, size_t errlen)
+{
+    if (!rc) {
+        errno = 0;
+        if (fflush(fp) != 0 || ferror(fp) || fsync(fileno(fp)) != 0) {
+            snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno ? errno : EIO));
+            rc = -1;
+        }
+    }
+    if (fclose(fp) != 0 && !rc) { snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno)); rc = -1; }
+    return rc;
+}
+
+/* Renames the staging files slot[0..n) into place when rc is 0, then removes whatever is left. Every target
+ * is still a regular file or absent before anything is renamed; the renames happen in one critical
+ * section, so a signal arriving meanwhile finds all of them done. */
+static int commit_all(const ms_output *outs, const int *slot, int n, int rc, char *err, size_t errlen)
+{
+    sigset_t old;
+    int k;
+    block(&old);
+    for (k = 0; k < n && !rc; k++)
+        if (outs[k].path) rc = target_kind_ok(outs[k].path, err, errlen);
+    for (k = 0; k < n && !rc; k++)
+        if (slot[k] >= 0) rc = stage_commit(slot[k], outs[k].path, err, errlen);
+    unblock(&old);
+    for (k = 0; k < n; k++)
+        if (slot[k] >= 0) stage_remove(slot[k]);   /* nothing left for those renamed */
+    return rc;
+}
+
+/* A staging file for output k, opened for writing; NULL with a message. */
+static FILE *open_staged(const ms_output *o, int *slot, char *err, size_t errlen)
+{
+    int fd;
+    *slot = stage_create(o->path, &fd, err, errlen);
+    if (*slot < 0) return NULL;
+    FILE *fp = fdopen(fd, "wb");
+    if (!fp) { snprintf(err, errlen, "%s: cannot write: %s", o->path, strerror(errno)); close(fd); }
+    return fp;
 }
 
 int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen)
@@ -292,33 +347,112 @@ int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err,
     for (k = 0; k < n; k++) slot[k] = -1;
     for (k = 0; k < n && !rc; k++) {
         if (!outs[k].path) continue;
-        int fd;
-        slot[k] = stage_create(outs[k].path, &fd, err, errlen);
-        if (slot[k] < 0) { rc = -1; break; }
-        FILE *fp = fdopen(fd, "wb");
-        if (!fp) { snprintf(err, errlen, "%s: cannot write: %s", outs[k].path, strerror(errno)); close(fd); rc = -1; break; }
-        rc = outs[k].write(f, fp, outs[k].path, err, errlen);
-        if (!rc) {
-            errno = 0;
-            if (fflush(fp) != 0 || ferror(fp) || fsync(fileno(fp)) != 0) {
-                snprintf(err, errlen, "%s: write failed: %s", outs[k].path, strerror(errno ? errno : EIO));
-                rc = -1;
-            }
-        }
-        if (fclose(fp) != 0 && !rc) { snprintf(err, errlen, "%s: write failed: %s", outs[k].path, strerror(errno)); rc = -1; }
+        FILE *fp = open_staged(&outs[k], &slot[k], err, errlen);
+        if (!fp) { rc = -1; break; }
+        rc = close_staged(fp, outs[k].path, outs[k].write(f, fp, outs[k].path, err, errlen), err, errlen);
     }
-    /* Every target is still a regular file or absent before anything is renamed; the renames happen
-     * in one critical section, so a signal arriving meanwhile finds all of them done. */
-    sigset_t old;
-    block(&old);
-    for (k = 0; k < n && !rc; k++)
-        if (outs[k].path) rc = target_kind_ok(outs[k].path, err, errlen);
-    for (k = 0; k < n && !rc; k++)
-        if (slot[k] >= 0) rc = stage_commit(slot[k], outs[k].path, err, errlen);
-    unblock(&old);
-    for (k = 0; k < n; k++)
-        if (slot[k] >= 0) stage_remove(slot[k]);   /* nothing left for those renamed */
+    return commit_all(outs, slot, n, rc, err, errlen);
+}
+
+/* ---- Outputs written band by band (output_stream.h) ---- */
+
+struct ms_outputs_stream {
+    const ms_output *outs;
+    int n, png;
+    int slot[MS_MAX_OUTPUTS];
+    FILE *fp[MS_MAX_OUTPUTS];
+    ms_image_kind kind[MS_MAX_OUTPUTS];
+    ms_image_rows *rows[MS_MAX_OUTPUTS];
+};
+
+int ms_outputs_streamable(const ms_output *outs, int n, char *err, size_t errlen)
+{
+    for (int k = 0; k < n; k++)
+        if (outs[k].path && ms_image_kind_of(outs[k].write) == MS_IMAGE_OTHER) {
+            snprintf(err, errlen, "%s: %s has its own writer, which needs the whole frame (not streamed)", outs[k].path,
+                     outs[k].flag);
+            return -1;
+        }
+    return 0;
+}
+
+static int stream_close(ms_outputs_stream *s, int rc, char *err, size_t errlen)
+{
+    for (int k = 0; k < s->n; k++) {
+        if (s->rows[k]) rc = ms_image_rows_end(s->rows[k], !rc, err, errlen) || rc ? -1 : 0;
+        s->rows[k] = NULL;
+        if (s->fp[k]) rc = close_staged(s->fp[k], s->outs[k].path, rc, err, errlen);
+        s->fp[k] = NULL;
+    }
     return rc;
+}
+
+void ms_outputs_stream_abort(ms_outputs_stream *s)
+{
+    if (!s) return;
+    char ignore[8];
+    stream_close(s, -1, ignore, sizeof ignore);
+    commit_all(s->outs, s->slot, s->n, -1, ignore, sizeof ignore);
+    free(s);
+}
+
+int ms_outputs_stream_open(const ms_output *outs, int n, int W, int H, int n_lights, ms_outputs_stream **out, char *err,
+                           size_t errlen)
+{
+    *out = NULL;
+    if (n > MS_MAX_OUTPUTS) { snprintf(err, errlen, "too many outputs"); return -1; }
+    if (ms_outputs_streamable(outs, n, err, errlen)) return -1;
+    ms_outputs_stream *s = calloc(1, sizeof *s);
+    if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
+    s->outs = outs;
+    s->n = n;
+    for (int k = 0; k < n; k++) s->slot[k] = -1;
+    for (int k = 0; k < n; k++) {
+        if (!outs[k].path) continue;
+        s->kind[k] = ms_image_kind_of(outs[k].write);
+        s->png |= s->kind[k] == MS_IMAGE_PNG;
+        s->fp[k] = open_staged(&outs[k], &s->slot[k], err, errlen);
+        if (s->fp[k] && s->kind[k] != MS_IMAGE_STATS)
+            s->rows[k] = ms_image_rows_begin(s->kind[k], W, H, n_lights, s->fp[k], outs[k].path, err, errlen);
+        if (!s->fp[k] || (s->kind[k] != MS_IMAGE_STATS && !s->rows[k])) { ms_outputs_stream_abort(s); return -1; }
+    }
+    *out = s;
+    return 0;
+}
+
+const char *ms_outputs_stream_png_path(const ms_outputs_stream *s)
+{
+    for (int k = 0; k < s->n; k++)
+        if (s->rows[k] && s->kind[k] == MS_IMAGE_PNG) return s->outs[k].path;
+    return NULL;
+}
+
+int ms_outputs_stream_rows(ms_outputs_stream *s, const ms_frame *band, int y0, int png, char *err, size_t errlen)
+{
+    for (int k = 0; k < s->n; k++)
+        if (s->rows[k] && (s->kind[k] == MS_IMAGE_PNG) == !!png && ms_image_rows_write(s->rows[k], band, y0, err, errlen))
+            return -1;
+    return 0;
+}
+
+int ms_outputs_stream_commit(ms_outputs_stream *s, const ms_frame *f, char *err, size_t errlen)
+{
+    int rc = 0;
+    for (int k = 0; k < s->n && !rc; k++)
+        if (s->fp[k] && s->kind[k] == MS_IMAGE_STATS) rc = s->outs[k].write(f, s->fp[k], s->outs[k].path, err, errlen);
+    rc = stream_close(s, rc, err, errlen);
+    rc = commit_all(s->outs, s->slot, s->n, rc, err, errlen);
+    free(s);
+    return rc;
+}
+
+int ms_outputs_spill(const char *near, char *err, size_t errlen)
+{
+    int fd;
+    const int slot = stage_create_rw(near, &fd, O_RDWR, err, errlen);
+    if (slot < 0) return -1;
+    stage_remove(slot);   /* unlinked at once: open until closed, gone with the process whatever happens */
+    return fd;
 }
 
 /* The single-output entry points of the public API. */

@@ -42,6 +42,7 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     cJSON_AddNumberToObject(o, "shadow_factor_s", s->shadow_factor_s);
     cJSON_AddNumberToObject(o, "filter_s", s->filter_s);
     cJSON_AddNumberToObject(o, "memory_need", (double)s->memory_need);
+    cJSON_AddNumberToObject(o, "stream_rows", s->stream_rows);
     cJSON_AddNumberToObject(o, "memory_budget", (double)s->memory_budget);
     cJSON_AddNumberToObject(o, "shadow_rays_per_s", s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s : 0.0);
     cJSON *c = cJSON_AddObjectToObject(o, "counters");

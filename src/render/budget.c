@@ -106,6 +106,11 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     if (!need) need = &local;
     memset(need, 0, sizeof *need);
     const uint64_t P = (uint64_t)s->W * (uint64_t)s->H, n = s->n_tris, mw8 = (uint64_t)s->mask_words * 8u;
+    /* The pixels the frame's planes hold at once: all, or a band's (streamed outputs, frame_stream.c). */
+    /* With the interleaved filter a band is kept until two rows of the next are rendered: 2 bands + 2 rows. */
+    const uint64_t rows_held = s->band_rows > 0 ? (uint64_t)s->band_rows * (s->filter ? 2u : 1u) + (s->filter ? 2u : 0u) : 0;
+    const uint64_t PB = rows_held && rows_held < (uint64_t)s->H ? (uint64_t)s->W * rows_held : P;
+    const uint64_t band_px = s->band_rows > 0 && (uint64_t)s->band_rows < (uint64_t)s->H ? (uint64_t)s->W * (uint64_t)s->band_rows : P;
     /* Phase 1 (frame_job.c, before the planes): the materialised scene and the BVH's build. */
     const uint64_t soup = s->materialise ? mul(n, TRI_BYTES) : 0;
     const uint64_t build = s->bvh ? mul(n, BVH_BUILD_PER_TRI) : 0;
@@ -120,8 +125,8 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     ms_need_add(need, "3dr set-ups", s->primary_3dr_setups ? mul(n, R3_SETUP_PER_TRI) : 0);
     /* frame_job.c: hits, rgb, per light V, S, S_spec (floats) and front (uint16), surfaces, tile flags. */
     const uint64_t frame_pp = sizeof(ms_hit) + 12u + (s->surf ? sizeof(ms_surface) : 0);
-    ms_need_add(need, "frame planes", mul(P, frame_pp) + P / 256u + 1u);
-    ms_need_add(need, "per-light planes", mul(mul(P, 14u), s->nl));
+    ms_need_add(need, "frame planes", mul(PB, frame_pp) + P / 256u + 1u);
+    ms_need_add(need, "per-light planes", mul(mul(PB, 14u), s->nl));
     uint64_t prim_pp = 0;
     if (s->primary_depth) prim_pp += sizeof(ms_hit) + 4u;                           /* primary_depth.c */
     if (s->primary_3dr) prim_pp += 20u + (s->primary_depth ? 0 : s->bvh ? 0 : sizeof(ms_hit));   /* primary_3dr.c */
@@ -138,7 +143,16 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     uint64_t finish_pp = 8u + (s->textured ? mul(12u, s->nl) : 0);
     if (s->filter && finish_pp < 8u + (s->surf ? 4u : 0)) finish_pp = 8u + (s->surf ? 4u : 0);
     if (s->whole_frame && shadow_pp > finish_pp) ms_need_add(need, "hpc receiver hierarchy and masks", mul(P, shadow_pp));
-    else ms_need_add(need, "finishing (filter, exposure)", mul(P, finish_pp));
+    else if (s->band_rows > 0) {
+        /* A band: its luminances (4), the PNG's scratch records (16) and the band it writes from them (rgb and
+         * the miss test, 16), textured lights' mean texels, the filtered V, S, S_spec per light; the writers' buffers (frame_stream.c): an EXR's
+         * 16-row block of every channel (at most R, G, B and V, S twice per light over the outputs) as given,
+         * packed and compressed, and the exposure's 65536-bucket histogram. */
+        ms_need_add(need, "finishing (filter, exposure)", mul(band_px, 36u + (s->textured ? mul(12u, s->nl) : 0) +
+                                                                 (s->filter ? mul(12u, s->nl) : 0)));
+        ms_need_add(need, "streamed outputs", mul(mul((uint64_t)s->W, 16u * 4u * 3u), 3u + 4u * (uint64_t)s->nl) + (1u << 20));
+    } else
+        ms_need_add(need, "finishing (filter, exposure)", mul(P, finish_pp));
     ms_need_add(need, "threads", mul((uint64_t)(s->threads > 0 ? s->threads : 1), PER_THREAD + 512u * mw8) + FIXED);
     /* The lights' occluders stay; the closed components' search, or the last light's build, come on top. */
     if (s->bvh && s->occluders) {
@@ -153,6 +167,14 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
         ms_need_add(need, "BVH and triangles", extra);
     }
     return need->total;
+}
+
+int ms_frame_band_rows(const ms_frame_shape *s, int rows, uint64_t budget)
+{
+    ms_frame_shape t = *s;
+    for (t.band_rows = rows; t.band_rows > MS_TILE_SIZE; t.band_rows = t.band_rows / 2 / MS_TILE_SIZE * MS_TILE_SIZE)
+        if (ms_frame_need(&t, NULL) <= budget) return t.band_rows;
+    return MS_TILE_SIZE;
 }
 
 /* One line of the parts, largest first: "frame planes 9.0 GiB, per-light planes 3.5 GiB". */
@@ -178,7 +200,7 @@ int ms_frame_budget_check(const ms_frame_shape *s, uint64_t budget, char *err, s
     ms_need need;
     const uint64_t total = ms_frame_need(s, &need);
     if (total <= budget) return 0;
-    char parts[256], tb[32], bb[32], hints[384];
+    char parts[256], tb[32], bb[32], hints[512];
     parts_text(&need, parts, sizeof parts);
     ms_bytes_text(total, tb, sizeof tb);
     ms_bytes_text(budget, bb, sizeof bb);
@@ -214,6 +236,7 @@ int ms_frame_budget_check(const ms_frame_shape *s, uint64_t budget, char *err, s
         t.materialise = t.bvh = t.shallow_per_light = t.hpc_order = t.embree = t.primary_3dr = t.primary_3dr_setups = 0;
         t.primary_depth = 1;
         t.whole_frame = 1;
+        t.band_rows = t.stream_rows = 0;   /* hpc takes the whole frame */
         t.scanline_slots = 0;
         t.filter = 0;
         char hb[32];
@@ -222,9 +245,21 @@ int ms_frame_budget_check(const ms_frame_shape *s, uint64_t budget, char *err, s
         at += (size_t)snprintf(hints + at, sizeof hints - at, "%s--method hpc streams the procedural triangles (about %s%s)",
                                at ? "; or " : "", hb, h <= budget ? ", which fits" : "");
     }
+    /* The outputs written as the rows finish. */
+    if (!s->band_rows && s->stream_rows > 0 && at < sizeof hints) {
+        t = *s;
+        t.band_rows = ms_frame_band_rows(s, s->stream_rows, budget);
+        char sb[32];
+        const uint64_t h = ms_frame_need(&t, NULL);
+        ms_bytes_text(h, sb, sizeof sb);
+        if (h <= budget || h <= total / 2)   /* said when it fits or saves much (not for a scene-bound need) */
+            at += (size_t)snprintf(hints + at, sizeof hints - at, "%s--stream writes the outputs as the rows finish (about %s%s)",
+                                   at ? "; or " : "", sb, h <= budget ? ", which fits" : "");
+    }
     if (!hints[0]) snprintf(hints, sizeof hints, "no frame size fits: the scene alone needs more");
-    snprintf(err, errlen, "a %dx%d frame with %zu light%s and %zu triangles needs about %s (%s) but the memory budget is "
-             "%s (--max-memory): %s", s->W, s->H, s->nl, s->nl == 1 ? "" : "s", s->n_tris, tb, parts, bb, hints);
+    snprintf(err, errlen, "a %dx%d frame%s with %zu light%s and %zu triangles needs about %s (%s) but the memory budget is "
+             "%s (--max-memory): %s", s->W, s->H, s->band_rows ? " streamed" : "", s->nl, s->nl == 1 ? "" : "s", s->n_tris, tb,
+             parts, bb, hints);
     return MS_ERR_BUDGET;
 }
 

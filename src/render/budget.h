@@ -46,14 +46,23 @@ typedef struct ms_frame_shape {
     int textured;           /* some light is textured (finish keeps a mean texel per light and pixel) */
     int occluders;          /* per-light occluders (visibility/occluders.h): closed components, culled BVHs */
     int threads;
+    /* Streamed outputs (frame_stream.c): the planes hold band_rows rows at a time (0: the whole frame); when the
+     * frame is not streamed, stream_rows is what a streamed one would hold (0: it cannot be streamed), for the
+     * hint. */
+    int band_rows, stream_rows;
 } ms_frame_shape;
+
+/* Streamed: the largest band of rows (rows, then halves of it, each a multiple of MS_TILE_SIZE) whose frame fits
+ * budget, or MS_TILE_SIZE when none does. */
+int ms_frame_band_rows(const ms_frame_shape *s, int rows, uint64_t budget);
 
 /* The frame's estimated peak in bytes, its parts into need (may be NULL). */
 uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need);
 
 /* 0 when the frame fits the budget; else MS_ERR_BUDGET and one line: "a WxH frame (...) needs about X (parts)
  * but the memory budget is B (--max-memory): hints", the hints saying what would fit (a smaller size at the
- * same aspect, fewer lights, --method hpc to stream a procedural scene). */
+ * same aspect, fewer lights, --method hpc to stream a procedural scene, --stream to write the outputs as
+ * the rows finish). */
 int ms_frame_budget_check(const ms_frame_shape *s, uint64_t budget, char *err, size_t errlen);
 
 /* A lightmap bake: size x size texels, nl lights, the scene's triangles, whether the BVH is built here. */

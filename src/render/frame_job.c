@@ -24,6 +24,7 @@
 #include "render_materialise.h"
 #include "interleave_filter.h"
 #include "budget.h"
+#include "frame_stream.h"
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,6 +53,14 @@ struct ms_frame_job {
     ms_occluders *occ;            /* per light: its occluders (sm->occluders, occluder_what), else NULL */
     ms_render_options opt;
     int W, H, tx, ty, ntiles, samples, spp, threads, rendered_any, streamed;
+    /* The rows the planes (hits, surf, the frame's) hold: y_base .. y_base + rows_held; the whole frame, or
+     * a band of band_rows at most when the outputs are streamed (frame_stream.c). */
+    int y_base, rows_held, band_rows;
+    /* Streamed: rows 0 .. rendered_to are rendered, 0 .. emitted_to handed out. With the interleaved filter
+     * (band_filter) a band is handed out once two rows of the next are rendered: the planes then hold a window
+     * of 2 band_rows + 2 rows from y_base, and the filtered band goes to band_vis, band_shadow, band_spec. */
+    int rendered_to, emitted_to, band_filter;
+    float *band_vis, *band_shadow, *band_spec;
     ms_hit *hits;
     ms_surface *surf;             /* per pixel, only for scenes with materials or normals (shade.h) */
     uint8_t *traced;              /* per tile: primary hits (and surfaces) are in hits (and surf) */
@@ -119,6 +128,9 @@ void ms_frame_job_free(ms_frame_job *j)
     free(j->hits);
     free(j->surf);
     free(j->traced);
+    free(j->band_vis);
+    free(j->band_shadow);
+    free(j->band_spec);
     ms_frame_free(&j->frame);
     if (j->own_soup) free(j->soup.tri);
     free(j);
@@ -197,7 +209,10 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
     return rc;
 }
 
-int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **out, char *err, size_t errlen)
+/* stream: MS_STREAM_OFF (the whole frame), MS_STREAM_ON (bands), or MS_STREAM_AUTO (bands when only they fit the
+ * budget). */
+static int job_create(const ms_scene *scene, const ms_render_options *opt, int stream, ms_frame_job **out, char *err,
+                      size_t errlen)
 {
     *out = NULL;
     const double t_start = omp_get_wtime();
@@ -285,14 +300,40 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         for (size_t l = 0; l < j->nlights; l++) fs.textured |= j->lights[l].texture != NULL;
         fs.threads = j->threads;
         fs.occluders = occluder_what(sm, opt) != 0;
+        /* Streamed outputs: bands of whole tile rows, by default about 512 tiles (and 16 per thread): a parallel
+         * region per band and light costs a barrier, which on a loaded machine means waiting for a time slice
+         * (bands of 128 tiles at 2048 wide took twice as long as the whole frame with the load at 11 on 2
+         * cores); fewer rows when the budget needs. Not for frame-level methods (their receivers are the
+         * whole frame). */
+        const int tiles_x = (W + TILE - 1) / TILE, want = 16 * j->threads > 512 ? 16 * j->threads : 512;
+        const int streamable = !sm->visibility_all;
+        if (opt->stream_rows < 0 || opt->stream_rows % TILE) {
+            snprintf(err, errlen, "stream_rows %d is not a multiple of %d", opt->stream_rows, TILE);
+            goto fail;
+        }
+        fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : TILE * ((want + tiles_x - 1) / tiles_x);
         const uint64_t budget = ms_memory_budget(opt->max_memory);
+        if (stream == MS_STREAM_ON && !streamable) {
+            snprintf(err, errlen, "streamed outputs: the method takes the whole frame at once (its receivers are all of the frame's pixels)");
+            goto fail;
+        }
+        /* AUTO streams only when that fits where the whole frame does not: else the whole frame's refusal names
+         * what would fit (--stream among it, with its need). */
+        if (stream == MS_STREAM_ON || (stream == MS_STREAM_AUTO && streamable && ms_frame_need(&fs, NULL) > budget)) {
+            ms_frame_shape t = fs;
+            t.band_rows = opt->stream_rows ? opt->stream_rows : ms_frame_band_rows(&fs, fs.stream_rows, budget);
+            if (stream == MS_STREAM_ON || ms_frame_need(&t, NULL) <= budget) {
+                fs = t;
+                j->band_rows = fs.band_rows < H ? fs.band_rows : H;
+            }
+        }
         if (ms_frame_budget_check(&fs, budget, err, errlen)) {
             if (auto_pick && fs.materialise && opt->pattern == MS_PATTERN_GRID && !opt->primary) {
                 /* "auto": a procedural scene that does not fit materialised is streamed by hpc. */
                 ms_frame_job_free(j);
                 ms_render_options streamed_opt = *opt;
                 streamed_opt.method = "hpc";
-                return ms_frame_job_create(scene, &streamed_opt, out, err, errlen);
+                return job_create(scene, &streamed_opt, stream, out, err, errlen);
             }
             rc = MS_ERR_BUDGET;
             goto fail;
@@ -335,7 +376,16 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
     j->ntiles = j->tx * j->ty;
     j->total = (long)(1 + j->nlights) * j->ntiles;
 
-    const size_t npix = (size_t)W * H, nl = j->nlights;
+    j->band_filter = j->band_rows && opt->pattern == MS_PATTERN_INTERLEAVED && !opt->no_filter;
+    j->rows_held = !j->band_rows ? H : j->band_filter ? (2 * j->band_rows + 2 < H ? 2 * j->band_rows + 2 : H) : j->band_rows;
+    const size_t npix = (size_t)W * j->rows_held, nl = j->nlights;
+    if (j->band_filter) {
+        const size_t nb = nl * (size_t)W * (size_t)j->band_rows;
+        j->band_vis = malloc(nb * sizeof(float));
+        j->band_shadow = malloc(nb * sizeof(float));
+        j->band_spec = malloc(nb * sizeof(float));
+        if (!j->band_vis || !j->band_shadow || !j->band_spec) { snprintf(err, errlen, "out of memory for a %dx%d band", W, j->band_rows); goto fail; }
+    }
     j->hits = malloc(npix * sizeof *j->hits);
     j->traced = calloc((size_t)j->ntiles, 1);
     j->sstate = calloc(nl, sizeof *j->sstate);
@@ -358,7 +408,7 @@ int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_
         if (!j->surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); goto fail; }
     }
     f->width = W;
-    f->height = H;
+    f->height = j->rows_held;
     /* The primary's create is timed as primary visibility: the rasterizing primaries (3dr-*, depth) do
      * their whole pass there. */
     const double t_primary = omp_get_wtime();
@@ -407,6 +457,19 @@ fail:
     return rc;
 }
 
+int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **out, char *err, size_t errlen)
+{
+    return job_create(scene, opt, MS_STREAM_OFF, out, err, errlen);
+}
+
+int ms_frame_job_create_stream(const ms_scene *scene, const ms_render_options *opt, int stream, ms_frame_job **out,
+                               int *band_rows, char *err, size_t errlen)
+{
+    const int rc = job_create(scene, opt, stream, out, err, errlen);
+    *band_rows = rc ? 0 : (*out)->band_rows;
+    return rc;
+}
+
 int ms_frame_job_tiles(const ms_frame_job *j, int *tiles_x, int *tiles_y)
 {
     if (tiles_x) *tiles_x = j->tx;
@@ -441,7 +504,7 @@ static void trace_tiles(ms_frame_job *j, const int *tiles, int n, int tick)
         ms_hit tile[TILE * TILE];
         j->pm->trace(j->pstate, &j->ctx, x0, y0, x1, y1, tile);
         for (int y = y0; y < y1; y++)
-            memcpy(&j->hits[(size_t)y * j->W + x0], &tile[(y - y0) * (x1 - x0)], (size_t)(x1 - x0) * sizeof *tile);
+            memcpy(&j->hits[(size_t)(y - j->y_base) * j->W + x0], &tile[(y - y0) * (x1 - x0)], (size_t)(x1 - x0) * sizeof *tile);
         j->traced[t] = 1;
         if (tick) progress_tick(j);
     }
@@ -457,7 +520,7 @@ static void surface_tiles(ms_frame_job *j, const int *tiles, int n)
         tile_rect(j, tiles ? tiles[i] : i, &x0, &y0, &x1, &y1);
         for (int y = y0; y < y1; y++)
             for (int x = x0; x < x1; x++) {
-                const size_t p = (size_t)y * j->W + x;
+                const size_t p = (size_t)(y - j->y_base) * j->W + x;
                 float viewer[3];   /* the eye, or up the pixel's own ray for an orthographic camera */
                 ms_camera_viewer(&j->ctx.cam, j->hits[p].p, viewer);
                 ms_surface_at(j->scene, &j->bvh, &j->hits[p], viewer, &j->surf[p]);
@@ -512,7 +575,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     light_ctx(j, l, &lctx);
     const ms_render_ctx ctx = lctx;
     const int W = j->W;
-    const size_t npix = (size_t)W * j->H, mw = (size_t)ctx.mask_words;
+    const size_t npix = (size_t)W * j->rows_held, mw = (size_t)ctx.mask_words;
     ms_frame *const out = &j->frame;
     float *const vis = out->vis + l * npix, *const shadow = out->shadow + l * npix;
     float *const spec = out->shadow_spec + l * npix;   /* S_spec (shade.h) where surf has a specular lobe, else S */
@@ -558,7 +621,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
             int nq = 0;
             for (int y = y0; y < y1 && ok; y++)
                 for (int x = x0; x < x1; x++) {
-                    size_t i = (size_t)y * W + x;
+                    size_t i = (size_t)(y - j->y_base) * W + x;
                     const ms_hit *h = &hits[i];
                     if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
                     ms_query_from_hit(&q[nq], h, (uint32_t)x, (uint32_t)y);
@@ -707,8 +770,38 @@ int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, siz
     return 0;
 }
 
+/* The frame's stats once every tile is rendered (finish, or a streamed frame's last band). */
+static void job_stats(ms_frame_job *j, ms_stats *st)
+{
+    const size_t nl = j->nlights;
+    st->triangles = j->scene->n_tris;
+    st->load_s = j->scene->load_s;
+    st->samples = j->samples;
+    st->samples_per_pixel = j->spp;
+    st->threads = j->threads;
+    st->width = j->W;
+    st->height = j->H;
+    st->method = j->sm->name;
+    st->primary = j->pm->name;
+    if (j->pm->counters) {
+        uint64_t c[3];
+        j->pm->counters(j->pstate, c);
+        st->primary_setups = c[0];
+        st->primary_edge_evals = c[1];
+        st->primary_nodes = c[2];
+    }
+    ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
+    if (j->sm->isa_used) j->sm->isa_used(j->sstate[nl - 1], &kisa, &tisa);
+    st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
+    st->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
+    st->pattern = ms_pattern_name(j->opt.pattern);
+    st->shadow_factor_s /= j->threads;   /* thread-seconds to seconds */
+    st->total_s = omp_get_wtime() - j->t_start + j->scene->load_s;
+}
+
 int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen)
 {
+    if (j->band_rows) { snprintf(err, errlen, "ms_frame_job_finish: a streamed job's frame is written band by band"); return -1; }
     memset(out, 0, sizeof *out);
     ms_frame *f = &j->frame;
     ms_stats *st = &f->stats;
@@ -748,35 +841,100 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
         st->shadow_s += st->filter_s;
         st->shadow_cpu_s += process_cpu_s() - cf;
     }
-    if (ms_frame_shade(j->scene, &j->ctx, j->lights, nl, j->hits, j->surf, j->threads, f)) {
+    if (ms_frame_shade(j->scene, &j->ctx, j->lights, nl, j->hits, j->surf, j->threads, 0, f, NULL)) {
         snprintf(err, errlen, "out of memory for the textured lights of a %dx%d frame", W, H);
         return -1;
     }
 
-    st->triangles = j->scene->n_tris;
-    st->load_s = j->scene->load_s;
-    st->samples = j->samples;
-    st->samples_per_pixel = j->spp;
-    st->threads = j->threads;
-    st->width = W;
-    st->height = H;
-    st->method = j->sm->name;
-    st->primary = j->pm->name;
-    if (j->pm->counters) {
-        uint64_t c[3];
-        j->pm->counters(j->pstate, c);
-        st->primary_setups = c[0];
-        st->primary_edge_evals = c[1];
-        st->primary_nodes = c[2];
-    }
-    ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
-    if (j->sm->isa_used) j->sm->isa_used(j->sstate[nl - 1], &kisa, &tisa);
-    st->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
-    st->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
-    st->pattern = ms_pattern_name(j->opt.pattern);
-    st->shadow_factor_s /= j->threads;   /* thread-seconds to seconds */
-    st->total_s = omp_get_wtime() - j->t_start + j->scene->load_s;
+    job_stats(j, st);
     *out = *f;
     memset(f, 0, sizeof *f);
     return 0;
+}
+
+int ms_frame_job_band_render(ms_frame_job *j, int y0, int rows, char *err, size_t errlen)
+{
+    if (!j->band_rows || y0 != j->rendered_to || y0 % TILE || rows < 1 || rows > j->band_rows || (rows % TILE && y0 + rows != j->H) ||
+        y0 + rows > j->H) {
+        snprintf(err, errlen, "ms_frame_job_band_render: rows %d..%d are not the next band of whole tile rows", y0, y0 + rows);
+        return -1;
+    }
+    /* Without the filter the planes hold this band alone (light l's plane at l * W * rows, as in a frame of that
+     * height); with it they keep the window from y_base (shifted in ms_frame_job_band_take). */
+    if (!j->band_filter) {
+        j->y_base = y0;
+        j->rows_held = rows;
+    }
+    const int ty0 = y0 / TILE, ty1 = (y0 + rows + TILE - 1) / TILE, n = (ty1 - ty0) * j->tx;
+    int *tiles = malloc((size_t)n * sizeof *tiles);
+    if (!tiles) { snprintf(err, errlen, "out of memory"); return -1; }
+    for (int i = 0; i < n; i++) tiles[i] = ty0 * j->tx + i;
+    const int rc = ms_frame_job_render(j, tiles, n, err, errlen);
+    free(tiles);
+    if (!rc) j->rendered_to = y0 + rows;
+    return rc;
+}
+
+/* Moves rows from .. rendered_to of every plane of the window to its start. */
+static void window_shift(ms_frame_job *j, int from)
+{
+    const size_t W = (size_t)j->W, cap = W * (size_t)j->rows_held, off = (size_t)(from - j->y_base) * W;
+    const size_t keep = (size_t)(j->rendered_to - from) * W;
+    memmove(j->hits, j->hits + off, keep * sizeof *j->hits);
+    if (j->surf) memmove(j->surf, j->surf + off, keep * sizeof *j->surf);
+    ms_frame *f = &j->frame;
+    for (size_t l = 0; l < j->nlights; l++) {
+        memmove(f->vis + l * cap, f->vis + l * cap + off, keep * sizeof *f->vis);
+        memmove(f->shadow + l * cap, f->shadow + l * cap + off, keep * sizeof *f->shadow);
+        memmove(f->shadow_spec + l * cap, f->shadow_spec + l * cap + off, keep * sizeof *f->shadow_spec);
+        memmove(f->front + l * cap, f->front + l * cap + off, keep * sizeof *f->front);
+    }
+    j->y_base = from;
+}
+
+int ms_frame_job_band_take(ms_frame_job *j, ms_frame *band, int *y0, float *lum, char *err, size_t errlen)
+{
+    const int a = j->emitted_to, W = j->W;
+    int b = j->band_filter ? a + j->band_rows : j->rendered_to;
+    if (b > j->H) b = j->H;
+    /* The filter reads two rows below the band: ready once they are rendered (or the frame ends there). */
+    if (a >= j->rendered_to || (j->band_filter && j->rendered_to < (b + 2 < j->H ? b + 2 : j->H))) return 0;
+    ms_frame *f = &j->frame, bf = *f;
+    bf.height = b - a;
+    const size_t off = (size_t)(a - j->y_base) * (size_t)W;
+    if (j->band_filter) {
+        const size_t cap = (size_t)W * (size_t)j->rows_held, bn = (size_t)W * (size_t)(b - a);
+        const double tf = omp_get_wtime();
+        for (size_t l = 0; l < j->nlights; l++) {
+            ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow + l * cap, j->y_base,
+                                      j->rows_held, a, b, j->band_vis + l * bn, j->band_shadow + l * bn, j->threads);
+            ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow_spec + l * cap,
+                                      j->y_base, j->rows_held, a, b, NULL, j->band_spec + l * bn, j->threads);
+        }
+        const double dt = omp_get_wtime() - tf;
+        f->stats.filter_s += dt;
+        f->stats.shadow_s += dt;
+        bf.vis = j->band_vis;
+        bf.shadow = j->band_shadow;
+        bf.shadow_spec = j->band_spec;
+        bf.front = NULL;   /* not handed out: the window's */
+    }
+    if (ms_frame_shade(j->scene, &j->ctx, j->lights, j->nlights, j->hits + off, j->surf ? j->surf + off : NULL, j->threads, a,
+                       &bf, lum)) {
+        snprintf(err, errlen, "out of memory for the textured lights of a %dx%d band", W, b - a);
+        return -1;
+    }
+    j->emitted_to = b;
+    if (j->band_filter && b < j->H) window_shift(j, b - 2);   /* the next band's filter reads rows b - 2, b - 1 */
+    if (b == j->H) job_stats(j, &f->stats);
+    bf.stats = f->stats;
+    *band = bf;
+    *y0 = a;
+    return 1;
+}
+
+void ms_frame_job_size(const ms_frame_job *j, int *W, int *H)
+{
+    *W = j->W;
+    *H = j->H;
 }

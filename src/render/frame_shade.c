@@ -17,7 +17,7 @@ static int cmp_float(const void *a, const void *b)
  * its unshadowed irradiance, 3 floats each (NULL entries for untextured lights); *out NULL when no light
  * is textured. 0, or -1 out of memory. */
 static int texture_means(const ms_render_ctx *ctx0, const ms_light *lights, size_t nlights, const ms_hit *hits, int W,
-                         size_t npix, int threads, float **out)
+                         int y0, size_t npix, int threads, float **out)
 {
     *out = NULL;
     size_t textured = 0;
@@ -34,7 +34,7 @@ static int texture_means(const ms_render_ctx *ctx0, const ms_light *lights, size
         for (size_t i = 0; i < npix; i++) {
             if (hits[i].prim == UINT32_MAX) continue;
             ms_shadow_query q;
-            ms_query_from_hit(&q, &hits[i], (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
+            ms_query_from_hit(&q, &hits[i], (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W + (size_t)y0));
             ms_light_texture_mean(&ctx, &q, tl + 3 * i);
         }
     }
@@ -43,7 +43,7 @@ static int texture_means(const ms_render_ctx *ctx0, const ms_light *lights, size
 }
 
 int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_light *lights, size_t nlights,
-                   const ms_hit *hits, const ms_surface *surf, int threads, ms_frame *out)
+                   const ms_hit *hits, const ms_surface *surf, int threads, int y0, ms_frame *out, float *lum_out)
 {
     /* Shading (shade.h): per light the exact unshadowed irradiance times S, plus the LTC specular times
      * S_spec (ratio estimators: exact where the light is wholly visible or hidden, converging as k grows);
@@ -51,8 +51,8 @@ int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_lig
     const int W = out->width;
     const size_t npix = (size_t)out->width * out->height;
     float *tex = NULL;   /* textured lights: the mean texel colour each pixel sees */
-    if (texture_means(ctx, lights, nlights, hits, W, npix, threads, &tex)) return -1;
-    float *lum = malloc(npix * sizeof(float));
+    if (texture_means(ctx, lights, nlights, hits, W, y0, npix, threads, &tex)) return -1;
+    float *lum = lum_out ? lum_out : malloc(npix * sizeof(float));
     size_t nlum = 0;
     /* In parallel (a disk across the horizon costs a 256-gon per pixel): lum[i] per pixel, misses
      * dropped after. */
@@ -60,7 +60,7 @@ int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_lig
     for (size_t i = 0; i < npix; i++) {
         float *c = out->rgb + 3 * i;
         c[0] = c[1] = c[2] = 0.0f;
-        if (lum) lum[i] = -1.0f;
+        if (lum) lum[i] = -INFINITY;
         if (hits[i].prim == UINT32_MAX) continue;
         ms_surface grey;
         if (!surf) {
@@ -93,6 +93,7 @@ int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_lig
         if (lum) lum[i] = y;
     }
     free(tex);
+    if (lum_out) return 0;   /* a band's: the exposure is the caller's (frame_stream.c) */
     for (size_t i = 0; lum && i < npix; i++)
         if (hits[i].prim != UINT32_MAX) lum[nlum++] = lum[i];
     out->exposure = 1.0f;

@@ -45,13 +45,25 @@ int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front
     if (!v0 || !s0) { free(v0); free(s0); return -1; }
     memcpy(v0, vis, npix * sizeof *v0);
     memcpy(s0, shadow, npix * sizeof *s0);
+    ms_interleave_filter_rows(W, H, hits, front, v0, s0, 0, H, 0, H, vis, shadow, threads);
+    free(v0);
+    free(s0);
+    return 0;
+}
+
+void ms_interleave_filter_rows(int W, int H, const ms_hit *hits, const uint16_t *front, const float *v0, const float *s0,
+                               int wy0, int wrows, int a, int b, float *vis, float *shadow, int threads)
+{
+    (void)wrows;   /* the caller's promise: rows a - 2 .. b + 1 of the frame are in the window */
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (int y = 0; y < H; y++)
+    for (int y = a; y < b; y++)
         for (int x = 0; x < W; x++) {
-            const size_t i = (size_t)y * W + x;
+            const size_t i = (size_t)(y - wy0) * W + x, o = (size_t)(y - a) * W + x;
             const ms_hit *c = &hits[i];
             /* A pixel with no sample in front keeps V = S = 0: its light is behind its plane, whatever its
-             * neighbours (facets of a curved surface, within the normal tolerance) see. */
+             * neighbours (facets of a curved surface, within the normal tolerance) see. A miss stays -1. */
+            if (vis) vis[o] = v0[i];
+            shadow[o] = s0[i];
             if (c->prim == UINT32_MAX || !front[i]) continue;
             float wsum = 0.0f, vsum = 0.0f, ssum = 0.0f;
             for (int dy = -2; dy <= 2; dy++) {
@@ -60,7 +72,7 @@ int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front
                 for (int dx = -2; dx <= 2; dx++) {
                     const int xx = x + dx;
                     if (xx < 0 || xx >= W) continue;
-                    const size_t j = (size_t)yy * W + xx;
+                    const size_t j = (size_t)(yy - wy0) * W + xx;
                     const ms_hit *h = &hits[j];
                     if (h->prim == UINT32_MAX || !front[j]) continue;
                     const float d[3] = { h->p[0] - c->p[0], h->p[1] - c->p[1], h->p[2] - c->p[2] };
@@ -75,11 +87,8 @@ int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front
                 }
             }
             if (wsum > 0.0f) {
-                vis[i] = vsum / wsum;
-                shadow[i] = ssum / wsum;
+                if (vis) vis[o] = vsum / wsum;
+                shadow[o] = ssum / wsum;
             }
         }
-    free(v0);
-    free(s0);
-    return 0;
 }

@@ -19,4 +19,11 @@
 int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front, float *vis, float *shadow,
                          int threads);
 
+/* The same filter over rows a .. b of a W x H frame, for streamed frames (frame_job.c): hits, front and the raw
+ * v0, s0 hold the window of rows wy0 .. wy0 + wrows, which must include rows a - 2 .. b + 1 where the frame has
+ * them; the filtered rows go to vis and shadow (row a first; vis may be NULL: S_spec is filtered with the
+ * raw V's weights, which do not depend on V). */
+void ms_interleave_filter_rows(int W, int H, const ms_hit *hits, const uint16_t *front, const float *v0, const float *s0,
+                               int wy0, int wrows, int a, int b, float *vis, float *shadow, int threads);
+
 #endif
