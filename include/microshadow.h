@@ -776,6 +776,40 @@ MS_API ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *op
  * and V. An ms_output_write_fn; ends in .exr. */
 MS_API int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 
+/* ---- The bake back onto the asset: a binary glTF 2.0 (docs/baking.md, "Back onto the asset") ----
+ *
+ * The scene's triangles as they were baked, in one .glb: node transforms applied (the loaders flatten every
+ * node tree into world positions, so each mesh of the scene file is one node with the identity transform,
+ * under a root node that carries ms_scene.origin as its translation when it is not zero: positions stay in
+ * the scene's frame, as exact as the scene holds them). One glTF mesh per scene-file mesh (ms_scene.tri_mesh),
+ * one primitive per material in it; vertices welded per primitive where position, normal and both UV sets
+ * agree bit for bit (a chart seam or a crease keeps two vertices). Attributes: POSITION, NORMAL (the shading
+ * normals where the scene has them, else the triangle's), TEXCOORD_0 (UV set 0 where the primitive has it)
+ * and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv); triangles without baked UVs (a mesh
+ * left out of the bake) form their own primitive without TEXCOORD_1 and without the lightmap. Materials carry
+ * the scene's base colour, metallic, roughness, emission and alpha mode, and their base-colour, normal,
+ * emissive and metallic-roughness textures (the decoded texels re-encoded as PNG: no file is read) where
+ * those use UV set 0. Every baked material references:
+ *   - the lightmap, extension MOZ_lightmap {index, texCoord: 1, intensity}: the irradiance summed over the
+ *     lights (ms_lightmap.frame.rgb), linear (no sRGB curve), divided by its largest value I over the texels
+ *     and channels, as an 8-bit RGB PNG; intensity = I restores it (E = texel / 255 * I, within half a step,
+ *     I / 510). Texels neither a triangle nor dilation reached are 0;
+ *   - the shadowmask in extras.shadowmask {index, texCoord: 1, channels: [{channel, light, shape}]}: S of
+ *     lights 0..3 in R, G, B, A of an 8-bit RGBA PNG (linear, S = byte / 255; unused channels 0, alpha 255
+ *     when fewer than 4 lights), a warning naming the lights left out beyond 4.
+ * Zero-area triangles (no normal) are left out with a warning. */
+typedef struct ms_bake_gltf_options {
+    int no_textures;     /* 1: materials keep their factors, no embedded material textures */
+    int no_shadowmask;   /* 1: no shadowmask image */
+} ms_bake_gltf_options;
+/* The .glb of scene and its lightmap lm (ms_bake of that scene) into a malloc'ed buffer *glb of *len bytes
+ * (free it). opt may be NULL. MS_OK, or an error with *glb = NULL. */
+MS_API ms_status ms_bake_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                              unsigned char **glb, size_t *len, char *err, size_t errlen);
+/* The same written to path (ending in .glb), all or nothing (staged beside it and renamed: ms_outputs_write). */
+MS_API ms_status ms_bake_write_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                                    const char *path, char *err, size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif
