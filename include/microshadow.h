@@ -266,6 +266,14 @@ typedef struct ms_scene {
     /* The world position of the local frame's origin (see above): 0, 0, 0 unless ms_scene_load moved a
      * distant scene. */
     double origin[3];
+    /* Objects (NULL where not known: one per mesh, tri_mesh): tri_object[i] is the object triangle i came
+     * from, numbered 0 .. n_objects-1 across the scene: each glTF node with a mesh, each file of another
+     * format. A baker gives each object its own region of the lightmap when their UVs overlap. */
+    uint32_t *tri_object;
+    size_t n_objects;
+    /* Per scene-file mesh (n_meshes entries, NULL: all 1): its texel density weight in bakes (scene file
+     * "lightmap": {"scale": s}), 0 for "lightmap": false (not baked; it still casts shadows). */
+    float *mesh_lightmap_scale;
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX

@@ -4,7 +4,7 @@
  * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
 #include "microshadow.h"
 #include "points.h"
-#include "lightmap_unwrap.h"
+#include "bake_uvs.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -63,39 +63,18 @@ static void closest_on_triangle(const double p[2], const double a[2], const doub
     w[0] = 1.0 - w[1] - w[2];
 }
 
-/* The UVs baked into: the scene's set where a triangle has it, xatlas where not. */
+/* The UVs baked into (bake_uvs.c): the scene's set, per-object regions, xatlas for the rest. */
 static ms_status choose_uvs(const ms_scene *sc, const ms_bake_options *o, int size, int padding, ms_lightmap *lm,
                             char *err, size_t errlen)
 {
     const size_t n = sc->n_tris;
     lm->uv = malloc((n ? n : 1) * 6 * sizeof(float));
-    uint8_t *want = calloc(n ? n : 1, 1);
-    if (!lm->uv || !want) { free(want); snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); return MS_ERR_NO_MEMORY; }
-    const float *set = o->uv_set >= 0 ? sc->tri_uv[o->uv_set] : NULL;
-    size_t missing = 0;
-    for (size_t i = 0; i < n; i++) {
-        int ok = set != NULL;
-        for (int k = 0; k < 6 && ok; k++) ok = isfinite(set[6 * i + k]);
-        if (ok) memcpy(lm->uv + 6 * i, set + 6 * i, 6 * sizeof(float));
-        else { want[i] = 1; missing++; }
-    }
+    if (!lm->uv) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); return MS_ERR_NO_MEMORY; }
     const double t0 = omp_get_wtime();
-    int rc = 0;
-    if (missing == n) rc = ms_lightmap_unwrap(sc->tri, n, want, size, padding, lm->uv, err, errlen);
-    else if (missing) {
-        /* Some meshes have the set, some not: the file's charts keep the top half of the lightmap
-         * (v halved), xatlas packs the rest into the bottom-left quarter (docs/baking.md). */
-        rc = ms_lightmap_unwrap(sc->tri, n, want, size / 2, padding, lm->uv, err, errlen);
-        for (size_t i = 0; i < n && !rc; i++)
-            for (int k = 0; k < 3; k++) {
-                float *u = lm->uv + 6 * i + 2 * k;
-                if (want[i]) { u[0] *= 0.5f; u[1] = 0.5f + 0.5f * u[1]; }
-                else u[1] *= 0.5f;
-            }
-    }
+    ms_bake_uv_report rep;
+    const int rc = ms_bake_uvs(sc, o->uv_set, size, padding, lm->uv, &rep, err, errlen);
     lm->unwrap_s = omp_get_wtime() - t0;
-    lm->unwrapped_tris = missing;
-    free(want);
+    lm->unwrapped_tris = rep.unwrapped;
     return rc ? MS_ERR_INVALID : MS_OK;
 }
 
