@@ -727,6 +727,10 @@ MS_API ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, 
  * ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
  * E_unshadowed * S * emission (ms_light_irradiance). Texels no triangle touches are filled by dilation
  * from their neighbours (across chart seams) so that bilinear lookups do not bleed black. */
+/* Called at the end of each pass of a bake, from the calling thread, with its name ("UVs", "texels", "leak
+ * test", "acceleration structure", "light 1/3", ..., "irradiance, dilation and seams") and its seconds: one
+ * progress line per pass for a command line (the points' progress callback goes on within the lights). */
+typedef void (*ms_bake_pass_fn)(void *user, const char *pass, double seconds);
 typedef struct ms_bake_options {
     ms_points_options points;  /* method, pattern, samples, threads, seed, isa, progress; zero: defaults */
     int size;                  /* texels per side; 0: 1024 (at most MS_MAX_IMAGE_SIZE) */
@@ -734,7 +738,10 @@ typedef struct ms_bake_options {
                                 * lacks it are unwrapped by xatlas into the free space of one atlas with
                                 * them (all of them if no mesh has the set); -1: xatlas for every triangle */
     int dilate;                /* texels of dilation; 0: 4; -1: none */
-    int padding;               /* texels between xatlas charts; 0: 2 */
+    int padding;               /* texels between charts (xatlas's and the lightmap's regions); 0: 4 */
+    int no_leak_fix;           /* 1: texels inside geometry keep their points (docs/baking.md, "Quality"); 0: moved */
+    ms_bake_pass_fn pass;      /* may be NULL */
+    void *pass_user;
 } ms_bake_options;
 
 typedef struct ms_lightmap {
@@ -752,6 +759,13 @@ typedef struct ms_lightmap {
     size_t texels;             /* texels on triangles */
     size_t unwrapped_tris;     /* triangles whose UVs xatlas made */
     double unwrap_s, raster_s; /* seconds in xatlas and in the texel rasterization */
+    size_t texels_moved;       /* texels whose centre lay inside geometry, moved to the visible side */
+    double leak_s;             /* seconds finding them */
+    /* Chart seams (ms_bake_finish): where two triangles share an edge in space but not in UVs, the lightmap
+     * sampled bilinearly on both sides at 8 points of the edge; the difference of the irradiance's largest
+     * channel relative to the lightmap's largest value, mean and max over the points, and their number. */
+    double seam_mean, seam_max;
+    size_t seam_points;
 } ms_lightmap;
 
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at

@@ -35,7 +35,8 @@ static void usage(FILE *f)
         "                      lights 0-3 in R, G, B, A; the materials' extras name them), one binary glTF\n"
         "  --stats OUT.json    timings and counters\n"
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
-        "  --padding N         texels between xatlas charts (default 2)\n"
+        "  --padding N         texels between charts and regions (default 4)\n"
+        "  --no-leak-fix       keep the points of texels whose centre lies inside geometry\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I, --max-memory SIZE   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture)\n"
@@ -59,23 +60,37 @@ static int write_glb(const ms_frame *f, FILE *out, const char *name, char *err, 
     return -1;
 }
 
+/* Within the lights' pass: a percentage on the terminal, overwritten by the pass's own line at its end. */
 static int progress_bar(void *user, double frac)
 {
     int *last = user;
     int pct = (int)(frac * 100.0);
-    if (pct != *last) {
+    if (pct != *last && pct < 100) {
         *last = pct;
-        fprintf(stderr, "\rbaking %3d%%", pct);
-        if (pct >= 100) fputc('\n', stderr);
+        fprintf(stderr, "\rbake: lights %3d%%", pct);
         fflush(stderr);
     }
     return 0;
 }
 
+/* One line per pass of the bake (ms_bake_options.pass). */
+static void pass_line(void *user, const char *pass, double seconds)
+{
+    (void)user;
+    fprintf(stderr, "\r\033[Kbake: %s: %.3f s\n", pass, seconds);
+    fflush(stderr);
+}
+
+static void pass_line_plain(void *user, const char *pass, double seconds)
+{
+    (void)user;
+    fprintf(stderr, "bake: %s: %.3f s\n", pass, seconds);
+}
+
 int ms_cli_bake(int argc, char **argv)
 {
     enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF };
+           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -86,7 +101,7 @@ int ms_cli_bake(int argc, char **argv)
         { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
         { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
         { "verbose", no_argument, 0, O_VERBOSE }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
-        { "gltf", required_argument, 0, O_GLTF },
+        { "gltf", required_argument, 0, O_GLTF }, { "no-leak-fix", no_argument, 0, O_NO_LEAK_FIX },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -154,6 +169,7 @@ int ms_cli_bake(int argc, char **argv)
         case O_VIS: outs[3].path = optarg; break;
         case O_SHADOW: outs[4].path = optarg; break;
         case O_GLTF: outs[5].path = optarg; break;
+        case O_NO_LEAK_FIX: bo.no_leak_fix = 1; break;
         case O_QUIET: quiet = 1; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &bo.points.max_memory)) return EXIT_BAD_INPUT; break;
         case O_VERBOSE: ms_set_warning_verbose(1); break;
@@ -199,7 +215,12 @@ int ms_cli_bake(int argc, char **argv)
     } else
 #endif
     {
-        if (!quiet && isatty(STDERR_FILENO)) { bo.points.progress = progress_bar; bo.points.progress_user = &last; }
+        if (!quiet && isatty(STDERR_FILENO)) {
+            bo.points.progress = progress_bar;
+            bo.points.progress_user = &last;
+            bo.pass = pass_line;
+        } else if (!quiet)
+            bo.pass = pass_line_plain;
         st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
     }
     if (st) {
@@ -226,10 +247,12 @@ int ms_cli_bake(int argc, char **argv)
         const ms_stats *s = &lm.frame.stats;
         const int nl = lm.frame.n_lights > 1 ? lm.frame.n_lights : 1;
         fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
-                "(rasterized in %.3fs), %d light%s, %d samples, method %s, %d threads: shadow %.3fs (%.0f texels/s), total %.3fs -> %s\n",
+                "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
+                "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, max %.4f of the largest irradiance -> %s%s%s\n",
                 scene_path ? scene_path : "built-in scene", s->triangles, lm.unwrapped_tris, lm.unwrap_s, lm.frame.width,
-                lm.frame.height, lm.texels, lm.raster_s, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads, s->shadow_s,
-                s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, outs[0].path);
+                lm.frame.height, lm.texels, lm.raster_s, lm.texels_moved, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads,
+                s->shadow_s, s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, lm.seam_points, lm.seam_mean,
+                lm.seam_max, outs[0].path, outs[5].path ? ", " : "", outs[5].path ? outs[5].path : "");
     }
     ms_lightmap_free(&lm);
     ms_scene_free(&scene);

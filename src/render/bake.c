@@ -5,6 +5,8 @@
 #include "microshadow.h"
 #include "points.h"
 #include "bake_uvs.h"
+#include "bake_leaks.h"
+#include "bake_seams.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -246,11 +248,20 @@ ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     ms_status bst = bake_budget(scene, o, size, 0, NULL, err, errlen);
     if (bst) return bst;
-    const int padding = o->padding > 0 ? o->padding : 2;
+    const int padding = o->padding > 0 ? o->padding : 4;
     ms_status st = choose_uvs(scene, o, size, padding, out, err, errlen);
+    if (!st && o->pass) o->pass(o->pass_user, "UVs", out->unwrap_s);
     const double t_raster = omp_get_wtime();
     if (!st) st = rasterize(scene, size, out, err, errlen);
     out->raster_s = omp_get_wtime() - t_raster;
+    if (!st && o->pass) o->pass(o->pass_user, "texels", out->raster_s);
+    const double t_leak = omp_get_wtime();
+    if (!st && !o->no_leak_fix &&
+        ms_bake_fix_leaks(scene, size, out->uv, out->triangle, out->position, out->normal, o->points.threads, &out->texels_moved,
+                          err, errlen))
+        st = MS_ERR_NO_MEMORY;
+    out->leak_s = omp_get_wtime() - t_leak;
+    if (!st && o->pass && !o->no_leak_fix) o->pass(o->pass_user, "leak test", out->leak_s);
     out->n_tris = scene->n_tris;
     const size_t nt = (size_t)size * size;
     size_t nl;
@@ -359,8 +370,14 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
             ms_stats one;
             memset(&one, 0, sizeof one);
             bp.light = l;
+            const double t_light = omp_get_wtime();
             st = ms_visibility_points_local(accel, &lights[l], &pts, &po, vl + l * m, sl + l * m, fl + l * m, &one, err, errlen);
             if (!st) add_stats(&sum, &one, l == 0);
+            if (!st && o->pass) {
+                char name[48];
+                snprintf(name, sizeof name, "light %zu/%zu", l + 1, nl);
+                o->pass(o->pass_user, name, omp_get_wtime() - t_light);
+            }
         }
         if (!st) {
             for (size_t l = 0; l < nl; l++)
@@ -389,6 +406,7 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     memset(&zero, 0, sizeof zero);
     const ms_bake_options *o = opt_in ? opt_in : &zero;
     const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
+    const double t_finish = omp_get_wtime();
     ms_frame *f = &lm->frame;
     const int size = f->width;
     const size_t nt = (size_t)size * size, m = lm->texels;
@@ -450,12 +468,17 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     free(lum);
     if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); return MS_ERR_NO_MEMORY; }
+    if (ms_bake_seams(scene, lm, &lm->seam_mean, &lm->seam_max, &lm->seam_points)) {
+        snprintf(err, errlen, "out of memory measuring the lightmap's seams");
+        return MS_ERR_NO_MEMORY;
+    }
     /* A NaN or infinite texel is an error, never a lightmap (microshadow.h: MS_MAX_RADIANCE). */
     if (ms_frame_check_finite(f, "the lightmap", err, errlen)) return MS_ERR_INVALID;
+    if (o->pass) o->pass(o->pass_user, "irradiance, dilation and seams", omp_get_wtime() - t_finish);
     f->stats.width = f->stats.height = size;
     f->stats.triangles = scene->n_tris;
     f->stats.load_s = scene->load_s;
-    f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s;
+    f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + lm->leak_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s;
     return MS_OK;
 }
 
@@ -479,8 +502,10 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
     if (st) return st;
     ms_accel *own = NULL;
     if (!accel) {
+        const double t_accel = omp_get_wtime();
         st = ms_accel_build(scene, opt_in ? opt_in->points.threads : 0, &own, err, errlen);
         accel = own;
+        if (!st && o->pass) o->pass(o->pass_user, "acceleration structure", omp_get_wtime() - t_accel);
     }
     if (!st) st = ms_bake_rows(accel, opt_in, out, 0, out->frame.height, err, errlen);
     if (!st) st = ms_bake_finish(scene, opt_in, out, err, errlen);
