@@ -761,7 +761,8 @@ typedef struct ms_lightmap {
     double unwrap_s, raster_s; /* seconds in xatlas and in the texel rasterization */
     size_t texels_moved;       /* texels whose centre lay inside geometry, moved to the visible side */
     double leak_s;             /* seconds finding them */
-    /* Chart seams (ms_bake_finish): where two triangles share an edge in space but not in UVs, the lightmap
+    /* Chart seams (ms_bake_finish): where two triangles share an edge in space but not in UVs and their planes
+     * meet within 8 degrees (a smooth surface; across a crease the sides differ by right), the lightmap
      * sampled bilinearly on both sides at 8 points of the edge; the difference of the irradiance's largest
      * channel relative to the lightmap's largest value, mean and max over the points, and their number. */
     double seam_mean, seam_max;

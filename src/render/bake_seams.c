@@ -6,6 +6,21 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Neighbours within 8 degrees of each other count as one smooth surface (a tessellated sphere's do). */
+#define SMOOTH_COS 0.99f
+
+static int unit_normal(const float *t, float n[3])
+{
+    const float e1[3] = { t[3] - t[0], t[4] - t[1], t[5] - t[2] }, e2[3] = { t[6] - t[0], t[7] - t[1], t[8] - t[2] };
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    const float l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(l > 0.0f)) return 0;
+    for (int d = 0; d < 3; d++) n[d] /= l;
+    return 1;
+}
+
 typedef struct edge_rec {
     float a[3], b[3];   /* endpoints, a before b in byte order */
     uint32_t tri;
@@ -69,9 +84,16 @@ int ms_bake_seams(const ms_scene *sc, const ms_lightmap *lm, double *mean, doubl
     for (size_t i = 0; i < (size_t)f->width * f->height; i++)
         if (f->vis[i] >= 0.0f) fmaxv = fmax(fmaxv, fmax(f->rgb[3 * i], fmax(f->rgb[3 * i + 1], f->rgb[3 * i + 2])));
     double sum = 0.0;
-    for (size_t i = 0; i + 1 < m; i++) {
+    for (size_t i = 0, j; i < m; i = j) {
+        /* the run of records of one edge: a seam only where exactly two triangles meet (manifold) */
+        for (j = i + 1; j < m && !memcmp(e[j].a, e[i].a, sizeof e[i].a) && !memcmp(e[j].b, e[i].b, sizeof e[i].b); j++) {}
+        if (j - i != 2) continue;
         const edge_rec *x = &e[i], *y = &e[i + 1];
-        if (memcmp(x->a, y->a, sizeof x->a) || memcmp(x->b, y->b, sizeof x->b)) continue;
+        /* only where the surface goes on smoothly: across a crease the two sides differ by right */
+        float na[3], nb[3];
+        if (!unit_normal(sc->tri + 9 * (size_t)x->tri, na) || !unit_normal(sc->tri + 9 * (size_t)y->tri, nb) ||
+            fabsf(na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) < SMOOTH_COS)
+            continue;
         if (!memcmp(x->ua, y->ua, sizeof x->ua) && !memcmp(x->ub, y->ub, sizeof x->ub)) continue;   /* one chart */
         for (int k = 0; k < 8; k++) {
             const double s = (k + 0.5) / 8.0;
@@ -82,7 +104,6 @@ int ms_bake_seams(const ms_scene *sc, const ms_lightmap *lm, double *mean, doubl
             *max = fmax(*max, d);
             (*points)++;
         }
-        i++;   /* the pair is used; a third triangle on the edge (non-manifold) pairs with the next */
     }
     if (*points) *mean = sum / (double)*points;
     free(e);

@@ -3,7 +3,8 @@
 #define MS_BAKE_SEAMS_H
 #include "microshadow.h"
 
-/* Over every edge two baked triangles share in space (the same two endpoints, bit for bit) but not in UVs:
+/* Over every edge exactly two baked triangles share in space (the same two endpoints, bit for bit) but not in UVs,
+ * where the surface is smooth (their planes within 8 degrees: across a crease the sides differ by right):
  * the irradiance's largest channel sampled bilinearly on either side at 8 points of the edge, the absolute
  * difference relative to the lightmap's largest value; its mean and max and the number of points (0, 0, 0
  * when there is no seam). 0, or -1 when out of memory. */
