@@ -802,13 +802,14 @@ MS_API int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, c
 /* ---- The bake back onto the asset: a binary glTF 2.0 (docs/baking.md, "Back onto the asset") ----
  *
  * The scene's triangles as they were baked, in one .glb: node transforms applied (the loaders flatten every
- * node tree into world positions, so each mesh of the scene file is one node with the identity transform,
+ * node tree into world positions, so each object is one node with the identity transform,
  * under a root node that carries ms_scene.origin as its translation when it is not zero: positions stay in
- * the scene's frame, as exact as the scene holds them). One glTF mesh per scene-file mesh (ms_scene.tri_mesh),
- * one primitive per material in it; vertices welded per primitive where position, normal and both UV sets
- * agree bit for bit (a chart seam or a crease keeps two vertices). Attributes: POSITION, NORMAL (the shading
- * normals where the scene has them, else the triangle's), TEXCOORD_0 (UV set 0 where the primitive has it)
- * and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv); triangles without baked UVs (a mesh
+ * the scene's frame, as exact as the scene holds them). One glTF node and mesh per object (ms_scene.tri_object:
+ * a glTF node's mesh, a file of another format; else per scene-file mesh), one primitive per material in it;
+ * vertices welded per primitive where position, normal and both UV sets agree bit for bit (a chart seam or a
+ * crease keeps two vertices). Attributes: POSITION, NORMAL (the shading normals where the scene has them,
+ * else the triangle's), TEXCOORD_0 (UV set 0 where the primitive has it, else a copy of TEXCOORD_1: glTF
+ * numbers the sets densely) and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv); triangles without baked UVs (a mesh
  * left out of the bake) form their own primitive without TEXCOORD_1 and without the lightmap. Materials carry
  * the scene's base colour, metallic, roughness, emission and alpha mode, and their base-colour, normal,
  * emissive and metallic-roughness textures (the decoded texels re-encoded as PNG: no file is read) where

@@ -293,7 +293,7 @@ static int add_maps(writer *w)
     return 0;
 }
 
-/* A triangle's group: its mesh, material and variant. */
+/* A triangle's group: its object (ms_scene.tri_object, else its mesh), material and variant. */
 typedef struct tri_key {
     uint32_t mesh, material, var, tri;
 } tri_key;
@@ -471,7 +471,7 @@ ms_status ms_bake_gltf(const ms_scene *sc, const ms_lightmap *lm, const ms_bake_
         if (!face_normal(sc->tri + 9 * t, fn)) { flat++; continue; }
         int var = all_finite(lm->uv + 6 * t, 6) ? VAR_BAKED : 0;
         if (sc->tri_uv[0] && all_finite(sc->tri_uv[0] + 6 * t, 6)) var |= VAR_UV0;
-        keys[m].mesh = sc->tri_mesh ? sc->tri_mesh[t] : 0;
+        keys[m].mesh = sc->tri_object ? sc->tri_object[t] : sc->tri_mesh ? sc->tri_mesh[t] : 0;
         keys[m].material = sc->tri_material && sc->tri_material[t] < sc->n_materials ? sc->tri_material[t] : MS_NO_MATERIAL;
         keys[m].var = (uint32_t)var;
         keys[m++].tri = (uint32_t)t;
@@ -490,8 +490,10 @@ ms_status ms_bake_gltf(const ms_scene *sc, const ms_lightmap *lm, const ms_bake_
         size_t b = a;
         while (b < m && keys[b].mesh == keys[a].mesh) b++;
         cJSON *mesh = cJSON_CreateObject();
-        char name[48];
-        snprintf(name, sizeof name, "mesh %u", keys[a].mesh);
+        char name[64];
+        if (sc->tri_object && sc->tri_mesh)
+            snprintf(name, sizeof name, "object %u (scene mesh %u)", keys[a].mesh, sc->tri_mesh[keys[a].tri]);
+        else snprintf(name, sizeof name, "mesh %u", keys[a].mesh);
         cJSON_AddStringToObject(mesh, "name", name);
         cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
         cJSON_AddItemToArray(w.meshes, mesh);
