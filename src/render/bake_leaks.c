@@ -6,7 +6,9 @@
  * As the established bakers do (Bakery's and Unity's "backface" test, Lightmass's texel validity), each
  * texel casts rays along its surface, in 8 directions of the receiver's tangent plane, as far as the
  * texel's own footprint reaches (0.75 of its world size, so every point its bilinear footprint may blend
- * is covered): when the nearest hit of a ray is the back of a triangle (the ray leaves a closed object),
+ * is covered): when the nearest hit of a ray is the back of a triangle (the ray leaves a solid: for a closed
+ * mesh the side its signed volume says is inside, whichever way its winding turns - the built-in scene's
+ * boxes are wound inward; for an open surface the side its winding declares the back),
  * the texel's point is inside that object, and it is moved to the nearest such exit, just past the face
  * (1% of the texel's size along the face's normal). The texel keeps its triangle as receiver; the point
  * stays in its plane (the rays run in it, started a hair above it so that coplanar neighbours are never
@@ -14,6 +16,7 @@
  * on a visible surface reaches it. */
 #include "bake_leaks.h"
 #include "accel/bvh.h"
+#include "accel/closed.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -37,12 +40,22 @@ int ms_bake_fix_leaks(const ms_scene *sc, int size, const float *uv, const uint3
     if (!sc->n_tris) return 0;
     ms_bvh bvh;
     if (ms_bvh_build(&bvh, sc->tri, sc->n_tris, threads)) { snprintf(err, errlen, "out of memory for the texels' BVH"); return -1; }
+    /* Which side of a face is out: a closed component's own orientation (its signed volume), whatever way its
+     * winding turns; an open surface's winding, as the asset declares its front. */
+    ms_closed closed;
+    if (ms_closed_find(sc->tri, sc->n_tris, &closed)) {
+        ms_bvh_free(&bvh);
+        snprintf(err, errlen, "out of memory for the texels' leak test");
+        return -1;
+    }
     const size_t np = (size_t)size * size;
     size_t count = 0;
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads > 0 ? threads : omp_get_num_procs()) reduction(+ : count)
     for (size_t i = 0; i < np; i++) {
         const uint32_t t = texel_tri[i];
         if (t == MS_NO_TRIANGLE) continue;
+        /* a receiver wound into its own solid faces the inside: nothing there to move it out to */
+        if (closed.component[t] != MS_OPEN_COMPONENT && closed.outward[closed.component[t]] < 0) continue;
         const float r = 0.75f * texel_world_size(sc->tri + 9 * t, uv + 6 * t, size);
         if (!(r > 0.0f) || !isfinite(r)) continue;
         const float *p = position + 3 * i, *n = normal + 3 * i;
@@ -75,7 +88,9 @@ int ms_bake_fix_leaks(const ms_scene *sc, int size, const float *uv, const uint3
             float nh[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0] };
             const float ln = sqrtf(nh[0] * nh[0] + nh[1] * nh[1] + nh[2] * nh[2]);
             if (!(ln > 0.0f)) continue;
-            for (int d = 0; d < 3; d++) nh[d] /= ln;
+            const uint32_t src = bvh.tri_source[h.prim], comp = closed.component[src];
+            const float out = comp == MS_OPEN_COMPONENT ? 1.0f : (float)closed.outward[comp];
+            for (int d = 0; d < 3; d++) nh[d] *= out / ln;
             const float facing = nh[0] * ray.d[0] + nh[1] * ray.d[1] + nh[2] * ray.d[2];
             if (facing <= 0.0f) continue;   /* the front of a face: the texel is outside it */
             best = h.t;
@@ -90,6 +105,7 @@ int ms_bake_fix_leaks(const ms_scene *sc, int size, const float *uv, const uint3
         }
     }
     ms_bvh_free(&bvh);
+    ms_closed_free(&closed);
     *moved = count;
     return 0;
 }
