@@ -270,6 +270,14 @@ typedef struct ms_scene {
     /* The world position of the local frame's origin (see above): 0, 0, 0 unless ms_scene_load moved a
      * distant scene. */
     double origin[3];
+    /* Objects (NULL where not known: one per mesh, tri_mesh): tri_object[i] is the object triangle i came
+     * from, numbered 0 .. n_objects-1 across the scene: each glTF node with a mesh, each file of another
+     * format. A baker gives each object its own region of the lightmap when their UVs overlap. */
+    uint32_t *tri_object;
+    size_t n_objects;
+    /* Per scene-file mesh (n_meshes entries, NULL: all 1): its texel density weight in bakes (scene file
+     * "lightmap": {"scale": s}), 0 for "lightmap": false (not baked; it still casts shadows). */
+    float *mesh_lightmap_scale;
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX
@@ -746,6 +754,10 @@ MS_API ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, 
  * ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
  * E_unshadowed * S * emission (ms_light_irradiance). Texels no triangle touches are filled by dilation
  * from their neighbours (across chart seams) so that bilinear lookups do not bleed black. */
+/* Called at the end of each pass of a bake, from the calling thread, with its name ("UVs", "texels", "leak
+ * test", "acceleration structure", "light 1/3", ..., "irradiance, dilation and seams") and its seconds: one
+ * progress line per pass for a command line (the points' progress callback goes on within the lights). */
+typedef void (*ms_bake_pass_fn)(void *user, const char *pass, double seconds);
 typedef struct ms_bake_options {
     ms_points_options points;  /* method, pattern, samples, threads, seed, isa, progress; zero: defaults */
     int size;                  /* texels per side; 0: 1024 (at most MS_MAX_IMAGE_SIZE) */
@@ -753,7 +765,10 @@ typedef struct ms_bake_options {
                                 * lacks it are unwrapped by xatlas into the free space of one atlas with
                                 * them (all of them if no mesh has the set); -1: xatlas for every triangle */
     int dilate;                /* texels of dilation; 0: 4; -1: none */
-    int padding;               /* texels between xatlas charts; 0: 2 */
+    int padding;               /* texels between charts (xatlas's and the lightmap's regions); 0: 4 */
+    int no_leak_fix;           /* 1: texels inside geometry keep their points (docs/baking.md, "Quality"); 0: moved */
+    ms_bake_pass_fn pass;      /* may be NULL */
+    void *pass_user;
 } ms_bake_options;
 
 typedef struct ms_lightmap {
@@ -771,6 +786,14 @@ typedef struct ms_lightmap {
     size_t texels;             /* texels on triangles */
     size_t unwrapped_tris;     /* triangles whose UVs xatlas made */
     double unwrap_s, raster_s; /* seconds in xatlas and in the texel rasterization */
+    size_t texels_moved;       /* texels whose centre lay inside geometry, moved to the visible side */
+    double leak_s;             /* seconds finding them */
+    /* Chart seams (ms_bake_finish): where two triangles share an edge in space but not in UVs and their planes
+     * meet within 8 degrees (a smooth surface; across a crease the sides differ by right), the lightmap
+     * sampled bilinearly on both sides at 8 points of the edge; the difference of the irradiance's largest
+     * channel relative to the lightmap's largest value, mean and max over the points, and their number. */
+    double seam_mean, seam_max;
+    size_t seam_points;
 } ms_lightmap;
 
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
@@ -802,6 +825,41 @@ MS_API ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *op
  * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
  * and V. An ms_output_write_fn; ends in .exr. */
 MS_API int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+
+/* ---- The bake back onto the asset: a binary glTF 2.0 (docs/baking.md, "Back onto the asset") ----
+ *
+ * The scene's triangles as they were baked, in one .glb: node transforms applied (the loaders flatten every
+ * node tree into world positions, so each object is one node with the identity transform,
+ * under a root node that carries ms_scene.origin as its translation when it is not zero: positions stay in
+ * the scene's frame, as exact as the scene holds them). One glTF node and mesh per object (ms_scene.tri_object:
+ * a glTF node's mesh, a file of another format; else per scene-file mesh), one primitive per material in it;
+ * vertices welded per primitive where position, normal and both UV sets agree bit for bit (a chart seam or a
+ * crease keeps two vertices). Attributes: POSITION, NORMAL (the shading normals where the scene has them,
+ * else the triangle's), TEXCOORD_0 (UV set 0 where the primitive has it, else a copy of TEXCOORD_1: glTF
+ * numbers the sets densely) and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv); triangles without baked UVs (a mesh
+ * left out of the bake) form their own primitive without TEXCOORD_1 and without the lightmap. Materials carry
+ * the scene's base colour, metallic, roughness, emission and alpha mode, and their base-colour, normal,
+ * emissive and metallic-roughness textures (the decoded texels re-encoded as PNG: no file is read) where
+ * those use UV set 0. Every baked material references:
+ *   - the lightmap, extension MOZ_lightmap {index, texCoord: 1, intensity}: the irradiance summed over the
+ *     lights (ms_lightmap.frame.rgb), linear (no sRGB curve), divided by its largest value I over the texels
+ *     and channels, as an 8-bit RGB PNG; intensity = I restores it (E = texel / 255 * I, within half a step,
+ *     I / 510). Texels neither a triangle nor dilation reached are 0;
+ *   - the shadowmask in extras.shadowmask {index, texCoord: 1, channels: [{channel, light, shape}]}: S of
+ *     lights 0..3 in R, G, B, A of an 8-bit RGBA PNG (linear, S = byte / 255; unused channels 0, alpha 255
+ *     when fewer than 4 lights), a warning naming the lights left out beyond 4.
+ * Zero-area triangles (no normal) are left out with a warning. */
+typedef struct ms_bake_gltf_options {
+    int no_textures;     /* 1: materials keep their factors, no embedded material textures */
+    int no_shadowmask;   /* 1: no shadowmask image */
+} ms_bake_gltf_options;
+/* The .glb of scene and its lightmap lm (ms_bake of that scene) into a malloc'ed buffer *glb of *len bytes
+ * (free it). opt may be NULL. MS_OK, or an error with *glb = NULL. */
+MS_API ms_status ms_bake_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                              unsigned char **glb, size_t *len, char *err, size_t errlen);
+/* The same written to path (ending in .glb), all or nothing (staged beside it and renamed: ms_outputs_write). */
+MS_API ms_status ms_bake_write_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                                    const char *path, char *err, size_t errlen);
 
 #ifdef __cplusplus
 }

@@ -5,17 +5,26 @@ set -euo pipefail
 # build and the fuzzers of .ci/run. python3-numpy: the Python module's tests (python/, run by ctest); python3-pip
 # and python3-setuptools: its package (python/pyproject.toml) installed offline by test_python_package.
 # libopenmpi-dev and openmpi-bin: the CLI's optional MPI mode (-DMS_MPI=ON; .ci/run builds and tests it).
+# nodejs, npm and chromium: the baked glTF's tests (the Khronos validator, the three.js viewer in headless
+# chromium); their npm packages (viewer/package.json: three, gltf-validator, puppeteer-core) go into
+# viewer/node_modules, never committed.
 pkgs=(build-essential cmake pkg-config libcjson-dev libpng-dev libturbojpeg0-dev libopenexr-dev libembree-dev
       libcmocka-dev gnuplot-nox clang libclang-rt-dev libomp-dev python3-numpy python3-pip python3-setuptools
-      libopenmpi-dev openmpi-bin)
+      libopenmpi-dev openmpi-bin nodejs npm chromium)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
-echo "installing: ${missing[*]}" >&2
-sudo=""
-[ "$(id -u)" -eq 0 ] || sudo="sudo"
-export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -qq
-$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "installing: ${missing[*]}" >&2
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+# The viewer's npm packages, pinned by viewer/package-lock.json (skipped offline: those tests then skip).
+viewer="$(cd "$(dirname "$0")/.." && pwd)/viewer"
+if command -v npm >/dev/null && [ ! -d "$viewer/node_modules/gltf-validator" ]; then
+  (cd "$viewer" && npm ci --no-audit --no-fund) || echo "install-deps: npm ci in $viewer failed: the glTF validator and viewer tests will skip" >&2
+fi

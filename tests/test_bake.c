@@ -4,8 +4,8 @@
  *     from the hit point and the two sample patterns allow (built-in scene, and the shared Quad);
  *   - analytic texel positions: a glTF ground quad with TEXCOORD_1 mapping (u, v) to (x, z) linearly
  *     bakes into exactly those UVs, and every texel whose centre lies inside it is evaluated at the
- *     point the linear map gives; an occluder without TEXCOORD_1 gets xatlas UVs in the lightmap's
- *     bottom-left quarter, the file's charts the top half; OBJ texture coordinates load as UV set 0;
+ *     point the linear map gives; an occluder without TEXCOORD_1 gets xatlas UVs outside the region the
+ *     file's charts are scaled (one factor) and offset into; OBJ texture coordinates load as UV set 0;
  *   - xatlas charts do not overlap: no texel centre lies inside two triangles' UV images;
  *   - dilation fills the texels around charts from their neighbours and leaves the rest at -1;
  *   - the CLI writes the EXR and the PNG together and refuses bad options with exit 2. */
@@ -238,27 +238,35 @@ static void test_gltf_uvs(void **st)
     ms_lightmap lm;
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
     assert_int_equal(lm.unwrapped_tris, 2);
-    long inside = 0;
+    /* The ground keeps the file's charts, scaled by one k and offset (its region); the occluder's xatlas
+     * charts lie outside that region. */
+    double lo[2] = { 1, 1 }, hi[2] = { 0, 0 };
+    for (int t = 0; t < 4; t++)
+        if (sc.tri[9 * t + 1] == 0.0f)
+            for (int k = 0; k < 6; k++) { lo[k & 1] = fmin(lo[k & 1], lm.uv[6 * t + k]); hi[k & 1] = fmax(hi[k & 1], lm.uv[6 * t + k]); }
+    const double kscale = hi[0] - lo[0];
+    assert_true(kscale > 0.3 && fabs((hi[1] - lo[1]) - kscale) < 1e-6);   /* the file's charts span [0,1]^2: one scale */
     for (int t = 0; t < 4; t++) {
         const int ground = sc.tri[9 * t + 1] == 0.0f;
         for (int k = 0; k < 3; k++) {
             const float *u = lm.uv + 6 * t + 2 * k;
-            if (ground) {   /* the file's UVs, v into the top half */
-                assert_true(u[0] == sc.tri_uv[1][6 * t + 2 * k]);
-                assert_true(u[1] == 0.5f * sc.tri_uv[1][6 * t + 2 * k + 1]);
-            } else {        /* xatlas, bottom-left quarter */
-                assert_true(u[0] >= 0.0f && u[0] <= 0.5f);
-                assert_true(u[1] >= 0.5f && u[1] <= 1.0f);
+            if (ground) {
+                assert_true(fabs(u[0] - (lo[0] + kscale * sc.tri_uv[1][6 * t + 2 * k])) < 1e-6);
+                assert_true(fabs(u[1] - (lo[1] + kscale * sc.tri_uv[1][6 * t + 2 * k + 1])) < 1e-6);
+            } else {
+                assert_true(u[0] >= 0.0f && u[0] <= 1.0f && u[1] >= 0.0f && u[1] <= 1.0f);
+                assert_true(u[0] <= lo[0] || u[0] >= hi[0] || u[1] <= lo[1] || u[1] >= hi[1]);
             }
         }
     }
+    long inside = 0;
     /* Texels inside the ground: evaluated where the linear map puts their centre. */
     for (int y = 0; y < size; y++)
         for (int x = 0; x < size; x++) {
             const size_t i = (size_t)y * size + x;
             const uint32_t t = lm.triangle[i];
             if (t == MS_NO_TRIANGLE || sc.tri[9 * t + 1] != 0.0f || !centre_inside(lm.uv + 6 * t, size, x, y, 1e-3)) continue;
-            const double u = (x + 0.5) / size, v = 2.0 * (y + 0.5) / size;
+            const double u = ((x + 0.5) / size - lo[0]) / kscale, v = ((y + 0.5) / size - lo[1]) / kscale;
             assert_true(fabs(lm.position[3 * i] - (u * 8 - 4)) < 1e-4);
             assert_true(fabs(lm.position[3 * i + 1]) < 1e-6);
             assert_true(fabs(lm.position[3 * i + 2] - (v * 8 - 4)) < 1e-4);
@@ -266,13 +274,13 @@ static void test_gltf_uvs(void **st)
             assert_true(lm.frame.vis[i] >= 0.0f && lm.frame.front[i] > 0);
             inside++;
         }
-    printf("glTF: %ld ground texels at their analytic positions\n", inside);
-    assert_true(inside > size * size / 2 - 4 * size);
+    printf("glTF: %ld ground texels at their analytic positions (region scale %.3f)\n", inside, kscale);
+    assert_true(inside > (long)(kscale * kscale * size * size) - 4 * size);
     /* The occluder (xatlas) got texels too, and the texel under the occluder's centre is dark. */
     long occl = 0;
     for (size_t i = 0; i < (size_t)size * size; i++) occl += lm.triangle[i] != MS_NO_TRIANGLE && sc.tri[9 * lm.triangle[i] + 1] != 0.0f;
     assert_true(occl > 10);
-    const size_t below = (size_t)(size / 4) * size + size / 2;   /* u = v = 0.5 of the ground: (0, 0, 0) */
+    const size_t below = (size_t)((lo[1] + 0.5 * kscale) * size) * size + (size_t)((lo[0] + 0.5 * kscale) * size);   /* (0, 0, 0) */
     assert_true(lm.frame.vis[below] == 0.0f);
     ms_lightmap_free(&lm);
     ms_scene_free(&sc);

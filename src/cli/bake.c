@@ -30,9 +30,13 @@ static void usage(FILE *f)
         "  --vis OUT.pfm|.exr  float V (several lights: an .exr has V0, V1, ..., a .pfm light 0)\n"
         "  --shadow OUT.pfm|.exr  float S, likewise\n"
         "  --png OUT.png       tone-mapped preview\n"
+        "  --gltf OUT.glb      the scene's meshes and materials with TEXCOORD_1 = the baked UVs, the lightmap\n"
+        "                      (MOZ_lightmap: linear 8-bit, intensity = its scale) and the shadowmask (S of\n"
+        "                      lights 0-3 in R, G, B, A; the materials' extras name them), one binary glTF\n"
         "  --stats OUT.json    timings and counters\n"
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
-        "  --padding N         texels between xatlas charts (default 2)\n"
+        "  --padding N         texels between charts and regions (default 4)\n"
+        "  --no-leak-fix       keep the points of texels whose centre lies inside geometry\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I, --max-memory SIZE   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture)\n"
@@ -43,23 +47,50 @@ static void usage(FILE *f)
         "  --help\n", MS_MAX_UV_SETS - 1);
 }
 
+/* --gltf: the glb is made whole before the outputs are written (it needs the scene and the lightmap, which an
+ * ms_output_write_fn is not given), then written as they are, all or nothing with the others. */
+static const unsigned char *g_glb;
+static size_t g_glb_len;
+
+static int write_glb(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
+{
+    (void)f;
+    if (fwrite(g_glb, 1, g_glb_len, out) == g_glb_len) return 0;
+    snprintf(err, errlen, "%s: write failed", name);
+    return -1;
+}
+
+/* Within the lights' pass: a percentage on the terminal, overwritten by the pass's own line at its end. */
 static int progress_bar(void *user, double frac)
 {
     int *last = user;
     int pct = (int)(frac * 100.0);
-    if (pct != *last) {
+    if (pct != *last && pct < 100) {
         *last = pct;
-        fprintf(stderr, "\rbaking %3d%%", pct);
-        if (pct >= 100) fputc('\n', stderr);
+        fprintf(stderr, "\rbake: lights %3d%%", pct);
         fflush(stderr);
     }
     return 0;
 }
 
+/* One line per pass of the bake (ms_bake_options.pass). */
+static void pass_line(void *user, const char *pass, double seconds)
+{
+    (void)user;
+    fprintf(stderr, "\r\033[Kbake: %s: %.3f s\n", pass, seconds);
+    fflush(stderr);
+}
+
+static void pass_line_plain(void *user, const char *pass, double seconds)
+{
+    (void)user;
+    fprintf(stderr, "bake: %s: %.3f s\n", pass, seconds);
+}
+
 int ms_cli_bake(int argc, char **argv)
 {
     enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY };
+           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -70,6 +101,7 @@ int ms_cli_bake(int argc, char **argv)
         { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
         { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
         { "verbose", no_argument, 0, O_VERBOSE }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
+        { "gltf", required_argument, 0, O_GLTF }, { "no-leak-fix", no_argument, 0, O_NO_LEAK_FIX },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -81,12 +113,14 @@ int ms_cli_bake(int argc, char **argv)
     static const char *const exr_suffix[] = { ".exr", NULL };
     static const char *const png_suffix[] = { ".png", NULL };
     static const char *const json_suffix[] = { ".json", NULL };
+    static const char *const glb_suffix[] = { ".glb", NULL };
     ms_output outs[] = {
         { "-o", "lightmap.exr", ms_exr_write_stream, exr_suffix },
         { "--png", NULL, ms_png_write_stream, png_suffix },
         { "--stats", NULL, ms_stats_write_stream, json_suffix },
         { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
         { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
+        { "--gltf", NULL, write_glb, glb_suffix },   /* g_glb: made by ms_bake_gltf after the bake */
     };
     enum { N_OUTS = sizeof outs / sizeof outs[0] };
     ms_bake_options bo;
@@ -134,6 +168,8 @@ int ms_cli_bake(int argc, char **argv)
         case O_STATS: outs[2].path = optarg; break;
         case O_VIS: outs[3].path = optarg; break;
         case O_SHADOW: outs[4].path = optarg; break;
+        case O_GLTF: outs[5].path = optarg; break;
+        case O_NO_LEAK_FIX: bo.no_leak_fix = 1; break;
         case O_QUIET: quiet = 1; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &bo.points.max_memory)) return EXIT_BAD_INPUT; break;
         case O_VERBOSE: ms_set_warning_verbose(1); break;
@@ -179,7 +215,12 @@ int ms_cli_bake(int argc, char **argv)
     } else
 #endif
     {
-        if (!quiet && isatty(STDERR_FILENO)) { bo.points.progress = progress_bar; bo.points.progress_user = &last; }
+        if (!quiet && isatty(STDERR_FILENO)) {
+            bo.points.progress = progress_bar;
+            bo.points.progress_user = &last;
+            bo.pass = pass_line;
+        } else if (!quiet)
+            bo.pass = pass_line_plain;
         st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
     }
     if (st) {
@@ -187,16 +228,31 @@ int ms_cli_bake(int argc, char **argv)
         ms_scene_free(&scene);
         return st == MS_ERR_NO_MEMORY ? 1 : EXIT_BAD_INPUT;
     }
-    int rc = ms_outputs_write(&lm.frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
-    if (rc) fprintf(stderr, "microshadow bake: %s\n", err);
+    unsigned char *glb = NULL;
+    int rc = 0;
+    if (outs[5].path) {
+        st = ms_bake_gltf(&scene, &lm, NULL, &glb, &g_glb_len, err, sizeof err);
+        if (st) {
+            fprintf(stderr, "microshadow bake: %s: %s\n", outs[5].path, err);
+            rc = st == MS_ERR_NO_MEMORY ? 1 : EXIT_BAD_INPUT;
+        }
+        g_glb = glb;
+    }
+    if (!rc) {
+        rc = ms_outputs_write(&lm.frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
+        if (rc) fprintf(stderr, "microshadow bake: %s\n", err);
+    }
+    free(glb);
     if (!quiet && !rc) {
         const ms_stats *s = &lm.frame.stats;
         const int nl = lm.frame.n_lights > 1 ? lm.frame.n_lights : 1;
         fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
-                "(rasterized in %.3fs), %d light%s, %d samples, method %s, %d threads: shadow %.3fs (%.0f texels/s), total %.3fs -> %s\n",
+                "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
+                "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, max %.4f of the largest irradiance -> %s%s%s\n",
                 scene_path ? scene_path : "built-in scene", s->triangles, lm.unwrapped_tris, lm.unwrap_s, lm.frame.width,
-                lm.frame.height, lm.texels, lm.raster_s, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads, s->shadow_s,
-                s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, outs[0].path);
+                lm.frame.height, lm.texels, lm.raster_s, lm.texels_moved, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads,
+                s->shadow_s, s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, lm.seam_points, lm.seam_mean,
+                lm.seam_max, outs[0].path, outs[5].path ? ", " : "", outs[5].path ? outs[5].path : "");
     }
     ms_lightmap_free(&lm);
     ms_scene_free(&scene);

@@ -25,6 +25,7 @@ static const layout_row rows[] = {
     STRUCT(ms_scene), FIELD(ms_scene, tri), FIELD(ms_scene, n_tris), FIELD(ms_scene, camera), FIELD(ms_scene, light),
     FIELD(ms_scene, samples), FIELD(ms_scene, load_s), FIELD(ms_scene, tri_mesh), FIELD(ms_scene, tri_uv),
     FIELD(ms_scene, n_meshes), FIELD(ms_scene, lights), FIELD(ms_scene, n_lights), FIELD(ms_scene, origin),
+    FIELD(ms_scene, tri_object), FIELD(ms_scene, n_objects), FIELD(ms_scene, mesh_lightmap_scale),
     STRUCT(ms_scene_load_options), FIELD(ms_scene_load_options, allow_outside_paths),
     STRUCT(ms_render_options), FIELD(ms_render_options, method), FIELD(ms_render_options, pattern),
     FIELD(ms_render_options, samples), FIELD(ms_render_options, width), FIELD(ms_render_options, height),
@@ -55,10 +56,14 @@ static const layout_row rows[] = {
     FIELD(ms_points_options, embree_mode), FIELD(ms_points_options, embree_filter),
     FIELD(ms_points_options, max_memory),
     STRUCT(ms_bake_options), FIELD(ms_bake_options, points), FIELD(ms_bake_options, size), FIELD(ms_bake_options, uv_set),
-    FIELD(ms_bake_options, dilate), FIELD(ms_bake_options, padding),
+    FIELD(ms_bake_options, dilate), FIELD(ms_bake_options, padding), FIELD(ms_bake_options, no_leak_fix),
+    FIELD(ms_bake_options, pass), FIELD(ms_bake_options, pass_user),
     STRUCT(ms_lightmap), FIELD(ms_lightmap, frame), FIELD(ms_lightmap, position), FIELD(ms_lightmap, normal),
     FIELD(ms_lightmap, triangle), FIELD(ms_lightmap, uv), FIELD(ms_lightmap, n_tris), FIELD(ms_lightmap, texels),
     FIELD(ms_lightmap, unwrapped_tris), FIELD(ms_lightmap, unwrap_s), FIELD(ms_lightmap, raster_s),
+    FIELD(ms_lightmap, texels_moved), FIELD(ms_lightmap, leak_s), FIELD(ms_lightmap, seam_mean), FIELD(ms_lightmap, seam_max),
+    FIELD(ms_lightmap, seam_points),
+    STRUCT(ms_bake_gltf_options), FIELD(ms_bake_gltf_options, no_textures), FIELD(ms_bake_gltf_options, no_shadowmask),
 };
 
 int ms_layout(const char *structure, const char *field, size_t *offset, size_t *size)

@@ -4,7 +4,9 @@
  * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
 #include "microshadow.h"
 #include "points.h"
-#include "lightmap_unwrap.h"
+#include "bake_uvs.h"
+#include "bake_leaks.h"
+#include "bake_seams.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -63,39 +65,18 @@ static void closest_on_triangle(const double p[2], const double a[2], const doub
     w[0] = 1.0 - w[1] - w[2];
 }
 
-/* The UVs baked into: the scene's set where a triangle has it, xatlas where not. */
+/* The UVs baked into (bake_uvs.c): the scene's set, per-object regions, xatlas for the rest. */
 static ms_status choose_uvs(const ms_scene *sc, const ms_bake_options *o, int size, int padding, ms_lightmap *lm,
                             char *err, size_t errlen)
 {
     const size_t n = sc->n_tris;
     lm->uv = malloc((n ? n : 1) * 6 * sizeof(float));
-    uint8_t *want = calloc(n ? n : 1, 1);
-    if (!lm->uv || !want) { free(want); snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); return MS_ERR_NO_MEMORY; }
-    const float *set = o->uv_set >= 0 ? sc->tri_uv[o->uv_set] : NULL;
-    size_t missing = 0;
-    for (size_t i = 0; i < n; i++) {
-        int ok = set != NULL;
-        for (int k = 0; k < 6 && ok; k++) ok = isfinite(set[6 * i + k]);
-        if (ok) memcpy(lm->uv + 6 * i, set + 6 * i, 6 * sizeof(float));
-        else { want[i] = 1; missing++; }
-    }
+    if (!lm->uv) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); return MS_ERR_NO_MEMORY; }
     const double t0 = omp_get_wtime();
-    int rc = 0;
-    if (missing == n) rc = ms_lightmap_unwrap(sc->tri, n, want, size, padding, lm->uv, err, errlen);
-    else if (missing) {
-        /* Some meshes have the set, some not: the file's charts keep the top half of the lightmap
-         * (v halved), xatlas packs the rest into the bottom-left quarter (docs/baking.md). */
-        rc = ms_lightmap_unwrap(sc->tri, n, want, size / 2, padding, lm->uv, err, errlen);
-        for (size_t i = 0; i < n && !rc; i++)
-            for (int k = 0; k < 3; k++) {
-                float *u = lm->uv + 6 * i + 2 * k;
-                if (want[i]) { u[0] *= 0.5f; u[1] = 0.5f + 0.5f * u[1]; }
-                else u[1] *= 0.5f;
-            }
-    }
+    ms_bake_uv_report rep;
+    const int rc = ms_bake_uvs(sc, o->uv_set, size, padding, lm->uv, &rep, err, errlen);
     lm->unwrap_s = omp_get_wtime() - t0;
-    lm->unwrapped_tris = missing;
-    free(want);
+    lm->unwrapped_tris = rep.unwrapped;
     return rc ? MS_ERR_INVALID : MS_OK;
 }
 
@@ -269,11 +250,20 @@ ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     ms_status bst = bake_budget(scene, o, size, 0, NULL, err, errlen);
     if (bst) return bst;
-    const int padding = o->padding > 0 ? o->padding : 2;
+    const int padding = o->padding > 0 ? o->padding : 4;
     ms_status st = choose_uvs(scene, o, size, padding, out, err, errlen);
+    if (!st && o->pass) o->pass(o->pass_user, "UVs", out->unwrap_s);
     const double t_raster = omp_get_wtime();
     if (!st) st = rasterize(scene, size, out, err, errlen);
     out->raster_s = omp_get_wtime() - t_raster;
+    if (!st && o->pass) o->pass(o->pass_user, "texels", out->raster_s);
+    const double t_leak = omp_get_wtime();
+    if (!st && !o->no_leak_fix &&
+        ms_bake_fix_leaks(scene, size, out->uv, out->triangle, out->position, out->normal, o->points.threads, &out->texels_moved,
+                          err, errlen))
+        st = MS_ERR_NO_MEMORY;
+    out->leak_s = omp_get_wtime() - t_leak;
+    if (!st && o->pass && !o->no_leak_fix) o->pass(o->pass_user, "leak test", out->leak_s);
     out->n_tris = scene->n_tris;
     const size_t nt = (size_t)size * size;
     size_t nl;
@@ -382,8 +372,14 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
             ms_stats one;
             memset(&one, 0, sizeof one);
             bp.light = l;
+            const double t_light = omp_get_wtime();
             st = ms_visibility_points_local(accel, &lights[l], &pts, &po, vl + l * m, sl + l * m, fl + l * m, &one, err, errlen);
             if (!st) add_stats(&sum, &one, l == 0);
+            if (!st && o->pass) {
+                char name[48];
+                snprintf(name, sizeof name, "light %zu/%zu", l + 1, nl);
+                o->pass(o->pass_user, name, omp_get_wtime() - t_light);
+            }
         }
         if (!st) {
             for (size_t l = 0; l < nl; l++)
@@ -412,6 +408,7 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     memset(&zero, 0, sizeof zero);
     const ms_bake_options *o = opt_in ? opt_in : &zero;
     const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
+    const double t_finish = omp_get_wtime();
     ms_frame *f = &lm->frame;
     const int size = f->width;
     const size_t nt = (size_t)size * size, m = lm->texels;
@@ -473,12 +470,17 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     free(lum);
     if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); return MS_ERR_NO_MEMORY; }
+    if (ms_bake_seams(scene, lm, &lm->seam_mean, &lm->seam_max, &lm->seam_points)) {
+        snprintf(err, errlen, "out of memory measuring the lightmap's seams");
+        return MS_ERR_NO_MEMORY;
+    }
     /* A NaN or infinite texel is an error, never a lightmap (microshadow.h: MS_MAX_RADIANCE). */
     if (ms_frame_check_finite(f, "the lightmap", err, errlen)) return MS_ERR_INVALID;
+    if (o->pass) o->pass(o->pass_user, "irradiance, dilation and seams", omp_get_wtime() - t_finish);
     f->stats.width = f->stats.height = size;
     f->stats.triangles = scene->n_tris;
     f->stats.load_s = scene->load_s;
-    f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s;
+    f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + lm->leak_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s;
     return MS_OK;
 }
 
@@ -502,8 +504,10 @@ ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_op
     if (st) return st;
     ms_accel *own = NULL;
     if (!accel) {
+        const double t_accel = omp_get_wtime();
         st = ms_accel_build(scene, opt_in ? opt_in->points.threads : 0, &own, err, errlen);
         accel = own;
+        if (!st && o->pass) o->pass(o->pass_user, "acceleration structure", omp_get_wtime() - t_accel);
     }
     if (!st) st = ms_bake_rows(accel, opt_in, out, 0, out->frame.height, err, errlen);
     if (!st) st = ms_bake_finish(scene, opt_in, out, err, errlen);

@@ -279,6 +279,8 @@ uint64_t ms_bake_need(const ms_bake_shape *s, ms_need *need)
      * per-light V, S, front (10) and the points call's Morton order (16). */
     ms_need_add(need, "texel points", mul(P, 56u + 10u * (uint64_t)s->nl));
     if (s->build_accel) ms_need_add(need, "BVH and triangles", ms_accel_need(n));
+    /* ms_bake_layout's leak test (bake_leaks.c): a BVH and the closed components, freed before the rows */
+    ms_need_add(need, "texel leak test", ms_accel_need(n) + closed_find_bytes(n));
     ms_need_add(need, "per-call triangle copies", s->whole_tri_copy ? mul(n, TRI_BYTES + HPC_ORDER_PER_TRI) : 0);
     ms_need_add(need, "threads", mul((uint64_t)(s->threads > 0 ? s->threads : 1), PER_THREAD + 512u * mw8) + FIXED);
     return need->total;

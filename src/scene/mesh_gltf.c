@@ -530,6 +530,7 @@ static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup
             float local[16], world[16];
             cgltf_node_transform_local(it.node, local);
             mat4_mul(world, it.parent, local);
+            if (it.node->mesh) ms_soup_new_object(soup);   /* each node's mesh is an object (lightmap UVs per object) */
             if (it.node->mesh)
                 for (size_t p = 0; p < it.node->mesh->primitives_count && !rc; p++)
                     rc = emit_primitive(d, mat_of, &it.node->mesh->primitives[p], world, soup, added, max_tris, path, err,

@@ -177,7 +177,13 @@ void ms_soup_transform(ms_tri_soup *soup, size_t from, size_t to, const double m
 
 int ms_soup_copy_range(ms_tri_soup *soup, size_t from, size_t to)
 {
+    /* the copy's objects are new ones, in the same order as the original's */
+    uint32_t lo = UINT32_MAX;
+    for (size_t t = from; t < to; t++) lo = soup->object[t] < lo ? soup->object[t] : lo;
+    ms_soup_new_object(soup);
+    const uint32_t base = soup->cur_object;
     for (size_t t = from; t < to; t++) {
+        soup->cur_object = base + (soup->object[t] - lo);
         float v[9], n[9], uv[MS_SOUP_UV_SETS][6];
         double vd[9];
         const float *uvp[MS_SOUP_UV_SETS] = { NULL };
@@ -188,6 +194,7 @@ int ms_soup_copy_range(ms_tri_soup *soup, size_t from, size_t to)
             if (soup->uv[s]) { memcpy(uv[s], soup->uv[s] + 6 * t, sizeof uv[s]); uvp[s] = uv[s]; }
         const uint32_t mat = soup->material ? soup->material[t] : MS_NO_MATERIAL;
         if (ms_soup_push_d(soup, v, vd, uvp, mat, soup->normal ? n : NULL)) return -1;
+        if (soup->cur_object + 1 > soup->n_objects) soup->n_objects = soup->cur_object + 1;
         if (t < soup->tangent_n) {   /* copied first: setting them may move the array */
             float tg[12];
             memcpy(tg, soup->tangent + 12 * t, sizeof tg);

@@ -69,6 +69,8 @@ int ms_scene_default(ms_scene *out)
     out->n_tris = s.n;
     out->tri_mesh = s.mesh;
     out->n_meshes = 1;
+    out->tri_object = s.object;
+    out->n_objects = s.n_objects;
     out->camera = (ms_camera){ { 0.0f, 6.5f, 10.0f }, { 0.0f, 0.6f, 0.0f }, { 0.0f, 1.0f, 0.0f }, 50.0f, 1024, 768, MS_CAMERA_PINHOLE, 0.0f, 0.0f };
     out->light = (ms_light){ { -1.25f, 6.0f, -1.25f }, { 2.5f, 0.0f, 0.0f }, { 0.0f, 0.0f, 2.5f },
                              { MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };

@@ -32,6 +32,11 @@ typedef struct ms_tri_soup {
     uint32_t *mesh;
     float *uv[MS_SOUP_UV_SETS];
     uint32_t cur_mesh;
+    /* The object each triangle came from (cur_object at the push): a glTF node's mesh, or a whole file of
+     * another format; numbered across the scene (ms_scene.tri_object). ms_soup_new_object starts one. */
+    uint32_t *object;
+    uint32_t cur_object, n_objects;
+    int object_used;   /* cur_object has triangles */
     /* Surfaces (material.c): per-triangle material index (MS_NO_MATERIAL) and vertex normals (9 floats,
      * NaN), each appearing with the first triangle that has one; the materials and textures loaded. */
     uint32_t *material;
@@ -55,6 +60,8 @@ int ms_soup_mikktspace(ms_tri_soup *soup, size_t first, size_t count, int set);
 /* The tangent array for all soup->n triangles (NaN-filled past the last set), handed over (NULL: none). */
 float *ms_soup_take_tangents(ms_tri_soup *soup);
 void ms_soup_free(ms_tri_soup *soup);
+/* Starts a new object for the triangles pushed from now on (the current one goes on while it has none). */
+void ms_soup_new_object(ms_tri_soup *soup);
 /* The same push with a material index (MS_NO_MATERIAL: none) and three vertex normals (or NULL). */
 int ms_soup_push_full(ms_tri_soup *soup, const float v[9], const float *const uv[MS_SOUP_UV_SETS],
                       uint32_t material, const float *normal9);

@@ -47,7 +47,8 @@ static _Thread_local const char *const *camera_keys = camera_keys_pinhole;
 static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t", "center", "normal", "radius",
                                           "emission", "power", "lumens", "texture", NULL };
 static const char *const render_keys[] = { "samples", NULL };
-static const char *const mesh_keys[] = { "file", "transform", NULL };
+static const char *const mesh_keys[] = { "file", "transform", "lightmap", NULL };
+static const char *const mesh_lightmap_keys[] = { "scale", NULL };
 
 /* Warnings wait until the scene loaded: a failed load prints its one error line only. */
 #define MAX_WARNINGS 16
@@ -614,7 +615,7 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     const cJSON *m;
     /* Per entry: its triangles [from, to) and transform, applied once every file is read; a file listed
      * again (same path) is copied from its first entry rather than read again. */
-    struct { char *path; size_t from, to; int has_xf; double xf[12]; } *ent = calloc((size_t)cJSON_GetArraySize(meshes), sizeof *ent);
+    struct { char *path; size_t from, to; int has_xf; double xf[12]; float lightmap_scale; } *ent = calloc((size_t)cJSON_GetArraySize(meshes), sizeof *ent);
     if (!ent) { snprintf(err, errlen, "%s: out of memory", json_path); free(dircopy); goto done; }
     cJSON_ArrayForEach(m, meshes) {
         const cJSON *file = cJSON_IsObject(m) ? cJSON_GetObjectItemCaseSensitive(m, "file") : NULL;
@@ -635,7 +636,29 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         const cJSON *xf = cJSON_GetObjectItemCaseSensitive(m, "transform");
         if (xf && ms_mesh_transform_parse(xf, objname, json_path, ent[i].xf, err, errlen)) goto mesh_fail;
         ent[i].has_xf = xf != NULL;
+        /* "lightmap": false (not baked, still casts) or {"scale": s} (texel density weight) */
+        const cJSON *lmk = cJSON_GetObjectItemCaseSensitive(m, "lightmap");
+        ent[i].lightmap_scale = 1.0f;
+        if (lmk) {
+            if (cJSON_IsFalse(lmk)) ent[i].lightmap_scale = 0.0f;
+            else if (cJSON_IsTrue(lmk)) ent[i].lightmap_scale = 1.0f;
+            else if (cJSON_IsObject(lmk)) {
+                char lname[48];
+                snprintf(lname, sizeof lname, "meshes[%d].lightmap", i);
+                warn_unknown(lmk, lname, mesh_lightmap_keys, json_path);
+                const cJSON *sc = cJSON_GetObjectItemCaseSensitive(lmk, "scale");
+                if (sc && !(cJSON_IsNumber(sc) && sc->valuedouble > 0.0 && sc->valuedouble <= 1e3)) {
+                    snprintf(err, errlen, "%s: meshes[%d].lightmap.scale must be a number in (0, 1000]", json_path, i);
+                    goto mesh_fail;
+                }
+                if (sc) ent[i].lightmap_scale = (float)sc->valuedouble;
+            } else {
+                snprintf(err, errlen, "%s: meshes[%d].lightmap must be false, true or {\"scale\": s}", json_path, i);
+                goto mesh_fail;
+            }
+        }
         soup.cur_mesh = (uint32_t)i;
+        ms_soup_new_object(&soup);
         ent[i].from = soup.n;
         int j = 0;
         while (j < i && strcmp(ent[j].path, mesh_path)) j++;
@@ -648,10 +671,21 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         if (!(ent[i].path = strdup(mesh_path))) { snprintf(err, errlen, "%s: out of memory", json_path); goto mesh_fail; }
         i++;
     }
+    float *lm_scale = malloc((i ? (size_t)i : 1) * sizeof *lm_scale);
+    if (!lm_scale) {
+        snprintf(err, errlen, "%s: out of memory", json_path);
+        for (int k = 0; k < i; k++) free(ent[k].path);
+        free(ent);
+        free(dircopy);
+        ms_soup_free(&soup);
+        goto done;
+    }
     for (int k = 0; k < i; k++) {
         if (ent[k].has_xf) ms_soup_transform(&soup, ent[k].from, ent[k].to, ent[k].xf);
+        lm_scale[k] = ent[k].lightmap_scale;
         free(ent[k].path);
     }
+    out->mesh_lightmap_scale = lm_scale;
     free(ent);
     free(dircopy);
     /* The scene's frame (scene_frame.c): chosen from the triangles' double positions, applied to them, the
@@ -664,6 +698,8 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     out->tri = soup.tri;
     out->n_tris = soup.n;
     out->tri_mesh = soup.mesh;
+    out->tri_object = soup.object;
+    out->n_objects = soup.n_objects;
     for (int s = 0; s < MS_MAX_UV_SETS; s++) out->tri_uv[s] = soup.uv[s];
     out->n_meshes = (size_t)i;
     out->materials = soup.mats;   /* surfaces: the soup's arrays change hands (ms_scene_free frees them) */
@@ -692,6 +728,8 @@ void ms_scene_free(ms_scene *s)
 {
     free(s->tri);
     free(s->tri_mesh);
+    free(s->tri_object);
+    free(s->mesh_lightmap_scale);
     for (int i = 0; i < MS_MAX_UV_SETS; i++) free(s->tri_uv[i]);
     free(s->materials);
     free(s->tri_material);

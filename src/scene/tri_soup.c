@@ -33,6 +33,9 @@ int ms_soup_push_d(ms_tri_soup *soup, const float v[9], const double *vd, const 
         uint32_t *m = realloc(soup->mesh, cap * sizeof *m);
         if (!m) return -1;
         soup->mesh = m;
+        uint32_t *o = realloc(soup->object, cap * sizeof *o);
+        if (!o) return -1;
+        soup->object = o;
         for (int s = 0; s < MS_SOUP_UV_SETS; s++) {
             if (!soup->uv[s]) continue;
             float *u = realloc(soup->uv[s], cap * 6 * sizeof(float));
@@ -79,8 +82,17 @@ int ms_soup_push_d(ms_tri_soup *soup, const float v[9], const double *vd, const 
     memcpy(soup->tri + 9 * soup->n, v, 9 * sizeof(float));
     for (int i = 0; i < 9; i++) soup->tri_d[9 * soup->n + i] = vd ? vd[i] : (double)v[i];
     soup->mesh[soup->n] = soup->cur_mesh;
+    if (!soup->n_objects) soup->n_objects = 1;   /* object 0 for loaders that never start one */
+    soup->object[soup->n] = soup->cur_object;
+    soup->object_used = 1;
     soup->n++;
     return 0;
+}
+
+void ms_soup_new_object(ms_tri_soup *soup)
+{
+    if (soup->object_used || !soup->n_objects) soup->cur_object = soup->n_objects++;
+    soup->object_used = 0;
 }
 
 int ms_soup_push(ms_tri_soup *soup, const float v[9]) { return ms_soup_push_uv(soup, v, NULL); }
@@ -90,6 +102,7 @@ void ms_soup_free(ms_tri_soup *soup)
     free(soup->tri);
     free(soup->tri_d);
     free(soup->mesh);
+    free(soup->object);
     for (int s = 0; s < MS_SOUP_UV_SETS; s++) free(soup->uv[s]);
     free(soup->material);
     free(soup->normal);

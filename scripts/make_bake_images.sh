@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The images of docs/baking.md, into docs/images/: the Quad's and the built-in scene's lightmaps, a frame of the
+# built-in scene, and the Stanford bunny (../shared/scenes) baked into a glTF, shown by the three.js viewer in
+# headless chromium beside microshadow's own frame of the same camera. Prints the bunny bake's summary line
+# (bake time, texels/s, seams) and the validator's verdict on its glb.
+# Usage: scripts/make_bake_images.sh [BUILD_DIR]   (a Release build: default build/; needs node, chromium and
+# viewer/node_modules for the viewer's image: scripts/install-deps.sh)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=$(cd "${1:-$root/build}" && pwd)
+ms=$build/microshadow
+out=$root/docs/images
+scenes=$(cd "$root/.." && pwd)/shared/scenes
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$out"
+
+# The Quad (its OBJ has no UV set 1: xatlas) and the built-in scene with a frame of it.
+"$ms" bake "$scenes/quad/quad.json" --uv 1 --size 256 --samples 1024 -o "$tmp/quad.exr" --png "$out/bake_quad.png" --quiet
+"$ms" bake --uv xatlas --size 512 --samples 1024 -o "$tmp/builtin.exr" --png "$out/bake_builtin.png" --quiet
+"$ms" --width 512 --height 384 --samples 1024 -o "$out/frame_builtin.png"
+
+# The bunny: its lightmap, the glb, the viewer's screenshot at the scene file's camera (512 x 512 here), the frame.
+# The shared scene file as it is, but for the ground's texel density: a quarter (its "lightmap" scale), so that
+# the bunny, not the 4 m of ground around it, gets most of the atlas.
+shared=$scenes/stanford-bunny/stanford-bunny.json
+bunny=$tmp/stanford-bunny.json
+/usr/bin/python3 -c "
+import json, os; s = json.load(open('$shared')); d = os.path.dirname('$shared')
+s['meshes'] = [{'file': os.path.join(d, m['file']), **({'lightmap': {'scale': 0.25}} if m['file'] == 'ground.obj' else {})}
+               for m in s['meshes']]
+json.dump(s, open('$bunny', 'w'), indent=1)"
+"$ms" bake "$bunny" --uv xatlas --size 1024 --samples 1024 -o "$tmp/bunny.exr" --png "$out/bake_bunny_lightmap.png" \
+    --gltf "$tmp/bunny.glb" 2>&1 | grep -v '^bake: ' | tee "$tmp/bake.log"
+node "$root/viewer/validate.mjs" "$tmp/bunny.glb"
+"$ms" "$bunny" --width 512 --height 512 --samples 1024 -o "$out/bake_bunny_frame.png"
+# the viewer needs the frame's exposure (the 99th percentile of unshadowed radiance to 1) and the camera at 512 x 512
+exposure=$(MICROSHADOW_LIBRARY="$build/libmicroshadow.so" PYTHONPATH="$root/python" /usr/bin/python3 -c "
+import microshadow as ms
+print(ms.render(ms.load('$bunny'), width=512, height=512, samples=1024)['exposure'])")
+/usr/bin/python3 -c "
+import json; s = json.load(open('$bunny')); s['camera']['width'] = s['camera']['height'] = 512
+json.dump({'camera': s['camera']}, open('$tmp/camera.json', 'w'))"
+node "$root/viewer/screenshot.mjs" "$tmp/bunny.glb" "$tmp/camera.json" "$out/bake_bunny_viewer.png" --exposure "$exposure"

@@ -1,0 +1,46 @@
+// Renders OUT.glb in viewer/index.html with headless Chromium (puppeteer-core driving Debian's chromium) and
+// saves the canvas as a PNG of the scene camera's size.
+// Usage: node viewer/screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode diffuse|standard]
+//        [--chromium PATH]   exit 0, 1 when the page fails (its error printed), 2 on bad arguments.
+import puppeteer from 'puppeteer-core';
+import { basename } from 'node:path';
+import { serve } from './serve.mjs';
+
+const args = process.argv.slice(2);
+const opt = { exposure: '1', mode: 'diffuse', chromium: '/usr/bin/chromium' };
+const pos = [];
+for (let i = 0; i < args.length; i++) {
+  if (args[i].startsWith('--')) opt[args[i].slice(2)] = args[++i];
+  else pos.push(args[i]);
+}
+if (pos.length !== 3) { console.error('usage: node screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode M]'); process.exit(2); }
+const [glb, sceneFile, out] = pos;
+const server = await serve([glb, sceneFile]);
+const { port } = server.address();
+const browser = await puppeteer.launch({
+  executablePath: opt.chromium, headless: true,
+  // software WebGL (SwiftShader) in a container without a GPU
+  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
+});
+let rc = 0;
+try {
+  const page = await browser.newPage();
+  page.on('console', (m) => { if (m.type() === 'error') console.error('page:', m.text()); });
+  const scene = JSON.parse(await (await import('node:fs/promises')).readFile(sceneFile, 'utf8'));
+  await page.setViewport({ width: scene.camera.width ?? 1024, height: scene.camera.height ?? 768, deviceScaleFactor: 1 });
+  const url = `http://127.0.0.1:${port}/index.html?glb=/data/${encodeURIComponent(basename(glb))}` +
+              `&scene=/data/${encodeURIComponent(basename(sceneFile))}&exposure=${opt.exposure}&mode=${opt.mode}`;
+  await page.goto(url);
+  await page.waitForFunction('window.viewerReady || window.viewerError', { timeout: 60000 });
+  const error = await page.evaluate('window.viewerError');
+  if (error) { console.error(`viewer: ${error}`); rc = 1; }
+  else {
+    const canvas = await page.$('canvas');
+    await canvas.screenshot({ path: out });
+    console.log(`${out}: ${scene.camera.width}x${scene.camera.height} screenshot of ${glb}`);
+  }
+} finally {
+  await browser.close();
+  server.close();
+}
+process.exit(rc);
