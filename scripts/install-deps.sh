@@ -13,6 +13,9 @@ pkgs=(build-essential cmake pkg-config libcjson-dev libpng-dev libturbojpeg0-dev
       libopenmpi-dev openmpi-bin nodejs npm chromium)
 missing=()
 for p in "${pkgs[@]}"; do
+  # Node.js from elsewhere (e.g. NodeSource's nodejs, which bundles npm and conflicts with Debian's npm
+  # package): its commands are what the tests need, not Debian's packages.
+  case $p in nodejs) command -v node >/dev/null && continue ;; npm) command -v npm >/dev/null && continue ;; esac
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
