@@ -4,13 +4,14 @@
 #include <math.h>
 #include <string.h>
 
-extern const ms_light_shape_ops ms_light_rect, ms_light_disk_shape, ms_light_sphere_shape;
+extern const ms_light_shape_ops ms_light_rect, ms_light_disk_shape, ms_light_sphere_shape, ms_light_triangle_shape;
 
 /* Indexed by ms_light_shape. */
 static const ms_light_shape_ops *const shapes[] = {
     [MS_LIGHT_RECT] = &ms_light_rect,
     [MS_LIGHT_DISK] = &ms_light_disk_shape,
     [MS_LIGHT_SPHERE] = &ms_light_sphere_shape,
+    [MS_LIGHT_TRIANGLE] = &ms_light_triangle_shape,
 };
 
 const ms_light_shape_ops *ms_light_shape_of(ms_light_shape shape)
