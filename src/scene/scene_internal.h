@@ -13,10 +13,16 @@
 #define MS_MAX_TRIS_PER_BYTE 4                    /* triangles emitted per input byte (glTF instancing) */
 #define MS_MAX_LIGHT_TEXTURE 8192                 /* texels per side of a light's emission image */
 #define MS_MAX_COORD 1e18f                        /* |coordinate|: squares and cross products stay finite in float */
+#define MS_MAX_LIGHTS 64                          /* a frame holds V and S per light: bounded memory */
 
 struct ms_scene;
 /* rel resolved against the folder of json_path (absolute paths as they are) into out; -1 if too long. */
 int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n);
+struct ms_light;
+/* The lights of the scene's emissive triangles (scene_emitters.c): *out (malloc'd, NULL when none) and
+ * *n_out; 0, or -1 with one line in err (naming path) when they would be more than `room` lights. */
+int ms_scene_emitter_lights(const struct ms_scene *s, size_t room, const char *path, struct ms_light **out,
+                            size_t *n_out, char *err, size_t errlen);
 #define MS_SOUP_UV_SETS 4   /* = MS_MAX_UV_SETS */
 /* Triangles as they are loaded, with the mesh each came from (cur_mesh at the push) and, per UV set,
  * the UVs of its vertices (6 floats; the array appears with the first triangle that has the set, NaN

@@ -27,7 +27,7 @@ static int line_of(const char *text, size_t off)
 
 /* Known keys, per object, for the unknown-key warnings. */
 static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "lights", "render",
-                                        "allow_outside_paths", NULL };
+                                        "allow_outside_paths", "lights_from_emissive", NULL };
 static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
 /* The camera's keys depend on camera.type (docs/cameras.md): each type reads the common ones and its own. */
 #define CAMERA_COMMON_KEYS "type", "eye", "target", "up", "width", "height"
@@ -245,7 +245,6 @@ static const cJSON *get_object(const cJSON *root, const char *key, const char *p
 
 /* ---- Lights: "light": {...} (one) or "lights": [{...}, ...] (docs/design.md, "Light shapes", "Units") ---- */
 
-#define MS_MAX_LIGHTS 64   /* a frame holds V and S per light: bounded memory */
 
 /* Reads key as a number (grey) or an array of three numbers, none negative; 1 if present, 0 if not, -1 bad. */
 static int get_amount(const cJSON *obj, const char *objname, const char *key, ms_vec3 *out, const char *path,
@@ -454,12 +453,15 @@ int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n)
     return k < 0 || (size_t)k >= n ? -1 : 0;
 }
 
-/* lp: MS_MAX_LIGHTS positions as the file gives them (scene_frame.c). */
-static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, const char *path, char *err, size_t errlen)
+/* lp: MS_MAX_LIGHTS positions as the file gives them (scene_frame.c). none_ok: the file may name no light
+ * (the emitters will be the lights; nothing is set then). */
+static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, int none_ok, const char *path, char *err,
+                        size_t errlen)
 {
     const cJSON *one = cJSON_GetObjectItemCaseSensitive(root, "light");
     const cJSON *many = cJSON_GetObjectItemCaseSensitive(root, "lights");
     if (one && many) { snprintf(err, errlen, "%s: give either \"light\" or \"lights\", not both", path); return -1; }
+    if (!one && !many && none_ok) return 0;
     if (!many) {
         const cJSON *light = get_object(root, "light", path, err, errlen);
         return light ? parse_light(light, "light", &out->light, lp, path, err, errlen) : -1;
@@ -484,6 +486,30 @@ static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, const c
 
 static int parse_with(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
                       ms_scene *out, char *err, size_t errlen);
+
+/* The scene's emissive triangles as lights after those the file names (file_lights: it names some). */
+static int add_emitter_lights(ms_scene *out, int file_lights, const char *path, char *err, size_t errlen)
+{
+    const size_t have = out->n_lights ? out->n_lights : file_lights ? 1 : 0;
+    ms_light *em = NULL;
+    size_t n_em = 0;
+    if (ms_scene_emitter_lights(out, MS_MAX_LIGHTS - have, path, &em, &n_em, err, errlen)) return -1;
+    if (!have && !n_em) {
+        snprintf(err, errlen, "%s: \"light\" is missing: the scene file names no light (\"light\" or \"lights\") and its meshes have no emissive "
+                 "triangles (glTF emissiveFactor, MTL Ke) to light it", path);
+        return -1;
+    }
+    if (!n_em) return 0;
+    ms_light *all = realloc(out->lights, (have + n_em) * sizeof *all);
+    if (!all) { free(em); snprintf(err, errlen, "%s: out of memory for the lights", path); return -1; }
+    if (have == 1 && !out->n_lights) all[0] = out->light;   /* "light": it becomes lights[0], texture and all */
+    memcpy(all + have, em, n_em * sizeof *em);
+    free(em);
+    out->lights = all;
+    out->n_lights = have + n_em;
+    out->light = all[0];
+    return 0;
+}
 
 /* The camera's eye and target and the lights' positions in the scene's frame (out->origin), from the
  * numbers of the file; nothing changes when the frame is the world's. */
@@ -620,9 +646,17 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         else c->fov = (float)v;
     }
 
+    /* The asset's emitters as lights (scene_emitters.c): by default when the file names no light. */
+    const int file_lights = cJSON_GetObjectItemCaseSensitive(root, "light") || cJSON_GetObjectItemCaseSensitive(root, "lights");
+    const cJSON *from_emissive = cJSON_GetObjectItemCaseSensitive(root, "lights_from_emissive");
+    if (from_emissive && !cJSON_IsBool(from_emissive)) {
+        snprintf(err, errlen, "%s: \"lights_from_emissive\" must be true or false", json_path);
+        goto done;
+    }
+    const int emitters = from_emissive ? cJSON_IsTrue(from_emissive) : !file_lights;
     light_pos lpos[MS_MAX_LIGHTS];
     memset(lpos, 0, sizeof lpos);
-    if (parse_lights(root, out, lpos, json_path, err, errlen)) goto done;
+    if (parse_lights(root, out, lpos, emitters, json_path, err, errlen)) goto done;
 
     out->samples = 1024;
     const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
@@ -659,6 +693,7 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         out->procedural.type = MS_PROCEDURAL_FLOWERS;
         out->procedural.seed = (uint32_t)seed;
         out->n_tris = (size_t)tris;
+        if (!file_lights) { missing(root, "", "light", json_path, err, errlen); goto done; }   /* no emitters here */
         rc = ms_scene_validate(out, json_path, err, errlen);
         goto done;
     }
@@ -743,6 +778,7 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     out->tri_tangent = ms_soup_take_tangents(&soup);
     out->textures = soup.tex;
     out->n_textures = soup.n_tex;
+    if (emitters && add_emitter_lights(out, file_lights, json_path, err, errlen)) goto done;
     rc = ms_scene_validate(out, json_path, err, errlen);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
