@@ -274,12 +274,89 @@ static void test_too_many_emitters(void **st)
     assert_false(tu_file_exists(out));
 }
 
+/* KHR_lights_punctual: a point light (10 cd, extras.radius 0.1) becomes a sphere of radiance 10 / (pi 0.1^2);
+ * a spot facing down (node rotated -90 degrees about x) a disk facing down of the scene file's
+ * punctual_radius; a directional light one warning line; V and S of the frame equal raytrace's by every
+ * method. */
+static void test_punctual(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("asset_lights_punctual");
+    const prim p[1] = { { &box[0][0], 10, white } };
+    write_gltf_ex(dir, "pl", p, 1, "\"extensionsUsed\":[\"KHR_lights_punctual\"],",
+                  ",{\"translation\":[0.2,1.5,-0.1],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}"
+                  ",{\"translation\":[-0.3,1.8,0.2],\"rotation\":[-0.70710678,0,0,0.70710678],"
+                  "\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}}"
+                  ",{\"rotation\":[-0.70710678,0,0,0.70710678],\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}}", 3,
+                  "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
+                  "{\"type\":\"point\",\"color\":[1,0.5,0.25],\"intensity\":10,\"extras\":{\"radius\":0.1}},"
+                  "{\"type\":\"spot\",\"intensity\":2,\"spot\":{\"outerConeAngle\":0.5}},"
+                  "{\"type\":\"directional\",\"intensity\":3}]}},");
+    const char *path = write_scene(dir, "pl.json", "pl.gltf", "\"punctual_radius\": 0.2");
+    ms_scene sc;
+    char err[512];
+    if (ms_scene_load(path, &sc, err, sizeof err)) fprintf(stderr, "%s\n", err);
+    size_t n;
+    const ms_light *L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 2);
+    assert_int_equal(L[0].shape, MS_LIGHT_SPHERE);
+    assert_float_equal(L[0].center.x, 0.2f, 0.0f);
+    assert_float_equal(L[0].center.y, 1.5f, 0.0f);
+    assert_float_equal(L[0].center.z, -0.1f, 0.0f);
+    assert_float_equal(L[0].radius, 0.1f, 0.0f);
+    /* candela to radiance: I = L pi r^2 */
+    assert_float_equal(L[0].emission.x, (float)(10.0 / (M_PI * 0.01)), 1e-3f);
+    assert_float_equal(L[0].emission.y, (float)(5.0 / (M_PI * 0.01)), 1e-3f);
+    assert_int_equal(L[1].shape, MS_LIGHT_DISK);
+    assert_float_equal(ms_light_area(&L[1]), (float)(M_PI * 0.04), 1e-6f);
+    assert_float_equal(L[1].emission.x, (float)(2.0 / (M_PI * 0.04)), 1e-4f);
+    const float ny = L[1].edge_s.z * L[1].edge_t.x - L[1].edge_s.x * L[1].edge_t.z;
+    assert_true(ny < 0.0f);   /* emits down */
+    /* the disk's centre */
+    assert_float_equal(L[1].corner.x + 0.5f * (L[1].edge_s.x + L[1].edge_t.x), -0.3f, 1e-6f);
+    assert_float_equal(L[1].corner.y + 0.5f * (L[1].edge_s.y + L[1].edge_t.y), 1.8f, 1e-6f);
+    /* every method's frame equals raytrace's, light by light */
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = 24;
+    o.samples = 256;
+    o.threads = 2;
+    ms_frame ref, f;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    const char *const *names = ms_method_names();
+    long lit = 0;
+    for (int i = 0; i < 2 * 24 * 24; i++) lit += ref.vis[i] > 0.0f;
+    assert_true(lit > 24 * 24 / 2);
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        long differ = 0;
+        for (int i = 0; i < 2 * 24 * 24; i++) differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i];
+        if (differ) fprintf(stderr, "punctual lights, method %s: %ld values differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_frame_free(&f);
+    }
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+    /* the CLI: one warning line each for the directional light and the spot's cone */
+    char out[4096], errbuf[4096];
+    tu_path(out, sizeof out, dir, "out.png");
+    const char *args[] = { path, "-o", out, "--quiet", NULL };
+    tu_run_result res;
+    assert_int_equal(tu_run_cli_ex(args, NULL, errbuf, sizeof errbuf, &res), 0);
+    printf("%s", errbuf);
+    assert_non_null(strstr(errbuf, "1 KHR_lights_punctual directional light ignored"));
+    assert_non_null(strstr(errbuf, "the cone is not modelled"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell_emitter),
         cmocka_unit_test(test_single_triangle_and_mtl),
         cmocka_unit_test(test_too_many_emitters),
+        cmocka_unit_test(test_punctual),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

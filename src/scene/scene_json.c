@@ -27,7 +27,8 @@ static int line_of(const char *text, size_t off)
 
 /* Known keys, per object, for the unknown-key warnings. */
 static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "lights", "render",
-                                        "allow_outside_paths", "lights_from_emissive", NULL };
+                                        "allow_outside_paths", "lights_from_emissive", "lights_from_punctual",
+                                        "punctual_radius", NULL };
 static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
 /* The camera's keys depend on camera.type (docs/cameras.md): each type reads the common ones and its own. */
 #define CAMERA_COMMON_KEYS "type", "eye", "target", "up", "width", "height"
@@ -487,27 +488,68 @@ static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, int non
 static int parse_with(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
                       ms_scene *out, char *err, size_t errlen);
 
-/* The scene's emissive triangles as lights after those the file names (file_lights: it names some). */
-static int add_emitter_lights(ms_scene *out, int file_lights, const char *path, char *err, size_t errlen)
+/* A glTF file's mesh-entry transform m (3 x 4, row-major) on a punctual light: its position moved, its
+ * direction turned by the linear part (renormalised). */
+static void punctual_transform(ms_punctual *p, const double m[12])
 {
-    const size_t have = out->n_lights ? out->n_lights : file_lights ? 1 : 0;
-    ms_light *em = NULL;
-    size_t n_em = 0;
-    if (ms_scene_emitter_lights(out, MS_MAX_LIGHTS - have, path, &em, &n_em, err, errlen)) return -1;
-    if (!have && !n_em) {
-        snprintf(err, errlen, "%s: \"light\" is missing: the scene file names no light (\"light\" or \"lights\") and its meshes have no emissive "
-                 "triangles (glTF emissiveFactor, MTL Ke) to light it", path);
+    double pos[3], dir[3], len = 0.0;
+    for (int r = 0; r < 3; r++) {
+        pos[r] = m[4 * r] * p->pos[0] + m[4 * r + 1] * p->pos[1] + m[4 * r + 2] * p->pos[2] + m[4 * r + 3];
+        dir[r] = m[4 * r] * p->dir[0] + m[4 * r + 1] * p->dir[1] + m[4 * r + 2] * p->dir[2];
+        len += dir[r] * dir[r];
+    }
+    len = sqrt(len);
+    for (int r = 0; r < 3; r++) { p->pos[r] = pos[r]; if (len > 0.0) p->dir[r] = dir[r] / len; }
+}
+
+static void warn_line(const char *line)
+{
+    if (g_warnings && g_warnings->n < MAX_WARNINGS)
+        snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%s", line);
+}
+
+/* Appends add[0 .. n_add-1] to the scene's lights (have: how many it has; "light" alone becomes lights[0]). */
+static int append_lights(ms_scene *out, size_t have, ms_light *add, size_t n_add, const char *path, char *err, size_t errlen)
+{
+    if (!n_add) return 0;
+    ms_light *all = realloc(out->lights, (have + n_add) * sizeof *all);
+    if (!all) { free(add); snprintf(err, errlen, "%s: out of memory for the lights", path); return -1; }
+    if (have == 1 && !out->n_lights) all[0] = out->light;   /* "light": it becomes lights[0], texture and all */
+    memcpy(all + have, add, n_add * sizeof *add);
+    free(add);
+    out->lights = all;
+    out->n_lights = have + n_add;
+    out->light = all[0];
+    return 0;
+}
+
+/* The asset's own lights after those the file names (file_lights: it names some): its KHR_lights_punctual
+ * lights (punct NULL: not wanted), then its emissive triangles (emitters: wanted). */
+static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const ms_punctual *punct, size_t n_punct,
+                            double punctual_radius, const char *path, char *err, size_t errlen)
+{
+    size_t have = out->n_lights ? out->n_lights : file_lights ? 1 : 0;
+    ms_light *add = NULL;
+    size_t n_add = 0;
+    if (punct) {
+        if (ms_scene_punctual_lights(punct, n_punct, out->origin, punctual_radius, MS_MAX_LIGHTS - have, path, warn_line,
+                                     &add, &n_add, err, errlen) ||
+            append_lights(out, have, add, n_add, path, err, errlen))
+            return -1;
+        have += n_add;
+    }
+    if (emitters) {
+        if (ms_scene_emitter_lights(out, MS_MAX_LIGHTS - have, path, &add, &n_add, err, errlen) ||
+            append_lights(out, have, add, n_add, path, err, errlen))
+            return -1;
+        have += n_add;
+    }
+    if (!have) {
+        snprintf(err, errlen, "%s: \"light\" is missing: the scene file names no light (\"light\" or \"lights\") and its meshes have neither "
+                 "emissive triangles (glTF emissiveFactor, MTL Ke) nor KHR_lights_punctual point or spot lights to light it",
+                 path);
         return -1;
     }
-    if (!n_em) return 0;
-    ms_light *all = realloc(out->lights, (have + n_em) * sizeof *all);
-    if (!all) { free(em); snprintf(err, errlen, "%s: out of memory for the lights", path); return -1; }
-    if (have == 1 && !out->n_lights) all[0] = out->light;   /* "light": it becomes lights[0], texture and all */
-    memcpy(all + have, em, n_em * sizeof *em);
-    free(em);
-    out->lights = all;
-    out->n_lights = have + n_em;
-    out->light = all[0];
     return 0;
 }
 
@@ -654,9 +696,21 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         goto done;
     }
     const int emitters = from_emissive ? cJSON_IsTrue(from_emissive) : !file_lights;
+    const cJSON *from_punctual = cJSON_GetObjectItemCaseSensitive(root, "lights_from_punctual");
+    if (from_punctual && !cJSON_IsBool(from_punctual)) {
+        snprintf(err, errlen, "%s: \"lights_from_punctual\" must be true or false", json_path);
+        goto done;
+    }
+    const int punctuals = from_punctual ? cJSON_IsTrue(from_punctual) : !file_lights;
+    double punctual_radius = 0.05;
+    if (get_number(root, "", "punctual_radius", 0, &punctual_radius, json_path, err, errlen)) goto done;
+    if (!(punctual_radius > 0.0) || punctual_radius > MS_MAX_COORD) {
+        snprintf(err, errlen, "%s: \"punctual_radius\" must be in (0, %g]", json_path, (double)MS_MAX_COORD);
+        goto done;
+    }
     light_pos lpos[MS_MAX_LIGHTS];
     memset(lpos, 0, sizeof lpos);
-    if (parse_lights(root, out, lpos, emitters, json_path, err, errlen)) goto done;
+    if (parse_lights(root, out, lpos, emitters || punctuals, json_path, err, errlen)) goto done;
 
     out->samples = 1024;
     const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
@@ -755,6 +809,8 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     }
     for (int k = 0; k < i; k++) {
         if (ent[k].has_xf) ms_soup_transform(&soup, ent[k].from, ent[k].to, ent[k].xf);
+        for (size_t q = 0; q < soup.n_punctual && ent[k].has_xf; q++)
+            if (soup.punctual[q].mesh == (uint32_t)k) punctual_transform(&soup.punctual[q], ent[k].xf);
         free(ent[k].path);
     }
     free(ent);
@@ -778,7 +834,16 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     out->tri_tangent = ms_soup_take_tangents(&soup);
     out->textures = soup.tex;
     out->n_textures = soup.n_tex;
-    if (emitters && add_emitter_lights(out, file_lights, json_path, err, errlen)) goto done;
+    if (add_asset_lights(out, file_lights, emitters, punctuals ? soup.punctual : NULL, soup.n_punctual, punctual_radius,
+                         json_path, err, errlen)) {
+        free(soup.punctual);
+        goto done;
+    }
+    if (!punctuals && soup.n_punctual && g_warnings && g_warnings->n < MAX_WARNINGS)
+        snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%.120s: %zu KHR_lights_punctual light%s "
+                 "ignored (the scene file names its lights; \"lights_from_punctual\": true adds them)", json_path,
+                 soup.n_punctual, soup.n_punctual > 1 ? "s" : "");
+    free(soup.punctual);
     rc = ms_scene_validate(out, json_path, err, errlen);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
