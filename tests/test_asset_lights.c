@@ -192,6 +192,14 @@ static void test_cornell_emitter(void **st)
     ms_scene_lights(&sc, &n);
     assert_int_equal((int)n, 1);
     ms_scene_free(&sc);
+    {   /* not silently: the CLI says the emitters were not made lights */
+        char out[4096], errbuf[2048];
+        tu_path(out, sizeof out, dir, "out.png");
+        const char *args[] = { path, "--quiet", "-o", out, NULL };
+        tu_run_result res;
+        assert_int_equal(tu_run_cli_ex(args, NULL, errbuf, sizeof errbuf, &res), 0);
+        assert_non_null(strstr(errbuf, "2 emissive triangles not made lights"));
+    }
     path = write_scene(dir, "box_both.json", "box.gltf",
                        "\"light\": { \"corner\": [-0.5, 1.99, -0.5], \"edge_s\": [1, 0, 0], \"edge_t\": [0, 0, 1] },"
                        " \"lights_from_emissive\": true");

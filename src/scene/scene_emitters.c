@@ -110,6 +110,14 @@ static int completes(const float *tj, const float *a, const float *b, const floa
     return (double)nj[0] * n[0] + (double)nj[1] * n[1] + (double)nj[2] * n[2] > 0.0;
 }
 
+size_t ms_scene_emissive_triangles(const ms_scene *s)
+{
+    size_t n = 0;
+    float e[3];
+    for (size_t t = 0; s->tri && t < s->n_tris; t++) n += emitter_radiance(s, t, e);
+    return n;
+}
+
 int ms_scene_emitter_lights(const ms_scene *s, size_t room, const char *path, ms_light **out, size_t *n_out, char *err,
                             size_t errlen)
 {

@@ -38,6 +38,8 @@ struct ms_light;
 int ms_scene_punctual_lights(const ms_punctual *p, size_t n, const double origin[3], double default_radius, size_t room,
                              const char *path, void (*warn)(const char *line), struct ms_light **out, size_t *n_out,
                              char *err, size_t errlen);
+/* How many of the scene's triangles emit (those ms_scene_emitter_lights would make lights of). */
+size_t ms_scene_emissive_triangles(const struct ms_scene *s);
 int ms_scene_emitter_lights(const struct ms_scene *s, size_t room, const char *path, struct ms_light **out,
                             size_t *n_out, char *err, size_t errlen);
 #define MS_SOUP_UV_SETS 4   /* = MS_MAX_UV_SETS */

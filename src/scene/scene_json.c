@@ -844,6 +844,11 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
                  "ignored (the scene file names its lights; \"lights_from_punctual\": true adds them)", json_path,
                  soup.n_punctual, soup.n_punctual > 1 ? "s" : "");
     free(soup.punctual);
+    const size_t n_emissive = emitters ? 0 : ms_scene_emissive_triangles(out);
+    if (n_emissive && g_warnings && g_warnings->n < MAX_WARNINGS)
+        snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%.120s: %zu emissive triangle%s not made "
+                 "lights (the scene file names its lights; \"lights_from_emissive\": true adds them)", json_path, n_emissive,
+                 n_emissive > 1 ? "s" : "");
     rc = ms_scene_validate(out, json_path, err, errlen);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
