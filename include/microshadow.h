@@ -141,8 +141,10 @@ typedef struct ms_camera {
  *     centre c, unit normal m and radius r the parallelogram is its bounding square (ms_light_disk);
  *   MS_LIGHT_SPHERE: a sphere (center, radius; the parallelogram fields unused). Seen from a receiver P
  *     outside it, its outline is a disk facing P (ms_light_sphere_outline): each receiver is sampled on
- *     its own outline disk, a per-receiver light frame (frames, points and bakes alike); not textured. */
-typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2 } ms_light_shape;
+ *     its own outline disk, a per-receiver light frame (frames, points and bakes alike); not textured.
+ *   MS_LIGHT_TRIANGLE: the triangle corner, corner + edge_s, corner + edge_t: the parameters with s + t < 1
+ *     (ms_light_triangle); emits towards cross(edge_s, edge_t); not textured. */
+typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2, MS_LIGHT_TRIANGLE = 3 } ms_light_shape;
 
 /* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
  * from the samples of its shape. Zero-initialised fields past emission keep a uniform parallelogram.
@@ -194,10 +196,14 @@ MS_API float ms_light_texel(const ms_light *l, float s, float t, float *rgb);
  * alone, and shape MS_LIGHT_DISK; emission is left as it is. 0, or -1 when m is zero or r not > 0. */
 MS_API int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
 
+/* Fills l as a triangle light of vertices a, b, c (corner a, edges b - a and c - a, shape MS_LIGHT_TRIANGLE),
+ * emitting towards cross(b - a, c - a); emission is left as it is. 0, or -1 when the vertices are collinear. */
+MS_API int ms_light_triangle(ms_light *l, ms_vec3 a, ms_vec3 b, ms_vec3 c);
+
 /* 1 if light parameters (s,t) lie on the light's shape (see ms_light_shape), 0 if not. */
 MS_API int ms_light_shape_contains(ms_light_shape shape, float s, float t);
 
-/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk; 4 pi r^2 for a sphere). */
+/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk, 1/2 for a triangle; 4 pi r^2 for a sphere). */
 MS_API float ms_light_area(const ms_light *l);
 
 /* Units of a light's emission in a scene file (docs/design.md, "Units"). The renderer works in radiance;

@@ -48,18 +48,34 @@ static verdict seg_hits(const float *t, const double p[3], const double L[3], do
     return YES;
 }
 
-typedef struct disk_geom { double c[3], m[3], r; } disk_geom;
+/* A disk (centre c, unit normal m, radius r), or a triangle (tri = 1: corner c, edges e1, e2). */
+typedef struct disk_geom { double c[3], m[3], r; int tri; double e1[3], e2[3]; } disk_geom;
+
+/* How far L lies off the shape: < 0 on it, > 0 off it. A disk: |L - c|^2 / r^2 - 1; a triangle: s + t - 1
+ * for L = c + s e1 + t e2 (least squares in double: L lies on the plane up to float rounding). */
+static double off_shape(const disk_geom *dg, const double L[3])
+{
+    double w[3];
+    for (int c = 0; c < 3; c++) w[c] = L[c] - dg->c[c];
+    if (!dg->tri) return (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) / (dg->r * dg->r) - 1.0;
+    const double *a = dg->e1, *b = dg->e2;
+    const double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2], bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const double wa = w[0] * a[0] + w[1] * a[1] + w[2] * a[2], wb = w[0] * b[0] + w[1] * b[1] + w[2] * b[2];
+    const double det = aa * bb - ab * ab, s = (wa * bb - wb * ab) / det, t = (wb * aa - wa * ab) / det;
+    return s + t - 1.0;
+}
 
 /* The expected bits of sample L for the receiver (p, n, prim): counted (front and on the disk) and visible. */
 static void brute_sample(const ms_bvh *bvh, uint32_t prim, const float *pf, const float *nf, const float *Lf,
                          const disk_geom *dg, verdict *counted, verdict *visible)
 {
-    double p[3], L[3], d[3], w[3];
-    for (int c = 0; c < 3; c++) { p[c] = pf[c]; L[c] = Lf[c]; d[c] = L[c] - p[c]; w[c] = L[c] - dg->c[c]; }
+    double p[3], L[3], d[3];
+    for (int c = 0; c < 3; c++) { p[c] = pf[c]; L[c] = Lf[c]; d[c] = L[c] - p[c]; }
     const double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     const double f = (d[0] * nf[0] + d[1] * nf[1] + d[2] * nf[2]) / dl;
-    const double r2 = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) / (dg->r * dg->r);
-    verdict cnt = f > 1e-5 && r2 < 1.0 - 1e-4 ? YES : (f < -1e-5 || r2 > 1.0 + 1e-4) ? NO : UNSURE;
+    const double off = off_shape(dg, L);
+    verdict cnt = f > 1e-5 && off < -1e-4 ? YES : (f < -1e-5 || off > 1e-4) ? NO : UNSURE;
     *counted = cnt;
     if (cnt == NO) { *visible = NO; return; }
     verdict occ = NO;
@@ -78,7 +94,16 @@ static void make_disk_scene(ms_scene *sc, ms_vec3 c, ms_vec3 m, float r, disk_ge
     tu_make_quad(sc);
     assert_int_equal(ms_light_disk(&sc->light, c, m, r), 0);
     const double ml = sqrt((double)m.x * m.x + (double)m.y * m.y + (double)m.z * m.z);
-    *dg = (disk_geom){ { c.x, c.y, c.z }, { m.x / ml, m.y / ml, m.z / ml }, r };
+    *dg = (disk_geom){ .c = { c.x, c.y, c.z }, .m = { m.x / ml, m.y / ml, m.z / ml }, .r = r };
+}
+
+/* The Quad (ground, occluder) with a triangle light a, b, c. */
+static void make_triangle_scene(ms_scene *sc, ms_vec3 a, ms_vec3 b, ms_vec3 c, disk_geom *dg)
+{
+    tu_make_quad(sc);
+    assert_int_equal(ms_light_triangle(&sc->light, a, b, c), 0);
+    *dg = (disk_geom){ .c = { a.x, a.y, a.z }, .tri = 1, .e1 = { (double)b.x - a.x, (double)b.y - a.y, (double)b.z - a.z },
+                       .e2 = { (double)c.x - a.x, (double)c.y - a.y, (double)c.z - a.z } };
 }
 
 /* Every method's masks on a disk light: equal to the brute force where it is sure, equal to raytrace's
@@ -126,14 +151,13 @@ static void check_disk_methods(ms_scene *sc, const disk_geom *dg, int size, int 
             brute_sample(&bvh, q[i].prim, q[i].p, q[i].n, pts + 3 * s, dg, &c, &v);
             bc[(size_t)i * spp + s] = c;
             bv[(size_t)i * spp + s] = v;
-            double w[3];
-            for (int a = 0; a < 3; a++) w[a] = pts[3 * s + a] - dg->c[a];
-            off_disk += w[0] * w[0] + w[1] * w[1] + w[2] * w[2] > dg->r * dg->r * 1.0001;
+            const double L[3] = { pts[3 * s], pts[3 * s + 1], pts[3 * s + 2] };
+            off_disk += off_shape(dg, L) > 1e-4;
             if (c != UNSURE && (int)c != ms_mask_get(front + i * mw, s)) front_bad++;
         }
     }
     assert_int_equal(front_bad, 0);
-    assert_true(off_disk > (long)nq * spp / 8);   /* the corners of the square: about 21% of the samples */
+    assert_true(off_disk > (long)nq * spp / 8);   /* the corners of the square (21%), half the parallelogram (50%) */
     /* raytrace first: its masks are the reference for the others */
     const char *const *names = ms_method_names();
     int have_ref = 0;
@@ -160,8 +184,8 @@ static void check_disk_methods(ms_scene *sc, const disk_geom *dg, int size, int 
                     if (have_ref) differ += got != ms_mask_get(ref + i * mw, s);
                 }
             if (bad || differ)
-                fprintf(stderr, "disk, %s pattern, method %s: %ld samples differ from the brute force, %ld from raytrace\n",
-                        ms_pattern_name(pat), names[mi], bad, differ);
+                fprintf(stderr, "%s, %s pattern, method %s: %ld samples differ from the brute force, %ld from raytrace\n",
+                        dg->tri ? "triangle" : "disk", ms_pattern_name(pat), names[mi], bad, differ);
             assert_int_equal(bad, 0);
             assert_int_equal(differ, 0);
             if (is_rt) { memcpy(ref, vis, (size_t)nq * mw * sizeof *vis); have_ref = 1; }
@@ -307,7 +331,7 @@ static void test_disk_irradiance(void **st)
         if (ms_light_disk(&l, c, m, r)) continue;
         disk_geom dg;
         const double ml = sqrt((double)m.x * m.x + (double)m.y * m.y + (double)m.z * m.z);
-        dg = (disk_geom){ { c.x, c.y, c.z }, { m.x / ml, m.y / ml, m.z / ml }, r };
+        dg = (disk_geom){ .c = { c.x, c.y, c.z }, .m = { m.x / ml, m.y / ml, m.z / ml }, .r = r };
         /* a point on the emitting side, 0.1 .. 2.1 from the plane, up to 2 to the side */
         const double h = 0.1 + 2.0 * fabs(v[7]);
         double p[3], n[3];
@@ -455,6 +479,19 @@ static void test_units(void **st)
     /* no unit given: radiance 1 */
     assert_float_equal(L[3].emission.x, 1.0f, 0.0f);
     ms_scene_free(&sc);
+    /* A triangle of legs 2 and 2 (area 2) emitting 100 W: L = 100 / (2 pi) = 15.91549; it emits towards
+     * cross(b - a, c - a) = (0, -4, 0), down. */
+    path = scene_with("units_tri.json",
+        "\"light\": { \"shape\": \"triangle\", \"vertices\": [[-1, 6, -1], [1, 6, -1], [-1, 6, 1]], \"power\": 100 }");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    assert_int_equal(sc.light.shape, MS_LIGHT_TRIANGLE);
+    assert_float_equal(ms_light_area(&sc.light), 2.0f, 1e-6f);
+    assert_float_equal(sc.light.emission.x, 15.91549f, 1e-4f);
+    assert_float_equal(sc.light.corner.y, 6.0f, 0.0f);
+    assert_float_equal(sc.light.edge_s.x, 2.0f, 0.0f);
+    assert_float_equal(sc.light.edge_t.z, 2.0f, 0.0f);
+    assert_float_equal(sc.light.edge_s.z * sc.light.edge_t.x - sc.light.edge_s.x * sc.light.edge_t.z, -4.0f, 0.0f);
+    ms_scene_free(&sc);
 }
 
 /* The CLI on a bad light: exit 2, one line naming the file and the problem. */
@@ -481,8 +518,15 @@ static void test_bad_light_json(void **st)
     snprintf(g_dir, sizeof g_dir, "%s", tu_tmpdir("lights_bad"));
     const char *rect = "\"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2]";
     char buf[1024];
-    snprintf(buf, sizeof buf, "\"light\": { \"shape\": \"triangle\", %s }", rect);
-    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\" or \"sphere\"");
+    snprintf(buf, sizeof buf, "\"light\": { \"shape\": \"hexagon\", %s }", rect);
+    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\", \"sphere\" or \"triangle\" (got \"hexagon\")");
+    expect_bad("b19.json", "\"light\": { \"shape\": \"triangle\", \"vertices\": [[0, 6, 0], [1, 6, 0], [2, 6, 0]] }",
+               "light.vertices must not be collinear");
+    expect_bad("b20.json", "\"light\": { \"shape\": \"triangle\", \"vertices\": [[0, 6, 0], [1, 6, 0]] }",
+               "light.vertices must be an array of 3 points");
+    expect_bad("b21.json", "\"light\": { \"shape\": \"triangle\", \"vertices\": [[0, 6, 0], [1, 6, 0], [0, 6, \"x\"]] }",
+               "light.vertices[2] must be an array of 3 finite numbers");
+    expect_bad("b22.json", "\"light\": { \"shape\": \"triangle\", \"corner\": [0, 6, 0] }", "light.vertices is missing");
     expect_bad("b2.json", "\"light\": { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0] }", "light.radius is missing");
     expect_bad("b3.json", "\"light\": { \"shape\": \"disk\", \"center\": [0, 6, 0], \"normal\": [0, -1, 0], \"radius\": -1 }",
                "light.radius must be in (0,");
@@ -807,8 +851,8 @@ static void test_sphere_irradiance(void **st)
         /* the exact outline in double */
         const double pd[3] = { p[0], p[1], p[2] }, nd[3] = { n[0], n[1], n[2] };
         const double dd = sqrt(pd[0] * pd[0] + pd[1] * pd[1] + pd[2] * pd[2]), f = R * R / (dd * dd);
-        disk_geom dg = { { pd[0] * f, pd[1] * f, pd[2] * f }, { pd[0] / dd, pd[1] / dd, pd[2] / dd },
-                         R * sqrt(dd * dd - R * R) / dd };
+        disk_geom dg = { .c = { pd[0] * f, pd[1] * f, pd[2] * f }, .m = { pd[0] / dd, pd[1] / dd, pd[2] / dd },
+                         .r = R * sqrt(dd * dd - R * R) / dd };
         const double want = disk_irradiance_numeric(&dg, pd, nd, 600);
         const double got = ms_light_irradiance(&sph, p, n);
         const double sin_s = R / dd;
@@ -876,8 +920,8 @@ static void test_sphere_every_method(void **st)
         const double p[3] = { hits[i].p[0], hits[i].p[1], hits[i].p[2] };
         const double w[3] = { p[0] - c[0], p[1] - c[1], p[2] - c[2] };
         const double d = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), f2 = R * R / (d * d);
-        const disk_geom dg = { { c[0] + w[0] * f2, c[1] + w[1] * f2, c[2] + w[2] * f2 }, { w[0] / d, w[1] / d, w[2] / d },
-                               R * sqrt(d * d - R * R) / d };
+        const disk_geom dg = { .c = { c[0] + w[0] * f2, c[1] + w[1] * f2, c[2] + w[2] * f2 },
+                               .m = { w[0] / d, w[1] / d, w[2] / d }, .r = R * sqrt(d * d - R * R) / d };
         int nf = 0, nv = 0, unsure = 0;
         for (int s2 = 0; s2 < 1024; s2++) {
             verdict cnt, v;
@@ -900,6 +944,139 @@ static void test_sphere_every_method(void **st)
     ms_scene_free(&sc);
 }
 
+/* ---- triangle lights ---- */
+
+/* Every method's masks on a triangle light equal the brute force (on the triangle by its barycentric
+ * s + t < 1 in world space) and raytrace's; the grid at two k and with the horizon crossing the light, and
+ * the ray tracers' other patterns. */
+static void test_triangle_every_method(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    disk_geom dg;
+    make_triangle_scene(&sc, (ms_vec3){ -1.2f, 6, -0.8f }, (ms_vec3){ 1.5f, 6.4f, -1.1f }, (ms_vec3){ 0.1f, 5.7f, 1.6f }, &dg);
+    check_disk_methods(&sc, &dg, 24, 32, MS_PATTERN_GRID);
+    check_disk_methods(&sc, &dg, 16, 16, MS_PATTERN_STRATIFIED);
+    check_disk_methods(&sc, &dg, 16, 32, MS_PATTERN_INTERLEAVED);
+    ms_scene_free(&sc);
+    /* low and steep: the triangle crosses the ground's plane */
+    make_triangle_scene(&sc, (ms_vec3){ -2, -0.8f, 4.5f }, (ms_vec3){ 2, -0.8f, 4.5f }, (ms_vec3){ 0, 2.5f, 3.5f }, &dg);
+    check_disk_methods(&sc, &dg, 24, 16, MS_PATTERN_GRID);
+    ms_scene_free(&sc);
+}
+
+/* Whole frames: every method's V, S and front on a triangle light equal raytrace's; half the
+ * parallelogram's samples count. */
+static void test_triangle_frames_equal(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    disk_geom dg;
+    make_triangle_scene(&sc, (ms_vec3){ -1.2f, 6, -0.8f }, (ms_vec3){ 1.5f, 6.4f, -1.1f }, (ms_vec3){ 0.1f, 5.7f, 1.6f }, &dg);
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = 32;
+    o.threads = 2;
+    char err[256];
+    ms_frame ref, f;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        long differ = 0;
+        for (int i = 0; i < 32 * 32; i++)
+            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        if (differ) fprintf(stderr, "triangle frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_frame_free(&f);
+    }
+    sc.light.shape = MS_LIGHT_RECT;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+    double tri_front = 0.0, rect_front = 0.0;
+    for (int i = 0; i < 32 * 32; i++) { tri_front += ref.front[i]; rect_front += f.front[i]; }
+    printf("triangle light: %.4f of the parallelogram's front samples count\n", tri_front / rect_front);
+    assert_true(fabs(tri_front / rect_front - 0.5) < 0.02);
+    ms_frame_free(&f);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
+/* The unshadowed irradiance against numerical integration over the triangle (n^2 sub-triangles, their
+ * centroids, double precision, max(cos theta_r, 0)), above and across the receiver's horizon. */
+static double triangle_irradiance_numeric(const double a[3], const double e1[3], const double e2[3], const double p[3],
+                                          const double n[3], int nsub)
+{
+    double m[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0] };
+    const double ml = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), dA = 0.5 * ml / ((double)nsub * nsub);
+    for (int c = 0; c < 3; c++) m[c] /= ml;
+    double sum = 0.0;
+    for (int i = 0; i < nsub; i++)
+        for (int j = 0; j < nsub - i; j++)
+            for (int up = 0; up < 2; up++) {
+                if (up && i + j + 1 >= nsub) continue;
+                /* the sub-triangle's centroid in (s, t) */
+                const double s = up ? (i + 2.0 / 3.0) / nsub : (i + 1.0 / 3.0) / nsub;
+                const double t = up ? (j + 2.0 / 3.0) / nsub : (j + 1.0 / 3.0) / nsub;
+                double d[3];
+                for (int c = 0; c < 3; c++) d[c] = a[c] + s * e1[c] + t * e2[c] - p[c];
+                const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], dl = sqrt(d2);
+                const double cr = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / dl;
+                const double cl = -(d[0] * m[0] + d[1] * m[1] + d[2] * m[2]) / dl;
+                if (cr > 0.0 && cl > 0.0) sum += cr * cl / d2 * dA;
+            }
+    return sum;
+}
+
+static void test_triangle_irradiance(void **st)
+{
+    (void)st;
+    tu_rng g = { 4321 };
+    double worst = 0.0;
+    int tested = 0, crossing = 0;
+    for (int trial = 0; trial < 200 && tested < 60; trial++) {
+        double v[15];
+        for (int i = 0; i < 15; i++) v[i] = (double)(tu_rng_next(&g) >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0;
+        const ms_vec3 A = { (float)v[0], (float)v[1] + 2.0f, (float)v[2] }, B = { (float)v[3], (float)v[4] + 2.0f, (float)v[5] },
+                      C = { (float)v[6], (float)v[7] + 2.0f, (float)v[8] };
+        ms_light l;
+        memset(&l, 0, sizeof l);
+        if (ms_light_triangle(&l, A, B, C) || ms_light_area(&l) < 0.05f) continue;
+        const float pf[3] = { (float)v[9], (float)v[10], (float)v[11] };
+        double n[3] = { v[12], v[13], v[14] };
+        const double nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (nl < 0.1) continue;
+        float nf[3];
+        for (int c = 0; c < 3; c++) { nf[c] = (float)(n[c] / nl); n[c] = nf[c]; }
+        const double a[3] = { A.x, A.y, A.z }, e1[3] = { (double)B.x - A.x, (double)B.y - A.y, (double)B.z - A.z },
+                     e2[3] = { (double)C.x - A.x, (double)C.y - A.y, (double)C.z - A.z }, p[3] = { pf[0], pf[1], pf[2] };
+        /* p on the emitting side, at least 0.3 from the triangle's plane (the numerical rule's accuracy) */
+        const double m[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0] };
+        const double side = (p[0] - a[0]) * m[0] + (p[1] - a[1]) * m[1] + (p[2] - a[2]) * m[2];
+        if (side < 0.3 * sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2])) continue;   /* 0.3 from its plane */
+        const double want = triangle_irradiance_numeric(a, e1, e2, p, n, 600);
+        if (want < 1e-3) continue;
+        const double got = ms_light_irradiance(&l, pf, nf);
+        int below = 0, above = 0;
+        for (int k = 0; k < 3; k++) {
+            const double q[3] = { a[0] + (k == 1) * e1[0] + (k == 2) * e2[0] - p[0], a[1] + (k == 1) * e1[1] + (k == 2) * e2[1] - p[1],
+                                  a[2] + (k == 1) * e1[2] + (k == 2) * e2[2] - p[2] };
+            const double h = q[0] * n[0] + q[1] * n[1] + q[2] * n[2];
+            below += h < 0.0;
+            above += h > 0.0;
+        }
+        crossing += below && above;
+        tested++;
+        worst = fmax(worst, fabs(got - want) / want);
+    }
+    printf("triangle irradiance vs numerical integration: %d points (%d with the triangle across the horizon), worst "
+           "relative error %.2e\n", tested, crossing, worst);
+    assert_true(tested >= 40 && crossing >= 5);
+    /* centroid rule at 360000 sub-triangles: ~1e-5; the float polygon formula ~1e-6 */
+    assert_true(worst < 2e-4);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -917,6 +1094,9 @@ int main(void)
         cmocka_unit_test(test_sphere_outline),
         cmocka_unit_test(test_sphere_irradiance),
         cmocka_unit_test(test_sphere_every_method),
+        cmocka_unit_test(test_triangle_every_method),
+        cmocka_unit_test(test_triangle_frames_equal),
+        cmocka_unit_test(test_triangle_irradiance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -170,6 +170,7 @@ _method_names = _sig("ms_method_names", ctypes.POINTER(ctypes.c_char_p))
 _irradiance = _sig("ms_light_irradiance", _f, ctypes.POINTER(_Light), ctypes.POINTER(_f), ctypes.POINTER(_f))
 _light_disk = _sig("ms_light_disk", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _Vec3, _f)
 _light_sphere = _sig("ms_light_sphere", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _f)
+_light_triangle = _sig("ms_light_triangle", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _Vec3, _Vec3)
 _nearest = _sig("ms_nearest_name", ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(_size))
 _version = _sig("ms_version", ctypes.c_char_p, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
                 ctypes.POINTER(ctypes.c_int))
@@ -181,12 +182,13 @@ __version__ = _version(None, None, None).decode()
 
 _PATTERNS = {"grid": 0, "stratified": 1, "interleaved": 2}
 _ISAS = {"auto": 0, "scalar": 1, "avx2": 2, "avx512": 3}
-_SHAPES = {"rect": 0, "disk": 1, "sphere": 2}
+_SHAPES = {"rect": 0, "disk": 1, "sphere": 2, "triangle": 3}
 _SHAPE_NAMES = {v: k for k, v in _SHAPES.items()}
 # A light dict's keys per shape: required, then optional.
 _LIGHT_KEYS = {"rect": (("corner", "edge_s", "edge_t"), ("shape", "emission", "texture")),
                "disk": (("center", "normal", "radius"), ("shape", "emission", "texture")),
-               "sphere": (("center", "radius"), ("shape", "emission"))}
+               "sphere": (("center", "radius"), ("shape", "emission")),
+               "triangle": (("vertices",), ("shape", "emission"))}
 
 
 def _errbuf():
@@ -254,7 +256,7 @@ def method_names():
 
 def _light_dict(L):
     """A light as a dict: its shape's parameters (rect: corner, edge_s, edge_t; disk: center, normal,
-    radius; sphere: center, radius), emission, and the texture (h, w, 3) when it has one."""
+    radius; sphere: center, radius; triangle: vertices), emission, and the texture (h, w, 3) when it has one."""
     v = lambda a: (a.x, a.y, a.z)  # noqa: E731
     shape = _SHAPE_NAMES.get(L.shape, "rect")
     d = {"shape": shape, "emission": v(L.emission)}
@@ -265,9 +267,12 @@ def _light_dict(L):
         m = np.cross(es, et)
         d.update(center=tuple(c + (es + et) / 2), normal=tuple(m / np.linalg.norm(m)),
                  radius=float(np.linalg.norm(es) / 2))
+    elif shape == "triangle":
+        c, es, et = (np.array(v(x), np.float64) for x in (L.corner, L.edge_s, L.edge_t))
+        d.update(vertices=(tuple(c), tuple(c + es), tuple(c + et)))
     else:
         d.update(center=v(L.center), radius=float(L.radius))
-    if L.texture and shape != "sphere":
+    if L.texture and shape not in ("sphere", "triangle"):
         d["texture"] = np.ctypeslib.as_array(L.texture, shape=(L.texture_height, L.texture_width, 3)).copy()
     return d
 
@@ -294,6 +299,12 @@ def _light_struct(light, arg="light"):
         if _light_disk(ctypes.byref(L), _vec3(arg + "['center']", light["center"]),
                        _vec3(arg + "['normal']", light["normal"]), float(light["radius"])) != 0:
             raise ValueError("%s: a disk needs a non-zero normal and a radius > 0" % arg)
+    elif shape == "triangle":
+        vs = light["vertices"]
+        if not isinstance(vs, (list, tuple)) or len(vs) != 3:
+            raise ValueError("%s['vertices']: expected 3 points" % arg)
+        if _light_triangle(ctypes.byref(L), *(_vec3(arg + "['vertices'][%d]" % i, vs[i]) for i in range(3))) != 0:
+            raise ValueError("%s: a triangle needs vertices that are not collinear" % arg)
     elif _light_sphere(ctypes.byref(L), _vec3(arg + "['center']", light["center"]), float(light["radius"])) != 0:
         raise ValueError("%s: a sphere needs a radius > 0" % arg)
     if light.get("texture") is not None:

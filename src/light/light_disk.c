@@ -3,6 +3,7 @@
 #include "light_shape.h"
 #include "core/vec.h"
 #include <math.h>
+#include <stdio.h>
 
 #define DISK_POLY 256   /* the irradiance's polygon across the horizon */
 
@@ -110,6 +111,16 @@ static int disk_polygon(const ms_light_frame *F, const float p[3], int sides, fl
     return sides;
 }
 
+static int disk_build(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n)
+{
+    const double r = v->v[2][0];
+    if (!(r > 0) || r > max_coord) { snprintf(msg, n, "radius must be in (0, %g]", (double)max_coord); return -1; }
+    const ms_vec3 c = { (float)v->v[0][0], (float)v->v[0][1], (float)v->v[0][2] };
+    const ms_vec3 m = { (float)v->v[1][0], (float)v->v[1][1], (float)v->v[1][2] };
+    if (ms_light_disk(l, c, m, (float)r)) { snprintf(msg, n, "normal must not be zero"); return -1; }
+    return 0;
+}
+
 const ms_light_shape_ops ms_light_disk_shape = {
     .shape = MS_LIGHT_DISK,
     .name = "disk",
@@ -118,4 +129,7 @@ const ms_light_shape_ops ms_light_disk_shape = {
     .area = disk_area,
     .irradiance = disk_irradiance,
     .polygon = disk_polygon,
+    .keys = { { "center", MS_LIGHT_KEY_POINT, 1, 0, 0 }, { "normal", MS_LIGHT_KEY_VECTOR, 1, 0, 0 },
+              { "radius", MS_LIGHT_KEY_NUMBER, 1, 0, 0 } },
+    .build = disk_build,
 };

@@ -38,6 +38,16 @@ static int rect_polygon(const ms_light_frame *F, const float p[3], int sides, fl
     return 4;
 }
 
+static int rect_build(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n)
+{
+    (void)max_coord; (void)msg; (void)n;   /* the parallelogram is checked as every light is (scene_validate.c) */
+    l->corner = (ms_vec3){ (float)v->v[0][0], (float)v->v[0][1], (float)v->v[0][2] };
+    l->edge_s = (ms_vec3){ (float)v->v[1][0], (float)v->v[1][1], (float)v->v[1][2] };
+    l->edge_t = (ms_vec3){ (float)v->v[2][0], (float)v->v[2][1], (float)v->v[2][2] };
+    l->shape = MS_LIGHT_RECT;
+    return 0;
+}
+
 const ms_light_shape_ops ms_light_rect = {
     .shape = MS_LIGHT_RECT,
     .name = "rect",
@@ -45,4 +55,7 @@ const ms_light_shape_ops ms_light_rect = {
     .area = rect_area,
     .irradiance = rect_irradiance,
     .polygon = rect_polygon,
+    .keys = { { "corner", MS_LIGHT_KEY_POINT, 1, 0, 0 }, { "edge_s", MS_LIGHT_KEY_VECTOR, 1, 0, 0 },
+              { "edge_t", MS_LIGHT_KEY_VECTOR, 1, 0, 0 } },
+    .build = rect_build,
 };

@@ -1,8 +1,9 @@
 /* The light-shape table: one row per shape (microshadow.h's ms_light_shape), each in its own file
  * (light_rect.c, light_disk.c, light_sphere.c), over the light's precomputed frame (light_frame.h). A new
- * shape is one file with its row plus its entry in light_shape.c's table (CONTRIBUTING.md); the scene
- * file's parsing of its keys stays in src/scene (scene_json.c), which checks a light with its row's
- * validate (scene_validate.c).
+ * shape is one file with its row plus its entry in light_shape.c's table (CONTRIBUTING.md). The row names
+ * its scene-file keys and builds the light from their values (keys, build): the scene layer reads the JSON
+ * generically (scene_json.c) and checks a light with the row's validate (scene_validate.c); this layer
+ * knows no JSON.
  *
  * Every shape is a mask over the parameters (s,t) of a parallelogram, so every pattern, every method and
  * the weights stay those of the parallelogram; a shape that is not planar (the sphere) stands, for each
@@ -12,6 +13,21 @@
 #include "microshadow.h"
 #include "light_frame.h"
 #include <stddef.h>
+
+/* A scene-file key of a shape's geometry. A point is moved into the scene's frame before build (the scene
+ * subtracts its origin in double); a vector and a number are taken as they are. */
+typedef enum ms_light_key_kind { MS_LIGHT_KEY_POINT, MS_LIGHT_KEY_VECTOR, MS_LIGHT_KEY_NUMBER } ms_light_key_kind;
+typedef struct ms_light_key {
+    const char *name;           /* NULL ends a row's list */
+    ms_light_key_kind kind;
+    int count;                  /* points and vectors: how many ([x, y, z], or [[x, y, z], ...] when more than 1) */
+    int optional;               /* 1: may be left out, then `fallback` (a number) */
+    double fallback;
+} ms_light_key;
+#define MS_LIGHT_KEYS_MAX 4
+#define MS_LIGHT_KEY_VALUES 9   /* three points */
+/* The values read for a row's keys, in the order of its list: v[key][0 .. 3 count - 1] (a number: v[key][0]). */
+typedef struct ms_light_params { double v[MS_LIGHT_KEYS_MAX][MS_LIGHT_KEY_VALUES]; } ms_light_params;
 
 typedef struct ms_light_shape_ops {
     ms_light_shape shape;
@@ -33,12 +49,26 @@ typedef struct ms_light_shape_ops {
     /* The checks of the shape's own fields beyond the parallelogram's (a scene's lights, scene_validate.c):
      * 0, or -1 with the problem in msg; coordinates must stay within +-max_coord. NULL: none. */
     int (*validate)(const ms_light *l, float max_coord, char *msg, size_t n);
+    /* The scene file's keys of the shape's geometry (besides "shape", the emission's and "texture"). */
+    ms_light_key keys[MS_LIGHT_KEYS_MAX + 1];
+    /* Sets l's geometry and shape from the values of `keys` (points in the scene's frame), leaving its emission
+     * and texture as they are: 0, or -1 with the problem in msg, which begins with the key it concerns
+     * ("radius must be in (0, 1e+18]"); coordinates and lengths must stay within +-max_coord. */
+    int (*build)(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n);
+    /* 1 when l's own fields are finite and make a light of positive area (the points API's check,
+     * render/points.c). NULL: the parallelogram's corner and edges. */
+    int (*finite)(const ms_light *l);
 } ms_light_shape_ops;
 
 /* The row of a shape; NULL for a value outside the enum (validation refuses those before they get here). */
 const ms_light_shape_ops *ms_light_shape_of(ms_light_shape shape);
 /* The row named `name` ("rect", "disk", "sphere"), NULL when there is none. */
 const ms_light_shape_ops *ms_light_shape_named(const char *name);
+/* The rows in table order, for listing names and keys: the i-th (0, 1, ...), NULL past the last. */
+const ms_light_shape_ops *ms_light_shape_at(size_t i);
+/* 1 when l's emission and geometry are finite and its area positive (its row's finite, or the
+ * parallelogram's); 0 also for an unknown shape. */
+int ms_light_finite(const ms_light *l);
 
 /* Lambert's formula over the polygon rel[0..m-1] (vertices relative to the receiver), clipped to its
  * hemisphere n . x >= 0 (irradiance.c); clip: scratch for at least m + 1 vertices. */

@@ -73,6 +73,21 @@ static int sphere_validate(const ms_light *l, float max_coord, char *msg, size_t
     return -1;
 }
 
+static int sphere_build(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n)
+{
+    const double r = v->v[1][0];
+    if (!(r > 0) || r > max_coord) { snprintf(msg, n, "radius must be in (0, %g]", (double)max_coord); return -1; }
+    ms_light_sphere(l, (ms_vec3){ (float)v->v[0][0], (float)v->v[0][1], (float)v->v[0][2] }, (float)r);
+    return 0;
+}
+
+/* Centre and radius; the parallelogram fields are unused. */
+static int sphere_finite(const ms_light *l)
+{
+    return isfinite(l->center.x) && isfinite(l->center.y) && isfinite(l->center.z) && isfinite(l->radius) &&
+           l->radius > 0.0f;
+}
+
 const ms_light_shape_ops ms_light_sphere_shape = {
     .shape = MS_LIGHT_SPHERE,
     .name = "sphere",
@@ -81,4 +96,7 @@ const ms_light_shape_ops ms_light_sphere_shape = {
     .irradiance = sphere_irradiance_f,
     .outline = ms_light_sphere_outline,
     .validate = sphere_validate,
+    .keys = { { "center", MS_LIGHT_KEY_POINT, 1, 0, 0 }, { "radius", MS_LIGHT_KEY_NUMBER, 1, 0, 0 } },
+    .build = sphere_build,
+    .finite = sphere_finite,
 };

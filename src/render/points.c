@@ -9,7 +9,6 @@
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
-#include "light/light_frame.h"
 #include "shadow/method.h"
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
@@ -161,18 +160,6 @@ static int cmp_morton(const void *a, const void *b)
 
 static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
-static int light_ok(const ms_light *l)
-{
-    if (!isfinite(l->emission.x) || !isfinite(l->emission.y) || !isfinite(l->emission.z)) return 0;
-    if (l->shape == MS_LIGHT_SPHERE)   /* centre and radius; the parallelogram fields are unused */
-        return isfinite(l->center.x) && isfinite(l->center.y) && isfinite(l->center.z) && isfinite(l->radius) &&
-               l->radius > 0.0f;
-    ms_light_frame F;
-    ms_light_frame_of(l, &F);
-    if (!v3_finite(F.corner) || !v3_finite(F.edge_s) || !v3_finite(F.edge_t)) return 0;
-    return v3_dot(F.normal, F.normal) > 0.0f;
-}
-
 /* Checks the arguments that do not need the method; MS_OK or MS_ERR_INVALID with a message. */
 static ms_status check_points(const ms_accel *a, const ms_points *pts, char *err, size_t errlen)
 {
@@ -244,8 +231,8 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     if (stats) memset(stats, 0, sizeof *stats);
     if (!a) { snprintf(err, errlen, "ms_visibility_points: no accel"); return MS_ERR_INVALID; }
     if (!light) light = &a->view.light;
-    if (!light_ok(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area (a sphere: radius not > 0)"); return MS_ERR_INVALID; }
-    if ((unsigned)light->shape > MS_LIGHT_SPHERE) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
+    if (!ms_light_shape_of(light->shape)) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
+    if (!ms_light_finite(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area (a sphere: radius not > 0)"); return MS_ERR_INVALID; }
     ms_status st = check_points(a, pts, err, errlen);
     if (st) return st;
     const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;

@@ -385,9 +385,8 @@ static long texture_of(const cgltf_data *d, const cgltf_options *opt, const cglt
  * others named in a warning); any other in extensionsRequired is an error, in extensionsUsed one warning
  * each saying what is left out. */
 static const char *const known_ext[] = { "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_texture_basisu",
-                                         "KHR_mesh_quantization" };
+                                         "KHR_mesh_quantization", "KHR_lights_punctual" };
 static const struct { const char *name, *left_out; } ext_left_out[] = {
-    { "KHR_lights_punctual", "its lights are ignored (lights come from the scene file)" },
     { "KHR_materials_unlit", "unlit materials are shaded as lit" },
     { "KHR_materials_pbrSpecularGlossiness", "specular-glossiness is ignored (metallic-roughness or the defaults shade)" },
     { "KHR_materials_variants", "only the default materials are used" },
@@ -502,6 +501,37 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
 
 typedef struct node_item { const cgltf_node *node; float parent[16]; } node_item;
 
+/* The node's KHR_lights_punctual light, placed by its world matrix (column-major): position its origin,
+ * direction its -Z axis; extras.radius read from the extras' JSON text when present. */
+static int push_punctual(ms_tri_soup *soup, const cgltf_light *cl, const float world[16], const char *path, char *err,
+                         size_t errlen)
+{
+    ms_punctual *grown = realloc(soup->punctual, (soup->n_punctual + 1) * sizeof *grown);
+    if (!grown) { snprintf(err, errlen, "%s: out of memory for its lights", path); return -1; }
+    soup->punctual = grown;
+    ms_punctual *p = &grown[soup->n_punctual++];
+    memset(p, 0, sizeof *p);
+    p->type = cl->type == cgltf_light_type_spot ? MS_PUNCTUAL_SPOT
+            : cl->type == cgltf_light_type_directional ? MS_PUNCTUAL_DIRECTIONAL : MS_PUNCTUAL_POINT;
+    for (int c = 0; c < 3; c++) p->color[c] = isfinite(cl->color[c]) && cl->color[c] > 0.0f ? cl->color[c] : 0.0f;
+    p->intensity = isfinite(cl->intensity) && cl->intensity > 0.0f ? cl->intensity : 0.0f;
+    double len = 0.0;
+    for (int c = 0; c < 3; c++) {
+        p->pos[c] = world[12 + c];
+        p->dir[c] = -(double)world[8 + c];
+        len += p->dir[c] * p->dir[c];
+    }
+    len = sqrt(len);
+    for (int c = 0; c < 3; c++) p->dir[c] = len > 0.0 ? p->dir[c] / len : (c == 2 ? -1.0 : 0.0);
+    const char *r = cl->extras.data ? strstr(cl->extras.data, "\"radius\"") : NULL;
+    if (r && (r = strchr(r, ':')) != NULL) {
+        const double v = strtod(r + 1, NULL);
+        if (isfinite(v) && v > 0.0 && v < 1e18) p->radius = (float)v;
+    }
+    p->mesh = soup->cur_mesh;
+    return 0;
+}
+
 /* Depth-first over the node trees without recursion; every node at most once (glTF requires trees,
  * and a node listed twice would expand exponentially: 41 such nodes are 2^40 instances). */
 static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup, size_t *added, size_t max_tris,
@@ -530,6 +560,7 @@ static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup
             float local[16], world[16];
             cgltf_node_transform_local(it.node, local);
             mat4_mul(world, it.parent, local);
+            if (it.node->light && !rc) rc = push_punctual(soup, it.node->light, world, path, err, errlen);
             if (it.node->mesh) ms_soup_new_object(soup);   /* each node's mesh is an object (lightmap UVs per object) */
             if (it.node->mesh)
                 for (size_t p = 0; p < it.node->mesh->primitives_count && !rc; p++)

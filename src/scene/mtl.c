@@ -4,7 +4,7 @@
  * metallic Pm (default 0), roughness Pr, else from the Phong exponent Ns as GGX alpha = sqrt(2 / (Ns + 2))
  * (Walter et al. 2007, eq. 33: the Beckmann width of a Phong lobe), else 1. map_d makes the material
  * alpha-tested (MS_ALPHA_MASK_MAP, cutoff 0.5, alpha = d times the map); d alone (no map) stays opaque for
- * visibility: a uniformly translucent surface is not a cut-out. */
+ * visibility: a uniformly translucent surface is not a cut-out. Ke is the emission (linear radiance). */
 #include "scene_internal.h"
 #include "microshadow.h"
 #include <ctype.h>
@@ -146,6 +146,10 @@ int ms_mtl_load_memory(char *buf, size_t len, const char *path, ms_tri_soup *sou
             p.m.base_color[3] = clamp01(f[0]);
         } else if (KEY("Tr") && floats(arg, f, 1) == 1) {
             p.m.base_color[3] = clamp01(1.0f - f[0]);
+        } else if (KEY("Ke") && floats(arg, f, 3) == 3) {
+            /* emission (linear radiance), bounded like glTF's; an emissive material may also become a light
+             * (scene file "lights_from_emissive", scene_emitters.c) */
+            for (int c = 0; c < 3; c++) p.m.emissive[c] = f[c] >= 0.0f && f[c] <= MS_MAX_RADIANCE ? f[c] : 0.0f;
         } else if (KEY("Pm") && floats(arg, f, 1) == 1) {
             p.m.metallic = clamp01(f[0]);
         } else if (KEY("Pr") && floats(arg, f, 1) == 1) {

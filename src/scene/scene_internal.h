@@ -13,10 +13,35 @@
 #define MS_MAX_TRIS_PER_BYTE 4                    /* triangles emitted per input byte (glTF instancing) */
 #define MS_MAX_LIGHT_TEXTURE 8192                 /* texels per side of a light's emission image */
 #define MS_MAX_COORD 1e18f                        /* |coordinate|: squares and cross products stay finite in float */
+#define MS_MAX_LIGHTS 64                          /* a frame holds V and S per light: bounded memory */
 
 struct ms_scene;
+/* A glTF KHR_lights_punctual light where the file puts it (mesh_gltf.c; world coordinates, the scene file's
+ * mesh transform applied by scene_json.c), made a light by scene_punctual.c. */
+enum { MS_PUNCTUAL_POINT = 0, MS_PUNCTUAL_SPOT = 1, MS_PUNCTUAL_DIRECTIONAL = 2 };
+typedef struct ms_punctual {
+    int type;
+    float color[3], intensity;   /* linear RGB; candela (point, spot) or lux (directional) */
+    double pos[3], dir[3];       /* the node's origin and its -Z axis (unit) */
+    float radius;                /* extras.radius; 0: not given */
+    uint32_t mesh;               /* the scene file's mesh entry */
+} ms_punctual;
 /* rel resolved against the folder of json_path (absolute paths as they are) into out; -1 if too long. */
 int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n);
+struct ms_light;
+/* The lights of the scene's emissive triangles (scene_emitters.c): *out (malloc'd, NULL when none) and
+ * *n_out; 0, or -1 with one line in err (naming path) when they would be more than `room` lights. */
+struct ms_light;
+/* The punctual lights p[0 .. n-1] as area lights in the scene's frame (scene_punctual.c): *out (malloc'd,
+ * NULL when none) and *n_out; radius default_radius where the light gives none; what is approximated or
+ * left out is told through warn; 0, or -1 with one line in err (naming path) when more than `room`. */
+int ms_scene_punctual_lights(const ms_punctual *p, size_t n, const double origin[3], double default_radius, size_t room,
+                             const char *path, void (*warn)(const char *line), struct ms_light **out, size_t *n_out,
+                             char *err, size_t errlen);
+/* How many of the scene's triangles emit (those ms_scene_emitter_lights would make lights of). */
+size_t ms_scene_emissive_triangles(const struct ms_scene *s);
+int ms_scene_emitter_lights(const struct ms_scene *s, size_t room, const char *path, struct ms_light **out,
+                            size_t *n_out, char *err, size_t errlen);
 #define MS_SOUP_UV_SETS 4   /* = MS_MAX_UV_SETS */
 /* Triangles as they are loaded, with the mesh each came from (cur_mesh at the push) and, per UV set,
  * the UVs of its vertices (6 floats; the array appears with the first triangle that has the set, NaN
@@ -51,6 +76,8 @@ typedef struct ms_tri_soup {
     float *tangent;
     size_t tangent_n;
     int allow_outside_paths;   /* files named by the meshes may lie outside their folders (ms_resolve_inside) */
+    ms_punctual *punctual;     /* glTF KHR_lights_punctual lights (ms_soup_free frees them) */
+    size_t n_punctual;
 } ms_tri_soup;
 /* Tangents t12 (12 floats per triangle) of triangles [first, first + count); 0, or -1 out of memory. */
 int ms_soup_set_tangents(ms_tri_soup *soup, size_t first, size_t count, const float *t12);

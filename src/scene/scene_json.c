@@ -4,6 +4,7 @@
 #include "mesh_transform.h"
 #include "../image/png_read.h"
 #include "../image/exr_read.h"
+#include "../light/light_shape.h"
 _Static_assert(MS_SOUP_UV_SETS == MS_MAX_UV_SETS, "one count of UV sets");
 #include <cjson/cJSON.h>
 #include <ctype.h>
@@ -26,7 +27,8 @@ static int line_of(const char *text, size_t off)
 
 /* Known keys, per object, for the unknown-key warnings. */
 static const char *const top_keys[] = { "meshes", "procedural", "camera", "light", "lights", "render",
-                                        "allow_outside_paths", NULL };
+                                        "allow_outside_paths", "lights_from_emissive", "lights_from_punctual",
+                                        "punctual_radius", NULL };
 static const char *const procedural_keys[] = { "type", "triangles", "seed", NULL };
 /* The camera's keys depend on camera.type (docs/cameras.md): each type reads the common ones and its own. */
 #define CAMERA_COMMON_KEYS "type", "eye", "target", "up", "width", "height"
@@ -44,8 +46,10 @@ static const struct { const char *name; ms_camera_type type; const char *const *
 };
 /* The keys of the camera being parsed (its type's), for the unknown-key warnings and typo hints. */
 static _Thread_local const char *const *camera_keys = camera_keys_pinhole;
-static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t", "center", "normal", "radius",
-                                          "emission", "power", "lumens", "texture", NULL };
+/* A light's keys: "shape", every shape's own (its row's keys, light/light_shape.h, in table order), the
+ * emission's and "texture" (light_keys_fill). */
+#define LIGHT_KEYS_MAX 48
+static _Thread_local const char *light_keys[LIGHT_KEYS_MAX] = { "shape", NULL };
 static const char *const render_keys[] = { "samples", NULL };
 static const char *const mesh_keys[] = { "file", "transform", "lightmap", NULL };
 static const char *const mesh_lightmap_keys[] = { "scale", NULL };
@@ -199,8 +203,9 @@ static void vec3_d(const cJSON *obj, const char *key, double out[3])
     for (int i = 0; i < 3; i++) out[i] = a ? cJSON_GetArrayItem(a, i)->valuedouble : 0.0;
 }
 
-/* A light's position as the file gives it, and what re-derives the light from it in the scene's frame. */
-typedef struct light_pos { double p[3]; ms_vec3 normal; float radius; } light_pos;
+/* A light's shape and the values of its geometry keys as the file gives them: what re-derives the light in
+ * the scene's frame. */
+typedef struct light_pos { const ms_light_shape_ops *shape; ms_light_params v; } light_pos;
 
 static int get_number(const cJSON *obj, const char *objname, const char *key, int required, double *out,
                       const char *path, char *err, size_t errlen)
@@ -242,7 +247,6 @@ static const cJSON *get_object(const cJSON *root, const char *key, const char *p
 
 /* ---- Lights: "light": {...} (one) or "lights": [{...}, ...] (docs/design.md, "Light shapes", "Units") ---- */
 
-#define MS_MAX_LIGHTS 64   /* a frame holds V and S per light: bounded memory */
 
 /* Reads key as a number (grey) or an array of three numbers, none negative; 1 if present, 0 if not, -1 bad. */
 static int get_amount(const cJSON *obj, const char *objname, const char *key, ms_vec3 *out, const char *path,
@@ -266,63 +270,132 @@ static int get_amount(const cJSON *obj, const char *objname, const char *key, ms
     return 1;
 }
 
-/* One light object: "shape" ("rect", the default, "disk" or "sphere"), its geometry, and at most one of
- * "emission" (radiance), "power" (watts) or "lumens" (luminous flux), default emission 1. */
+/* light_keys: "shape", every row's keys once each, then the emission's and "texture". */
+static void light_keys_fill(void)
+{
+    static const char *const tail[] = { "emission", "power", "lumens", "texture" };
+    size_t n = 0;
+    light_keys[n++] = "shape";
+    light_keys[n] = NULL;
+    const ms_light_shape_ops *o;
+    for (size_t i = 0; (o = ms_light_shape_at(i)) != NULL; i++)
+        for (int k = 0; o->keys[k].name; k++)
+            if (!is_known(o->keys[k].name, light_keys) && n + 1 < LIGHT_KEYS_MAX - 4) {
+                light_keys[n++] = o->keys[k].name;
+                light_keys[n] = NULL;
+            }
+    for (size_t i = 0; i < 4; i++) light_keys[n++] = tail[i];
+    light_keys[n] = NULL;
+}
+
+/* The shapes' names for messages: "\"rect\", \"disk\" or \"sphere\"" (textured_only: those that take a texture). */
+static void shape_names(char *buf, size_t n, int textured_only)
+{
+    const ms_light_shape_ops *o, *names[16];
+    size_t m = 0, len = 0;
+    buf[0] = 0;
+    for (size_t i = 0; (o = ms_light_shape_at(i)) != NULL && m < 16; i++)
+        if (!textured_only || o->textured) names[m++] = o;
+    for (size_t i = 0; i < m && len < n; i++) {
+        const int k = snprintf(buf + len, n - len, "%s\"%s\"", i == 0 ? "" : i + 1 == m ? " or " : ", ", names[i]->name);
+        if (k < 0) break;
+        len += (size_t)k;
+    }
+}
+
+/* The values of a shape's geometry keys (its row's keys): each point or vector as get_vec3 checks it ([x, y, z],
+ * or count of them nested), each number by get_number (an optional one absent: its fallback). */
+static int get_light_keys(const cJSON *obj, const char *objname, const ms_light_shape_ops *o, ms_light_params *v,
+                          const char *path, char *err, size_t errlen)
+{
+    memset(v, 0, sizeof *v);
+    for (int k = 0; o->keys[k].name; k++) {
+        const ms_light_key *key = &o->keys[k];
+        const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key->name);
+        if (key->kind == MS_LIGHT_KEY_NUMBER) {
+            v->v[k][0] = key->fallback;
+            if (get_number(obj, objname, key->name, !key->optional, &v->v[k][0], path, err, errlen)) return -1;
+            continue;
+        }
+        if (key->count == 1) {
+            ms_vec3 f;
+            if (get_vec3(obj, objname, key->name, !key->optional, &f, path, err, errlen)) return -1;
+            vec3_d(obj, key->name, v->v[k]);
+            continue;
+        }
+        if (!item) {
+            if (key->optional) continue;
+            missing(obj, objname, key->name, path, err, errlen);
+            return -1;
+        }
+        if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != key->count) {
+            snprintf(err, errlen, "%s: %s.%s must be an array of %d points [x, y, z]", path, objname, key->name, key->count);
+            return -1;
+        }
+        for (int i = 0; i < key->count; i++) {
+            const cJSON *pt = cJSON_GetArrayItem(item, i);
+            if (!cJSON_IsArray(pt) || cJSON_GetArraySize(pt) != 3) {
+                snprintf(err, errlen, "%s: %s.%s[%d] must be an array of 3 numbers", path, objname, key->name, i);
+                return -1;
+            }
+            for (int c = 0; c < 3; c++) {
+                const cJSON *x = cJSON_GetArrayItem(pt, c);
+                if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) {
+                    snprintf(err, errlen, "%s: %s.%s[%d] must be an array of 3 finite numbers", path, objname, key->name, i);
+                    return -1;
+                }
+                if (float_ok(x->valuedouble, objname, key->name, 3 * i + c, path, err, errlen)) return -1;
+                v->v[k][3 * i + c] = x->valuedouble;
+            }
+        }
+    }
+    return 0;
+}
+
+/* Builds l's geometry from the values of its shape's keys with the scene's origin o subtracted from its points
+ * (in double, then rounded once, as ms_scene_frame_point). */
+static int light_build(ms_light *l, const light_pos *lp, const double o[3], char *msg, size_t n)
+{
+    ms_light_params v = lp->v;
+    for (int k = 0; lp->shape->keys[k].name; k++)
+        if (lp->shape->keys[k].kind == MS_LIGHT_KEY_POINT)
+            for (int i = 0; i < 3 * lp->shape->keys[k].count; i++) v.v[k][i] -= o[i % 3];
+    return lp->shape->build(l, &v, MS_MAX_COORD, msg, n);
+}
+
+/* One light object: "shape" (a row of light/light_shape.h's table; "rect" by default), its geometry (the
+ * row's keys), and at most one of "emission" (radiance), "power" (watts) or "lumens" (luminous flux),
+ * default emission 1. */
 static int parse_light(const cJSON *obj, const char *objname, ms_light *l, light_pos *lp, const char *path, char *err,
                        size_t errlen)
 {
     if (!cJSON_IsObject(obj)) { snprintf(err, errlen, "%s: %s must be an object", path, objname); return -1; }
+    light_keys_fill();
     warn_unknown(obj, objname, light_keys, path);
     memset(l, 0, sizeof *l);
     const cJSON *shape = cJSON_GetObjectItemCaseSensitive(obj, "shape");
     const char *sh = "rect";
+    char names[160];
+    shape_names(names, sizeof names, 0);
     if (shape) {
-        if (!cJSON_IsString(shape)) { snprintf(err, errlen, "%s: %s.shape must be \"rect\", \"disk\" or \"sphere\"", path, objname); return -1; }
+        if (!cJSON_IsString(shape)) { snprintf(err, errlen, "%s: %s.shape must be %s", path, objname, names); return -1; }
         sh = shape->valuestring;
     }
-    if (!strcmp(sh, "rect")) {
-        if (get_vec3(obj, objname, "corner", 1, &l->corner, path, err, errlen) ||
-            get_vec3(obj, objname, "edge_s", 1, &l->edge_s, path, err, errlen) ||
-            get_vec3(obj, objname, "edge_t", 1, &l->edge_t, path, err, errlen))
-            return -1;
-        vec3_d(obj, "corner", lp->p);
-    } else if (!strcmp(sh, "disk")) {
-        ms_vec3 c = { 0, 0, 0 }, m = { 0, 0, 0 };
-        double r = 0;
-        if (get_vec3(obj, objname, "center", 1, &c, path, err, errlen) ||
-            get_vec3(obj, objname, "normal", 1, &m, path, err, errlen) ||
-            get_number(obj, objname, "radius", 1, &r, path, err, errlen))
-            return -1;
-        if (!(r > 0) || r > MS_MAX_COORD) {
-            snprintf(err, errlen, "%s: %s.radius must be in (0, %g]", path, objname, (double)MS_MAX_COORD);
-            return -1;
-        }
-        if (ms_light_disk(l, c, m, (float)r)) {
-            snprintf(err, errlen, "%s: %s.normal must not be zero", path, objname);
-            return -1;
-        }
-        vec3_d(obj, "center", lp->p);
-        lp->normal = m;
-        lp->radius = (float)r;
-    } else if (!strcmp(sh, "sphere")) {
-        ms_vec3 c = { 0, 0, 0 };
-        double r = 0;
-        if (get_vec3(obj, objname, "center", 1, &c, path, err, errlen) ||
-            get_number(obj, objname, "radius", 1, &r, path, err, errlen))
-            return -1;
-        if (!(r > 0) || r > MS_MAX_COORD) {
-            snprintf(err, errlen, "%s: %s.radius must be in (0, %g]", path, objname, (double)MS_MAX_COORD);
-            return -1;
-        }
-        if (cJSON_GetObjectItemCaseSensitive(obj, "texture")) {
-            snprintf(err, errlen, "%s: %s: a sphere light cannot be textured (rect and disk can)", path, objname);
-            return -1;
-        }
-        ms_light_sphere(l, c, (float)r);
-        vec3_d(obj, "center", lp->p);
-        lp->radius = (float)r;
-    } else {
-        snprintf(err, errlen, "%s: %s.shape must be \"rect\", \"disk\" or \"sphere\" (got \"%.40s\")", path, objname, sh);
+    lp->shape = ms_light_shape_named(sh);
+    if (!lp->shape) {
+        snprintf(err, errlen, "%s: %s.shape must be %s (got \"%.40s\")", path, objname, names, sh);
+        return -1;
+    }
+    if (get_light_keys(obj, objname, lp->shape, &lp->v, path, err, errlen)) return -1;
+    if (!lp->shape->textured && cJSON_GetObjectItemCaseSensitive(obj, "texture")) {
+        shape_names(names, sizeof names, 1);
+        snprintf(err, errlen, "%s: %s: a %s light cannot be textured (%s can)", path, objname, sh, names);
+        return -1;
+    }
+    static const double no_origin[3] = { 0.0, 0.0, 0.0 };
+    char msg[200];
+    if (light_build(l, lp, no_origin, msg, sizeof msg)) {
+        snprintf(err, errlen, "%s: %s.%s", path, objname, msg);
         return -1;
     }
     static const char *const unit_key[] = { "emission", "power", "lumens" };
@@ -382,12 +455,15 @@ int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n)
     return k < 0 || (size_t)k >= n ? -1 : 0;
 }
 
-/* lp: MS_MAX_LIGHTS positions as the file gives them (scene_frame.c). */
-static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, const char *path, char *err, size_t errlen)
+/* lp: MS_MAX_LIGHTS positions as the file gives them (scene_frame.c). none_ok: the file may name no light
+ * (the emitters will be the lights; nothing is set then). */
+static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, int none_ok, const char *path, char *err,
+                        size_t errlen)
 {
     const cJSON *one = cJSON_GetObjectItemCaseSensitive(root, "light");
     const cJSON *many = cJSON_GetObjectItemCaseSensitive(root, "lights");
     if (one && many) { snprintf(err, errlen, "%s: give either \"light\" or \"lights\", not both", path); return -1; }
+    if (!one && !many && none_ok) return 0;
     if (!many) {
         const cJSON *light = get_object(root, "light", path, err, errlen);
         return light ? parse_light(light, "light", &out->light, lp, path, err, errlen) : -1;
@@ -413,6 +489,71 @@ static int parse_lights(const cJSON *root, ms_scene *out, light_pos *lp, const c
 static int parse_with(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
                       ms_scene *out, char *err, size_t errlen);
 
+/* A glTF file's mesh-entry transform m (3 x 4, row-major) on a punctual light: its position moved, its
+ * direction turned by the linear part (renormalised). */
+static void punctual_transform(ms_punctual *p, const double m[12])
+{
+    double pos[3], dir[3], len = 0.0;
+    for (int r = 0; r < 3; r++) {
+        pos[r] = m[4 * r] * p->pos[0] + m[4 * r + 1] * p->pos[1] + m[4 * r + 2] * p->pos[2] + m[4 * r + 3];
+        dir[r] = m[4 * r] * p->dir[0] + m[4 * r + 1] * p->dir[1] + m[4 * r + 2] * p->dir[2];
+        len += dir[r] * dir[r];
+    }
+    len = sqrt(len);
+    for (int r = 0; r < 3; r++) { p->pos[r] = pos[r]; if (len > 0.0) p->dir[r] = dir[r] / len; }
+}
+
+static void warn_line(const char *line)
+{
+    if (g_warnings && g_warnings->n < MAX_WARNINGS)
+        snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%s", line);
+}
+
+/* Appends add[0 .. n_add-1] to the scene's lights (have: how many it has; "light" alone becomes lights[0]). */
+static int append_lights(ms_scene *out, size_t have, ms_light *add, size_t n_add, const char *path, char *err, size_t errlen)
+{
+    if (!n_add) return 0;
+    ms_light *all = realloc(out->lights, (have + n_add) * sizeof *all);
+    if (!all) { free(add); snprintf(err, errlen, "%s: out of memory for the lights", path); return -1; }
+    if (have == 1 && !out->n_lights) all[0] = out->light;   /* "light": it becomes lights[0], texture and all */
+    memcpy(all + have, add, n_add * sizeof *add);
+    free(add);
+    out->lights = all;
+    out->n_lights = have + n_add;
+    out->light = all[0];
+    return 0;
+}
+
+/* The asset's own lights after those the file names (file_lights: it names some): its KHR_lights_punctual
+ * lights (punct NULL: not wanted), then its emissive triangles (emitters: wanted). */
+static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const ms_punctual *punct, size_t n_punct,
+                            double punctual_radius, const char *path, char *err, size_t errlen)
+{
+    size_t have = out->n_lights ? out->n_lights : file_lights ? 1 : 0;
+    ms_light *add = NULL;
+    size_t n_add = 0;
+    if (punct) {
+        if (ms_scene_punctual_lights(punct, n_punct, out->origin, punctual_radius, MS_MAX_LIGHTS - have, path, warn_line,
+                                     &add, &n_add, err, errlen) ||
+            append_lights(out, have, add, n_add, path, err, errlen))
+            return -1;
+        have += n_add;
+    }
+    if (emitters) {
+        if (ms_scene_emitter_lights(out, MS_MAX_LIGHTS - have, path, &add, &n_add, err, errlen) ||
+            append_lights(out, have, add, n_add, path, err, errlen))
+            return -1;
+        have += n_add;
+    }
+    if (!have) {
+        snprintf(err, errlen, "%s: \"light\" is missing: the scene file names no light (\"light\" or \"lights\") and its meshes have neither "
+                 "emissive triangles (glTF emissiveFactor, MTL Ke) nor KHR_lights_punctual point or spot lights to light it",
+                 path);
+        return -1;
+    }
+    return 0;
+}
+
 /* The camera's eye and target and the lights' positions in the scene's frame (out->origin), from the
  * numbers of the file; nothing changes when the frame is the world's. */
 static void frame_camera_lights(const cJSON *cam, ms_scene *out, const light_pos *lp)
@@ -430,11 +571,8 @@ static void frame_camera_lights(const cJSON *cam, ms_scene *out, const light_pos
     const size_t n = out->n_lights ? out->n_lights : 1;
     for (size_t i = 0; i < n; i++) {
         ms_light *l = out->n_lights ? &out->lights[i] : &out->light;
-        ms_scene_frame_point(lp[i].p, o, f);
-        const ms_vec3 c = { f[0], f[1], f[2] };
-        if (l->shape == MS_LIGHT_DISK) ms_light_disk(l, c, lp[i].normal, lp[i].radius);
-        else if (l->shape == MS_LIGHT_SPHERE) ms_light_sphere(l, c, lp[i].radius);
-        else l->corner = c;
+        char msg[200];
+        light_build(l, &lp[i], o, msg, sizeof msg);   /* built from the same values at parse time: it succeeds */
     }
     if (out->n_lights) out->light = out->lights[0];
 }
@@ -551,9 +689,29 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         else c->fov = (float)v;
     }
 
+    /* The asset's emitters as lights (scene_emitters.c): by default when the file names no light. */
+    const int file_lights = cJSON_GetObjectItemCaseSensitive(root, "light") || cJSON_GetObjectItemCaseSensitive(root, "lights");
+    const cJSON *from_emissive = cJSON_GetObjectItemCaseSensitive(root, "lights_from_emissive");
+    if (from_emissive && !cJSON_IsBool(from_emissive)) {
+        snprintf(err, errlen, "%s: \"lights_from_emissive\" must be true or false", json_path);
+        goto done;
+    }
+    const int emitters = from_emissive ? cJSON_IsTrue(from_emissive) : !file_lights;
+    const cJSON *from_punctual = cJSON_GetObjectItemCaseSensitive(root, "lights_from_punctual");
+    if (from_punctual && !cJSON_IsBool(from_punctual)) {
+        snprintf(err, errlen, "%s: \"lights_from_punctual\" must be true or false", json_path);
+        goto done;
+    }
+    const int punctuals = from_punctual ? cJSON_IsTrue(from_punctual) : !file_lights;
+    double punctual_radius = 0.05;
+    if (get_number(root, "", "punctual_radius", 0, &punctual_radius, json_path, err, errlen)) goto done;
+    if (!(punctual_radius > 0.0) || punctual_radius > MS_MAX_COORD) {
+        snprintf(err, errlen, "%s: \"punctual_radius\" must be in (0, %g]", json_path, (double)MS_MAX_COORD);
+        goto done;
+    }
     light_pos lpos[MS_MAX_LIGHTS];
     memset(lpos, 0, sizeof lpos);
-    if (parse_lights(root, out, lpos, json_path, err, errlen)) goto done;
+    if (parse_lights(root, out, lpos, emitters || punctuals, json_path, err, errlen)) goto done;
 
     out->samples = 1024;
     const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
@@ -590,6 +748,7 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         out->procedural.type = MS_PROCEDURAL_FLOWERS;
         out->procedural.seed = (uint32_t)seed;
         out->n_tris = (size_t)tris;
+        if (!file_lights) { missing(root, "", "light", json_path, err, errlen); goto done; }   /* no emitters here */
         rc = ms_scene_validate(out, json_path, err, errlen);
         goto done;
     }
@@ -683,6 +842,8 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     for (int k = 0; k < i; k++) {
         if (ent[k].has_xf) ms_soup_transform(&soup, ent[k].from, ent[k].to, ent[k].xf);
         lm_scale[k] = ent[k].lightmap_scale;
+        for (size_t q = 0; q < soup.n_punctual && ent[k].has_xf; q++)
+            if (soup.punctual[q].mesh == (uint32_t)k) punctual_transform(&soup.punctual[q], ent[k].xf);
         free(ent[k].path);
     }
     out->mesh_lightmap_scale = lm_scale;
@@ -709,6 +870,21 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     out->tri_tangent = ms_soup_take_tangents(&soup);
     out->textures = soup.tex;
     out->n_textures = soup.n_tex;
+    if (add_asset_lights(out, file_lights, emitters, punctuals ? soup.punctual : NULL, soup.n_punctual, punctual_radius,
+                         json_path, err, errlen)) {
+        free(soup.punctual);
+        goto done;
+    }
+    if (!punctuals && soup.n_punctual && g_warnings && g_warnings->n < MAX_WARNINGS)
+        snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%.120s: %zu KHR_lights_punctual light%s "
+                 "ignored (the scene file names its lights; \"lights_from_punctual\": true adds them)", json_path,
+                 soup.n_punctual, soup.n_punctual > 1 ? "s" : "");
+    free(soup.punctual);
+    const size_t n_emissive = emitters ? 0 : ms_scene_emissive_triangles(out);
+    if (n_emissive && g_warnings && g_warnings->n < MAX_WARNINGS)
+        snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%.120s: %zu emissive triangle%s not made "
+                 "lights (the scene file names its lights; \"lights_from_emissive\": true adds them)", json_path, n_emissive,
+                 n_emissive > 1 ? "s" : "");
     rc = ms_scene_validate(out, json_path, err, errlen);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);

@@ -110,5 +110,6 @@ void ms_soup_free(ms_tri_soup *soup)
     free(soup->mats);
     for (size_t i = 0; i < soup->n_tex; i++) free(soup->tex[i].rgba);
     free(soup->tex);
+    free(soup->punctual);
     memset(soup, 0, sizeof *soup);
 }

@@ -253,6 +253,19 @@ class LightsTest(unittest.TestCase):
     def tearDownClass(cls):
         cls.dir.cleanup()
 
+    def test_triangle_light(self):
+        # a triangle from a scene file comes out with its vertices, and goes back in as the same light
+        tri = {"shape": "triangle", "vertices": [[-1, 6, -1], [1, 6, -1], [-1, 6, 1]], "emission": [1, 2, 3]}
+        path = os.path.join(self.dir.name, "triangle.json")
+        with open(path, "w") as f:
+            f.write(scene_json([tri]))
+        got = ms.load(path).lights[0]
+        self.assertEqual(got["shape"], "triangle")
+        np.testing.assert_array_equal(np.asarray(got["vertices"], float), np.asarray(tri["vertices"], float))
+        np.testing.assert_array_equal(np.asarray(got["emission"], float), np.asarray(tri["emission"], float))
+        L, _ = ms._light_struct(got)
+        self.assertEqual(ms._light_dict(L)["vertices"], got["vertices"])
+
     def test_lights_out(self):
         got = self.scenes["all"].lights
         self.assertEqual([l["shape"] for l in got], ["rect", "disk", "sphere"])

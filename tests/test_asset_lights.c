@@ -1,0 +1,370 @@
+/* The asset's own emitters as lights (scene file "lights_from_emissive", src/scene/scene_emitters.c), each
+ * against an oracle of its own, on glTF and OBJ files written here:
+ *   - a Cornell-box-like glTF whose scene file names no light: its emitter quad (two triangles) is one rect
+ *     light with emissiveFactor x KHR_materials_emissive_strength, facing down; the floor's unshadowed
+ *     irradiance under it equals the analytic form factor of a parallel rectangle (Howell's corner formula,
+ *     summed over four corner rectangles) times the emission; the emitter casts no shadow on the floor under
+ *     it (V = S = 1 by every method), while it does shadow a light placed above it;
+ *   - a single emissive triangle: one triangle light with its vertices and front face;
+ *   - OBJ/MTL Ke: the same quad, one rect light;
+ *   - 70 separate emissive triangles: one error line naming the count and the way out;
+ *   - "lights_from_emissive": false and no light: the missing light named. */
+#include "testutil.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct prim { const float *tri; int n; const char *material; } prim;
+
+/* name.gltf + name.bin in dir: one mesh, one non-indexed primitive per entry (positions only), at node 0;
+ * more_nodes (NULL: none): n_more further root nodes (",{...}" each), top_ext: the top-level "extensions". */
+static void write_gltf_ex(const char *dir, const char *name, const prim *p, int np, const char *ext_used,
+                          const char *more_nodes, int n_more, const char *top_ext)
+{
+    char path[4096], bin[256];
+    snprintf(bin, sizeof bin, "%s.bin", name);
+    size_t total = 0;
+    for (int i = 0; i < np; i++) total += (size_t)p[i].n * 36;
+    FILE *f = fopen(tu_path(path, sizeof path, dir, bin), "wb");
+    assert_non_null(f);
+    for (int i = 0; i < np; i++) assert_int_equal(fwrite(p[i].tri, 36, (size_t)p[i].n, f), (size_t)p[i].n);
+    fclose(f);
+    size_t cap = 4096 + (size_t)np * 512, len = 0;
+    char *js = malloc(cap);
+    assert_non_null(js);
+#define PUT(...) (len += (size_t)snprintf(js + len, cap - len, __VA_ARGS__))
+    PUT("{\"asset\":{\"version\":\"2.0\"},%s%s\"scene\":0,\"scenes\":[{\"nodes\":[0", ext_used ? ext_used : "",
+        top_ext ? top_ext : "");
+    for (int i = 1; i <= n_more; i++) PUT(",%d", i);
+    PUT("]}],\"nodes\":[{\"mesh\":0}%s],\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],\"bufferViews\":[",
+        more_nodes ? more_nodes : "", bin, total);
+    size_t off = 0;
+    for (int i = 0; i < np; i++) {
+        PUT("%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%d}", i ? "," : "", off, p[i].n * 36);
+        off += (size_t)p[i].n * 36;
+    }
+    PUT("],\"accessors\":[");
+    for (int i = 0; i < np; i++) {
+        float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+        for (int v = 0; v < 3 * p[i].n; v++)
+            for (int c = 0; c < 3; c++) { lo[c] = fminf(lo[c], p[i].tri[3 * v + c]); hi[c] = fmaxf(hi[c], p[i].tri[3 * v + c]); }
+        PUT("%s{\"bufferView\":%d,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\",\"min\":[%.9g,%.9g,%.9g],"
+            "\"max\":[%.9g,%.9g,%.9g]}", i ? "," : "", i, 3 * p[i].n, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    }
+    PUT("],\"materials\":[");
+    for (int i = 0; i < np; i++) PUT("%s%s", i ? "," : "", p[i].material);
+    PUT("],\"meshes\":[{\"primitives\":[");
+    for (int i = 0; i < np; i++) PUT("%s{\"attributes\":{\"POSITION\":%d},\"material\":%d}", i ? "," : "", i, i);
+    PUT("]}]}");
+#undef PUT
+    assert_true(len < cap);
+    char gl[256];
+    snprintf(gl, sizeof gl, "%s.gltf", name);
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, gl), js), 0);
+    free(js);
+}
+
+static void write_gltf(const char *dir, const char *name, const prim *p, int np, const char *ext_used)
+{
+    write_gltf_ex(dir, name, p, np, ext_used, NULL, 0, NULL);
+}
+
+/* A scene file over mesh `mesh` with `extra` (lights, switches) after the camera. */
+static const char *write_scene(const char *dir, const char *name, const char *mesh, const char *extra)
+{
+    static char path[4096];
+    char text[4096];
+    snprintf(text, sizeof text,
+             "{ \"meshes\": [ { \"file\": \"%s\" } ],\n"
+             " \"camera\": { \"eye\": [0, 1, 3.5], \"target\": [0, 0.6, 0], \"up\": [0, 1, 0], \"fov_y\": 60,"
+             " \"width\": 24, \"height\": 24 }%s%s,\n \"render\": { \"samples\": 256 } }\n", mesh, extra[0] ? ",\n " : "", extra);
+    tu_path(path, sizeof path, dir, name);
+    assert_int_equal(tu_write_file(path, text), 0);
+    return path;
+}
+
+/* The box: floor (y = 0, facing up), ceiling (y = 2, facing down), back and side walls; 2 x 2 x 2. */
+static const float box[10][9] = {
+    { -1, 0, -1, -1, 0, 1, 1, 0, 1 }, { -1, 0, -1, 1, 0, 1, 1, 0, -1 },
+    { -1, 2, -1, 1, 2, 1, -1, 2, 1 }, { -1, 2, -1, 1, 2, -1, 1, 2, 1 },
+    { -1, 0, -1, 1, 0, -1, 1, 2, -1 }, { -1, 0, -1, 1, 2, -1, -1, 2, -1 },
+    { -1, 0, -1, -1, 2, -1, -1, 2, 1 }, { -1, 0, -1, -1, 2, 1, -1, 0, 1 },
+    { 1, 0, -1, 1, 0, 1, 1, 2, 1 }, { 1, 0, -1, 1, 2, 1, 1, 2, -1 } };
+/* The emitter: x, z in [-0.25, 0.25] at y = 1.9, counter-clockwise seen from below (its front faces down). */
+#define EM_Y 1.9f
+static const float emitter[2][9] = { { -0.25f, EM_Y, -0.25f, 0.25f, EM_Y, -0.25f, -0.25f, EM_Y, 0.25f },
+                                     { 0.25f, EM_Y, -0.25f, 0.25f, EM_Y, 0.25f, -0.25f, EM_Y, 0.25f } };
+static const char *const white = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.8,0.8,0.8,1],\"metallicFactor\":0}}";
+static const char *const glow = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.8,0.8,0.8,1],\"metallicFactor\":0},"
+                                "\"emissiveFactor\":[1,0.5,0.25],\"extensions\":{\"KHR_materials_emissive_strength\":"
+                                "{\"emissiveStrength\":4}}}";
+static const char *const ext = "\"extensionsUsed\":[\"KHR_materials_emissive_strength\"],";
+
+/* Irradiance per unit radiance at a point under the corner of a parallel rectangle [0, x] x [0, z] at height h
+ * (Howell's catalogue, "differential planar element to parallel rectangle, normal through a corner":
+ * pi F = (A / sqrt(1 + A^2)) atan(B / sqrt(1 + A^2)) + (B / sqrt(1 + B^2)) atan(A / sqrt(1 + B^2)), halved),
+ * signed by the corner's quadrant. */
+static double corner_rect(double x, double z, double h)
+{
+    const double A = fabs(x) / h, B = fabs(z) / h;
+    const double f = 0.5 * (A / sqrt(1 + A * A) * atan(B / sqrt(1 + A * A)) + B / sqrt(1 + B * B) * atan(A / sqrt(1 + B * B)));
+    return (x < 0 ? -1 : 1) * (z < 0 ? -1 : 1) * f;
+}
+
+/* The rectangle [x0, x1] x [z0, z1] at height h above the point (px, 0, pz), receiver facing up. */
+static double rect_irradiance(double x0, double x1, double z0, double z1, double h, double px, double pz)
+{
+    x0 -= px; x1 -= px; z0 -= pz; z1 -= pz;
+    return corner_rect(x1, z1, h) - corner_rect(x0, z1, h) - corner_rect(x1, z0, h) + corner_rect(x0, z0, h);
+}
+
+static void test_cornell_emitter(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("asset_lights_cornell");
+    const prim p[2] = { { &box[0][0], 10, white }, { &emitter[0][0], 2, glow } };
+    write_gltf(dir, "box", p, 2, ext);
+    const char *path = write_scene(dir, "box.json", "box.gltf", "");
+    ms_scene sc;
+    char err[512];
+    if (ms_scene_load(path, &sc, err, sizeof err)) fprintf(stderr, "%s\n", err);
+    size_t n;
+    const ms_light *L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 1);
+    assert_int_equal(L[0].shape, MS_LIGHT_RECT);
+    /* emissiveFactor (1, 0.5, 0.25) x strength 4 */
+    assert_float_equal(L[0].emission.x, 4.0f, 0.0f);
+    assert_float_equal(L[0].emission.y, 2.0f, 0.0f);
+    assert_float_equal(L[0].emission.z, 1.0f, 0.0f);
+    const float nx = L[0].edge_s.y * L[0].edge_t.z - L[0].edge_s.z * L[0].edge_t.y;
+    const float ny = L[0].edge_s.z * L[0].edge_t.x - L[0].edge_s.x * L[0].edge_t.z;
+    assert_float_equal(nx, 0.0f, 0.0f);
+    assert_float_equal(ny, -0.25f, 1e-7f);   /* 0.5 x 0.5, facing down */
+    assert_float_equal(ms_light_area(&L[0]), 0.25f, 1e-7f);
+    /* the floor's irradiance, analytic, at points under and beside the emitter */
+    static const float pts[4][3] = { { 0, 0, 0 }, { 0.3f, 0, -0.2f }, { -0.7f, 0, 0.6f }, { 0.1f, 0, 0.24f } };
+    static const float up[4][3] = { { 0, 1, 0 }, { 0, 1, 0 }, { 0, 1, 0 }, { 0, 1, 0 } };
+    double worst = 0.0;
+    for (int i = 0; i < 4; i++) {
+        const double want = rect_irradiance(-0.25, 0.25, -0.25, 0.25, EM_Y, pts[i][0], pts[i][2]);
+        const double got = ms_light_irradiance(&L[0], pts[i], up[i]);
+        worst = fmax(worst, fabs(got - want) / want);
+        printf("floor (%g, %g): irradiance %.6g x emission (4, 2, 1), analytic %.6g\n", pts[i][0], pts[i][2], got, want);
+    }
+    assert_true(worst < 1e-5);
+    /* no shadow of the emitter on the floor: V = S = 1 by every method */
+    ms_accel *acc = NULL;
+    assert_int_equal(ms_accel_build(&sc, 2, &acc, err, sizeof err), 0);
+    const ms_points q = { .n = 4, .position = &pts[0][0], .normal = &up[0][0] };
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        ms_points_options o;
+        memset(&o, 0, sizeof o);
+        o.method = names[mi];
+        o.samples = 256;
+        o.threads = 1;
+        float v[4], s[4];
+        uint16_t fr[4];
+        assert_int_equal(ms_visibility_points(acc, NULL, &q, &o, v, s, fr, NULL, err, sizeof err), 0);
+        for (int i = 0; i < 4; i++) {
+            if (v[i] != 1.0f || s[i] != 1.0f) fprintf(stderr, "%s: point %d: V %g S %g\n", names[mi], i, v[i], s[i]);
+            assert_true(v[i] == 1.0f && s[i] == 1.0f);
+            assert_true(fr[i] > 0);
+        }
+    }
+    /* A light just above the emitter, facing down: the emitter does shadow it. */
+    ms_light above = L[0];
+    above.corner.y = 1.95f;
+    float v[4], s[4];
+    ms_points_options o;
+    memset(&o, 0, sizeof o);
+    o.samples = 256;
+    o.threads = 1;
+    assert_int_equal(ms_visibility_points(acc, &above, &q, &o, v, s, NULL, NULL, err, sizeof err), 0);
+    assert_true(v[0] == 0.0f);
+    ms_accel_free(acc);
+    ms_scene_free(&sc);
+    /* A scene file naming a light: the emitters are added only on request, after it. */
+    path = write_scene(dir, "box_light.json", "box.gltf",
+                       "\"light\": { \"corner\": [-0.5, 1.99, -0.5], \"edge_s\": [1, 0, 0], \"edge_t\": [0, 0, 1] }");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 1);
+    ms_scene_free(&sc);
+    {   /* not silently: the CLI says the emitters were not made lights */
+        char out[4096], errbuf[2048];
+        tu_path(out, sizeof out, dir, "out.png");
+        const char *args[] = { path, "--quiet", "-o", out, NULL };
+        tu_run_result res;
+        assert_int_equal(tu_run_cli_ex(args, NULL, errbuf, sizeof errbuf, &res), 0);
+        assert_non_null(strstr(errbuf, "2 emissive triangles not made lights"));
+    }
+    path = write_scene(dir, "box_both.json", "box.gltf",
+                       "\"light\": { \"corner\": [-0.5, 1.99, -0.5], \"edge_s\": [1, 0, 0], \"edge_t\": [0, 0, 1] },"
+                       " \"lights_from_emissive\": true");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 2);
+    assert_float_equal(L[0].corner.y, 1.99f, 0.0f);
+    assert_float_equal(L[1].emission.x, 4.0f, 0.0f);
+    ms_scene_free(&sc);
+    path = write_scene(dir, "box_none.json", "box.gltf", "\"lights_from_emissive\": false");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), -1);
+    assert_non_null(strstr(err, "\"light\" is missing"));
+}
+
+static void test_single_triangle_and_mtl(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("asset_lights_tri");
+    const prim p[2] = { { &box[0][0], 10, white }, { &emitter[0][0], 1, glow } };
+    write_gltf(dir, "tri", p, 2, ext);
+    ms_scene sc;
+    char err[512];
+    assert_int_equal(ms_scene_load(write_scene(dir, "tri.json", "tri.gltf", ""), &sc, err, sizeof err), 0);
+    size_t n;
+    const ms_light *L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 1);
+    assert_int_equal(L[0].shape, MS_LIGHT_TRIANGLE);
+    assert_float_equal(ms_light_area(&L[0]), 0.125f, 1e-7f);
+    const float *t = emitter[0];
+    assert_true(L[0].corner.x == t[0] && L[0].corner.y == t[1] && L[0].corner.z == t[2]);
+    assert_true(L[0].edge_s.x == t[3] - t[0] && L[0].edge_t.z == t[8] - t[2]);
+    /* it emits down: the floor below is lit, a point above it is not */
+    const float below[3] = { -0.1f, 0, -0.1f }, above[3] = { -0.1f, 3, -0.1f }, nu[3] = { 0, 1, 0 }, nd[3] = { 0, -1, 0 };
+    assert_true(ms_light_irradiance(&L[0], below, nu) > 0.0f);
+    assert_true(ms_light_irradiance(&L[0], above, nd) == 0.0f);
+    ms_scene_free(&sc);
+    /* OBJ/MTL: Ke on the quad (one face of four vertices, triangulated into two): one rect light */
+    char path[4096];
+    tu_write_file(tu_path(path, sizeof path, dir, "q.mtl"), "newmtl lamp\nKd 0.8 0.8 0.8\nKe 2 3 4\n");
+    tu_write_file(tu_path(path, sizeof path, dir, "q.obj"),
+                  "mtllib q.mtl\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nf 1 2 3 4\n"
+                  "v -0.25 1.9 -0.25\nv 0.25 1.9 -0.25\nv 0.25 1.9 0.25\nv -0.25 1.9 0.25\nusemtl lamp\nf 5 6 7 8\n");
+    assert_int_equal(ms_scene_load(write_scene(dir, "q.json", "q.obj", ""), &sc, err, sizeof err), 0);
+    L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 1);
+    assert_int_equal(L[0].shape, MS_LIGHT_RECT);
+    assert_float_equal(L[0].emission.z, 4.0f, 0.0f);
+    assert_float_equal(ms_light_area(&L[0]), 0.25f, 1e-7f);
+    assert_true(ms_light_irradiance(&L[0], below, nu) > 0.0f);
+    ms_scene_free(&sc);
+}
+
+/* 70 separate emissive triangles: 70 lights, over the limit of 64: one line with the count and the way out. */
+static void test_too_many_emitters(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("asset_lights_many");
+    float *t = malloc(70 * 9 * sizeof *t);
+    assert_non_null(t);
+    for (int i = 0; i < 70; i++) {
+        const float x = -0.9f + 0.025f * (float)i;
+        const float v[9] = { x, 1.9f, 0, x + 0.01f, 1.9f, 0, x, 1.9f, 0.01f };
+        memcpy(t + 9 * i, v, sizeof v);
+    }
+    const prim p[2] = { { &box[0][0], 10, white }, { t, 70, glow } };
+    write_gltf(dir, "many", p, 2, ext);
+    free(t);
+    const char *path = write_scene(dir, "many.json", "many.gltf", "");
+    char out[4096], errbuf[2048];
+    tu_path(out, sizeof out, dir, "out.png");
+    const char *args[] = { path, "--quiet", "-o", out, NULL };
+    tu_run_result res;
+    const int rc = tu_run_cli_ex(args, NULL, errbuf, sizeof errbuf, &res);
+    printf("70 emitters: exit %d: %s", rc, errbuf);
+    assert_int_equal(rc, 2);
+    assert_int_equal(res.lines, 1);
+    assert_non_null(strstr(errbuf, "many.json"));
+    assert_non_null(strstr(errbuf, "70 lights"));
+    assert_non_null(strstr(errbuf, "\"lights_from_emissive\": false"));
+    assert_false(tu_file_exists(out));
+}
+
+/* KHR_lights_punctual: a point light (10 cd, extras.radius 0.1) becomes a sphere of radiance 10 / (pi 0.1^2);
+ * a spot facing down (node rotated -90 degrees about x) a disk facing down of the scene file's
+ * punctual_radius; a directional light one warning line; V and S of the frame equal raytrace's by every
+ * method. */
+static void test_punctual(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("asset_lights_punctual");
+    const prim p[1] = { { &box[0][0], 10, white } };
+    write_gltf_ex(dir, "pl", p, 1, "\"extensionsUsed\":[\"KHR_lights_punctual\"],",
+                  ",{\"translation\":[0.2,1.5,-0.1],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}"
+                  ",{\"translation\":[-0.3,1.8,0.2],\"rotation\":[-0.70710678,0,0,0.70710678],"
+                  "\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}}"
+                  ",{\"rotation\":[-0.70710678,0,0,0.70710678],\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}}", 3,
+                  "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
+                  "{\"type\":\"point\",\"color\":[1,0.5,0.25],\"intensity\":10,\"extras\":{\"radius\":0.1}},"
+                  "{\"type\":\"spot\",\"intensity\":2,\"spot\":{\"outerConeAngle\":0.5}},"
+                  "{\"type\":\"directional\",\"intensity\":3}]}},");
+    const char *path = write_scene(dir, "pl.json", "pl.gltf", "\"punctual_radius\": 0.2");
+    ms_scene sc;
+    char err[512];
+    if (ms_scene_load(path, &sc, err, sizeof err)) fprintf(stderr, "%s\n", err);
+    size_t n;
+    const ms_light *L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 2);
+    assert_int_equal(L[0].shape, MS_LIGHT_SPHERE);
+    assert_float_equal(L[0].center.x, 0.2f, 0.0f);
+    assert_float_equal(L[0].center.y, 1.5f, 0.0f);
+    assert_float_equal(L[0].center.z, -0.1f, 0.0f);
+    assert_float_equal(L[0].radius, 0.1f, 0.0f);
+    /* candela to radiance: I = L pi r^2 */
+    assert_float_equal(L[0].emission.x, (float)(10.0 / (M_PI * 0.01)), 1e-3f);
+    assert_float_equal(L[0].emission.y, (float)(5.0 / (M_PI * 0.01)), 1e-3f);
+    assert_int_equal(L[1].shape, MS_LIGHT_DISK);
+    assert_float_equal(ms_light_area(&L[1]), (float)(M_PI * 0.04), 1e-6f);
+    assert_float_equal(L[1].emission.x, (float)(2.0 / (M_PI * 0.04)), 1e-4f);
+    const float ny = L[1].edge_s.z * L[1].edge_t.x - L[1].edge_s.x * L[1].edge_t.z;
+    assert_true(ny < 0.0f);   /* emits down */
+    /* the disk's centre */
+    assert_float_equal(L[1].corner.x + 0.5f * (L[1].edge_s.x + L[1].edge_t.x), -0.3f, 1e-6f);
+    assert_float_equal(L[1].corner.y + 0.5f * (L[1].edge_s.y + L[1].edge_t.y), 1.8f, 1e-6f);
+    /* every method's frame equals raytrace's, light by light */
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = 24;
+    o.samples = 256;
+    o.threads = 2;
+    ms_frame ref, f;
+    o.method = "raytrace";
+    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
+    const char *const *names = ms_method_names();
+    long lit = 0;
+    for (int i = 0; i < 2 * 24 * 24; i++) lit += ref.vis[i] > 0.0f;
+    assert_true(lit > 24 * 24 / 2);
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+        long differ = 0;
+        for (int i = 0; i < 2 * 24 * 24; i++) differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i];
+        if (differ) fprintf(stderr, "punctual lights, method %s: %ld values differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_frame_free(&f);
+    }
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+    /* the CLI: one warning line each for the directional light and the spot's cone */
+    char out[4096], errbuf[4096];
+    tu_path(out, sizeof out, dir, "out.png");
+    const char *args[] = { path, "-o", out, "--quiet", NULL };
+    tu_run_result res;
+    assert_int_equal(tu_run_cli_ex(args, NULL, errbuf, sizeof errbuf, &res), 0);
+    printf("%s", errbuf);
+    assert_non_null(strstr(errbuf, "1 KHR_lights_punctual directional light ignored"));
+    assert_non_null(strstr(errbuf, "the cone is not modelled"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cornell_emitter),
+        cmocka_unit_test(test_single_triangle_and_mtl),
+        cmocka_unit_test(test_too_many_emitters),
+        cmocka_unit_test(test_punctual),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
