@@ -266,6 +266,7 @@ typedef struct ms_scene {
     /* The world position of the local frame's origin (see above): 0, 0, 0 unless ms_scene_load moved a
      * distant scene. */
     double origin[3];
+    int aa;              /* primary samples per pixel from the scene file (render.aa; 0: not given) */
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX
@@ -465,6 +466,15 @@ typedef struct ms_render_options {
                              * axis-aligned rectangles and rectangles sharing a side into one (docs/culling.md:
                              * the same points, so the same V and S up to ties on the rectangles' sides) */
     uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
+    /* Pixel anti-aliasing (docs/antialiasing.md): K = aa primary samples per pixel (1, 4, 9 or 16; 0: the
+     * scene's render.aa, else 1), on the s x s grid of the pixel's strata centres (s = sqrt K). Each has its own
+     * hit, front mask and shadow query (every method answers each as a pixel of an s-times larger frame, on
+     * that pixel's samples), and the frame's rgb, V, S and S_spec are their box-filtered average per pixel (V,
+     * S over the samples that hit; -1 where none did; rgb counts misses as black). K = 1 is the frame as without
+     * anti-aliasing, bit for bit. */
+    int aa;
+    int aa_split;           /* aa > 1: the pixel's N light samples split among its K hits (N/K each, which must be
+                             * a valid sample count for the pattern) instead of all N for every hit */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */

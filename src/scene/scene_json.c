@@ -46,7 +46,7 @@ static const struct { const char *name; ms_camera_type type; const char *const *
 static _Thread_local const char *const *camera_keys = camera_keys_pinhole;
 static const char *const light_keys[] = { "shape", "corner", "edge_s", "edge_t", "center", "normal", "radius",
                                           "emission", "power", "lumens", "texture", NULL };
-static const char *const render_keys[] = { "samples", NULL };
+static const char *const render_keys[] = { "samples", "aa", NULL };
 static const char *const mesh_keys[] = { "file", "transform", NULL };
 
 /* Warnings wait until the scene loaded: a failed load prints its one error line only. */
@@ -560,6 +560,11 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         if (!cJSON_IsObject(render)) { snprintf(err, errlen, "%s: \"render\" must be an object", json_path); goto done; }
         warn_unknown(render, "render", render_keys, json_path);
         if (get_int(render, "render", "samples", 0, 1, 1 << 20, &out->samples, json_path, err, errlen)) goto done;
+        if (get_int(render, "render", "aa", 0, 1, 16, &out->aa, json_path, err, errlen)) goto done;
+        if (out->aa && out->aa != 1 && out->aa != 4 && out->aa != 9 && out->aa != 16) {
+            snprintf(err, errlen, "%s: render.aa must be 1, 4, 9 or 16 (got %d)", json_path, out->aa);
+            goto done;
+        }
     }
 
     const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(root, "meshes");
