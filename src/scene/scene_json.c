@@ -560,10 +560,14 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         if (!cJSON_IsObject(render)) { snprintf(err, errlen, "%s: \"render\" must be an object", json_path); goto done; }
         warn_unknown(render, "render", render_keys, json_path);
         if (get_int(render, "render", "samples", 0, 1, 1 << 20, &out->samples, json_path, err, errlen)) goto done;
-        if (get_int(render, "render", "aa", 0, 1, 16, &out->aa, json_path, err, errlen)) goto done;
-        if (out->aa && out->aa != 1 && out->aa != 4 && out->aa != 9 && out->aa != 16) {
-            snprintf(err, errlen, "%s: render.aa must be 1, 4, 9 or 16 (got %d)", json_path, out->aa);
-            goto done;
+        if (cJSON_GetObjectItemCaseSensitive(render, "aa")) {   /* absent: 0, the caller's default */
+            int aa = 1;
+            if (get_int(render, "render", "aa", 1, 1, 16, &aa, json_path, err, errlen)) goto done;
+            if (aa != 1 && aa != 4 && aa != 9 && aa != 16) {
+                snprintf(err, errlen, "%s: render.aa must be 1, 4, 9 or 16 (got %d)", json_path, aa);
+                goto done;
+            }
+            out->aa = aa;
         }
     }
 
