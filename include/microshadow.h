@@ -355,8 +355,12 @@ typedef struct ms_scene_load_options {
     int allow_outside_paths;
 } ms_scene_load_options;
 MS_API int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen);
-/* The built-in procedural scene: a ground, occluders of several sizes, a light. */
+/* The built-in procedural scene: a ground, occluders of several sizes, a light (the tests' fixture). */
 MS_API int ms_scene_default(ms_scene *out);
+/* The built-in scene the CLI renders without a scene file: smooth-shaded curved objects (per-vertex normals),
+ * a procedurally textured ground, a metal and rough plastics, alpha-tested leaf cards, and a rect, a disk and a
+ * sphere light of different colours; 768 x 512, 256 samples. 0, or -1 when out of memory. */
+MS_API int ms_scene_showcase(ms_scene *out);
 /* Puts a scene built in world coordinates (tri, camera, lights as floats; origin usually 0) into the frame
  * ms_scene_load would choose for it (see ms_scene): tri, the camera's eye and target and the lights' corners
  * and centres moved, origin set. The detail a float lost far from the origin is not recovered, but every

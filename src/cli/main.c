@@ -256,7 +256,7 @@ static int cli_main(int argc, char **argv)
             fprintf(stderr, "microshadow: %s\n", err);
             return EXIT_BAD_INPUT;
         }
-    } else if (ms_scene_default(&scene)) {
+    } else if (ms_scene_showcase(&scene)) {
         fprintf(stderr, "microshadow: out of memory building the default scene\n");
         return 1;
     }
