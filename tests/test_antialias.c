@@ -8,7 +8,8 @@
  *   - K = 1 (and 0) is the frame without anti-aliasing bit for bit (aa = 0 against aa = 1; the CLI's picture
  *     was compared with the unmodified binary when this was written);
  *   - every method agrees with raytrace under K = 4, full and split, as without anti-aliasing;
- *   - split: each primary sample gets N/K samples; the scene file's render.aa; bad values refused. */
+ *   - split: each primary sample gets N/K samples; the scene file's render.aa; bad values refused;
+ *   - the CLI: anti-aliased (K = 4) by default, K = 1 when the V or S plane is written, unless --aa says. */
 #include "testutil.h"
 #include <math.h>
 #include <stdio.h>
@@ -266,12 +267,66 @@ static void test_scene_file(void **st)
     assert_non_null(strstr(err, "render.aa"));
 }
 
+/* The CLI: anti-aliased by default (the EXR's V is the library's at aa = 4), one primary sample when the V
+ * plane is asked for (the PFM is the library's at aa = 1), --aa overrides, bad values refused. */
+static void test_cli(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("test_antialias_cli");
+    char exr[512], pfm[512], png[512], err[512];
+    tu_path(exr, sizeof exr, dir, "a.exr");
+    tu_path(pfm, sizeof pfm, dir, "v.pfm");
+    tu_path(png, sizeof png, dir, "p.png");
+    ms_scene sc;
+    assert_int_equal(ms_scene_showcase(&sc), 0);
+    ms_frame f1, f4;
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.method = "raytrace";
+    o.samples = 256;
+    o.width = 24;
+    o.height = 16;
+    o.threads = 2;
+    o.aa = 1;
+    tu_render_ok(&sc, &o, &f1);
+    o.aa = 4;
+    tu_render_ok(&sc, &o, &f4);
+    const char *base[] = { "--method", "raytrace", "--samples", "256", "--width", "24", "--height", "16", "--threads", "2",
+                           "--quiet", "-o", exr, NULL, NULL, NULL, NULL };
+    if (tu_run_cli(base, err, sizeof err)) fail_msg("CLI: %s", err);
+    float v[24 * 16];
+    assert_int_equal(tu_read_exr_channel(exr, "V0", 24, 16, v), 0);
+    assert_memory_equal(v, f4.vis, sizeof v);
+    base[12] = png;
+    base[13] = "--vis";
+    base[14] = pfm;
+    if (tu_run_cli(base, err, sizeof err)) fail_msg("CLI: %s", err);
+    int w, h;
+    float *pv = tu_read_pfm(pfm, &w, &h);
+    assert_non_null(pv);
+    assert_memory_equal(pv, f1.vis, sizeof v);
+    free(pv);
+    base[15] = "--aa=4";   /* asked for: the planes anti-aliased too */
+    if (tu_run_cli(base, err, sizeof err)) fail_msg("CLI: %s", err);
+    pv = tu_read_pfm(pfm, &w, &h);
+    assert_non_null(pv);
+    assert_memory_equal(pv, f4.vis, sizeof v);
+    free(pv);
+    const char *bad[] = { "--aa", "2", "--quiet", "-o", png, NULL };
+    assert_int_equal(tu_run_cli(bad, err, sizeof err), 2);
+    assert_non_null(strstr(err, "--aa"));
+    ms_frame_free(&f1);
+    ms_frame_free(&f4);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_half_plane_edge), cmocka_unit_test(test_k1_unchanged),
         cmocka_unit_test(test_methods_agree),   cmocka_unit_test(test_split),
         cmocka_unit_test(test_bad_values),      cmocka_unit_test(test_scene_file),
+        cmocka_unit_test(test_cli),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
