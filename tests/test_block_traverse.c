@@ -109,6 +109,14 @@ static void block_equals_pixel(const ms_scene *sc, const char *label, const int 
                        label, kernels[m], ks[ki], ms_isa_name((ms_isa)cap), b.n, differ,
                        (unsigned long long)rb, (unsigned long long)rp);
                 assert_int_equal(differ, 0);
+                /* The SIMD Scanline kernel's set-up shared by a block's pixels (block_raster_impl.h,
+                 * br_scan_setup) must have run, or the comparison above proved nothing about it. */
+                if (m == 0 && cap >= MS_ISA_AVX2) {
+                    const uint64_t shared = counter(&b, "shared_setups");
+                    printf("%-22s %-12s k=%-2d %-6s: %llu of the rasterizations set up for several pixels at once\n",
+                           label, kernels[m], ks[ki], ms_isa_name((ms_isa)cap), (unsigned long long)shared);
+                    assert_true(shared > 0);
+                }
                 free(b.vis);
                 free(p.vis);
             }

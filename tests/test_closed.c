@@ -11,8 +11,8 @@
  * Interior boxes (src/accel/interior.c): every point sampled in every box lies inside its component by a
  * ray-parity count written here, and at least the clearance from each of its triangles (point-triangle
  * distance, double); open meshes get none. Frames of a dense sphere over a ground: scanline with the boxes
- * and the cull (its default), without either, per pixel, hierarchical, raytrace with and without the cull
- * give the same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none);
+ * and the cull (its default), without either, per pixel, hierarchical, raytrace with and without the cull,
+ * mft with and without the boxes (the driver's interior pass) give the same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none);
  * the points API with the boxes equals raytrace point for point. */
 #include "testutil.h"
 #include "accel/closed.h"
@@ -567,8 +567,11 @@ static void test_interior_frames(void **st)
         float *v_pix = frame_vis(&sc, "scanline", MS_TRAVERSAL_PIXEL, 0, MS_CLOSED_CULL_DEFAULT, NULL);
         float *v_hier = frame_vis(&sc, "hierarchical", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_OFF, NULL);
         float *v_rt = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_DEFAULT, &s_rt);
-        ms_stats s_rtc;
+        ms_stats s_rtc, s_mft, s_mft_no;
         float *v_rtc = frame_vis(&sc, "raytrace", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_ON, &s_rtc);
+        /* mft takes the boxes through the driver's interior pass (MS_OCC_INTERIOR_PASS), raytrace's V */
+        float *v_mft = frame_vis(&sc, "mft", MS_TRAVERSAL_BLOCK, 0, MS_CLOSED_CULL_DEFAULT, &s_mft);
+        float *v_mft_no = frame_vis(&sc, "mft", MS_TRAVERSAL_BLOCK, 1, MS_CLOSED_CULL_DEFAULT, &s_mft_no);
         /* the default: the micro-raster methods cull what has no interior boxes (the bar's bottom and a
          * side, not the sphere), raytrace nothing; asked to, raytrace culls the sphere's back too; for the
          * light within the sphere's box, only the bar */
@@ -578,8 +581,12 @@ static void test_interior_frames(void **st)
         if (light == 0) {
             assert_true(s_int.interior_boxes > 0);
             assert_true(counter(&s_int, "interior_rasterized") > 0);
+            assert_int_equal(s_mft.interior_boxes, s_int.interior_boxes);
+            /* the pass ran: the blocks of the boxes' pass come before those of the triangles' */
+            assert_true(counter(&s_mft, "blocks") > counter(&s_mft_no, "blocks"));
         } else {
             assert_int_equal(s_int.interior_boxes, 0);
+            assert_int_equal(s_mft.interior_boxes, 0);
         }
         assert_int_equal(s_rt.interior_boxes, 0);   /* raytrace takes none: it is the reference here */
         int shadowed = 0;
@@ -591,7 +598,9 @@ static void test_interior_frames(void **st)
         assert_memory_equal(v_int, v_hier, npix * sizeof *v_int);
         assert_memory_equal(v_int, v_rt, npix * sizeof *v_int);
         assert_memory_equal(v_int, v_rtc, npix * sizeof *v_int);
-        free(v_int); free(v_no); free(v_pix); free(v_hier); free(v_rt); free(v_rtc);
+        assert_memory_equal(v_mft, v_rt, npix * sizeof *v_int);
+        assert_memory_equal(v_mft_no, v_rt, npix * sizeof *v_int);
+        free(v_int); free(v_no); free(v_pix); free(v_hier); free(v_rt); free(v_rtc); free(v_mft); free(v_mft_no);
     }
     ms_scene_free(&sc);
 }

@@ -27,7 +27,8 @@ static void usage(FILE *f)
         "  --method M          shadow method:");
     for (const char *const *m = ms_method_names(); *m; m++) fprintf(f, " %s", *m);
     fprintf(f,
-        " (default scanline)\n"
+        " (default scanline),\n"
+        "                      or auto: the one measured fastest for the pattern and scene (docs/methods.md)\n"
         "  --pattern P         light samples: grid (default), stratified, or interleaved (N/16 per pixel\n"
         "                      of a 4x4 block, then a 4x4 depth- and normal-aware filter; ray tracers only)\n"
         "  --samples N         256, 1024 or 4096 light samples (default: the scene's); stratified also 16, 64\n"
@@ -58,6 +59,9 @@ static void usage(FILE *f)
         "                      answer, docs/culling.md); default: on for the micro-raster methods\n"
         "  --no-interior       micro-raster methods: no interior boxes (docs/culling.md; to measure)\n"
         "  --no-merge          micro-raster methods: do not merge coplanar rectangles (docs/culling.md)\n"
+        "  --embree-mode M     embree method: packet16 (default: rtcOccluded16) or stream (docs/embree.md)\n"
+        "  --embree-filter F   embree method: when the receiver's triangle is filtered out: plane (default),\n"
+        "                      always, none (to measure only: the receiver then shadows itself)\n"
         "  --max-memory SIZE   memory budget (e.g. 512M, 8G; default %d%% of physical memory): a frame that\n"
         "                      would need more is refused before anything is allocated, naming what fits\n"
         "  --quiet             no progress or summary on stderr\n"
@@ -93,7 +97,7 @@ static int cli_main(int argc, char **argv)
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
            O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR, O_NO_MERGE, O_MAX_MEMORY,
-           O_AA, O_AA_SPLIT };
+           O_EMBREE_MODE, O_EMBREE_FILTER, O_AA, O_AA_SPLIT };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -110,6 +114,7 @@ static int cli_main(int argc, char **argv)
         { "no-interior", no_argument, 0, O_NO_INTERIOR },
         { "no-merge", no_argument, 0, O_NO_MERGE },
         { "max-memory", required_argument, 0, O_MAX_MEMORY },
+        { "embree-mode", required_argument, 0, O_EMBREE_MODE }, { "embree-filter", required_argument, 0, O_EMBREE_FILTER },
         { "aa", required_argument, 0, O_AA }, { "aa-split", no_argument, 0, O_AA_SPLIT },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
@@ -121,19 +126,6 @@ static int cli_main(int argc, char **argv)
 #endif
     ms_render_options opt;
     ms_render_options_default(&opt);
-    /* The library reads no environment; for measuring (docs/embree.md) the CLI maps these onto options. */
-    const char *em = getenv("MS_EMBREE_MODE"), *ef = getenv("MS_EMBREE_FILTER");
-    if (em && *em) {
-        if (!strcmp(em, "packet16")) opt.embree_mode = MS_EMBREE_PACKET16;
-        else if (!strcmp(em, "stream")) opt.embree_mode = MS_EMBREE_STREAM;
-        else { fprintf(stderr, "microshadow: MS_EMBREE_MODE: '%s' is not packet16 or stream\n", em); return EXIT_BAD_INPUT; }
-    }
-    if (ef && *ef) {
-        if (!strcmp(ef, "plane")) opt.embree_filter = MS_EMBREE_FILTER_PLANE;
-        else if (!strcmp(ef, "always")) opt.embree_filter = MS_EMBREE_FILTER_ALWAYS;
-        else if (!strcmp(ef, "none")) opt.embree_filter = MS_EMBREE_FILTER_NONE;
-        else { fprintf(stderr, "microshadow: MS_EMBREE_FILTER: '%s' is not plane, always or none\n", ef); return EXIT_BAD_INPUT; }
-    }
     /* A name whose ending the CLI does not write (out.jpg, out.tiff, no ending) is refused, not written as
      * PNG bytes under that name. */
     static const char *const image_suffixes[] = { ".png", ".exr", NULL };
@@ -201,6 +193,17 @@ static int cli_main(int argc, char **argv)
             break;
         case O_NO_INTERIOR: opt.no_interior = 1; break;
         case O_NO_MERGE: opt.no_merge = 1; break;
+        case O_EMBREE_MODE:
+            if (!strcmp(optarg, "packet16")) opt.embree_mode = MS_EMBREE_PACKET16;
+            else if (!strcmp(optarg, "stream")) opt.embree_mode = MS_EMBREE_STREAM;
+            else { fprintf(stderr, "microshadow: --embree-mode: '%s' is not packet16 or stream\n", optarg); return EXIT_BAD_INPUT; }
+            break;
+        case O_EMBREE_FILTER:
+            if (!strcmp(optarg, "plane")) opt.embree_filter = MS_EMBREE_FILTER_PLANE;
+            else if (!strcmp(optarg, "always")) opt.embree_filter = MS_EMBREE_FILTER_ALWAYS;
+            else if (!strcmp(optarg, "none")) opt.embree_filter = MS_EMBREE_FILTER_NONE;
+            else { fprintf(stderr, "microshadow: --embree-filter: '%s' is not plane, always or none\n", optarg); return EXIT_BAD_INPUT; }
+            break;
         case O_AA:
             if (ms_cli_parse_long(&cli, "--aa", optarg, 1, 16, &v)) return EXIT_BAD_INPUT;
             if (v != 1 && v != 4 && v != 9 && v != 16) {

@@ -34,3 +34,14 @@ ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k, ms_isa cap, ms_isa *chosen
     if (chosen) *chosen = isa;
     return ms_raster_kernel_isa(id, k, isa);
 }
+
+ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k)
+{
+    static const ms_raster_fn kernels[2][3] = { MS_PERK_TABLE(ms_scanline, avx2), MS_PERK_TABLE(ms_scanline, avx512) };
+    static const ms_scan_rows_fn rows[2][3] = { MS_PERK_TABLE(ms_scanline_rows3, avx2), MS_PERK_TABLE(ms_scanline_rows3, avx512) };
+    const int w = ms_k_index(k);
+    if (w < 0 || !kernel) return NULL;
+    for (int i = 0; i < 2; i++)
+        if (kernel == kernels[i][w]) return rows[i][w];
+    return NULL;
+}

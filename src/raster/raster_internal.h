@@ -216,6 +216,21 @@ static inline void ms_flat_y_bounds(const float yv[8], unsigned up, unsigned dn,
     if (*y1 > k - 1) *y1 = k - 1;
 }
 
+/* Per-triangle data of the SIMD Scanline kernel's row loop (scanline_simd_impl.h): for each of the (up
+ * to) five edges a lower and an upper bound a*y + b on x, neutral (0 resp. k-1) where the edge is not of
+ * that kind, and the scanline range. The rows evaluate 3 edge lanes, or 5 when a clip edge is active. */
+typedef struct ms_scan_vec {
+    float al[8], bl[8], au[8], bu[8];
+    int y0, y1;
+} ms_scan_vec;
+
+/* The SIMD Scanline kernel's row loop over three edges (no clip edge), for a caller that computed the
+ * set-up itself with the kernel's operations (the block traversal: one triangle for many pixels at once,
+ * block_raster_impl.h): the buffer is then the kernel's bit for bit. NULL when `kernel` is not a SIMD
+ * Scanline instance for k (the portable kernels round their rows differently). */
+typedef void (*ms_scan_rows_fn)(const ms_scan_vec *v, void *buf);
+ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k);
+
 /* The kernel instances (core/perk.h names): portable Scanline, Bounds, Hierarchical; SIMD Scanline for
  * AVX2 + FMA (8 scanlines per instruction) and AVX-512 (16), one source: scanline_simd_impl.h. */
 #define MS_RASTER_PARAMS (const ms_raster_frame *f, const float tri[9], void *buf)
@@ -231,6 +246,8 @@ MS_PERK_DECLARE(void, ms_hier, avx2, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_bounds, avx512, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_hier, avx512, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_clear_halfplane, scalar, (const float e[3], void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows3, avx2, (const ms_scan_vec *v, void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows3, avx512, (const ms_scan_vec *v, void *buf));
 
 /* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
  * (0 when setup rejects it). */

@@ -24,14 +24,6 @@
 #error "scanline_simd_impl.h is for the _avx2.c and _avx512.c files"
 #endif
 
-/* Per-triangle data of the row loop: for each of the (up to) five edges a lower and an upper bound
- * a*y + b on x, neutral (0 resp. k-1) where the edge is not of that kind, and the scanline range. The
- * rows evaluate 3 edge lanes, or 5 when a clip edge is active. */
-typedef struct ms_scan_vec {
-    float al[8], bl[8], au[8], bu[8];
-    int y0, y1;
-} ms_scan_vec;
-
 SI vi ms_idx8(int a, int b, int c, int d, int e, int f, int g, int h) { return _mm256_setr_epi32(a, b, c, d, e, f, g, h); }
 
 /* 1: rows to do; 0: nothing to rasterize; -1: the other instance (clip or not) is needed. */
@@ -240,6 +232,10 @@ SI void MS_KFN(ms_simd_rows)(const ms_scan_vec *v, const int ne, void *out)
     }
 #endif
 }
+
+/* The row loop alone, three edges, for the block traversal's set-up of one triangle for many pixels
+ * (block_raster_impl.h, br_scan_setup): raster_internal.h, ms_raster_rows. */
+void MS_KFN(ms_scanline_rows3)(const ms_scan_vec *v, void *out) { MS_KFN(ms_simd_rows)(v, 3, out); }
 
 /* Without an active clip edge (the common case) the setup is shorter and the rows evaluate three edge
  * lanes instead of five. */

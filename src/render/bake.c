@@ -240,7 +240,9 @@ static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, in
     const int samples = o->points.samples > 0 ? o->points.samples : MS_SAMPLES_DEFAULT;
     bs.mask_words = (samples + 63) / 64;
     bs.threads = o->points.threads > 0 ? o->points.threads : omp_get_num_procs();
-    const ms_shadow_method *sm = ms_find_shadow_method(o->points.method ? o->points.method : MS_DEFAULT_METHOD);
+    const char *method = o->points.method ? o->points.method : MS_DEFAULT_METHOD;
+    if (strcmp(method, MS_AUTO_METHOD) == 0) method = ms_auto_method(o->points.pattern);
+    const ms_shadow_method *sm = ms_find_shadow_method(method);
     bs.whole_tri_copy = sm && sm->visibility_all;
     if (need) *need = ms_bake_need(&bs, NULL);
     return ms_bake_budget_check(&bs, ms_memory_budget(o->points.max_memory), err, errlen) ? MS_ERR_BUDGET : MS_OK;

@@ -249,6 +249,7 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     ms_status st = check_points(a, pts, err, errlen);
     if (st) return st;
     const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;
+    if (strcmp(method, MS_AUTO_METHOD) == 0) method = ms_auto_method(opt->pattern);
     const ms_shadow_method *sm = ms_find_shadow_method(method);
     if (!sm) {
         if (ms_method_available(method) < 0) snprintf(err, errlen, "method '%s' is not compiled into this build", method);

@@ -56,5 +56,7 @@ typedef struct ms_shadow_method {
 
 /* Known shadow methods, compiled in or not (registry.c). */
 const ms_shadow_method *ms_find_shadow_method(const char *name);
+/* "auto" (MS_AUTO_METHOD): the method measured fastest for the pattern (registry.c says from which figures). */
+const char *ms_auto_method(ms_pattern pattern);
 
 #endif

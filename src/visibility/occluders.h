@@ -45,8 +45,11 @@ typedef struct ms_occluders {
 #define MS_INTERIOR_RES 32
 #define MS_INTERIOR_MIN_TRIS 256
 
-/* What a light's occluders are built with (ms_shadow_method.occluders). */
-enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4, MS_OCC_MERGE = 8 };
+/* What a light's occluders are built with (ms_shadow_method.occluders). MS_OCC_INTERIOR_PASS (with
+ * MS_OCC_INTERIOR): a method that does not rasterize the interior boxes itself is run by the frame's driver
+ * over them first (a second state whose BVH is the boxes' triangles), then over the scene's triangles with
+ * the samples the boxes left (frame_job.c). */
+enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4, MS_OCC_MERGE = 8, MS_OCC_INTERIOR_PASS = 16 };
 
 /* The occluders of light l (every shape: its hull is its parallelogram, or a sphere's box) for the scene
  * whose BVH is `scene_bvh` and closed components `closed` (found over scene->tri), with alpha-tested

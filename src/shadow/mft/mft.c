@@ -246,7 +246,7 @@ const ms_shadow_method ms_shadow_mft = {
     .name = "mft",
     .primary = "bvh",
     .needs_grid = 0,
-    .occluders = MS_OCC_CULL,
+    .occluders = MS_OCC_CULL | MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS | MS_OCC_MERGE,
     .n_counters = MS_MFT_COUNTERS,
     .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",
                        "leaf_frusta_culled", "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",

@@ -27,12 +27,15 @@ enum {
     MS_BR_LEAF_LANES_CULLED = MS_BT_COUNTERS, /* pixels dropped at a leaf by their own frustum */
     MS_BR_TRI_LANES,                   /* (triangle, pixel) pairs reaching the leaf tests */
     MS_BR_CULLED_DEPTH, MS_BR_CULLED_RECT, MS_BR_CULLED_CORNER, MS_BR_CULLED_COVERAGE,
-    MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS, MS_BR_COUNTERS
+    MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS,
+    MS_BR_SHARED_SETUP,                /* of the rasterizations, those set up for several pixels at once */
+    MS_BR_COUNTERS
 };
 
 /* Flags: MS_BR_FRUSTUM_SHRINK also narrows a pixel's traversal frustum to its rectangle (the paper's
- * "FS"); MS_BR_ORDER visits nearer children first. */
-enum { MS_BR_ORDER = 1, MS_BR_FRUSTUM_SHRINK = 2 };
+ * "FS"); MS_BR_ORDER visits nearer children first; MS_BR_NO_LANE_SETUP leaves every triangle's set-up to
+ * the kernel pixel by pixel (to measure and test the shared set-up, block_raster_impl.h br_scan_setup). */
+enum { MS_BR_ORDER = 1, MS_BR_FRUSTUM_SHRINK = 2, MS_BR_NO_LANE_SETUP = 4 };
 
 typedef void (*ms_block_raster_fn)(const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh,
                                    ms_raster_fn raster, float near, float far, uint64_t *cnt, int flags);

@@ -47,7 +47,142 @@ typedef struct br_state {
     float mabs2[3][MS_BLOCK_LANES];  /* |m[2][a]| */
     float rx0[MS_BLOCK_LANES], rx1[MS_BLOCK_LANES], ry0[MS_BLOCK_LANES], ry1[MS_BLOCK_LANES];
     int rect[MS_BLOCK_LANES][4];
+    /* The Scanline kernel's set-up for many pixels at once (br_scan_setup): its row loop, NULL when the
+     * kernel is not the SIMD Scanline (or a lane's frame culls back faces), and the lanes' frames' mt,
+     * near and far. */
+    ms_scan_rows_fn rows;
+    float mt[3][3][MS_BLOCK_LANES];
+    float near_l[MS_BLOCK_LANES], far_l[MS_BLOCK_LANES];
 } br_state;
+
+/* Smallest number of a block's pixels that rasterize one triangle for which its set-up is computed for
+ * them together (br_scan_setup) rather than by the kernel pixel by pixel. Measured (512², 256 samples, one
+ * thread, shadow CPU seconds): with AVX-512 (one register for 16 lanes) 2 is best, 1 and 4 within noise
+ * of it; with AVX2 (two halves) 2 cost 5% against the kernel alone and 4 broke even or won (ogre -11%). */
+#if defined(MS_TARGET_AVX512)
+#define BR_LANE_SETUP_MIN 2
+#else
+#define BR_LANE_SETUP_MIN 4
+#endif
+
+/* The lanes' Scanline set-ups of one triangle, the output of br_scan_setup. */
+typedef struct br_setup {
+    float al[3][MS_BLOCK_LANES], bl[3][MS_BLOCK_LANES], au[3][MS_BLOCK_LANES], bu[3][MS_BLOCK_LANES];
+    int32_t y0[MS_BLOCK_LANES], y1[MS_BLOCK_LANES];
+    unsigned rows;       /* lanes with scanlines to clear */
+    unsigned kernel;     /* lanes left to the kernel: a clip edge, an edge parallel to the scanlines, a
+                          * non-finite length (rare) */
+} br_setup;
+
+/* Issue #29 item 2, "set up each triangle once per block": the SIMD Scanline kernel's set-up
+ * (scanline_simd_impl.h, ms_scan_vec_setup, clip-free instance) laid out with one pixel per lane instead
+ * of one vertex or edge per lane, so that a triangle that several pixels of the block rasterize is set up
+ * for all of them in one pass and each pixel runs only the kernel's row loop (ms_raster_rows). Every
+ * value is computed with the kernel's operations in the kernel's order (lanes16.h: one IEEE operation
+ * per lane, no FMA; the kernel's mul + add, its division y / z for the box where the leaf test above
+ * multiplies by 1 / z), and every choice the kernel makes with a mask (shortest sides, nearest vertex,
+ * longest edge, lower or upper bound) is the same comparison here, so each lane's ms_scan_vec is the
+ * kernel's bit for bit and so is the buffer (test_block_traverse compares the masks with the per-pixel
+ * traversal's, which calls the kernel). What the kernel does rarely stays with it: a lane whose triangle
+ * reaches the near or far plane (clip edges), has an edge parallel to the scanlines, or has a non-finite
+ * length goes to the kernel. The world edges and the plane normal do not depend on the pixel: they are
+ * computed once, in scalar form with the same operations.
+ * x, y, z: the vertices' light-index coordinates per lane, zmin / zmax their widened depth range (the
+ * leaf test's, the kernel's operations); a[v][j] the world vectors P_v - C. */
+static inline void br_scan_setup(const br_state *s, const float *tri, unsigned lanes, const l16 a[3][3],
+                                 const l16 x[3], const l16 y[3], const l16 z[3], l16 zmin, l16 zmax, int k,
+                                 br_setup *o)
+{
+    const l16 zero = l16_set1(0.0f), kf = l16_set1((float)k);
+    unsigned kernel = lanes & (l16_lt(zmin, l16_load(s->near_l)) | l16_gt(zmax, l16_load(s->far_l)));
+    /* World edges w[i] = P_{i+2} - P_{i+1} and their squared lengths (the kernel's lanes 4..6). */
+    float w[3][3], el[3];
+    for (int i = 0; i < 3; i++) {
+        const float *p = tri + 3 * ((i + 1) % 3), *q = tri + 3 * ((i + 2) % 3);
+        for (int j = 0; j < 3; j++) w[i][j] = q[j] - p[j];
+        el[i] = w[i][0] * w[i][0] + w[i][1] * w[i][1] + w[i][2] * w[i][2];
+    }
+    l16 len[3];
+    for (int v = 0; v < 3; v++) {
+        len[v] = l16_add(l16_add(l16_mul(a[v][0], a[v][0]), l16_mul(a[v][1], a[v][1])), l16_mul(a[v][2], a[v][2]));
+        kernel |= lanes & ~l16_le(len[v], l16_set1(3.4e38f));   /* NaN or infinite: the kernel decides */
+    }
+    /* The edge equations: edge i from the two shortest sides of (C, P_{i+1}, P_{i+2}). */
+    l16 ex[3], ey[3], ez[3];
+    for (int i = 0; i < 3; i++) {
+        const int ia = (i + 1) % 3, ib = (i + 2) % 3;
+        const l16 wl = l16_set1(el[i]);
+        const unsigned va_longest = l16_le(len[ib], len[ia]) & l16_le(wl, len[ia]);
+        const unsigned e_longest = ~va_longest & l16_le(len[ib], wl);
+        l16 X[3], Y[3];
+        for (int j = 0; j < 3; j++) {
+            X[j] = l16_select(va_longest, a[ib][j], a[ia][j]);
+            Y[j] = l16_select(e_longest, a[ib][j], l16_set1(w[i][j]));
+        }
+        const l16 ux = l16_sub(l16_mul(X[1], Y[2]), l16_mul(X[2], Y[1]));
+        const l16 uy = l16_sub(l16_mul(X[2], Y[0]), l16_mul(X[0], Y[2]));
+        const l16 uz = l16_sub(l16_mul(X[0], Y[1]), l16_mul(X[1], Y[0]));
+        l16 e[3];
+        for (int r = 0; r < 3; r++)
+            e[r] = l16_add(l16_add(l16_mul(l16_load(s->mt[r][0]), ux), l16_mul(l16_load(s->mt[r][1]), uy)),
+                           l16_mul(l16_load(s->mt[r][2]), uz));
+        ex[i] = e[0]; ey[i] = e[1]; ez[i] = e[2];
+    }
+    /* The plane normal from the two shortest edges (the longest edge's candidate, ties to the lower
+     * index) and D from the vertex nearest C (ties to the lower index), as the kernel picks them. */
+    const int long_i = el[0] >= el[1] ? (el[0] >= el[2] ? 0 : 2) : (el[1] >= el[2] ? 1 : 2);
+    const float *sa = w[(long_i + 1) % 3], *sb = w[(long_i + 2) % 3];
+    const float nw[3] = { sa[1] * sb[2] - sa[2] * sb[1], sa[2] * sb[0] - sa[0] * sb[2], sa[0] * sb[1] - sa[1] * sb[0] };
+    const unsigned n0 = l16_le(len[0], len[1]) & l16_le(len[0], len[2]);
+    const unsigned n1 = ~l16_le(len[0], len[1]) & l16_le(len[1], len[2]);
+    l16 an[3];
+    for (int j = 0; j < 3; j++) an[j] = l16_select(n0, a[0][j], l16_select(n1, a[1][j], a[2][j]));
+    const l16 d = l16_add(l16_add(l16_mul(an[0], l16_set1(nw[0])), l16_mul(an[1], l16_set1(nw[1]))),
+                          l16_mul(an[2], l16_set1(nw[2])));
+    /* D = 0: the plane contains C, nothing to rasterize (nor for NaN). */
+    unsigned live = lanes & ~kernel & (l16_lt(d, zero) | l16_gt(d, zero));
+    const unsigned dneg = l16_lt(d, zero);
+    const l16 flat = l16_set1(MS_FLAT_EDGE), minus1 = l16_set1(-1.0f);
+    for (int i = 0; i < 3 && live; i++) {
+        const l16 r = l16_div(minus1, ex[i]);
+        const l16 ax = l16_mul(l16_abs(ex[i]), kf), ay = l16_mul(l16_abs(ey[i]), kf), az = l16_abs(ez[i]);
+        const unsigned steep = l16_gt(ax, l16_mul(flat, l16_max(ay, az)));
+        const unsigned flat_y = ~steep & l16_gt(ay, l16_mul(flat, az));
+        kernel |= live & flat_y;
+        /* Constant and negative over the buffer (after the two-sided flip by D's sign): nothing. */
+        const unsigned neg = (dneg & l16_gt(ez[i], zero)) | (~dneg & l16_lt(ez[i], zero));
+        live &= ~flat_y & ~(~steep & neg);
+        const unsigned lower = steep & ((dneg & l16_lt(ex[i], zero)) | (~dneg & l16_gt(ex[i], zero)));
+        const unsigned upper = steep & ~lower;
+        const l16 av = l16_mul(ey[i], r), bv = l16_mul(ez[i], r);
+        l16_store(o->al[i], l16_select(lower, av, zero));
+        l16_store(o->bl[i], l16_select(lower, bv, zero));
+        l16_store(o->au[i], l16_select(upper, av, zero));
+        l16_store(o->bu[i], l16_select(upper, bv, l16_set1((float)k - 1.0f)));
+    }
+    /* Scanline range: the box of the projected vertices when in front of C (the kernel's division),
+     * else the whole buffer. */
+    const unsigned front = live & l16_gt(zmin, zero);
+    l16 y0 = zero, y1 = l16_set1((float)k - 1.0f);
+    if (front) {
+        const l16 slack = l16_set1(MS_BOX_SLACK);
+        l16 px[3], py[3];
+        for (int v = 0; v < 3; v++) { px[v] = l16_div(x[v], z[v]); py[v] = l16_div(y[v], z[v]); }
+        const l16 ylo = l16_min(l16_max(l16_sub(l16_min(l16_min(py[0], py[1]), py[2]), slack), minus1), kf);
+        const l16 yhi = l16_min(l16_max(l16_add(l16_max(l16_max(py[0], py[1]), py[2]), slack), minus1), kf);
+        const l16 xlo = l16_min(l16_max(l16_sub(l16_min(l16_min(px[0], px[1]), px[2]), slack), minus1), kf);
+        const l16 xhi = l16_min(l16_max(l16_add(l16_max(l16_max(px[0], px[1]), px[2]), slack), minus1), kf);
+        const l16 iy0 = l16_max(l16_ceil(ylo), zero), iy1 = l16_min(l16_floor(yhi), l16_set1((float)k - 1.0f));
+        const l16 ix0 = l16_max(l16_ceil(xlo), zero), ix1 = l16_min(l16_floor(xhi), l16_set1((float)k - 1.0f));
+        live &= ~(front & (l16_gt(iy0, iy1) | l16_gt(ix0, ix1)));
+        y0 = l16_select(front, iy0, y0);
+        y1 = l16_select(front, iy1, y1);
+    }
+    l16_store_int(o->y0, y0);
+    l16_store_int(o->y1, y1);
+    o->rows = live;
+    o->kernel = kernel;
+}
 
 /* The four corner directions of lane rectangle r (columns r[0]..r[1], rows r[2]..r[3]) from C: sample
  * (i, j) is C + mt[2] + i mt[0] + j mt[1] (raster.h). */
@@ -97,14 +232,34 @@ static inline int MS_KFN(br_update_lane)(br_state *s, int l, int frustum, int fi
 }
 
 
-/* 1 if a visible sample lies in columns x0..x1 of rows y0..y1. */
+/* 1 if a visible sample lies in columns x0..x1 of rows y0..y1. The hottest test of the traversal (every
+ * leaf and every triangle that passes the lane tests asks it per pixel): for k = 16 and 32 with AVX2 the
+ * buffer is a few vector registers and the rows' mask is built by comparison, with no loop over rows to
+ * mispredict; the same bits as the loop. */
 static inline int MS_KFN(br_covers)(const MS_WORD *buf, int x0, int x1, int y0, int y1)
 {
     const MS_WORD ones = (MS_WORD)~(MS_WORD)0;   /* cast after ~: uint16_t promotes to int */
     const MS_WORD mask = (MS_WORD)((MS_WORD)(ones >> (MS_K - 1 - (x1 - x0))) << x0);
+#if (defined(MS_TARGET_AVX2) || defined(MS_TARGET_AVX512)) && MS_K == 16
+    const __m256i rows = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m256i in = _mm256_andnot_si256(_mm256_cmpgt_epi16(_mm256_set1_epi16((short)y0), rows),
+                                           _mm256_cmpgt_epi16(_mm256_set1_epi16((short)(y1 + 1)), rows));
+    const __m256i m = _mm256_and_si256(in, _mm256_set1_epi16((short)mask));
+    return !_mm256_testz_si256(_mm256_loadu_si256((const __m256i *)buf), m);
+#elif (defined(MS_TARGET_AVX2) || defined(MS_TARGET_AVX512)) && MS_K == 32
+    const __m256i lo = _mm256_set1_epi32(y0), hi = _mm256_set1_epi32(y1 + 1), cm = _mm256_set1_epi32((int)mask);
+    __m256i acc = _mm256_setzero_si256();
+    for (int q = y0 >> 3; q <= y1 >> 3; q++) {
+        const __m256i rows = _mm256_add_epi32(_mm256_set1_epi32(8 * q), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        const __m256i in = _mm256_andnot_si256(_mm256_cmpgt_epi32(lo, rows), _mm256_cmpgt_epi32(hi, rows));
+        acc = _mm256_or_si256(acc, _mm256_and_si256(in, _mm256_loadu_si256((const __m256i *)(buf + 8 * q))));
+    }
+    return !_mm256_testz_si256(acc, cm);
+#else
     MS_WORD any = 0;
     for (int j = y0; j <= y1; j++) any |= buf[j];
     return (any & mask) != 0;
+#endif
 }
 
 /* The lanes of mask whose rectangle frustum (light-index space: i in [rx0, rx1], j in [ry0, ry1] on the
@@ -158,19 +313,20 @@ static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_nod
      * buffer. */
     unsigned cand = keep & front;
     if (cand) {
-        float bx0[MS_BLOCK_LANES], bx1[MS_BLOCK_LANES], by0[MS_BLOCK_LANES], by1[MS_BLOCK_LANES];
-        l16_store(bx0, px0); l16_store(bx1, px1); l16_store(by0, py0); l16_store(by1, py1);
+        /* The projected box in sample indices (slack, clamp, rounding), within each lane's rectangle. */
+        const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+        const l16 ax0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(px0, sl), lo1), hi1)), l16_load(s->rx0));
+        const l16 ax1 = l16_min(l16_floor(l16_min(l16_max(l16_add(px1, sl), lo1), hi1)), l16_load(s->rx1));
+        const l16 ay0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(py0, sl), lo1), hi1)), l16_load(s->ry0));
+        const l16 ay1 = l16_min(l16_floor(l16_min(l16_max(l16_add(py1, sl), lo1), hi1)), l16_load(s->ry1));
+        const unsigned empty = cand & (l16_gt(ax0, ax1) | l16_gt(ay0, ay1));
+        keep &= ~empty;
+        cand &= ~empty;
+        int32_t xa[MS_BLOCK_LANES], xb[MS_BLOCK_LANES], ya[MS_BLOCK_LANES], yb[MS_BLOCK_LANES];
+        l16_store_int(xa, ax0); l16_store_int(xb, ax1); l16_store_int(ya, ay0); l16_store_int(yb, ay1);
         for (; cand; cand &= cand - 1) {
             const int l = __builtin_ctz(cand);
-            const int *r = s->rect[l];
-            const float kmax = (float)(MS_K - 1);
-            const int ix0 = ms_ceil_i(ms_clampf(bx0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int ix1 = ms_floor_i(ms_clampf(bx1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int iy0 = ms_ceil_i(ms_clampf(by0[l] - MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int iy1 = ms_floor_i(ms_clampf(by1[l] + MS_TRAV_SIDE_SLACK, -1.0f, kmax + 1.0f));
-            const int xa = ix0 > r[0] ? ix0 : r[0], xb = ix1 < r[1] ? ix1 : r[1];
-            const int ya = iy0 > r[2] ? iy0 : r[2], yb = iy1 < r[3] ? iy1 : r[3];
-            if (xa > xb || ya > yb || !MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa, xb, ya, yb)) keep &= ~(1u << l);
+            if (!MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa[l], xb[l], ya[l], yb[l])) keep &= ~(1u << l);
         }
     }
     return keep;
@@ -204,7 +360,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
     if (!mask) return;
     unsigned rasterized = 0;
-    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_corner = 0, c_cov = 0, c_rast = 0;
+    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_corner = 0, c_cov = 0, c_rast = 0, c_shared = 0;
     for (uint32_t t = n->first; t < n->first + n->count; t++) {
         unsigned lanes = mask & fr->live;
         if (!lanes) break;
@@ -213,9 +369,9 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
         if (!lanes) continue;
         tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
         const float *tri = s->b->tri + 9 * (size_t)t;
-        l16 x[3], y[3], z[3], zlo[3], zhi[3];
+        l16 x[3], y[3], z[3], zlo[3], zhi[3], av[3][3];
         for (int v = 0; v < 3; v++) {
-            l16 a[3], aa[3];
+            l16 *a = av[v], aa[3];
             for (int k = 0; k < 3; k++) { a[k] = l16_sub(l16_set1(tri[3 * v + k]), c[k]); aa[k] = l16_abs(a[k]); }
             x[v] = l16_add(l16_add(l16_mul(m[0][0], a[0]), l16_mul(m[0][1], a[1])), l16_mul(m[0][2], a[2]));
             y[v] = l16_add(l16_add(l16_mul(m[1][0], a[0]), l16_mul(m[1][1], a[1])), l16_mul(m[1][2], a[2]));
@@ -290,16 +446,45 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
         }
         int32_t ix0[MS_BLOCK_LANES], ix1[MS_BLOCK_LANES], iy0[MS_BLOCK_LANES], iy1[MS_BLOCK_LANES];
         l16_store_int(ix0, bx0); l16_store_int(ix1, bx1); l16_store_int(iy0, by0); l16_store_int(iy1, by1);
-        for (; pass; pass &= pass - 1) {
-            const int l = __builtin_ctz(pass);
+        /* The pixels that pass the coverage test; those set up together below, the others by the kernel. */
+        unsigned cover = 0;
+        for (unsigned p = pass; p; p &= p - 1) {
+            const int l = __builtin_ctz(p);
             /* Behind C somewhere (front clear): the kernel scans its whole rectangle, which holds visible
              * samples by construction. */
             if ((front >> l & 1) && !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], ix0[l], ix1[l], iy0[l], iy1[l])) { c_cov++; continue; }
+            cover |= 1u << l;
+        }
+        if (!cover) continue;
+        c_rast += (uint64_t)ms_bt_popcount16(cover);
+        rasterized |= cover;
+        unsigned by_kernel = cover;
+        if (s->rows && ms_bt_popcount16(cover) >= BR_LANE_SETUP_MIN) {
+            /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel. */
+            unsigned alpha = 0;
+            for (unsigned p = cover; p; p &= p - 1) {
+                const int l = __builtin_ctz(p);
+                const ms_alpha_pixel *ap = (const ms_alpha_pixel *)in->frame[l]->alpha;
+                if (ap && ap->ctx->alpha->flag[t]) alpha |= 1u << l;
+            }
+            br_setup su;
+            br_scan_setup(s, tri, cover & ~alpha, av, x, y, z, zmin, zmax, MS_K, &su);
+            by_kernel = alpha | su.kernel;
+            c_shared += (uint64_t)ms_bt_popcount16(su.rows);
+            for (unsigned p = su.rows; p; p &= p - 1) {
+                const int l = __builtin_ctz(p);
+                ms_scan_vec v;
+                for (int i = 0; i < 3; i++) { v.al[i] = su.al[i][l]; v.bl[i] = su.bl[i][l]; v.au[i] = su.au[i][l]; v.bu[i] = su.bu[i][l]; }
+                v.y0 = su.y0[l];
+                v.y1 = su.y1[l];
+                s->rows(&v, in->buf[l]);
+            }
+        }
+        for (; by_kernel; by_kernel &= by_kernel - 1) {
+            const int l = __builtin_ctz(by_kernel);
             /* An alpha-tested triangle clears only its opaque samples (alpha.h): the rectangle, coverage and
              * early-out tests that read the buffer afterwards see only what it really occludes. */
             ms_raster_or_alpha(in->frame[l], s->raster, tri, t, in->buf[l]);
-            rasterized |= 1u << l;
-            c_rast++;
         }
     }
     cnt[MS_BR_TRI_LANES] += tri_lanes;
@@ -308,6 +493,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_CULLED_CORNER] += c_corner;
     cnt[MS_BR_CULLED_COVERAGE] += c_cov;
     cnt[MS_BR_RASTERIZED] += c_rast;
+    cnt[MS_BR_SHARED_SETUP] += c_shared;
     /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */
     const int fs = s->flags & MS_BR_FRUSTUM_SHRINK;
     for (; rasterized; rasterized &= rasterized - 1) {
@@ -339,8 +525,12 @@ void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms
     s.in = in;
     s.raster = raster;
     s.flags = flags;
+    s.rows = (flags & MS_BR_NO_LANE_SETUP) ? NULL : ms_raster_rows(raster, MS_K);
     memset(s.m, 0, sizeof s.m);
     memset(s.mabs2, 0, sizeof s.mabs2);
+    memset(s.mt, 0, sizeof s.mt);
+    memset(s.near_l, 0, sizeof s.near_l);
+    memset(s.far_l, 0, sizeof s.far_l);
     for (int l = 0; l < MS_BLOCK_LANES; l++) {
         s.rx0[l] = s.ry0[l] = 1.0f;
         s.rx1[l] = s.ry1[l] = 0.0f;
@@ -350,6 +540,11 @@ void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms
         for (int r = 0; r < 3; r++)
             for (int a = 0; a < 3; a++) s.m[r][a][l] = f->m[r][a];
         for (int a = 0; a < 3; a++) s.mabs2[a][l] = fabsf(f->m[2][a]);
+        for (int r = 0; r < 3; r++)
+            for (int a = 0; a < 3; a++) s.mt[r][a][l] = f->mt[r][a];
+        s.near_l[l] = f->near;
+        s.far_l[l] = f->far;
+        if (f->cull_backfaces || f->k != MS_K) s.rows = NULL;
         /* The starting frustum bounds the front samples (the horizon already cleared the rest). */
         MS_KFN(br_update_lane)(&s, l, 1, 1);
     }
