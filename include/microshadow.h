@@ -284,6 +284,7 @@ typedef struct ms_scene {
     /* Per scene-file mesh (n_meshes entries, NULL: all 1): its texel density weight in bakes (scene file
      * "lightmap": {"scale": s}), 0 for "lightmap": false (not baked; it still casts shadows). */
     float *mesh_lightmap_scale;
+    int aa;              /* primary samples per pixel from the scene file (render.aa; 0: not given) */
 } ms_scene;
 
 #define MS_NO_MATERIAL UINT32_MAX
@@ -372,8 +373,12 @@ typedef struct ms_scene_load_options {
     int allow_outside_paths;
 } ms_scene_load_options;
 MS_API int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen);
-/* The built-in procedural scene: a ground, occluders of several sizes, a light. */
+/* The built-in procedural scene: a ground, occluders of several sizes, a light (the tests' fixture). */
 MS_API int ms_scene_default(ms_scene *out);
+/* The built-in scene the CLI renders without a scene file: smooth-shaded curved objects (per-vertex normals),
+ * a procedurally textured ground, a metal and rough plastics, alpha-tested leaf cards, and a rect, a disk and a
+ * sphere light of different colours; 768 x 512, 256 samples. 0, or -1 when out of memory. */
+MS_API int ms_scene_showcase(ms_scene *out);
 /* Puts a scene built in world coordinates (tri, camera, lights as floats; origin usually 0) into the frame
  * ms_scene_load would choose for it (see ms_scene): tri, the camera's eye and target and the lights' corners
  * and centres moved, origin set. The detail a float lost far from the origin is not recovered, but every
@@ -493,6 +498,15 @@ typedef struct ms_render_options {
     ms_stream_mode stream;  /* ms_render_outputs only (ms_render always holds the whole frame) */
     int stream_rows;        /* streamed: rows per band, a multiple of MS_TILE_SIZE; 0: about 512 tiles' worth, fewer
                              * (down to one tile row) when the budget needs */
+    /* Pixel anti-aliasing (docs/antialiasing.md): K = aa primary samples per pixel (1, 4, 9 or 16; 0: the
+     * scene's render.aa, else 1), on the s x s grid of the pixel's strata centres (s = sqrt K). Each has its own
+     * hit, front mask and shadow query (every method answers each as a pixel of an s-times larger frame, on
+     * that pixel's samples), and the frame's rgb, V, S and S_spec are their box-filtered average per pixel (V,
+     * S over the samples that hit; -1 where none did; rgb counts misses as black). K = 1 is the frame as without
+     * anti-aliasing, bit for bit. */
+    int aa;
+    int aa_split;           /* aa > 1: the pixel's N light samples split among its K hits (N/K each, which must be
+                             * a valid sample count for the pattern) instead of all N for every hit */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */

@@ -291,7 +291,7 @@ static void test_cli(void **st)
     assert_int_equal(tu_run_cli(a1, err, sizeof err), 0);
     assert_int_equal(tu_run_cli(a2, err, sizeof err), 0);
     ms_scene sc;
-    assert_int_equal(ms_scene_default(&sc), 0);
+    assert_int_equal(ms_scene_showcase(&sc), 0);   /* the CLI's built-in scene */
     const char *paths[2] = { pf, pr };
     float *got[2];
     for (int nf = 0; nf < 2; nf++) {

@@ -189,7 +189,7 @@ static void test_stats(void **st)
     const char *dir = tu_tmpdir("outputs_stats");
     char path[4096], err[512];
     ms_scene s;
-    assert_int_equal(ms_scene_default(&s), 0);
+    assert_int_equal(ms_scene_showcase(&s), 0);   /* the CLI's built-in scene, rendered below through it too */
     ms_render_options opt;
     tu_render_options_default(&opt);
     opt.method = "raytrace";

@@ -14,6 +14,8 @@
 #include <strings.h>
 #include <unistd.h>
 
+/* --aa when neither it nor the scene's render.aa is given (docs/antialiasing.md: the measured cost). */
+#define MS_CLI_AA_DEFAULT 4
 
 static void usage(FILE *f)
 {
@@ -32,6 +34,11 @@ static void usage(FILE *f)
         "  --samples N         256, 1024 or 4096 light samples (default: the scene's); stratified also 16, 64\n"
         "  --no-filter         interleaved: raw per-pixel V and S, without the filter\n"
         "  --width W, --height H   image size (default: the scene camera's)\n"
+        "  --aa K              anti-aliasing: K = 1, 4, 9 or 16 primary samples per pixel, each with its own\n"
+        "                      shadow query; the pixel is their average (default: the scene's render.aa,\n"
+        "                      else %d; 1 when --vis or --shadow asks for the sample-for-sample planes)\n"
+        "  --aa-split          with --aa K: the pixel's N light samples split among its K primary samples\n"
+        "                      (N/K each) instead of N for each\n"
         "  --threads T         threads (default: all cores)\n"
         "  --seed S            seed of the per-pixel sample patterns (default 0)\n"
         "  -o OUT.png|.exr     shaded image (default microshadow.png): PNG tone-mapped sRGB, EXR linear HDR\n"
@@ -68,7 +75,7 @@ static void usage(FILE *f)
         "                      one-sided), queue (rank 0 hands them out), static (round robin)\n"
         "  --mpi-chunk N       under mpirun: tiles per hand-out (default: --threads, or 4)\n"
 #endif
-        "  --help, --version\n", MS_MEMORY_DEFAULT_PERCENT);
+        "  --help, --version\n", MS_CLI_AA_DEFAULT, MS_MEMORY_DEFAULT_PERCENT);
 }
 
 static int progress_bar(void *user, double frac)
@@ -93,7 +100,7 @@ static int cli_main(int argc, char **argv)
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
            O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR, O_NO_MERGE, O_MAX_MEMORY,
-           O_EMBREE_MODE, O_EMBREE_FILTER, O_STREAM, O_NO_STREAM };
+           O_EMBREE_MODE, O_EMBREE_FILTER, O_STREAM, O_NO_STREAM, O_AA, O_AA_SPLIT };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -112,6 +119,7 @@ static int cli_main(int argc, char **argv)
         { "max-memory", required_argument, 0, O_MAX_MEMORY },
         { "embree-mode", required_argument, 0, O_EMBREE_MODE }, { "embree-filter", required_argument, 0, O_EMBREE_FILTER },
         { "stream", no_argument, 0, O_STREAM }, { "no-stream", no_argument, 0, O_NO_STREAM },
+        { "aa", required_argument, 0, O_AA }, { "aa-split", no_argument, 0, O_AA_SPLIT },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -202,6 +210,15 @@ static int cli_main(int argc, char **argv)
             break;
         case O_STREAM: opt.stream = MS_STREAM_ON; break;
         case O_NO_STREAM: opt.stream = MS_STREAM_OFF; break;
+        case O_AA:
+            if (ms_cli_parse_long(&cli, "--aa", optarg, 1, 16, &v)) return EXIT_BAD_INPUT;
+            if (v != 1 && v != 4 && v != 9 && v != 16) {
+                fprintf(stderr, "microshadow: --aa: %ld is not one of 1, 4, 9, 16\n", v);
+                return EXIT_BAD_INPUT;
+            }
+            opt.aa = (int)v;
+            break;
+        case O_AA_SPLIT: opt.aa_split = 1; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &opt.max_memory)) return EXIT_BAD_INPUT; break;
         case O_EXPOSURE: {
             char *end;
@@ -248,10 +265,13 @@ static int cli_main(int argc, char **argv)
             fprintf(stderr, "microshadow: %s\n", err);
             return EXIT_BAD_INPUT;
         }
-    } else if (ms_scene_default(&scene)) {
+    } else if (ms_scene_showcase(&scene)) {
         fprintf(stderr, "microshadow: out of memory building the default scene\n");
         return 1;
     }
+    /* Anti-aliased pictures by default; the V and S planes, which users compare method against method
+     * and with other renderers sample for sample, stay one primary sample per pixel unless asked. */
+    if (!opt.aa && !scene.aa) opt.aa = outs[OUT_VIS].path || outs[OUT_SHADOW].path ? 1 : MS_CLI_AA_DEFAULT;
     int last = -1;
     ms_stats stats;
     const char *what = scene_path ? scene_path : "built-in scene";

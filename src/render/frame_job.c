@@ -25,6 +25,7 @@
 #include "interleave_filter.h"
 #include "budget.h"
 #include "frame_stream.h"
+#include "frame_aa.h"
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,6 +62,7 @@ struct ms_frame_job {
      * of 2 band_rows + 2 rows from y_base, and the filtered band goes to band_vis, band_shadow, band_spec. */
     int rendered_to, emitted_to, band_filter;
     float *band_vis, *band_shadow, *band_spec;
+    int aa_s, aa_split;           /* anti-aliasing: W, H are s times the output's; frame_aa.c resolves them */
     ms_hit *hits;
     ms_surface *surf;             /* per pixel, only for scenes with materials or normals (shade.h) */
     uint8_t *traced;              /* per tile: primary hits (and surfaces) are in hits (and surf) */
@@ -254,11 +256,25 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     j->lights = ms_scene_lights(scene, &j->nlights);
     int rc = -1;
     const int samples = opt->samples > 0 ? opt->samples : scene->samples;
+    /* Anti-aliasing: K primary samples per pixel as the pixels of an s-times larger frame (s = sqrt K), which
+     * every primary and shadow method renders as it renders any frame; finish resolves it (frame_aa.c). */
+    const int aa = opt->aa > 0 ? opt->aa : scene->aa > 0 ? scene->aa : 1;
+    int aa_s = 1;
+    while (aa_s * aa_s < aa) aa_s++;
+    if (opt->aa < 0 || aa_s * aa_s != aa || aa_s > 4) { snprintf(err, errlen, "aa must be 1, 4, 9 or 16 (got %d)", opt->aa < 0 ? opt->aa : aa); goto fail; }
+    const int aa_split = opt->aa_split && aa > 1;
+    /* Split: each of the K hits gets N/K of the pixel's samples (its own pattern, seeded by its sub-pixel). */
+    const int hit_samples = aa_split ? samples / aa : samples;
+    if (aa_split && (samples % aa || !ms_pattern_samples_per_pixel(opt->pattern, hit_samples))) {
+        snprintf(err, errlen, "aa_split: %d samples over %d primary samples leave %d each, not a sample count of the %s pattern",
+                 samples, aa, samples / aa, ms_pattern_name(opt->pattern));
+        goto fail;
+    }
     if ((unsigned)opt->pattern > MS_PATTERN_INTERLEAVED) { snprintf(err, errlen, "unknown pattern %d", (int)opt->pattern); goto fail; }
     if ((unsigned)opt->traversal > MS_TRAVERSAL_PIXEL) { snprintf(err, errlen, "unknown traversal %d", (int)opt->traversal); goto fail; }
     if ((unsigned)opt->closed_cull > MS_CLOSED_CULL_OFF) { snprintf(err, errlen, "unknown closed_cull %d", (int)opt->closed_cull); goto fail; }
     /* Samples per pixel: N, or N/16 for interleaved; always a multiple of 16 (full ray packets). */
-    const int spp = ms_pattern_samples_per_pixel(opt->pattern, samples);
+    const int spp = ms_pattern_samples_per_pixel(opt->pattern, hit_samples);
     if (!spp) {
         snprintf(err, errlen, "samples must be %s with the %s pattern (got %d)",
                  opt->pattern == MS_PATTERN_STRATIFIED ? "16, 64, 256, 1024 or 4096" : "256, 1024 or 4096",
@@ -269,12 +285,14 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         snprintf(err, errlen, "method '%s' needs --pattern grid", sm->name);
         goto fail;
     }
-    const int W = opt->width > 0 ? opt->width : scene->camera.width;
-    const int H = opt->height > 0 ? opt->height : scene->camera.height;
-    if (W < 1 || H < 1 || W > MS_MAX_IMAGE_SIZE || H > MS_MAX_IMAGE_SIZE) {
-        snprintf(err, errlen, "width and height must be in [1, %d]", MS_MAX_IMAGE_SIZE);
+    const int W_out = opt->width > 0 ? opt->width : scene->camera.width;
+    const int H_out = opt->height > 0 ? opt->height : scene->camera.height;
+    if (W_out < 1 || H_out < 1 || W_out > MS_MAX_IMAGE_SIZE / aa_s || H_out > MS_MAX_IMAGE_SIZE / aa_s) {
+        if (aa_s > 1) snprintf(err, errlen, "width and height must be in [1, %d] with aa %d", MS_MAX_IMAGE_SIZE / aa_s, aa);
+        else snprintf(err, errlen, "width and height must be in [1, %d]", MS_MAX_IMAGE_SIZE);
         goto fail;
     }
+    const int W = W_out * aa_s, H = H_out * aa_s;
     /* The memory budget, before anything proportional to the frame or the scene is allocated. */
     {
         ms_frame_shape fs;
@@ -306,7 +324,8 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
          * cores); fewer rows when the budget needs. Not for frame-level methods (their receivers are the
          * whole frame). */
         const int tiles_x = (W + TILE - 1) / TILE, want = 16 * j->threads > 512 ? 16 * j->threads : 512;
-        const int streamable = !sm->visibility_all;
+        /* Anti-aliasing resolves the s-times larger frame once it is whole (frame_aa.c): not banded yet. */
+        const int streamable = !sm->visibility_all && aa_s == 1;
         if (opt->stream_rows < 0 || opt->stream_rows % TILE) {
             snprintf(err, errlen, "stream_rows %d is not a multiple of %d", opt->stream_rows, TILE);
             goto fail;
@@ -314,7 +333,8 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : TILE * ((want + tiles_x - 1) / tiles_x);
         const uint64_t budget = ms_memory_budget(opt->max_memory);
         if (stream == MS_STREAM_ON && !streamable) {
-            snprintf(err, errlen, "streamed outputs: the method takes the whole frame at once (its receivers are all of the frame's pixels)");
+            if (aa_s > 1) snprintf(err, errlen, "streamed outputs: anti-aliasing (aa %d) resolves the whole frame; stream with aa 1", aa);
+            else snprintf(err, errlen, "streamed outputs: the method takes the whole frame at once (its receivers are all of the frame's pixels)");
             goto fail;
         }
         /* AUTO streams only when that fits where the whole frame does not: else the whole frame's refusal names
@@ -350,7 +370,7 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         j->t_start = omp_get_wtime();   /* the generation counts as loading (soup.load_s) */
     }
     ms_render_ctx *ctx = &j->ctx;
-    ms_render_ctx_init(ctx, scene, streamed ? NULL : &j->bvh, &j->lights[0], opt->pattern, ms_samples_to_k(samples),
+    ms_render_ctx_init(ctx, scene, streamed ? NULL : &j->bvh, &j->lights[0], opt->pattern, ms_samples_to_k(hit_samples),
                        opt->seed, j->threads);
     if (ms_camera_basis_init(&ctx->cam, &scene->camera, W, H)) {
         snprintf(err, errlen, "camera is degenerate (eye = target, up parallel to the view, or a field of view, extent or type out of range)");
@@ -371,6 +391,8 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     j->H = H;
     j->samples = samples;
     j->spp = spp;
+    j->aa_s = aa_s;
+    j->aa_split = aa_split;
     j->tx = (W + TILE - 1) / TILE;
     j->ty = (H + TILE - 1) / TILE;
     j->ntiles = j->tx * j->ty;
@@ -777,7 +799,7 @@ static void job_stats(ms_frame_job *j, ms_stats *st)
     st->triangles = j->scene->n_tris;
     st->load_s = j->scene->load_s;
     st->samples = j->samples;
-    st->samples_per_pixel = j->spp;
+    st->samples_per_pixel = j->spp * (j->aa_split ? j->aa_s * j->aa_s : 1);
     st->threads = j->threads;
     st->width = j->W;
     st->height = j->H;
@@ -843,6 +865,10 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
     }
     if (ms_frame_shade(j->scene, &j->ctx, j->lights, nl, j->hits, j->surf, j->threads, 0, f, NULL)) {
         snprintf(err, errlen, "out of memory for the textured lights of a %dx%d frame", W, H);
+        return -1;
+    }
+    if (j->aa_s > 1 && ms_frame_aa_resolve(f, j->aa_s, j->aa_split ? j->aa_s * j->aa_s : 1)) {
+        snprintf(err, errlen, "out of memory resolving the anti-aliased %dx%d frame", W / j->aa_s, H / j->aa_s);
         return -1;
     }
 

@@ -50,7 +50,7 @@ static _Thread_local const char *const *camera_keys = camera_keys_pinhole;
  * emission's and "texture" (light_keys_fill). */
 #define LIGHT_KEYS_MAX 48
 static _Thread_local const char *light_keys[LIGHT_KEYS_MAX] = { "shape", NULL };
-static const char *const render_keys[] = { "samples", NULL };
+static const char *const render_keys[] = { "samples", "aa", NULL };
 static const char *const mesh_keys[] = { "file", "transform", "lightmap", NULL };
 static const char *const mesh_lightmap_keys[] = { "scale", NULL };
 
@@ -719,6 +719,15 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
         if (!cJSON_IsObject(render)) { snprintf(err, errlen, "%s: \"render\" must be an object", json_path); goto done; }
         warn_unknown(render, "render", render_keys, json_path);
         if (get_int(render, "render", "samples", 0, 1, 1 << 20, &out->samples, json_path, err, errlen)) goto done;
+        if (cJSON_GetObjectItemCaseSensitive(render, "aa")) {   /* absent: 0, the caller's default */
+            int aa = 1;
+            if (get_int(render, "render", "aa", 1, 1, 16, &aa, json_path, err, errlen)) goto done;
+            if (aa != 1 && aa != 4 && aa != 9 && aa != 16) {
+                snprintf(err, errlen, "%s: render.aa must be 1, 4, 9 or 16 (got %d)", json_path, aa);
+                goto done;
+            }
+            out->aa = aa;
+        }
     }
 
     const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(root, "meshes");

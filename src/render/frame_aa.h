@@ -1,0 +1,13 @@
+/* Pixel anti-aliasing's resolve (ms_render_options.aa): a frame rendered s times larger in each direction
+ * becomes the output frame, each pixel the box-filtered average of its s x s primary samples. */
+#ifndef MS_FRAME_AA_H
+#define MS_FRAME_AA_H
+#include "microshadow.h"
+
+/* Replaces f's planes (rgb; every light's vis, shadow, shadow_spec, front) by their s x s box averages and
+ * divides f's width and height by s. rgb averages all s*s samples (a miss is black); V, S and S_spec average
+ * the samples that hit (-1 where none did); front is the pixel's samples in front: the hits' mean times
+ * front_scale (1 when every hit has the pixel's N samples, s*s when they split them). 0, or -1 out of memory
+ * (f unchanged). */
+int ms_frame_aa_resolve(ms_frame *f, int s, int front_scale);
+#endif
