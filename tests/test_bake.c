@@ -162,19 +162,6 @@ static void test_matches_frame_quad(void **st)
 
 /* ---- a glTF with TEXCOORD_1 on the ground and none on the occluder ---- */
 
-static void b64(const unsigned char *in, size_t n, char *out)
-{
-    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = tab[v >> 18 & 63];
-        out[o++] = tab[v >> 12 & 63];
-        out[o++] = i + 1 < n ? tab[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? tab[v & 63] : '=';
-    }
-    out[o] = 0;
-}
 
 /* Ground: x, z in [-4, 4] at y = 0, two triangles facing up, TEXCOORD_1 (u, v) = ((x+4)/8, (z+4)/8).
  * Occluder: a 1x1 square at y = 1.5, no TEXCOORD_1 (only TEXCOORD_0, which must not be used). */
@@ -191,7 +178,7 @@ static void write_gltf_scene(const char *dir, char *json_path, size_t n)
     memcpy(buf + 120, opos, 72);
     memcpy(buf + 192, ouv0, 48);
     char enc[400];
-    b64(buf, sizeof buf, enc);
+    tu_base64(buf, sizeof buf, enc);
     char text[4096];
     snprintf(text, sizeof text,
         "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"

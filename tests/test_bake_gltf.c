@@ -23,19 +23,6 @@
 #define SIZE 128
 #define SAMPLES 256
 
-static void b64(const unsigned char *in, size_t n, char *out)
-{
-    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = tab[v >> 18 & 63];
-        out[o++] = tab[v >> 12 & 63];
-        out[o++] = i + 1 < n ? tab[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? tab[v & 63] : '=';
-    }
-    out[o] = 0;
-}
 
 /* The texture of the ground: 4x4 RGB, each texel its own colour. */
 static void checker(uint8_t px[48])
@@ -60,7 +47,7 @@ static void write_scene(const char *dir, char *json_path, size_t n)
     memcpy(buf + 72, uv0, 48);
     memcpy(buf + 120, uv1, 48);
     char enc[300];
-    b64(buf, sizeof buf, enc);
+    tu_base64(buf, sizeof buf, enc);
     uint8_t px[48];
     checker(px);
     png_image img;
@@ -72,7 +59,7 @@ static void write_scene(const char *dir, char *json_path, size_t n)
     png_alloc_size_t plen = sizeof png;
     assert_true(png_image_write_to_memory(&img, png, &plen, 0, px, 0, NULL));
     char penc[1500];
-    b64(png, plen, penc);
+    tu_base64(png, plen, penc);
     char text[8192];
     snprintf(text, sizeof text,
         "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"

@@ -18,19 +18,6 @@
 
 #define SIZE 256
 
-static void b64(const unsigned char *in, size_t n, char *out)
-{
-    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = tab[v >> 18 & 63];
-        out[o++] = tab[v >> 12 & 63];
-        out[o++] = i + 1 < n ? tab[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? tab[v & 63] : '=';
-    }
-    out[o] = 0;
-}
 
 /* The objects as they are written: positions (non-indexed triangles) and TEXCOORD_1. */
 #define MAX_V 64
@@ -109,7 +96,7 @@ static void write_scene(const char *dir, const char *cube_lightmap, char *json, 
         snprintf(roots + strlen(roots), sizeof roots - strlen(roots), "%s%d", o ? "," : "", o);
         off += (size_t)ob->nv * 20;
     }
-    b64(buf, bytes, enc);
+    tu_base64(buf, bytes, enc);
     sprintf(text, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[%s]}],\"nodes\":[%s],\"meshes\":[%s],"
             "\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/octet-stream;base64,%s\"}],\"bufferViews\":[%s],\"accessors\":[%s]}",
             roots, nodes, meshes, bytes, enc, views, accs);

@@ -334,19 +334,6 @@ static size_t tiny_png(const uint8_t *rgba, int w, int h, uint8_t *out)
     return n;
 }
 
-static void base64(const uint8_t *in, size_t n, char *out)
-{
-    static const char tb[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = tb[v >> 18 & 63];
-        out[o++] = tb[v >> 12 & 63];
-        out[o++] = i + 1 < n ? tb[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? tb[v & 63] : '=';
-    }
-    out[o] = 0;
-}
 
 /* The texture: two texels, A on the left, B on the right (sRGB). */
 static const uint8_t TEX_A[4] = { 200, 100, 50, 255 }, TEX_B[4] = { 10, 240, 90, 255 };
@@ -398,9 +385,9 @@ static void write_gltf_scene(const char *dir, int occluder, float tilt, const ui
     memcpy(buf + bl, png, pl);   /* bufferView 3 (used by image mode 2) */
     bl += pl;
     char b64[sizeof buf * 2];
-    base64(buf, bl, b64);
+    tu_base64(buf, bl, b64);
     char images[1024], png64[512];
-    base64(png, pl, png64);
+    tu_base64(png, pl, png64);
     if (g_image_mode == 0) snprintf(images, sizeof images, "[{\"uri\":\"tex.png\"}]");
     else if (g_image_mode == 1) snprintf(images, sizeof images, "[{\"uri\":\"data:image/png;base64,%s\"}]", png64);
     else snprintf(images, sizeof images, "[{\"bufferView\":3,\"mimeType\":\"image/png\"}]");
