@@ -316,6 +316,8 @@ int ms_scene_showcase(ms_scene *out)
     out->n_tris = s.n;
     out->tri_mesh = s.mesh;
     out->n_meshes = 1;
+    out->tri_object = s.object;
+    out->n_objects = s.n_objects;
     for (int i = 0; i < MS_MAX_UV_SETS; i++) out->tri_uv[i] = s.uv[i];
     out->materials = s.mats;
     out->n_materials = s.n_mats;
