@@ -30,7 +30,7 @@ static long long wrap_index(float i, long long n, int mode)
 /* The texture at (u, v) (texel centres at (i + 0.5) / width) through the material's sampling: its
  * transform, then bilinear or nearest, with repeat (glTF's default), clamp or mirrored repeat. Colour
  * channels sRGB-decoded when srgb, else raw / 255 (normal maps). */
-static void texture_rgba(const ms_texture *t, const ms_texture_sampling *sm, float u, float v, int srgb, float out[4])
+static int texture_rgba(const ms_texture *t, const ms_texture_sampling *sm, float u, float v, int srgb, float out[4])
 {
     if (sm->transformed) {
         const float *m = sm->transform;
@@ -40,12 +40,15 @@ static void texture_rgba(const ms_texture *t, const ms_texture_sampling *sm, flo
     }
     const long long w = t->width, h = t->height;
     for (int c = 0; c < 4; c++) out[c] = 0.0f;
+    /* A transform can take finite UVs to infinity or NaN (found by rendering the fuzz corpora): nothing is
+     * read there. Below 1e30, u * w (w <= MS_MAX_IMAGE_SIZE) stays finite and the index arithmetic exact. */
+    if (!(fabsf(u) < 1e30f) || !(fabsf(v) < 1e30f)) return 0;
     if (sm->nearest) {
         const long long x = wrap_index(floorf(u * (float)w), w, sm->wrap_s), y = wrap_index(floorf(v * (float)h), h, sm->wrap_t);
         const uint8_t *px = t->rgba + 4 * ((size_t)y * (size_t)w + (size_t)x);
         for (int c = 0; c < 3; c++) out[c] = srgb ? srgb_to_linear(px[c]) : (float)px[c] / 255.0f;
         out[3] = (float)px[3] / 255.0f;
-        return;
+        return 1;
     }
     const float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
     const float fx0 = floorf(x), fy0 = floorf(y);
@@ -75,10 +78,11 @@ static void texture_rgba(const ms_texture *t, const ms_texture_sampling *sm, flo
             for (int c = 0; c < 3; c++) out[c] += wgt * (srgb ? srgb_to_linear(px[c]) : (float)px[c] / 255.0f);
             out[3] += wgt * (float)px[3] / 255.0f;
         }
+    return 1;
 }
 
 /* The material's texture tex at the hit (barycentrics b of triangle t, UV set set); 0 when it has none
- * there (no UVs, non-finite UVs, an empty texture). */
+ * there (no UVs, non-finite UVs or UVs the texture transform takes beyond 1e30, an empty texture). */
 static int lookup(const ms_scene *s, size_t t, const float b[3], int32_t tex, int32_t set, const ms_texture_sampling *sm,
                   int srgb, float out[4])
 {
@@ -87,8 +91,7 @@ static int lookup(const ms_scene *s, size_t t, const float b[3], int32_t tex, in
     const float u = b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4], v = b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5];
     const ms_texture *tx = &s->textures[tex];
     if (!isfinite(u) || !isfinite(v) || !tx->rgba || tx->width <= 0 || tx->height <= 0) return 0;
-    texture_rgba(tx, sm, u, v, srgb, out);
-    return 1;
+    return texture_rgba(tx, sm, u, v, srgb, out);
 }
 
 /* The normal map's perturbation of the unit shading normal n (before it is turned to the eye): texel t ->
