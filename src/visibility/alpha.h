@@ -102,11 +102,17 @@ void ms_alpha_raster(const ms_alpha_pixel *ap, const ms_raster_frame *f, ms_rast
 /* The traversals' call for every triangle they would hand to the kernel: the kernel itself for an opaque
  * triangle (one load and a predicted branch when the frame has no alpha context), ms_alpha_raster for an
  * alpha-tested one. */
+/* 1 when frame f tests triangle prim for alpha (its samples go through ms_alpha_raster), 0 when it is opaque. */
+static inline int ms_frame_alpha_tested(const ms_raster_frame *f, uint32_t prim)
+{
+    const ms_alpha_pixel *ap = (const ms_alpha_pixel *)f->alpha;
+    return ap && ap->ctx->alpha->flag[prim];
+}
+
 static inline void ms_raster_or_alpha(const ms_raster_frame *f, ms_raster_fn raster, const float tri[9], uint32_t prim,
                                       void *buf)
 {
-    const ms_alpha_pixel *ap = (const ms_alpha_pixel *)f->alpha;
-    if (ap && ap->ctx->alpha->flag[prim]) ms_alpha_raster(ap, f, raster, tri, prim, buf);
+    if (ms_frame_alpha_tested(f, prim)) ms_alpha_raster((const ms_alpha_pixel *)f->alpha, f, raster, tri, prim, buf);
     else raster(f, tri, buf);
 }
 

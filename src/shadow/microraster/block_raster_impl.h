@@ -464,8 +464,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
             unsigned alpha = 0;
             for (unsigned p = cover; p; p &= p - 1) {
                 const int l = __builtin_ctz(p);
-                const ms_alpha_pixel *ap = (const ms_alpha_pixel *)in->frame[l]->alpha;
-                if (ap && ap->ctx->alpha->flag[t]) alpha |= 1u << l;
+                if (ms_frame_alpha_tested(in->frame[l], t)) alpha |= 1u << l;
             }
             br_setup su;
             br_scan_setup(s, tri, cover & ~alpha, av, x, y, z, zmin, zmax, MS_K, &su);
