@@ -5,11 +5,11 @@
  *
  *     ms_scene scene;
  *     char err[512];
- *     if (ms_scene_load("scene.json", &scene, err, sizeof err) != 0) { puts(err); return 2; }
+ *     if (ms_scene_load("scene.json", &scene, err, sizeof err) != MS_OK) { puts(err); return 2; }
  *     ms_render_options opt;
  *     ms_render_options_default(&opt);          // method "scanline", grid pattern, all cores
  *     ms_frame frame;
- *     if (ms_render(&scene, &opt, &frame, err, sizeof err) != 0) { ... }
+ *     if (ms_render(&scene, &opt, &frame, err, sizeof err) != MS_OK) { ... }
  *     ms_write_png(&frame, "out.png", err, sizeof err);
  *     ms_frame_free(&frame); ms_scene_free(&scene);
  *
@@ -35,8 +35,11 @@
  * surface rounding leaves it. Every shadow method computes V and S on the same samples, so methods can be
  * compared sample for sample. Pixels whose primary ray misses the scene get V = S = -1.
  *
- * Errors: functions that can fail return 0 on success and non-zero on failure, writing one line of
- * text (naming the file where there is one) into the caller's buffer err[errlen].
+ * Errors: every function that can fail returns an ms_status, MS_OK (0) on success, writing one line of text
+ * (naming the file where there is one) into the caller's buffer err[errlen] on failure.
+ *
+ * ABI: the entry points that take the public structs check, on every call, that the program was compiled
+ * against this library's layout of them ("The ABI check", at the end).
  */
 #ifndef MICROSHADOW_H
 #define MICROSHADOW_H
@@ -44,6 +47,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -63,6 +67,22 @@ extern "C" {
 #define MS_API
 #endif
 
+/* What every function that can fail returns: MS_OK (0), or the kind of failure, with one line of text (naming
+ * the file where there is one) in the caller's buffer err[errlen] where the function takes one. The CLI maps
+ * them to exit codes (README, "Exit codes"). */
+typedef enum ms_status {
+    MS_OK = 0,
+    MS_ERR_INVALID = 1,     /* a bad argument (the message names it) */
+    MS_ERR_NO_MEMORY = 2,
+    MS_ERR_CANCELLED = 3,   /* the progress callback returned non-zero */
+    MS_ERR_METHOD = 4,      /* unknown method, not compiled in, or its set-up failed */
+    MS_ERR_IO = 5,          /* reading or writing a file failed */
+    MS_ERR_BUDGET = 6       /* the call would need more memory than its budget (max_memory): refused before
+                             * allocating; the message names the need, the budget and what would fit */
+} ms_status;
+/* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o", "over the memory budget". */
+MS_API const char *ms_status_name(ms_status s);
+
 /* The version of the library that is running: the string (e.g. "0.2.0"), and its numbers through whichever
  * pointers are not NULL. Compare with MS_VERSION_MAJOR/MINOR to detect a library other than the one a
  * program was built against. */
@@ -74,10 +94,10 @@ MS_API const char *ms_version(int *major, int *minor, int *patch);
 MS_API const char *ms_nearest_name(const char *word, const char *const *names, size_t *distance);
 
 /* The layout of a public struct as this library was compiled: with field NULL, the struct's size in *size;
- * else the field's offset and size. 0, or -1 when the struct or field is not listed (src/core/layout.c
+ * else the field's offset and size. MS_OK, or MS_ERR_INVALID when the struct or field is not listed (src/core/layout.c
  * lists what bindings read). For bindings that mirror the structs (the Python module checks its mirror at
  * load time with it); C and C++ programs have the header. offset and size may be NULL. */
-MS_API int ms_layout(const char *structure, const char *field, size_t *offset, size_t *size);
+MS_API ms_status ms_layout(const char *structure, const char *field, size_t *offset, size_t *size);
 
 /* Limits. Images are at most MS_MAX_IMAGE_SIZE pixels on a side; a frame has N = 256, 1024 or 4096 light
  * samples (a k x k grid, k = 16, 32, 64), the stratified pattern also 16 or 64 (k = 4, 8). Every pixel
@@ -179,13 +199,14 @@ typedef struct ms_light {
     float radius;        /* MS_LIGHT_SPHERE only */
 } ms_light;
 
-/* Fills l as a sphere light of centre c and radius r (emission left as it is). 0, or -1 when r is not > 0. */
-MS_API int ms_light_sphere(ms_light *l, ms_vec3 c, float r);
+/* Fills l as a sphere light of centre c and radius r (emission left as it is). MS_OK, or MS_ERR_INVALID when r is
+ * not > 0. */
+MS_API ms_status ms_light_sphere(ms_light *l, ms_vec3 c, float r);
 /* The outline of sphere light l seen from p: the disk where the cone of tangents from p touches the sphere,
  * centre c + (p - c) r^2/d^2, radius r sqrt(d^2 - r^2)/d (d = |p - c|), facing p, as a disk light
  * (ms_light_disk) with l's emission. Every ray from p to this disk meets the sphere first at its near side,
- * and the disk subtends the sphere's solid angle. 0, or -1 when p is not outside the sphere. */
-MS_API int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk);
+ * and the disk subtends the sphere's solid angle. MS_OK, or MS_ERR_INVALID when p is not outside the sphere. */
+MS_API ms_status ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk);
 
 /* Luminance of the texel at (s,t) of a textured light (0.2126 R + 0.7152 G + 0.0722 B), and its colour
  * into rgb when rgb is not NULL; 1 (and white) for an untextured light. */
@@ -193,12 +214,14 @@ MS_API float ms_light_texel(const ms_light *l, float s, float t, float *rgb);
 
 /* Fills l as a disk light of centre c, normal m (emitting towards m; need not be unit length, not zero)
  * and radius r: its bounding square, edges 2r along two unit vectors perpendicular to m chosen from m
- * alone, and shape MS_LIGHT_DISK; emission is left as it is. 0, or -1 when m is zero or r not > 0. */
-MS_API int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
+ * alone, and shape MS_LIGHT_DISK; emission is left as it is. MS_OK, or MS_ERR_INVALID when m is zero or r not
+ * > 0. */
+MS_API ms_status ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
 
 /* Fills l as a triangle light of vertices a, b, c (corner a, edges b - a and c - a, shape MS_LIGHT_TRIANGLE),
- * emitting towards cross(b - a, c - a); emission is left as it is. 0, or -1 when the vertices are collinear. */
-MS_API int ms_light_triangle(ms_light *l, ms_vec3 a, ms_vec3 b, ms_vec3 c);
+ * emitting towards cross(b - a, c - a); emission is left as it is. MS_OK, or MS_ERR_INVALID when the vertices are
+ * collinear. */
+MS_API ms_status ms_light_triangle(ms_light *l, ms_vec3 a, ms_vec3 b, ms_vec3 c);
 
 /* 1 if light parameters (s,t) lie on the light's shape (see ms_light_shape), 0 if not. */
 MS_API int ms_light_shape_contains(ms_light_shape shape, float s, float t);
@@ -361,7 +384,7 @@ MS_API void ms_set_warning_verbose(int verbose);
 /* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL read by microshadow, glTF 2.0 through cgltf; paths
  * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
  * unknown keys warnings. */
-MS_API int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
+static inline ms_status ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
 /* Options of ms_scene_load_ex; zero (or NULL) means ms_scene_load's behaviour. */
 typedef struct ms_scene_load_options {
     /* Files that meshes name - glTF buffer and image URIs, OBJ mtllib files, MTL maps (map_Kd, map_d) - are
@@ -372,21 +395,22 @@ typedef struct ms_scene_load_options {
      * are the scene author's and are not restricted. */
     int allow_outside_paths;
 } ms_scene_load_options;
-MS_API int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen);
+static inline ms_status ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err,
+                                         size_t errlen);
 /* The built-in procedural scene: a ground, occluders of several sizes, a light (the tests' fixture). */
-MS_API int ms_scene_default(ms_scene *out);
+static inline ms_status ms_scene_default(ms_scene *out);
 /* The built-in scene the CLI renders without a scene file: smooth-shaded curved objects (per-vertex normals),
  * a procedurally textured ground, a metal and rough plastics, alpha-tested leaf cards, and a rect, a disk and a
- * sphere light of different colours; 768 x 512, 256 samples. 0, or -1 when out of memory. */
-MS_API int ms_scene_showcase(ms_scene *out);
+ * sphere light of different colours; 768 x 512, 256 samples. MS_OK, or MS_ERR_NO_MEMORY. */
+static inline ms_status ms_scene_showcase(ms_scene *out);
 /* Puts a scene built in world coordinates (tri, camera, lights as floats; origin usually 0) into the frame
  * ms_scene_load would choose for it (see ms_scene): tri, the camera's eye and target and the lights' corners
  * and centres moved, origin set. The detail a float lost far from the origin is not recovered, but every
  * method then works at the scene's own magnitudes (bounds as tight, time as at home). Nothing changes for a
- * scene about the origin, a procedural scene, or one already in its frame. 0, or -1 when out of memory. */
-MS_API int ms_scene_localize(ms_scene *s);
+ * scene about the origin, a procedural scene, or one already in its frame. MS_OK, or MS_ERR_NO_MEMORY. */
+MS_API ms_status ms_scene_localize(ms_scene *s);
 /* Checks camera, light and geometry for NaN/inf and degenerate cases. `what` names the source. */
-MS_API int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen);
+MS_API ms_status ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen);
 MS_API void ms_scene_free(ms_scene *s);
 
 typedef enum ms_pattern {
@@ -398,8 +422,8 @@ typedef enum ms_pattern {
 
 /* "grid", "stratified", "interleaved" ("unknown" otherwise). */
 MS_API const char *ms_pattern_name(ms_pattern p);
-/* Parses one of those names; 0, or -1 for anything else. */
-MS_API int ms_pattern_from_name(const char *name, ms_pattern *out);
+/* Parses one of those names; MS_OK, or MS_ERR_INVALID for anything else. */
+MS_API ms_status ms_pattern_from_name(const char *name, ms_pattern *out);
 
 /* Instruction-set levels of the SIMD kernels and the traversal, in increasing order. As a cap,
  * MS_ISA_AUTO (0) means none: the best level the CPU runs; a cap above the CPU gives the CPU's best. */
@@ -412,8 +436,8 @@ typedef enum ms_isa {
 
 /* "auto", "scalar", "avx2", "avx512". */
 MS_API const char *ms_isa_name(ms_isa isa);
-/* Parses one of those names; 0, or -1 for anything else. */
-MS_API int ms_isa_from_name(const char *name, ms_isa *out);
+/* Parses one of those names; MS_OK, or MS_ERR_INVALID for anything else. */
+MS_API ms_status ms_isa_from_name(const char *name, ms_isa *out);
 /* The best level this CPU (and OS: saved register state) runs. */
 MS_API ms_isa ms_cpu_isa(void);
 
@@ -510,7 +534,11 @@ typedef struct ms_render_options {
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
-MS_API void ms_render_options_default(ms_render_options *o);
+static inline void ms_render_options_default(ms_render_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->method = MS_DEFAULT_METHOD;
+}
 
 /* Names of the shadow methods compiled in, NULL-terminated. */
 MS_API const char *const *ms_method_names(void);
@@ -578,11 +606,12 @@ typedef struct ms_frame {
     int n_lights;
 } ms_frame;
 
-/* A frame: 0, or non-zero with a message in err and *out zeroed: MS_ERR_CANCELLED (3) when the progress
- * callback cancelled it, MS_ERR_BUDGET (6) when it would need more memory than the budget (nothing was
- * allocated for it then), -1 otherwise. */
-MS_API int ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
-              char *err, size_t errlen);
+/* A frame: MS_OK, or a status with a message in err and *out zeroed: MS_ERR_CANCELLED when the progress
+ * callback cancelled it, MS_ERR_BUDGET when it would need more memory than the budget (nothing was allocated
+ * for it then), MS_ERR_METHOD for a method (or primary) unknown, not compiled in or failing its set-up,
+ * MS_ERR_NO_MEMORY, MS_ERR_INVALID for bad options or a bad scene. */
+static inline ms_status ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out, char *err,
+                                  size_t errlen);
 MS_API void ms_frame_free(ms_frame *f);
 
 /* ---- A frame tile by tile: for drivers that spread one frame over processes (the CLI's MPI mode) ----
@@ -600,10 +629,10 @@ MS_API void ms_frame_free(ms_frame *f);
 #define MS_TILE_SIZE 16
 typedef struct ms_frame_job ms_frame_job;
 /* Checks the options, builds the acceleration structure and sets up the methods, the shadow method once per
- * light, kept until ms_frame_job_free (what ms_render does first, with its messages). 0 and *job, or -1 (MS_ERR_BUDGET
- * over the memory budget, before allocating) with *job = NULL. */
-MS_API int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **job, char *err,
-                        size_t errlen);
+ * light, kept until ms_frame_job_free (what ms_render does first, with its messages). MS_OK and *job, or a status
+ * as ms_render's (MS_ERR_BUDGET over the memory budget, before allocating) with *job = NULL. */
+static inline ms_status ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **job,
+                                            char *err, size_t errlen);
 /* The number of tiles; tiles_x and tiles_y (may be NULL) get the frame's tiles per row and per column. */
 MS_API int ms_frame_job_tiles(const ms_frame_job *job, int *tiles_x, int *tiles_y);
 /* 1 when the method renders split frames with the whole frame's answer; 0 for a frame-level method whose
@@ -612,16 +641,16 @@ MS_API int ms_frame_job_tiles(const ms_frame_job *job, int *tiles_x, int *tiles_
 MS_API int ms_frame_job_splittable(const ms_frame_job *job);
 /* Primary hits, and V, S, S_spec and front for every light, of the n tiles listed (tiles NULL: all of them, n = the number of tiles) into
  * the job's frame, the stats' visible_pixels, shadow_rays, penumbra_pixels, counters and seconds (primary_s,
- * shadow_s, shadow_cpu_s, and shadow_factor_s in thread-seconds until finish) summed over calls. 0, or -1 with a message
+ * shadow_s, shadow_cpu_s, and shadow_factor_s in thread-seconds until finish) summed over calls. MS_OK, or a status with a message
  * (MS_ERR_CANCELLED when the options' progress callback cancelled: the job's frame is then incomplete). */
-MS_API int ms_frame_job_render(ms_frame_job *job, const int *tiles, int n, char *err, size_t errlen);
+MS_API ms_status ms_frame_job_render(ms_frame_job *job, const int *tiles, int n, char *err, size_t errlen);
 /* The frame being assembled (full size, n_lights planes; only the rendered tiles' pixels are set;
  * vis, shadow and shadow_spec unfiltered).
  * Owned by the job. A driver may write other jobs' tiles and sums of their stats into it before finish. */
 MS_API ms_frame *ms_frame_job_frame(ms_frame_job *job);
 /* Completes the frame (see above) and moves it to *out (ms_frame_free it); the job is left empty: free it.
- * Every tile must have been rendered here or copied in. 0, or -1 with a message. */
-MS_API int ms_frame_job_finish(ms_frame_job *job, ms_frame *out, char *err, size_t errlen);
+ * Every tile must have been rendered here or copied in. MS_OK, or a status with a message. */
+MS_API ms_status ms_frame_job_finish(ms_frame_job *job, ms_frame *out, char *err, size_t errlen);
 MS_API void ms_frame_job_free(ms_frame_job *job);
 
 /* Outputs, all or nothing. A caller that writes several outputs of one frame lists them in an ms_output
@@ -631,7 +660,7 @@ MS_API void ms_frame_job_free(ms_frame_job *job);
  * into place only when all were written; any failure removes the staging files, and so do SIGINT,
  * SIGTERM, SIGHUP and SIGQUIT once ms_outputs_cleanup_on_signals was called (for programs: a library
  * caller with its own signal handling need not call it). New files get 0666 less the umask. */
-typedef int (*ms_output_write_fn)(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+typedef ms_status (*ms_output_write_fn)(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 typedef struct ms_output {
     const char *flag;             /* how the caller named it, for messages ("-o", "--vis") */
     const char *path;             /* NULL: not requested */
@@ -639,20 +668,20 @@ typedef struct ms_output {
     const char *const *suffixes;  /* NULL-terminated accepted endings (case-insensitive), or NULL: any */
 } ms_output;
 #define MS_MAX_OUTPUTS 8
-MS_API int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
+MS_API ms_status ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
 /* Before writing anything it checks the frame (ms_frame_check_finite): a NaN or infinite value is an error
  * naming the first output's path and the pixel, and no file is written. */
-MS_API int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
+MS_API ms_status ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen);
 /* 0 when every value of the frame or lightmap (rgb, each light's vis, shadow, shadow_spec; the NULL ones
- * skipped) and, with rgb, the exposure are finite; else -1 with one line "what: ... at pixel (x, y) is NaN". */
-MS_API int ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen);
+ * skipped) and, with rgb, the exposure are finite; else MS_ERR_INVALID with one line "what: ... at pixel (x, y) is NaN". */
+MS_API ms_status ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen);
 MS_API void ms_outputs_cleanup_on_signals(void);
 /* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name; with several lights the EXR has
  * one channel per light, V0, V1, ... resp. S0, S1, ..., and the PFM light 0); the stats as JSON. */
-MS_API int ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
-MS_API int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
-MS_API int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
-MS_API int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API ms_status ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API ms_status ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API ms_status ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API ms_status ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 extern const char *const ms_float_image_suffixes[];   /* ".pfm", ".exr" */
 
 /* A frame rendered and written to outs[0..n) (ms_outputs_check them first), all or nothing: the whole frame in
@@ -662,16 +691,16 @@ extern const char *const ms_float_image_suffixes[];   /* ".pfm", ".exr" */
  * unlinked scratch file beside it, once its exposure (the exact 99th percentile, from a histogram gathered as the
  * bands finish and one pass over the spill) is known. Byte for byte the same files either way. exposure_ev:
  * stops added to the PNG's automatic exposure. stats (may be NULL) gets the frame's stats. 0; MS_ERR_BUDGET,
- * MS_ERR_CANCELLED or -1 when the frame failed (nothing written); MS_ERR_IO when an output failed (nothing
+ * MS_ERR_CANCELLED or another status when the frame failed (nothing written); MS_ERR_IO when an output failed (nothing
  * written either); each with a message. */
-MS_API int ms_render_outputs(const ms_scene *scene, const ms_render_options *opt, double exposure_ev, const ms_output *outs,
-                             int n, ms_stats *stats, char *err, size_t errlen);
+static inline ms_status ms_render_outputs(const ms_scene *scene, const ms_render_options *opt, double exposure_ev,
+                                          const ms_output *outs, int n, ms_stats *stats, char *err, size_t errlen);
 
 /* One output alone, all or nothing (checked, staged and renamed). */
-MS_API int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */
-MS_API int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .pfm or .exr, float V */
-MS_API int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
-MS_API int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
+MS_API ms_status ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */
+MS_API ms_status ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .pfm or .exr, float V */
+MS_API ms_status ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
+MS_API ms_status ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
 
 /* Unshadowed irradiance at point p with unit normal n from the light, per unit emitted radiance.
  * Parallelogram: exact (polygon form factor, light clipped to the receiver's hemisphere). Disk over a
@@ -695,25 +724,12 @@ MS_API float ms_light_irradiance(const ms_light *l, const float p[3], const floa
  * points are grouped by proximity (Morton order of their positions) so that coherent methods stay
  * coherent; results come back in the caller's order. */
 
-/* Status codes of the points API (and ms_bake); a one-line message goes into err as elsewhere. */
-typedef enum ms_status {
-    MS_OK = 0,
-    MS_ERR_INVALID = 1,     /* a bad argument (the message names it) */
-    MS_ERR_NO_MEMORY = 2,
-    MS_ERR_CANCELLED = 3,   /* the progress callback returned non-zero */
-    MS_ERR_METHOD = 4,      /* unknown method, not compiled in, or its set-up failed */
-    MS_ERR_IO = 5,          /* reading or writing a file failed */
-    MS_ERR_BUDGET = 6       /* the call would need more memory than its budget (max_memory): refused before
-                             * allocating; the message names the need, the budget and what would fit */
-} ms_status;
-/* "ok", "invalid argument", "out of memory", "cancelled", "method", "i/o", "over the memory budget". */
-MS_API const char *ms_status_name(ms_status s);
 
 
 typedef struct ms_accel ms_accel;
 /* Builds the acceleration structure of the scene's triangles (copied: the scene may be freed after).
  * threads: 0 for all cores. MS_OK and *out, or an error with *out = NULL. */
-MS_API ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
+static inline ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen);
 MS_API void ms_accel_free(ms_accel *a);
 MS_API size_t ms_accel_triangles(const ms_accel *a);
 /* The lights of the scene the accel was built from (its own copies, texels included: valid until
@@ -759,9 +775,9 @@ typedef struct ms_points_options {
  * stats when non-NULL. */
 /* A V or S that came out NaN or infinite is MS_ERR_INVALID naming the first such point (the arrays are then
  * not to be used). */
-MS_API ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
-                               const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
-                               ms_stats *stats, char *err, size_t errlen);
+static inline ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
+                                             const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
+                                             ms_stats *stats, char *err, size_t errlen);
 
 /* ---- Lightmap baking (docs/baking.md) ----
  *
@@ -819,8 +835,8 @@ typedef struct ms_lightmap {
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
  * vis + l*size*size, as frames hold them), the irradiance summed over the lights. accel: the scene's
  * (ms_accel_build), or NULL to build one here. MS_OK, or an error with out zeroed. */
-MS_API ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
-                  char *err, size_t errlen);
+static inline ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
+                                char *err, size_t errlen);
 MS_API void ms_lightmap_free(ms_lightmap *lm);
 
 /* A lightmap row by row, for drivers that spread a bake over processes (the CLI's MPI mode): ms_bake is
@@ -831,7 +847,8 @@ MS_API void ms_lightmap_free(ms_lightmap *lm);
  * finish's). */
 /* The options' checks, the UVs (xatlas where needed) and the texels' points: out->position, normal,
  * triangle, texels, and frame's arrays (vis, shadow -1 until baked). MS_OK, or an error with out zeroed. */
-MS_API ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err, size_t errlen);
+static inline ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err,
+                                       size_t errlen);
 /* V, S and front of the texels of rows [y0, y1) for every light of the accel (ms_visibility_points with
  * the texel keys, one call per light), their stats added to lm->frame.stats. lm is left as it was on an
  * error. */
@@ -844,7 +861,7 @@ MS_API ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *op
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
  * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
  * and V. An ms_output_write_fn; ends in .exr. */
-MS_API int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API ms_status ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 
 /* ---- The bake back onto the asset: a binary glTF 2.0 (docs/baking.md, "Back onto the asset") ----
  *
@@ -875,11 +892,108 @@ typedef struct ms_bake_gltf_options {
 } ms_bake_gltf_options;
 /* The .glb of scene and its lightmap lm (ms_bake of that scene) into a malloc'ed buffer *glb of *len bytes
  * (free it). opt may be NULL. MS_OK, or an error with *glb = NULL. */
-MS_API ms_status ms_bake_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
-                              unsigned char **glb, size_t *len, char *err, size_t errlen);
+static inline ms_status ms_bake_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                                     unsigned char **glb, size_t *len, char *err, size_t errlen);
 /* The same written to path (ending in .glb), all or nothing (staged beside it and renamed: ms_outputs_write). */
-MS_API ms_status ms_bake_write_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
-                                    const char *path, char *err, size_t errlen);
+static inline ms_status ms_bake_write_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                                           const char *path, char *err, size_t errlen);
+
+/* ---- The ABI check ----
+ *
+ * Each checked entry point above (ms_scene_load, ms_scene_load_ex, ms_scene_default, ms_scene_showcase,
+ * ms_render, ms_render_outputs, ms_frame_job_create, ms_accel_build, ms_visibility_points, ms_bake,
+ * ms_bake_layout, ms_bake_gltf, ms_bake_write_gltf) is an inline function that hands the library the size of
+ * every public struct as the program was compiled (ms_abi_compiled), and the library compares them with its own
+ * before it reads or writes any: a program built against another microshadow header - a static library or a
+ * shared one from another version, a binding's mirror gone stale - gets MS_ERR_INVALID and one line naming the
+ * first struct that differs, never a struct read or written at the wrong size. Fields are only appended to the
+ * structs, so a later version can accept an older program's smaller structs; before 1.0 it does not (the
+ * soname changes with every minor version). Bindings that mirror the structs call the *_abi functions with
+ * their mirrors' sizes (0 for a struct they do not mirror: not compared). */
+typedef struct ms_abi {
+    uint32_t abi_size;                      /* sizeof(ms_abi): the fields that follow that the caller knows */
+    uint32_t version_major, version_minor;  /* MS_VERSION_MAJOR, MS_VERSION_MINOR; 0, 0: not compared */
+    uint32_t camera, light, procedural, scene, texture, texture_sampling, material, scene_load_options,
+             render_options, stats, frame, output, points, points_options, bake_options, lightmap,
+             bake_gltf_options;
+} ms_abi;
+
+static inline const ms_abi *ms_abi_compiled(void)
+{
+    static const ms_abi abi = {
+        (uint32_t)sizeof(ms_abi), MS_VERSION_MAJOR, MS_VERSION_MINOR, (uint32_t)sizeof(ms_camera),
+        (uint32_t)sizeof(ms_light), (uint32_t)sizeof(ms_procedural), (uint32_t)sizeof(ms_scene),
+        (uint32_t)sizeof(ms_texture), (uint32_t)sizeof(ms_texture_sampling), (uint32_t)sizeof(ms_material),
+        (uint32_t)sizeof(ms_scene_load_options), (uint32_t)sizeof(ms_render_options), (uint32_t)sizeof(ms_stats),
+        (uint32_t)sizeof(ms_frame), (uint32_t)sizeof(ms_output), (uint32_t)sizeof(ms_points),
+        (uint32_t)sizeof(ms_points_options), (uint32_t)sizeof(ms_bake_options), (uint32_t)sizeof(ms_lightmap),
+        (uint32_t)sizeof(ms_bake_gltf_options)
+    };
+    return &abi;
+}
+
+/* The exported forms of the checked entry points: abi first, then the arguments documented above
+ * (ms_scene_load is ms_scene_load_abi with opt NULL). */
+MS_API ms_status ms_scene_load_abi(const ms_abi *abi, const char *json_path, const ms_scene_load_options *opt,
+                                   ms_scene *out, char *err, size_t errlen);
+MS_API ms_status ms_scene_default_abi(const ms_abi *abi, ms_scene *out);
+MS_API ms_status ms_scene_showcase_abi(const ms_abi *abi, ms_scene *out);
+MS_API ms_status ms_render_abi(const ms_abi *abi, const ms_scene *scene, const ms_render_options *opt, ms_frame *out,
+                               char *err, size_t errlen);
+MS_API ms_status ms_render_outputs_abi(const ms_abi *abi, const ms_scene *scene, const ms_render_options *opt,
+                                       double exposure_ev, const ms_output *outs, int n, ms_stats *stats, char *err,
+                                       size_t errlen);
+MS_API ms_status ms_frame_job_create_abi(const ms_abi *abi, const ms_scene *scene, const ms_render_options *opt,
+                                         ms_frame_job **job, char *err, size_t errlen);
+MS_API ms_status ms_accel_build_abi(const ms_abi *abi, const ms_scene *scene, int threads, ms_accel **out, char *err,
+                                    size_t errlen);
+MS_API ms_status ms_visibility_points_abi(const ms_abi *abi, const ms_accel *a, const ms_light *light,
+                                          const ms_points *pts, const ms_points_options *opt, float *vis,
+                                          float *shadow, uint16_t *front, ms_stats *stats, char *err, size_t errlen);
+MS_API ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt,
+                             ms_lightmap *out, char *err, size_t errlen);
+MS_API ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_bake_options *opt,
+                                    ms_lightmap *out, char *err, size_t errlen);
+MS_API ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *scene, const ms_lightmap *lm,
+                                  const ms_bake_gltf_options *opt, unsigned char **glb, size_t *len, char *err,
+                                  size_t errlen);
+MS_API ms_status ms_bake_write_gltf_abi(const ms_abi *abi, const ms_scene *scene, const ms_lightmap *lm,
+                                        const ms_bake_gltf_options *opt, const char *path, char *err, size_t errlen);
+
+static inline ms_status ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen)
+{ return ms_scene_load_abi(ms_abi_compiled(), json_path, NULL, out, err, errlen); }
+static inline ms_status ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err,
+                                         size_t errlen)
+{ return ms_scene_load_abi(ms_abi_compiled(), json_path, opt, out, err, errlen); }
+static inline ms_status ms_scene_default(ms_scene *out) { return ms_scene_default_abi(ms_abi_compiled(), out); }
+static inline ms_status ms_scene_showcase(ms_scene *out) { return ms_scene_showcase_abi(ms_abi_compiled(), out); }
+static inline ms_status ms_render(const ms_scene *scene, const ms_render_options *opt, ms_frame *out, char *err,
+                                  size_t errlen)
+{ return ms_render_abi(ms_abi_compiled(), scene, opt, out, err, errlen); }
+static inline ms_status ms_render_outputs(const ms_scene *scene, const ms_render_options *opt, double exposure_ev,
+                                          const ms_output *outs, int n, ms_stats *stats, char *err, size_t errlen)
+{ return ms_render_outputs_abi(ms_abi_compiled(), scene, opt, exposure_ev, outs, n, stats, err, errlen); }
+static inline ms_status ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **job,
+                                            char *err, size_t errlen)
+{ return ms_frame_job_create_abi(ms_abi_compiled(), scene, opt, job, err, errlen); }
+static inline ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen)
+{ return ms_accel_build_abi(ms_abi_compiled(), scene, threads, out, err, errlen); }
+static inline ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
+                                             const ms_points_options *opt, float *vis, float *shadow, uint16_t *front,
+                                             ms_stats *stats, char *err, size_t errlen)
+{ return ms_visibility_points_abi(ms_abi_compiled(), a, light, pts, opt, vis, shadow, front, stats, err, errlen); }
+static inline ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *out,
+                                char *err, size_t errlen)
+{ return ms_bake_abi(ms_abi_compiled(), scene, accel, opt, out, err, errlen); }
+static inline ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err,
+                                       size_t errlen)
+{ return ms_bake_layout_abi(ms_abi_compiled(), scene, opt, out, err, errlen); }
+static inline ms_status ms_bake_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                                     unsigned char **glb, size_t *len, char *err, size_t errlen)
+{ return ms_bake_gltf_abi(ms_abi_compiled(), scene, lm, opt, glb, len, err, errlen); }
+static inline ms_status ms_bake_write_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                                           const char *path, char *err, size_t errlen)
+{ return ms_bake_write_gltf_abi(ms_abi_compiled(), scene, lm, opt, path, err, errlen); }
 
 #ifdef __cplusplus
 }

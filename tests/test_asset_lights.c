@@ -210,7 +210,7 @@ static void test_cornell_emitter(void **st)
     assert_float_equal(L[1].emission.x, 4.0f, 0.0f);
     ms_scene_free(&sc);
     path = write_scene(dir, "box_none.json", "box.gltf", "\"lights_from_emissive\": false");
-    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), -1);
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), MS_ERR_INVALID);
     assert_non_null(strstr(err, "\"light\" is missing"));
 }
 

@@ -438,7 +438,7 @@ static void test_outputs_full_disk(void **st)
     size_t n = fread(text, 1, sizeof text - 1, f);
     text[n] = 0;
     fclose(f);
-    if (strncmp(text, "RESULT -1 ", 10)) fail_msg("stderr or result unexpected: '%s'", text);
+    if (strncmp(text, "RESULT 5 ", 9)) fail_msg("stderr or result unexpected (MS_ERR_IO expected): '%s'", text);
     if (!strstr(text, path) || !strstr(text, "write failed: File too large")) fail_msg("message: '%s'", text);
     assert_int_equal(tu_count_entries(dir), 0);
 }
@@ -446,19 +446,19 @@ static void test_outputs_full_disk(void **st)
 /* The staging files are removed when a signal arrives during the write phase: a writer that raises
  * SIGTERM (and one that raises SIGINT) after the first output was staged, in a child process. */
 static int g_sig;
-static int writer_ok(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
+static ms_status writer_ok(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
 {
     (void)f; (void)name; (void)err; (void)errlen;
     fputs("staged", out);
-    return 0;
+    return MS_OK;
 }
-static int writer_signal(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
+static ms_status writer_signal(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
 {
     (void)f; (void)name; (void)err; (void)errlen;
     fputs("half", out);
     fflush(out);
     raise(g_sig);
-    return 0;
+    return MS_OK;
 }
 
 static void test_outputs_signal_removes_staging(void **st)

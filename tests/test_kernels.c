@@ -718,8 +718,8 @@ static void test_isa_cap(void **state)
         assert_int_equal(back, caps[c]);
     }
     ms_isa dummy;
-    assert_int_equal(ms_isa_from_name("sse", &dummy), -1);
-    assert_int_equal(ms_isa_from_name(NULL, &dummy), -1);
+    assert_int_equal(ms_isa_from_name("sse", &dummy), MS_ERR_INVALID);
+    assert_int_equal(ms_isa_from_name(NULL, &dummy), MS_ERR_INVALID);
 }
 
 int main(void)

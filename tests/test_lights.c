@@ -814,7 +814,7 @@ static void test_sphere_outline(void **st)
     memset(&sph, 0, sizeof sph);
     ms_light_sphere(&sph, (ms_vec3){ 0, 0, 0 }, 1.0f);
     const float in[3] = { 0.5f, 0, 0 };
-    assert_int_equal(ms_light_sphere_outline(&sph, in, &disk), -1);
+    assert_int_equal(ms_light_sphere_outline(&sph, in, &disk), MS_ERR_INVALID);
 }
 
 /* Sphere irradiance (Snyder's closed form) against numerical integration over the exact outline disk

@@ -213,7 +213,7 @@ static void test_refusals(void **state)
     o.max_memory = 0;
     o.stream = MS_STREAM_ON;
     o.method = "hpc";
-    assert_int_equal(render_to(&sc, &o, sub, "b", 0, &st, err, sizeof err), -1);
+    assert_int_equal(render_to(&sc, &o, sub, "b", 0, &st, err, sizeof err), MS_ERR_INVALID);
     assert_non_null(strstr(err, "whole frame"));
     assert_int_equal(tu_count_entries(sub), 0);
     ms_scene_free(&sc);

@@ -140,7 +140,7 @@ _RenderOptions = _mirror("ms_render_options", [
     ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS_CANCEL),
     ("progress_user", _p), ("isa", ctypes.c_int), ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
     ("traversal", ctypes.c_int), ("no_filter", ctypes.c_int), ("primary", ctypes.c_char_p),
-    ("consistent_primary", ctypes.c_int), ("max_memory", ctypes.c_uint64)])
+    ("consistent_primary", ctypes.c_int), ("max_memory", ctypes.c_uint64), ("aa", ctypes.c_int), ("aa_split", ctypes.c_int)])
 _Points = _mirror("ms_points", [("n", _size), ("position", _p), ("normal", _p), ("triangle", _p), ("key", _p)])
 _PointsOptions = _mirror("ms_points_options", [
     ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("threads", ctypes.c_int),
@@ -154,16 +154,41 @@ _BakeOptions = _mirror("ms_bake_options", [("points", _PointsOptions), ("size", 
                                            ("dilate", ctypes.c_int), ("padding", ctypes.c_int)])
 
 _ERR = ctypes.c_char_p
-_scene_load = _sig("ms_scene_load_ex", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_LoadOptions),
-                   ctypes.POINTER(_Scene), _ERR, _size)
-_scene_default = _sig("ms_scene_default", ctypes.c_int, ctypes.POINTER(_Scene))
+
+
+class _Abi(ctypes.Structure):
+    """ms_abi (microshadow.h, "The ABI check"): the size of each struct as this module mirrors it, handed to the
+    library's checked entry points (the *_abi functions) with every call; 0 for a struct the module does not
+    mirror (not compared), and no version (the mirrors were checked against the library with ms_layout)."""
+    _fields_ = [(n, ctypes.c_uint32) for n in (
+        "abi_size", "version_major", "version_minor", "camera", "light", "procedural", "scene", "texture",
+        "texture_sampling", "material", "scene_load_options", "render_options", "stats", "frame", "output", "points",
+        "points_options", "bake_options", "lightmap", "bake_gltf_options")]
+
+
+_ABI = _Abi(abi_size=ctypes.sizeof(_Abi), camera=ctypes.sizeof(_Camera), light=ctypes.sizeof(_Light),
+            scene=ctypes.sizeof(_Scene), scene_load_options=ctypes.sizeof(_LoadOptions),
+            render_options=ctypes.sizeof(_RenderOptions), stats=ctypes.sizeof(_Stats), frame=ctypes.sizeof(_Frame),
+            points=ctypes.sizeof(_Points), points_options=ctypes.sizeof(_PointsOptions),
+            bake_options=ctypes.sizeof(_BakeOptions), lightmap=ctypes.sizeof(_Lightmap))
+
+
+def _checked(name, res, *args):
+    """One of the library's checked entry points: its exported form name_abi, given this module's ABI table."""
+    fn = _sig(name + "_abi", res, ctypes.POINTER(_Abi), *args)
+    return lambda *a: fn(ctypes.byref(_ABI), *a)
+
+
+_scene_load = _checked("ms_scene_load", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_LoadOptions),
+                       ctypes.POINTER(_Scene), _ERR, _size)
+_scene_default = _checked("ms_scene_default", ctypes.c_int, ctypes.POINTER(_Scene))
 _scene_free = _sig("ms_scene_free", None, ctypes.POINTER(_Scene))
-_accel_build = _sig("ms_accel_build", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.c_int, ctypes.POINTER(_p), _ERR, _size)
+_accel_build = _checked("ms_accel_build", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.c_int, ctypes.POINTER(_p), _ERR, _size)
 _accel_free = _sig("ms_accel_free", None, _p)
 _accel_lights = _sig("ms_accel_lights", ctypes.POINTER(_Light), _p, ctypes.POINTER(_size))
-_vis_points = _sig("ms_visibility_points", ctypes.c_int, _p, ctypes.POINTER(_Light), ctypes.POINTER(_Points),
+_vis_points = _checked("ms_visibility_points", ctypes.c_int, _p, ctypes.POINTER(_Light), ctypes.POINTER(_Points),
                    ctypes.POINTER(_PointsOptions), _p, _p, _p, ctypes.POINTER(_Stats), _ERR, _size)
-_render = _sig("ms_render", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.POINTER(_RenderOptions),
+_render = _checked("ms_render", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.POINTER(_RenderOptions),
                ctypes.POINTER(_Frame), _ERR, _size)
 _frame_free = _sig("ms_frame_free", None, ctypes.POINTER(_Frame))
 _method_names = _sig("ms_method_names", ctypes.POINTER(ctypes.c_char_p))
@@ -174,7 +199,7 @@ _light_triangle = _sig("ms_light_triangle", ctypes.c_int, ctypes.POINTER(_Light)
 _nearest = _sig("ms_nearest_name", ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(_size))
 _version = _sig("ms_version", ctypes.c_char_p, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
                 ctypes.POINTER(ctypes.c_int))
-_bake = _sig("ms_bake", ctypes.c_int, ctypes.POINTER(_Scene), _p, ctypes.POINTER(_BakeOptions),
+_bake = _checked("ms_bake", ctypes.c_int, ctypes.POINTER(_Scene), _p, ctypes.POINTER(_BakeOptions),
              ctypes.POINTER(_Lightmap), _ERR, _size)
 _lightmap_free = _sig("ms_lightmap_free", None, ctypes.POINTER(_Lightmap))
 
@@ -481,13 +506,15 @@ def _planes(ptr, n_lights, h, w, shape=None):
 
 
 def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto",
-           primary=None, consistent_primary=False, progress=None, max_memory=0):
+           primary=None, consistent_primary=False, progress=None, max_memory=0, aa=1, aa_split=False):
     """A frame (ms_render): dict of vis, shadow (H, W) float32 (-1 where the primary ray missed), front
     (H, W) uint16 (all of light 0), rgb (H, W, 3) linear radiance summed over the lights, exposure, stats
     (a dict), and lights: one dict per light of the scene with its vis, shadow, shadow_spec and front
     (H, W). primary: the primary visibility method (docs/primary.md; None: the method's pairing).
     progress: fn(fraction) -> truthy to cancel (Error with status 3). max_memory: the memory budget in bytes
-    (0: the library's default); a frame over it is refused before allocating (Error with status 6)."""
+    (0: the library's default); a frame over it is refused before allocating (Error with status 6). aa: primary
+    samples per pixel (1, 4, 9 or 16; docs/antialiasing.md), the planes then their box-filtered average per
+    pixel; aa_split: the pixel's light samples split among them instead of all for each."""
     if not isinstance(scene, Scene):
         raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
     opt = _RenderOptions()
@@ -498,6 +525,9 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
     opt.samples, opt.width, opt.height, opt.threads, opt.seed = int(samples), int(width), int(height), int(threads), int(seed)
     opt.isa = _choice("isa", isa, _ISAS)
     opt.max_memory = _max_memory(max_memory)
+    if isinstance(aa, bool) or not isinstance(aa, int) or aa not in (1, 4, 9, 16):
+        raise ValueError("aa: expected 1, 4, 9 or 16 primary samples per pixel, got %r" % (aa,))
+    opt.aa, opt.aa_split = aa, 1 if aa_split else 0
     cb = _progress_cancel(progress)
     opt.progress = cb
     fr, err = _Frame(), _errbuf()
@@ -542,7 +572,7 @@ def light_irradiance(light, point, normal):
 
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
-         dilate=4, padding=2, accel=None, progress=None, max_memory=0):
+         dilate=4, padding=4, accel=None, progress=None, max_memory=0):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
     (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off
     the triangles; position in the scene's frame: add scene.origin for world coordinates), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked

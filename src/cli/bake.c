@@ -52,12 +52,12 @@ static void usage(FILE *f)
 static const unsigned char *g_glb;
 static size_t g_glb_len;
 
-static int write_glb(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
+static ms_status write_glb(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
 {
     (void)f;
-    if (fwrite(g_glb, 1, g_glb_len, out) == g_glb_len) return 0;
+    if (fwrite(g_glb, 1, g_glb_len, out) == g_glb_len) return MS_OK;
     snprintf(err, errlen, "%s: write failed", name);
-    return -1;
+    return MS_ERR_IO;
 }
 
 /* Within the lights' pass: a percentage on the terminal, overwritten by the pass's own line at its end. */
@@ -195,10 +195,11 @@ int ms_cli_bake(int argc, char **argv)
     if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) { fprintf(stderr, "microshadow bake: %s\n", err); return EXIT_BAD_INPUT; }
     ms_scene scene;
     if (scene_path) {
-        if (ms_scene_load(scene_path, &scene, err, sizeof err)) { fprintf(stderr, "microshadow bake: %s\n", err); return EXIT_BAD_INPUT; }
+        const ms_status lst = ms_scene_load(scene_path, &scene, err, sizeof err);
+        if (lst) { fprintf(stderr, "microshadow bake: %s\n", err); return ms_cli_exit_code(lst); }
     } else if (ms_scene_default(&scene)) {
-        fprintf(stderr, "microshadow bake: out of memory building the default scene\n");
-        return 1;
+        fprintf(stderr, "microshadow bake: out of memory building the built-in scene\n");
+        return EXIT_NO_MEMORY;
     }
     int last = -1;
     ms_lightmap lm;
@@ -226,7 +227,7 @@ int ms_cli_bake(int argc, char **argv)
     if (st) {
         fprintf(stderr, "microshadow bake: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
         ms_scene_free(&scene);
-        return st == MS_ERR_NO_MEMORY ? 1 : EXIT_BAD_INPUT;
+        return ms_cli_exit_code(st);
     }
     unsigned char *glb = NULL;
     int rc = 0;
@@ -234,12 +235,12 @@ int ms_cli_bake(int argc, char **argv)
         st = ms_bake_gltf(&scene, &lm, NULL, &glb, &g_glb_len, err, sizeof err);
         if (st) {
             fprintf(stderr, "microshadow bake: %s: %s\n", outs[5].path, err);
-            rc = st == MS_ERR_NO_MEMORY ? 1 : EXIT_BAD_INPUT;
+            rc = ms_cli_exit_code(st);
         }
         g_glb = glb;
     }
     if (!rc) {
-        rc = ms_outputs_write(&lm.frame, outs, N_OUTS, err, sizeof err) ? EXIT_BAD_INPUT : 0;
+        rc = ms_cli_exit_code(ms_outputs_write(&lm.frame, outs, N_OUTS, err, sizeof err));
         if (rc) fprintf(stderr, "microshadow bake: %s\n", err);
     }
     free(glb);

@@ -254,20 +254,22 @@ static int cli_main(int argc, char **argv)
     char err[1024];
     /* Refuse bad outputs before a long render; from here on a signal removes any staging file. */
     ms_outputs_cleanup_on_signals();
-    if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) {
+    const ms_status cst = ms_outputs_check(outs, N_OUTS, err, sizeof err);
+    if (cst) {
         fprintf(stderr, "microshadow: %s\n", err);
-        return EXIT_BAD_INPUT;
+        return ms_cli_exit_code(cst);
     }
 
     ms_scene scene;
     if (scene_path) {
-        if (ms_scene_load(scene_path, &scene, err, sizeof err)) {
+        const ms_status lst = ms_scene_load(scene_path, &scene, err, sizeof err);
+        if (lst) {
             fprintf(stderr, "microshadow: %s\n", err);
-            return EXIT_BAD_INPUT;
+            return ms_cli_exit_code(lst);
         }
     } else if (ms_scene_showcase(&scene)) {
-        fprintf(stderr, "microshadow: out of memory building the default scene\n");
-        return 1;
+        fprintf(stderr, "microshadow: out of memory building the built-in scene\n");
+        return EXIT_NO_MEMORY;
     }
     /* Anti-aliased pictures by default; the V and S planes, which users compare method against method
      * and with other renderers sample for sample, stay one primary sample per pixel unless asked. */
@@ -290,25 +292,25 @@ static int cli_main(int argc, char **argv)
             return mrc ? EXIT_BAD_INPUT : 0;
         }
         frame.exposure *= (float)exp2(exposure_ev);
-        const int wrc = ms_outputs_write(&frame, outs, N_OUTS, err, sizeof err);
+        const ms_status wrc = ms_outputs_write(&frame, outs, N_OUTS, err, sizeof err);
         stats = frame.stats;
         ms_frame_free(&frame);
         if (wrc) {
             fprintf(stderr, "microshadow: %s\n", err);
             ms_scene_free(&scene);
-            return EXIT_BAD_INPUT;
+            return ms_cli_exit_code(wrc);
         }
     } else
 #endif
     {
         if (!quiet && isatty(STDERR_FILENO)) { opt.progress = progress_bar; opt.progress_user = &last; }
         /* Rendered and written together: streamed band by band when asked, or when only that fits the budget. */
-        const int rrc = ms_render_outputs(&scene, &opt, exposure_ev, outs, N_OUTS, &stats, err, sizeof err);
+        const ms_status rrc = ms_render_outputs(&scene, &opt, exposure_ev, outs, N_OUTS, &stats, err, sizeof err);
         if (rrc == MS_ERR_IO) fprintf(stderr, "microshadow: %s\n", err);
         else if (rrc) fprintf(stderr, "microshadow: %s: %s\n", what, err);
         if (rrc) {
             ms_scene_free(&scene);
-            return EXIT_BAD_INPUT;
+            return ms_cli_exit_code(rrc);
         }
     }
     if (!quiet && stats.stream_rows && opt.stream == MS_STREAM_AUTO) {

@@ -265,13 +265,13 @@ void ms_mpi_report_json(const ms_mpi_report *rep, FILE *f)
     fprintf(f, "]\n\t}");
 }
 
-int ms_mpi_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
+ms_status ms_mpi_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
 {
     char *buf = NULL;
     size_t len = 0;
     FILE *m = open_memstream(&buf, &len);
-    if (!m) { snprintf(err, errlen, "%s: out of memory", name); return -1; }
-    const int rc = ms_stats_write_stream(f, m, name, err, errlen);
+    if (!m) { snprintf(err, errlen, "%s: out of memory", name); return MS_ERR_NO_MEMORY; }
+    const ms_status rc = ms_stats_write_stream(f, m, name, err, errlen);
     fclose(m);
     if (rc) { free(buf); return rc; }
     /* The library's JSON object ends in "}\n": reopen it for the report. */
@@ -285,7 +285,7 @@ int ms_mpi_stats_write_stream(const ms_frame *f, FILE *out, const char *name, ch
     fputs(",\n\t", out);
     ms_mpi_report_json(&ms_mpi_last_report, out);
     fputs("\n}\n", out);
-    return 0;
+    return MS_OK;
 }
 
 uint64_t ms_mpi_hash(uint64_t h, const void *data, size_t n)

@@ -60,7 +60,7 @@ void ms_mpi_report_free(ms_mpi_report *rep);
 /* The report as a JSON object's text (no braces around it: "\"mpi\": {...}"), into f. */
 void ms_mpi_report_json(const ms_mpi_report *rep, FILE *f);
 /* An ms_output_write_fn for --stats in MPI mode: the frame's stats JSON with the "mpi" report added. */
-int ms_mpi_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+ms_status ms_mpi_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 /* The report ms_mpi_stats_write_stream adds (set by the frame or bake driver on rank 0). */
 extern ms_mpi_report ms_mpi_last_report;
 

@@ -86,6 +86,17 @@ int ms_cli_parse_long(const ms_cli_parser *p, const char *opt, const char *s, lo
     return 0;
 }
 
+int ms_cli_exit_code(ms_status st)
+{
+    switch (st) {
+    case MS_OK: return 0;
+    case MS_ERR_INVALID: case MS_ERR_IO: case MS_ERR_METHOD: case MS_ERR_BUDGET: return EXIT_BAD_INPUT;
+    case MS_ERR_NO_MEMORY: return EXIT_NO_MEMORY;
+    case MS_ERR_CANCELLED: return EXIT_CANCELLED;
+    }
+    return 1;
+}
+
 int ms_cli_check_method(const ms_cli_parser *p, const char *method)
 {
     const int avail = ms_method_available(method);

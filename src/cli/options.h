@@ -6,7 +6,16 @@
 #include <getopt.h>
 #include <stdint.h>
 
+#include "microshadow.h"
+
+/* Exit codes (README, "Exit codes"): 0 success; 2 bad input or a request refused (a malformed or unreadable
+ * file, a bad option, an unwritable output, a method not compiled in, over the memory budget); 3 out of memory
+ * although the estimate fitted the budget; 4 cancelled; 1 anything else. */
 #define EXIT_BAD_INPUT 2
+#define EXIT_NO_MEMORY 3
+#define EXIT_CANCELLED 4
+/* The exit code of a library status. */
+int ms_cli_exit_code(ms_status st);
 #define MS_CLI_MAX_OPTIONS 64
 
 typedef struct ms_cli_parser {

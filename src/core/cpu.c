@@ -72,10 +72,10 @@ const char *ms_isa_name(ms_isa isa)
     }
 }
 
-int ms_isa_from_name(const char *name, ms_isa *out)
+ms_status ms_isa_from_name(const char *name, ms_isa *out)
 {
     static const ms_isa all[] = { MS_ISA_AUTO, MS_ISA_SCALAR, MS_ISA_AVX2, MS_ISA_AVX512 };
     for (size_t i = 0; name && i < sizeof all / sizeof all[0]; i++)
-        if (strcmp(name, ms_isa_name(all[i])) == 0) { *out = all[i]; return 0; }
-    return -1;
+        if (strcmp(name, ms_isa_name(all[i])) == 0) { *out = all[i]; return MS_OK; }
+    return MS_ERR_INVALID;
 }

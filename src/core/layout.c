@@ -35,6 +35,7 @@ static const layout_row rows[] = {
     FIELD(ms_render_options, primary), FIELD(ms_render_options, consistent_primary),
     FIELD(ms_render_options, closed_cull), FIELD(ms_render_options, no_interior), FIELD(ms_render_options, no_merge),
     FIELD(ms_render_options, max_memory), FIELD(ms_render_options, stream), FIELD(ms_render_options, stream_rows),
+    FIELD(ms_render_options, aa), FIELD(ms_render_options, aa_split),
     STRUCT(ms_stats), FIELD(ms_stats, triangles), FIELD(ms_stats, load_s), FIELD(ms_stats, build_s),
     FIELD(ms_stats, setup_s), FIELD(ms_stats, primary_s), FIELD(ms_stats, shadow_s), FIELD(ms_stats, total_s),
     FIELD(ms_stats, samples), FIELD(ms_stats, threads), FIELD(ms_stats, width), FIELD(ms_stats, height),
@@ -66,7 +67,7 @@ static const layout_row rows[] = {
     STRUCT(ms_bake_gltf_options), FIELD(ms_bake_gltf_options, no_textures), FIELD(ms_bake_gltf_options, no_shadowmask),
 };
 
-int ms_layout(const char *structure, const char *field, size_t *offset, size_t *size)
+ms_status ms_layout(const char *structure, const char *field, size_t *offset, size_t *size)
 {
     for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
         const layout_row *r = &rows[i];
@@ -74,7 +75,7 @@ int ms_layout(const char *structure, const char *field, size_t *offset, size_t *
         if (field ? !r->field || strcmp(r->field, field) != 0 : r->field != NULL) continue;
         if (offset) *offset = r->offset;
         if (size) *size = r->size;
-        return 0;
+        return MS_OK;
     }
-    return -1;
+    return MS_ERR_INVALID;
 }

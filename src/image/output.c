@@ -203,32 +203,32 @@ static int same_target(const char *a, const char *b)
     return strcmp(ra, rb) == 0;
 }
 
-int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
+ms_status ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
 {
     for (int i = 0; i < n; i++) {
         const char *p = outs[i].path;
         if (!p) continue;
-        if (!p[0]) { snprintf(err, errlen, "empty output path (%s)", outs[i].flag); return -1; }
+        if (!p[0]) { snprintf(err, errlen, "empty output path (%s)", outs[i].flag); return MS_ERR_INVALID; }
         for (int j = 0; j < i; j++)
             if (outs[j].path && same_target(outs[j].path, p)) {
                 snprintf(err, errlen, "%s: given to both %s and %s (each output needs its own file)", p, outs[j].flag, outs[i].flag);
-                return -1;
+                return MS_ERR_INVALID;
             }
-        if (target_kind_ok(p, err, errlen)) return -1;
+        if (target_kind_ok(p, err, errlen)) return MS_ERR_IO;
         char dir[PATH_MAX];
         dir_of(p, dir, sizeof dir);
         long name_max = pathconf(dir, _PC_NAME_MAX);
         size_t blen = strlen(base_of(p));
-        if (blen == 0) { snprintf(err, errlen, "%s: cannot write: no file name", p); return -1; }
+        if (blen == 0) { snprintf(err, errlen, "%s: cannot write: no file name", p); return MS_ERR_IO; }
         if (name_max > 0 && blen > (size_t)name_max) {
             snprintf(err, errlen, "%s: cannot write: the file name is %zu bytes, more than this filesystem's %ld", p, blen, name_max);
-            return -1;
+            return MS_ERR_IO;
         }
-        if (strlen(p) >= PATH_MAX) { snprintf(err, errlen, "%s: cannot write: the path is too long", p); return -1; }
+        if (strlen(p) >= PATH_MAX) { snprintf(err, errlen, "%s: cannot write: the path is too long", p); return MS_ERR_IO; }
         /* The directory accepts a new file (creating and removing a staging file proves it). */
         int fd;
         int slot = stage_create(p, &fd, err, errlen);
-        if (slot < 0) return -1;
+        if (slot < 0) return MS_ERR_IO;
         close(fd);
         stage_remove(slot);
     }
@@ -243,9 +243,9 @@ int ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen)
             ok |= has_suffix(p, outs[i].suffixes[k]);
             snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? " or " : "", outs[i].suffixes[k]);
         }
-        if (!ok) { snprintf(err, errlen, "%s: %s needs a file ending in %s", p, outs[i].flag, list); return -1; }
+        if (!ok) { snprintf(err, errlen, "%s: %s needs a file ending in %s", p, outs[i].flag, list); return MS_ERR_INVALID; }
     }
-    return 0;
+    return MS_OK;
 }
 
 /* The first non-finite value of plane p (w*h values of `per` floats each, `planes` planes), or 0. */
@@ -269,9 +269,9 @@ static int first_bad(const float *p, int w, int h, int y0, int per, int planes, 
     return 0;
 }
 
-int ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen)
+ms_status ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen)
 {
-    return ms_band_check_finite(f, 0, what, err, errlen);
+    return ms_band_check_finite(f, 0, what, err, errlen) ? MS_ERR_INVALID : MS_OK;
 }
 
 int ms_band_check_finite(const ms_frame *f, int y0, const char *what, char *err, size_t errlen)
@@ -333,15 +333,15 @@ static FILE *open_staged(const ms_output *o, int *slot, char *err, size_t errlen
     return fp;
 }
 
-int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen)
+ms_status ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen)
 {
     int slot[MS_MAX_OUTPUTS];
     int rc = 0, k;
-    if (n > MS_MAX_OUTPUTS) { snprintf(err, errlen, "too many outputs"); return -1; }
+    if (n > MS_MAX_OUTPUTS) { snprintf(err, errlen, "too many outputs"); return MS_ERR_INVALID; }
     /* The last guard: a frame or lightmap with a NaN or infinite value is an error, before any file exists. */
     for (k = 0; k < n; k++)
         if (outs[k].path) {
-            if (ms_frame_check_finite(f, outs[k].path, err, errlen)) return -1;
+            if (ms_frame_check_finite(f, outs[k].path, err, errlen)) return MS_ERR_INVALID;
             break;
         }
     for (k = 0; k < n; k++) slot[k] = -1;
@@ -351,7 +351,7 @@ int ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err,
         if (!fp) { rc = -1; break; }
         rc = close_staged(fp, outs[k].path, outs[k].write(f, fp, outs[k].path, err, errlen), err, errlen);
     }
-    return commit_all(outs, slot, n, rc, err, errlen);
+    return commit_all(outs, slot, n, rc, err, errlen) ? MS_ERR_IO : MS_OK;
 }
 
 /* ---- Outputs written band by band (output_stream.h) ---- */
@@ -464,22 +464,22 @@ static int write_one(const ms_frame *f, const char *path, const char *flag, ms_o
     return ms_outputs_write(f, &o, 1, err, errlen);
 }
 
-int ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen)
+ms_status ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen)
 {
-    return write_one(f, path, "PNG", ms_png_write_stream, NULL, err, errlen);
+    return write_one(f, path, "PNG", ms_png_write_stream, NULL, err, errlen) ? MS_ERR_IO : MS_OK;
 }
 
-int ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen)
+ms_status ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen)
 {
-    return write_one(f, path, "the visibility image", ms_vis_write_stream, ms_float_image_suffixes, err, errlen);
+    return write_one(f, path, "the visibility image", ms_vis_write_stream, ms_float_image_suffixes, err, errlen) ? MS_ERR_IO : MS_OK;
 }
 
-int ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen)
+ms_status ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen)
 {
-    return write_one(f, path, "the shadow factor image", ms_shadow_write_stream, ms_float_image_suffixes, err, errlen);
+    return write_one(f, path, "the shadow factor image", ms_shadow_write_stream, ms_float_image_suffixes, err, errlen) ? MS_ERR_IO : MS_OK;
 }
 
-int ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen)
+ms_status ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen)
 {
-    return write_one(f, path, "stats", ms_stats_write_stream, NULL, err, errlen);
+    return write_one(f, path, "stats", ms_stats_write_stream, NULL, err, errlen) ? MS_ERR_IO : MS_OK;
 }

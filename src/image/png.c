@@ -119,10 +119,10 @@ int ms_png_rows_end(ms_png_rows *p, int ok, const char *path, char *err, size_t 
     return rc;
 }
 
-int ms_png_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
+ms_status ms_png_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
     ms_png_rows *p = ms_png_rows_begin(f->width, f->height, out, path, err, errlen);
-    if (!p) return -1;
+    if (!p) return MS_ERR_IO;
     const int rc = ms_png_rows_write(p, f, path, err, errlen);
-    return ms_png_rows_end(p, rc == 0, path, err, errlen) || rc ? -1 : 0;
+    return ms_png_rows_end(p, rc == 0, path, err, errlen) || rc ? MS_ERR_IO : MS_OK;
 }

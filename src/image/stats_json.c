@@ -5,11 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
+ms_status ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
     const ms_stats *s = &f->stats;
     cJSON *o = cJSON_CreateObject();
-    if (!o) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    if (!o) { snprintf(err, errlen, "%s: out of memory", path); return MS_ERR_NO_MEMORY; }
     cJSON_AddStringToObject(o, "version", MS_VERSION_STRING);
     cJSON_AddStringToObject(o, "method", s->method);
     cJSON_AddStringToObject(o, "pattern", s->pattern);
@@ -49,9 +49,9 @@ int ms_stats_write_stream(const ms_frame *f, FILE *out, const char *path, char *
     for (int i = 0; c && i < s->n_counters; i++) cJSON_AddNumberToObject(c, s->counter_name[i], (double)s->counter[i]);
     char *text = cJSON_Print(o);
     cJSON_Delete(o);
-    if (!text) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    if (!text) { snprintf(err, errlen, "%s: out of memory", path); return MS_ERR_NO_MEMORY; }
     fputs(text, out);
     fputc('\n', out);
     free(text);
-    return 0;   /* write errors surface at the flush */
+    return MS_OK;   /* write errors surface at the flush */
 }

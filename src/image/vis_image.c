@@ -261,17 +261,17 @@ static int write_whole(ms_image_kind kind, const ms_frame *f, FILE *out, const c
     return ms_float_rows_end(r, rc == 0, err, errlen) || rc ? -1 : 0;
 }
 
-int ms_vis_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
+ms_status ms_vis_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
-    return write_whole(MS_IMAGE_VIS, f, out, path, err, errlen);
+    return write_whole(MS_IMAGE_VIS, f, out, path, err, errlen) ? MS_ERR_IO : MS_OK;
 }
 
-int ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
+ms_status ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
-    return write_whole(MS_IMAGE_SHADOW, f, out, path, err, errlen);
+    return write_whole(MS_IMAGE_SHADOW, f, out, path, err, errlen) ? MS_ERR_IO : MS_OK;
 }
 
-int ms_exr_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
+ms_status ms_exr_write_stream(const ms_frame *f, FILE *out, const char *path, char *err, size_t errlen)
 {
-    return write_whole(MS_IMAGE_EXR_RGB, f, out, path, err, errlen);
+    return write_whole(MS_IMAGE_EXR_RGB, f, out, path, err, errlen) ? MS_ERR_IO : MS_OK;
 }

@@ -13,11 +13,11 @@ static int disk_contains(float s, float t)
     return x * x + y * y < 1.0f;
 }
 
-int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r)
+ms_status ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r)
 {
     float n[3] = { m.x, m.y, m.z };
     const float len = v3_len(n);
-    if (!(len > 0.0f) || !(r > 0.0f) || !isfinite(len) || !isfinite(r)) return -1;
+    if (!(len > 0.0f) || !(r > 0.0f) || !isfinite(len) || !isfinite(r)) return MS_ERR_INVALID;
     v3_scale(n, n, 1.0f / len);
     /* An orthonormal frame from n alone (Duff et al. 2017, "Building an orthonormal basis, revisited"):
      * continuous except where n.z changes sign, and exact enough that the square is a square. */
@@ -30,7 +30,7 @@ int ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r)
     l->edge_s = (ms_vec3){ d * e1[0], d * e1[1], d * e1[2] };
     l->edge_t = (ms_vec3){ d * e2[0], d * e2[1], d * e2[2] };
     l->shape = MS_LIGHT_DISK;
-    return 0;
+    return MS_OK;
 }
 
 static float disk_area(const ms_light *l, const ms_light_frame *F)

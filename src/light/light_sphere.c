@@ -6,9 +6,9 @@
 #include <stdio.h>
 #include <string.h>
 
-int ms_light_sphere(ms_light *l, ms_vec3 c, float r)
+ms_status ms_light_sphere(ms_light *l, ms_vec3 c, float r)
 {
-    if (!(r > 0.0f) || !isfinite(r)) return -1;
+    if (!(r > 0.0f) || !isfinite(r)) return MS_ERR_INVALID;
     l->shape = MS_LIGHT_SPHERE;
     l->center = c;
     l->radius = r;
@@ -16,17 +16,17 @@ int ms_light_sphere(ms_light *l, ms_vec3 c, float r)
     l->corner = (ms_vec3){ c.x - r, c.y, c.z - r };
     l->edge_s = (ms_vec3){ 2.0f * r, 0.0f, 0.0f };
     l->edge_t = (ms_vec3){ 0.0f, 0.0f, 2.0f * r };
-    return 0;
+    return MS_OK;
 }
 
-int ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk)
+ms_status ms_light_sphere_outline(const ms_light *l, const float p[3], ms_light *disk)
 {
     /* In double: the tangent circle's radius r sqrt(d^2 - r^2)/d loses everything to cancellation in
      * float when the point is close to the sphere. */
     const double c[3] = { l->center.x, l->center.y, l->center.z }, r = l->radius;
     const double w[3] = { p[0] - c[0], p[1] - c[1], p[2] - c[2] };
     const double d2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-    if (!(d2 > r * r * (1.0 + 1e-6))) return -1;
+    if (!(d2 > r * r * (1.0 + 1e-6))) return MS_ERR_INVALID;
     const double f = r * r / d2, rr = r * sqrt(d2 - r * r) / sqrt(d2);
     const ms_vec3 cc = { (float)(c[0] + w[0] * f), (float)(c[1] + w[1] * f), (float)(c[2] + w[2] * f) };
     const ms_vec3 m = { (float)w[0], (float)w[1], (float)w[2] };
@@ -88,13 +88,19 @@ static int sphere_finite(const ms_light *l)
            l->radius > 0.0f;
 }
 
+/* The shape table's outline hook (0 or -1) over the API's ms_light_sphere_outline. */
+static int sphere_outline(const ms_light *l, const float p[3], ms_light *disk)
+{
+    return ms_light_sphere_outline(l, p, disk) == MS_OK ? 0 : -1;
+}
+
 const ms_light_shape_ops ms_light_sphere_shape = {
     .shape = MS_LIGHT_SPHERE,
     .name = "sphere",
     .textured = 0,
     .area = sphere_area,
     .irradiance = sphere_irradiance_f,
-    .outline = ms_light_sphere_outline,
+    .outline = sphere_outline,
     .validate = sphere_validate,
     .keys = { { "center", MS_LIGHT_KEY_POINT, 1, 0, 0 }, { "radius", MS_LIGHT_KEY_NUMBER, 1, 0, 0 } },
     .build = sphere_build,

@@ -6,17 +6,17 @@
 #include <math.h>
 #include <stdio.h>
 
-int ms_light_triangle(ms_light *l, ms_vec3 a, ms_vec3 b, ms_vec3 c)
+ms_status ms_light_triangle(ms_light *l, ms_vec3 a, ms_vec3 b, ms_vec3 c)
 {
     const float s[3] = { b.x - a.x, b.y - a.y, b.z - a.z }, t[3] = { c.x - a.x, c.y - a.y, c.z - a.z };
     float n[3];
     v3_cross(n, s, t);
-    if (!(v3_dot(n, n) > 0.0f) || !v3_finite(n)) return -1;
+    if (!(v3_dot(n, n) > 0.0f) || !v3_finite(n)) return MS_ERR_INVALID;
     l->corner = a;
     l->edge_s = (ms_vec3){ s[0], s[1], s[2] };
     l->edge_t = (ms_vec3){ t[0], t[1], t[2] };
     l->shape = MS_LIGHT_TRIANGLE;
-    return 0;
+    return MS_OK;
 }
 
 /* Strict, as the disk's: a sample on the diagonal s + t = 1 is off the triangle. */

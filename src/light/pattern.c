@@ -25,11 +25,11 @@ const char *ms_pattern_name(ms_pattern p)
     return "unknown";
 }
 
-int ms_pattern_from_name(const char *name, ms_pattern *out)
+ms_status ms_pattern_from_name(const char *name, ms_pattern *out)
 {
     for (int p = MS_PATTERN_GRID; p <= MS_PATTERN_INTERLEAVED; p++)
-        if (strcmp(name, ms_pattern_name((ms_pattern)p)) == 0) { *out = (ms_pattern)p; return 0; }
-    return -1;
+        if (strcmp(name, ms_pattern_name((ms_pattern)p)) == 0) { *out = (ms_pattern)p; return MS_OK; }
+    return MS_ERR_INVALID;
 }
 
 int ms_samples_to_k(int samples)

@@ -3,6 +3,7 @@
  * through ms_visibility_points (so every method bakes, on the frames' sample patterns keyed by texel),
  * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
 #include "microshadow.h"
+#include "core/abi.h"
 #include "points.h"
 #include "bake_uvs.h"
 #include "bake_leaks.h"
@@ -230,8 +231,11 @@ static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, in
 }
 
 /* The layout of the lightmap (ms_bake_layout): checks, UVs, texel rasterization, the frame's arrays. */
-ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *out, char *err, size_t errlen)
+ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *out,
+                             char *err, size_t errlen)
 {
+    const ms_status ast = ms_abi_check(abi, "ms_bake_layout", err, errlen);
+    if (ast) return ast;
     if (!out) { snprintf(err, errlen, "ms_bake: out is NULL"); return MS_ERR_INVALID; }
     memset(out, 0, sizeof *out);
     ms_bake_options zero;
@@ -485,9 +489,11 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
 }
 
 /* ms_bake_layout, every row in one ms_bake_rows call, ms_bake_finish. */
-ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *out,
-                  char *err, size_t errlen)
+ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt_in,
+                      ms_lightmap *out, char *err, size_t errlen)
 {
+    const ms_status ast = ms_abi_check(abi, "ms_bake", err, errlen);
+    if (ast) return ast;
     const double t_start = omp_get_wtime();
     if (out) memset(out, 0, sizeof *out);
     ms_bake_options zero;

@@ -3,6 +3,7 @@
  * binary glTF 2.0. The JSON is built with cJSON; the binary chunk is ours: every accessor and image in one
  * buffer, each view aligned to 4 bytes. */
 #include "microshadow.h"
+#include "core/abi.h"
 #include "image/png_encode.h"
 #include "scene/scene_internal.h"
 #include <cjson/cJSON.h>
@@ -406,9 +407,11 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     return prim;
 }
 
-ms_status ms_bake_gltf(const ms_scene *sc, const ms_lightmap *lm, const ms_bake_gltf_options *opt, unsigned char **glb,
-                       size_t *len, char *err, size_t errlen)
+ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
+                           unsigned char **glb, size_t *len, char *err, size_t errlen)
 {
+    const ms_status ast = ms_abi_check(abi, "ms_bake_gltf", err, errlen);
+    if (ast) return ast;
     if (glb) *glb = NULL;
     if (len) *len = 0;
     if (!sc || !lm || !glb || !len) { snprintf(err, errlen, "ms_bake_gltf: NULL argument"); return MS_ERR_INVALID; }
@@ -559,17 +562,19 @@ done:
 static _Thread_local const unsigned char *t_glb;
 static _Thread_local size_t t_glb_len;
 
-static int write_glb(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
+static ms_status write_glb(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
 {
     (void)f;
-    if (fwrite(t_glb, 1, t_glb_len, out) == t_glb_len) return 0;
+    if (fwrite(t_glb, 1, t_glb_len, out) == t_glb_len) return MS_OK;
     snprintf(err, errlen, "%s: write failed", name);
-    return -1;
+    return MS_ERR_IO;
 }
 
-ms_status ms_bake_write_gltf(const ms_scene *sc, const ms_lightmap *lm, const ms_bake_gltf_options *opt, const char *path,
-                             char *err, size_t errlen)
+ms_status ms_bake_write_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_lightmap *lm,
+                                 const ms_bake_gltf_options *opt, const char *path, char *err, size_t errlen)
 {
+    const ms_status ast = ms_abi_check(abi, "ms_bake_write_gltf", err, errlen);
+    if (ast) return ast;
     static const char *const glb_suffix[] = { ".glb", NULL };
     ms_output o = { "glTF", path ? path : "", write_glb, glb_suffix };
     if (ms_outputs_check(&o, 1, err, errlen)) return MS_ERR_IO;

@@ -11,6 +11,7 @@
  * state for the job's life (set-ups such as hpc's light hierarchy and the frusta are per light), so that
  * any call can render any tile for every light. */
 #include "microshadow.h"
+#include "core/abi.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
 #include "shadow/method.h"
@@ -213,7 +214,7 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
 
 /* stream: MS_STREAM_OFF (the whole frame), MS_STREAM_ON (bands), or MS_STREAM_AUTO (bands when only they fit the
  * budget). */
-static int job_create(const ms_scene *scene, const ms_render_options *opt, int stream, ms_frame_job **out, char *err,
+static ms_status job_create(const ms_scene *scene, const ms_render_options *opt, int stream, ms_frame_job **out, char *err,
                       size_t errlen)
 {
     *out = NULL;
@@ -225,10 +226,10 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     if (!sm) {
         if (ms_method_available(method) < 0) snprintf(err, errlen, "method '%s' is not compiled into this build", method);
         else snprintf(err, errlen, "unknown method '%s'", method);
-        return -1;
+        return MS_ERR_METHOD;
     }
     ms_frame_job *j = calloc(1, sizeof *j);
-    if (!j) { snprintf(err, errlen, "out of memory"); return -1; }
+    if (!j) { snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
     j->t_start = t_start;
     j->opt = *opt;
     j->sm = sm;
@@ -241,12 +242,12 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         if (strcmp(pname, "embree") == 0) snprintf(err, errlen, "primary method 'embree' is not compiled into this build");
         else snprintf(err, errlen, "unknown primary method '%s' (bvh, embree, depth, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)", pname);
         free(j);
-        return -1;
+        return MS_ERR_METHOD;
     }
     if (strcmp(pm->name, "depth") == 0 && !(procedural && sm->streams)) {
         snprintf(err, errlen, "primary method 'depth' needs a procedural scene and a streaming shadow method (e.g. hpc)");
         free(j);
-        return -1;
+        return MS_ERR_INVALID;
     }
     /* A procedural scene: streamed when the shadow method and the primary can (no BVH), else materialised
      * (below, once the options are checked and the budget allows it). */
@@ -254,7 +255,7 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     j->streamed = streamed;
     j->scene = scene;
     j->lights = ms_scene_lights(scene, &j->nlights);
-    int rc = -1;
+    ms_status rc = MS_ERR_INVALID;
     const int samples = opt->samples > 0 ? opt->samples : scene->samples;
     /* Anti-aliasing: K primary samples per pixel as the pixels of an s-times larger frame (s = sqrt K), which
      * every primary and shadow method renders as it renders any frame; finish resolves it (frame_aa.c). */
@@ -376,8 +377,8 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         snprintf(err, errlen, "camera is degenerate (eye = target, up parallel to the view, or a field of view, extent or type out of range)");
         goto fail;
     }
-    if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); goto fail; }
-    if (!streamed && ms_alpha_build(scene, &j->bvh, &j->alpha)) { snprintf(err, errlen, "out of memory for the alpha-tested triangles"); goto fail; }
+    if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); rc = MS_ERR_NO_MEMORY; goto fail; }
+    if (!streamed && ms_alpha_build(scene, &j->bvh, &j->alpha)) { snprintf(err, errlen, "out of memory for the alpha-tested triangles"); rc = MS_ERR_NO_MEMORY; goto fail; }
     ctx->alpha = j->alpha;
     ctx->isa_cap = opt->isa;
     ctx->no_occlusion_cull = opt->no_occlusion_cull;
@@ -406,7 +407,7 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
         j->band_vis = malloc(nb * sizeof(float));
         j->band_shadow = malloc(nb * sizeof(float));
         j->band_spec = malloc(nb * sizeof(float));
-        if (!j->band_vis || !j->band_shadow || !j->band_spec) { snprintf(err, errlen, "out of memory for a %dx%d band", W, j->band_rows); goto fail; }
+        if (!j->band_vis || !j->band_shadow || !j->band_spec) { snprintf(err, errlen, "out of memory for a %dx%d band", W, j->band_rows); rc = MS_ERR_NO_MEMORY; goto fail; }
     }
     j->hits = malloc(npix * sizeof *j->hits);
     j->traced = calloc((size_t)j->ntiles, 1);
@@ -422,12 +423,13 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     f->n_lights = (int)nl;
     if (!j->hits || !j->traced || !j->sstate || !j->own_sstate || !j->interior_sstate || !f->vis || !f->shadow || !f->shadow_spec || !f->front || !f->rgb) {
         snprintf(err, errlen, "out of memory for a %dx%d frame", W, H);
+        rc = MS_ERR_NO_MEMORY;
         goto fail;
     }
     /* The surfaces (material, shading normal) of the hits: S_spec needs them with the masks. */
     if (!streamed && (scene->tri_material || scene->tri_normal)) {
         j->surf = malloc(npix * sizeof *j->surf);
-        if (!j->surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); goto fail; }
+        if (!j->surf) { snprintf(err, errlen, "out of memory for the surfaces of a %dx%d frame", W, H); rc = MS_ERR_NO_MEMORY; goto fail; }
     }
     f->width = W;
     f->height = j->rows_held;
@@ -443,20 +445,21 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     const int occ_what = occluder_what(sm, opt);
     if (occ_what && !streamed && occluders_build(j, occ_what, &f->stats)) {
         snprintf(err, errlen, "out of memory for the lights' occluders");
+        rc = MS_ERR_NO_MEMORY;
         goto fail;
     }
     for (size_t l = 0; l < nl; l++) {
         ms_render_ctx lc;
         light_ctx(j, l, &lc);
-        if (sm->create(&lc, &j->sstate[l], err, errlen)) { j->sstate[l] = NULL; goto fail; }
+        if (sm->create(&lc, &j->sstate[l], err, errlen)) { j->sstate[l] = NULL; rc = MS_ERR_METHOD; goto fail; }
         if (lc.prim_merged) {
             light_own_ctx(j, l, &lc);
-            if (sm->create(&lc, &j->own_sstate[l], err, errlen)) { j->own_sstate[l] = NULL; goto fail; }
+            if (sm->create(&lc, &j->own_sstate[l], err, errlen)) { j->own_sstate[l] = NULL; rc = MS_ERR_METHOD; goto fail; }
         }
         light_ctx(j, l, &lc);
         if ((sm->occluders & MS_OCC_INTERIOR_PASS) && lc.interior) {
             light_interior_ctx(j, l, &lc);
-            if (sm->create(&lc, &j->interior_sstate[l], err, errlen)) { j->interior_sstate[l] = NULL; goto fail; }
+            if (sm->create(&lc, &j->interior_sstate[l], err, errlen)) { j->interior_sstate[l] = NULL; rc = MS_ERR_METHOD; goto fail; }
         }
     }
     ms_stats *st = &f->stats;
@@ -479,8 +482,12 @@ fail:
     return rc;
 }
 
-int ms_frame_job_create(const ms_scene *scene, const ms_render_options *opt, ms_frame_job **out, char *err, size_t errlen)
+ms_status ms_frame_job_create_abi(const ms_abi *abi, const ms_scene *scene, const ms_render_options *opt,
+                                  ms_frame_job **out, char *err, size_t errlen)
 {
+    *out = NULL;
+    const ms_status st = ms_abi_check(abi, "ms_frame_job_create", err, errlen);
+    if (st) return st;
     return job_create(scene, opt, MS_STREAM_OFF, out, err, errlen);
 }
 
@@ -748,17 +755,17 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     return failed ? -1 : 0;
 }
 
-int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, size_t errlen)
+ms_status ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, size_t errlen)
 {
     const ms_shadow_method *sm = j->sm;
     const int whole = !tiles && n == j->ntiles && !j->rendered_any;
-    if (!tiles && n != j->ntiles) { snprintf(err, errlen, "ms_frame_job_render: tiles is NULL but n is not the frame's %d tiles", j->ntiles); return -1; }
+    if (!tiles && n != j->ntiles) { snprintf(err, errlen, "ms_frame_job_render: tiles is NULL but n is not the frame's %d tiles", j->ntiles); return MS_ERR_INVALID; }
     for (int i = 0; tiles && i < n; i++)
-        if (tiles[i] < 0 || tiles[i] >= j->ntiles) { snprintf(err, errlen, "ms_frame_job_render: tile %d is not in [0, %d)", tiles[i], j->ntiles); return -1; }
+        if (tiles[i] < 0 || tiles[i] >= j->ntiles) { snprintf(err, errlen, "ms_frame_job_render: tile %d is not in [0, %d)", tiles[i], j->ntiles); return MS_ERR_INVALID; }
     if (!whole && !ms_frame_job_splittable(j)) {
         snprintf(err, errlen, "method '%s' renders only whole frames (the receivers its hierarchy rasterizes triangles for, "
                  "and so its rounding at their edges, depend on all of the frame's pixels)", sm->name);
-        return -1;
+        return MS_ERR_INVALID;
     }
     j->rendered_any = 1;
     ms_stats *st = &j->frame.stats;
@@ -778,7 +785,7 @@ int ms_frame_job_render(ms_frame_job *j, const int *tiles, int n, char *err, siz
     if (cancelled(j)) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
     if (failed) {
         snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name);
-        return -1;
+        return MS_ERR_NO_MEMORY;
     }
     st->primary_s += t1 - t0;
     st->shadow_s += omp_get_wtime() - t1;
@@ -821,9 +828,9 @@ static void job_stats(ms_frame_job *j, ms_stats *st)
     st->total_s = omp_get_wtime() - j->t_start + j->scene->load_s;
 }
 
-int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen)
+ms_status ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen)
 {
-    if (j->band_rows) { snprintf(err, errlen, "ms_frame_job_finish: a streamed job's frame is written band by band"); return -1; }
+    if (j->band_rows) { snprintf(err, errlen, "ms_frame_job_finish: a streamed job's frame is written band by band"); return MS_ERR_INVALID; }
     memset(out, 0, sizeof *out);
     ms_frame *f = &j->frame;
     ms_stats *st = &f->stats;
@@ -831,7 +838,7 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
     const size_t npix = (size_t)W * H, nl = j->nlights;
     /* Hit points (and surfaces) of the tiles other jobs rendered: the filter and the shading need them all. */
     int *missing = malloc((size_t)j->ntiles * sizeof *missing), nm = 0;
-    if (!missing) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); return -1; }
+    if (!missing) { snprintf(err, errlen, "out of memory for a %dx%d frame", W, H); return MS_ERR_NO_MEMORY; }
     for (int t = 0; t < j->ntiles; t++)
         if (!j->traced[t]) missing[nm++] = t;
     const double tp = omp_get_wtime();
@@ -857,7 +864,7 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
         free(raw_vis);
         if (ferr) {
             snprintf(err, errlen, "out of memory for the interleaved filter of a %dx%d frame", W, H);
-            return -1;
+            return MS_ERR_NO_MEMORY;
         }
         st->filter_s = omp_get_wtime() - tf;
         st->shadow_s += st->filter_s;
@@ -865,11 +872,11 @@ int ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t errlen
     }
     if (ms_frame_shade(j->scene, &j->ctx, j->lights, nl, j->hits, j->surf, j->threads, 0, f, NULL)) {
         snprintf(err, errlen, "out of memory for the textured lights of a %dx%d frame", W, H);
-        return -1;
+        return MS_ERR_NO_MEMORY;
     }
     if (j->aa_s > 1 && ms_frame_aa_resolve(f, j->aa_s, j->aa_split ? j->aa_s * j->aa_s : 1)) {
         snprintf(err, errlen, "out of memory resolving the anti-aliased %dx%d frame", W / j->aa_s, H / j->aa_s);
-        return -1;
+        return MS_ERR_NO_MEMORY;
     }
 
     job_stats(j, st);

@@ -8,6 +8,7 @@
  * counts the lower 16 bits inside the bucket that holds the percentile's rank, which gives the exact value
  * (the same float the whole frame's sort picks), and a second pass writes the PNG's rows. */
 #include "frame_stream.h"
+#include "core/abi.h"
 #include "image/output_stream.h"
 #include <errno.h>
 #include <math.h>
@@ -134,7 +135,7 @@ static int spill_png(png_spill *s, ms_outputs_stream *os, float exposure, char *
 }
 
 /* The banded job's frame into the outputs. */
-static int stream_frame(ms_frame_job *job, int band_rows, double exposure_ev, const ms_output *outs, int n,
+static ms_status stream_frame(ms_frame_job *job, int band_rows, double exposure_ev, const ms_output *outs, int n,
                         ms_stats *stats, char *err, size_t errlen)
 {
     int W, H;
@@ -148,7 +149,7 @@ static int stream_frame(ms_frame_job *job, int band_rows, double exposure_ev, co
     png_spill sp = { .fd = -1, .W = W, .H = H, .band_rows = band_rows };
     const size_t bpix = (size_t)W * (size_t)band_rows;
     float *lum = NULL;
-    int rc = 0;
+    ms_status rc = MS_OK;
     if (png) {
         lum = malloc(bpix * sizeof *lum);
         sp.rec = malloc(bpix * 16);
@@ -157,18 +158,18 @@ static int stream_frame(ms_frame_job *job, int band_rows, double exposure_ev, co
         sp.hist = calloc(65536, sizeof *sp.hist);
         if (!lum || !sp.rec || !sp.rgb || !sp.vis || !sp.hist) {
             snprintf(err, errlen, "out of memory for a band of %dx%d", W, band_rows);
-            rc = -1;
+            rc = MS_ERR_NO_MEMORY;
         } else if ((sp.fd = ms_outputs_spill(png, err, errlen)) < 0) rc = MS_ERR_IO;
     }
     ms_frame band;
     memset(&band, 0, sizeof band);
     for (int y0 = 0; y0 < H && !rc; y0 += band_rows) {
         const int rows = H - y0 < band_rows ? H - y0 : band_rows;
-        rc = ms_frame_job_band_render(job, y0, rows, err, errlen);
-        if (rc) rc = rc == MS_ERR_CANCELLED ? MS_ERR_CANCELLED : -1;
+        const int brc = ms_frame_job_band_render(job, y0, rows, err, errlen);
+        if (brc) rc = brc > 0 ? (ms_status)brc : MS_ERR_INVALID;
         int by0, got;
         while (!rc && (got = ms_frame_job_band_take(job, &band, &by0, lum, err, errlen)) != 0) {
-            if (got < 0) rc = -1;
+            if (got < 0) rc = MS_ERR_NO_MEMORY;
             else if (first && ms_band_check_finite(&band, by0, first, err, errlen)) rc = MS_ERR_IO;
             else if (ms_outputs_stream_rows(os, &band, by0, 0, err, errlen)) rc = MS_ERR_IO;
             else if (png && spill_band(&sp, &band, lum, by0, err, errlen)) rc = MS_ERR_IO;
@@ -199,28 +200,30 @@ static int stream_frame(ms_frame_job *job, int band_rows, double exposure_ev, co
     return rc;
 }
 
-int ms_render_outputs(const ms_scene *scene, const ms_render_options *opt, double exposure_ev, const ms_output *outs,
-                      int n, ms_stats *stats, char *err, size_t errlen)
+ms_status ms_render_outputs_abi(const ms_abi *abi, const ms_scene *scene, const ms_render_options *opt,
+                                double exposure_ev, const ms_output *outs, int n, ms_stats *stats, char *err,
+                                size_t errlen)
 {
+    const ms_status ast = ms_abi_check(abi, "ms_render_outputs", err, errlen);
+    if (ast) return ast;
     if (stats) memset(stats, 0, sizeof *stats);
     int mode = (int)opt->stream;
-    if (mode < MS_STREAM_AUTO || mode > MS_STREAM_OFF) { snprintf(err, errlen, "unknown stream mode %d", mode); return -1; }
+    if (mode < MS_STREAM_AUTO || mode > MS_STREAM_OFF) { snprintf(err, errlen, "unknown stream mode %d", mode); return MS_ERR_INVALID; }
     if (mode != MS_STREAM_OFF && ms_outputs_streamable(outs, n, err, errlen)) {
-        if (mode == MS_STREAM_ON) return -1;
+        if (mode == MS_STREAM_ON) return MS_ERR_INVALID;
         mode = MS_STREAM_OFF;   /* a caller's own writer takes the whole frame */
     }
     ms_frame_job *job;
     int band_rows;
-    const int crc = ms_frame_job_create_stream(scene, opt, mode, &job, &band_rows, err, errlen);
-    if (crc) return crc == MS_ERR_BUDGET ? MS_ERR_BUDGET : -1;
-    int rc;
+    const ms_status crc = ms_frame_job_create_stream(scene, opt, mode, &job, &band_rows, err, errlen);
+    if (crc) return crc;
+    ms_status rc;
     if (band_rows) rc = stream_frame(job, band_rows, exposure_ev, outs, n, stats, err, errlen);
     else {
         ms_frame frame;
         memset(&frame, 0, sizeof frame);
         rc = ms_frame_job_render(job, NULL, ms_frame_job_tiles(job, NULL, NULL), err, errlen);
-        if (rc == 0) rc = ms_frame_job_finish(job, &frame, err, errlen) ? -1 : 0;
-        else if (rc != MS_ERR_CANCELLED) rc = -1;
+        if (rc == MS_OK) rc = ms_frame_job_finish(job, &frame, err, errlen);
         if (rc == 0) {
             frame.exposure *= (float)exp2(exposure_ev);
             if (ms_outputs_write(&frame, outs, n, err, errlen)) rc = MS_ERR_IO;

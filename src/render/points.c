@@ -5,6 +5,7 @@
  * visible masks, V and S from ms_resolve_vs. A point's sample pattern is keyed like a pixel, so the same
  * receiver with the same key gets the same V and S as in a frame (test_points checks it bit for bit). */
 #include "microshadow.h"
+#include "core/abi.h"
 #include "points.h"
 #include "budget.h"
 #include "light/pattern.h"
@@ -51,8 +52,11 @@ const char *ms_status_name(ms_status s)
     return "unknown status";
 }
 
-ms_status ms_accel_build(const ms_scene *scene, int threads, ms_accel **out, char *err, size_t errlen)
+ms_status ms_accel_build_abi(const ms_abi *abi, const ms_scene *scene, int threads, ms_accel **out, char *err,
+                             size_t errlen)
 {
+    const ms_status ast = ms_abi_check(abi, "ms_accel_build", err, errlen);
+    if (ast) return ast;
     if (!out) { snprintf(err, errlen, "ms_accel_build: out is NULL"); return MS_ERR_INVALID; }
     *out = NULL;
     if (!scene) { snprintf(err, errlen, "ms_accel_build: no scene"); return MS_ERR_INVALID; }
@@ -200,10 +204,12 @@ void ms_accel_origin(const ms_accel *a, double origin[3])
     for (int c = 0; c < 3; c++) origin[c] = a ? a->view.origin[c] : 0.0;
 }
 
-ms_status ms_visibility_points(const ms_accel *a, const ms_light *light, const ms_points *pts,
-                               const ms_points_options *opt, float *vis, float *shadow, uint16_t *front_out,
-                               ms_stats *stats, char *err, size_t errlen)
+ms_status ms_visibility_points_abi(const ms_abi *abi, const ms_accel *a, const ms_light *light, const ms_points *pts,
+                                   const ms_points_options *opt, float *vis, float *shadow, uint16_t *front_out,
+                                   ms_stats *stats, char *err, size_t errlen)
 {
+    const ms_status ast = ms_abi_check(abi, "ms_visibility_points", err, errlen);
+    if (ast) return ast;
     /* World positions into the scene's frame (scene_frame.c): subtracted in double, which is exact for points
      * near the geometry (the origin is a multiple of a power of two above the floats' spacing there). */
     if (!a || !pts || !pts->position || !pts->n ||

@@ -6,6 +6,7 @@
  * curved objects (per-vertex normals), a textured ground, a metal and rough plastics, alpha-tested leaf
  * cards, lit by a rect, a disk and a sphere light of different colours. */
 #include "microshadow.h"
+#include "../core/abi.h"
 #include "scene_internal.h"
 #include <math.h>
 #include <stdlib.h>
@@ -53,8 +54,10 @@ static int sphere(ms_tri_soup *s, float cx, float cy, float cz, float r, int rin
     return 0;
 }
 
-int ms_scene_default(ms_scene *out)
+ms_status ms_scene_default_abi(const ms_abi *abi, ms_scene *out)
 {
+    char msg[256];
+    if (ms_abi_check(abi, "ms_scene_default", msg, sizeof msg)) { ms_warn("%s", msg); return MS_ERR_INVALID; }
     memset(out, 0, sizeof *out);
     ms_tri_soup s = { 0 };
     const float g0[3] = { -8, 0, -8 }, g1[3] = { 8, 0, -8 }, g2[3] = { 8, 0, 8 }, g3[3] = { -8, 0, 8 };
@@ -66,7 +69,7 @@ int ms_scene_default(ms_scene *out)
         quad(&s, p0, p1, p2, p3) ||                             /* floating open plate */
         sphere(&s, -0.8f, 0.9f, -2.6f, 0.9f, 24, 48)) {         /* sphere resting on the ground */
         ms_soup_free(&s);
-        return -1;
+        return MS_ERR_NO_MEMORY;
     }
     free(s.tri_d);   /* generated about the origin: the scene's frame is the world's */
     out->tri = s.tri;
@@ -79,7 +82,7 @@ int ms_scene_default(ms_scene *out)
     out->light = (ms_light){ { -1.25f, 6.0f, -1.25f }, { 2.5f, 0.0f, 0.0f }, { 0.0f, 0.0f, 2.5f },
                              { MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION, MS_DEFAULT_EMISSION }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
     out->samples = 1024;
-    return 0;
+    return MS_OK;
 }
 
 /* ---- The showcase scene ---- */
@@ -239,8 +242,10 @@ static int leaf_texture(ms_texture *t)
 
 enum { MAT_GROUND, MAT_GOLD, MAT_RED, MAT_BLUE, MAT_WHITE, MAT_LEAF, N_MATS };
 
-int ms_scene_showcase(ms_scene *out)
+ms_status ms_scene_showcase_abi(const ms_abi *abi, ms_scene *out)
 {
+    char msg[256];
+    if (ms_abi_check(abi, "ms_scene_showcase", msg, sizeof msg)) { ms_warn("%s", msg); return MS_ERR_INVALID; }
     memset(out, 0, sizeof *out);
     ms_tri_soup s = { 0 };
     ms_texture *tex = calloc(2, sizeof *tex);
@@ -309,7 +314,7 @@ int ms_scene_showcase(ms_scene *out)
         for (int i = 0; tex && i < 2; i++) free(tex[i].rgba);
         free(tex);
         free(lights);
-        return -1;
+        return MS_ERR_NO_MEMORY;
     }
     free(s.tri_d);   /* generated about the origin: the scene's frame is the world's */
     out->tri = s.tri;
@@ -330,5 +335,5 @@ int ms_scene_showcase(ms_scene *out)
     out->light = lights[0];
     out->camera = (ms_camera){ { 0.0f, 5.0f, 9.5f }, { 0.0f, 0.9f, 0.0f }, { 0.0f, 1.0f, 0.0f }, 45.0f, 768, 512, MS_CAMERA_PINHOLE, 0.0f, 0.0f };
     out->samples = 256;
-    return 0;
+    return MS_OK;
 }

@@ -58,12 +58,12 @@ static void shift3(ms_vec3 *v, const double d[3])
     v->z = (float)((double)v->z + d[2]);
 }
 
-int ms_scene_localize(ms_scene *s)
+ms_status ms_scene_localize(ms_scene *s)
 {
-    if (!s || !s->tri || !s->n_tris) return 0;   /* procedural scenes are generated about the origin */
+    if (!s || !s->tri || !s->n_tris) return MS_OK;   /* procedural scenes are generated about the origin */
     const size_t n = 9 * s->n_tris;
     double *w = malloc(n * sizeof *w);
-    if (!w) return -1;
+    if (!w) return MS_ERR_NO_MEMORY;
     for (size_t i = 0; i < n; i++) w[i] = (double)s->tri[i] + s->origin[i % 3];
     double o[3];
     ms_scene_frame_origin(w, s->n_tris, o);
@@ -83,5 +83,5 @@ int ms_scene_localize(ms_scene *s)
         for (int a = 0; a < 3; a++) s->origin[a] = o[a];
     }
     free(w);
-    return 0;
+    return MS_OK;
 }

@@ -5,6 +5,7 @@
 #include "../image/png_read.h"
 #include "../image/exr_read.h"
 #include "../light/light_shape.h"
+#include "../core/abi.h"
 _Static_assert(MS_SOUP_UV_SETS == MS_MAX_UV_SETS, "one count of UV sets");
 #include <cjson/cJSON.h>
 #include <ctype.h>
@@ -577,20 +578,21 @@ static void frame_camera_lights(const cJSON *cam, ms_scene *out, const light_pos
     if (out->n_lights) out->light = out->lights[0];
 }
 
-int ms_scene_load_ex(const char *json_path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen)
+ms_status ms_scene_load_abi(const ms_abi *abi, const char *json_path, const ms_scene_load_options *opt, ms_scene *out,
+                            char *err, size_t errlen)
 {
+    const ms_status st = ms_abi_check(abi, "ms_scene_load", err, errlen);
+    if (st) return st;
     memset(out, 0, sizeof *out);
     char *text;
     size_t len;
-    if (ms_read_input(json_path, MS_MAX_SCENE_BYTES, MS_INPUT_SCENE, &text, &len, err, errlen)) { ms_one_line(err); return -1; }
-    int rc = parse_with(text, len, json_path, opt, out, err, errlen);
+    if (ms_read_input(json_path, MS_MAX_SCENE_BYTES, MS_INPUT_SCENE, &text, &len, err, errlen)) {
+        ms_one_line(err);
+        return MS_ERR_IO;
+    }
+    const int rc = parse_with(text, len, json_path, opt, out, err, errlen);
     free(text);
-    return rc;
-}
-
-int ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen)
-{
-    return ms_scene_load_ex(json_path, NULL, out, err, errlen);
+    return rc ? MS_ERR_INVALID : MS_OK;
 }
 
 static int scene_parse(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,

@@ -70,7 +70,7 @@ static int validate_light(const ms_light *l, const char *name, const char *what,
     return 0;
 }
 
-int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen)
+ms_status ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t errlen)
 {
     const ms_camera *c = &s->camera;
     /* Each type's own number only (the others are unused and may be anything). */
@@ -78,16 +78,16 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
                     : c->type == MS_CAMERA_FISHEYE ? c->fov : 0.0f;
     if (!vec_ok(c->eye) || !vec_ok(c->target) || !vec_ok(c->up) || !isfinite(own)) {
         snprintf(err, errlen, "%s: camera has a NaN or infinite value", what);
-        return -1;
+        return MS_ERR_INVALID;
     }
     size_t nl;
     const ms_light *lights = ms_scene_lights(s, &nl);
-    if (s->n_lights && !s->lights) { snprintf(err, errlen, "%s: the scene has no lights array", what); return -1; }
+    if (s->n_lights && !s->lights) { snprintf(err, errlen, "%s: the scene has no lights array", what); return MS_ERR_INVALID; }
     for (size_t i = 0; i < nl; i++) {
         char name[32];
         if (s->n_lights) snprintf(name, sizeof name, "lights[%zu]", i);
         else snprintf(name, sizeof name, "light");
-        if (validate_light(&lights[i], name, what, err, errlen)) return -1;
+        if (validate_light(&lights[i], name, what, err, errlen)) return MS_ERR_INVALID;
     }
     /* Beyond 1e18, squared lengths and cross products overflow single precision: the camera basis or
      * the light's area would come out infinite and be misreported as degenerate. */
@@ -97,13 +97,13 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         if (!in_range(coords[i].v)) {
             snprintf(err, errlen, "%s: %s has a coordinate beyond +-%g (too large for single precision)", what,
                      coords[i].name, (double)MS_MAX_COORD);
-            return -1;
+            return MS_ERR_INVALID;
         }
     switch (c->type) {
     case MS_CAMERA_PINHOLE:
         if (!(c->fov_y > 0.0f && c->fov_y < 180.0f)) {
             snprintf(err, errlen, "%s: camera.fov_y must be in (0, 180) degrees", what);
-            return -1;
+            return MS_ERR_INVALID;
         }
         break;
     case MS_CAMERA_ORTHOGRAPHIC:
@@ -111,13 +111,13 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         if (!(c->ortho_height > 0.0f && c->ortho_height <= MS_MAX_COORD / MS_MAX_IMAGE_SIZE)) {
             snprintf(err, errlen, "%s: camera.ortho_height must be in (0, %g] world units", what,
                      (double)(MS_MAX_COORD / MS_MAX_IMAGE_SIZE));
-            return -1;
+            return MS_ERR_INVALID;
         }
         break;
     case MS_CAMERA_FISHEYE:
         if (!(c->fov > 0.0f && c->fov <= 360.0f)) {
             snprintf(err, errlen, "%s: camera.fov must be in (0, 360] degrees", what);
-            return -1;
+            return MS_ERR_INVALID;
         }
         break;
     case MS_CAMERA_LATLONG:
@@ -125,38 +125,38 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         break;
     default:
         snprintf(err, errlen, "%s: camera.type %d is unknown", what, (int)c->type);
-        return -1;
+        return MS_ERR_INVALID;
     }
     if (c->width < 1 || c->height < 1 || c->width > MS_MAX_IMAGE_SIZE || c->height > MS_MAX_IMAGE_SIZE) {
         snprintf(err, errlen, "%s: camera width and height must be in [1, %d]", what, MS_MAX_IMAGE_SIZE);
-        return -1;
+        return MS_ERR_INVALID;
     }
     ms_camera_basis b;
     if (c->eye.x == c->target.x && c->eye.y == c->target.y && c->eye.z == c->target.z) {
         snprintf(err, errlen, "%s: camera.eye equals camera.target", what);
-        return -1;
+        return MS_ERR_INVALID;
     }
     if (ms_camera_basis_init(&b, c, c->width, c->height)) {
         snprintf(err, errlen, "%s: camera.up is zero or parallel to the view direction", what);
-        return -1;
+        return MS_ERR_INVALID;
     }
     if (!s->tri && s->procedural.type == MS_PROCEDURAL_NONE && s->n_tris) {
         snprintf(err, errlen, "%s: the scene has no triangle array", what);
-        return -1;
+        return MS_ERR_INVALID;
     }
     if (s->n_tris == 0) {
         snprintf(err, errlen, "%s: the scene has no triangles", what);
-        return -1;
+        return MS_ERR_INVALID;
     }
     for (size_t i = 0; s->tri && i < 9 * s->n_tris; i++) {
         if (!isfinite(s->tri[i])) {
             snprintf(err, errlen, "%s: triangle %zu has a NaN or infinite coordinate", what, i / 9);
-            return -1;
+            return MS_ERR_INVALID;
         }
         if (fabsf(s->tri[i]) > MS_MAX_COORD) {
             snprintf(err, errlen, "%s: triangle %zu has a coordinate beyond +-%g (too large for single precision)", what,
                      i / 9, (double)MS_MAX_COORD);
-            return -1;
+            return MS_ERR_INVALID;
         }
     }
     /* Surfaces (loaders produce them valid; a library caller may not): every reference in range. */
@@ -164,25 +164,25 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         const ms_texture *t = &s->textures[i];
         if (!t->rgba || t->width < 1 || t->height < 1 || t->width > MS_MAX_IMAGE_SIZE || t->height > MS_MAX_IMAGE_SIZE) {
             snprintf(err, errlen, "%s: texture %zu has no pixels or a size outside 1..%d", what, i, MS_MAX_IMAGE_SIZE);
-            return -1;
+            return MS_ERR_INVALID;
         }
     }
     for (size_t i = 0; i < s->n_materials; i++) {
         const ms_material *m = &s->materials[i];
         int ok = m->metallic >= 0.0f && m->metallic <= 1.0f && m->roughness >= 0.0f && m->roughness <= 1.0f;
         for (int c = 0; c < 4; c++) ok &= m->base_color[c] >= 0.0f && m->base_color[c] <= 1.0f;
-        if (!ok) { snprintf(err, errlen, "%s: material %zu has a factor outside [0, 1] (or NaN)", what, i); return -1; }
+        if (!ok) { snprintf(err, errlen, "%s: material %zu has a factor outside [0, 1] (or NaN)", what, i); return MS_ERR_INVALID; }
         if (m->base_color_texture < -1 || (m->base_color_texture >= 0 && (size_t)m->base_color_texture >= s->n_textures) ||
             m->base_color_uv < 0 || m->base_color_uv >= MS_MAX_UV_SETS) {
             snprintf(err, errlen, "%s: material %zu names a texture or UV set that does not exist", what, i);
-            return -1;
+            return MS_ERR_INVALID;
         }
         if (m->alpha_mode < MS_ALPHA_OPAQUE || m->alpha_mode > MS_ALPHA_MASK_MAP ||
             (m->alpha_mode != MS_ALPHA_OPAQUE && !(m->alpha_cutoff >= 0.0f && m->alpha_cutoff <= 1.0f)) ||
             (m->alpha_mode == MS_ALPHA_MASK_MAP &&
              (m->alpha_texture < -1 || (m->alpha_texture >= 0 && (size_t)m->alpha_texture >= s->n_textures)))) {
             snprintf(err, errlen, "%s: material %zu has a bad alpha mode, cutoff (outside [0, 1]) or alpha texture", what, i);
-            return -1;
+            return MS_ERR_INVALID;
         }
         /* issue 30's fields: samplers, maps and emission */
         const ms_texture_sampling *sm[4] = { &m->base_color_sampling, &m->normal_sampling, &m->emissive_sampling, &m->mr_sampling };
@@ -200,13 +200,13 @@ int ms_scene_validate(const ms_scene *s, const char *what, char *err, size_t err
         if (!ok) {
             snprintf(err, errlen, "%s: material %zu has a bad sampler, transform, normal, emissive or metallic-roughness map, or emission "
                      "(negative, non-finite or beyond 1e30)", what, i);
-            return -1;
+            return MS_ERR_INVALID;
         }
     }
     for (size_t i = 0; s->tri_material && i < s->n_tris; i++)
         if (s->tri_material[i] != MS_NO_MATERIAL && s->tri_material[i] >= s->n_materials) {
             snprintf(err, errlen, "%s: triangle %zu names material %u of %zu", what, i, s->tri_material[i], s->n_materials);
-            return -1;
+            return MS_ERR_INVALID;
         }
-    return 0;
+    return MS_OK;
 }

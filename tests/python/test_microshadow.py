@@ -423,6 +423,32 @@ class StrictTest(unittest.TestCase):
             self.assertIn("../outside.mtl", str(cm.exception))
             self.assertEqual(ms.load(path, allow_outside_paths=True).n_triangles, 4)
 
+    def test_antialias(self):
+        # aa=4: each pixel is the 2x2 pixels of the frame twice as large, averaged over those that hit
+        big = ms.render(self.scene, method="scanline", samples=256, width=96, height=96)
+        aa = ms.render(self.scene, method="scanline", samples=256, width=48, height=48, aa=4)
+        self.assertEqual(aa["vis"].shape, (48, 48))
+        v = big["vis"].reshape(48, 2, 48, 2).transpose(0, 2, 1, 3).reshape(48, 48, 4)
+        hits = (v >= 0).sum(axis=2)
+        mean = np.where(hits > 0, np.where(v >= 0, v, 0).sum(axis=2) / np.maximum(hits, 1), -1)
+        np.testing.assert_allclose(aa["vis"], mean, atol=1e-6)
+        self.assertTrue(((hits > 0) & (hits < 4)).any())   # some pixels straddle a silhouette
+        with self.assertRaises(ValueError) as cm:
+            ms.render(self.scene, aa=3)
+        self.assertIn("aa", str(cm.exception))
+
+    def test_abi_checked(self):
+        # the module hands the library its mirrors' sizes with every call; a stale table is refused by name
+        bad = ms._Abi.from_buffer_copy(ms._ABI)
+        bad.frame += 8
+        fn = ms._lib.ms_render_abi
+        fn.restype = ctypes.c_int
+        opt, fr, err = ms._RenderOptions(), ms._Frame(), ctypes.create_string_buffer(512)
+        rc = fn(ctypes.byref(bad), ctypes.byref(self.scene._s), ctypes.byref(opt), ctypes.byref(fr), err, len(err))
+        self.assertEqual(rc, 1)
+        self.assertIn("ms_frame", err.value.decode())
+        self.assertEqual(ms._ABI.render_options, ctypes.sizeof(ms._RenderOptions))
+
     def test_version(self):
         self.assertRegex(ms.__version__, r"^\d+\.\d+\.\d+$")
 

@@ -1,0 +1,170 @@
+/* The library's contract (issue 23): the ABI check of the checked entry points (a program's struct sizes
+ * against the library's: a mismatch is refused before any struct is read or written), and the status every
+ * failing function returns, one case per kind, each provoked for real (a missing file, a method that does
+ * not exist, a budget too small, a callback that cancels, an unwritable output). */
+#include "testutil.h"
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+static ms_abi table(void) { return *ms_abi_compiled(); }
+
+static void test_abi_matches(void **st)
+{
+    (void)st;
+    ms_abi a = table();
+    assert_int_equal(a.abi_size, sizeof(ms_abi));
+    assert_int_equal(a.render_options, sizeof(ms_render_options));
+    assert_int_equal(a.frame, sizeof(ms_frame));
+    ms_scene sc;
+    assert_int_equal(ms_scene_default_abi(&a, &sc), MS_OK);
+    assert_true(sc.n_tris > 0);
+    ms_scene_free(&sc);
+}
+
+/* A struct of another size is refused, the message names the entry point and the struct, and the caller's
+ * output is left as it was (not written at the library's size). */
+static void test_abi_size_mismatch(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), MS_OK);
+    ms_render_options o;
+    ms_render_options_default(&o);
+    o.width = o.height = 16;
+    ms_abi a = table();
+    a.render_options += 8;
+    ms_frame f;
+    memset(&f, 0xab, sizeof f);
+    char err[256] = "";
+    assert_int_equal(ms_render_abi(&a, &sc, &o, &f, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "ms_render:"));
+    assert_non_null(strstr(err, "ms_render_options"));
+    unsigned char expect[sizeof f];
+    memset(expect, 0xab, sizeof expect);
+    assert_memory_equal(&f, expect, sizeof f);
+
+    a = table();
+    a.frame -= 8;
+    assert_int_equal(ms_render_abi(&a, &sc, &o, &f, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "ms_frame"));
+    a = table();
+    a.lightmap += 16;   /* a struct the call does not take: the whole table is one program's, so it is refused too */
+    ms_accel *acc = NULL;
+    assert_int_equal(ms_accel_build_abi(&a, &sc, 1, &acc, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "ms_accel_build"));
+    assert_non_null(strstr(err, "ms_lightmap"));
+    ms_scene_free(&sc);
+}
+
+static void test_abi_version_and_table(void **st)
+{
+    (void)st;
+    char err[256] = "";
+    ms_scene sc;
+    ms_abi a = table();
+    a.version_minor += 1;
+    assert_int_equal(ms_scene_load_abi(&a, "/nonexistent/scene.json", NULL, &sc, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "built against microshadow"));
+    /* Zeroes are not compared: a binding that mirrors only some structs passes 0 for the others. */
+    ms_abi z;
+    memset(&z, 0, sizeof z);
+    z.abi_size = sizeof z;
+    assert_int_equal(ms_scene_default_abi(&z, &sc), MS_OK);
+    ms_scene_free(&sc);
+    /* A table from an older header lists fewer structs; those it does not list are not compared. */
+    a = table();
+    a.abi_size = (uint32_t)offsetof(ms_abi, scene);
+    a.scene += 8;
+    assert_int_equal(ms_scene_default_abi(&a, &sc), MS_OK);
+    ms_scene_free(&sc);
+    a.abi_size = 4;
+    assert_int_equal(ms_scene_load_abi(&a, "x.json", NULL, &sc, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "too small"));
+    assert_int_equal(ms_scene_load_abi(NULL, "x.json", NULL, &sc, err, sizeof err), MS_ERR_INVALID);
+}
+
+static int cancel_at_once(void *user, double frac)
+{
+    (void)user; (void)frac;
+    return 1;
+}
+
+/* Each status, provoked. */
+static void test_statuses(void **st)
+{
+    (void)st;
+    char err[512] = "";
+    ms_pattern p;
+    assert_int_equal(ms_pattern_from_name("gird", &p), MS_ERR_INVALID);
+    assert_int_equal(ms_pattern_from_name("grid", &p), MS_OK);
+    ms_isa isa;
+    assert_int_equal(ms_isa_from_name("sse9", &isa), MS_ERR_INVALID);
+    size_t off, size;
+    assert_int_equal(ms_layout("ms_nothing", NULL, &off, &size), MS_ERR_INVALID);
+    assert_int_equal(ms_layout("ms_frame", "vis", &off, &size), MS_OK);
+    assert_int_equal(off, offsetof(ms_frame, vis));
+    ms_light l;
+    memset(&l, 0, sizeof l);
+    assert_int_equal(ms_light_disk(&l, (ms_vec3){ 0, 1, 0 }, (ms_vec3){ 0, -1, 0 }, 0.0f), MS_ERR_INVALID);
+    assert_int_equal(ms_light_sphere(&l, (ms_vec3){ 0, 1, 0 }, -1.0f), MS_ERR_INVALID);
+
+    const char *dir = tu_tmpdir("test_api_contract");
+    char path[512];
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "missing.json"), &sc, err, sizeof err), MS_ERR_IO);
+    assert_non_null(strstr(err, "missing.json"));
+    tu_path(path, sizeof path, dir, "broken.json");
+    assert_int_equal(tu_write_file(path, "{ \"camera\": "), 0);
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "broken.json"));
+
+    assert_int_equal(ms_scene_default(&sc), MS_OK);
+    assert_int_equal(ms_scene_validate(&sc, "built-in", err, sizeof err), MS_OK);
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.width = o.height = 32;
+    o.samples = 256;
+    ms_frame f;
+    o.method = "no-such-method";
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), MS_ERR_METHOD);
+    assert_non_null(strstr(err, "no-such-method"));
+    o.method = "scanline";
+    o.max_memory = 4096;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), MS_ERR_BUDGET);
+    o.max_memory = 0;
+    o.aa = 3;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), MS_ERR_INVALID);
+    o.aa = 0;
+    o.progress = cancel_at_once;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), MS_ERR_CANCELLED);
+    o.progress = NULL;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), MS_OK);
+
+    /* Outputs: a wrong ending is the caller's mistake, an unwritable place an i/o failure. */
+    static const char *const png_only[] = { ".png", NULL };
+    ms_output out = { "-o", tu_path(path, sizeof path, dir, "x.jpg"), ms_png_write_stream, png_only };
+    assert_int_equal(ms_outputs_check(&out, 1, err, sizeof err), MS_ERR_INVALID);
+    out.path = "/nonexistent-dir/x.png";
+    assert_int_equal(ms_outputs_check(&out, 1, err, sizeof err), MS_ERR_IO);
+    assert_int_equal(ms_write_png(&f, "/nonexistent-dir/x.png", err, sizeof err), MS_ERR_IO);
+    assert_int_equal(ms_write_png(&f, tu_path(path, sizeof path, dir, "ok.png"), err, sizeof err), MS_OK);
+    assert_true(tu_file_exists(path));
+    f.vis[5] = NAN;
+    assert_int_equal(ms_frame_check_finite(&f, "frame", err, sizeof err), MS_ERR_INVALID);
+    ms_frame_free(&f);
+    ms_scene_free(&sc);
+    assert_string_equal(ms_status_name(MS_ERR_BUDGET), "over the memory budget");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_abi_matches),
+        cmocka_unit_test(test_abi_size_mismatch),
+        cmocka_unit_test(test_abi_version_and_table),
+        cmocka_unit_test(test_statuses),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
