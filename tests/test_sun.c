@@ -5,6 +5,8 @@
  *     the sun), and raytrace's equal a brute force in double: a sample counts when it lies in front of the
  *     receiver and its direction within the sun's cone, and is occluded when a triangle meets the ray from P
  *     towards it at any distance beyond the near range (no far limit at all);
+ *   - bakes (the points API, given the sun unplaced): every method's V, S and front equal raytrace's, and
+ *     raytrace's the brute force;
  *   - the penumbra: a pole's shadow edge at distance d from the pole is d tan(0.53 deg) wide (within a pixel
  *     of an orthographic view from above);
  *   - irradiance: pi L sin^2 alpha cos theta above the horizon, numerical integration over the cone across it;
@@ -226,6 +228,89 @@ static void check_every_method(float deg)
 
 static void test_every_method_wide(void **st) { (void)st; check_every_method(8.0f); }
 static void test_every_method_sun(void **st) { (void)st; check_every_method(0.53f); }
+
+/* ---- bakes (the points API): the sun given unplaced, placed for the accel's scene ---- */
+
+/* The Quad (ground, a square occluder at height 2) under a sun of 6 degrees: every method's baked V, S and front
+ * equal raytrace's texel for texel, and raytrace's V and front the brute force (no far limit) where it decides. */
+static void test_bake(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    tu_make_quad(&sc);
+    assert_int_equal(ms_light_sun(&sc.light, (ms_vec3){ 0.3f, 1.0f, 0.2f }, 6.0f), 0);
+    sc.light.emission = (ms_vec3){ 1, 1, 1 };
+    const int size = 40;
+    const size_t nt = (size_t)size * size;
+    char err[512];
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = size;
+    bo.uv_set = -1;
+    bo.points.samples = 256;
+    bo.points.threads = 2;
+    bo.points.isa = tu_isa_cap();
+    bo.points.method = "raytrace";
+    ms_lightmap ref, lm;
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &ref, err, sizeof err), MS_OK);
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        bo.points.method = names[mi];
+        assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+        long differ = 0;
+        for (size_t i = 0; i < nt; i++)
+            differ += lm.frame.vis[i] != ref.frame.vis[i] || lm.frame.shadow[i] != ref.frame.shadow[i] ||
+                      lm.frame.front[i] != ref.frame.front[i];
+        if (differ) fprintf(stderr, "sun bake, method %s: %ld texels differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_lightmap_free(&lm);
+    }
+    ms_light sun = sc.light;
+    float box[6];
+    tri_box(&sc, box);
+    ms_light_sun_place(&sun, box);
+    const double ta = tan(3.0 * M_PI / 180.0), u[3] = { sun.center.x, sun.center.y, sun.center.z };
+    float pts[3 * 256];
+    long decided = 0, partial = 0, bad = 0, texels = 0;
+    for (size_t i = 0; i < nt; i++) {
+        if (ref.triangle[i] == MS_NO_TRIANGLE) continue;
+        texels++;
+        const float *pf = ref.position + 3 * i, *n = ref.normal + 3 * i;
+        const double p[3] = { pf[0], pf[1], pf[2] };
+        ms_light disk;
+        assert_int_equal(ms_light_shape_of(MS_LIGHT_SUN)->outline(&sun, pf, &disk), 0);
+        ms_pattern_points(MS_PATTERN_GRID, &disk, 16, (uint32_t)(i % size), (uint32_t)(i / size), 0, pts);
+        int nf = 0, nv = 0, unsure = 0;
+        for (int s = 0; s < 256 && !unsure; s++) {
+            const double L[3] = { pts[3 * s], pts[3 * s + 1], pts[3 * s + 2] };
+            const double d[3] = { L[0] - p[0], L[1] - p[1], L[2] - p[2] };
+            const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], along = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+            const double off = (r2 - along * along) / (along * along * ta * ta) - 1.0;
+            const double side = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / sqrt(r2);
+            if (fabs(off) < 1e-4 || fabs(side) < 1e-5) { unsure = 1; break; }
+            if (off > 0.0 || side < 0.0) continue;
+            nf++;
+            verdict occ = NO;
+            for (size_t t = 0; t < sc.n_tris && occ != YES; t++) {
+                if (t == ref.triangle[i]) continue;
+                const verdict v = ray_hits(sc.tri + 9 * t, p, L, 1e-4);
+                if (v != NO) occ = v;
+            }
+            if (occ == UNSURE) unsure = 1;
+            nv += occ == NO;
+        }
+        if (unsure) continue;
+        decided++;
+        partial += nv > 0 && nv < nf;
+        bad += ref.frame.vis[i] != (nf ? (float)nv / (float)nf : 0.0f) || ref.frame.front[i] != nf;
+    }
+    printf("sun bake: the brute force decided %ld of %ld texels (%ld in penumbra); %ld differ from raytrace\n", decided,
+           texels, partial, bad);
+    assert_int_equal(bad, 0);
+    assert_true(decided > texels * 8 / 10 && partial > 10);
+    ms_lightmap_free(&ref);
+    ms_scene_free(&sc);
+}
 
 /* ---- the penumbra of a pole ---- */
 
@@ -490,6 +575,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_method_wide),
         cmocka_unit_test(test_every_method_sun),
+        cmocka_unit_test(test_bake),
         cmocka_unit_test(test_penumbra_width),
         cmocka_unit_test(test_sun_irradiance),
         cmocka_unit_test(test_gltf_directional),
