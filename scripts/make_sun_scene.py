@@ -8,7 +8,7 @@ posts at height 6, and a plank leaning from the ground up to height 10, lit by t
 0.53 degrees, 40 degrees above the horizon): the shadows' penumbra widens with the height of what casts
 them, d tan(0.53 deg) at distance d from it (0.1 at the 14-high pole's tip). An orthographic view from
 above. Also OUTDIR/sun_rect.json: the same scene lit by a rect light instead (the sun's direction, at 40
-units, 2 x 2), to compare the cost of a sun with a rect on the same scene (docs/lights.md).
+units, a square of the sun's solid angle), to compare the cost of a sun with a rect on the same scene (docs/lights.md).
 Everything is generated: the repository holds this script, not the mesh. Standard library only."""
 import json
 import math
@@ -72,16 +72,18 @@ def main():
                                        height=256))
         with open(os.path.join(out, name), "w") as o:
             json.dump(zoom, o, indent=1)
-    # the rect: 2 x 2 at 40 units along the sun's direction, facing the scene
+    # the rect: at 40 units along the sun's direction, facing the scene, a square of the sun's solid angle
+    # (side 40 tan(alpha) sqrt(pi) = 0.33): the same penumbrae to first order
     c = [40 * x for x in d]
+    half = 0.5 * 40 * math.tan(math.radians(0.265)) * math.sqrt(math.pi)
     e1 = [-d[2], 0.0, d[0]]
     l1 = math.sqrt(sum(x * x for x in e1))
     e1 = [x / l1 for x in e1]
     e2 = [d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2], d[0] * e1[1] - d[1] * e1[0]]
     # cross(edge_s, edge_t) must point back at the scene (-d): edge_s = e2, edge_t = e1 gives -d
-    rect = {"corner": [round(c[a] - e1[a] - e2[a], 6) for a in range(3)],
-            "edge_s": [round(2 * e2[a], 6) for a in range(3)], "edge_t": [round(2 * e1[a], 6) for a in range(3)],
-            "emission": 1000}
+    rect = {"corner": [round(c[a] - half * (e1[a] + e2[a]), 6) for a in range(3)],
+            "edge_s": [round(2 * half * e2[a], 6) for a in range(3)],
+            "edge_t": [round(2 * half * e1[a], 6) for a in range(3)], "emission": 1000}
     scene["light"] = rect
     with open(os.path.join(out, "sun_rect.json"), "w") as o:
         json.dump(scene, o, indent=1)
