@@ -205,7 +205,7 @@ static void test_cornell_emitter(void **st)
                        " \"lights_from_emissive\": true");
     assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
     L = ms_scene_lights(&sc, &n);
-    assert_int_equal((int)n, 3);
+    assert_int_equal((int)n, 2);
     assert_float_equal(L[0].corner.y, 1.99f, 0.0f);
     assert_float_equal(L[1].emission.x, 4.0f, 0.0f);
     ms_scene_free(&sc);
