@@ -6,7 +6,7 @@
  *     receiver and its direction within the sun's cone, and is occluded when a triangle meets the ray from P
  *     towards it at any distance beyond the near range (no far limit at all);
  *   - bakes (the points API, given the sun unplaced): every method's V, S and front equal raytrace's, and
- *     raytrace's the brute force;
+ *     raytrace's the brute force; points far outside the scene: their segments still reach it;
  *   - the penumbra: a pole's shadow edge at distance d from the pole is d tan(0.53 deg) wide (within a pixel
  *     of an orthographic view from above);
  *   - irradiance: pi L sin^2 alpha cos theta above the horizon, numerical integration over the cone across it;
@@ -312,6 +312,53 @@ static void test_bake(void **st)
     ms_scene_free(&sc);
 }
 
+/* Points outside the scene's ball (the points API only): their segments grow so that they still leave the
+ * scene. Under the Quad's ground at 200 below (its sun ray meets the ground 4 off centre): V = 0 by every
+ * method, where a segment of the scene's length D = 57 would end in the air below the ground and see the sun;
+ * 200 above: V = 1; and every method equals raytrace at points around the scene. */
+static void test_points_outside(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    tu_make_quad(&sc);
+    assert_int_equal(ms_light_sun(&sc.light, (ms_vec3){ 0.02f, 1.0f, 0.01f }, 2.0f), 0);
+    sc.light.emission = (ms_vec3){ 1, 1, 1 };
+    ms_accel *acc = NULL;
+    char err[512];
+    assert_int_equal(ms_accel_build(&sc, 2, &acc, err, sizeof err), MS_OK);
+    enum { N = 6 };
+    const float pos[N][3] = { { 0, -200, 0 }, { 0, 200, 0 }, { 0.5f, 1, 0.3f }, { -30, 3, 40 }, { 1, -5, 1 }, { 12, 0.5f, -3 } };
+    const float nrm[N][3] = { { 0, 1, 0 }, { 0, 1, 0 }, { 0, 1, 0 }, { 0.2f, 1, 0 }, { 0, 1, 0 }, { -1, 1, 0 } };
+    const ms_points q = { .n = N, .position = &pos[0][0], .normal = &nrm[0][0] };
+    float rv[N], rs[N], v[N], s[N];
+    uint16_t rf[N], f[N];
+    ms_points_options o;
+    memset(&o, 0, sizeof o);
+    o.samples = 256;
+    o.threads = 1;
+    o.isa = tu_isa_cap();
+    o.method = "raytrace";
+    assert_int_equal(ms_visibility_points(acc, NULL, &q, &o, rv, rs, rf, NULL, err, sizeof err), MS_OK);
+    printf("sun, points: V under the ground %g, far above %g, under the occluder %g, beside the scene %g\n", (double)rv[0],
+           (double)rv[1], (double)rv[2], (double)rv[3]);
+    assert_true(rv[0] == 0.0f && rf[0] > 0);
+    assert_true(rv[1] == 1.0f && rf[1] > 0);
+    assert_true(rv[2] == 0.0f);
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        assert_int_equal(ms_visibility_points(acc, NULL, &q, &o, v, s, f, NULL, err, sizeof err), MS_OK);
+        for (int i = 0; i < N; i++) {
+            if (v[i] != rv[i] || s[i] != rs[i] || f[i] != rf[i])
+                fprintf(stderr, "sun points, method %s, point %d: V %g S %g front %d, raytrace %g %g %d\n", names[mi], i,
+                        (double)v[i], (double)s[i], f[i], (double)rv[i], (double)rs[i], rf[i]);
+            assert_true(v[i] == rv[i] && s[i] == rs[i] && f[i] == rf[i]);
+        }
+    }
+    ms_accel_free(acc);
+    ms_scene_free(&sc);
+}
+
 /* ---- the penumbra of a pole ---- */
 
 /* A 1 x 80 x 1 pole on a ground of 400 x 400, the sun at 45 degrees towards -x: the shadow runs along +x and
@@ -576,6 +623,7 @@ int main(void)
         cmocka_unit_test(test_every_method_wide),
         cmocka_unit_test(test_every_method_sun),
         cmocka_unit_test(test_bake),
+        cmocka_unit_test(test_points_outside),
         cmocka_unit_test(test_penumbra_width),
         cmocka_unit_test(test_sun_irradiance),
         cmocka_unit_test(test_gltf_directional),
