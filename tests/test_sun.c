@@ -7,6 +7,8 @@
  *     towards it at any distance beyond the near range (no far limit at all);
  *   - bakes (the points API, given the sun unplaced): every method's V, S and front equal raytrace's, and
  *     raytrace's the brute force; points far outside the scene: their segments still reach it;
+ *   - the closed-mesh cull at its limit: a box's face nearly parallel to the sun, kept (every method equals
+ *     raytrace, which culls nothing);
  *   - the penumbra: a pole's shadow edge at distance d from the pole is d tan(0.53 deg) wide (within a pixel
  *     of an orthographic view from above);
  *   - irradiance: pi L sin^2 alpha cos theta above the horizon, numerical integration over the cone across it;
@@ -359,6 +361,58 @@ static void test_points_outside(void **st)
     ms_scene_free(&sc);
 }
 
+/* The closed-mesh cull with the sun's hull at its limit: a box (12 triangles) over a ground, its +x face at
+ * x = 1.2 nearly parallel to the sun (the sun 0.5 degrees off the vertical towards +x, its disk 0.265 degrees
+ * in radius: every direction of the cone is in front of that face, by 0.235 degrees at least). Points on the
+ * ground under the box's edge see the sun through the bottom face (facing away: culled) and out through that
+ * side face, which must be kept: every method's V, S and front equal raytrace's (which culls nothing), with
+ * samples in penumbra. A hull of the square at distance D alone (seen from the origin, not from every receiver)
+ * culls that face and fails here. */
+static void test_cull_grazing(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    memset(&sc, 0, sizeof sc);
+    sc.tri = malloc((2 + 12) * 9 * sizeof *sc.tri);
+    assert_non_null(sc.tri);
+    static const float ground[2][9] = { { -10, 0, -10, -10, 0, 10, 10, 0, 10 }, { -10, 0, -10, 10, 0, 10, 10, 0, -10 } };
+    memcpy(sc.tri, ground, sizeof ground);
+    sc.n_tris = put_box(sc.tri, 2, (const float[]){ 0.2f, 1, -0.5f }, (const float[]){ 1.2f, 2, 0.5f }, 1);
+    const double b = 0.5 * M_PI / 180.0;
+    assert_int_equal(ms_light_sun(&sc.light, (ms_vec3){ (float)sin(b), (float)cos(b), 0 }, 0.53f), 0);
+    sc.light.emission = (ms_vec3){ 1, 1, 1 };
+    /* an orthographic view under the box, of the ground about x = 1.187: 64 x 16 pixels of 0.000625 */
+    sc.camera = (ms_camera){ { 1.19f, 0.5f, 3 }, { 1.19f, 0, 0 }, { 0, 1, 0 }, 0, 64, 16, MS_CAMERA_ORTHOGRAPHIC, 0, 0.01f };
+    sc.samples = 1024;
+    ms_render_options o;
+    tu_render_options_default(&o);
+    o.threads = 2;
+    o.method = "raytrace";
+    ms_frame ref, fr;
+    tu_render_ok(&sc, &o, &ref);
+    int partial = 0, dark = 0;
+    for (int i = 0; i < 64 * 16; i++) { partial += ref.vis[i] > 0.0f && ref.vis[i] < 1.0f; dark += ref.vis[i] == 0.0f; }
+    const char *const *names = ms_method_names();
+    for (int mi = 0; names[mi]; mi++) {
+        o.method = names[mi];
+        tu_render_ok(&sc, &o, &fr);
+        long differ = 0;
+        for (int i = 0; i < 64 * 16; i++)
+            differ += fr.vis[i] != ref.vis[i] || fr.shadow[i] != ref.shadow[i] || fr.front[i] != ref.front[i];
+        if (!strcmp(names[mi], "scanline")) {
+            printf("sun grazing a box's face: %d of %d pixels in penumbra, %d in umbra; scanline culled %llu triangles\n",
+                   partial, 64 * 16, dark, (unsigned long long)fr.stats.occluders_culled);
+            assert_true(fr.stats.occluders_culled > 0);
+        }
+        if (differ) fprintf(stderr, "sun grazing, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
+        assert_int_equal(differ, 0);
+        ms_frame_free(&fr);
+    }
+    assert_true(partial > 16 && dark > 16);
+    ms_frame_free(&ref);
+    ms_scene_free(&sc);
+}
+
 /* ---- the penumbra of a pole ---- */
 
 /* A 1 x 80 x 1 pole on a ground of 400 x 400, the sun at 45 degrees towards -x: the shadow runs along +x and
@@ -624,6 +678,7 @@ int main(void)
         cmocka_unit_test(test_every_method_sun),
         cmocka_unit_test(test_bake),
         cmocka_unit_test(test_points_outside),
+        cmocka_unit_test(test_cull_grazing),
         cmocka_unit_test(test_penumbra_width),
         cmocka_unit_test(test_sun_irradiance),
         cmocka_unit_test(test_gltf_directional),
