@@ -26,8 +26,8 @@
 #include "budget.h"
 #include "frame_stream.h"
 #include "frame_aa.h"
-#include <omp.h>
 #include "sun_place.h"
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -381,10 +381,8 @@ static int job_create(const ms_scene *scene, const ms_render_options *opt, int s
     }
     if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); goto fail; }
     {   /* suns placed for the scene's box before anything uses the lights' geometry */
-        float box[6];
         int oom;
-        ms_scene_tri_box(scene, streamed ? NULL : &j->bvh, box);
-        j->placed_lights = ms_lights_placed(j->lights, j->nlights, box, &oom);
+        j->placed_lights = ms_lights_placed(j->lights, j->nlights, scene, streamed ? NULL : &j->bvh, &oom);
         if (oom) { snprintf(err, errlen, "out of memory for the lights"); goto fail; }
         if (j->placed_lights) { j->lights = j->placed_lights; ctx->light = j->lights[0]; }
     }

@@ -36,7 +36,7 @@ void ms_scene_tri_box(const ms_scene *s, const ms_bvh *bvh, float box[6])
         if (!isfinite(box[a])) box[a] = 0.0f;   /* no triangles */
 }
 
-ms_light *ms_lights_placed(const ms_light *lights, size_t n, const float box[6], int *oom)
+ms_light *ms_lights_placed(const ms_light *lights, size_t n, const ms_scene *s, const ms_bvh *bvh, int *oom)
 {
     *oom = 0;
     size_t suns = 0;
@@ -45,6 +45,8 @@ ms_light *ms_lights_placed(const ms_light *lights, size_t n, const float box[6],
     ms_light *out = malloc(n * sizeof *out);
     if (!out) { *oom = 1; return NULL; }
     memcpy(out, lights, n * sizeof *out);
+    float box[6];
+    ms_scene_tri_box(s, bvh, box);
     for (size_t l = 0; l < n; l++) ms_light_sun_place(&out[l], box);
     return out;
 }
