@@ -163,8 +163,14 @@ typedef struct ms_camera {
  *     outside it, its outline is a disk facing P (ms_light_sphere_outline): each receiver is sampled on
  *     its own outline disk, a per-receiver light frame (frames, points and bakes alike); not textured.
  *   MS_LIGHT_TRIANGLE: the triangle corner, corner + edge_s, corner + edge_t: the parameters with s + t < 1
- *     (ms_light_triangle); emits towards cross(edge_s, edge_t); not textured. */
-typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2, MS_LIGHT_TRIANGLE = 3 } ms_light_shape;
+ *     (ms_light_triangle); emits towards cross(edge_s, edge_t); not textured.
+ *   MS_LIGHT_SUN: a disk at infinity (ms_light_sun): the cone of directions of angular diameter 2 alpha about
+ *     the unit direction `center` (towards the sun), the same from every receiver. Each receiver P is sampled
+ *     on its own outline, the disk of radius D tan(alpha) at P + D center facing P, with the disk's mask; D
+ *     (`radius`) is set by the renderer from the scene's extent so that every segment ends outside the
+ *     scene (no far limit for the scene's occluders; the near range is 1e-4 D): docs/design.md, "The sun";
+ *     not textured. */
+typedef enum ms_light_shape { MS_LIGHT_RECT = 0, MS_LIGHT_DISK = 1, MS_LIGHT_SPHERE = 2, MS_LIGHT_TRIANGLE = 3, MS_LIGHT_SUN = 4 } ms_light_shape;
 
 /* An area light. It emits radiance `emission` (linear RGB) from the side cross(edge_s, edge_t) points to,
  * from the samples of its shape. Zero-initialised fields past emission keep a uniform parallelogram.
@@ -195,8 +201,8 @@ typedef struct ms_light {
     ms_light_shape shape;
     const float *texture;
     int texture_width, texture_height;
-    ms_vec3 center;      /* MS_LIGHT_SPHERE only */
-    float radius;        /* MS_LIGHT_SPHERE only */
+    ms_vec3 center;      /* MS_LIGHT_SPHERE only (MS_LIGHT_SUN: the unit direction towards the sun) */
+    float radius;        /* MS_LIGHT_SPHERE only (MS_LIGHT_SUN: the placement distance D, 0 until rendered) */
 } ms_light;
 
 /* Fills l as a sphere light of centre c and radius r (emission left as it is). MS_OK, or MS_ERR_INVALID when r is
@@ -223,10 +229,19 @@ MS_API ms_status ms_light_disk(ms_light *l, ms_vec3 c, ms_vec3 m, float r);
  * collinear. */
 MS_API ms_status ms_light_triangle(ms_light *l, ms_vec3 a, ms_vec3 b, ms_vec3 c);
 
+/* Fills l as a sun (MS_LIGHT_SUN): a disk at infinity in unit direction dir from the scene (towards the sun;
+ * need not be unit length, not zero) of angular diameter angular_diameter_deg in (0, 90] degrees (the Sun's:
+ * 0.53). Its parallelogram is the outline's bounding square at unit distance (the disk of radius
+ * tan(alpha) at dir, emitting towards -dir), center the unit dir, radius 0 (the renderer places it);
+ * emission, its radiance, is left as it is (irradiance at normal incidence E = pi L sin^2 alpha).
+ * MS_OK, or MS_ERR_INVALID when dir is zero or the diameter out of range. */
+MS_API ms_status ms_light_sun(ms_light *l, ms_vec3 dir, float angular_diameter_deg);
+
 /* 1 if light parameters (s,t) lie on the light's shape (see ms_light_shape), 0 if not. */
 MS_API int ms_light_shape_contains(ms_light_shape shape, float s, float t);
 
-/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk, 1/2 for a triangle; 4 pi r^2 for a sphere). */
+/* The emitting area of the light's shape (|edge_s x edge_t|, times pi/4 for a disk, 1/2 for a triangle; 4 pi r^2 for a sphere;
+ * sin^2 alpha for a sun, so that watts and lumens convert to radiance from W m^-2 and lux at normal incidence). */
 MS_API float ms_light_area(const ms_light *l);
 
 /* Units of a light's emission in a scene file (docs/design.md, "Units"). The renderer works in radiance;
@@ -709,7 +724,9 @@ MS_API ms_status ms_write_stats_json(const ms_frame *f, const char *path, char *
  * receiver's plane; across the horizon, and for an ellipse, the polygon formula on a clipped 256-gon of
  * the same area (an approximation; error measured in tests/test_lights.c). Sphere: exact, pi (r/d)^2
  * cos theta wholly above the horizon, Snyder's closed form across it (as in Lagarde & de Rousiers,
- * "Moving Frostbite to PBR", 2014); 0 at points inside the sphere. */
+ * "Moving Frostbite to PBR", 2014); 0 at points inside the sphere. Sun: the same cone, exact, pi sin^2 alpha
+ * cos theta wholly above the horizon (theta from the sun's direction), Snyder's form across it; the same at
+ * every p. */
 MS_API float ms_light_irradiance(const ms_light *l, const float p[3], const float n[3]);
 
 /* ---- Visibility at any points: the library for bakers (docs/baking.md) ----

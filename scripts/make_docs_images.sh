@@ -3,6 +3,7 @@
 #   builtin.png          the README's first command (the CLI's built-in scene, its default anti-aliasing)
 #   sibenik-*.png        docs/cameras.md: docs/examples/sibenik-*.json (shared scenes), 256x256, latlong 512x256
 #   foliage.png          docs/shading.md: scripts/make_foliage_scene.py, scanline, 1024 samples
+#   sun*.png             docs/lights.md ("The sun"): scripts/make_sun_scene.py, 1024 samples
 #   real_spot.png        docs/real-assets.md: Spot from the assets folder (spot/spot/spot.json), 480x480
 #   real_igea.png        docs/real-assets.md: Igea from the assets folder (igea_scene.json), 480x480
 #   bake_*.png, frame_builtin.png   docs/baking.md: scripts/make_bake_images.sh (the bake pictures' own script)
@@ -46,6 +47,15 @@ if command -v python3 > /dev/null; then
     render foliage.png "$tmp/foliage/foliage.json" --method scanline --samples 1024
 else
     skip foliage.png "python3 is needed for scripts/make_foliage_scene.py"
+fi
+
+if command -v python3 > /dev/null; then
+    python3 "$repo/scripts/make_sun_scene.py" "$tmp/sun"
+    render sun.png "$tmp/sun/sun.json" --exposure -1
+    render sun_base.png "$tmp/sun/sun_base.json" --exposure -1
+    render sun_tip.png "$tmp/sun/sun_tip.json" --exposure -1
+else
+    skip "sun*.png" "python3 is needed for scripts/make_sun_scene.py"
 fi
 
 if [ -f "$assets/spot/spot/spot.json" ]; then

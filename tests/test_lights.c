@@ -519,7 +519,7 @@ static void test_bad_light_json(void **st)
     const char *rect = "\"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2]";
     char buf[1024];
     snprintf(buf, sizeof buf, "\"light\": { \"shape\": \"hexagon\", %s }", rect);
-    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\", \"sphere\" or \"triangle\" (got \"hexagon\")");
+    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\", \"sphere\", \"triangle\" or \"sun\" (got \"hexagon\")");
     expect_bad("b19.json", "\"light\": { \"shape\": \"triangle\", \"vertices\": [[0, 6, 0], [1, 6, 0], [2, 6, 0]] }",
                "light.vertices must not be collinear");
     expect_bad("b20.json", "\"light\": { \"shape\": \"triangle\", \"vertices\": [[0, 6, 0], [1, 6, 0]] }",

@@ -196,6 +196,7 @@ _irradiance = _sig("ms_light_irradiance", _f, ctypes.POINTER(_Light), ctypes.POI
 _light_disk = _sig("ms_light_disk", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _Vec3, _f)
 _light_sphere = _sig("ms_light_sphere", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _f)
 _light_triangle = _sig("ms_light_triangle", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _Vec3, _Vec3)
+_light_sun = _sig("ms_light_sun", ctypes.c_int, ctypes.POINTER(_Light), _Vec3, _f)
 _nearest = _sig("ms_nearest_name", ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(_size))
 _version = _sig("ms_version", ctypes.c_char_p, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
                 ctypes.POINTER(ctypes.c_int))
@@ -207,13 +208,14 @@ __version__ = _version(None, None, None).decode()
 
 _PATTERNS = {"grid": 0, "stratified": 1, "interleaved": 2}
 _ISAS = {"auto": 0, "scalar": 1, "avx2": 2, "avx512": 3}
-_SHAPES = {"rect": 0, "disk": 1, "sphere": 2, "triangle": 3}
+_SHAPES = {"rect": 0, "disk": 1, "sphere": 2, "triangle": 3, "sun": 4}
 _SHAPE_NAMES = {v: k for k, v in _SHAPES.items()}
 # A light dict's keys per shape: required, then optional.
 _LIGHT_KEYS = {"rect": (("corner", "edge_s", "edge_t"), ("shape", "emission", "texture")),
                "disk": (("center", "normal", "radius"), ("shape", "emission", "texture")),
                "sphere": (("center", "radius"), ("shape", "emission")),
-               "triangle": (("vertices",), ("shape", "emission"))}
+               "triangle": (("vertices",), ("shape", "emission")),
+               "sun": (("direction",), ("shape", "emission", "angular_diameter_deg"))}
 
 
 def _errbuf():
@@ -281,7 +283,8 @@ def method_names():
 
 def _light_dict(L):
     """A light as a dict: its shape's parameters (rect: corner, edge_s, edge_t; disk: center, normal,
-    radius; sphere: center, radius; triangle: vertices), emission, and the texture (h, w, 3) when it has one."""
+    radius; sphere: center, radius; triangle: vertices; sun: direction towards it, angular_diameter_deg),
+    emission, and the texture (h, w, 3) when it has one."""
     v = lambda a: (a.x, a.y, a.z)  # noqa: E731
     shape = _SHAPE_NAMES.get(L.shape, "rect")
     d = {"shape": shape, "emission": v(L.emission)}
@@ -295,9 +298,13 @@ def _light_dict(L):
     elif shape == "triangle":
         c, es, et = (np.array(v(x), np.float64) for x in (L.corner, L.edge_s, L.edge_t))
         d.update(vertices=(tuple(c), tuple(c + es), tuple(c + et)))
+    elif shape == "sun":
+        # its square at unit distance has the edge 2 tan(alpha) (ms_light_sun)
+        half = np.linalg.norm(np.array(v(L.edge_s), np.float64)) / 2
+        d.update(direction=v(L.center), angular_diameter_deg=float(np.degrees(2 * np.arctan(half))))
     else:
         d.update(center=v(L.center), radius=float(L.radius))
-    if L.texture and shape not in ("sphere", "triangle"):
+    if L.texture and shape not in ("sphere", "triangle", "sun"):
         d["texture"] = np.ctypeslib.as_array(L.texture, shape=(L.texture_height, L.texture_width, 3)).copy()
     return d
 
@@ -330,6 +337,10 @@ def _light_struct(light, arg="light"):
             raise ValueError("%s['vertices']: expected 3 points" % arg)
         if _light_triangle(ctypes.byref(L), *(_vec3(arg + "['vertices'][%d]" % i, vs[i]) for i in range(3))) != 0:
             raise ValueError("%s: a triangle needs vertices that are not collinear" % arg)
+    elif shape == "sun":
+        deg = light.get("angular_diameter_deg", 0.53)
+        if _light_sun(ctypes.byref(L), _vec3(arg + "['direction']", light["direction"]), float(deg)) != 0:
+            raise ValueError("%s: a sun needs a non-zero direction and an angular diameter in (0, 90] degrees" % arg)
     elif _light_sphere(ctypes.byref(L), _vec3(arg + "['center']", light["center"]), float(light["radius"])) != 0:
         raise ValueError("%s: a sphere needs a radius > 0" % arg)
     if light.get("texture") is not None:

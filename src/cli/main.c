@@ -22,7 +22,7 @@ static void usage(FILE *f)
     fprintf(f,
         "usage: microshadow [SCENE.json] [options]\n"
         "       microshadow bake [SCENE.json] [options]   (a lightmap: microshadow bake --help)\n"
-        "Renders soft shadows from the scene's area lights (rect, disk, sphere, triangle, textured; the meshes' own emitters and glTF punctual lights when the scene file names none; the built-in scene without SCENE).\n"
+        "Renders soft shadows from the scene's area lights (rect, disk, sphere, triangle, sun, textured; the meshes' own emitters and glTF punctual lights when the scene file names none; the built-in scene without SCENE).\n"
         "\n"
         "  --method M          shadow method:");
     for (const char *const *m = ms_method_names(); *m; m++) fprintf(f, " %s", *m);

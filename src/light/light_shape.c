@@ -4,7 +4,8 @@
 #include <math.h>
 #include <string.h>
 
-extern const ms_light_shape_ops ms_light_rect, ms_light_disk_shape, ms_light_sphere_shape, ms_light_triangle_shape;
+extern const ms_light_shape_ops ms_light_rect, ms_light_disk_shape, ms_light_sphere_shape, ms_light_triangle_shape,
+    ms_light_sun_shape;
 
 /* Indexed by ms_light_shape. */
 static const ms_light_shape_ops *const shapes[] = {
@@ -12,6 +13,7 @@ static const ms_light_shape_ops *const shapes[] = {
     [MS_LIGHT_DISK] = &ms_light_disk_shape,
     [MS_LIGHT_SPHERE] = &ms_light_sphere_shape,
     [MS_LIGHT_TRIANGLE] = &ms_light_triangle_shape,
+    [MS_LIGHT_SUN] = &ms_light_sun_shape,
 };
 
 const ms_light_shape_ops *ms_light_shape_of(ms_light_shape shape)

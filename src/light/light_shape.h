@@ -42,6 +42,9 @@ typedef struct ms_light_shape_ops {
     /* A shape that is not planar: the planar light standing for it as seen from p (frames, points and bakes
      * sample each receiver on it); 0, or -1 when p sees none. NULL: the light itself is planar. */
     int (*outline)(const ms_light *l, const float p[3], ms_light *planar);
+    /* Points whose convex hull holds every sample the shape gives (occluders.c's ms_light_hull) into pts;
+     * returns their number (at most 8). NULL: the parallelogram, or a round shape's box. */
+    int (*hull)(const ms_light *l, float pts[8][3]);
     /* A planar shape's outline as a convex polygon relative to p (the LTC specular, render/ltc.c): round
      * shapes as `sides` vertices inscribed and scaled to the shape's area; returns the vertex count (at most
      * max(4, sides)). */
@@ -69,6 +72,15 @@ const ms_light_shape_ops *ms_light_shape_at(size_t i);
 /* 1 when l's emission and geometry are finite and its area positive (its row's finite, or the
  * parallelogram's); 0 also for an unknown shape. */
 int ms_light_finite(const ms_light *l);
+
+/* The irradiance per unit radiance of a round cone of directions of half-angle sigma (sin^2 sigma = s2)
+ * whose axis makes cos theta = ct with the receiver's normal, exact across the horizon (light_sphere.c). */
+double ms_light_cone_irradiance(double ct, double s2);
+/* The sun (light_sun.c): its outline seen from p (a disk at p + D_P direction, facing p), and its placement
+ * for the scene whose triangles' box (local frame) is box: sets the distance D (l->radius) so that every
+ * segment from the scene ends outside it. Other shapes are left as they are. */
+int ms_light_sun_outline(const ms_light *l, const float p[3], ms_light *disk);
+void ms_light_sun_place(ms_light *l, const float box[6]);
 
 /* Lambert's formula over the polygon rel[0..m-1] (vertices relative to the receiver), clipped to its
  * hemisphere n . x >= 0 (irradiance.c); clip: scratch for at least m + 1 vertices. */

@@ -41,20 +41,24 @@ static float sphere_area(const ms_light *l, const ms_light_frame *F)
     return 4.0f * (float)M_PI * l->radius * l->radius;
 }
 
-/* A sphere of radius r at distance d, its centre at angle theta from the normal (sin^2 sigma = (r/d)^2):
- * pi sin^2 sigma cos theta when wholly above the horizon (cos^2 theta > sin^2 sigma), else Snyder's exact
- * expression for the part above it (Lagarde & de Rousiers 2014, "illuminanceSphereOrDisk"). */
+/* A round cone of directions (a sphere, or the sun) of half-angle sigma, its axis at angle theta from the
+ * normal: pi sin^2 sigma cos theta when wholly above the horizon (cos^2 theta > sin^2 sigma), else Snyder's
+ * exact expression for the part above it (Lagarde & de Rousiers 2014, "illuminanceSphereOrDisk"). */
+double ms_light_cone_irradiance(double ct, double s2)
+{
+    if (ct * ct > s2) return ct > 0.0 ? M_PI * s2 * ct : 0.0;
+    const double st = sqrt(fmax(1.0 - ct * ct, 0.0)), x = sqrt(1.0 / s2 - 1.0);
+    const double y = -x * ct / st, sty = st * sqrt(fmax(1.0 - y * y, 0.0));
+    return fmax((ct * acos(y) - x * sty) * s2 + atan(sty / x), 0.0);
+}
+
+/* A sphere of radius r at distance d: the cone of sin^2 sigma = (r/d)^2 towards its centre. */
 static double sphere_irradiance(const ms_light *l, const float p[3], const float n[3])
 {
     const double w[3] = { (double)l->center.x - p[0], (double)l->center.y - p[1], (double)l->center.z - p[2] };
     const double d2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], r = l->radius;
     if (!(d2 > r * r)) return 0.0;
-    const double s2 = r * r / d2;
-    const double ct = (w[0] * n[0] + w[1] * n[1] + w[2] * n[2]) / sqrt(d2);
-    if (ct * ct > s2) return ct > 0.0 ? M_PI * s2 * ct : 0.0;
-    const double st = sqrt(fmax(1.0 - ct * ct, 0.0)), x = sqrt(1.0 / s2 - 1.0);
-    const double y = -x * ct / st, sty = st * sqrt(fmax(1.0 - y * y, 0.0));
-    return fmax((ct * acos(y) - x * sty) * s2 + atan(sty / x), 0.0);
+    return ms_light_cone_irradiance((w[0] * n[0] + w[1] * n[1] + w[2] * n[2]) / sqrt(d2), r * r / d2);
 }
 
 static float sphere_irradiance_f(const ms_light *l, const ms_light_frame *F, const float p[3], const float n[3])

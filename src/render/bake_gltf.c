@@ -6,6 +6,7 @@
 #include "core/abi.h"
 #include "image/png_encode.h"
 #include "scene/scene_internal.h"
+#include "light/light_shape.h"
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
@@ -168,9 +169,11 @@ static cJSON *texture_info(writer *w, int32_t tex, int32_t uv, const ms_texture_
 
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
 
+/* The scene file's name of the shape (the light-shape table's: triangles and suns too). */
 static const char *shape_name(ms_light_shape s)
 {
-    return s == MS_LIGHT_DISK ? "disk" : s == MS_LIGHT_SPHERE ? "sphere" : "rect";
+    const ms_light_shape_ops *o = ms_light_shape_of(s);
+    return o ? o->name : "rect";
 }
 
 /* Variants of a material: baked (TEXCOORD_1 and the lightmap), with TEXCOORD_0 (its textures). */

@@ -27,6 +27,7 @@
 #include "budget.h"
 #include "frame_stream.h"
 #include "frame_aa.h"
+#include "sun_place.h"
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,6 +45,7 @@ struct ms_frame_job {
     ms_render_ctx ctx;            /* ctx.light: light 0; each light's pass uses a copy with its light */
     const ms_light *lights;
     size_t nlights;
+    ms_light *placed_lights;      /* the lights with their suns placed for the scene (sun_place.h); NULL: none */
     ms_bvh bvh;
     struct ms_alpha *alpha;       /* alpha-tested triangles (NULL: none), ctx.alpha */
     void *pstate;
@@ -126,6 +128,7 @@ void ms_frame_job_free(ms_frame_job *j)
     if (j->pm && j->pstate) j->pm->destroy(j->pstate);
     for (size_t l = 0; j->occ && l < j->nlights; l++) ms_occluders_free(&j->occ[l]);
     free(j->occ);
+    free(j->placed_lights);
     ms_bvh_free(&j->bvh);
     ms_alpha_free(j->alpha);
     free(j->hits);
@@ -378,6 +381,12 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
         goto fail;
     }
     if (!streamed && ms_bvh_build(&j->bvh, scene->tri, scene->n_tris, j->threads)) { snprintf(err, errlen, "BVH build failed: out of memory"); rc = MS_ERR_NO_MEMORY; goto fail; }
+    {   /* suns placed for the scene's box before anything uses the lights' geometry */
+        int oom;
+        j->placed_lights = ms_lights_placed(j->lights, j->nlights, scene, streamed ? NULL : &j->bvh, &oom);
+        if (oom) { snprintf(err, errlen, "out of memory for the lights"); rc = MS_ERR_NO_MEMORY; goto fail; }
+        if (j->placed_lights) { j->lights = j->placed_lights; ctx->light = j->lights[0]; }
+    }
     if (!streamed && ms_alpha_build(scene, &j->bvh, &j->alpha)) { snprintf(err, errlen, "out of memory for the alpha-tested triangles"); rc = MS_ERR_NO_MEMORY; goto fail; }
     ctx->alpha = j->alpha;
     ctx->isa_cap = opt->isa;

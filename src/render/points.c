@@ -14,6 +14,7 @@
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
 #include "visibility/occluders.h"
+#include "sun_place.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -108,6 +109,9 @@ ms_status ms_accel_build_abi(const ms_abi *abi, const ms_scene *scene, int threa
         memcpy(t, src[l].texture, nt * sizeof *t);
         a->lights[l].texture = t;
     }
+    float sbox[6];
+    ms_scene_tri_box(scene, &a->bvh, sbox);
+    for (size_t l = 0; l < nl; l++) ms_light_sun_place(&a->lights[l], sbox);   /* the interior clearance's lights */
     a->view.light = a->lights[0];
     if (scene->n_tris && (ms_closed_find(scene->tri, scene->n_tris, &a->closed) ||
                           ms_interior_find(scene->tri, scene->n_tris, &a->closed, MS_INTERIOR_RES, MS_INTERIOR_MIN_TRIS,
@@ -239,6 +243,12 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     if (!light) light = &a->view.light;
     if (!ms_light_shape_of(light->shape)) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
     if (!ms_light_finite(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area (a sphere: radius not > 0)"); return MS_ERR_INVALID; }
+    /* A sun: placed for the accel's scene as frames place it (sun_place.h), whatever distance the caller's holds. */
+    ms_light placed = *light;
+    float sbox[6];
+    ms_scene_tri_box(&a->view, &a->bvh, sbox);
+    ms_light_sun_place(&placed, sbox);
+    light = &placed;
     ms_status st = check_points(a, pts, err, errlen);
     if (st) return st;
     const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;

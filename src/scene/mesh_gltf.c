@@ -502,7 +502,8 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
 typedef struct node_item { const cgltf_node *node; float parent[16]; } node_item;
 
 /* The node's KHR_lights_punctual light, placed by its world matrix (column-major): position its origin,
- * direction its -Z axis; extras.radius read from the extras' JSON text when present. */
+ * direction its -Z axis; extras.radius and extras.angular_diameter_deg read from the extras' JSON text when
+ * present. */
 static int push_punctual(ms_tri_soup *soup, const cgltf_light *cl, const float world[16], const char *path, char *err,
                          size_t errlen)
 {
@@ -527,6 +528,11 @@ static int push_punctual(ms_tri_soup *soup, const cgltf_light *cl, const float w
     if (r && (r = strchr(r, ':')) != NULL) {
         const double v = strtod(r + 1, NULL);
         if (isfinite(v) && v > 0.0 && v < 1e18) p->radius = (float)v;
+    }
+    const char *ad = cl->extras.data ? strstr(cl->extras.data, "\"angular_diameter_deg\"") : NULL;
+    if (ad && (ad = strchr(ad, ':')) != NULL) {
+        const double v = strtod(ad + 1, NULL);   /* checked where the sun is made (scene_punctual.c) */
+        p->angular_deg = isfinite(v) && fabs(v) < 1e6 && v != 0.0 ? (float)v : -1.0f;
     }
     p->mesh = soup->cur_mesh;
     return 0;

@@ -76,7 +76,7 @@ ms_status ms_scene_localize(ms_scene *s)
         ms_light *l = s->n_lights && s->lights ? s->lights : &s->light;
         const size_t nl = s->n_lights && s->lights ? s->n_lights : 1;
         for (size_t i = 0; i < nl; i++) {
-            shift3(&l[i].corner, d);
+            if (l[i].shape != MS_LIGHT_SUN) shift3(&l[i].corner, d);   /* a sun's square is a direction's */
             if (l[i].shape == MS_LIGHT_SPHERE) shift3(&l[i].center, d);
         }
         if (s->n_lights && s->lights) s->light = s->lights[0];

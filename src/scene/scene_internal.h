@@ -24,6 +24,7 @@ typedef struct ms_punctual {
     float color[3], intensity;   /* linear RGB; candela (point, spot) or lux (directional) */
     double pos[3], dir[3];       /* the node's origin and its -Z axis (unit) */
     float radius;                /* extras.radius; 0: not given */
+    float angular_deg;           /* directional: extras.angular_diameter_deg; 0: not given */
     uint32_t mesh;               /* the scene file's mesh entry */
 } ms_punctual;
 /* rel resolved against the folder of json_path (absolute paths as they are) into out; -1 if too long. */

@@ -548,7 +548,7 @@ static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const 
     }
     if (!have) {
         snprintf(err, errlen, "%s: \"light\" is missing: the scene file names no light (\"light\" or \"lights\") and its meshes have neither "
-                 "emissive triangles (glTF emissiveFactor, MTL Ke) nor KHR_lights_punctual point or spot lights to light it",
+                 "emissive triangles (glTF emissiveFactor, MTL Ke) nor KHR_lights_punctual lights to light it",
                  path);
         return -1;
     }

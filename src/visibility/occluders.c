@@ -16,7 +16,9 @@ int ms_light_hull(const ms_light *l, float pts[8][3], float box[6])
 {
     const ms_light_shape_ops *ops = ms_light_shape_of(l->shape);
     int n;
-    if (ops && ops->outline) {
+    if (ops && ops->hull) {
+        n = ops->hull(l, pts);
+    } else if (ops && ops->outline) {
         const float c[3] = { l->center.x, l->center.y, l->center.z }, r = l->radius;
         for (n = 0; n < 8; n++)
             for (int a = 0; a < 3; a++) pts[n][a] = c[a] + (n >> a & 1 ? r : -r);

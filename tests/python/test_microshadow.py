@@ -329,6 +329,34 @@ class LightsTest(unittest.TestCase):
             for a, b in ((Vi, V), (Vd, V), (V1, V), (Si, S_all[i]), (Sd, S_all[i]), (S1, S_all[i])):
                 np.testing.assert_array_equal(a, b, err_msg=name)
 
+    def test_sun(self):
+        # a sun straight overhead over the ground under the square [-2,2]^2 at y = 2: the cone of directions
+        # (half-angle 4 degrees) from ground point p meets y = 2 in a disk of radius 2 tan(4 deg) about p; wholly
+        # hidden when that disk lies inside the square, wholly visible when it lies outside
+        pos, nor = self.ground()
+        sun = {"shape": "sun", "direction": (0, 1, 0), "angular_diameter_deg": 8.0, "emission": (2, 2, 2)}
+        acc = ms.Accel(self.scenes["all"])
+        V, S = ms.visibility_points(acc, pos, nor, light=sun)
+        r = 2 * np.tan(np.radians(4.0))
+        d = np.max(np.abs(pos[:, [0, 2]]), axis=1)
+        inside, clear = d < 2 - r - 0.01, d > 2 + r + 0.01
+        self.assertGreater(inside.sum(), 5)
+        self.assertGreater(clear.sum(), 100)
+        self.assertTrue(np.all(V[inside] == 0.0))
+        self.assertTrue(np.all(V[clear] == 1.0))
+        Vr, Sr = ms.visibility_points(acc, pos, nor, light=sun, method="raytrace")
+        np.testing.assert_array_equal(V, Vr)
+        # the dict round trip, and the irradiance of a disk at infinity: pi L sin^2(alpha) cos(theta)
+        L, _ = ms._light_struct(sun)
+        back = ms._light_dict(L)
+        self.assertEqual(back["shape"], "sun")
+        self.assertAlmostEqual(back["angular_diameter_deg"], 8.0, places=4)
+        np.testing.assert_allclose(back["direction"], (0, 1, 0), atol=1e-7)
+        e = ms.light_irradiance(sun, (0, 0, 0), (0, 1, 0))
+        self.assertAlmostEqual(e / (np.pi * np.sin(np.radians(4.0)) ** 2), 1.0, places=5)
+        with self.assertRaises(ValueError):
+            ms.visibility_points(acc, pos, nor, light={"shape": "sun", "direction": (0, 0, 0)})
+
     def test_bake_per_light(self):
         many = ms.bake(self.scenes["all"], size=32, uv=None, samples=256, method="raytrace")
         self.assertEqual(len(many["lights"]), 3)
