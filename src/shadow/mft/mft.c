@@ -144,7 +144,7 @@ void ms_mft_rays_from(ms_mft_lane *L, int ch, const float *pts)
     for (int l = 0; l < 16; l++)
         for (int a = 0; a < 3; a++) {
             L->d[a][base + l] = pts[3 * l + a] - L->c[a];
-            L->inv[a][base + l] = 1.0f / L->d[a][base + l];
+            if (L->inv[a]) L->inv[a][base + l] = 1.0f / L->d[a][base + l];
         }
     /* The shear axis raytrace shares over a packet (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]). */
     int kz;
@@ -204,6 +204,60 @@ static int mft_morton(int x, int y)
     return m;
 }
 
+/* The shear axis every live ray of each group shares (the usual case: one light, nearby receivers). */
+static void mft_groups_kz_all(ms_mft_rayblock *rb)
+{
+    for (int gi = 0; gi < rb->n; gi++) {
+        ms_mft_group *G = &rb->g[gi];
+        int kz = -2;
+        G->alone = 0;
+        for (unsigned m = G->live; m; m &= m - 1) {
+            const int k = G->kz[__builtin_ctz(m)];
+            if (k < 0) { G->alone |= m & -m; continue; }
+            kz = kz == -2 || kz == k ? k : -1;
+        }
+        G->kz_all = kz < 0 ? (kz == -2 ? 0 : -1) : kz;
+    }
+}
+
+/* A block whose queries have distinct sets, each set one sample per cell (every frame's block): slot =
+ * set, so a group's points are one row of cell_pts; its rays are formed by the tracer, 16 at a time
+ * (mft_group_impl.h, mftg_form). Returns 0 when no query has a front sample. */
+static int mft_block_by_set(const ms_shadow_query *q, const int *order, int g, int end, const uint64_t *front,
+                            uint64_t *vis, size_t mw, int n, int ncell, const float *cell_pts, const uint16_t *sample_of,
+                            const int *set_cell, ms_mft_rayblock *rb)
+{
+    unsigned present = 0;
+    int first = -1;
+    for (int e = g; e < end; e++) {
+        const int i = order[e];
+        uint64_t *m = vis + (size_t)i * mw;
+        memcpy(m, front + (size_t)i * mw, mw * sizeof *m);   /* the front mask is the starting set */
+        if (ms_mask_count(m, (int)mw) == 0) continue;
+        const int set = ms_interleaved_set(q[i].px, q[i].py);
+        present |= 1u << set;
+        if (first < 0) first = set;
+        for (int a = 0; a < 3; a++) rb->c[a][set] = q[i].p[a];
+        rb->skip[set] = q[i].prim;
+        rb->mask[set] = m;
+    }
+    if (!present) return 0;
+    for (int set = 0; set < 16; set++)
+        if (!(present >> set & 1)) {   /* an absent slot: a finite stand-in, never live */
+            for (int a = 0; a < 3; a++) rb->c[a][set] = rb->c[a][first];
+            rb->skip[set] = UINT32_MAX;
+            rb->mask[set] = NULL;
+        }
+    rb->nq = 16;
+    rb->n = ncell;
+    rb->present = present;
+    rb->form_n = n;
+    rb->cell_pts = cell_pts;
+    rb->sample_of = sample_of;
+    rb->set_cell = set_cell;
+    return 1;
+}
+
 /* The interleaved mode: per block, each query's rays formed as raytrace forms them (ms_mft_rays, per
  * 16-sample packet), then regrouped by the cell of the light their sample lies in (mft.h, ms_mft_rayblock):
  * cell (floor(s g), floor(t g)) of a g x g grid, g^2 = N/16. A pixel's set is a (0, m, 2)-net, so it has one
@@ -236,8 +290,44 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
     L.kz = kzs;
     float *set_pts = scratch + (size_t)8 * n, *st = set_pts + (size_t)16 * 3 * n;
     int *set_cell = (int *)(st + (size_t)2 * n);
+    /* The sets' points by cell, [cell][axis][set], and the sample of each set in each cell; regular: the
+     * sets with one sample per cell (all of them: pattern.c's sets are nets). */
+    float *cell_pts = malloc((size_t)ncell * 3 * 16 * sizeof *cell_pts);
+    uint16_t *sample_of = malloc((size_t)16 * ncell * sizeof *sample_of);
+    if (!cell_pts || !sample_of) { free(rb.g); free(next); free(scratch); free(cell_pts); free(sample_of); return -1; }
+    unsigned regular = 0;
     for (int g = 0; g < nq;) {
         const int end = ms_block_group_end(ctx, q, order, nq, g);
+        /* The sets' tables, formed when first needed. */
+        unsigned sets = 0, dup = 0;
+        for (int e = g; e < end; e++) {
+            const int set = ms_interleaved_set(q[order[e]].px, q[order[e]].py);
+            dup |= sets & 1u << set;
+            sets |= 1u << set;
+            if (have_set >> set & 1) continue;
+            ms_pattern_points_range(f->pattern, &f->light, f->k, q[order[e]].px, q[order[e]].py, f->seed, 0, n,
+                                    set_pts + (size_t)set * 3 * n);
+            ms_pattern_st(f->pattern, f->k, q[order[e]].px, q[order[e]].py, f->seed, st);
+            unsigned seen[MS_SAMPLES_MAX / 16 / 32] = { 0 };
+            int ok = 1;
+            for (int j = 0; j < n; j++) {
+                const int cx = (int)(st[2 * j] * (float)gside), cy = (int)(st[2 * j + 1] * (float)gside);
+                const int c = mft_morton(cx < gside ? cx : gside - 1, cy < gside ? cy : gside - 1);
+                set_cell[(size_t)set * n + j] = c;
+                ok &= !(seen[c >> 5] >> (c & 31) & 1u);
+                seen[c >> 5] |= 1u << (c & 31);
+                sample_of[(size_t)set * ncell + c] = (uint16_t)j;
+                for (int a = 0; a < 3; a++) cell_pts[((size_t)c * 3 + a) * 16 + set] = set_pts[(size_t)set * 3 * n + 3 * j + a];
+            }
+            have_set |= 1u << set;
+            regular |= (unsigned)ok << set;
+        }
+        if (!dup && (sets & ~regular) == 0 && ncell == n) {
+            if (mft_block_by_set(q, order, g, end, front, vis, mw, n, ncell, cell_pts, sample_of, set_cell, &rb))
+                s->groups(f, &rb, ctx->bvh, &s->sh, cnt);
+            g = end;
+            continue;
+        }
         rb.nq = 0;
         rb.n = ncell;
         memset(rb.g, 0, (size_t)ncell * sizeof *rb.g);
@@ -258,15 +348,6 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
             const int set = ms_interleaved_set(L.px, L.py);
             const float *pts = set_pts + (size_t)set * 3 * n;
             const int *cell_of = set_cell + (size_t)set * n;
-            if (!(have_set >> set & 1)) {
-                ms_pattern_points_range(f->pattern, &f->light, f->k, L.px, L.py, f->seed, 0, n, set_pts + (size_t)set * 3 * n);
-                ms_pattern_st(f->pattern, f->k, L.px, L.py, f->seed, st);
-                for (int j = 0; j < n; j++) {
-                    const int cx = (int)(st[2 * j] * (float)gside), cy = (int)(st[2 * j + 1] * (float)gside);
-                    set_cell[(size_t)set * n + j] = mft_morton(cx < gside ? cx : gside - 1, cy < gside ? cy : gside - 1);
-                }
-                have_set |= 1u << set;
-            }
             for (int ch = 0; ch < np; ch++) {
                 unsigned live = (unsigned)(m[ch >> 2] >> (ch & 3) * 16) & 0xFFFFu;
                 if (!live) continue;
@@ -305,23 +386,16 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
                 }
             }
         }
-        /* The shear axis every ray of a group shares (the usual case: one light, nearby receivers). */
-        for (int gi = 0; gi < rb.n; gi++) {
-            ms_mft_group *G = &rb.g[gi];
-            int kz = -2;
-            for (unsigned m = G->live; m; m &= m - 1) {
-                const int k = G->kz[__builtin_ctz(m)];
-                if (k < 0) continue;
-                kz = kz == -2 || kz == k ? k : -1;
-            }
-            G->kz_all = kz < 0 ? (kz == -2 ? 0 : -1) : kz;
-        }
+        mft_groups_kz_all(&rb);
+        rb.form_n = 0;
         if (rb.nq) s->groups(f, &rb, ctx->bvh, &s->sh, cnt);
         g = end;
     }
     free(rb.g);
     free(next);
     free(scratch);
+    free(cell_pts);
+    free(sample_of);
     return 0;
 }
 
@@ -331,10 +405,14 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     const mft_method *s = state;
     const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
 #ifdef MFT_NULL_MEASURE
-    memcpy(vis, front, (size_t)nq * mw * sizeof *vis); (void)s; (void)ns; (void)cnt; (void)q; return 0;
+    /* Measurement builds only: no ray traced (every front sample visible), to measure what the frame
+     * costs around the method (front masks, V and S, the filter: docs/methods.md). */
+    memcpy(vis, front, (size_t)nq * mw * sizeof *vis);
+    (void)s; (void)ns; (void)cnt; (void)q;
+    return 0;
 #endif
     int *order = malloc((size_t)nq * sizeof *order);
-    float *rayf = malloc(MS_BLOCK_LANES * 8 * ns * sizeof *rayf);
+    float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
     signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
     if (!order || !rayf || !kzs) { free(order); free(rayf); free(kzs); return -1; }
     ms_block_order(ctx, q, nq, order);
@@ -357,9 +435,9 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     }
     ms_mft_block blk;
     for (int l = 0; l < MS_BLOCK_LANES; l++) {
-        float *base = rayf + (size_t)l * 8 * ns;
+        float *base = rayf + (size_t)l * 5 * ns;
         for (int a = 0; a < 3; a++) blk.lane[l].d[a] = base + (size_t)a * ns;
-        for (int a = 0; a < 3; a++) blk.lane[l].inv[a] = base + (size_t)(5 + a) * ns;
+        for (int a = 0; a < 3; a++) blk.lane[l].inv[a] = NULL;   /* the grid's tracer takes no ray box test */
         blk.lane[l].sx = base + 3 * ns;
         blk.lane[l].sy = base + 4 * ns;
         blk.lane[l].kz = kzs + (size_t)l * (ns / 16);

@@ -43,7 +43,7 @@ typedef struct ms_mft_lane {
     uint64_t *mask;               /* mask_words words: live rays */
     /* Its rays, formed per 16-sample packet when first tested (ms_mft_rays; ready: one bit per packet). */
     float *d[3], *sx, *sy;        /* per sample */
-    float *inv[3];                /* per sample: 1 / d, for the rays' own box test (interleaved, mft_impl.h) */
+    float *inv[3];                /* per sample: 1 / d (the interleaved groups' box test), NULL: not formed */
     signed char *kz;              /* per packet: the shear axis, -1: lanes tested one by one */
     uint64_t ready[4];
     float m[3][3];                /* rows: X - C -> (cell a, cell b, c) with X = C + c (P - C) + a S/k + b T/k */
@@ -71,6 +71,7 @@ typedef struct ms_mft_group {
     uint16_t sample[MS_BLOCK_LANES];     /* the ray's sample index in its pixel's set */
     unsigned live;                       /* slots with a live ray */
     int kz_all;                          /* the axis every live ray shares, -1 if none */
+    unsigned alone;                      /* slots with kz < 0 */
 } ms_mft_group;
 
 typedef struct ms_mft_rayblock {
@@ -80,6 +81,14 @@ typedef struct ms_mft_rayblock {
     uint64_t *mask[MS_BLOCK_LANES];      /* their masks: the front mask in, the visible samples out */
     int n, cap;                          /* groups */
     ms_mft_group *g;
+    /* form_n > 0: the groups' rays are still to be formed (every query's N/16 = form_n samples one per
+     * cell, slot = set): the points by cell [cell][axis][slot], each slot's sample in each cell, each
+     * slot's cell of each sample, and the slots present. */
+    int form_n;
+    const float *cell_pts;
+    const uint16_t *sample_of;
+    const int *set_cell;
+    unsigned present;
 } ms_mft_rayblock;
 
 /* Counters after the traversal's (block_traverse.h), named in mft.c. */

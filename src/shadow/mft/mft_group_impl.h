@@ -41,6 +41,12 @@
 #include "visibility/alpha.h"
 
 #define MFTG_REL 1e-5f
+#ifndef MFTG_TRI_CULL
+#define MFTG_TRI_CULL 4   /* groups at a triangle from which it is culled for all at once */
+#endif
+#ifndef MFTG_CR
+#define MFTG_CR 1
+#endif
 
 typedef struct mftg_state {
     ms_block_frusta *fr;
@@ -119,8 +125,7 @@ static unsigned mftg_rays(const mftg_state *s, const ms_mft_group *g, unsigned b
                           const l16 V[3][3], l16 num, const float *numv)
 {
     const ms_mft_frame *f = s->f;
-    unsigned alone = 0;
-    for (unsigned m = bits; m; m &= m - 1) alone |= (unsigned)(g->kz[__builtin_ctz(m)] < 0) << __builtin_ctz(m);
+    const unsigned alone = bits & g->alone;
     unsigned hit = 0;
     for (unsigned m = alone; m; m &= m - 1) {
         const int q = __builtin_ctz(m);
@@ -212,11 +217,14 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
             tmag = fmaxf(tmag, fmaxf(fabsf(tb.bmin[a]), fabsf(tb.bmax[a])));
         }
         l16 tlo;
-        const unsigned in_box = mftg_traverse_node(fr, &tb, &tlo) & lanes;
+        /* Worth its cost (one test for 16 groups) only with several groups at the triangle: measured,
+         * with one or two it costs more than their 16-ray tests save (the ogre: +18% CPU). */
+        const int cull = ms_bt_popcount16(lanes) >= MFTG_TRI_CULL;
+        const unsigned in_box = cull ? mftg_traverse_node(fr, &tb, &tlo) & lanes : lanes;
         c_box += (uint64_t)ms_bt_popcount16(lanes & ~in_box);
         lanes = in_box;
         if (!lanes) continue;
-        {
+        if (cull) {
             /* a = (C - v) . N over the origins' box, b = (P - v) . N over the points': the vertices' own
              * offsets span [wlo, whi] (N is rounded). A hit needs the segment to cross the plane at t =
              * a / (a - b) in [near, far]: not both ends on one side, and |a| >= near |a - b|. */
@@ -302,7 +310,7 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
     cnt[MS_MFT_ISEC16] += isec;
     cnt[MS_MFT_FRUSTA_EARLY_OUT] += early;
     /* 4. The groups that lost rays: their boxes from the live rays (CR). */
-    for (unsigned m = lost & fr->live; m; m &= m - 1) {
+    for (unsigned m = MFTG_CR ? lost & fr->live : 0u; m; m &= m - 1) {
         mftg_lane_bounds(s, __builtin_ctz(m));
         cnt[MS_MFT_RECT_SHRINKS]++;
     }
@@ -348,18 +356,21 @@ static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
             unsigned ml = mftg_traverse_node(f, &sh->nodes[c0], &t0) & mask;
             unsigned mr = mftg_traverse_node(f, &sh->nodes[c0 + 1], &t1) & mask;
             tests += 2;
+            const ms_bvh_node *n0 = &sh->nodes[c0], *n1 = &sh->nodes[c0 + 1];
             const int test_rays = depth + 1 >= MFTG_RAY_DEPTH;
             for (unsigned m = ml | mr; m; m &= m - 1) {
                 const int l = __builtin_ctz(m);
                 const unsigned live = rays[l] & s->grp[l]->live;
                 if (ml >> l & 1) {
-                    rl[l] = (uint16_t)(test_rays ? mftg_ray_box(s, s->grp[l], &sh->nodes[c0]) & live : live);
-                    ray_tests += test_rays;
+                    const int t = test_rays;
+                    rl[l] = (uint16_t)(t ? mftg_ray_box(s, s->grp[l], n0) & live : live);
+                    ray_tests += (uint64_t)t;
                     if (!rl[l]) { ml &= ~(1u << l); lanes_culled++; }
                 }
                 if (mr >> l & 1) {
-                    rr[l] = (uint16_t)(test_rays ? mftg_ray_box(s, s->grp[l], &sh->nodes[c0 + 1]) & live : live);
-                    ray_tests += test_rays;
+                    const int t = test_rays;
+                    rr[l] = (uint16_t)(t ? mftg_ray_box(s, s->grp[l], n1) & live : live);
+                    ray_tests += (uint64_t)t;
                     if (!rr[l]) { mr &= ~(1u << l); lanes_culled++; }
                 }
             }
@@ -399,6 +410,72 @@ done:
     cnt[MS_MFT_LEAF_LANES_CULLED] += lanes_culled;
 }
 
+/* The rays of a block by set (rb->form_n, mft.c: mft_block_by_set), 16 slots at a time with raytrace's
+ * operations: d = P - C, 1 / d, each slot packet's shear axis over its 16 samples in sample order
+ * (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]); every lane one IEEE operation (lanes16.h), so the rays are
+ * raytrace's floats. */
+static void mftg_form(ms_mft_rayblock *rb)
+{
+    const int n = rb->form_n, ncell = rb->n;
+    l16 C[3];
+    for (int a = 0; a < 3; a++) C[a] = l16_load(rb->c[a]);
+    const l16 one = l16_set1(1.0f);
+    for (int c = 0; c < ncell; c++) {
+        ms_mft_group *G = &rb->g[c];
+        for (int a = 0; a < 3; a++) {
+            const l16 P = l16_load(rb->cell_pts + ((size_t)c * 3 + a) * 16), d = l16_sub(P, C[a]);
+            l16_store(G->p[a], P);
+            l16_store(G->d[a], d);
+            l16_store(G->inv[a], l16_div(one, d));
+        }
+        unsigned live = 0;
+        for (int q = 0; q < 16; q++) {
+            const int j = rb->sample_of[(size_t)q * ncell + c];
+            G->sample[q] = (uint16_t)j;
+            if (rb->present >> q & 1) live |= (unsigned)(rb->mask[q][j >> 6] >> (j & 63) & 1u) << q;
+        }
+        G->live = live;
+    }
+    signed char kz[16][MS_SAMPLES_MAX / 16 / 16];
+    for (int q = 0; q < 16; q++) {
+        if (!(rb->present >> q & 1)) continue;
+        for (int ch = 0; ch < n / 16; ch++) {
+            float dx[16], dy[16], dz[16];
+            for (int l = 0; l < 16; l++) {
+                const ms_mft_group *G = &rb->g[rb->set_cell[(size_t)q * n + 16 * ch + l]];
+                dx[l] = G->d[0][q];
+                dy[l] = G->d[1][q];
+                dz[l] = G->d[2][q];
+            }
+            int k0;
+            kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, &k0);
+        }
+    }
+    for (int c = 0; c < ncell; c++) {
+        ms_mft_group *G = &rb->g[c];
+        unsigned k1 = 0, k2 = 0;
+        int kall = -2;
+        G->alone = 0;
+        for (int q = 0; q < 16; q++) {
+            const int k = (rb->present >> q & 1) ? kz[q][G->sample[q] >> 4] : 0;
+            G->kz[q] = (signed char)k;
+            G->alone |= (unsigned)(k < 0) << q;
+            k1 |= (unsigned)(k == 1) << q;
+            k2 |= (unsigned)(k == 2) << q;
+            if ((G->live >> q & 1) && k >= 0) kall = kall == -2 || kall == k ? k : -1;
+        }
+        G->kz_all = kall < 0 ? (kall == -2 ? 0 : -1) : kall;
+        /* kz = 0: (kx, ky) = (1, 2); 1: (2, 0); 2: (0, 1); a slot without an axis (tested alone) takes 0's. */
+        l16 d[3], inv[3];
+        for (int a = 0; a < 3; a++) { d[a] = l16_load(G->d[a]); inv[a] = l16_load(G->inv[a]); }
+        const l16 ikz = l16_select(k1, inv[1], l16_select(k2, inv[2], inv[0]));
+        const l16 dkx = l16_select(k1, d[2], l16_select(k2, d[0], d[1]));
+        const l16 dky = l16_select(k1, d[0], l16_select(k2, d[1], d[2]));
+        l16_store(G->sx, l16_mul(dkx, ikz));
+        l16_store(G->sy, l16_mul(dky, ikz));
+    }
+}
+
 void MS_CAT(ms_mft_groups_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_rayblock *rb, const ms_bvh *b,
                                            const ms_bvh_shallow *sh, uint64_t *cnt)
 {
@@ -410,6 +487,7 @@ void MS_CAT(ms_mft_groups_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_raybloc
     s.f = f;
     s.rb = rb;
     s.b = b;
+    if (rb->form_n) mftg_form(rb);
     for (int a = 0; a < 3; a++) memcpy(s.c[a], rb->c[a], sizeof s.c[a]);
     for (int q = 0; q < rb->nq; q++) {
         float c[3] = { rb->c[0][q], rb->c[1][q], rb->c[2][q] }, lo[3], hi[3];
