@@ -4,12 +4,14 @@
  *
  * A group is the up to 16 rays of one cell of the light, one from each pixel of a 4x4 block (mft.c): 16
  * receivers close together to 16 points in 1/16 of the light (256 samples; 1/64 at 1024). Sixteen groups
- * are sixteen SIMD lanes of the multi-frusta traversal (block_traverse_loop.h), each bounded by the box of
- * its live rays' origins and the box of their sample points (ms_block_frusta_set_lane_box); in a leaf,
- * per triangle:
- *   1. culling of all 16 groups at once: the triangle's box against each group's segments (the
- *      traversal's own interval test), and its plane against the boxes of origins and points (every
- *      segment wholly on one side, or meeting the plane only before the near end, t < near);
+ * are sixteen SIMD lanes of the multi-frusta traversal (block_traverse_loop.h's node test, our own loop,
+ * mftg_traverse), each bounded by the box of its live rays' origins and the box of their sample points
+ * (ms_block_frusta_set_lane_box); below the frusta each lane's rays take raytrace's slab test, 16 in one
+ * register, at every child its frustum reaches, and go on with the rays that enter; in a leaf, per
+ * triangle:
+ *   1. where 4 or more groups reach it, culling of them all at once: the triangle's box against each
+ *      group's segments (the traversal's own interval test), and its plane against the boxes of origins
+ *      and points (every segment wholly on one side, or meeting the plane only before the near end);
  *   2. the triangle relative to each of the 16 receivers and its plane offset (ms_wt_offset), once per
  *      triangle, one receiver per SIMD lane;
  *   3. per surviving group, its 16 rays in one SIMD operation: method raytrace's watertight test
@@ -28,6 +30,9 @@
  *  - a group has 16 apexes, so it has no corner rays: the paper's corner-ray culling (the triangle's edge
  *    planes through the apex) is replaced by the triangle-box and plane tests of step 1, which hold for a
  *    box of apexes; the paper's back-face culling is not used (shadows need both sides);
+ *  - the per-ray box test at every node (the paper's "Ray-AABB" at the leaves only, which did not pay on
+ *    Larrabee): a group's rays are a quarter of the light apart, wider than small triangles, so its
+ *    frustum alone reached 10x the leaves its rays enter (ogre 256^2; docs/methods.md);
  *  - the rays are formed once per block (not on demand from delta vectors): the exact agreement with
  *    raytrace needs its shear (one division per ray) and its shared packet axis.
  * Culling is conservative: each test carries a relative slack of 1e-5 of the magnitudes involved (about
@@ -41,8 +46,11 @@
 #include "visibility/alpha.h"
 
 #define MFTG_REL 1e-5f
+/* Measurement switches (builds with -D..., docs/methods.md): the groups at a triangle from which it is
+ * culled for all at once (1: always; with one or two groups the cull cost more than it saved, ogre +18%);
+ * CR on or off (within noise). */
 #ifndef MFTG_TRI_CULL
-#define MFTG_TRI_CULL 4   /* groups at a triangle from which it is culled for all at once */
+#define MFTG_TRI_CULL 4
 #endif
 #ifndef MFTG_CR
 #define MFTG_CR 1
