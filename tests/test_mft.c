@@ -12,6 +12,7 @@
 #include "accel/bvh.h"
 #include "light/pattern.h"
 #include "shadow/microraster/block_traverse.h"
+#include "shadow/mft/mft.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -174,15 +175,17 @@ static void test_grazing_sliver_block(void **state)
 
 /* The masks and counters of mft on a size x size view of sc, through the method's interface, under an
  * ISA cap and the given switches. Caller frees the masks. */
-static uint64_t *mft_masks(const ms_scene *sc, ms_pattern pat, int k, int size, ms_isa cap, int fs, int no_order,
-                           uint64_t cnt[MS_MAX_COUNTERS], ms_isa *isa, int *n_out)
+static uint64_t *mft_masks_ex(const ms_scene *sc, ms_pattern pat, int k, int size, ms_isa cap, int fs, int no_order,
+                              int in_order, uint64_t cnt[MS_MAX_COUNTERS], ms_isa *isa, int *n_out, int *mw_out,
+                              uint64_t **ref_out)
 {
     ms_bvh bvh;
     assert_int_equal(ms_bvh_build(&bvh, sc->tri, sc->n_tris, 1), 0);
     ms_render_ctx ctx;
     tu_ctx_init(&ctx, sc, &bvh, size, size, k);
     ctx.isa_cap = cap;
-    ctx.pattern = pat;
+    tu_ctx_set_pattern(&ctx, pat);
+    ctx.queries_in_order = in_order;
     ctx.frustum_shrink = fs;
     ctx.no_child_order = no_order;
     const ms_primary_method *pm = ms_find_primary_method("bvh");
@@ -219,12 +222,78 @@ static uint64_t *mft_masks(const ms_scene *sc, ms_pattern pat, int k, int size, 
     memset(cnt, 0, MS_MAX_COUNTERS * sizeof *cnt);
     assert_int_equal(sm->visibility(ss, &ctx, q, nq, front, vis, cnt), 0);
     sm->destroy(ss);
+    if (ref_out) {
+        /* The reference tracer's masks for the same queries, samples and front masks. */
+        uint64_t *ref = calloc((size_t)nq * mw + 1, sizeof *ref), rc[MS_MAX_COUNTERS] = { 0 };
+        float *rp = malloc((size_t)ctx.samples * 3 * sizeof *rp);
+        assert_non_null(ref);
+        assert_non_null(rp);
+        for (int i = 0; i < nq; i++) ms_raytrace_visible_samples(&ctx, &q[i], rp, front + i * mw, ref + i * mw, rc);
+        free(rp);
+        *ref_out = ref;
+    }
+    if (mw_out) *mw_out = (int)mw;
     free(front);
     free(hits);
     free(q);
     ms_bvh_free(&bvh);
     *n_out = nq;
     return vis;
+}
+
+static uint64_t *mft_masks(const ms_scene *sc, ms_pattern pat, int k, int size, ms_isa cap, int fs, int no_order,
+                           uint64_t cnt[MS_MAX_COUNTERS], ms_isa *isa, int *n_out)
+{
+    return mft_masks_ex(sc, pat, k, size, cap, fs, no_order, 0, cnt, isa, n_out, NULL, NULL);
+}
+
+/* The interleaved mode's two ways of forming a block's ray groups (mft.c): by set (a frame's 4x4 blocks:
+ * 16 distinct sets) and the general one (queries in proximity order, the points API: 16 consecutive
+ * queries of a row share sets). Both give raytrace's masks, query for query; the ISA instances give the
+ * same masks and counters. */
+static void test_interleaved_group_paths(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    for (int in_order = 0; in_order <= 1; in_order++)
+        for (int k = 16; k <= 32; k *= 2) {
+            uint64_t c0[MS_MAX_COUNTERS], *ref = NULL;
+            ms_isa isa0;
+            int n0, mw;
+            uint64_t *got = mft_masks_ex(&sc, MS_PATTERN_INTERLEAVED, k, 48, MS_ISA_SCALAR, 0, 0, in_order, c0, &isa0, &n0,
+                                         &mw, &ref);
+            long differ = 0, partial = 0;
+            for (int i = 0; i < n0; i++) {
+                differ += memcmp(got + (size_t)i * mw, ref + (size_t)i * mw, (size_t)mw * sizeof *got) != 0;
+                int nv = 0;
+                for (int w = 0; w < mw; w++) nv += __builtin_popcountll(ref[(size_t)i * mw + w]);
+                partial += nv > 0 && nv < k * k / 16;
+            }
+            printf("interleaved N=%d, %s: %ld of %d queries differ from raytrace (%ld partly lit), %llu groups, %llu 16-ray tests\n",
+                   k * k, in_order ? "queries in order (general grouping)" : "4x4 blocks (by set)", differ, n0, partial,
+                   (unsigned long long)c0[MS_MFT_FRUSTA], (unsigned long long)c0[MS_MFT_ISEC16]);
+            assert_true(partial > 20);
+            assert_int_equal(differ, 0);
+            assert_int_equal(c0[MS_MFT_PAIRS], c0[MS_MFT_CULLED_BOX] + c0[MS_MFT_CULLED_PLANE] + c0[MS_MFT_PAIRS_TESTED]);
+            assert_true(c0[MS_MFT_ISEC16] <= c0[MS_MFT_PAIRS_TESTED]);
+            assert_true(c0[MS_MFT_FRUSTA] <= 16 * c0[MS_BT_BLOCKS] + 16);
+            for (int cap = MS_ISA_AVX2; cap <= MS_ISA_AVX512; cap++) {
+                if (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa()) continue;
+                uint64_t c1[MS_MAX_COUNTERS];
+                ms_isa isa1;
+                int n1;
+                uint64_t *g1 = mft_masks_ex(&sc, MS_PATTERN_INTERLEAVED, k, 48, (ms_isa)cap, 0, 0, in_order, c1, &isa1, &n1,
+                                            NULL, NULL);
+                assert_int_equal(n1, n0);
+                assert_memory_equal(got, g1, (size_t)n0 * mw * sizeof *got);
+                assert_memory_equal(c0, c1, sizeof c0);
+                free(g1);
+            }
+            free(got);
+            free(ref);
+        }
+    ms_scene_free(&sc);
 }
 
 /* The portable, AVX2 and AVX-512 instances: the same masks and the same counters (every decision is
@@ -333,6 +402,7 @@ int main(void)
         cmocka_unit_test(test_bunny_equals),
         cmocka_unit_test(test_grazing_sliver_block),
         cmocka_unit_test(test_isa_instances_identical),
+        cmocka_unit_test(test_interleaved_group_paths),
         cmocka_unit_test(test_switches_keep_masks),
         cmocka_unit_test(test_counters_account),
     };

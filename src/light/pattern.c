@@ -86,14 +86,32 @@ static uint32_t sobol2(uint32_t i)
     return r;
 }
 
+/* The 16 sets are the same over a frame, and every pixel asks for its set several times (front mask,
+ * rays, resolve): each thread keeps the sets of the last (samples, seed) it formed. */
+static _Thread_local struct {
+    int samples;
+    uint32_t seed, have;   /* have: one bit per set */
+    uint32_t u[16][256], v[16][256];
+} interleaved_cache;
+
 void ms_interleaved_uv(int samples, int set, uint32_t seed, uint32_t *u, uint32_t *v)
 {
     const uint32_t n = (uint32_t)samples / 16u, base = (uint32_t)set * n;
-    const uint32_t su = ms_hash3(seed, 0x1A7E2C3Bu, 0x5EEDu), sv = ms_hash3(seed, 0x0C4F9D21u, 0x5EEDu);
-    for (uint32_t l = 0; l < n; l++) {
-        u[l] = radical_inverse2(base + l) ^ su;
-        v[l] = sobol2(base + l) ^ sv;
+    if (interleaved_cache.samples != samples || interleaved_cache.seed != seed) {
+        interleaved_cache.samples = samples;
+        interleaved_cache.seed = seed;
+        interleaved_cache.have = 0;
     }
+    if (!(interleaved_cache.have >> set & 1u)) {
+        const uint32_t su = ms_hash3(seed, 0x1A7E2C3Bu, 0x5EEDu), sv = ms_hash3(seed, 0x0C4F9D21u, 0x5EEDu);
+        for (uint32_t l = 0; l < n; l++) {
+            interleaved_cache.u[set][l] = radical_inverse2(base + l) ^ su;
+            interleaved_cache.v[set][l] = sobol2(base + l) ^ sv;
+        }
+        interleaved_cache.have |= 1u << set;
+    }
+    memcpy(u, interleaved_cache.u[set], n * sizeof *u);
+    memcpy(v, interleaved_cache.v[set], n * sizeof *v);
 }
 
 /* Light parameters of sample n of the stratified pattern. */

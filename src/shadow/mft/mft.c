@@ -32,6 +32,7 @@
 
 typedef struct mft_method {
     ms_mft_fn block;
+    ms_mft_group_fn groups;       /* the interleaved mode's tracer (mft_group_impl.h) */
     ms_isa isa;
     ms_bvh_shallow sh;
     ms_mft_frame f;
@@ -45,6 +46,16 @@ ms_mft_fn ms_mft_isa(ms_isa isa)
         [MS_ISA_AVX512] = ms_mft_block_avx512,
     };
     if (isa < MS_ISA_SCALAR || isa > MS_ISA_AVX512 || ms_cpu_isa() < isa) return NULL;
+    return table[isa];
+}
+
+static ms_mft_group_fn mft_groups_isa(ms_isa isa)
+{
+    static const ms_mft_group_fn table[] = {
+        [MS_ISA_SCALAR] = ms_mft_groups_scalar,
+        [MS_ISA_AVX2] = ms_mft_groups_avx2,
+        [MS_ISA_AVX512] = ms_mft_groups_avx512,
+    };
     return table[isa];
 }
 
@@ -72,6 +83,7 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     mft_method *s = calloc(1, sizeof *s);
     if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
     s->block = ms_mft_select(ctx->isa_cap, &s->isa);
+    if (s->block) s->groups = mft_groups_isa(s->isa);
     if (!s->block || ms_bvh_shallow_build(&s->sh, ctx->bvh, MFT_SHALLOW_LEAF)) {
         free(s);
         snprintf(err, errlen, "out of memory for the shallow BVH");
@@ -88,10 +100,9 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     f->seed = ctx->seed;
     f->alpha = ctx->alpha;
     f->flags = (ctx->no_child_order ? 0 : MS_MFT_ORDER) | (ctx->frustum_shrink ? MS_MFT_FS : 0);
-    /* The paper's own mode: each pixel of a 4x4 block its own set of N/16 points (pattern.c), tested
-     * packet by packet against the whole light's frustum (footprints and CR need samples in cells). */
+    /* The paper's own mode: each pixel of a 4x4 block its own set of N/16 points (pattern.c), traced by
+     * cell of the light across the block (mft_visibility_groups). */
     f->cells = ctx->pattern != MS_PATTERN_INTERLEAVED;
-    if (!f->cells) f->flags |= MS_MFT_NO_FOOTPRINT;
 #ifdef MFT_NO_FOOTPRINT
     f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
 #endif
@@ -122,13 +133,18 @@ static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
 
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
 {
-    const int base = ch * 16;
     float pts[3 * 16];
-    ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, base, 16, pts);
+    ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
+    ms_mft_rays_from(L, ch, pts);
+}
+
+void ms_mft_rays_from(ms_mft_lane *L, int ch, const float *pts)
+{
+    const int base = ch * 16;
     for (int l = 0; l < 16; l++)
         for (int a = 0; a < 3; a++) {
             L->d[a][base + l] = pts[3 * l + a] - L->c[a];
-            L->inv[a][base + l] = 1.0f / L->d[a][base + l];
+            if (L->inv[a]) L->inv[a][base + l] = 1.0f / L->d[a][base + l];
         }
     /* The shear axis raytrace shares over a packet (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]). */
     int kz;
@@ -179,13 +195,224 @@ static void mft_lane_setup(const ms_mft_frame *f, const ms_shadow_query *q, ms_m
     L->foot_slack = (float)(f->margin + 0.02 + 1e-4 * d3_len(w) * (fmax(d3_len(m[0]), d3_len(m[1])) + f->k * d3_len(m[2])));
 }
 
+/* Morton index of cell (x, y), x, y < 16: cells 16 at a time form 4x4 squares of the light, so the 16
+ * groups that traverse together are neighbours. */
+static int mft_morton(int x, int y)
+{
+    int m = 0;
+    for (int b = 0; b < 4; b++) m |= (x >> b & 1) << (2 * b) | (y >> b & 1) << (2 * b + 1);
+    return m;
+}
+
+/* The shear axis every live ray of each group shares (the usual case: one light, nearby receivers). */
+static void mft_groups_kz_all(ms_mft_rayblock *rb)
+{
+    for (int gi = 0; gi < rb->n; gi++) {
+        ms_mft_group *G = &rb->g[gi];
+        int kz = -2;
+        G->alone = 0;
+        for (unsigned m = G->live; m; m &= m - 1) {
+            const int k = G->kz[__builtin_ctz(m)];
+            if (k < 0) { G->alone |= m & -m; continue; }
+            kz = kz == -2 || kz == k ? k : -1;
+        }
+        G->kz_all = kz < 0 ? (kz == -2 ? 0 : -1) : kz;
+    }
+}
+
+/* A block whose queries have distinct sets, each set one sample per cell (every frame's block): slot =
+ * set, so a group's points are one row of cell_pts; its rays are formed by the tracer, 16 at a time
+ * (mft_group_impl.h, mftg_form). Returns 0 when no query has a front sample. */
+static int mft_block_by_set(const ms_shadow_query *q, const int *order, int g, int end, const uint64_t *front,
+                            uint64_t *vis, size_t mw, int n, int ncell, const float *cell_pts, const uint16_t *sample_of,
+                            const int *set_cell, ms_mft_rayblock *rb)
+{
+    unsigned present = 0;
+    int first = -1;
+    for (int e = g; e < end; e++) {
+        const int i = order[e];
+        uint64_t *m = vis + (size_t)i * mw;
+        memcpy(m, front + (size_t)i * mw, mw * sizeof *m);   /* the front mask is the starting set */
+        if (ms_mask_count(m, (int)mw) == 0) continue;
+        const int set = ms_interleaved_set(q[i].px, q[i].py);
+        present |= 1u << set;
+        if (first < 0) first = set;
+        for (int a = 0; a < 3; a++) rb->c[a][set] = q[i].p[a];
+        rb->skip[set] = q[i].prim;
+        rb->mask[set] = m;
+    }
+    if (!present) return 0;
+    for (int set = 0; set < 16; set++)
+        if (!(present >> set & 1)) {   /* an absent slot: a finite stand-in, never live */
+            for (int a = 0; a < 3; a++) rb->c[a][set] = rb->c[a][first];
+            rb->skip[set] = UINT32_MAX;
+            rb->mask[set] = NULL;
+        }
+    rb->nq = 16;
+    rb->n = ncell;
+    rb->present = present;
+    rb->form_n = n;
+    rb->cell_pts = cell_pts;
+    rb->sample_of = sample_of;
+    rb->set_cell = set_cell;
+    return 1;
+}
+
+/* The interleaved mode: per block, each query's rays formed as raytrace forms them (ms_mft_rays, per
+ * 16-sample packet), then regrouped by the cell of the light their sample lies in (mft.h, ms_mft_rayblock):
+ * cell (floor(s g), floor(t g)) of a g x g grid, g^2 = N/16. A pixel's set is a (0, m, 2)-net, so it has one
+ * sample per cell; a second one (no shared pattern gives it) would open another group for that cell. */
+static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, const ms_render_ctx *ctx,
+                                 const ms_shadow_query *q, const int *order, int nq, const uint64_t *front,
+                                 uint64_t *vis, uint64_t *cnt)
+{
+    const size_t mw = (size_t)ctx->mask_words;
+    const int n = ms_pattern_spp(f->pattern, f->k), np = n / 16;
+    int gside = 1;
+    while (gside * gside < n) gside *= 2;
+    const int ncell = gside * gside;
+    ms_mft_rayblock rb;
+    memset(&rb, 0, sizeof rb);
+    rb.cap = ncell + MS_BLOCK_LANES;
+    rb.g = malloc((size_t)rb.cap * sizeof *rb.g);
+    int *next = malloc((size_t)rb.cap * sizeof *next);
+    /* The points and cells of the 16 sets, each set being the same in every block (pattern.c), formed when
+     * a query first needs them: per set 3n floats, n cells; then st (2n) for the one being formed. */
+    float *scratch = malloc((size_t)n * 8 * sizeof(float) + (size_t)16 * n * 4 * sizeof(float) + (size_t)n * 2 * sizeof(float));
+    signed char kzs[MS_SAMPLES_MAX / 16];
+    if (!rb.g || !next || !scratch) { free(rb.g); free(next); free(scratch); return -1; }
+    unsigned have_set = 0;
+    ms_mft_lane L;
+    memset(&L, 0, sizeof L);
+    for (int a = 0; a < 3; a++) { L.d[a] = scratch + (size_t)a * n; L.inv[a] = scratch + (size_t)(3 + a) * n; }
+    L.sx = scratch + (size_t)6 * n;
+    L.sy = scratch + (size_t)7 * n;
+    L.kz = kzs;
+    float *set_pts = scratch + (size_t)8 * n, *st = set_pts + (size_t)16 * 3 * n;
+    int *set_cell = (int *)(st + (size_t)2 * n);
+    /* The sets' points by cell, [cell][axis][set], and the sample of each set in each cell; regular: the
+     * sets with one sample per cell (all of them: pattern.c's sets are nets). */
+    float *cell_pts = malloc((size_t)ncell * 3 * 16 * sizeof *cell_pts);
+    uint16_t *sample_of = malloc((size_t)16 * ncell * sizeof *sample_of);
+    if (!cell_pts || !sample_of) { free(rb.g); free(next); free(scratch); free(cell_pts); free(sample_of); return -1; }
+    unsigned regular = 0;
+    for (int g = 0; g < nq;) {
+        const int end = ms_block_group_end(ctx, q, order, nq, g);
+        /* The sets' tables, formed when first needed. */
+        unsigned sets = 0, dup = 0;
+        for (int e = g; e < end; e++) {
+            const int set = ms_interleaved_set(q[order[e]].px, q[order[e]].py);
+            dup |= sets & 1u << set;
+            sets |= 1u << set;
+            if (have_set >> set & 1) continue;
+            ms_pattern_points_range(f->pattern, &f->light, f->k, q[order[e]].px, q[order[e]].py, f->seed, 0, n,
+                                    set_pts + (size_t)set * 3 * n);
+            ms_pattern_st(f->pattern, f->k, q[order[e]].px, q[order[e]].py, f->seed, st);
+            unsigned seen[MS_SAMPLES_MAX / 16 / 32] = { 0 };
+            int ok = 1;
+            for (int j = 0; j < n; j++) {
+                const int cx = (int)(st[2 * j] * (float)gside), cy = (int)(st[2 * j + 1] * (float)gside);
+                const int c = mft_morton(cx < gside ? cx : gside - 1, cy < gside ? cy : gside - 1);
+                set_cell[(size_t)set * n + j] = c;
+                ok &= !(seen[c >> 5] >> (c & 31) & 1u);
+                seen[c >> 5] |= 1u << (c & 31);
+                sample_of[(size_t)set * ncell + c] = (uint16_t)j;
+                for (int a = 0; a < 3; a++) cell_pts[((size_t)c * 3 + a) * 16 + set] = set_pts[(size_t)set * 3 * n + 3 * j + a];
+            }
+            have_set |= 1u << set;
+            regular |= (unsigned)ok << set;
+        }
+        if (!dup && (sets & ~regular) == 0 && ncell == n) {
+            if (mft_block_by_set(q, order, g, end, front, vis, mw, n, ncell, cell_pts, sample_of, set_cell, &rb))
+                s->groups(f, &rb, ctx->bvh, &s->sh, cnt);
+            g = end;
+            continue;
+        }
+        rb.nq = 0;
+        rb.n = ncell;
+        memset(rb.g, 0, (size_t)ncell * sizeof *rb.g);
+        for (int c = 0; c < ncell; c++) next[c] = -1;
+        for (int e = g; e < end; e++) {
+            const int i = order[e];
+            uint64_t *m = vis + (size_t)i * mw;
+            memcpy(m, front + (size_t)i * mw, mw * sizeof *m);   /* the front mask is the starting set */
+            if (ms_mask_count(m, (int)mw) == 0) continue;
+            const int slot = rb.nq++;
+            for (int a = 0; a < 3; a++) rb.c[a][slot] = q[i].p[a];
+            rb.skip[slot] = q[i].prim;
+            rb.mask[slot] = m;
+            memcpy(L.c, q[i].p, sizeof L.c);
+            L.px = q[i].px;
+            L.py = q[i].py;
+            memset(L.ready, 0, sizeof L.ready);
+            const int set = ms_interleaved_set(L.px, L.py);
+            const float *pts = set_pts + (size_t)set * 3 * n;
+            const int *cell_of = set_cell + (size_t)set * n;
+            for (int ch = 0; ch < np; ch++) {
+                unsigned live = (unsigned)(m[ch >> 2] >> (ch & 3) * 16) & 0xFFFFu;
+                if (!live) continue;
+                ms_mft_rays_from(&L, ch, pts + 3 * 16 * ch);
+                for (; live; live &= live - 1) {
+                    const int j = 16 * ch + __builtin_ctz(live);
+                    int gi = cell_of[j];
+                    while (rb.g[gi].live >> slot & 1) {
+                        if (next[gi] < 0) {
+                            if (rb.n == rb.cap) {
+                                const int cap = 2 * rb.cap;
+                                ms_mft_group *ng = realloc(rb.g, (size_t)cap * sizeof *ng);
+                                int *nn = ng ? realloc(next, (size_t)cap * sizeof *nn) : NULL;
+                                if (ng) rb.g = ng;
+                                if (nn) next = nn;
+                                if (!ng || !nn) { free(rb.g); free(next); free(scratch); return -1; }
+                                rb.cap = cap;
+                            }
+                            memset(&rb.g[rb.n], 0, sizeof *rb.g);
+                            next[rb.n] = -1;
+                            next[gi] = rb.n++;
+                        }
+                        gi = next[gi];
+                    }
+                    ms_mft_group *G = &rb.g[gi];
+                    for (int a = 0; a < 3; a++) {
+                        G->d[a][slot] = L.d[a][j];
+                        G->inv[a][slot] = L.inv[a][j];
+                        G->p[a][slot] = pts[3 * j + a];
+                    }
+                    G->sx[slot] = L.sx[j];
+                    G->sy[slot] = L.sy[j];
+                    G->kz[slot] = L.kz[ch];
+                    G->sample[slot] = (uint16_t)j;
+                    G->live |= 1u << slot;
+                }
+            }
+        }
+        mft_groups_kz_all(&rb);
+        rb.form_n = 0;
+        if (rb.nq) s->groups(f, &rb, ctx->bvh, &s->sh, cnt);
+        g = end;
+    }
+    free(rb.g);
+    free(next);
+    free(scratch);
+    free(cell_pts);
+    free(sample_of);
+    return 0;
+}
+
 static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
                           const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
     const mft_method *s = state;
     const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
+#ifdef MFT_NULL_MEASURE
+    /* Measurement builds only: no ray traced (every front sample visible), to measure what the frame
+     * costs around the method (front masks, V and S, the filter: docs/methods.md). */
+    memcpy(vis, front, (size_t)nq * mw * sizeof *vis);
+    (void)s; (void)ns; (void)cnt; (void)q;
+    return 0;
+#endif
     int *order = malloc((size_t)nq * sizeof *order);
-    float *rayf = malloc(MS_BLOCK_LANES * 8 * ns * sizeof *rayf);
+    float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
     signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));
     if (!order || !rayf || !kzs) { free(order); free(rayf); free(kzs); return -1; }
     ms_block_order(ctx, q, nq, order);
@@ -199,11 +426,18 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
         mft_frame_light(&own, cl);
         f = &own;
     }
+    if (!f->cells) {
+        free(rayf);
+        free(kzs);
+        const int rc = mft_visibility_groups(s, f, ctx, q, order, nq, front, vis, cnt);
+        free(order);
+        return rc;
+    }
     ms_mft_block blk;
     for (int l = 0; l < MS_BLOCK_LANES; l++) {
-        float *base = rayf + (size_t)l * 8 * ns;
+        float *base = rayf + (size_t)l * 5 * ns;
         for (int a = 0; a < 3; a++) blk.lane[l].d[a] = base + (size_t)a * ns;
-        for (int a = 0; a < 3; a++) blk.lane[l].inv[a] = base + (size_t)(5 + a) * ns;
+        for (int a = 0; a < 3; a++) blk.lane[l].inv[a] = NULL;   /* the grid's tracer takes no ray box test */
         blk.lane[l].sx = base + 3 * ns;
         blk.lane[l].sy = base + 4 * ns;
         blk.lane[l].kz = kzs + (size_t)l * (ns / 16);
@@ -250,7 +484,8 @@ const ms_shadow_method ms_shadow_mft = {
     .n_counters = MS_MFT_COUNTERS,
     .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",
                        "leaf_frusta_culled", "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",
-                       "culled_footprint", "pairs_tested", "isec_tests16", "frusta_early_out", "rect_shrinks" },
+                       "culled_footprint", "pairs_tested", "isec_tests16", "frusta_early_out", "rect_shrinks",
+                       "culled_tri_box", "ray_box_tests16" },
     .create = mft_create,
     .visibility = mft_visibility,
     .destroy = mft_destroy,

@@ -43,7 +43,7 @@ typedef struct ms_mft_lane {
     uint64_t *mask;               /* mask_words words: live rays */
     /* Its rays, formed per 16-sample packet when first tested (ms_mft_rays; ready: one bit per packet). */
     float *d[3], *sx, *sy;        /* per sample */
-    float *inv[3];                /* per sample: 1 / d, for the rays' own box test (interleaved, mft_impl.h) */
+    float *inv[3];                /* per sample: 1 / d (the interleaved groups' box test), NULL: not formed */
     signed char *kz;              /* per packet: the shear axis, -1: lanes tested one by one */
     uint64_t ready[4];
     float m[3][3];                /* rows: X - C -> (cell a, cell b, c) with X = C + c (P - C) + a S/k + b T/k */
@@ -57,11 +57,45 @@ typedef struct ms_mft_block {
     ms_mft_lane lane[MS_BLOCK_LANES];
 } ms_mft_block;
 
+/* The interleaved mode (mft_group_impl.h): a block's rays regrouped by their place on the light. Each
+ * pixel's N/16 points are a (0, m, 2)-net (pattern.c), so each cell of a g x g grid over the light (g^2 =
+ * N/16) holds exactly one point of every pixel: a group is the (up to) 16 rays of one cell, ray q from the
+ * block's query q, nearby receivers to nearby points, a thin frustum; the N/16 groups of a block traverse 16
+ * at a time. Rays are formed as method raytrace forms them (ms_mft_rays: the pixel's 16-sample packets,
+ * their shear axis and per-ray shear), so ray q of a group has its own shear axis kz[q]. */
+typedef struct ms_mft_group {
+    float d[3][MS_BLOCK_LANES], sx[MS_BLOCK_LANES], sy[MS_BLOCK_LANES];
+    float inv[3][MS_BLOCK_LANES];        /* 1 / d: raytrace's box test */
+    float p[3][MS_BLOCK_LANES];          /* the sample points (the alpha test's segment ends) */
+    signed char kz[MS_BLOCK_LANES];      /* -1: the ray is tested alone (ms_wt_segment) */
+    uint16_t sample[MS_BLOCK_LANES];     /* the ray's sample index in its pixel's set */
+    unsigned live;                       /* slots with a live ray */
+    int kz_all;                          /* the axis every live ray shares, -1 if none */
+    unsigned alone;                      /* slots with kz < 0 */
+} ms_mft_group;
+
+typedef struct ms_mft_rayblock {
+    int nq;                              /* queries (slots) */
+    float c[3][MS_BLOCK_LANES];          /* their receiver points */
+    uint32_t skip[MS_BLOCK_LANES];       /* their own triangles */
+    uint64_t *mask[MS_BLOCK_LANES];      /* their masks: the front mask in, the visible samples out */
+    int n, cap;                          /* groups */
+    ms_mft_group *g;
+    /* form_n > 0: the groups' rays are still to be formed (every query's N/16 = form_n samples one per
+     * cell, slot = set): the points by cell [cell][axis][slot], each slot's sample in each cell, each
+     * slot's cell of each sample, and the slots present. */
+    int form_n;
+    const float *cell_pts;
+    const uint16_t *sample_of;
+    const int *set_cell;
+    unsigned present;
+} ms_mft_rayblock;
+
 /* Counters after the traversal's (block_traverse.h), named in mft.c. */
 enum {
     MS_MFT_FRUSTA = MS_BT_COUNTERS, MS_MFT_LEAF_LANES_CULLED, MS_MFT_PAIRS, MS_MFT_CULLED_HORIZON, MS_MFT_CULLED_PLANE,
     MS_MFT_CULLED_CORNER, MS_MFT_CULLED_FOOTPRINT, MS_MFT_PAIRS_TESTED, MS_MFT_ISEC16, MS_MFT_FRUSTA_EARLY_OUT,
-    MS_MFT_RECT_SHRINKS, MS_MFT_COUNTERS
+    MS_MFT_RECT_SHRINKS, MS_MFT_CULLED_BOX, MS_MFT_RAY_BOX, MS_MFT_COUNTERS
 };
 
 /* The directions from c to the four corners of cell rectangle r (columns r[0]..r[1], rows r[2]..r[3]),
@@ -70,12 +104,19 @@ void ms_mft_corners(const ms_mft_frame *f, const float c[3], const int r[4], flo
 
 /* Forms packet ch (samples 16 ch .. 16 ch + 15) of lane L's rays, as method raytrace forms them. */
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch);
+/* The same from the packet's 16 sample points (the pattern's, ms_pattern_points_range). */
+void ms_mft_rays_from(ms_mft_lane *L, int ch, const float *pts);
 
 typedef void (*ms_mft_fn)(const ms_mft_frame *f, ms_mft_block *blk, const ms_bvh *b, const ms_bvh_shallow *sh,
                           uint64_t *cnt);
 void ms_mft_block_scalar(const ms_mft_frame *, ms_mft_block *, const ms_bvh *, const ms_bvh_shallow *, uint64_t *);
 void ms_mft_block_avx2(const ms_mft_frame *, ms_mft_block *, const ms_bvh *, const ms_bvh_shallow *, uint64_t *);
 void ms_mft_block_avx512(const ms_mft_frame *, ms_mft_block *, const ms_bvh *, const ms_bvh_shallow *, uint64_t *);
+typedef void (*ms_mft_group_fn)(const ms_mft_frame *f, ms_mft_rayblock *rb, const ms_bvh *b, const ms_bvh_shallow *sh,
+                                uint64_t *cnt);
+void ms_mft_groups_scalar(const ms_mft_frame *, ms_mft_rayblock *, const ms_bvh *, const ms_bvh_shallow *, uint64_t *);
+void ms_mft_groups_avx2(const ms_mft_frame *, ms_mft_rayblock *, const ms_bvh *, const ms_bvh_shallow *, uint64_t *);
+void ms_mft_groups_avx512(const ms_mft_frame *, ms_mft_rayblock *, const ms_bvh *, const ms_bvh_shallow *, uint64_t *);
 /* The instance for isa (NULL if this CPU lacks it) and the one for a cap. */
 ms_mft_fn ms_mft_isa(ms_isa isa);
 ms_mft_fn ms_mft_select(ms_isa cap, ms_isa *chosen);

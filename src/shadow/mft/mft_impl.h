@@ -42,10 +42,10 @@
  *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
  *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept);
- *  - in the interleaved mode, at a leaf, each packet's rays take raytrace's box test before the triangles
- *    (mft_ray_box: the paper's "Ray-AABB", which did not pay on Larrabee): its frusta span the whole light.
- *    On the grid the same test (once per leaf and packet) cut the 16-ray tests 1.3-3.6x but not the time
- *    (big-light Sponza -7%, GRIDS-like bars and ogre +4-7% CPU): not kept (docs/design.md, "mft"). */
+ *  - the interleaved pattern is traced by mft_group_impl.h (rays regrouped by cell of the light); there
+ *    each group's rays take raytrace's box test per node (the paper's "Ray-AABB"). On the grid the same
+ *    test (once per leaf and packet) cut the 16-ray tests 1.3-3.6x but not the time (big-light Sponza -7%,
+ *    GRIDS-like bars and ogre +4-7% CPU): not kept (docs/design.md, "mft"). */
 #include <math.h>
 #include <string.h>
 #include "mft.h"
@@ -76,9 +76,6 @@ typedef struct mft_state {
     float sp[4][3][MS_BLOCK_LANES];   /* the frusta's side planes through C (normals facing in) */
     float olo[3][MS_BLOCK_LANES], ohi[3][MS_BLOCK_LANES];   /* C shifted by the box margin (ms_wt_box_origins) */
 } mft_state;
-
-/* Interleaved: the most packets a pixel has (4096 / 16 points, 16 per packet). */
-#define MFT_MAX_IPK 16
 
 /* Row j (k bits) of a sample mask. */
 static inline uint64_t mft_row(const uint64_t *m, int k, int j)
@@ -175,28 +172,6 @@ static unsigned mft_leaf_lanes(const mft_state *s, const ms_bvh_node *n, unsigne
     return mask & ~out;
 }
 
-
-/* The rays of packet ch of lane l that enter leaf n's box: method raytrace's box test (raytrace_impl.h,
- * packet_enters) per ray, the same widened box and Ize's factor, so it never drops a ray the exact test hits.
- * The paper's "Ray-AABB" leaf test (Table 2), used in the interleaved mode only: there a pixel's 16 rays
- * spread over the whole light, so its frustum is the whole light's and culls almost nothing (bunny 256^2:
- * 11.4M 16-ray tests against raytrace's 0.57M), whereas a ray is thin: one 16-lane slab test per frustum
- * and leaf leaves only the rays that reach the leaf, and skips the leaf for the frustum when none does. */
-static unsigned mft_ray_box(const mft_state *s, int l, int ch, const ms_bvh_node *n)
-{
-    const ms_mft_lane *L = &s->blk->lane[l];
-    const int base = ch * 16;
-    l16 t0 = l16_set1(s->f->near), t1 = l16_set1(s->f->far);
-    for (int a = 0; a < 3; a++) {
-        const l16 inv = l16_load(L->inv[a] + base);
-        const l16 x = l16_mul(l16_set1(n->bmin[a] - s->olo[a][l]), inv), y = l16_mul(l16_set1(n->bmax[a] - s->ohi[a][l]), inv);
-        /* raytrace's compares: mn = x < y ? x : y, mx = x < y ? y : x; a NaN leaves t0, t1 as they were */
-        const l16 mn = l16_min(x, y), mx = l16_select(l16_lt(x, y), y, x);
-        t0 = l16_max(mn, t0);
-        t1 = l16_min(mx, t1);
-    }
-    return l16_le(t0, l16_mul(t1, l16_set1(MS_WT_FAR_SCALE)));
-}
 
 /* The rays of 16-sample packet ch of lane L (bits: the live ones) that triangle tri hits: raytrace's
  * packet_triangle (raytrace_impl.h), the same operations in the same order. V: the vertices relative to
@@ -351,22 +326,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     }
     const unsigned before = mask & fr->live;
     mask = mft_leaf_lanes(s, n, before);
-    /* Interleaved: each live packet's rays against the leaf's box (mft_ray_box). */
-    uint16_t enter[MS_BLOCK_LANES][MFT_MAX_IPK];
-    if (!f->cells)
-        for (unsigned m = mask; m; m &= m - 1) {
-            const int l = __builtin_ctz(m);
-            ms_mft_lane *L = &blk->lane[l];
-            unsigned any = 0;
-            for (uint64_t pm = s->livech[l][0]; pm; pm &= pm - 1) {
-                const int ch = __builtin_ctzll(pm);
-                const unsigned live = (unsigned)(L->mask[ch >> 2] >> (ch & 3) * 16) & 0xFFFFu;
-                if (!(L->ready[0] >> ch & 1)) ms_mft_rays(f, L, ch);
-                enter[l][ch] = (uint16_t)(mft_ray_box(s, l, ch, n) & live);
-                any |= enter[l][ch];
-            }
-            if (!any) mask &= ~(1u << l);
-        }
     cnt[MS_MFT_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
     if (!mask) return;
     l16 c[3], hn[3], cd[4][3], cl[4];
@@ -533,8 +492,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             for (int ci = 0; ci < nc; ci++) {
                 const int ch = cand[ci], w = ch >> 6, sh = (ch & 3) * 16;
                 const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
-                unsigned bits = all & ccols[ci];
-                if (!f->cells) bits &= enter[l][ch];
+                const unsigned bits = all & ccols[ci];
                 if (!bits) continue;
                 if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
                 isec++;
@@ -562,9 +520,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_MFT_PAIRS_TESTED] += tested;
     cnt[MS_MFT_ISEC16] += isec;
     cnt[MS_MFT_FRUSTA_EARLY_OUT] += early;
-    /* CR (and FS): the corner rays of the frusta that lost rays here, from their live rectangle (only
-     * where samples sit in cells: the interleaved sets keep the whole light). */
-    for (unsigned m = f->cells ? terminated & fr->live : 0u; m; m &= m - 1) {
+    /* CR (and FS): the corner rays of the frusta that lost rays here, from their live rectangle. */
+    for (unsigned m = terminated & fr->live; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         int r[4];
         mft_live_rect(blk->lane[l].mask, k, r);
@@ -609,11 +566,7 @@ void MS_CAT(ms_mft_block_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_block *b
                 for (int a = 0; a < 3; a++) s.m[r][a][l] = L->m[r][a];
             }
         }
-        if (!f->cells) {
-            /* Interleaved: a pixel's N/16 samples are no rows of cells; its rectangle is the whole light. */
-            s.rect[l][0] = s.rect[l][2] = 0;
-            s.rect[l][1] = s.rect[l][3] = f->k - 1;
-        } else if (!mft_live_rect(L->mask, f->k, s.rect[l])) continue;   /* the caller hands over non-empty masks */
+        if (!mft_live_rect(L->mask, f->k, s.rect[l])) continue;   /* the caller hands over non-empty masks */
         for (int ch = 0; ch < f->samples / 16; ch++)
             if (L->mask[ch >> 2] >> (ch & 3) * 16 & 0xFFFFu) s.livech[l][ch >> 6] |= UINT64_C(1) << (ch & 63);
         mft_lane_frustum(&s, l, 1);

@@ -1,2 +1,3 @@
-/* The portable instance of method mft's block tracer (mft_impl.h). */
+/* The portable instance of method mft's block tracers (mft_impl.h, mft_group_impl.h). */
 #include "mft_impl.h"
+#include "mft_group_impl.h"

@@ -33,7 +33,27 @@ void ms_block_frusta_set_lane(ms_block_frusta *f, int lane, const float c[3], co
         hi += rel * mag;
         if (lo == 0.0f) lo = -TINY;
         if (hi == 0.0f) hi = TINY;
-        f->c[a][lane] = c[a];
+        f->c[a][lane] = f->chi[a][lane] = c[a];
+        f->rlo[a][lane] = 1.0f / lo;
+        f->rhi[a][lane] = 1.0f / hi;
+        f->pos_hi[a] = (f->pos_hi[a] & ~bit) | (hi > 0.0f ? bit : 0u);
+        f->neg_lo[a] = (f->neg_lo[a] & ~bit) | (lo < 0.0f ? bit : 0u);
+    }
+    f->live |= bit;
+}
+
+void ms_block_frusta_set_lane_box(ms_block_frusta *f, int lane, const float clo[3], const float chi[3], const float plo[3],
+                                  const float phi[3], float rel)
+{
+    const unsigned bit = 1u << lane;
+    for (int a = 0; a < 3; a++) {
+        const float mag = ms_maxf(ms_maxf(fabsf(clo[a]), fabsf(chi[a])), ms_maxf(fabsf(plo[a]), fabsf(phi[a])));
+        /* dlo bounds the upper envelope's slope (from clo), dhi the lower's (from chi); 2 mag bounds |P - C|. */
+        float lo = plo[a] - clo[a] - rel * 2.0f * mag, hi = phi[a] - chi[a] + rel * 2.0f * mag;
+        if (lo == 0.0f) lo = -TINY;
+        if (hi == 0.0f) hi = TINY;
+        f->c[a][lane] = clo[a];
+        f->chi[a][lane] = chi[a];
         f->rlo[a][lane] = 1.0f / lo;
         f->rhi[a][lane] = 1.0f / hi;
         f->pos_hi[a] = (f->pos_hi[a] & ~bit) | (hi > 0.0f ? bit : 0u);

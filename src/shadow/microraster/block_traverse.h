@@ -14,7 +14,8 @@
  * often straddles zero on the light's own axes, so both signs are handled, per lane, by selects. The
  * test is conservative in floating point: node boxes are widened by a world margin that covers the
  * rounding of bmin - C, a zero direction bound is replaced by a tiny one of the same side (the box only
- * grows), and the final comparison allows a relative 2^-16. */
+ * grows), and the final comparison allows a relative 2^-16. A lane may also carry a box of apexes
+ * (ms_block_frusta_set_lane_box): then the lower bound uses the box's high corner and the upper its low. */
 #ifndef MS_BLOCK_TRAVERSE_H
 #define MS_BLOCK_TRAVERSE_H
 #include <stdint.h>
@@ -23,7 +24,8 @@
 #define MS_BLOCK_LANES 16
 
 typedef struct ms_block_frusta {
-    float c[3][MS_BLOCK_LANES];        /* apex per lane: the receiver point C */
+    float c[3][MS_BLOCK_LANES];        /* apex per lane: the receiver point C (the low corner of a box of apexes) */
+    float chi[3][MS_BLOCK_LANES];      /* the box's high corner: c for a single apex */
     float rlo[3][MS_BLOCK_LANES];      /* 1 / dlo per axis (dlo never 0) */
     float rhi[3][MS_BLOCK_LANES];      /* 1 / dhi */
     unsigned pos_hi[3], neg_lo[3];     /* lanes whose dhi > 0, whose dlo < 0, per axis */
@@ -52,5 +54,12 @@ void ms_block_frusta_init(ms_block_frusta *f, const ms_bvh_node *root, float nea
  * (world vectors corner - C, as exact as the caller has them), widening the box by rel times the
  * magnitudes involved, and makes the lane live. */
 void ms_block_frusta_set_lane(ms_block_frusta *f, int lane, const float c[3], const float d[4][3], float rel);
+/* Sets lane i to segments from any point of the box [clo, chi] to any point of the box [plo, phi] (method
+ * mft's interleaved groups: 16 rays from 16 receivers). Per axis X(t) = (1 - t) C + t P lies in
+ * [clo + t (plo - clo), chi + t (phi - chi)] for t in [0, 1], so the slab test above holds with the apex
+ * clo and the direction bound dlo = plo - clo on the upper side and chi, dhi = phi - chi on the lower;
+ * widened by rel times the magnitudes, as ms_block_frusta_set_lane. */
+void ms_block_frusta_set_lane_box(ms_block_frusta *f, int lane, const float clo[3], const float chi[3], const float plo[3],
+                                  const float phi[3], float rel);
 
 #endif

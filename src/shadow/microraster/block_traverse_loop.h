@@ -5,7 +5,8 @@
  *                  (MS_BT_COUNTERS traversal counters);
  *   BT_LEAF(s, n, mask)  processes leaf n for the lanes of mask; it clears from s->fr->live the lanes
  *                  it finishes (every sample occluded);
- *   BT_FN          the name of the traversal function to define.
+ *   BT_FN          the name of the traversal function to define (and BT_FN##_node, the node test);
+ *   BT_NODE_ONLY   (optional) define only the node test.
  * Depth first. Where both children survive, the nearer one first by a majority of the lanes that reach
  * both (the paper orders by its frusta's entry distances the same way); a pushed node keeps its lane
  * mask, which is narrowed on pop to the lanes still live. */
@@ -20,9 +21,8 @@ static inline unsigned MS_CAT(BT_FN, _node)(const ms_block_frusta *f, const ms_b
     l16 tlo = l16_set1(f->near), thi = l16_set1(f->far);
     const l16 ninf = l16_set1(-INFINITY), pinf = l16_set1(INFINITY);
     for (int a = 0; a < 3; a++) {
-        const l16 c = l16_load(f->c[a]);
-        const l16 alo = l16_sub(l16_set1(n->bmin[a] - f->margin), c);
-        const l16 ahi = l16_sub(l16_set1(n->bmax[a] + f->margin), c);
+        const l16 alo = l16_sub(l16_set1(n->bmin[a] - f->margin), l16_load(f->chi[a]));
+        const l16 ahi = l16_sub(l16_set1(n->bmax[a] + f->margin), l16_load(f->c[a]));
         const l16 c1 = l16_mul(alo, l16_load(f->rhi[a]));   /* t dhi >= alo: lower if dhi > 0, else upper */
         const l16 c2 = l16_mul(ahi, l16_load(f->rlo[a]));   /* t dlo <= ahi: upper if dlo > 0, else lower */
         tlo = l16_max(tlo, l16_max(l16_select(f->pos_hi[a], c1, ninf), l16_select(f->neg_lo[a], c2, ninf)));
@@ -36,6 +36,7 @@ static inline unsigned MS_CAT(BT_FN, _node)(const ms_block_frusta *f, const ms_b
     return l16_le(tlo, l16_add(thi, l16_mul(l16_abs(thi), l16_set1(1.0f / 65536.0f))));
 }
 
+#ifndef BT_NODE_ONLY   /* BT_NODE_ONLY: only the node test, for an includer with its own loop (mft_group_impl.h) */
 static void BT_FN(BT_STATE *s, const ms_bvh_shallow *sh, int order)
 {
     ms_block_frusta *f = s->fr;
@@ -87,3 +88,4 @@ static void BT_FN(BT_STATE *s, const ms_bvh_shallow *sh, int order)
 done:
     cnt[MS_BT_AABB_TESTS] += tests;
 }
+#endif

@@ -1,0 +1,516 @@
+/* Method mft in the interleaved mode (Benthin & Wald 2009, sec. 4.5): the tracer of a block's ray groups
+ * (mft.h, ms_mft_rayblock), one source compiled per ISA (mft_scalar.c, mft_avx2.c, mft_avx512.c) with
+ * lanes16.h for the file's target; defines ms_mft_groups_<isa>.
+ *
+ * A group is the up to 16 rays of one cell of the light, one from each pixel of a 4x4 block (mft.c): 16
+ * receivers close together to 16 points in 1/16 of the light (256 samples; 1/64 at 1024). Sixteen groups
+ * are sixteen SIMD lanes of the multi-frusta traversal (block_traverse_loop.h's node test, our own loop,
+ * mftg_traverse), each bounded by the box of its live rays' origins and the box of their sample points
+ * (ms_block_frusta_set_lane_box); below the frusta each lane's rays take raytrace's slab test, 16 in one
+ * register, at every child its frustum reaches, and go on with the rays that enter; in a leaf, per
+ * triangle:
+ *   1. where 4 or more groups reach it, culling of them all at once: the triangle's box against each
+ *      group's segments (the traversal's own interval test), and its plane against the boxes of origins
+ *      and points (every segment wholly on one side, or meeting the plane only before the near end);
+ *   2. the triangle relative to each of the 16 receivers and its plane offset (ms_wt_offset), once per
+ *      triangle, one receiver per SIMD lane;
+ *   3. per surviving group, its 16 rays in one SIMD operation: method raytrace's watertight test
+ *      (raytrace_impl.h, packet_triangle) with each ray's own shear axis (its pixel's packet's) and
+ *      shear, operation for operation, so every ray gets raytrace's answer; one bit per ray, a hit clears
+ *      it (in the group and in its pixel's mask); a group with no live ray leaves the traversal;
+ *   4. after a leaf in which a group lost rays, its boxes are recomputed from its live rays (the paper's
+ *      CR, frustum shrinking, here both for the culling and the traversal).
+ *
+ * Departures from the paper, and why:
+ *  - the paper traces one frustum per pixel, its 16 rays (one interleaved set) spread over the whole light,
+ *    so each frustum spans the whole light and culls little (measured here: bunny 256^2, 11.4M 16-ray tests
+ *    against raytrace's 0.57M before the per-ray box test, then a traversal as costly as raytrace's,
+ *    docs/methods.md). Grouping the same 256 rays of a block by cell instead gives 16 frusta each 1/4 of
+ *    the light across, from a 4x4-pixel patch of receivers: the rays and the answers are the same;
+ *  - a group has 16 apexes, so it has no corner rays: the paper's corner-ray culling (the triangle's edge
+ *    planes through the apex) is replaced by the triangle-box and plane tests of step 1, which hold for a
+ *    box of apexes; the paper's back-face culling is not used (shadows need both sides);
+ *  - the per-ray box test at every node (the paper's "Ray-AABB" at the leaves only, which did not pay on
+ *    Larrabee): a group's rays are a quarter of the light apart, wider than small triangles, so its
+ *    frustum alone reached 10x the leaves its rays enter (ogre 256^2; docs/methods.md);
+ *  - the rays are formed once per block (not on demand from delta vectors): the exact agreement with
+ *    raytrace needs its shear (one division per ray) and its shared packet axis.
+ * Culling is conservative: each test carries a relative slack of 1e-5 of the magnitudes involved (about
+ * 170 float ulps), far above the watertight test's own error (a few ulps of the vertices' distance). */
+#include <math.h>
+#include <string.h>
+#include "mft.h"
+#include "visibility/lanes16.h"
+#include "core/perk.h"
+#include "accel/ray_triangle.h"
+#include "visibility/alpha.h"
+
+#define MFTG_REL 1e-5f
+/* Measurement switches (builds with -D..., docs/methods.md): the groups at a triangle from which it is
+ * culled for all at once (1: always; with one or two groups the cull cost more than it saved, ogre +18%);
+ * CR on or off (within noise). */
+#ifndef MFTG_TRI_CULL
+#define MFTG_TRI_CULL 4
+#endif
+#ifndef MFTG_CR
+#define MFTG_CR 1
+#endif
+
+typedef struct mftg_state {
+    ms_block_frusta *fr;
+    uint64_t *bt_cnt;
+    const ms_mft_frame *f;
+    ms_mft_rayblock *rb;
+    const ms_bvh *b;
+    ms_mft_group *grp[MS_BLOCK_LANES];   /* the group of each lane */
+    /* Per lane: its origins' box and its points' box (centre and half extent), and a magnitude. */
+    float oc[3][MS_BLOCK_LANES], oh[3][MS_BLOCK_LANES], pc[3][MS_BLOCK_LANES], ph[3][MS_BLOCK_LANES];
+    float mag[MS_BLOCK_LANES];
+    float c[3][MS_BLOCK_LANES];          /* the receivers, one per lane (slot q) */
+    float olo[3][MS_BLOCK_LANES], ohi[3][MS_BLOCK_LANES];   /* them shifted by raytrace's box margin */
+} mftg_state;
+
+/* The rays of group g (bits) that enter box n: method raytrace's box test (raytrace_impl.h, packet_enters)
+ * per ray, its widened box and Ize's factor, so it never drops a ray that raytrace's triangle test
+ * finds blocked by a triangle in the box. */
+static inline unsigned mftg_ray_box(const mftg_state *s, const ms_mft_group *g, const ms_bvh_node *n)
+{
+    l16 t0 = l16_set1(s->f->near), t1 = l16_set1(s->f->far);
+    for (int a = 0; a < 3; a++) {
+        const l16 inv = l16_load(g->inv[a]);
+        const l16 x = l16_mul(l16_sub(l16_set1(n->bmin[a]), l16_load(s->olo[a])), inv);
+        const l16 y = l16_mul(l16_sub(l16_set1(n->bmax[a]), l16_load(s->ohi[a])), inv);
+        /* raytrace's compares: mn = x < y ? x : y, mx = x < y ? y : x; a NaN leaves t0, t1 as they were */
+        const l16 mn = l16_min(x, y), mx = l16_select(l16_lt(x, y), y, x);
+        t0 = l16_max(mn, t0);
+        t1 = l16_min(mx, t1);
+    }
+    return l16_le(t0, l16_mul(t1, l16_set1(MS_WT_FAR_SCALE))) & g->live;
+}
+
+/* Lane l's frustum from its group's live rays. */
+static void mftg_lane_bounds(mftg_state *s, int l)
+{
+    const ms_mft_group *g = s->grp[l];
+    const ms_mft_rayblock *rb = s->rb;
+    float clo[3], chi[3], plo[3], phi[3];
+    for (int a = 0; a < 3; a++) { clo[a] = plo[a] = INFINITY; chi[a] = phi[a] = -INFINITY; }
+    for (unsigned m = g->live; m; m &= m - 1) {
+        const int q = __builtin_ctz(m);
+        for (int a = 0; a < 3; a++) {
+            const float c = rb->c[a][q], p = g->p[a][q];
+            clo[a] = c < clo[a] ? c : clo[a];
+            chi[a] = c > chi[a] ? c : chi[a];
+            plo[a] = p < plo[a] ? p : plo[a];
+            phi[a] = p > phi[a] ? p : phi[a];
+        }
+    }
+    float mag = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        s->oc[a][l] = 0.5f * (clo[a] + chi[a]);
+        s->oh[a][l] = 0.5f * (chi[a] - clo[a]);
+        s->pc[a][l] = 0.5f * (plo[a] + phi[a]);
+        s->ph[a][l] = 0.5f * (phi[a] - plo[a]);
+        for (int e = 0; e < 4; e++) { const float x = fabsf(e == 0 ? clo[a] : e == 1 ? chi[a] : e == 2 ? plo[a] : phi[a]); mag = x > mag ? x : mag; }
+    }
+    s->mag[l] = mag;
+    ms_block_frusta_set_lane_box(s->fr, l, clo, chi, plo, phi, MFTG_REL);
+}
+
+#define BT_STATE mftg_state
+#define BT_FN mftg_traverse
+#define BT_NODE_ONLY
+#include "shadow/microraster/block_traverse_loop.h"
+#undef BT_STATE
+#undef BT_FN
+#undef BT_NODE_ONLY
+
+/* The triangle's rays of group g (bits: its live slots, less those whose own triangle this is) that it
+ * blocks: raytrace's packet_triangle per ray, the same operations in the same order, with the ray's own
+ * shear axis. V[v][x]: the vertices relative to each slot's receiver (x: world axis); num: ms_wt_offset per
+ * slot. */
+static unsigned mftg_rays(const mftg_state *s, const ms_mft_group *g, unsigned bits, const float *tri, const float N[3],
+                          const l16 V[3][3], l16 num, const float *numv)
+{
+    const ms_mft_frame *f = s->f;
+    const unsigned alone = bits & g->alone;
+    unsigned hit = 0;
+    for (unsigned m = alone; m; m &= m - 1) {
+        const int q = __builtin_ctz(m);
+        const float o[3] = { s->rb->c[0][q], s->rb->c[1][q], s->rb->c[2][q] }, d[3] = { g->d[0][q], g->d[1][q], g->d[2][q] };
+        if (ms_wt_segment(o, d, tri, N, f->near, f->far)) hit |= 1u << q;
+    }
+    bits &= ~alone;
+    if (!bits) return hit;
+    /* Per slot, the vertices permuted to its axes (kx, ky, kz cyclic): one permutation when every ray of
+     * the group shares kz, else per-slot selects. */
+    l16 A[3][3];   /* [vertex][x, y, z] */
+    if (g->kz_all >= 0) {
+        const int kz = g->kz_all, kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+        for (int v = 0; v < 3; v++) { A[v][0] = V[v][kx]; A[v][1] = V[v][ky]; A[v][2] = V[v][kz]; }
+    } else {
+        unsigned k0 = 0, k1 = 0;
+        for (int q = 0; q < MS_BLOCK_LANES; q++) { k0 |= (unsigned)(g->kz[q] == 0) << q; k1 |= (unsigned)(g->kz[q] == 1) << q; }
+        for (int v = 0; v < 3; v++) {
+            A[v][0] = l16_select(k0, V[v][1], l16_select(k1, V[v][2], V[v][0]));
+            A[v][1] = l16_select(k0, V[v][2], l16_select(k1, V[v][0], V[v][1]));
+            A[v][2] = l16_select(k0, V[v][0], l16_select(k1, V[v][1], V[v][2]));
+        }
+    }
+    const l16 sx = l16_load(g->sx), sy = l16_load(g->sy);
+    const l16 ax = l16_sub(A[0][0], l16_mul(sx, A[0][2])), ay = l16_sub(A[0][1], l16_mul(sy, A[0][2]));
+    const l16 bx = l16_sub(A[1][0], l16_mul(sx, A[1][2])), by = l16_sub(A[1][1], l16_mul(sy, A[1][2]));
+    const l16 cx = l16_sub(A[2][0], l16_mul(sx, A[2][2])), cy = l16_sub(A[2][1], l16_mul(sy, A[2][2]));
+    const l16 u = l16_sub(l16_mul(cx, by), l16_mul(cy, bx));
+    const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
+    const l16 w = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
+    const l16 zero = l16_set1(0.0f);
+    /* raytrace's tests with fewer compares, as mft_packet (mft_impl.h). */
+    const unsigned z = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(w)), zero);
+    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), w), zero) & l16_gt(l16_max(l16_max(u, v), w), zero);
+    const l16 det = l16_add(l16_add(u, v), w);
+    const l16 den = l16_add(l16_add(l16_mul(l16_load(g->d[0]), l16_set1(N[0])), l16_mul(l16_load(g->d[1]), l16_set1(N[1]))),
+                            l16_mul(l16_load(g->d[2]), l16_set1(N[2])));
+    const l16 ns = l16_select(l16_lt(den, zero), l16_sub(zero, num), num), aden = l16_abs(den);
+    hit |= bits & ~z & ~mixed & l16_gt(l16_abs(det), zero) & l16_gt(aden, zero) &
+           l16_le(l16_mul(l16_set1(f->near), aden), ns) & l16_le(ns, l16_mul(l16_set1(f->far), aden));
+    /* An edge function exactly 0: redone by the scalar test (in double), as raytrace does (rare). */
+    for (unsigned m = bits & z; m; m &= m - 1) {
+        const int q = __builtin_ctz(m), kz = g->kz[q];
+        float Vq[3][3];
+        for (int vv = 0; vv < 3; vv++)
+            for (int x = 0; x < 3; x++) Vq[vv][x] = tri[3 * vv + x] - s->rb->c[x][q];
+        const float d[3] = { g->d[0][q], g->d[1][q], g->d[2][q] };
+        if (ms_wt_segment_sheared(Vq[0], Vq[1], Vq[2], kz, g->sx[q], g->sy[q], d, N, numv[q], f->near, f->far))
+            hit |= 1u << q;
+    }
+    return hit;
+}
+
+/* Leaf n for the lanes of mask, whose rays[l] entered its box. */
+static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const uint16_t *enter)
+{
+    ms_block_frusta *fr = s->fr;
+    const ms_mft_frame *f = s->f;
+    ms_mft_rayblock *rb = s->rb;
+    uint64_t *cnt = s->bt_cnt;
+    /* The slots whose own triangle is in this leaf. */
+    uint32_t skip_tri[MS_BLOCK_LANES];
+    unsigned skip_slot[MS_BLOCK_LANES];
+    int nskip = 0;
+    for (int q = 0; q < rb->nq; q++)
+        if (rb->skip[q] - n->first < n->count) { skip_tri[nskip] = rb->skip[q]; skip_slot[nskip++] = 1u << q; }
+    const l16 zero = l16_set1(0.0f), rel = l16_set1(MFTG_REL);
+    l16 oc[3], oh[3], pc[3], ph[3], cq[3];
+    for (int a = 0; a < 3; a++) {
+        oc[a] = l16_load(s->oc[a]); oh[a] = l16_load(s->oh[a]);
+        pc[a] = l16_load(s->pc[a]); ph[a] = l16_load(s->ph[a]);
+        cq[a] = l16_load(s->c[a]);
+    }
+    const l16 lmag = l16_load(s->mag), near = l16_set1(f->near);
+    unsigned lost = 0;
+    uint64_t pairs = 0, c_box = 0, c_plane = 0, tested = 0, isec = 0, early = 0;
+    for (uint32_t t = n->first; t < n->first + n->count; t++) {
+        unsigned lanes = mask & fr->live;
+        if (!lanes) break;
+        pairs += (uint64_t)ms_bt_popcount16(lanes);
+        const float *tri = s->b->tri + 9 * (size_t)t, *N = s->b->tri_n + 3 * (size_t)t;
+        /* 1. The triangle's box against the groups' segments (the traversal's test), then its plane. */
+        ms_bvh_node tb;
+        float tmag = 0.0f;
+        for (int a = 0; a < 3; a++) {
+            const float x = tri[a], y = tri[3 + a], z = tri[6 + a];
+            tb.bmin[a] = x < y ? (x < z ? x : z) : (y < z ? y : z);
+            tb.bmax[a] = x > y ? (x > z ? x : z) : (y > z ? y : z);
+            tmag = fmaxf(tmag, fmaxf(fabsf(tb.bmin[a]), fabsf(tb.bmax[a])));
+        }
+        l16 tlo;
+        /* Worth its cost (one test for 16 groups) only with several groups at the triangle: measured,
+         * with one or two it costs more than their 16-ray tests save (the ogre: +18% CPU). */
+        const int cull = ms_bt_popcount16(lanes) >= MFTG_TRI_CULL;
+        const unsigned in_box = cull ? mftg_traverse_node(fr, &tb, &tlo) & lanes : lanes;
+        c_box += (uint64_t)ms_bt_popcount16(lanes & ~in_box);
+        lanes = in_box;
+        if (!lanes) continue;
+        if (cull) {
+            /* a = (C - v) . N over the origins' box, b = (P - v) . N over the points': the vertices' own
+             * offsets span [wlo, whi] (N is rounded). A hit needs the segment to cross the plane at t =
+             * a / (a - b) in [near, far]: not both ends on one side, and |a| >= near |a - b|. */
+            const float nl1 = fabsf(N[0]) + fabsf(N[1]) + fabsf(N[2]);
+            float wlo = INFINITY, whi = -INFINITY;
+            for (int v = 0; v < 3; v++) {
+                const float w = tri[3 * v] * N[0] + tri[3 * v + 1] * N[1] + tri[3 * v + 2] * N[2];
+                wlo = w < wlo ? w : wlo;
+                whi = w > whi ? w : whi;
+            }
+            const l16 an[3] = { l16_set1(fabsf(N[0])), l16_set1(fabsf(N[1])), l16_set1(fabsf(N[2])) };
+            l16 o = zero, oe = zero, p = zero, pe = zero;
+            for (int a = 0; a < 3; a++) {
+                const l16 na = l16_set1(N[a]);
+                o = l16_add(o, l16_mul(oc[a], na));
+                oe = l16_add(oe, l16_mul(oh[a], an[a]));
+                p = l16_add(p, l16_mul(pc[a], na));
+                pe = l16_add(pe, l16_mul(ph[a], an[a]));
+            }
+            const l16 tol = l16_mul(l16_mul(l16_max(lmag, l16_set1(tmag)), l16_set1(nl1)), rel);
+            const l16 wl = l16_set1(wlo), wh = l16_set1(whi);
+            const l16 alo = l16_sub(l16_sub(o, oe), wh), ahi = l16_sub(l16_add(o, oe), wl);
+            const l16 blo = l16_sub(l16_sub(p, pe), wh), bhi = l16_sub(l16_add(p, pe), wl);
+            const l16 ntol = l16_sub(zero, tol);
+            unsigned out = (l16_gt(alo, tol) & l16_gt(blo, tol)) | (l16_lt(ahi, ntol) & l16_lt(bhi, ntol));
+            /* a - b = (C - P) . N over both boxes; near: max |a| < near min |a - b|. */
+            const l16 dlo = l16_sub(l16_sub(o, oe), l16_add(p, pe)), dhi = l16_sub(l16_add(o, oe), l16_sub(p, pe));
+            const unsigned dpos = l16_gt(dlo, zero), dneg = l16_lt(dhi, zero);
+            const l16 dmin = l16_select(dpos, dlo, l16_sub(zero, dhi));
+            const l16 amax = l16_max(l16_abs(alo), l16_abs(ahi));
+            out |= (dpos | dneg) & l16_lt(l16_add(amax, tol), l16_mul(near, l16_sub(dmin, tol)));
+            c_plane += (uint64_t)ms_bt_popcount16(lanes & out);
+            lanes &= ~out;
+            if (!lanes) continue;
+        }
+        unsigned skip = 0;
+        for (int q = 0; q < nskip; q++)
+            if (skip_tri[q] == t) skip |= skip_slot[q];
+        /* 2. The triangle relative to each receiver (slot q in lane q) and ms_wt_offset, bit for bit. */
+        l16 V[3][3], lv[3];
+        for (int v = 0; v < 3; v++) {
+            for (int x = 0; x < 3; x++) V[v][x] = l16_sub(l16_set1(tri[3 * v + x]), cq[x]);
+            lv[v] = l16_add(l16_add(l16_mul(V[v][0], V[v][0]), l16_mul(V[v][1], V[v][1])), l16_mul(V[v][2], V[v][2]));
+        }
+        /* nr = lv0 <= lv1 ? (lv0 <= lv2 ? 0 : 2) : (lv1 <= lv2 ? 1 : 2) */
+        const unsigned le01 = l16_le(lv[0], lv[1]), p0 = le01 & l16_le(lv[0], lv[2]), p1 = ~le01 & l16_le(lv[1], lv[2]);
+        l16 vn[3];
+        for (int x = 0; x < 3; x++) vn[x] = l16_select(p0, V[0][x], l16_select(p1, V[1][x], V[2][x]));
+        const l16 num = l16_add(l16_add(l16_mul(vn[0], l16_set1(N[0])), l16_mul(vn[1], l16_set1(N[1]))), l16_mul(vn[2], l16_set1(N[2])));
+        float numv[MS_BLOCK_LANES];
+        l16_store(numv, num);
+        /* 3. Each surviving group's rays, 16 in one operation. */
+        for (; lanes; lanes &= lanes - 1) {
+            const int l = __builtin_ctz(lanes);
+            ms_mft_group *g = s->grp[l];
+            const unsigned bits = g->live & enter[l] & ~skip;
+            tested++;
+            if (!bits) continue;
+            isec++;
+            unsigned hit = mftg_rays(s, g, bits, tri, N, V, num, numv);
+            /* An alpha-tested triangle keeps only the rays where it is opaque (alpha.h: the segment from the
+             * receiver to the sample point, as every method decides). */
+            if (hit && f->alpha && f->alpha->flag[t])
+                for (unsigned m = hit; m; m &= m - 1) {
+                    const int q = __builtin_ctz(m);
+                    const float o[3] = { rb->c[0][q], rb->c[1][q], rb->c[2][q] }, pt[3] = { g->p[0][q], g->p[1][q], g->p[2][q] };
+                    if (!ms_alpha_segment_occludes(f->alpha, t, o, pt)) hit &= ~(1u << q);
+                }
+            if (!hit) continue;
+            g->live &= ~hit;
+            for (unsigned m = hit; m; m &= m - 1) {
+                const int q = __builtin_ctz(m), i = g->sample[q];
+                rb->mask[q][i >> 6] &= ~(UINT64_C(1) << (i & 63));
+            }
+            lost |= 1u << l;
+            if (!g->live) { fr->live &= ~(1u << l); early++; }
+        }
+    }
+    cnt[MS_MFT_PAIRS] += pairs;
+    cnt[MS_MFT_CULLED_BOX] += c_box;
+    cnt[MS_MFT_CULLED_PLANE] += c_plane;
+    cnt[MS_MFT_PAIRS_TESTED] += tested;
+    cnt[MS_MFT_ISEC16] += isec;
+    cnt[MS_MFT_FRUSTA_EARLY_OUT] += early;
+    /* 4. The groups that lost rays: their boxes from the live rays (CR). */
+    for (unsigned m = MFTG_CR ? lost & fr->live : 0u; m; m &= m - 1) {
+        mftg_lane_bounds(s, __builtin_ctz(m));
+        cnt[MS_MFT_RECT_SHRINKS]++;
+    }
+}
+
+/* Depth-first over the shallow BVH, as block_traverse_loop.h, with each lane's rays: a child is visited
+ * for the lanes whose frustum may reach it (all 16 at once) and, of those, whose rays enter it (one 16-ray
+ * box test per lane, raytrace's; from depth MFTG_RAY_DEPTH on, above it the rays pass). The frusta cull
+ * the upper levels for 16 groups at a time; the rays the lower ones, where a group's frustum, however
+ * thin on the light, is wide against small triangles (measured: the ogre at 256^2, 14.5M lane-leaf visits
+ * for 1.5M leaves when only the leaves tested the rays). Departure from the paper (frusta only). */
+#ifndef MFTG_RAY_DEPTH
+#define MFTG_RAY_DEPTH 0
+#endif
+static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
+{
+    ms_block_frusta *f = s->fr;
+    uint64_t *cnt = s->bt_cnt;
+    l16 t0, t1;
+    cnt[MS_BT_BLOCKS]++;
+    cnt[MS_BT_AABB_TESTS]++;
+    unsigned mask = mftg_traverse_node(f, &sh->nodes[0], &t0) & f->live;
+    if (!mask) return;
+    uint32_t st_node[MS_BVH_STACK];
+    unsigned st_mask[MS_BVH_STACK];
+    uint16_t st_rays[MS_BVH_STACK][MS_BLOCK_LANES];
+    uint8_t st_depth[MS_BVH_STACK];
+    uint16_t rays[MS_BLOCK_LANES], rl[MS_BLOCK_LANES], rr[MS_BLOCK_LANES];
+    for (int l = 0; l < MS_BLOCK_LANES; l++) rays[l] = (uint16_t)(s->grp[l] ? s->grp[l]->live : 0u);
+    int sp = 0, depth = 0;
+    uint32_t ni = 0;
+    uint64_t tests = 0, ray_tests = 0, lanes_culled = 0;
+    for (;;) {
+        const ms_bvh_node *n = &sh->nodes[ni];
+        if (n->count) {
+            cnt[MS_BT_LEAVES]++;
+            cnt[MS_BT_TRIS_ACCESSED] += n->count;
+            mftg_leaf(s, n, mask, rays);
+            if (!f->live) { cnt[MS_BT_BLOCKS_EARLY_OUT]++; break; }
+        } else {
+            const uint32_t c0 = n->first;
+            mask &= f->live;
+            unsigned ml = mftg_traverse_node(f, &sh->nodes[c0], &t0) & mask;
+            unsigned mr = mftg_traverse_node(f, &sh->nodes[c0 + 1], &t1) & mask;
+            tests += 2;
+            const ms_bvh_node *n0 = &sh->nodes[c0], *n1 = &sh->nodes[c0 + 1];
+            const int test_rays = depth + 1 >= MFTG_RAY_DEPTH;
+            for (unsigned m = ml | mr; m; m &= m - 1) {
+                const int l = __builtin_ctz(m);
+                const unsigned live = rays[l] & s->grp[l]->live;
+                if (ml >> l & 1) {
+                    const int t = test_rays;
+                    rl[l] = (uint16_t)(t ? mftg_ray_box(s, s->grp[l], n0) & live : live);
+                    ray_tests += (uint64_t)t;
+                    if (!rl[l]) { ml &= ~(1u << l); lanes_culled++; }
+                }
+                if (mr >> l & 1) {
+                    const int t = test_rays;
+                    rr[l] = (uint16_t)(t ? mftg_ray_box(s, s->grp[l], n1) & live : live);
+                    ray_tests += (uint64_t)t;
+                    if (!rr[l]) { mr &= ~(1u << l); lanes_culled++; }
+                }
+            }
+            depth++;
+            if (ml && mr) {
+                int right_first = 0;
+                if (order) {
+                    const unsigned both = ml & mr;
+                    right_first = 2 * ms_bt_popcount16(l16_lt(t1, t0) & both) > ms_bt_popcount16(both);
+                }
+                st_depth[sp] = (uint8_t)depth;
+                if (right_first) {
+                    st_node[sp] = c0; st_mask[sp] = ml; memcpy(st_rays[sp++], rl, sizeof rl);
+                    ni = c0 + 1; mask = mr; memcpy(rays, rr, sizeof rr);
+                } else {
+                    st_node[sp] = c0 + 1; st_mask[sp] = mr; memcpy(st_rays[sp++], rr, sizeof rr);
+                    ni = c0; mask = ml; memcpy(rays, rl, sizeof rl);
+                }
+                continue;
+            }
+            if (ml) { ni = c0; mask = ml; memcpy(rays, rl, sizeof rl); continue; }
+            if (mr) { ni = c0 + 1; mask = mr; memcpy(rays, rr, sizeof rr); continue; }
+        }
+        for (;;) {
+            if (sp == 0) goto done;
+            --sp;
+            mask = st_mask[sp] & f->live;
+            if (mask) break;
+        }
+        ni = st_node[sp];
+        depth = st_depth[sp];
+        memcpy(rays, st_rays[sp], sizeof rays);
+    }
+done:
+    cnt[MS_BT_AABB_TESTS] += tests;
+    cnt[MS_MFT_RAY_BOX] += ray_tests;
+    cnt[MS_MFT_LEAF_LANES_CULLED] += lanes_culled;
+}
+
+/* The rays of a block by set (rb->form_n, mft.c: mft_block_by_set), 16 slots at a time with raytrace's
+ * operations: d = P - C, 1 / d, each slot packet's shear axis over its 16 samples in sample order
+ * (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]); every lane one IEEE operation (lanes16.h), so the rays are
+ * raytrace's floats. */
+static void mftg_form(ms_mft_rayblock *rb)
+{
+    const int n = rb->form_n, ncell = rb->n;
+    l16 C[3];
+    for (int a = 0; a < 3; a++) C[a] = l16_load(rb->c[a]);
+    const l16 one = l16_set1(1.0f);
+    for (int c = 0; c < ncell; c++) {
+        ms_mft_group *G = &rb->g[c];
+        for (int a = 0; a < 3; a++) {
+            const l16 P = l16_load(rb->cell_pts + ((size_t)c * 3 + a) * 16), d = l16_sub(P, C[a]);
+            l16_store(G->p[a], P);
+            l16_store(G->d[a], d);
+            l16_store(G->inv[a], l16_div(one, d));
+        }
+        unsigned live = 0;
+        for (int q = 0; q < 16; q++) {
+            const int j = rb->sample_of[(size_t)q * ncell + c];
+            G->sample[q] = (uint16_t)j;
+            if (rb->present >> q & 1) live |= (unsigned)(rb->mask[q][j >> 6] >> (j & 63) & 1u) << q;
+        }
+        G->live = live;
+    }
+    signed char kz[16][MS_SAMPLES_MAX / 16 / 16];
+    for (int q = 0; q < 16; q++) {
+        if (!(rb->present >> q & 1)) continue;
+        for (int ch = 0; ch < n / 16; ch++) {
+            float dx[16], dy[16], dz[16];
+            for (int l = 0; l < 16; l++) {
+                const ms_mft_group *G = &rb->g[rb->set_cell[(size_t)q * n + 16 * ch + l]];
+                dx[l] = G->d[0][q];
+                dy[l] = G->d[1][q];
+                dz[l] = G->d[2][q];
+            }
+            int k0;
+            kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, &k0);
+        }
+    }
+    for (int c = 0; c < ncell; c++) {
+        ms_mft_group *G = &rb->g[c];
+        unsigned k1 = 0, k2 = 0;
+        int kall = -2;
+        G->alone = 0;
+        for (int q = 0; q < 16; q++) {
+            const int k = (rb->present >> q & 1) ? kz[q][G->sample[q] >> 4] : 0;
+            G->kz[q] = (signed char)k;
+            G->alone |= (unsigned)(k < 0) << q;
+            k1 |= (unsigned)(k == 1) << q;
+            k2 |= (unsigned)(k == 2) << q;
+            if ((G->live >> q & 1) && k >= 0) kall = kall == -2 || kall == k ? k : -1;
+        }
+        G->kz_all = kall < 0 ? (kall == -2 ? 0 : -1) : kall;
+        /* kz = 0: (kx, ky) = (1, 2); 1: (2, 0); 2: (0, 1); a slot without an axis (tested alone) takes 0's. */
+        l16 d[3], inv[3];
+        for (int a = 0; a < 3; a++) { d[a] = l16_load(G->d[a]); inv[a] = l16_load(G->inv[a]); }
+        const l16 ikz = l16_select(k1, inv[1], l16_select(k2, inv[2], inv[0]));
+        const l16 dkx = l16_select(k1, d[2], l16_select(k2, d[0], d[1]));
+        const l16 dky = l16_select(k1, d[0], l16_select(k2, d[1], d[2]));
+        l16_store(G->sx, l16_mul(dkx, ikz));
+        l16_store(G->sy, l16_mul(dky, ikz));
+    }
+}
+
+void MS_CAT(ms_mft_groups_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_rayblock *rb, const ms_bvh *b,
+                                           const ms_bvh_shallow *sh, uint64_t *cnt)
+{
+    ms_block_frusta fr;
+    mftg_state s;
+    memset(&s, 0, sizeof s);
+    s.fr = &fr;
+    s.bt_cnt = cnt;
+    s.f = f;
+    s.rb = rb;
+    s.b = b;
+    if (rb->form_n) mftg_form(rb);
+    for (int a = 0; a < 3; a++) memcpy(s.c[a], rb->c[a], sizeof s.c[a]);
+    for (int q = 0; q < rb->nq; q++) {
+        float c[3] = { rb->c[0][q], rb->c[1][q], rb->c[2][q] }, lo[3], hi[3];
+        ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, c, lo, hi);
+        for (int a = 0; a < 3; a++) { s.olo[a][q] = lo[a]; s.ohi[a][q] = hi[a]; }
+    }
+    for (int g0 = 0; g0 < rb->n; g0 += MS_BLOCK_LANES) {
+        ms_block_frusta_init(&fr, &sh->nodes[0], f->near, f->far);
+        memset(s.grp, 0, sizeof s.grp);
+        for (int l = 0; l < MS_BLOCK_LANES && g0 + l < rb->n; l++) {
+            s.grp[l] = &rb->g[g0 + l];
+            if (!s.grp[l]->live) continue;
+            mftg_lane_bounds(&s, l);
+            cnt[MS_MFT_FRUSTA]++;
+        }
+        if (fr.live) mftg_traverse(&s, sh, f->flags & MS_MFT_ORDER);
+    }
+}
