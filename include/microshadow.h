@@ -1,5 +1,5 @@
 /*
- * microshadow — physically based soft shadows from area lights (parallelograms, disks, spheres), on the CPU.
+ * microshadow — physically based soft shadows from area lights (parallelograms, disks, spheres, triangles, the sun), on the CPU.
  *
  * One entry point does a whole frame:
  *
