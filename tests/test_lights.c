@@ -242,9 +242,7 @@ static void test_disk_frames_equal(void **st)
     for (int mi = 0; names[mi]; mi++) {
         o.method = names[mi];
         assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        long differ = 0;
-        for (int i = 0; i < 40 * 40; i++)
-            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        const long differ = tu_frame_values_differ(&f, &ref);
         if (differ) fprintf(stderr, "disk frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
         assert_int_equal(differ, 0);
         ms_frame_free(&f);
@@ -890,9 +888,7 @@ static void test_sphere_every_method(void **st)
     for (int mi = 0; names[mi]; mi++) {
         o.method = names[mi];
         assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        long differ = 0;
-        for (int i = 0; i < size * size; i++)
-            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        const long differ = tu_frame_values_differ(&f, &ref);
         if (differ) fprintf(stderr, "sphere frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
         assert_int_equal(differ, 0);
         ms_frame_free(&f);
@@ -985,9 +981,7 @@ static void test_triangle_frames_equal(void **st)
     for (int mi = 0; names[mi]; mi++) {
         o.method = names[mi];
         assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        long differ = 0;
-        for (int i = 0; i < 32 * 32; i++)
-            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        const long differ = tu_frame_values_differ(&f, &ref);
         if (differ) fprintf(stderr, "triangle frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
         assert_int_equal(differ, 0);
         ms_frame_free(&f);

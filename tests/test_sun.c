@@ -142,9 +142,7 @@ static void check_every_method(float deg)
     for (int mi = 0; names[mi]; mi++) {
         o.method = names[mi];
         assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        long differ = 0;
-        for (int i = 0; i < size * size; i++)
-            differ += f.vis[i] != ref.vis[i] || f.shadow[i] != ref.shadow[i] || f.front[i] != ref.front[i];
+        const long differ = tu_frame_values_differ(&f, &ref);
         if (!strcmp(names[mi], "scanline")) {
             /* the light-dependent optimisations are at work for the sun, not turned off */
             printf("sun %.2f deg, scanline: %llu triangles culled, %llu interior boxes, %llu triangles merged\n",

@@ -138,6 +138,19 @@ tu_agreement tu_compare_frames(const ms_frame *a, const ms_frame *b)
     return g;
 }
 
+long tu_frame_values_differ(const ms_frame *a, const ms_frame *b)
+{
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    const int la = a->n_lights > 1 ? a->n_lights : 1, lb = b->n_lights > 1 ? b->n_lights : 1;
+    assert_int_equal(la, lb);
+    const long n = (long)a->width * a->height * la;
+    long differ = 0;
+    for (long i = 0; i < n; i++)
+        differ += a->vis[i] != b->vis[i] || a->shadow[i] != b->shadow[i] || a->front[i] != b->front[i];
+    return differ;
+}
+
 void tu_query_from_hit(ms_shadow_query *q, const ms_hit *h, int x, int y)
 {
     ms_query_from_hit(q, h, (uint32_t)x, (uint32_t)y);

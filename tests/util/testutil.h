@@ -56,6 +56,10 @@ typedef struct tu_agreement {
     double max_ds;
 } tu_agreement;
 tu_agreement tu_compare_frames(const ms_frame *a, const ms_frame *b);
+/* Values of two frames of the same size that are not bit for bit equal: V, S and the front count of every
+ * light's plane (the larger n_lights of the two; 0 means 1). For methods that must give raytrace's answer
+ * exactly. */
+long tu_frame_values_differ(const ms_frame *a, const ms_frame *b);
 
 /* Internal-API helpers for tests that drive shadow methods directly on chosen points. */
 struct ms_render_ctx;
