@@ -157,25 +157,11 @@ static unsigned mftg_rays(const mftg_state *s, const ms_mft_group *g, unsigned b
             A[v][2] = l16_select(k0, V[v][0], l16_select(k1, V[v][1], V[v][2]));
         }
     }
-    const l16 sx = l16_load(g->sx), sy = l16_load(g->sy);
-    const l16 ax = l16_sub(A[0][0], l16_mul(sx, A[0][2])), ay = l16_sub(A[0][1], l16_mul(sy, A[0][2]));
-    const l16 bx = l16_sub(A[1][0], l16_mul(sx, A[1][2])), by = l16_sub(A[1][1], l16_mul(sy, A[1][2]));
-    const l16 cx = l16_sub(A[2][0], l16_mul(sx, A[2][2])), cy = l16_sub(A[2][1], l16_mul(sy, A[2][2]));
-    const l16 u = l16_sub(l16_mul(cx, by), l16_mul(cy, bx));
-    const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
-    const l16 w = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
-    const l16 zero = l16_set1(0.0f);
-    /* raytrace's tests with fewer compares, as mft_packet (mft_impl.h). */
-    const unsigned z = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(w)), zero);
-    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), w), zero) & l16_gt(l16_max(l16_max(u, v), w), zero);
-    const l16 det = l16_add(l16_add(u, v), w);
-    const l16 den = l16_add(l16_add(l16_mul(l16_load(g->d[0]), l16_set1(N[0])), l16_mul(l16_load(g->d[1]), l16_set1(N[1]))),
-                            l16_mul(l16_load(g->d[2]), l16_set1(N[2])));
-    const l16 ns = l16_select(l16_lt(den, zero), l16_sub(zero, num), num), aden = l16_abs(den);
-    hit |= bits & ~z & ~mixed & l16_gt(l16_abs(det), zero) & l16_gt(aden, zero) &
-           l16_le(l16_mul(l16_set1(f->near), aden), ns) & l16_le(ns, l16_mul(l16_set1(f->far), aden));
+    const l16 dir[3] = { l16_load(g->d[0]), l16_load(g->d[1]), l16_load(g->d[2]) };
+    unsigned z;
+    hit |= mft_rays16((const l16 (*)[3])A, l16_load(g->sx), l16_load(g->sy), dir, N, num, f->near, f->far, bits, &z);
     /* An edge function exactly 0: redone by the scalar test (in double), as raytrace does (rare). */
-    for (unsigned m = bits & z; m; m &= m - 1) {
+    for (unsigned m = z; m; m &= m - 1) {
         const int q = __builtin_ctz(m), kz = g->kz[q];
         float Vq[3][3];
         for (int vv = 0; vv < 3; vv++)
