@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -463,6 +464,24 @@ void tu_unit_icosphere(int levels, double **verts, size_t *n_verts, int **tris, 
     *n_verts = np;
     *tris = tri;
     *n_tris = nt;
+}
+
+void tu_png_base64(const unsigned char *rgb, int w, int h, char *out, size_t cap)
+{
+    png_image im;
+    memset(&im, 0, sizeof im);
+    im.version = PNG_IMAGE_VERSION;
+    im.width = (png_uint_32)w;
+    im.height = (png_uint_32)h;
+    im.format = PNG_FORMAT_RGB;
+    png_alloc_size_t len = 0;
+    assert_true(png_image_write_to_memory(&im, NULL, &len, 0, rgb, 0, NULL));   /* the size it needs */
+    unsigned char *mem = malloc(len);
+    assert_non_null(mem);
+    assert_true(png_image_write_to_memory(&im, mem, &len, 0, rgb, 0, NULL));
+    assert_true(4 * ((len + 2) / 3) + 1 <= cap);
+    tu_base64(mem, len, out);
+    free(mem);
 }
 
 void tu_base64(const unsigned char *in, size_t n, char *out)

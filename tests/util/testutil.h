@@ -15,6 +15,9 @@ const char *tu_path(char *buf, size_t n, const char *dir, const char *name);
 int tu_write_file(const char *path, const char *text);
 /* Base64 of in[0..n) into out (4 ceil(n/3) characters and a NUL), for glTF data: URIs written by tests. */
 void tu_base64(const unsigned char *in, size_t n, char *out);
+/* An 8-bit RGB image of w x h texels (rows top first) as a PNG (libpng), base64-encoded into out[cap]: the payload
+ * of a glTF "data:image/png;base64," URI. Fails the test when it does not fit. */
+void tu_png_base64(const unsigned char *rgb, int w, int h, char *out, size_t cap);
 /* Reads channel `name` of a one-part scanline EXR of w x h pixels as floats into img (rows top to
  * bottom); -1 when it has no such channel. */
 int tu_read_exr_channel(const char *path, const char *name, int w, int h, float *img);
