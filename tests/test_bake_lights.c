@@ -127,32 +127,7 @@ static void test_textured_and_disk(void **st)
     two_lights_vs_single(pair, "raytrace", 32);
 }
 
-typedef enum { NO = 0, YES = 1, UNSURE = 2 } verdict;
-
-/* Segment p -> L against triangle t in double precision, the occluding range [1e-4, 1 - 1e-4]: UNSURE
- * within 1e-6 of an edge or of the range's ends. */
-static verdict seg_hits(const float *t, const double p[3], const double L[3])
-{
-    double e1[3], e2[3], d[3], s[3], h[3], q[3];
-    for (int c = 0; c < 3; c++) {
-        e1[c] = (double)t[3 + c] - t[c];
-        e2[c] = (double)t[6 + c] - t[c];
-        d[c] = L[c] - p[c];
-        s[c] = p[c] - t[c];
-    }
-    h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
-    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
-    if (fabs(det) < 1e-300) return NO;
-    const double f = 1.0 / det;
-    const double b1 = f * (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]);
-    q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
-    const double b2 = f * (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
-    const double u = f * (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]);
-    const double eps = 1e-6;
-    if (b1 < -eps || b2 < -eps || b1 + b2 > 1 + eps || u < 1e-4 - eps || u > 1 - 1e-4 + eps) return NO;
-    if (b1 < eps || b2 < eps || b1 + b2 > 1 - eps || u < 1e-4 + eps || u > 1 - 1e-4 - eps) return UNSURE;
-    return YES;
-}
+typedef enum { NO = 0, YES = 1, UNSURE = 2 } verdict;   /* tu_segment_hits' answers */
 
 /* Every method's sphere-light bake equals raytrace's; raytrace's V the brute force where it decides. The
  * sphere above the occluder, and one the occluder cuts through (texels inside it: V = S = 0, front 0; texels
@@ -215,7 +190,7 @@ static void sphere_every_method(ms_light sph, int want_inside)
             verdict v = YES;
             for (size_t t = 0; t < sc.n_tris && v != NO; t++) {
                 if (t == ref.triangle[i]) continue;
-                const verdict h = seg_hits(sc.tri + 9 * t, pd, L);
+                const verdict h = (verdict)tu_segment_hits(sc.tri + 9 * t, pd, L, 1e-4, 1.0 - 1e-4);
                 if (h == UNSURE) { unsure = 1; break; }
                 if (h == YES) v = NO;
             }

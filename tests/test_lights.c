@@ -20,33 +20,7 @@
 
 /* ---- brute force ---- */
 
-typedef enum { NO = 0, YES = 1, UNSURE = 2 } verdict;
-
-/* Segment p -> L against triangle t, double precision: YES if it crosses t at u in [near, far], UNSURE
- * within 1e-6 of an edge or of the range's ends. */
-static verdict seg_hits(const float *t, const double p[3], const double L[3], double near, double far)
-{
-    double e1[3], e2[3], d[3], s[3], h[3], q[3];
-    for (int c = 0; c < 3; c++) {
-        e1[c] = (double)t[3 + c] - t[c];
-        e2[c] = (double)t[6 + c] - t[c];
-        d[c] = L[c] - p[c];
-        s[c] = p[c] - t[c];
-    }
-    h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
-    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
-    if (fabs(det) < 1e-300) return NO;   /* parallel: a segment in the plane of a triangle never counts */
-    const double f = 1.0 / det;
-    const double b1 = f * (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]);
-    q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
-    const double b2 = f * (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
-    const double u = f * (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]);
-    const double m = fmin(fmin(b1, b2), 1.0 - b1 - b2);
-    const double eps = 1e-6;
-    if (m < -eps || u < near - eps || u > far + eps) return NO;
-    if (m < eps || fabs(u - near) < eps || fabs(u - far) < eps) return UNSURE;
-    return YES;
-}
+typedef enum { NO = 0, YES = 1, UNSURE = 2 } verdict;   /* tu_segment_hits' answers */
 
 /* A disk (centre c, unit normal m, radius r), or a triangle (tri = 1: corner c, edges e1, e2). */
 typedef struct disk_geom { double c[3], m[3], r; int tri; double e1[3], e2[3]; } disk_geom;
@@ -81,7 +55,7 @@ static void brute_sample(const ms_bvh *bvh, uint32_t prim, const float *pf, cons
     verdict occ = NO;
     for (uint32_t t = 0; t < bvh->n_tris && occ != YES; t++) {
         if (t == prim) continue;
-        const verdict v = seg_hits(bvh->tri + 9 * (size_t)t, p, L, 1e-4, 1.0 - 1e-4);
+        const verdict v = (verdict)tu_segment_hits(bvh->tri + 9 * (size_t)t, p, L, 1e-4, 1.0 - 1e-4);
         if (v == YES) occ = YES;
         else if (v == UNSURE) occ = UNSURE;
     }

@@ -25,32 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum { NO = 0, YES = 1, UNSURE = 2 } verdict;
-
-/* Ray p + u (L - p), u >= near, against triangle t in double: YES / NO, UNSURE within 1e-6 of an edge or the
- * near end. No far end: the sun is at infinity. */
-static verdict ray_hits(const float *t, const double p[3], const double L[3], double near)
-{
-    double e1[3], e2[3], d[3], s[3], h[3], q[3];
-    for (int c = 0; c < 3; c++) {
-        e1[c] = (double)t[3 + c] - t[c];
-        e2[c] = (double)t[6 + c] - t[c];
-        d[c] = L[c] - p[c];
-        s[c] = p[c] - t[c];
-    }
-    h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
-    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
-    if (fabs(det) < 1e-300) return NO;
-    const double f = 1.0 / det;
-    const double b1 = f * (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]);
-    q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
-    const double b2 = f * (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
-    const double u = f * (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]);
-    const double m = fmin(fmin(b1, b2), 1.0 - b1 - b2), eps = 1e-6;
-    if (m < -eps || u < near - eps) return NO;
-    if (m < eps || fabs(u - near) < eps) return UNSURE;
-    return YES;
-}
+typedef enum { NO = 0, YES = 1, UNSURE = 2 } verdict;   /* tu_segment_hits' answers */
 
 /* ---- the scene: a ground of 4 x 4 squares, a closed box of 7 x 7 squares per face, a tilted triangle ---- */
 
@@ -201,7 +176,7 @@ static void check_every_method(float deg)
             verdict occ = NO;
             for (uint32_t t = 0; t < bvh.n_tris && occ != YES; t++) {
                 if (t == hits[i].prim) continue;
-                const verdict v = ray_hits(bvh.tri + 9 * (size_t)t, p, L, 1e-4);
+                const verdict v = (verdict)tu_segment_hits(bvh.tri + 9 * (size_t)t, p, L, 1e-4, INFINITY);   /* a ray: no far end */
                 if (v != NO) occ = v;
             }
             if (occ == UNSURE) { unsure = 1; break; }
@@ -293,7 +268,7 @@ static void test_bake(void **st)
             verdict occ = NO;
             for (size_t t = 0; t < sc.n_tris && occ != YES; t++) {
                 if (t == ref.triangle[i]) continue;
-                const verdict v = ray_hits(sc.tri + 9 * t, p, L, 1e-4);
+                const verdict v = (verdict)tu_segment_hits(sc.tri + 9 * t, p, L, 1e-4, INFINITY);
                 if (v != NO) occ = v;
             }
             if (occ == UNSURE) unsure = 1;

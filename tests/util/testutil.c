@@ -152,6 +152,30 @@ long tu_frame_values_differ(const ms_frame *a, const ms_frame *b)
     return differ;
 }
 
+int tu_segment_hits(const float *t, const double p[3], const double L[3], double near, double far)
+{
+    double e1[3], e2[3], d[3], s[3], h[3], q[3];
+    for (int c = 0; c < 3; c++) {
+        e1[c] = (double)t[3 + c] - t[c];
+        e2[c] = (double)t[6 + c] - t[c];
+        d[c] = L[c] - p[c];
+        s[c] = p[c] - t[c];
+    }
+    h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
+    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+    if (fabs(det) < 1e-300) return 0;   /* parallel: a segment in the plane of a triangle never counts */
+    const double f = 1.0 / det;
+    const double b1 = f * (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]);
+    q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
+    const double b2 = f * (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
+    const double u = f * (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]);
+    const double m = fmin(fmin(b1, b2), 1.0 - b1 - b2);
+    const double eps = 1e-6;
+    if (m < -eps || u < near - eps || u > far + eps) return 0;
+    if (m < eps || fabs(u - near) < eps || fabs(u - far) < eps) return 2;
+    return 1;
+}
+
 void tu_query_from_hit(ms_shadow_query *q, const ms_hit *h, int x, int y)
 {
     ms_query_from_hit(q, h, (uint32_t)x, (uint32_t)y);

@@ -63,6 +63,11 @@ tu_agreement tu_compare_frames(const ms_frame *a, const ms_frame *b);
  * light's plane (the larger n_lights of the two; 0 means 1). For methods that must give raytrace's answer
  * exactly. */
 long tu_frame_values_differ(const ms_frame *a, const ms_frame *b);
+/* The brute-force oracle of the shadow tests: segment p + u (L - p) against triangle t (9 floats) in double
+ * precision (Moller-Trumbore): 1 if it crosses t at u in [near, far] (far may be INFINITY: a ray), 0 if not, 2
+ * (unsure: a float test may decide either way) within 1e-6 of an edge or of the range's ends. A segment in the
+ * triangle's plane never counts. */
+int tu_segment_hits(const float *t, const double p[3], const double L[3], double near, double far);
 
 /* Internal-API helpers for tests that drive shadow methods directly on chosen points. */
 struct ms_render_ctx;
