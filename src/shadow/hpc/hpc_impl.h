@@ -83,6 +83,7 @@
 #include "raster/raster.h"
 #include "core/perk.h"
 #include "visibility/lanes16.h"
+#include "visibility/wt_rays16.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -563,23 +564,11 @@ static unsigned group_block16(const shared *sh, const ms_shadow_query *q, const 
 #undef HPC_VCOMP
     }
     const l16 inv = l16_div(l16_set1(1.0f), dz), sx = l16_mul(dx, inv), sy = l16_mul(dy, inv);
-    const l16 ax = l16_sub(Ax, l16_mul(sx, Az)), ay = l16_sub(Ay, l16_mul(sy, Az));
-    const l16 bx = l16_sub(Bx, l16_mul(sx, Bz)), by = l16_sub(By, l16_mul(sy, Bz));
-    const l16 cx = l16_sub(Cx, l16_mul(sx, Cz)), cy = l16_sub(Cy, l16_mul(sy, Cz));
-    const l16 u = l16_sub(l16_mul(cx, by), l16_mul(cy, bx));
-    const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
-    const l16 ww = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
-    const l16 zero = l16_set1(0.0f);
-    /* As mft_packet: some edge exactly 0 iff the least |edge| is 0; mixed signs iff the least < 0 < the largest. */
-    const unsigned z = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(ww)), zero);
-    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), ww), zero) & l16_gt(l16_max(l16_max(u, v), ww), zero);
-    const l16 det = l16_add(l16_add(u, v), ww);
     const float *N = t->N, near = sh->ctx->near, far = sh->ctx->far;
-    const l16 den = l16_add(l16_add(l16_mul(d[0], l16_set1(N[0])), l16_mul(d[1], l16_set1(N[1]))), l16_mul(d[2], l16_set1(N[2])));
-    const l16 ns = l16_select(l16_lt(den, zero), l16_set1(-num), l16_set1(num)), aden = l16_abs(den);
-    unsigned hit = live & ~mneg & ~z & ~mixed & l16_gt(l16_abs(det), zero) & l16_gt(aden, zero) &
-                   l16_le(l16_mul(l16_set1(near), aden), ns) & l16_le(ns, l16_mul(l16_set1(far), aden));
-    const unsigned rest = live & (mneg | z);
+    const l16 V3[3][3] = { { Ax, Ay, Az }, { Bx, By, Bz }, { Cx, Cy, Cz } };
+    unsigned z;
+    unsigned hit = ms_wt_rays16(V3, sx, sy, d, N, l16_set1(num), near, far, live & ~mneg, &z);
+    const unsigned rest = (live & mneg) | z;
     if (rest) {
         float dv[3][LANES], sxv[LANES], syv[LANES];
         for (int a = 0; a < 3; a++) l16_store(dv[a], d[a]);

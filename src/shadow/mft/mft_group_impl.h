@@ -159,7 +159,7 @@ static unsigned mftg_rays(const mftg_state *s, const ms_mft_group *g, unsigned b
     }
     const l16 dir[3] = { l16_load(g->d[0]), l16_load(g->d[1]), l16_load(g->d[2]) };
     unsigned z;
-    hit |= mft_rays16((const l16 (*)[3])A, l16_load(g->sx), l16_load(g->sy), dir, N, num, f->near, f->far, bits, &z);
+    hit |= ms_wt_rays16((const l16 (*)[3])A, l16_load(g->sx), l16_load(g->sy), dir, N, num, f->near, f->far, bits, &z);
     /* An edge function exactly 0: redone by the scalar test (in double), as raytrace does (rare). */
     for (unsigned m = z; m; m &= m - 1) {
         const int q = __builtin_ctz(m), kz = g->kz[q];

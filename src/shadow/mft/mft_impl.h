@@ -50,6 +50,7 @@
 #include <string.h>
 #include "mft.h"
 #include "visibility/lanes16.h"
+#include "visibility/wt_rays16.h"
 #include "core/perk.h"
 #include "accel/ray_triangle.h"
 #include "light/pattern.h"
@@ -173,33 +174,6 @@ static unsigned mft_leaf_lanes(const mft_state *s, const ms_bvh_node *n, unsigne
 }
 
 
-/* raytrace's packet_triangle (raytrace_impl.h) for 16 rays, the same operations in the same order, with fewer
- * compares (the same answers for finite edge functions: some edge exactly 0 iff the least |edge| is 0; mixed
- * signs iff the least is < 0 and the largest > 0). A[v]: vertex v relative to each ray's origin, permuted to
- * the ray's axes (x, y, then the shear axis z); sx, sy: the rays' shears; d: their directions (world axes);
- * num: (v - origin) . N per ray (ms_wt_offset). The rays of bits that the triangle blocks within [near, far];
- * *edge0: those with an edge function exactly 0, which the caller redoes in double as raytrace does (rare).
- * Shared by the grid mode's packets (mft_packet) and the interleaved mode's groups (mft_group_impl.h). */
-static inline unsigned mft_rays16(const l16 A[3][3], l16 sx, l16 sy, const l16 d[3], const float N[3], l16 num,
-                                  float near, float far, unsigned bits, unsigned *edge0)
-{
-    const l16 ax = l16_sub(A[0][0], l16_mul(sx, A[0][2])), ay = l16_sub(A[0][1], l16_mul(sy, A[0][2]));
-    const l16 bx = l16_sub(A[1][0], l16_mul(sx, A[1][2])), by = l16_sub(A[1][1], l16_mul(sy, A[1][2]));
-    const l16 cx = l16_sub(A[2][0], l16_mul(sx, A[2][2])), cy = l16_sub(A[2][1], l16_mul(sy, A[2][2]));
-    const l16 u = l16_sub(l16_mul(cx, by), l16_mul(cy, bx));
-    const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
-    const l16 w = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
-    const l16 zero = l16_set1(0.0f);
-    const unsigned z = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(w)), zero);
-    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), w), zero) & l16_gt(l16_max(l16_max(u, v), w), zero);
-    const l16 det = l16_add(l16_add(u, v), w);
-    const l16 den = l16_add(l16_add(l16_mul(d[0], l16_set1(N[0])), l16_mul(d[1], l16_set1(N[1]))), l16_mul(d[2], l16_set1(N[2])));
-    const l16 ns = l16_select(l16_lt(den, zero), l16_sub(zero, num), num), aden = l16_abs(den);
-    *edge0 = bits & z;
-    return bits & ~z & ~mixed & l16_gt(l16_abs(det), zero) & l16_gt(aden, zero) & l16_le(l16_mul(l16_set1(near), aden), ns) &
-           l16_le(ns, l16_mul(l16_set1(far), aden));
-}
-
 /* The rays of 16-sample packet ch of lane L (bits: the live ones) that triangle tri hits: raytrace's
  * packet_triangle (raytrace_impl.h), the same operations in the same order. V: the vertices relative to
  * C; num: (v - C) . N from the vertex nearest C (ms_wt_offset). */
@@ -223,7 +197,7 @@ static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const fl
                           { l16_set1(V[2][kx]), l16_set1(V[2][ky]), Cz } };
     const l16 dir[3] = { l16_load(L->d[0] + base), l16_load(L->d[1] + base), l16_load(L->d[2] + base) };
     unsigned z;
-    hit = mft_rays16(A, sx, sy, dir, N, l16_set1(num), near, far, bits, &z);
+    hit = ms_wt_rays16(A, sx, sy, dir, N, l16_set1(num), near, far, bits, &z);
     /* An edge function exactly 0: redone by the scalar test (in double), as raytrace does (rare). */
     for (unsigned m = z; m; m &= m - 1) {
         const int l = __builtin_ctz(m), i = base + l;
