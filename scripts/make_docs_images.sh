@@ -6,6 +6,8 @@
 #   sun*.png             docs/lights.md ("The sun"): scripts/make_sun_scene.py, 1024 samples
 #   real_spot.png        docs/real-assets.md: Spot from the assets folder (spot/spot/spot.json), 480x480
 #   real_igea.png        docs/real-assets.md: Igea from the assets folder (igea_scene.json), 480x480
+#   asset-emitter-public-cornell.png   docs/lights.md: Vinc3r's Cornell box glTF (assets folder
+#                        cornellbox/BJS-2.80-Eevee-gltf), lit by its own emitter, no light in the scene file
 #   bake_*.png, frame_builtin.png   docs/baking.md: scripts/make_bake_images.sh (the bake pictures' own script)
 # Pictures whose inputs are absent (the shared scenes, the real assets: never committed) are skipped with a
 # message and left as they are. No docs picture comes from the dense scenes (scripts/make_dense_scenes.py).
@@ -67,6 +69,18 @@ if [ -f "$assets/igea_scene.json" ] && [ -f "$assets/igea.ply" ]; then
     render real_igea.png "$assets/igea_scene.json" --width 480 --height 480
 else
     skip real_igea.png "$assets/igea_scene.json or igea.ply is absent (docs/real-assets.md: where Igea comes from)"
+fi
+
+cornell=$assets/cornellbox/BJS-2.80-Eevee-gltf/assets/cornellBox-2.80-Eevee-gltf.gltf
+if [ -f "$cornell" ]; then
+    # no "light" and no "lights": the glTF's emissive lamp becomes the scene's lights (docs/lights.md)
+    cat > "$tmp/cornell.json" <<JSON
+{"meshes": [{"file": "$cornell"}], "allow_outside_paths": true,
+ "camera": {"eye": [0, 1.5, 4.5], "target": [0, 1.5, 0], "up": [0, 1, 0], "fov_y": 62, "width": 800, "height": 450}}
+JSON
+    render asset-emitter-public-cornell.png "$tmp/cornell.json" --method scanline
+else
+    skip asset-emitter-public-cornell.png "$cornell is absent (docs/lights.md: where the Cornell box comes from)"
 fi
 
 # >>> bake pictures hook (docs/baking.md): made by their own script when it exists <<<
