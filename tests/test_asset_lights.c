@@ -7,7 +7,10 @@
  *     it (V = S = 1 by every method), while it does shadow a light placed above it;
  *   - a single emissive triangle: one triangle light with its vertices and front face;
  *   - OBJ/MTL Ke: the same quad, one rect light;
- *   - 70 separate emissive triangles: one error line naming the count and the way out;
+ *   - 70 separate emissive triangles: one error line naming the count, the emitting materials by name with
+ *     their triangle counts, and the ways out; "lights_from_emissive": ["lamp"] makes the lamp material's
+ *     quad the one light (the 70 glow without being lights, in one warning line); a name that is no
+ *     emitting material's is an error listing those there are; the same choice by MTL name;
  *   - "lights_from_emissive": false and no light: the missing light named. */
 #include "testutil.h"
 #include <math.h>
@@ -252,7 +255,12 @@ static void test_single_triangle_and_mtl(void **st)
     ms_scene_free(&sc);
 }
 
-/* 70 separate emissive triangles: 70 lights, over the limit of 64: one line with the count and the way out. */
+/* A named copy of glow (its emission) and its name. */
+static const char *const screen = "{\"name\":\"screen\",\"emissiveFactor\":[0.2,0.2,0.2]}";
+static const char *const lamp = "{\"name\":\"lamp\",\"emissiveFactor\":[3,2,1]}";
+
+/* 70 separate emissive triangles ("screen") beside a quad ("lamp"): 71 lights, over the limit of 64: one line
+ * with the count, the materials, and the ways out; then the lamp chosen by name. */
 static void test_too_many_emitters(void **st)
 {
     (void)st;
@@ -264,8 +272,8 @@ static void test_too_many_emitters(void **st)
         const float v[9] = { x, 1.9f, 0, x + 0.01f, 1.9f, 0, x, 1.9f, 0.01f };
         memcpy(t + 9 * i, v, sizeof v);
     }
-    const prim p[2] = { { &box[0][0], 10, white }, { t, 70, glow } };
-    write_gltf(dir, "many", p, 2, ext);
+    const prim p[3] = { { &box[0][0], 10, white }, { t, 70, screen }, { &emitter[0][0], 2, lamp } };
+    write_gltf(dir, "many", p, 3, NULL);
     free(t);
     const char *path = write_scene(dir, "many.json", "many.gltf", "");
     char out[4096], errbuf[2048];
@@ -277,9 +285,56 @@ static void test_too_many_emitters(void **st)
     assert_int_equal(rc, 2);
     assert_int_equal(res.lines, 1);
     assert_non_null(strstr(errbuf, "many.json"));
-    assert_non_null(strstr(errbuf, "70 lights"));
+    assert_non_null(strstr(errbuf, "71 lights"));
+    assert_non_null(strstr(errbuf, "\"screen\": 70 triangles, \"lamp\": 2 triangles"));
+    assert_non_null(strstr(errbuf, "\"lights_from_emissive\": [\"name\", ...]"));
     assert_non_null(strstr(errbuf, "\"lights_from_emissive\": false"));
     assert_false(tu_file_exists(out));
+
+    /* Only the lamp: one rect light of its emission; the screen's 70 triangles said in one warning line. */
+    path = write_scene(dir, "lamp.json", "many.gltf", "\"lights_from_emissive\": [\"lamp\"]");
+    ms_scene sc;
+    char err[1024];
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), MS_OK);
+    size_t n;
+    const ms_light *L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 1);
+    assert_int_equal(L[0].shape, MS_LIGHT_RECT);
+    assert_true(L[0].emission.x == 3.0f && L[0].emission.y == 2.0f && L[0].emission.z == 1.0f);
+    assert_float_equal(ms_light_area(&L[0]), 0.25f, 1e-7f);
+    ms_scene_free(&sc);
+    const char *args2[] = { path, "--quiet", "-o", out, NULL };
+    assert_int_equal(tu_run_cli_ex(args2, NULL, errbuf, sizeof errbuf, &res), 0);
+    assert_non_null(strstr(errbuf, "70 emissive triangles of materials not listed in \"lights_from_emissive\""));
+    assert_true(tu_file_exists(out));
+    /* Both named: over the limit again, the same line. */
+    path = write_scene(dir, "both.json", "many.gltf", "\"lights_from_emissive\": [\"lamp\", \"screen\"]");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "71 lights"));
+    /* A name that is no emitting material's ("white" has no name; a typo): the error lists those there are. */
+    path = write_scene(dir, "typo.json", "many.gltf", "\"lights_from_emissive\": [\"lamp \"]");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "names \"lamp \", which is no emitting material"));
+    assert_non_null(strstr(err, "\"screen\": 70 triangles, \"lamp\": 2 triangles"));
+    path = write_scene(dir, "empty.json", "many.gltf", "\"lights_from_emissive\": []");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "a non-empty list of material names"));
+    /* MTL: the same choice by newmtl name. */
+    char mpath[4096];
+    tu_write_file(tu_path(mpath, sizeof mpath, dir, "m.mtl"), "newmtl sign\nKe 0.1 0.1 0.1\nnewmtl lamp\nKe 2 3 4\n");
+    tu_write_file(tu_path(mpath, sizeof mpath, dir, "m.obj"),
+                  "mtllib m.mtl\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nusemtl sign\nf 1 2 3 4\n"
+                  "v -0.25 1.9 -0.25\nv 0.25 1.9 -0.25\nv 0.25 1.9 0.25\nv -0.25 1.9 0.25\nusemtl lamp\nf 5 6 7 8\n");
+    assert_int_equal(ms_scene_load(write_scene(dir, "m.json", "m.obj", "\"lights_from_emissive\": [\"lamp\"]"), &sc,
+                                   err, sizeof err), MS_OK);
+    L = ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 1);
+    assert_true(L[0].emission.z == 4.0f && L[0].corner.y == 1.9f);
+    ms_scene_free(&sc);
+    assert_int_equal(ms_scene_load(write_scene(dir, "m2.json", "m.obj", ""), &sc, err, sizeof err), MS_OK);
+    ms_scene_lights(&sc, &n);
+    assert_int_equal((int)n, 2);
+    ms_scene_free(&sc);
 }
 
 /* KHR_lights_punctual: a point light (10 cd, extras.radius 0.1) becomes a sphere of radiance 10 / (pi 0.1^2);

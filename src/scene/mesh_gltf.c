@@ -492,7 +492,7 @@ static int load_materials(const cgltf_data *d, const cgltf_options *opt, const c
                 warned_blend = 1;
             }
         }
-        mat_of[i] = ms_soup_add_material(soup, &m);
+        mat_of[i] = ms_soup_add_material(soup, &m, cm->name);
         if (mat_of[i] < 0) { snprintf(err, errlen, "%s: out of memory, or more than %d materials", path, MS_MAX_MATERIALS); rc = -1; }
     }
     free(tex_of);

@@ -82,7 +82,7 @@ static int flush(pending *p, ms_tri_soup *soup, ms_mtl_lib *lib)
         const float alpha = sqrtf(2.0f / (fmaxf(p->ns, 0.0f) + 2.0f));
         p->m.roughness = clamp01(sqrtf(alpha));
     }
-    const long idx = ms_soup_add_material(soup, &p->m);
+    const long idx = ms_soup_add_material(soup, &p->m, p->name);
     if (idx < 0) return -1;
     char **nn = realloc(lib->names, (lib->n + 1) * sizeof *nn);
     if (!nn) return -1;

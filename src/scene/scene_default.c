@@ -270,7 +270,7 @@ ms_status ms_scene_showcase_abi(const ms_abi *abi, ms_scene *out)
     m[MAT_LEAF].base_color_texture = 1;
     m[MAT_LEAF].alpha_mode = MS_ALPHA_MASK;
     m[MAT_LEAF].roughness = 0.8f;
-    for (int i = 0; i < N_MATS && !failed; i++) failed = ms_soup_add_material(&s, &m[i]) != i;
+    for (int i = 0; i < N_MATS && !failed; i++) failed = ms_soup_add_material(&s, &m[i], NULL) != i;
 
     const float g0[3] = { -8, 0, 8 }, g1[3] = { 8, 0, 8 }, g2[3] = { 8, 0, -8 }, g3[3] = { -8, 0, -8 };
     const float gold[4] = { -0.4f, 1.0f, -0.6f, 1.0f };
@@ -317,6 +317,7 @@ ms_status ms_scene_showcase_abi(const ms_abi *abi, ms_scene *out)
         return MS_ERR_NO_MEMORY;
     }
     free(s.tri_d);   /* generated about the origin: the scene's frame is the world's */
+    ms_soup_free_names(&s);
     out->tri = s.tri;
     out->n_tris = s.n;
     out->tri_mesh = s.mesh;

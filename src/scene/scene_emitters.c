@@ -61,14 +61,22 @@ static void texture_mean(const ms_scene *s, const ms_material *m, size_t t, floa
     for (int c = 0; c < 3; c++) out[c] = (float)(acc[c] / count);
 }
 
-/* Triangle t's emitted radiance into e; 0 when it emits nothing. */
-static int emitter_radiance(const ms_scene *s, size_t t, float e[3])
+/* Triangle t's material when it emits, else MS_NO_MATERIAL. */
+static uint32_t emitting_material(const ms_scene *s, size_t t)
 {
-    if (!s->tri_material || !s->materials) return 0;
+    if (!s->tri_material || !s->materials) return MS_NO_MATERIAL;
     const uint32_t mi = s->tri_material[t];
-    if (mi == MS_NO_MATERIAL || mi >= s->n_materials) return 0;
+    if (mi == MS_NO_MATERIAL || mi >= s->n_materials) return MS_NO_MATERIAL;
     const ms_material *m = &s->materials[mi];
-    if (!(m->emissive[0] > 0.0f || m->emissive[1] > 0.0f || m->emissive[2] > 0.0f)) return 0;
+    return m->emissive[0] > 0.0f || m->emissive[1] > 0.0f || m->emissive[2] > 0.0f ? mi : MS_NO_MATERIAL;
+}
+
+/* Triangle t's emitted radiance into e when it emits and its material is chosen; 0 otherwise. */
+static int emitter_radiance(const ms_scene *s, const ms_emitter_choice *choice, size_t t, float e[3])
+{
+    const uint32_t mi = emitting_material(s, t);
+    if (mi == MS_NO_MATERIAL || (choice && choice->lit && !choice->lit[mi])) return 0;
+    const ms_material *m = &s->materials[mi];
     float tm[3];
     texture_mean(s, m, t, tm);
     for (int c = 0; c < 3; c++) e[c] = m->emissive[c] * tm[c];
@@ -110,28 +118,70 @@ static int completes(const float *tj, const float *a, const float *b, const floa
     return (double)nj[0] * n[0] + (double)nj[1] * n[1] + (double)nj[2] * n[2] > 0.0;
 }
 
-size_t ms_scene_emissive_triangles(const ms_scene *s)
+size_t ms_scene_emissive_triangles(const ms_scene *s, const ms_emitter_choice *choice)
 {
     size_t n = 0;
     float e[3];
-    for (size_t t = 0; s->tri && t < s->n_tris; t++) n += emitter_radiance(s, t, e);
+    for (size_t t = 0; s->tri && t < s->n_tris; t++) n += emitter_radiance(s, choice, t, e);
     return n;
 }
 
-int ms_scene_emitter_lights(const ms_scene *s, size_t room, const char *path, ms_light **out, size_t *n_out, char *err,
-                            size_t errlen)
+void ms_scene_emissive_materials_text(const ms_scene *s, char *const *names, char *buf, size_t n)
+{
+    if (n) buf[0] = '\0';
+    size_t *count = s->n_materials ? calloc(s->n_materials, sizeof *count) : NULL;
+    if (!count) return;
+    for (size_t t = 0; s->tri && t < s->n_tris; t++) {
+        const uint32_t mi = emitting_material(s, t);
+        if (mi != MS_NO_MATERIAL) count[mi]++;
+    }
+    size_t used = 0, shown = 0, left = 0;
+    for (;;) {   /* the most triangles first: a few passes over a short list */
+        size_t best = SIZE_MAX;
+        for (size_t m = 0; m < s->n_materials; m++)
+            if (count[m] && (best == SIZE_MAX || count[m] > count[best])) best = m;
+        if (best == SIZE_MAX) break;
+        if (shown == 6) { left++; count[best] = 0; continue; }
+        char label[160];
+        if (names && names[best]) snprintf(label, sizeof label, "\"%.120s\"", names[best]);
+        else snprintf(label, sizeof label, "material %zu (no name)", best);
+        const int w = snprintf(buf + used, used < n ? n - used : 0, "%s%s: %zu triangle%s", shown ? ", " : "", label,
+                               count[best], count[best] > 1 ? "s" : "");
+        if (w > 0) used += (size_t)w;
+        shown++;
+        count[best] = 0;
+    }
+    if (left && used < n) snprintf(buf + used, n - used, " and %zu more", left);
+    free(count);
+}
+
+/* The ways out of too many emitters, for the error lines below. */
+static void too_many(const ms_scene *s, const ms_emitter_choice *choice, const char *what, size_t room, const char *path,
+                     char *err, size_t errlen)
+{
+    char mats[512];
+    ms_scene_emissive_materials_text(s, choice ? choice->names : NULL, mats, sizeof mats);
+    snprintf(err, errlen, "%s: %s, more than the %zu a frame can still hold (%d in all; emissive materials: %s): list the "
+             "materials that are lamps, \"lights_from_emissive\": [\"name\", ...] (the others still glow), or set "
+             "\"lights_from_emissive\": false and name the lights in the scene file, or raise MS_MAX_LIGHTS "
+             "(src/scene/scene_internal.h)", path, what, room, MS_MAX_LIGHTS, mats);
+}
+
+int ms_scene_emitter_lights(const ms_scene *s, const ms_emitter_choice *choice, size_t room, const char *path,
+                            ms_light **out, size_t *n_out, char *err, size_t errlen)
 {
     *out = NULL;
     *n_out = 0;
     if (!s->tri || !s->tri_material) return 0;
     size_t n_e = 0;
     float e[3];
-    for (size_t t = 0; t < s->n_tris; t++) n_e += emitter_radiance(s, t, e);
+    for (size_t t = 0; t < s->n_tris; t++) n_e += emitter_radiance(s, choice, t, e);
     if (!n_e) return 0;
     if (n_e > PAIRING_MAX || (n_e + 1) / 2 > room) {
-        snprintf(err, errlen, "%s: the meshes have %zu emissive triangles, at least %zu lights, more than the %zu a frame "
-                 "can still hold (%d in all): set \"lights_from_emissive\": false and name the lights in the scene file, "
-                 "or raise MS_MAX_LIGHTS (src/scene/scene_internal.h)", path, n_e, (n_e + 1) / 2, room, MS_MAX_LIGHTS);
+        char what[160];
+        snprintf(what, sizeof what, "the meshes have %zu emissive triangles to make lights of, at least %zu lights", n_e,
+                 (n_e + 1) / 2);
+        too_many(s, choice, what, room, path, err, errlen);
         return -1;
     }
     size_t *idx = malloc(n_e * sizeof *idx);
@@ -144,14 +194,14 @@ int ms_scene_emitter_lights(const ms_scene *s, size_t room, const char *path, ms
     }
     n_e = 0;
     for (size_t t = 0; t < s->n_tris; t++)
-        if (emitter_radiance(s, t, e)) idx[n_e++] = t;
+        if (emitter_radiance(s, choice, t, e)) idx[n_e++] = t;
     size_t n = 0;
     for (size_t i = 0; i < n_e; i++) {
         if (used[i]) continue;
         used[i] = 1;
         const float *ti = s->tri + 9 * idx[i];
         float ei[3], e1[3], e2[3], nrm[3];
-        emitter_radiance(s, idx[i], ei);
+        emitter_radiance(s, choice, idx[i], ei);
         vsub(e1, ti + 3, ti);
         vsub(e2, ti + 6, ti);
         cross(nrm, e1, e2);
@@ -165,7 +215,7 @@ int ms_scene_emitter_lights(const ms_scene *s, size_t room, const char *path, ms
                 if (used[j] || s->tri_material[idx[j]] != s->tri_material[idx[i]]) continue;
                 if (!completes(s->tri + 9 * idx[j], a, b, c, nrm)) continue;
                 float ej[3];
-                emitter_radiance(s, idx[j], ej);
+                emitter_radiance(s, choice, idx[j], ej);
                 /* cross(b - a, c - a) is the front face's normal for every rotation of (a, b, c) */
                 l->corner = (ms_vec3){ a[0], a[1], a[2] };
                 l->edge_s = (ms_vec3){ b[0] - a[0], b[1] - a[1], b[2] - a[2] };
@@ -188,9 +238,9 @@ int ms_scene_emitter_lights(const ms_scene *s, size_t room, const char *path, ms
     free(used);
     if (n > room) {
         free(L);
-        snprintf(err, errlen, "%s: the meshes' emissive triangles make %zu lights, more than the %zu a frame can still "
-                 "hold (%d in all): set \"lights_from_emissive\": false and name the lights in the scene file, or raise "
-                 "MS_MAX_LIGHTS (src/scene/scene_internal.h)", path, n, room, MS_MAX_LIGHTS);
+        char what[160];
+        snprintf(what, sizeof what, "the meshes' emissive triangles make %zu lights", n);
+        too_many(s, choice, what, room, path, err, errlen);
         return -1;
     }
     if (!n) { free(L); return 0; }

@@ -30,19 +30,30 @@ typedef struct ms_punctual {
 /* rel resolved against the folder of json_path (absolute paths as they are) into out; -1 if too long. */
 int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n);
 struct ms_light;
-/* The lights of the scene's emissive triangles (scene_emitters.c): *out (malloc'd, NULL when none) and
- * *n_out; 0, or -1 with one line in err (naming path) when they would be more than `room` lights. */
-struct ms_light;
 /* The punctual lights p[0 .. n-1] as area lights in the scene's frame (scene_punctual.c): *out (malloc'd,
  * NULL when none) and *n_out; radius default_radius where the light gives none; what is approximated or
  * left out is told through warn; 0, or -1 with one line in err (naming path) when more than `room`. */
 int ms_scene_punctual_lights(const ms_punctual *p, size_t n, const double origin[3], double default_radius, size_t room,
                              const char *path, void (*warn)(const char *line), struct ms_light **out, size_t *n_out,
                              char *err, size_t errlen);
-/* How many of the scene's triangles emit (those ms_scene_emitter_lights would make lights of). */
-size_t ms_scene_emissive_triangles(const struct ms_scene *s);
-int ms_scene_emitter_lights(const struct ms_scene *s, size_t room, const char *path, struct ms_light **out,
-                            size_t *n_out, char *err, size_t errlen);
+/* Which emitting materials become lights (scene file "lights_from_emissive": true or a list of names):
+ * lit[m] for material m (NULL: every one); names[m] the materials' names for messages (NULL: none kept,
+ * or NULL entries). */
+typedef struct ms_emitter_choice {
+    const unsigned char *lit;
+    char *const *names;
+} ms_emitter_choice;
+/* How many of the scene's triangles emit and are chosen (those ms_scene_emitter_lights makes lights of;
+ * choice NULL: every emissive triangle). */
+size_t ms_scene_emissive_triangles(const struct ms_scene *s, const ms_emitter_choice *choice);
+/* The scene's emitting materials as text for a message, e.g. "light.000: 10 triangles, material 4: 2 triangles",
+ * the most triangles first, at most six named ("and 3 more"). */
+void ms_scene_emissive_materials_text(const struct ms_scene *s, char *const *names, char *buf, size_t n);
+/* The lights of the scene's chosen emissive triangles (scene_emitters.c): *out (malloc'd, NULL when none)
+ * and *n_out; 0, or -1 with one line in err (naming path and the emitting materials) when they would be
+ * more than `room` lights. */
+int ms_scene_emitter_lights(const struct ms_scene *s, const ms_emitter_choice *choice, size_t room, const char *path,
+                            struct ms_light **out, size_t *n_out, char *err, size_t errlen);
 #define MS_SOUP_UV_SETS 4   /* = MS_MAX_UV_SETS */
 /* Triangles as they are loaded, with the mesh each came from (cur_mesh at the push) and, per UV set,
  * the UVs of its vertices (6 floats; the array appears with the first triangle that has the set, NaN
@@ -69,6 +80,10 @@ typedef struct ms_tri_soup {
     float *normal;
     struct ms_material *mats;
     size_t n_mats;
+    /* The materials' names as the files give them (glTF material name, MTL newmtl), NULL for none: only
+     * for choosing the asset's emitters by name (scene file "lights_from_emissive": [...]); not handed to
+     * the scene (ms_soup_free_names). */
+    char **mat_names;
     struct ms_texture *tex;
     size_t n_tex;
     size_t tex_bytes;   /* decoded texture bytes so far (bounded: MS_MAX_TEXTURE_BYTES) */
@@ -104,8 +119,11 @@ void ms_scene_frame_origin(const double *tri_d, size_t n, double origin[3]);
 void ms_scene_frame_apply(float *tri, const double *tri_d, size_t n, const double origin[3]);
 /* A world position (double) in the frame: out = (float)(p - origin), each coordinate. */
 void ms_scene_frame_point(const double p[3], const double origin[3], float out[3]);
-/* Appends a material; its index, or -1 when out of memory or past MS_MAX_MATERIALS. */
-long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m);
+/* Appends a material and its name (NULL: none; copied); its index, or -1 when out of memory or past
+ * MS_MAX_MATERIALS. */
+long ms_soup_add_material(ms_tri_soup *soup, const struct ms_material *m, const char *name);
+/* Frees the materials' names (also done by ms_soup_free). */
+void ms_soup_free_names(ms_tri_soup *soup);
 
 /* Textures (texture.c). At most MS_MAX_TEXTURE_SIDE texels a side, MS_MAX_TEXTURE_BYTES decoded per scene. */
 #define MS_MAX_TEXTURE_SIDE 16384

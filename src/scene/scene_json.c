@@ -525,10 +525,41 @@ static int append_lights(ms_scene *out, size_t have, ms_light *add, size_t n_add
     return 0;
 }
 
+/* The materials named by "lights_from_emissive": [...] (list) as lit[m] = 1 (*lit, calloc'd), every material
+ * of that name in every mesh; a name that is no emitting material's is an error listing those there are. */
+static int choose_emitters(const ms_scene *out, const cJSON *list, char *const *names, unsigned char **lit,
+                           const char *path, char *err, size_t errlen)
+{
+    *lit = calloc(out->n_materials ? out->n_materials : 1, 1);
+    if (!*lit) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        return -1;
+    }
+    for (const cJSON *it = list->child; it; it = it->next) {
+        int found = 0;
+        for (size_t m = 0; names && m < out->n_materials; m++) {
+            const ms_material *mm = &out->materials[m];
+            const int emits = mm->emissive[0] > 0.0f || mm->emissive[1] > 0.0f || mm->emissive[2] > 0.0f;
+            if (names[m] && emits && !strcmp(names[m], it->valuestring)) (*lit)[m] = 1, found = 1;
+        }
+        if (!found) {
+            char mats[512];
+            ms_scene_emissive_materials_text(out, names, mats, sizeof mats);
+            snprintf(err, errlen, "%s: \"lights_from_emissive\" names \"%.120s\", which is no emitting material of the "
+                     "meshes (theirs: %s)", path, it->valuestring, mats[0] ? mats : "none");
+            free(*lit);
+            *lit = NULL;
+            return -1;
+        }
+    }
+    return 0;
+}
+
 /* The asset's own lights after those the file names (file_lights: it names some): its KHR_lights_punctual
- * lights (punct NULL: not wanted), then its emissive triangles (emitters: wanted). */
-static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const ms_punctual *punct, size_t n_punct,
-                            double punctual_radius, const char *path, char *err, size_t errlen)
+ * lights (punct NULL: not wanted), then its emissive triangles of the chosen materials (emitters: wanted). */
+static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const ms_emitter_choice *choice,
+                            const ms_punctual *punct, size_t n_punct, double punctual_radius, const char *path, char *err,
+                            size_t errlen)
 {
     size_t have = out->n_lights ? out->n_lights : file_lights ? 1 : 0;
     ms_light *add = NULL;
@@ -541,7 +572,7 @@ static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const 
         have += n_add;
     }
     if (emitters) {
-        if (ms_scene_emitter_lights(out, MS_MAX_LIGHTS - have, path, &add, &n_add, err, errlen) ||
+        if (ms_scene_emitter_lights(out, choice, MS_MAX_LIGHTS - have, path, &add, &n_add, err, errlen) ||
             append_lights(out, have, add, n_add, path, err, errlen))
             return -1;
         have += n_add;
@@ -693,12 +724,19 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
 
     /* The asset's emitters as lights (scene_emitters.c): by default when the file names no light. */
     const int file_lights = cJSON_GetObjectItemCaseSensitive(root, "light") || cJSON_GetObjectItemCaseSensitive(root, "lights");
+    /* true, false, or the names of the materials whose emissive triangles become lights (the others still
+     * glow in the shading): an asset's lamps among its glowing screens, signs or text. */
     const cJSON *from_emissive = cJSON_GetObjectItemCaseSensitive(root, "lights_from_emissive");
-    if (from_emissive && !cJSON_IsBool(from_emissive)) {
-        snprintf(err, errlen, "%s: \"lights_from_emissive\" must be true or false", json_path);
+    const int emitter_list = cJSON_IsArray(from_emissive);
+    int list_ok = emitter_list && cJSON_GetArraySize(from_emissive) > 0;
+    for (const cJSON *it = emitter_list ? from_emissive->child : NULL; it; it = it->next)
+        list_ok &= cJSON_IsString(it) && it->valuestring[0] != '\0';
+    if (from_emissive && !cJSON_IsBool(from_emissive) && !list_ok) {
+        snprintf(err, errlen, "%s: \"lights_from_emissive\" must be true, false or a non-empty list of material names",
+                 json_path);
         goto done;
     }
-    const int emitters = from_emissive ? cJSON_IsTrue(from_emissive) : !file_lights;
+    const int emitters = from_emissive ? !cJSON_IsFalse(from_emissive) : !file_lights;
     const cJSON *from_punctual = cJSON_GetObjectItemCaseSensitive(root, "lights_from_punctual");
     if (from_punctual && !cJSON_IsBool(from_punctual)) {
         snprintf(err, errlen, "%s: \"lights_from_punctual\" must be true or false", json_path);
@@ -881,17 +919,33 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     out->tri_tangent = ms_soup_take_tangents(&soup);
     out->textures = soup.tex;
     out->n_textures = soup.n_tex;
-    if (add_asset_lights(out, file_lights, emitters, punctuals ? soup.punctual : NULL, soup.n_punctual, punctual_radius,
-                         json_path, err, errlen)) {
+    unsigned char *lit = NULL;
+    if (emitter_list && choose_emitters(out, from_emissive, soup.mat_names, &lit, json_path, err, errlen)) {
+        ms_soup_free_names(&soup);
         free(soup.punctual);
         goto done;
     }
+    const ms_emitter_choice choice = { lit, soup.mat_names };
+    const int lights_failed = add_asset_lights(out, file_lights, emitters, &choice, punctuals ? soup.punctual : NULL,
+                                               soup.n_punctual, punctual_radius, json_path, err, errlen);
+    const size_t n_unlisted = lit && !lights_failed ? ms_scene_emissive_triangles(out, NULL) -
+                                                          ms_scene_emissive_triangles(out, &choice) : 0;
+    ms_soup_free_names(&soup);
+    free(lit);
+    if (lights_failed) {
+        free(soup.punctual);
+        goto done;
+    }
+    if (n_unlisted && g_warnings && g_warnings->n < MAX_WARNINGS)
+        snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%.120s: %zu emissive triangle%s of "
+                 "materials not listed in \"lights_from_emissive\" not made lights (they still glow)", json_path,
+                 n_unlisted, n_unlisted > 1 ? "s" : "");
     if (!punctuals && soup.n_punctual && g_warnings && g_warnings->n < MAX_WARNINGS)
         snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%.120s: %zu KHR_lights_punctual light%s "
                  "ignored (the scene file names its lights; \"lights_from_punctual\": true adds them)", json_path,
                  soup.n_punctual, soup.n_punctual > 1 ? "s" : "");
     free(soup.punctual);
-    const size_t n_emissive = emitters ? 0 : ms_scene_emissive_triangles(out);
+    const size_t n_emissive = emitters ? 0 : ms_scene_emissive_triangles(out, NULL);
     if (n_emissive && g_warnings && g_warnings->n < MAX_WARNINGS)
         snprintf(g_warnings->line[g_warnings->n++], sizeof g_warnings->line[0], "%.120s: %zu emissive triangle%s not made "
                  "lights (the scene file names its lights; \"lights_from_emissive\": true adds them)", json_path, n_emissive,

@@ -107,6 +107,7 @@ void ms_soup_free(ms_tri_soup *soup)
     free(soup->material);
     free(soup->normal);
     free(soup->tangent);
+    ms_soup_free_names(soup);
     free(soup->mats);
     for (size_t i = 0; i < soup->n_tex; i++) free(soup->tex[i].rgba);
     free(soup->tex);
