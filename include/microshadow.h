@@ -525,8 +525,8 @@ typedef struct ms_render_options {
                              * (ties by the top-left rule, t ties to the smaller id): the same hits as 3dr-* */
     ms_closed_cull_mode closed_cull; /* leave out of every light's occluders the triangles of closed meshes that face
                              * away from the whole light: the same V and S (docs/culling.md). Default: on for the
-                             * micro-raster methods (with their interior boxes it pays: thin closed parts halve),
-                             * off for raytrace and mft (on bulky meshes it costs them: the kept far side projects
+                             * micro-raster methods and mft (with their interior boxes it pays: thin closed parts
+                             * halve), off for raytrace (on bulky meshes it costs it: the kept far side projects
                              * smaller); embree and hpc never cull */
     int no_interior;        /* micro-raster methods: no interior boxes (virtual occluders inside closed meshes,
                              * docs/culling.md: the same V and S); to measure what they buy */
