@@ -322,9 +322,13 @@ static int cli_main(int argc, char **argv)
     }
     if (!quiet) {
         const ms_stats *s = &stats;
-        fprintf(stderr, "%s: %zu triangles, %dx%d, %d samples (%s), method %s, %d threads: build %.3fs, setup %.3fs, primary %.3fs, "
-                "shadow %.3fs (%.1f M shadow rays/s), total %.3fs -> %s\n",
-                what, s->triangles, s->width, s->height, s->samples, s->pattern, s->method,
+        /* the lights' count too: an asset's own emitters and punctual lights become lights without a line of
+         * the scene file naming them */
+        size_t n_lights;
+        ms_scene_lights(&scene, &n_lights);
+        fprintf(stderr, "%s: %zu triangles, %zu light%s, %dx%d, %d samples (%s), method %s, %d threads: build %.3fs, setup %.3fs, "
+                "primary %.3fs, shadow %.3fs (%.1f M shadow rays/s), total %.3fs -> %s\n",
+                what, s->triangles, n_lights, n_lights == 1 ? "" : "s", s->width, s->height, s->samples, s->pattern, s->method,
                 s->threads, s->build_s, s->setup_s, s->primary_s, s->shadow_s,
                 s->shadow_s > 0 ? (double)s->shadow_rays / s->shadow_s * 1e-6 : 0.0, s->total_s, outs[OUT_PNG].path);
     }
