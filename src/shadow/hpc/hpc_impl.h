@@ -136,6 +136,8 @@ typedef struct shared {
     uint64_t *gmask;                 /* G x mw: the samples of each group */
     double light_poly[12];
     double group_poly[64][12];
+    float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
+    int footprint;                   /* hpc (not hpc-scanline) with the footprint test: no V_Gk */
     float light_lo[3], light_hi[3], scale;
     float reach;                     /* farthest distance from the light's box to the receivers' box */
     size_t n;
@@ -478,6 +480,88 @@ static int alpha_opaque(const shared *sh, const tri_job *t, const ms_shadow_quer
     return ms_alpha_segment_occludes(sh->ctx->alpha, t->self, q->p, L);
 }
 
+/* ---- the footprint test (hpc, in place of the paper's group volumes V_Gk) ----
+ *
+ * Departure from the paper. For a receiver p and a triangle (vertices A, B, C relative to p, the floats the
+ * exact test uses), the exact test's edge functions for the direction d are U = ((C x B) . d) / d[kz],
+ * V = ((A x C) . d) / d[kz], W = ((B x A) . d) / d[kz] (the 2D cross product of two vertices sheared along d
+ * is the triple product over d[kz]), and it reports a hit only when they do not have strictly mixed signs.
+ * The sample directions d(i, j) = p0 + i ds + j dt - p of the receiver's grid are affine in (i, j), so each
+ * E_e = (X_e . d) is an affine function e0 + i e1 + j e2 of the sample's indices: the triangle's footprint on
+ * the light, in the grid's own coordinates, for this one receiver (V_Gk bounds it over the whole group
+ * polygon and all pixels' grids, and costs 24 double-precision planes per group and triangle). A group or a
+ * lane is rejected when over all its samples some E_e > s_e and some E_e' < -s_e'.
+ *
+ * The slack s_e bounds the exact test's rounding, so that no sample it calls blocked is ever rejected: with
+ * the shear |sx|, |sy| <= 2 (the packet axis, ms_wt_packet_axis; 1 for a lane's own axis) the sheared
+ * coordinates are off by at most 9.1 u |V|inf (u = 2^-24, V the vertex), U by at most 146 u |Y1|inf
+ * |Y2|inf for the two vertices Y1, Y2 of its edge (the double fall-back at a zero edge only rounds less),
+ * so E = U d[kz] by 146 u |Y1| |Y2| |d|inf; the float direction d is off the affine d(i, j) by at most
+ * 5 u S per component (S = |p0| + k |ds| + k |dt| + |p|, all inf-norms), which moves E by at most
+ * |X_e|_1 5 u S <= 30 u |Y1| |Y2| S; and this test's own float evaluation (the cross product, the three
+ * dots, the affine sum) errs by at most 90 u |Y1| |Y2| dmax (dmax >= |d|inf of every sample). s_e =
+ * u |Y1| |Y2| (512 dmax + 128 S) covers the sum twice. The t range and alpha only remove hits. */
+typedef struct hpc_footprint {
+    float e[3][3];   /* per edge function: e0, e1 (per column i), e2 (per row j) */
+    float s[3];      /* per edge function: the slack */
+} hpc_footprint;
+
+static inline float inf_norm3(const float v[3]) { return ms_maxf(fabsf(v[0]), ms_maxf(fabsf(v[1]), fabsf(v[2]))); }
+
+static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3], const float C[3], const ms_grid *g,
+                            const float p[3], int k)
+{
+    const float *Y[3][2] = { { C, B }, { A, C }, { B, A } };
+    float w[3];
+    for (int a = 0; a < 3; a++) w[a] = g->p0[a] - p[a];
+    const float ext = (float)k * (inf_norm3(g->ds) + inf_norm3(g->dt));
+    const float dmax = inf_norm3(w) + ext, S = inf_norm3(g->p0) + ext + inf_norm3(p);
+    const float rel = 5.9604645e-08f * (512.0f * dmax + 128.0f * S);   /* u (512 dmax + 128 S) */
+    for (int e = 0; e < 3; e++) {
+        const float *y1 = Y[e][0], *y2 = Y[e][1];
+        float X[3];
+        v3_cross(X, y1, y2);
+        f->e[e][0] = v3_dot(X, w);
+        f->e[e][1] = v3_dot(X, g->ds);
+        f->e[e][2] = v3_dot(X, g->dt);
+        f->s[e] = rel * inf_norm3(y1) * inf_norm3(y2);
+    }
+}
+
+/* The groups (bit gk) whose samples the footprint may hold: a group is out when over its gs x gs samples
+ * one edge function stays above its slack and another below minus its slack (16 groups per operation). */
+static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
+{
+    const l16 zero = l16_set1(0.0f), span = l16_set1((float)(sh->gs - 1));
+    uint64_t cand = 0;
+    for (int g0 = 0; g0 < sh->G; g0 += LANES) {
+        const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
+        unsigned pos = 0, neg = 0;
+        for (int e = 0; e < 3; e++) {
+            const l16 base = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
+            const l16 di = l16_mul(l16_set1(f->e[e][1]), span), dj = l16_mul(l16_set1(f->e[e][2]), span);
+            const l16 lo = l16_add(l16_add(base, l16_min(di, zero)), l16_min(dj, zero));
+            const l16 hi = l16_add(l16_add(base, l16_max(di, zero)), l16_max(dj, zero));
+            pos |= l16_gt(lo, l16_set1(f->s[e]));
+            neg |= l16_lt(hi, l16_set1(-f->s[e]));
+        }
+        cand |= (uint64_t)(~(pos & neg) & 0xffffu) << g0;
+    }
+    return cand & sh->all_groups;
+}
+
+/* The lanes (sample li, lj each) the footprint may hold. */
+static unsigned footprint_lanes(const hpc_footprint *f, l16 li, l16 lj)
+{
+    unsigned pos = 0, neg = 0;
+    for (int e = 0; e < 3; e++) {
+        const l16 E = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), li)), l16_mul(l16_set1(f->e[e][2]), lj));
+        pos |= l16_gt(E, l16_set1(f->s[e]));
+        neg |= l16_lt(E, l16_set1(-f->s[e]));
+    }
+    return ~(pos & neg) & 0xffffu;
+}
+
 /* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
  * alpha-tested triangle blocks a sample only where it is opaque (any hit, alpha.h). */
 static int cast_group(const shared *sh, chunk *c, uint64_t *open, const int8_t *kz, int gk, const ms_shadow_query *q,
@@ -588,19 +672,31 @@ static unsigned group_block16(const shared *sh, const ms_shadow_query *q, const 
 
 /* cast_group with the 16-lane test: the group's open samples 16 at a time. */
 static int cast_group16(const shared *sh, chunk *c, uint64_t *open, const int8_t *kz, int gk, const ms_shadow_query *q,
-                        const ms_grid *g, const tri_job *t, const float A[3], const float B[3], const float C[3], float num)
+                        const ms_grid *g, const tri_job *t, const float A[3], const float B[3], const float C[3], float num,
+                        const hpc_footprint *fp)
 {
     const int k = sh->k, gs = sh->gs, gpr = k / gs, rows = LANES / gs;
     const int i0 = (gk % gpr) * gs, j0 = (gk / gpr) * gs;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
     const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
     int left = 0;
+    unsigned any_hit = 0;
     for (int jb = j0; jb < j0 + gs; jb += rows) {
+        unsigned lanes = 0xffffu;
+        if (fp) {   /* only the lanes the footprint may hold (they alone can be hit) */
+            static const float off[2][2][LANES] = {
+                { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+                { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+            const int wi = gs == 8;
+            lanes = footprint_lanes(fp, l16_add(l16_set1((float)i0), l16_load(off[wi][0])), l16_add(l16_set1((float)jb), l16_load(off[wi][1])));
+            if (!lanes) continue;
+        }
         unsigned live = 0;
         for (int r = 0; r < rows; r++) {
             const int s0 = (jb + r) * k + i0;
             live |= (unsigned)(open[s0 >> 6] >> (s0 & 63) & seg) << (r * gs);
         }
+        live &= lanes;
         if (!live) continue;
         c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
         unsigned hit = group_block16(sh, q, g, kz, i0, jb, gs, live, t, A, B, C, num);
@@ -610,11 +706,13 @@ static int cast_group16(const shared *sh, chunk *c, uint64_t *open, const int8_t
                 if (!alpha_opaque(sh, t, q, g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
             }
         c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
+        any_hit |= hit;
         for (int r = 0; r < rows; r++) {
             const int s0 = (jb + r) * k + i0;
             open[s0 >> 6] &= ~((uint64_t)(hit >> (r * gs) & seg) << (s0 & 63));
         }
     }
+    if (fp && !any_hit) return 0;   /* nothing newly blocked: the group's state is as it was */
     for (int j = j0; j < j0 + gs && !left; j++) {
         const int s0 = j * k + i0;
         left |= (open[s0 >> 6] >> (s0 & 63) & seg) != 0;
@@ -672,6 +770,18 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     ms_grid g;   /* the point's samples, formed when first needed */
     int have_g = 0;
 #define HPC_GRID() (have_g ? (void)0 : (ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g), (void)(have_g = 1)))
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
+    uint64_t gu = sh->gumbra[r], todo = 0;
+    hpc_footprint fp;
+    if (sh->footprint) {
+        HPC_GRID();
+        footprint_setup(&fp, A, B, C, &g, q->p, sh->k);
+        c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
+        /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
+        todo = footprint_groups(sh, &fp) & ~gu;
+        if (!todo) return;   /* nothing this triangle can block here: no mask either (D) */
+    }
     int32_t s = sh->slot[r];
     if (s < 0) {
         HPC_GRID();
@@ -680,13 +790,10 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
         memcpy(slot_mask(sh, c, s), sh->front + (size_t)r * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
         slot_setup(sh, c, s, q, &g);
     }
-    if (!c->gvol_built) build_group_volumes(sh, c, t);
+    if (!c->gvol_built && !sh->footprint) build_group_volumes(sh, c, t);
     uint64_t *open = slot_mask(sh, c, s);
     const int8_t *kz = slot_kz(sh, c, s);
-    float A[3], B[3], C[3];
-    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
     const float num = ms_wt_offset(q->p, t->v, t->N);
-    uint64_t gu = sh->gumbra[r];
     if (sh->scanline && slot_frame(sh, c, s)->k) {
         int any = 0;
         for (int i = 0; i < nag && !any; i++) {
@@ -705,6 +812,13 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
             for (int gk = 0; gk < sh->G; gk++)
                 if (!(gu >> gk & 1u) && group_done(sh, open, gk)) gu |= UINT64_C(1) << gk;
         }
+    } else if (sh->footprint) {   /* the footprint test in place of V_Gk (see above) */
+        for (uint64_t m = todo; m; m &= m - 1) {
+            const int gk = __builtin_ctzll(m);
+            const int done = sh->sw & MS_HPC_OFF_SIMD_SAMPLES ? cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
+                                                              : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num, &fp);
+            if (done) gu |= UINT64_C(1) << gk;
+        }
     } else {
         for (int i = 0; i < nag; i++) {
             const int gk = (int)ag[i].k;
@@ -713,7 +827,7 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
             if (!vol_point(sh, &c->gvol[gk], ag[i].planes, q->p, &c->cnt[C_PLANE_TESTS])) continue;
             HPC_GRID();
             const int done = sh->sw & MS_HPC_OFF_SIMD_SAMPLES ? cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
-                                                              : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num);
+                                                              : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num, NULL);
             if (done) gu |= UINT64_C(1) << gk;
         }
     }
@@ -876,6 +990,11 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     sh.gs = k >= 64 ? 8 : 4;     /* 16, 64, 64 groups for k = 16, 32, 64 (a group-umbra word; 2x2 groups at
                                   * k = 16 tripled the box-plane tests and the time on a flowers scene) */
     sh.G = (k / sh.gs) * (k / sh.gs);
+    for (int g = 0; g < sh.G; g++) {
+        sh.group_i0[g] = (float)(g % (k / sh.gs) * sh.gs);
+        sh.group_j0[g] = (float)(g / (k / sh.gs) * sh.gs);
+    }
+    sh.footprint = !scanline && !(sh.sw & MS_HPC_OFF_FOOTPRINT);
     sh.all_groups = sh.G == 64 ? UINT64_MAX : (UINT64_C(1) << sh.G) - 1u;
     sh.npk = k * k / LANES;
     sh.n = n;
