@@ -138,6 +138,8 @@ typedef struct shared {
     double group_poly[64][12];
     float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
     int footprint;                   /* hpc (not hpc-scanline) with the footprint test: no V_Gk */
+    float grid_ds[3], grid_dt[3];    /* the grid's steps, the same for every pixel (pattern.c) */
+    float *p0;                       /* per receiver: its grid's origin (NULL: formed per pair) */
     float light_lo[3], light_hi[3], scale;
     float reach;                     /* farthest distance from the light's box to the receivers' box */
     size_t n;
@@ -672,31 +674,19 @@ static unsigned group_block16(const shared *sh, const ms_shadow_query *q, const 
 
 /* cast_group with the 16-lane test: the group's open samples 16 at a time. */
 static int cast_group16(const shared *sh, chunk *c, uint64_t *open, const int8_t *kz, int gk, const ms_shadow_query *q,
-                        const ms_grid *g, const tri_job *t, const float A[3], const float B[3], const float C[3], float num,
-                        const hpc_footprint *fp)
+                        const ms_grid *g, const tri_job *t, const float A[3], const float B[3], const float C[3], float num)
 {
     const int k = sh->k, gs = sh->gs, gpr = k / gs, rows = LANES / gs;
     const int i0 = (gk % gpr) * gs, j0 = (gk / gpr) * gs;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
     const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
     int left = 0;
-    unsigned any_hit = 0;
     for (int jb = j0; jb < j0 + gs; jb += rows) {
-        unsigned lanes = 0xffffu;
-        if (fp) {   /* only the lanes the footprint may hold (they alone can be hit) */
-            static const float off[2][2][LANES] = {
-                { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
-                { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
-            const int wi = gs == 8;
-            lanes = footprint_lanes(fp, l16_add(l16_set1((float)i0), l16_load(off[wi][0])), l16_add(l16_set1((float)jb), l16_load(off[wi][1])));
-            if (!lanes) continue;
-        }
         unsigned live = 0;
         for (int r = 0; r < rows; r++) {
             const int s0 = (jb + r) * k + i0;
             live |= (unsigned)(open[s0 >> 6] >> (s0 & 63) & seg) << (r * gs);
         }
-        live &= lanes;
         if (!live) continue;
         c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
         unsigned hit = group_block16(sh, q, g, kz, i0, jb, gs, live, t, A, B, C, num);
@@ -706,13 +696,11 @@ static int cast_group16(const shared *sh, chunk *c, uint64_t *open, const int8_t
                 if (!alpha_opaque(sh, t, q, g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
             }
         c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
-        any_hit |= hit;
         for (int r = 0; r < rows; r++) {
             const int s0 = (jb + r) * k + i0;
             open[s0 >> 6] &= ~((uint64_t)(hit >> (r * gs) & seg) << (s0 & 63));
         }
     }
-    if (fp && !any_hit) return 0;   /* nothing newly blocked: the group's state is as it was */
     for (int j = j0; j < j0 + gs && !left; j++) {
         const int s0 = j * k + i0;
         left |= (open[s0 >> 6] >> (s0 & 63) & seg) != 0;
@@ -760,6 +748,124 @@ static int group_done(const shared *sh, const uint64_t *open, int gk)
     return 1;
 }
 
+/* Receiver r's open groups after a triangle (L72-L75): its umbra bits, and at full umbra its mask back. */
+static void record_umbra(const shared *sh, chunk *c, uint32_t r, int32_t s, uint64_t gu)
+{
+    if (sh->sw & MS_HPC_OFF_UMBRA) return;   /* A off: umbra found by casting is not recorded */
+    sh->gumbra[r] = gu;
+    if (gu == sh->all_groups) {
+        sh->full[r] = 1;
+        if (!(sh->sw & MS_HPC_OFF_ON_DEMAND)) {   /* D: the mask goes back (L75) */
+            slot_put(c, s);
+            sh->slot[r] = -1;
+        }
+        c->umbra_in_tree++;
+        c->cnt[C_FULL_UMBRA_POINTS]++;
+    }
+}
+
+/* The mask and sample data of receiver r (D: made when a triangle first may block it, L59-L64). -1 when out
+ * of memory. */
+static int32_t slot_of(const shared *sh, chunk *c, uint32_t r, const ms_grid *g)
+{
+    int32_t s = sh->slot[r];
+    if (s >= 0) return s;
+    if ((s = slot_get(sh, c)) < 0) { c->failed = 1; return -1; }
+    sh->slot[r] = s;
+    memcpy(slot_mask(sh, c, s), sh->front + (size_t)r * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
+    slot_setup(sh, c, s, &sh->q[r], g);
+    return s;
+}
+
+/* Receiver r inside V_L against the triangle, with the footprint test in place of V_Gk (above): the groups
+ * it may touch, then in each the lanes it may hold, and the exact test only on those that are open. The
+ * mask, the packets' shear axes and the plane offset are made only when some lane needs the exact test. */
+static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t)
+{
+    const ms_shadow_query *q = &sh->q[r];
+    ms_grid g;
+    if (sh->p0) {
+        memcpy(g.p0, sh->p0 + 3 * (size_t)r, sizeof g.p0);
+        memcpy(g.ds, sh->grid_ds, sizeof g.ds);
+        memcpy(g.dt, sh->grid_dt, sizeof g.dt);
+        g.k = sh->k;
+    } else {
+        ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g);
+    }
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
+    hpc_footprint fp;
+    footprint_setup(&fp, A, B, C, &g, q->p, sh->k);
+    uint64_t gu = sh->gumbra[r];
+    c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
+    /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
+    const uint64_t todo = footprint_groups(sh, &fp) & ~gu;
+    if (!todo) return;
+    static const float off[2][2][LANES] = {
+        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+    const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8;
+    const uint64_t seg = (UINT64_C(1) << gs) - 1u;
+    const l16 oi = l16_load(off[wi][0]), oj = l16_load(off[wi][1]);
+    const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
+    int32_t s = sh->slot[r];
+    const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)r * sh->mw;
+    float num = 0.0f;
+    const int8_t *kz = NULL;
+    const uint64_t gu0 = gu;
+    for (uint64_t m = todo; m; m &= m - 1) {
+        const int gk = __builtin_ctzll(m);
+        const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
+        unsigned any = 0;
+        for (int jb = j0; jb < j0 + gs; jb += rows) {
+            const unsigned lanes = footprint_lanes(&fp, l16_add(l16_set1((float)i0), oi), l16_add(l16_set1((float)jb), oj));
+            if (!lanes) continue;
+            unsigned live = 0;
+            for (int rr = 0; rr < rows; rr++) {
+                const int s0 = (jb + rr) * k + i0;
+                live |= (unsigned)(open[s0 >> 6] >> (s0 & 63) & seg) << (rr * gs);
+            }
+            live &= lanes;
+            if (!live) continue;
+            if (!kz) {   /* the first exact test of this pair */
+                if (s < 0 && (s = slot_of(sh, c, r, &g)) < 0) return;
+                open = slot_mask(sh, c, s);
+                kz = slot_kz(sh, c, s);
+                num = ms_wt_offset(q->p, t->v, t->N);
+            }
+            c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
+            unsigned hit;
+            if (sh->sw & MS_HPC_OFF_SIMD_SAMPLES) {   /* one lane at a time, the scalar form */
+                hit = 0;
+                for (unsigned b = live; b; b &= b - 1) {
+                    const int l = __builtin_ctz(b), i = i0 + l % gs, j = jb + l / gs;
+                    float d[3];
+                    for (int a = 0; a < 3; a++) d[a] = (g.p0[a] + (float)i * g.ds[a] + (float)j * g.dt[a]) - q->p[a];
+                    hit |= (unsigned)sample_blocked(q->p, d, kz[(j * k + i) / LANES], t->v, t->N, A, B, C, num, sh->ctx->near,
+                                                    sh->ctx->far) << l;
+                }
+            } else {
+                hit = group_block16(sh, q, &g, kz, i0, jb, gs, live, t, A, B, C, num);
+            }
+            if (hit && alpha)
+                for (unsigned b = hit; b; b &= b - 1) {
+                    const int l = __builtin_ctz(b);
+                    if (!alpha_opaque(sh, t, q, &g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
+                }
+            if (!hit) continue;
+            c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
+            any |= hit;
+            uint64_t *w = slot_mask(sh, c, s);
+            for (int rr = 0; rr < rows; rr++) {
+                const int s0 = (jb + rr) * k + i0;
+                w[s0 >> 6] &= ~((uint64_t)(hit >> (rr * gs) & seg) << (s0 & 63));
+            }
+        }
+        if (any && group_done(sh, open, gk)) gu |= UINT64_C(1) << gk;
+    }
+    if (gu != gu0) record_umbra(sh, c, r, s, gu);
+}
+
 /* One receiver of a leaf against the triangle (L56-L75). */
 static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t, uint32_t pl, const act_group *ag, int nag)
 {
@@ -767,21 +873,10 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     if (sh->full[r] || q->prim == t->self) return;
     c->cnt[C_POINT_TESTS]++;
     if (!vol_point(sh, &t->vl, pl, q->p, &c->cnt[C_PLANE_TESTS])) return;
+    if (sh->footprint) { cast_point_footprint(sh, c, r, t); return; }
     ms_grid g;   /* the point's samples, formed when first needed */
     int have_g = 0;
 #define HPC_GRID() (have_g ? (void)0 : (ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g), (void)(have_g = 1)))
-    float A[3], B[3], C[3];
-    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
-    uint64_t gu = sh->gumbra[r], todo = 0;
-    hpc_footprint fp;
-    if (sh->footprint) {
-        HPC_GRID();
-        footprint_setup(&fp, A, B, C, &g, q->p, sh->k);
-        c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
-        /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
-        todo = footprint_groups(sh, &fp) & ~gu;
-        if (!todo) return;   /* nothing this triangle can block here: no mask either (D) */
-    }
     int32_t s = sh->slot[r];
     if (s < 0) {
         HPC_GRID();
@@ -790,10 +885,13 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
         memcpy(slot_mask(sh, c, s), sh->front + (size_t)r * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
         slot_setup(sh, c, s, q, &g);
     }
-    if (!c->gvol_built && !sh->footprint) build_group_volumes(sh, c, t);
+    if (!c->gvol_built) build_group_volumes(sh, c, t);
     uint64_t *open = slot_mask(sh, c, s);
     const int8_t *kz = slot_kz(sh, c, s);
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
     const float num = ms_wt_offset(q->p, t->v, t->N);
+    uint64_t gu = sh->gumbra[r];
     if (sh->scanline && slot_frame(sh, c, s)->k) {
         int any = 0;
         for (int i = 0; i < nag && !any; i++) {
@@ -812,13 +910,6 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
             for (int gk = 0; gk < sh->G; gk++)
                 if (!(gu >> gk & 1u) && group_done(sh, open, gk)) gu |= UINT64_C(1) << gk;
         }
-    } else if (sh->footprint) {   /* the footprint test in place of V_Gk (see above) */
-        for (uint64_t m = todo; m; m &= m - 1) {
-            const int gk = __builtin_ctzll(m);
-            const int done = sh->sw & MS_HPC_OFF_SIMD_SAMPLES ? cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
-                                                              : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num, &fp);
-            if (done) gu |= UINT64_C(1) << gk;
-        }
     } else {
         for (int i = 0; i < nag; i++) {
             const int gk = (int)ag[i].k;
@@ -827,22 +918,12 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
             if (!vol_point(sh, &c->gvol[gk], ag[i].planes, q->p, &c->cnt[C_PLANE_TESTS])) continue;
             HPC_GRID();
             const int done = sh->sw & MS_HPC_OFF_SIMD_SAMPLES ? cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
-                                                              : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num, NULL);
+                                                              : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num);
             if (done) gu |= UINT64_C(1) << gk;
         }
     }
 #undef HPC_GRID
-    if (sh->sw & MS_HPC_OFF_UMBRA) return;   /* A off: umbra found by casting is not recorded */
-    sh->gumbra[r] = gu;
-    if (gu == sh->all_groups) {
-        sh->full[r] = 1;
-        if (!(sh->sw & MS_HPC_OFF_ON_DEMAND)) {   /* D: the mask goes back (L75) */
-            slot_put(c, s);
-            sh->slot[r] = -1;
-        }
-        c->umbra_in_tree++;
-        c->cnt[C_FULL_UMBRA_POINTS]++;
-    }
+    record_umbra(sh, c, r, s, gu);
 }
 
 /* PROCESS-RECURSIVE (L35-L81). */
@@ -1063,6 +1144,26 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         sh.slot[r] = -1;
         if (!sh.full[r]) idx[nlive++] = (uint32_t)r;
     }
+    if (sh.footprint && n) {
+        /* Each receiver's grid origin, formed once: the footprint test needs its grid for every triangle whose
+         * V_L holds it. The steps are the light's (the same for every pixel, pattern.c); checked bit for bit,
+         * and the grids formed per pair if they ever differ. */
+        ms_grid g0;
+        ms_grid_for_pixel(&ctx->light, k, q[0].px, q[0].py, ctx->seed, &g0);
+        memcpy(sh.grid_ds, g0.ds, sizeof sh.grid_ds);
+        memcpy(sh.grid_dt, g0.dt, sizeof sh.grid_dt);
+        sh.p0 = malloc(n * 3 * sizeof *sh.p0);
+        int same = sh.p0 != NULL;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(& : same)
+        for (size_t r = 0; r < (same ? n : 0); r++) {
+            ms_grid g;
+            ms_grid_for_pixel(&ctx->light, k, q[r].px, q[r].py, ctx->seed, &g);
+            memcpy(sh.p0 + 3 * r, g.p0, sizeof g.p0);
+            same &= !memcmp(g.ds, sh.grid_ds, sizeof g.ds) && !memcmp(g.dt, sh.grid_dt, sizeof g.dt);
+        }
+        if (!same) { free(sh.p0); sh.p0 = NULL; }
+        else counters[C_SAMPLE_BYTES] += (uint64_t)n * 3u * sizeof *sh.p0;
+    }
     const uint32_t target = (uint32_t)((nlive + cap - 1) / cap) > 1024u ? (uint32_t)((nlive + cap - 1) / cap) : 1024u;
     nchunks = nlive ? make_chunks(&sh, idx, nlive, target, ch, cap) : 0;
     if (nchunks < 0) goto done;
@@ -1141,6 +1242,7 @@ done:
     free(ids);
     free(sh.gmask);
     free(sh.gumbra);
+    free(sh.p0);
     free(sh.full);
     free(sh.slot);
     return rc;
