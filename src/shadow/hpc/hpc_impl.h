@@ -504,7 +504,7 @@ static int alpha_opaque(const shared *sh, const tri_job *t, const ms_shadow_quer
  * dots, the affine sum) errs by at most 90 u |Y1| |Y2| dmax (dmax >= |d|inf of every sample). s_e =
  * u |Y1| |Y2| (512 dmax + 128 S) covers the sum twice. The t range and alpha only remove hits. */
 typedef struct hpc_footprint {
-    float e[3][3];   /* per edge function: e0, e1 (per column i), e2 (per row j) */
+    float e[4][3];   /* per edge function, and their sum (e[3]): e0, e1 (per column i), e2 (per row j) */
     float s[3];      /* per edge function: the slack */
 } hpc_footprint;
 
@@ -514,11 +514,14 @@ static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3]
                             const float p[3], int k)
 {
     const float *Y[3][2] = { { C, B }, { A, C }, { B, A } };
-    float w[3];
-    for (int a = 0; a < 3; a++) w[a] = g->p0[a] - p[a];
-    const float ext = (float)k * (inf_norm3(g->ds) + inf_norm3(g->dt));
-    const float dmax = inf_norm3(w) + ext, S = inf_norm3(g->p0) + ext + inf_norm3(p);
-    const float rel = 5.9604645e-08f * (512.0f * dmax + 128.0f * S);   /* u (512 dmax + 128 S) */
+    float w[3], dmax = 0.0f, S = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        w[a] = g->p0[a] - p[a];
+        const float ext = (float)(k - 1) * (fabsf(g->ds[a]) + fabsf(g->dt[a]));
+        dmax = ms_maxf(dmax, fabsf(w[a]) + ext);                       /* >= |d|inf of every sample */
+        S = ms_maxf(S, fabsf(g->p0[a]) + ext + fabsf(p[a]));
+    }
+    const float rel = 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));   /* u (512 dmax + 128 S) */
     for (int e = 0; e < 3; e++) {
         const float *y1 = Y[e][0], *y2 = Y[e][1];
         float X[3];
@@ -528,26 +531,44 @@ static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3]
         f->e[e][2] = v3_dot(X, g->dt);
         f->s[e] = rel * inf_norm3(y1) * inf_norm3(y2);
     }
+    for (int c = 0; c < 3; c++) f->e[3][c] = f->e[0][c] + f->e[1][c] + f->e[2][c];
 }
 
-/* The groups (bit gk) whose samples the footprint may hold: a group is out when over its gs x gs samples
- * one edge function stays above its slack and another below minus its slack (16 groups per operation). */
+/* Which sign a hit needs, from the sum of the edge functions, E_sum = -((B - A) x (C - A)) . d (which side of
+ * the triangle's plane the direction points to): a hit has all three of one sign (zeros aside), so where
+ * E_sum stays above twice the sum of the slacks (its coefficients' and evaluation's rounding are far below
+ * them) not all three can be <= 0 up to their slacks: all are >= 0, and any E_e < -s_e rules the samples
+ * out; alike below. Elsewhere (the plane through the receiver parallel to the triangle crosses these
+ * samples) only mixed signs beyond the slacks rule them out. lo, hi: bounds of E_0, E_1, E_2 and E_sum over
+ * each lane's samples. Returns the lanes that may be hit. */
+static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const float s[3])
+{
+    const float s2 = 2.0f * (s[0] + s[1] + s[2]);
+    const unsigned up = l16_gt(lo[3], l16_set1(s2)), down = l16_lt(hi[3], l16_set1(-s2));
+    unsigned pos = 0, neg = 0;
+    for (int e = 0; e < 3; e++) {
+        pos |= l16_gt(lo[e], l16_set1(s[e]));     /* E_e > s_e throughout */
+        neg |= l16_lt(hi[e], l16_set1(-s[e]));    /* E_e < -s_e throughout */
+    }
+    return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
+}
+
+/* The groups (bit gk) whose samples the footprint may hold, bounding each edge function over the group's
+ * gs x gs samples (16 groups per operation). */
 static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
 {
     const l16 zero = l16_set1(0.0f), span = l16_set1((float)(sh->gs - 1));
     uint64_t cand = 0;
     for (int g0 = 0; g0 < sh->G; g0 += LANES) {
         const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
-        unsigned pos = 0, neg = 0;
-        for (int e = 0; e < 3; e++) {
+        l16 lo[4], hi[4];
+        for (int e = 0; e < 4; e++) {
             const l16 base = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
             const l16 di = l16_mul(l16_set1(f->e[e][1]), span), dj = l16_mul(l16_set1(f->e[e][2]), span);
-            const l16 lo = l16_add(l16_add(base, l16_min(di, zero)), l16_min(dj, zero));
-            const l16 hi = l16_add(l16_add(base, l16_max(di, zero)), l16_max(dj, zero));
-            pos |= l16_gt(lo, l16_set1(f->s[e]));
-            neg |= l16_lt(hi, l16_set1(-f->s[e]));
+            lo[e] = l16_add(l16_add(base, l16_min(di, zero)), l16_min(dj, zero));
+            hi[e] = l16_add(l16_add(base, l16_max(di, zero)), l16_max(dj, zero));
         }
-        cand |= (uint64_t)(~(pos & neg) & 0xffffu) << g0;
+        cand |= (uint64_t)footprint_keep(lo, hi, f->s) << g0;
     }
     return cand & sh->all_groups;
 }
@@ -555,13 +576,10 @@ static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
 /* The lanes (sample li, lj each) the footprint may hold. */
 static unsigned footprint_lanes(const hpc_footprint *f, l16 li, l16 lj)
 {
-    unsigned pos = 0, neg = 0;
-    for (int e = 0; e < 3; e++) {
-        const l16 E = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), li)), l16_mul(l16_set1(f->e[e][2]), lj));
-        pos |= l16_gt(E, l16_set1(f->s[e]));
-        neg |= l16_lt(E, l16_set1(-f->s[e]));
-    }
-    return ~(pos & neg) & 0xffffu;
+    l16 E[4];
+    for (int e = 0; e < 4; e++)
+        E[e] = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), li)), l16_mul(l16_set1(f->e[e][2]), lj));
+    return footprint_keep(E, E, f->s);
 }
 
 /* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
