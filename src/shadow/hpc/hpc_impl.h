@@ -795,6 +795,18 @@ static int32_t slot_of(const shared *sh, chunk *c, uint32_t r, const ms_grid *g)
     return s;
 }
 
+/* The open bits of the 16 samples (i0 + l % gs, jb + l / gs) as lanes l, gs = 4 (4 rows) or 8 (2 rows); written
+ * out row by row (a loop over the rows is vectorised into a gather, slower than these loads). */
+static inline unsigned block_open(const uint64_t *open, int k, int i0, int jb, int gs)
+{
+    const int s0 = jb * k + i0, s1 = s0 + k;
+    if (gs == 8)
+        return (unsigned)(open[s0 >> 6] >> (s0 & 63) & 0xffu) | (unsigned)(open[s1 >> 6] >> (s1 & 63) & 0xffu) << 8;
+    const int s2 = s1 + k, s3 = s2 + k;
+    return (unsigned)(open[s0 >> 6] >> (s0 & 63) & 15u) | (unsigned)(open[s1 >> 6] >> (s1 & 63) & 15u) << 4 |
+           (unsigned)(open[s2 >> 6] >> (s2 & 63) & 15u) << 8 | (unsigned)(open[s3 >> 6] >> (s3 & 63) & 15u) << 12;
+}
+
 /* Receiver r inside V_L against the triangle, with the footprint test in place of V_Gk (above): the groups
  * it may touch, then in each the lanes it may hold, and the exact test only on those that are open. The
  * mask, the packets' shear axes and the plane offset are made only when some lane needs the exact test. */
@@ -838,12 +850,7 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
         for (int jb = j0; jb < j0 + gs; jb += rows) {
             const unsigned lanes = footprint_lanes(&fp, l16_add(l16_set1((float)i0), oi), l16_add(l16_set1((float)jb), oj));
             if (!lanes) continue;
-            unsigned live = 0;
-            for (int rr = 0; rr < rows; rr++) {
-                const int s0 = (jb + rr) * k + i0;
-                live |= (unsigned)(open[s0 >> 6] >> (s0 & 63) & seg) << (rr * gs);
-            }
-            live &= lanes;
+            const unsigned live = block_open(open, k, i0, jb, gs) & lanes;
             if (!live) continue;
             if (!kz) {   /* the first exact test of this pair */
                 if (s < 0 && (s = slot_of(sh, c, r, &g)) < 0) return;
