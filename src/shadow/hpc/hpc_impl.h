@@ -105,6 +105,7 @@ enum {
     /* The paper's Table 2 breakdown: phase times (microseconds; the sort is the source's, hpc_method.c) and
      * memory by kind (bytes allocated at the peak). */
     C_SORT_US, C_BUILD_US, C_REBUILD_THREAD_US, C_CAST_US, C_SAMPLE_BYTES, C_HIERARCHY_BYTES, C_MASK_BYTES,
+    C_PAIRS_IN_VL,   /* (receiver, triangle) pairs past the point-in-V_L test: the work the samples' tests start from */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -898,6 +899,7 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     if (sh->full[r] || q->prim == t->self) return;
     c->cnt[C_POINT_TESTS]++;
     if (!vol_point(sh, &t->vl, pl, q->p, &c->cnt[C_PLANE_TESTS])) return;
+    c->cnt[C_PAIRS_IN_VL]++;
     if (sh->footprint) { cast_point_footprint(sh, c, r, t); return; }
     ms_grid g;   /* the point's samples, formed when first needed */
     int have_g = 0;
