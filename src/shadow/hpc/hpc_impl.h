@@ -140,7 +140,7 @@ typedef struct shared {
     float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
     int footprint;                   /* hpc (not hpc-scanline) with the footprint test: no V_Gk */
     float grid_ds[3], grid_dt[3];    /* the grid's steps, the same for every pixel (pattern.c) */
-    float *p0;                       /* per receiver: its grid's origin (NULL: formed per pair) */
+    float *p0;                       /* per receiver: its grid's origin and footprint_rel (NULL: formed per pair) */
     float light_lo[3], light_hi[3], scale;
     float reach;                     /* farthest distance from the light's box to the receivers' box */
     size_t n;
@@ -511,26 +511,33 @@ typedef struct hpc_footprint {
 
 static inline float inf_norm3(const float v[3]) { return ms_maxf(fabsf(v[0]), ms_maxf(fabsf(v[1]), fabsf(v[2]))); }
 
-static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3], const float C[3], const ms_grid *g,
-                            const float p[3], int k)
+/* The slack's factor for a receiver at p with grid g: u (512 dmax + 128 S), 1% up for its own rounding. */
+static float footprint_rel(const ms_grid *g, const float p[3], int k)
 {
-    const float *Y[3][2] = { { C, B }, { A, C }, { B, A } };
-    float w[3], dmax = 0.0f, S = 0.0f;
+    float dmax = 0.0f, S = 0.0f;
     for (int a = 0; a < 3; a++) {
-        w[a] = g->p0[a] - p[a];
         const float ext = (float)(k - 1) * (fabsf(g->ds[a]) + fabsf(g->dt[a]));
-        dmax = ms_maxf(dmax, fabsf(w[a]) + ext);                       /* >= |d|inf of every sample */
+        dmax = ms_maxf(dmax, fabsf(g->p0[a] - p[a]) + ext);           /* >= |d|inf of every sample */
         S = ms_maxf(S, fabsf(g->p0[a]) + ext + fabsf(p[a]));
     }
-    const float rel = 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));   /* u (512 dmax + 128 S) */
+    return 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));
+}
+
+/* rel: footprint_rel of the receiver. */
+static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3], const float C[3], const ms_grid *g,
+                            const float p[3], float rel)
+{
+    const float *Y[3][2] = { { C, B }, { A, C }, { B, A } };
+    const float w[3] = { g->p0[0] - p[0], g->p0[1] - p[1], g->p0[2] - p[2] };
+    const float nA = inf_norm3(A), nB = inf_norm3(B), nC = inf_norm3(C);
+    const float nrm[3][2] = { { nC, nB }, { nA, nC }, { nB, nA } };
     for (int e = 0; e < 3; e++) {
-        const float *y1 = Y[e][0], *y2 = Y[e][1];
         float X[3];
-        v3_cross(X, y1, y2);
+        v3_cross(X, Y[e][0], Y[e][1]);
         f->e[e][0] = v3_dot(X, w);
         f->e[e][1] = v3_dot(X, g->ds);
         f->e[e][2] = v3_dot(X, g->dt);
-        f->s[e] = rel * inf_norm3(y1) * inf_norm3(y2);
+        f->s[e] = rel * nrm[e][0] * nrm[e][1];
     }
     for (int c = 0; c < 3; c++) f->e[3][c] = f->e[0][c] + f->e[1][c] + f->e[2][c];
 }
@@ -574,13 +581,18 @@ static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
     return cand & sh->all_groups;
 }
 
-/* The lanes (sample li, lj each) the footprint may hold. */
-static unsigned footprint_lanes(const hpc_footprint *f, l16 li, l16 lj)
+/* The lanes of the 16-sample block at (i0, j0) the footprint may hold; off[e]: the block's offsets
+ * e1 di + e2 dj per lane, made once per pair (footprint_offsets). */
+static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0, int j0)
 {
     l16 E[4];
-    for (int e = 0; e < 4; e++)
-        E[e] = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), li)), l16_mul(l16_set1(f->e[e][2]), lj));
+    for (int e = 0; e < 4; e++) E[e] = l16_add(l16_set1(f->e[e][0] + f->e[e][1] * (float)i0 + f->e[e][2] * (float)j0), off[e]);
     return footprint_keep(E, E, f->s);
+}
+
+static void footprint_offsets(const hpc_footprint *f, l16 oi, l16 oj, l16 off[4])
+{
+    for (int e = 0; e < 4; e++) off[e] = l16_add(l16_mul(l16_set1(f->e[e][1]), oi), l16_mul(l16_set1(f->e[e][2]), oj));
 }
 
 /* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
@@ -816,7 +828,7 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
     const ms_shadow_query *q = &sh->q[r];
     ms_grid g;
     if (sh->p0) {
-        memcpy(g.p0, sh->p0 + 3 * (size_t)r, sizeof g.p0);
+        memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
         memcpy(g.ds, sh->grid_ds, sizeof g.ds);
         memcpy(g.dt, sh->grid_dt, sizeof g.dt);
         g.k = sh->k;
@@ -826,7 +838,7 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
     float A[3], B[3], C[3];
     for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
     hpc_footprint fp;
-    footprint_setup(&fp, A, B, C, &g, q->p, sh->k);
+    footprint_setup(&fp, A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
     /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
@@ -837,7 +849,8 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
         { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
     const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
-    const l16 oi = l16_load(off[wi][0]), oj = l16_load(off[wi][1]);
+    l16 foff[4];
+    footprint_offsets(&fp, l16_load(off[wi][0]), l16_load(off[wi][1]), foff);
     const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
     int32_t s = sh->slot[r];
     const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)r * sh->mw;
@@ -849,7 +862,7 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
         const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
         unsigned any = 0;
         for (int jb = j0; jb < j0 + gs; jb += rows) {
-            const unsigned lanes = footprint_lanes(&fp, l16_add(l16_set1((float)i0), oi), l16_add(l16_set1((float)jb), oj));
+            const unsigned lanes = footprint_lanes(&fp, foff, i0, jb);
             if (!lanes) continue;
             const unsigned live = block_open(open, k, i0, jb, gs) & lanes;
             if (!live) continue;
@@ -1179,17 +1192,18 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         ms_grid_for_pixel(&ctx->light, k, q[0].px, q[0].py, ctx->seed, &g0);
         memcpy(sh.grid_ds, g0.ds, sizeof sh.grid_ds);
         memcpy(sh.grid_dt, g0.dt, sizeof sh.grid_dt);
-        sh.p0 = malloc(n * 3 * sizeof *sh.p0);
+        sh.p0 = malloc(n * 4 * sizeof *sh.p0);
         int same = sh.p0 != NULL;
 #pragma omp parallel for schedule(static) num_threads(threads) reduction(& : same)
         for (size_t r = 0; r < (same ? n : 0); r++) {
             ms_grid g;
             ms_grid_for_pixel(&ctx->light, k, q[r].px, q[r].py, ctx->seed, &g);
-            memcpy(sh.p0 + 3 * r, g.p0, sizeof g.p0);
+            memcpy(sh.p0 + 4 * r, g.p0, sizeof g.p0);
+            sh.p0[4 * r + 3] = footprint_rel(&g, q[r].p, k);
             same &= !memcmp(g.ds, sh.grid_ds, sizeof g.ds) && !memcmp(g.dt, sh.grid_dt, sizeof g.dt);
         }
         if (!same) { free(sh.p0); sh.p0 = NULL; }
-        else counters[C_SAMPLE_BYTES] += (uint64_t)n * 3u * sizeof *sh.p0;
+        else counters[C_SAMPLE_BYTES] += (uint64_t)n * 4u * sizeof *sh.p0;
     }
     const uint32_t target = (uint32_t)((nlive + cap - 1) / cap) > 1024u ? (uint32_t)((nlive + cap - 1) / cap) : 1024u;
     nchunks = nlive ? make_chunks(&sh, idx, nlive, target, ch, cap) : 0;
