@@ -42,7 +42,8 @@
  *    (tri_margin); a triangle that may touch the light gets no volume (nothing culled, every relation
  *    tested).
  *  - below 1K points the split is a 16-bin SAH (count-weighted, the paper's "total surface area of the
- *    children" unweighted would split off single points), and leaves hold up to 8 points.
+ *    children" unweighted would split off single points), and leaves hold up to 8 points (16 for hpc,
+ *    whose leaves test 16 points at once).
  *  - the light samples behind a receiver's plane (the horizon) count as blocked from the start, so umbra
  *    bits mean "no front sample left open"; a receiver's hit triangle never blocks it.
  *  - hpc-scanline: the leaf rasterizes the triangle into the receiver's k x k buffer with the Scanline
@@ -91,6 +92,7 @@
 #include <string.h>
 
 #define LEAF_POINTS 8
+#define LEAF_POINTS_FOOTPRINT 16   /* hpc's leaves, whose points are tested 16 at a time (cast_leaf_footprint) */
 #define MIDDLE_SPLIT_ABOVE 1024   /* the paper's 1K */
 #define SAH_BINS 16
 #define MEDIAN_BELOW_DEPTH 40     /* median splits from here: depth at most 40 + log2(points) */
@@ -302,7 +304,7 @@ static int build_tree(const shared *sh, chunk *c)
         const uint32_t depth = stack[--sp];
         hnode *N = &c->nodes[stack[--sp]];
         bounds_of(sh, c->idx + N->first, N->count, N->lo, N->hi);
-        if (N->count <= LEAF_POINTS) continue;
+        if (N->count <= (sh->footprint ? LEAF_POINTS_FOOTPRINT : LEAF_POINTS)) continue;
         const uint32_t m = split_points(sh, c->idx + N->first, N->count, N->lo, N->hi, depth >= MEDIAN_BELOW_DEPTH);
         const uint32_t l = c->n_nodes;
         c->n_nodes += 2;
@@ -823,6 +825,9 @@ static inline unsigned block_open(const uint64_t *open, int k, int i0, int jb, i
 /* Receiver r inside V_L against the triangle, with the footprint test in place of V_Gk (above): the groups
  * it may touch, then in each the lanes it may hold, and the exact test only on those that are open. The
  * mask, the packets' shear axes and the plane offset are made only when some lane needs the exact test. */
+static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *grid, const float A[3],
+                           const float B[3], const float C[3], const hpc_footprint *f);
+
 static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t)
 {
     const ms_shadow_query *q = &sh->q[r];
@@ -839,6 +844,17 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
     for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
     hpc_footprint fp;
     footprint_setup(&fp, A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
+    cast_footprint(sh, c, r, t, &g, A, B, C, &fp);
+}
+
+/* Receiver r's samples against the triangle from its footprint fp (made by footprint_setup or, for a leaf's
+ * points at once, by cast_leaf_footprint); A, B, C: the vertices relative to it, g: its grid. */
+static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *grid, const float A[3],
+                           const float B[3], const float C[3], const hpc_footprint *f)
+{
+    const ms_shadow_query *q = &sh->q[r];
+    const ms_grid g = *grid;
+    const hpc_footprint fp = *f;
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
     /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
@@ -966,6 +982,91 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     record_umbra(sh, c, r, s, gu);
 }
 
+/* The points of a leaf inside V_L against the triangle with the footprint test, 16 receivers per operation
+ * (departure: the paper handles a leaf's points one by one): the point-in-V_L test (POINT-IN-VOLUME, the
+ * same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per lane), then each
+ * point's groups and samples (cast_footprint). */
+_Static_assert(LEAF_POINTS_FOOTPRINT <= LANES, "a leaf's points fit the lanes");
+static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, const tri_job *t, uint32_t pl)
+{
+    float P[3][LANES] = { { 0 } }, W[3][LANES] = { { 0 } }, R[LANES] = { 0 };
+    uint32_t rr[LANES];
+    unsigned act = 0;
+    for (uint32_t i = 0; i < N->count; i++) {
+        const uint32_t r = c->idx[N->first + i];
+        rr[i] = r;
+        if (sh->full[r] || sh->q[r].prim == t->self) continue;
+        act |= 1u << i;
+        for (int a = 0; a < 3; a++) { P[a][i] = sh->q[r].p[a]; W[a][i] = sh->p0[4 * (size_t)r + a] - P[a][i]; }
+        R[i] = sh->p0[4 * (size_t)r + 3];
+    }
+    if (!act) return;
+    const int tested = __builtin_popcount(act);
+    c->cnt[C_POINT_TESTS] += (uint64_t)tested;
+    const l16 px = l16_load(P[0]), py = l16_load(P[1]), pz = l16_load(P[2]);
+    const hpc_volume *v = &t->vl;
+    uint32_t planes = pl & (v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u);
+    c->cnt[C_PLANE_TESTS] += (uint64_t)tested * (uint64_t)__builtin_popcount(planes);
+    const l16 neps = l16_set1(-v->eps);
+    for (; planes && act; planes &= planes - 1) {
+        const int i = __builtin_ctz(planes);
+        const l16 d = l16_add(l16_add(l16_add(l16_mul(l16_set1(v->soa[0][i]), px), l16_mul(l16_set1(v->soa[1][i]), py)),
+                                      l16_mul(l16_set1(v->soa[2][i]), pz)),
+                              l16_set1(v->soa[3][i]));
+        act &= ~l16_lt(d, neps);
+    }
+    if (!act) return;
+    c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act);
+    /* footprint_setup per lane */
+    l16 Y[3][3], nY[3];
+    for (int vtx = 0; vtx < 3; vtx++) {
+        const l16 pc[3] = { px, py, pz };
+        for (int a = 0; a < 3; a++) Y[vtx][a] = l16_sub(l16_set1(t->v[3 * vtx + a]), pc[a]);
+        nY[vtx] = l16_max(l16_abs(Y[vtx][0]), l16_max(l16_abs(Y[vtx][1]), l16_abs(Y[vtx][2])));
+    }
+    const l16 w[3] = { l16_load(W[0]), l16_load(W[1]), l16_load(W[2]) }, rel = l16_load(R);
+    static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A */
+    float fe[4][3][LANES], fs[3][LANES];
+    l16 esum[3];
+    for (int e = 0; e < 3; e++) {
+        const l16 *y1 = Y[pair[e][0]], *y2 = Y[pair[e][1]];
+        const l16 X[3] = { l16_sub(l16_mul(y1[1], y2[2]), l16_mul(y1[2], y2[1])), l16_sub(l16_mul(y1[2], y2[0]), l16_mul(y1[0], y2[2])),
+                           l16_sub(l16_mul(y1[0], y2[1]), l16_mul(y1[1], y2[0])) };
+        const l16 c0 = l16_add(l16_add(l16_mul(X[0], w[0]), l16_mul(X[1], w[1])), l16_mul(X[2], w[2]));
+        const l16 c1 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_ds[0])), l16_mul(X[1], l16_set1(sh->grid_ds[1]))),
+                               l16_mul(X[2], l16_set1(sh->grid_ds[2])));
+        const l16 c2 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_dt[0])), l16_mul(X[1], l16_set1(sh->grid_dt[1]))),
+                               l16_mul(X[2], l16_set1(sh->grid_dt[2])));
+        l16_store(fe[e][0], c0);
+        l16_store(fe[e][1], c1);
+        l16_store(fe[e][2], c2);
+        l16_store(fs[e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
+        if (e == 0) { esum[0] = c0; esum[1] = c1; esum[2] = c2; }
+        else { esum[0] = l16_add(esum[0], c0); esum[1] = l16_add(esum[1], c1); esum[2] = l16_add(esum[2], c2); }
+    }
+    for (int a = 0; a < 3; a++) l16_store(fe[3][a], esum[a]);
+    for (unsigned m = act; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        const uint32_t r = rr[l];
+        hpc_footprint fp;
+        for (int e = 0; e < 4; e++)
+            for (int a = 0; a < 3; a++) fp.e[e][a] = fe[e][a][l];
+        for (int e = 0; e < 3; e++) fp.s[e] = fs[e][l];
+        ms_grid g;
+        memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
+        memcpy(g.ds, sh->grid_ds, sizeof g.ds);
+        memcpy(g.dt, sh->grid_dt, sizeof g.dt);
+        g.k = sh->k;
+        float Av[3], Bv[3], Cv[3];
+        for (int a = 0; a < 3; a++) {
+            Av[a] = t->v[a] - P[a][l];
+            Bv[a] = t->v[3 + a] - P[a][l];
+            Cv[a] = t->v[6 + a] - P[a][l];
+        }
+        cast_footprint(sh, c, r, t, &g, Av, Bv, Cv, &fp);
+    }
+}
+
 /* PROCESS-RECURSIVE (L35-L81). */
 static void cast_node(const shared *sh, chunk *c, uint32_t ni, const tri_job *t, uint32_t pl, const act_group *ag, int nag)
 {
@@ -994,7 +1095,9 @@ static void cast_node(const shared *sh, chunk *c, uint32_t ni, const tri_job *t,
         N->gumbra = c->nodes[l].gumbra & c->nodes[l + 1].gumbra;
         N->full = c->nodes[l].full & c->nodes[l + 1].full;
     } else {
-        for (uint32_t i = N->first; i < N->first + N->count; i++) cast_point(sh, c, c->idx[i], t, pl2, ag2, n2);
+        if (sh->footprint && sh->p0 && N->count <= LANES) cast_leaf_footprint(sh, c, N, t, pl2);
+        else
+            for (uint32_t i = N->first; i < N->first + N->count; i++) cast_point(sh, c, c->idx[i], t, pl2, ag2, n2);
         node_bits_from_points(sh, c, N);
     }
 }
