@@ -570,16 +570,21 @@ static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const fl
  * gs x gs samples (16 groups per operation). */
 static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
 {
-    const l16 zero = l16_set1(0.0f), span = l16_set1((float)(sh->gs - 1));
+    const float span = (float)(sh->gs - 1);
+    float dlo[4], dhi[4];   /* each function's least and largest change from a group's first sample */
+    for (int e = 0; e < 4; e++) {
+        const float di = f->e[e][1] * span, dj = f->e[e][2] * span;
+        dlo[e] = ms_minf(di, 0.0f) + ms_minf(dj, 0.0f);
+        dhi[e] = ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f);
+    }
     uint64_t cand = 0;
     for (int g0 = 0; g0 < sh->G; g0 += LANES) {
         const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
         l16 lo[4], hi[4];
         for (int e = 0; e < 4; e++) {
             const l16 base = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
-            const l16 di = l16_mul(l16_set1(f->e[e][1]), span), dj = l16_mul(l16_set1(f->e[e][2]), span);
-            lo[e] = l16_add(l16_add(base, l16_min(di, zero)), l16_min(dj, zero));
-            hi[e] = l16_add(l16_add(base, l16_max(di, zero)), l16_max(dj, zero));
+            lo[e] = l16_add(base, l16_set1(dlo[e]));
+            hi[e] = l16_add(base, l16_set1(dhi[e]));
         }
         cand |= (uint64_t)footprint_keep(lo, hi, f->s) << g0;
     }
@@ -856,12 +861,12 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job
                            const float B[3], const float C[3], const hpc_footprint *f)
 {
     const ms_shadow_query *q = &sh->q[r];
-    const ms_grid g = *grid;
-    const hpc_footprint fp = *f;
+    const ms_grid *const g = grid;
+    const hpc_footprint *const fp = f;
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
     /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
-    const uint64_t todo = footprint_groups(sh, &fp) & ~gu;
+    const uint64_t todo = footprint_groups(sh, fp) & ~gu;
     if (!todo) return;
     static const float off[2][2][LANES] = {
         { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
@@ -869,7 +874,7 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job
     const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
     l16 foff[4];
-    footprint_offsets(&fp, l16_load(off[wi][0]), l16_load(off[wi][1]), foff);
+    footprint_offsets(fp, l16_load(off[wi][0]), l16_load(off[wi][1]), foff);
     const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
     int32_t s = sh->slot[r];
     const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
@@ -881,12 +886,12 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job
         const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
         unsigned any = 0;
         for (int jb = j0; jb < j0 + gs; jb += rows) {
-            const unsigned lanes = footprint_lanes(&fp, foff, i0, jb);
+            const unsigned lanes = footprint_lanes(fp, foff, i0, jb);
             if (!lanes) continue;
             const unsigned live = block_open(open, k, i0, jb, gs) & lanes;
             if (!live) continue;
             if (!kz) {   /* the first exact test of this pair */
-                if (s < 0 && (s = slot_of(sh, c, r, &g)) < 0) return;
+                if (s < 0 && (s = slot_of(sh, c, r, g)) < 0) return;
                 open = slot_mask(sh, c, s);
                 kz = slot_kz(sh, c, s);
                 num = ms_wt_offset(q->p, t->v, t->N);
@@ -898,17 +903,17 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job
                 for (unsigned b = live; b; b &= b - 1) {
                     const int l = __builtin_ctz(b), i = i0 + l % gs, j = jb + l / gs;
                     float d[3];
-                    for (int a = 0; a < 3; a++) d[a] = (g.p0[a] + (float)i * g.ds[a] + (float)j * g.dt[a]) - q->p[a];
+                    for (int a = 0; a < 3; a++) d[a] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
                     hit |= (unsigned)sample_blocked(q->p, d, kz[(j * k + i) / LANES], t->v, t->N, A, B, C, num, sh->ctx->near,
                                                     sh->ctx->far) << l;
                 }
             } else {
-                hit = group_block16(sh, q, &g, kz, i0, jb, gs, live, t, A, B, C, num);
+                hit = group_block16(sh, q, g, kz, i0, jb, gs, live, t, A, B, C, num);
             }
             if (hit && alpha)
                 for (unsigned b = hit; b; b &= b - 1) {
                     const int l = __builtin_ctz(b);
-                    if (!alpha_opaque(sh, t, q, &g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
+                    if (!alpha_opaque(sh, t, q, g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
                 }
             if (!hit) continue;
             c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
