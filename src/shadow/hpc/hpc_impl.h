@@ -46,6 +46,18 @@
  *    whose leaves test 16 points at once).
  *  - the light samples behind a receiver's plane (the horizon) count as blocked from the start, so umbra
  *    bits mean "no front sample left open"; a receiver's hit triangle never blocks it.
+ *  - hpc (not hpc-scanline) replaces the group volumes V_Gk by the footprint test (below, "the footprint
+ *    test"): per receiver and triangle, the exact test's edge functions as affine functions of the sample
+ *    indices, bounded per group and per 16-sample block with a proven slack for the exact test's rounding.
+ *    V_Gk bounds a group over the whole group polygon and every pixel's grid, and costs 24 double-precision
+ *    candidate planes per group and triangle; the footprint is one receiver's own grid, in float, and
+ *    leaves only the samples the triangle may cover (on a GRIDS-like scene 162M sample tests became 6M).
+ *    Nodes are then culled by V_L alone (no group volumes to test boxes against); the paper's form stays
+ *    for hpc-scanline (whose Scanline kernel the slack does not bound) and under MS_HPC_OFF_FOOTPRINT.
+ *    A leaf's points (up to 16 for hpc) take the point-in-V_L test and the footprint set-up 16 at a time,
+ *    and the receivers are renumbered in hierarchy order so that a leaf's data lie together in memory.
+ *  - the triangles are ctx->bvh's: with the light's occluders (hpc_method.c), those of closed components
+ *    facing away from the whole light are left out (docs/culling.md proves it changes no V or S).
  *  - hpc-scanline: the leaf rasterizes the triangle into the receiver's k x k buffer with the Scanline
  *    kernel (Woop 2010; src/raster) once some active group's volume holds the point, instead of testing
  *    the samples one by one (points that see the light nearly edge-on are tested per sample, as
