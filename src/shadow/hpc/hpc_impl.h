@@ -845,8 +845,8 @@ static inline unsigned block_open(const uint64_t *open, int k, int i0, int jb, i
 /* Receiver r inside V_L against the triangle, with the footprint test in place of V_Gk (above): the groups
  * it may touch, then in each the lanes it may hold, and the exact test only on those that are open. The
  * mask, the packets' shear axes and the plane offset are made only when some lane needs the exact test. */
-static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *grid, const float A[3],
-                           const float B[3], const float C[3], const hpc_footprint *f);
+static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *g, const float A[3],
+                           const float B[3], const float C[3], const hpc_footprint *fp);
 
 static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t)
 {
@@ -869,12 +869,10 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
 
 /* Receiver r's samples against the triangle from its footprint fp (made by footprint_setup or, for a leaf's
  * points at once, by cast_leaf_footprint); A, B, C: the vertices relative to it, g: its grid. */
-static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *grid, const float A[3],
-                           const float B[3], const float C[3], const hpc_footprint *f)
+static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *g, const float A[3],
+                           const float B[3], const float C[3], const hpc_footprint *fp)
 {
     const ms_shadow_query *q = &sh->q[r];
-    const ms_grid *const g = grid;
-    const hpc_footprint *const fp = f;
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
     /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
