@@ -526,8 +526,9 @@ typedef struct ms_render_options {
     ms_closed_cull_mode closed_cull; /* leave out of every light's occluders the triangles of closed meshes that face
                              * away from the whole light: the same V and S (docs/culling.md). Default: on for the
                              * micro-raster methods and mft (with their interior boxes it pays: thin closed parts
-                             * halve), off for raytrace (on bulky meshes it costs it: the kept far side projects
-                             * smaller); embree and hpc never cull */
+                             * halve) and hpc, hpc-scanline (every triangle left out is pairs saved), off for
+                             * raytrace (on bulky meshes it costs it: the kept far side projects smaller); embree
+                             * never culls */
     int no_interior;        /* micro-raster methods: no interior boxes (virtual occluders inside closed meshes,
                              * docs/culling.md: the same V and S); to measure what they buy */
     int no_merge;           /* micro-raster methods: occluders as given, without merging the two halves of

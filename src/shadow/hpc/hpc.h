@@ -19,7 +19,7 @@ typedef struct hpc_source {
     size_t (*next)(void *user, float *tri, uint32_t *ids, size_t max);
 } hpc_source;
 
-#define HPC_N_COUNTERS 23
+#define HPC_N_COUNTERS 24
 #define HPC_COUNTER_SORT_US 16   /* filled by the method (hpc_method.c): the sort is the source's */
 
 /* For n receivers with their front masks (receiver.h), writes the visible masks: the front samples that no
@@ -53,7 +53,8 @@ enum {
     MS_HPC_OFF_ON_DEMAND = 8,    /* D: on-demand masks: every receiver gets its mask before the first triangle */
     MS_HPC_OFF_SORT = 16,        /* coarse blocker sorting: the scene's order (hpc_method.c) */
     MS_HPC_OFF_SIMD_SAMPLES = 32,/* the 16-lane sample test: one sample at a time (the scalar form) */
-    MS_HPC_OFF_SIMD_PLANES = 64  /* the 16-lane volume tests: one plane at a time */
+    MS_HPC_OFF_SIMD_PLANES = 64, /* the 16-lane volume tests: one plane at a time */
+    MS_HPC_OFF_FOOTPRINT = 128   /* hpc's footprint test (hpc_impl.h): the group volumes V_Gk, as the paper */
 };
 extern int ms_hpc_switches;
 

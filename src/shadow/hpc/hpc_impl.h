@@ -42,9 +42,22 @@
  *    (tri_margin); a triangle that may touch the light gets no volume (nothing culled, every relation
  *    tested).
  *  - below 1K points the split is a 16-bin SAH (count-weighted, the paper's "total surface area of the
- *    children" unweighted would split off single points), and leaves hold up to 8 points.
+ *    children" unweighted would split off single points), and leaves hold up to 8 points (16 for hpc,
+ *    whose leaves test 16 points at once).
  *  - the light samples behind a receiver's plane (the horizon) count as blocked from the start, so umbra
  *    bits mean "no front sample left open"; a receiver's hit triangle never blocks it.
+ *  - hpc (not hpc-scanline) replaces the group volumes V_Gk by the footprint test (below, "the footprint
+ *    test"): per receiver and triangle, the exact test's edge functions as affine functions of the sample
+ *    indices, bounded per group and per 16-sample block with a proven slack for the exact test's rounding.
+ *    V_Gk bounds a group over the whole group polygon and every pixel's grid, and costs 24 double-precision
+ *    candidate planes per group and triangle; the footprint is one receiver's own grid, in float, and
+ *    leaves only the samples the triangle may cover (on a GRIDS-like scene 162M sample tests became 6M).
+ *    Nodes are then culled by V_L alone (no group volumes to test boxes against); the paper's form stays
+ *    for hpc-scanline (whose Scanline kernel the slack does not bound) and under MS_HPC_OFF_FOOTPRINT.
+ *    A leaf's points (up to 16 for hpc) take the point-in-V_L test and the footprint set-up 16 at a time,
+ *    and the receivers are renumbered in hierarchy order so that a leaf's data lie together in memory.
+ *  - the triangles are ctx->bvh's: with the light's occluders (hpc_method.c), those of closed components
+ *    facing away from the whole light are left out (docs/culling.md proves it changes no V or S).
  *  - hpc-scanline: the leaf rasterizes the triangle into the receiver's k x k buffer with the Scanline
  *    kernel (Woop 2010; src/raster) once some active group's volume holds the point, instead of testing
  *    the samples one by one (points that see the light nearly edge-on are tested per sample, as
@@ -91,6 +104,7 @@
 #include <string.h>
 
 #define LEAF_POINTS 8
+#define LEAF_POINTS_FOOTPRINT 16   /* hpc's leaves, whose points are tested 16 at a time (cast_leaf_footprint) */
 #define MIDDLE_SPLIT_ABOVE 1024   /* the paper's 1K */
 #define SAH_BINS 16
 #define MEDIAN_BELOW_DEPTH 40     /* median splits from here: depth at most 40 + log2(points) */
@@ -105,6 +119,7 @@ enum {
     /* The paper's Table 2 breakdown: phase times (microseconds; the sort is the source's, hpc_method.c) and
      * memory by kind (bytes allocated at the peak). */
     C_SORT_US, C_BUILD_US, C_REBUILD_THREAD_US, C_CAST_US, C_SAMPLE_BYTES, C_HIERARCHY_BYTES, C_MASK_BYTES,
+    C_PAIRS_IN_VL,   /* (receiver, triangle) pairs past the point-in-V_L test: the work the samples' tests start from */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -136,11 +151,17 @@ typedef struct shared {
     uint64_t *gmask;                 /* G x mw: the samples of each group */
     double light_poly[12];
     double group_poly[64][12];
+    float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
+    int footprint;                   /* hpc (not hpc-scanline) with the footprint test: no V_Gk */
+    float grid_ds[3], grid_dt[3];    /* the grid's steps, the same for every pixel (pattern.c) */
+    float *p0;                       /* per receiver: its grid's origin and footprint_rel (NULL: formed per pair) */
     float light_lo[3], light_hi[3], scale;
     float reach;                     /* farthest distance from the light's box to the receivers' box */
     size_t n;
     const ms_shadow_query *q;
-    const uint64_t *front;
+    const uint64_t *front;           /* indexed by the caller's receiver numbers: orig[r] */
+    const uint32_t *orig;            /* per receiver: the caller's number (receivers are renumbered in
+                                      * hierarchy order, so that a leaf's points lie together in memory) */
     uint64_t *gumbra;                /* per receiver */
     uint8_t *full;
     int32_t *slot;
@@ -149,6 +170,7 @@ typedef struct shared {
 
 /* One chunk of receivers with its own hierarchy and mask pool (one thread at a time). */
 typedef struct chunk {
+    uint32_t base, n0;               /* its receivers' numbers: base .. base + n0 - 1 */
     uint32_t *idx;
     uint32_t n;                      /* points in the hierarchy (full-umbra ones leave at a rebuild) */
     uint32_t umbra_in_tree;
@@ -297,7 +319,7 @@ static int build_tree(const shared *sh, chunk *c)
         const uint32_t depth = stack[--sp];
         hnode *N = &c->nodes[stack[--sp]];
         bounds_of(sh, c->idx + N->first, N->count, N->lo, N->hi);
-        if (N->count <= LEAF_POINTS) continue;
+        if (N->count <= (sh->footprint ? LEAF_POINTS_FOOTPRINT : LEAF_POINTS)) continue;
         const uint32_t m = split_points(sh, c->idx + N->first, N->count, N->lo, N->hi, depth >= MEDIAN_BELOW_DEPTH);
         const uint32_t l = c->n_nodes;
         c->n_nodes += 2;
@@ -476,6 +498,123 @@ static int alpha_opaque(const shared *sh, const tri_job *t, const ms_shadow_quer
     float L[3];
     for (int a = 0; a < 3; a++) L[a] = g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a];
     return ms_alpha_segment_occludes(sh->ctx->alpha, t->self, q->p, L);
+}
+
+/* ---- the footprint test (hpc, in place of the paper's group volumes V_Gk) ----
+ *
+ * Departure from the paper. For a receiver p and a triangle (vertices A, B, C relative to p, the floats the
+ * exact test uses), the exact test's edge functions for the direction d are U = ((C x B) . d) / d[kz],
+ * V = ((A x C) . d) / d[kz], W = ((B x A) . d) / d[kz] (the 2D cross product of two vertices sheared along d
+ * is the triple product over d[kz]), and it reports a hit only when they do not have strictly mixed signs.
+ * The sample directions d(i, j) = p0 + i ds + j dt - p of the receiver's grid are affine in (i, j), so each
+ * E_e = (X_e . d) is an affine function e0 + i e1 + j e2 of the sample's indices: the triangle's footprint on
+ * the light, in the grid's own coordinates, for this one receiver (V_Gk bounds it over the whole group
+ * polygon and all pixels' grids, and costs 24 double-precision planes per group and triangle). A group or a
+ * lane is rejected when over all its samples some E_e > s_e and some E_e' < -s_e'.
+ *
+ * The slack s_e bounds the exact test's rounding, so that no sample it calls blocked is ever rejected: with
+ * the shear |sx|, |sy| <= 2 (the packet axis, ms_wt_packet_axis; 1 for a lane's own axis) the sheared
+ * coordinates are off by at most 9.1 u |V|inf (u = 2^-24, V the vertex), U by at most 146 u |Y1|inf
+ * |Y2|inf for the two vertices Y1, Y2 of its edge (the double fall-back at a zero edge only rounds less),
+ * so E = U d[kz] by 146 u |Y1| |Y2| |d|inf; the float direction d is off the affine d(i, j) by at most
+ * 5 u S per component (S = |p0| + k |ds| + k |dt| + |p|, all inf-norms), which moves E by at most
+ * |X_e|_1 5 u S <= 30 u |Y1| |Y2| S; and this test's own float evaluation (the cross product, the three
+ * dots, the affine sum) errs by at most 90 u |Y1| |Y2| dmax (dmax >= |d|inf of every sample). s_e =
+ * u |Y1| |Y2| (512 dmax + 128 S) covers the sum twice. The t range and alpha only remove hits. */
+typedef struct hpc_footprint {
+    float e[4][3];   /* per edge function, and their sum (e[3]): e0, e1 (per column i), e2 (per row j) */
+    float s[3];      /* per edge function: the slack */
+} hpc_footprint;
+
+static inline float inf_norm3(const float v[3]) { return ms_maxf(fabsf(v[0]), ms_maxf(fabsf(v[1]), fabsf(v[2]))); }
+
+/* The slack's factor for a receiver at p with grid g: u (512 dmax + 128 S), 1% up for its own rounding. */
+static float footprint_rel(const ms_grid *g, const float p[3], int k)
+{
+    float dmax = 0.0f, S = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        const float ext = (float)(k - 1) * (fabsf(g->ds[a]) + fabsf(g->dt[a]));
+        dmax = ms_maxf(dmax, fabsf(g->p0[a] - p[a]) + ext);           /* >= |d|inf of every sample */
+        S = ms_maxf(S, fabsf(g->p0[a]) + ext + fabsf(p[a]));
+    }
+    return 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));
+}
+
+/* rel: footprint_rel of the receiver. */
+static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3], const float C[3], const ms_grid *g,
+                            const float p[3], float rel)
+{
+    const float *Y[3][2] = { { C, B }, { A, C }, { B, A } };
+    const float w[3] = { g->p0[0] - p[0], g->p0[1] - p[1], g->p0[2] - p[2] };
+    const float nA = inf_norm3(A), nB = inf_norm3(B), nC = inf_norm3(C);
+    const float nrm[3][2] = { { nC, nB }, { nA, nC }, { nB, nA } };
+    for (int e = 0; e < 3; e++) {
+        float X[3];
+        v3_cross(X, Y[e][0], Y[e][1]);
+        f->e[e][0] = v3_dot(X, w);
+        f->e[e][1] = v3_dot(X, g->ds);
+        f->e[e][2] = v3_dot(X, g->dt);
+        f->s[e] = rel * nrm[e][0] * nrm[e][1];
+    }
+    for (int c = 0; c < 3; c++) f->e[3][c] = f->e[0][c] + f->e[1][c] + f->e[2][c];
+}
+
+/* Which sign a hit needs, from the sum of the edge functions, E_sum = -((B - A) x (C - A)) . d (which side of
+ * the triangle's plane the direction points to): a hit has all three of one sign (zeros aside), so where
+ * E_sum stays above twice the sum of the slacks (its coefficients' and evaluation's rounding are far below
+ * them) not all three can be <= 0 up to their slacks: all are >= 0, and any E_e < -s_e rules the samples
+ * out; alike below. Elsewhere (the plane through the receiver parallel to the triangle crosses these
+ * samples) only mixed signs beyond the slacks rule them out. lo, hi: bounds of E_0, E_1, E_2 and E_sum over
+ * each lane's samples. Returns the lanes that may be hit. */
+static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const float s[3])
+{
+    const float s2 = 2.0f * (s[0] + s[1] + s[2]);
+    const unsigned up = l16_gt(lo[3], l16_set1(s2)), down = l16_lt(hi[3], l16_set1(-s2));
+    unsigned pos = 0, neg = 0;
+    for (int e = 0; e < 3; e++) {
+        pos |= l16_gt(lo[e], l16_set1(s[e]));     /* E_e > s_e throughout */
+        neg |= l16_lt(hi[e], l16_set1(-s[e]));    /* E_e < -s_e throughout */
+    }
+    return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
+}
+
+/* The groups (bit gk) whose samples the footprint may hold, bounding each edge function over the group's
+ * gs x gs samples (16 groups per operation). */
+static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
+{
+    const float span = (float)(sh->gs - 1);
+    float dlo[4], dhi[4];   /* each function's least and largest change from a group's first sample */
+    for (int e = 0; e < 4; e++) {
+        const float di = f->e[e][1] * span, dj = f->e[e][2] * span;
+        dlo[e] = ms_minf(di, 0.0f) + ms_minf(dj, 0.0f);
+        dhi[e] = ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f);
+    }
+    uint64_t cand = 0;
+    for (int g0 = 0; g0 < sh->G; g0 += LANES) {
+        const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
+        l16 lo[4], hi[4];
+        for (int e = 0; e < 4; e++) {
+            const l16 base = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
+            lo[e] = l16_add(base, l16_set1(dlo[e]));
+            hi[e] = l16_add(base, l16_set1(dhi[e]));
+        }
+        cand |= (uint64_t)footprint_keep(lo, hi, f->s) << g0;
+    }
+    return cand & sh->all_groups;
+}
+
+/* The lanes of the 16-sample block at (i0, j0) the footprint may hold; off[e]: the block's offsets
+ * e1 di + e2 dj per lane, made once per pair (footprint_offsets). */
+static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0, int j0)
+{
+    l16 E[4];
+    for (int e = 0; e < 4; e++) E[e] = l16_add(l16_set1(f->e[e][0] + f->e[e][1] * (float)i0 + f->e[e][2] * (float)j0), off[e]);
+    return footprint_keep(E, E, f->s);
+}
+
+static void footprint_offsets(const hpc_footprint *f, l16 oi, l16 oj, l16 off[4])
+{
+    for (int e = 0; e < 4; e++) off[e] = l16_add(l16_mul(l16_set1(f->e[e][1]), oi), l16_mul(l16_set1(f->e[e][2]), oj));
 }
 
 /* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
@@ -662,6 +801,144 @@ static int group_done(const shared *sh, const uint64_t *open, int gk)
     return 1;
 }
 
+/* Receiver r's open groups after a triangle (L72-L75): its umbra bits, and at full umbra its mask back. */
+static void record_umbra(const shared *sh, chunk *c, uint32_t r, int32_t s, uint64_t gu)
+{
+    if (sh->sw & MS_HPC_OFF_UMBRA) return;   /* A off: umbra found by casting is not recorded */
+    sh->gumbra[r] = gu;
+    if (gu == sh->all_groups) {
+        sh->full[r] = 1;
+        if (!(sh->sw & MS_HPC_OFF_ON_DEMAND)) {   /* D: the mask goes back (L75) */
+            slot_put(c, s);
+            sh->slot[r] = -1;
+        }
+        c->umbra_in_tree++;
+        c->cnt[C_FULL_UMBRA_POINTS]++;
+    }
+}
+
+/* The mask and sample data of receiver r (D: made when a triangle first may block it, L59-L64). -1 when out
+ * of memory. */
+static int32_t slot_of(const shared *sh, chunk *c, uint32_t r, const ms_grid *g)
+{
+    int32_t s = sh->slot[r];
+    if (s >= 0) return s;
+    if ((s = slot_get(sh, c)) < 0) { c->failed = 1; return -1; }
+    sh->slot[r] = s;
+    memcpy(slot_mask(sh, c, s), sh->front + (size_t)sh->orig[r] * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
+    slot_setup(sh, c, s, &sh->q[r], g);
+    return s;
+}
+
+/* The open bits of the 16 samples (i0 + l % gs, jb + l / gs) as lanes l, gs = 4 (4 rows) or 8 (2 rows); written
+ * out row by row (a loop over the rows is vectorised into a gather, slower than these loads). */
+static inline unsigned block_open(const uint64_t *open, int k, int i0, int jb, int gs)
+{
+    const int s0 = jb * k + i0, s1 = s0 + k;
+    if (gs == 8)
+        return (unsigned)(open[s0 >> 6] >> (s0 & 63) & 0xffu) | (unsigned)(open[s1 >> 6] >> (s1 & 63) & 0xffu) << 8;
+    const int s2 = s1 + k, s3 = s2 + k;
+    return (unsigned)(open[s0 >> 6] >> (s0 & 63) & 15u) | (unsigned)(open[s1 >> 6] >> (s1 & 63) & 15u) << 4 |
+           (unsigned)(open[s2 >> 6] >> (s2 & 63) & 15u) << 8 | (unsigned)(open[s3 >> 6] >> (s3 & 63) & 15u) << 12;
+}
+
+/* Receiver r inside V_L against the triangle, with the footprint test in place of V_Gk (above): the groups
+ * it may touch, then in each the lanes it may hold, and the exact test only on those that are open. The
+ * mask, the packets' shear axes and the plane offset are made only when some lane needs the exact test. */
+static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *g, const float A[3],
+                           const float B[3], const float C[3], const hpc_footprint *fp);
+
+static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t)
+{
+    const ms_shadow_query *q = &sh->q[r];
+    ms_grid g;
+    if (sh->p0) {
+        memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
+        memcpy(g.ds, sh->grid_ds, sizeof g.ds);
+        memcpy(g.dt, sh->grid_dt, sizeof g.dt);
+        g.k = sh->k;
+    } else {
+        ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g);
+    }
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
+    hpc_footprint fp;
+    footprint_setup(&fp, A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
+    cast_footprint(sh, c, r, t, &g, A, B, C, &fp);
+}
+
+/* Receiver r's samples against the triangle from its footprint fp (made by footprint_setup or, for a leaf's
+ * points at once, by cast_leaf_footprint); A, B, C: the vertices relative to it, g: its grid. */
+static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *g, const float A[3],
+                           const float B[3], const float C[3], const hpc_footprint *fp)
+{
+    const ms_shadow_query *q = &sh->q[r];
+    uint64_t gu = sh->gumbra[r];
+    c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
+    /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
+    const uint64_t todo = footprint_groups(sh, fp) & ~gu;
+    if (!todo) return;
+    static const float off[2][2][LANES] = {
+        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+    const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8;
+    const uint64_t seg = (UINT64_C(1) << gs) - 1u;
+    l16 foff[4];
+    footprint_offsets(fp, l16_load(off[wi][0]), l16_load(off[wi][1]), foff);
+    const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
+    int32_t s = sh->slot[r];
+    const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
+    float num = 0.0f;
+    const int8_t *kz = NULL;
+    const uint64_t gu0 = gu;
+    for (uint64_t m = todo; m; m &= m - 1) {
+        const int gk = __builtin_ctzll(m);
+        const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
+        unsigned any = 0;
+        for (int jb = j0; jb < j0 + gs; jb += rows) {
+            const unsigned lanes = footprint_lanes(fp, foff, i0, jb);
+            if (!lanes) continue;
+            const unsigned live = block_open(open, k, i0, jb, gs) & lanes;
+            if (!live) continue;
+            if (!kz) {   /* the first exact test of this pair */
+                if (s < 0 && (s = slot_of(sh, c, r, g)) < 0) return;
+                open = slot_mask(sh, c, s);
+                kz = slot_kz(sh, c, s);
+                num = ms_wt_offset(q->p, t->v, t->N);
+            }
+            c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
+            unsigned hit;
+            if (sh->sw & MS_HPC_OFF_SIMD_SAMPLES) {   /* one lane at a time, the scalar form */
+                hit = 0;
+                for (unsigned b = live; b; b &= b - 1) {
+                    const int l = __builtin_ctz(b), i = i0 + l % gs, j = jb + l / gs;
+                    float d[3];
+                    for (int a = 0; a < 3; a++) d[a] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
+                    hit |= (unsigned)sample_blocked(q->p, d, kz[(j * k + i) / LANES], t->v, t->N, A, B, C, num, sh->ctx->near,
+                                                    sh->ctx->far) << l;
+                }
+            } else {
+                hit = group_block16(sh, q, g, kz, i0, jb, gs, live, t, A, B, C, num);
+            }
+            if (hit && alpha)
+                for (unsigned b = hit; b; b &= b - 1) {
+                    const int l = __builtin_ctz(b);
+                    if (!alpha_opaque(sh, t, q, g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
+                }
+            if (!hit) continue;
+            c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
+            any |= hit;
+            uint64_t *w = slot_mask(sh, c, s);
+            for (int rr = 0; rr < rows; rr++) {
+                const int s0 = (jb + rr) * k + i0;
+                w[s0 >> 6] &= ~((uint64_t)(hit >> (rr * gs) & seg) << (s0 & 63));
+            }
+        }
+        if (any && group_done(sh, open, gk)) gu |= UINT64_C(1) << gk;
+    }
+    if (gu != gu0) record_umbra(sh, c, r, s, gu);
+}
+
 /* One receiver of a leaf against the triangle (L56-L75). */
 static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t, uint32_t pl, const act_group *ag, int nag)
 {
@@ -669,6 +946,8 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     if (sh->full[r] || q->prim == t->self) return;
     c->cnt[C_POINT_TESTS]++;
     if (!vol_point(sh, &t->vl, pl, q->p, &c->cnt[C_PLANE_TESTS])) return;
+    c->cnt[C_PAIRS_IN_VL]++;
+    if (sh->footprint) { cast_point_footprint(sh, c, r, t); return; }
     ms_grid g;   /* the point's samples, formed when first needed */
     int have_g = 0;
 #define HPC_GRID() (have_g ? (void)0 : (ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g), (void)(have_g = 1)))
@@ -677,7 +956,7 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
         HPC_GRID();
         if ((s = slot_get(sh, c)) < 0) { c->failed = 1; return; }
         sh->slot[r] = s;
-        memcpy(slot_mask(sh, c, s), sh->front + (size_t)r * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
+        memcpy(slot_mask(sh, c, s), sh->front + (size_t)sh->orig[r] * sh->mw, (size_t)sh->mw * sizeof(uint64_t));
         slot_setup(sh, c, s, q, &g);
     }
     if (!c->gvol_built) build_group_volumes(sh, c, t);
@@ -718,16 +997,91 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
         }
     }
 #undef HPC_GRID
-    if (sh->sw & MS_HPC_OFF_UMBRA) return;   /* A off: umbra found by casting is not recorded */
-    sh->gumbra[r] = gu;
-    if (gu == sh->all_groups) {
-        sh->full[r] = 1;
-        if (!(sh->sw & MS_HPC_OFF_ON_DEMAND)) {   /* D: the mask goes back (L75) */
-            slot_put(c, s);
-            sh->slot[r] = -1;
+    record_umbra(sh, c, r, s, gu);
+}
+
+/* The points of a leaf inside V_L against the triangle with the footprint test, 16 receivers per operation
+ * (departure: the paper handles a leaf's points one by one): the point-in-V_L test (POINT-IN-VOLUME, the
+ * same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per lane), then each
+ * point's groups and samples (cast_footprint). */
+_Static_assert(LEAF_POINTS_FOOTPRINT <= LANES, "a leaf's points fit the lanes");
+static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, const tri_job *t, uint32_t pl)
+{
+    float P[3][LANES] = { { 0 } }, W[3][LANES] = { { 0 } }, R[LANES] = { 0 };
+    uint32_t rr[LANES];
+    unsigned act = 0;
+    for (uint32_t i = 0; i < N->count; i++) {
+        const uint32_t r = c->idx[N->first + i];
+        rr[i] = r;
+        if (sh->full[r] || sh->q[r].prim == t->self) continue;
+        act |= 1u << i;
+        for (int a = 0; a < 3; a++) { P[a][i] = sh->q[r].p[a]; W[a][i] = sh->p0[4 * (size_t)r + a] - P[a][i]; }
+        R[i] = sh->p0[4 * (size_t)r + 3];
+    }
+    if (!act) return;
+    const int tested = __builtin_popcount(act);
+    c->cnt[C_POINT_TESTS] += (uint64_t)tested;
+    const l16 px = l16_load(P[0]), py = l16_load(P[1]), pz = l16_load(P[2]);
+    const hpc_volume *v = &t->vl;
+    uint32_t planes = pl & (v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u);
+    c->cnt[C_PLANE_TESTS] += (uint64_t)tested * (uint64_t)__builtin_popcount(planes);
+    const l16 neps = l16_set1(-v->eps);
+    for (; planes && act; planes &= planes - 1) {
+        const int i = __builtin_ctz(planes);
+        const l16 d = l16_add(l16_add(l16_add(l16_mul(l16_set1(v->soa[0][i]), px), l16_mul(l16_set1(v->soa[1][i]), py)),
+                                      l16_mul(l16_set1(v->soa[2][i]), pz)),
+                              l16_set1(v->soa[3][i]));
+        act &= ~l16_lt(d, neps);
+    }
+    if (!act) return;
+    c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act);
+    /* footprint_setup per lane */
+    l16 Y[3][3], nY[3];
+    for (int vtx = 0; vtx < 3; vtx++) {
+        const l16 pc[3] = { px, py, pz };
+        for (int a = 0; a < 3; a++) Y[vtx][a] = l16_sub(l16_set1(t->v[3 * vtx + a]), pc[a]);
+        nY[vtx] = l16_max(l16_abs(Y[vtx][0]), l16_max(l16_abs(Y[vtx][1]), l16_abs(Y[vtx][2])));
+    }
+    const l16 w[3] = { l16_load(W[0]), l16_load(W[1]), l16_load(W[2]) }, rel = l16_load(R);
+    static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A */
+    float fe[4][3][LANES], fs[3][LANES];
+    l16 esum[3];
+    for (int e = 0; e < 3; e++) {
+        const l16 *y1 = Y[pair[e][0]], *y2 = Y[pair[e][1]];
+        const l16 X[3] = { l16_sub(l16_mul(y1[1], y2[2]), l16_mul(y1[2], y2[1])), l16_sub(l16_mul(y1[2], y2[0]), l16_mul(y1[0], y2[2])),
+                           l16_sub(l16_mul(y1[0], y2[1]), l16_mul(y1[1], y2[0])) };
+        const l16 c0 = l16_add(l16_add(l16_mul(X[0], w[0]), l16_mul(X[1], w[1])), l16_mul(X[2], w[2]));
+        const l16 c1 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_ds[0])), l16_mul(X[1], l16_set1(sh->grid_ds[1]))),
+                               l16_mul(X[2], l16_set1(sh->grid_ds[2])));
+        const l16 c2 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_dt[0])), l16_mul(X[1], l16_set1(sh->grid_dt[1]))),
+                               l16_mul(X[2], l16_set1(sh->grid_dt[2])));
+        l16_store(fe[e][0], c0);
+        l16_store(fe[e][1], c1);
+        l16_store(fe[e][2], c2);
+        l16_store(fs[e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
+        if (e == 0) { esum[0] = c0; esum[1] = c1; esum[2] = c2; }
+        else { esum[0] = l16_add(esum[0], c0); esum[1] = l16_add(esum[1], c1); esum[2] = l16_add(esum[2], c2); }
+    }
+    for (int a = 0; a < 3; a++) l16_store(fe[3][a], esum[a]);
+    for (unsigned m = act; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        const uint32_t r = rr[l];
+        hpc_footprint fp;
+        for (int e = 0; e < 4; e++)
+            for (int a = 0; a < 3; a++) fp.e[e][a] = fe[e][a][l];
+        for (int e = 0; e < 3; e++) fp.s[e] = fs[e][l];
+        ms_grid g;
+        memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
+        memcpy(g.ds, sh->grid_ds, sizeof g.ds);
+        memcpy(g.dt, sh->grid_dt, sizeof g.dt);
+        g.k = sh->k;
+        float Av[3], Bv[3], Cv[3];
+        for (int a = 0; a < 3; a++) {
+            Av[a] = t->v[a] - P[a][l];
+            Bv[a] = t->v[3 + a] - P[a][l];
+            Cv[a] = t->v[6 + a] - P[a][l];
         }
-        c->umbra_in_tree++;
-        c->cnt[C_FULL_UMBRA_POINTS]++;
+        cast_footprint(sh, c, r, t, &g, Av, Bv, Cv, &fp);
     }
 }
 
@@ -759,7 +1113,9 @@ static void cast_node(const shared *sh, chunk *c, uint32_t ni, const tri_job *t,
         N->gumbra = c->nodes[l].gumbra & c->nodes[l + 1].gumbra;
         N->full = c->nodes[l].full & c->nodes[l + 1].full;
     } else {
-        for (uint32_t i = N->first; i < N->first + N->count; i++) cast_point(sh, c, c->idx[i], t, pl2, ag2, n2);
+        if (sh->footprint && sh->p0 && N->count <= LANES) cast_leaf_footprint(sh, c, N, t, pl2);
+        else
+            for (uint32_t i = N->first; i < N->first + N->count; i++) cast_point(sh, c, c->idx[i], t, pl2, ag2, n2);
         node_bits_from_points(sh, c, N);
     }
 }
@@ -876,6 +1232,11 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     sh.gs = k >= 64 ? 8 : 4;     /* 16, 64, 64 groups for k = 16, 32, 64 (a group-umbra word; 2x2 groups at
                                   * k = 16 tripled the box-plane tests and the time on a flowers scene) */
     sh.G = (k / sh.gs) * (k / sh.gs);
+    for (int g = 0; g < sh.G; g++) {
+        sh.group_i0[g] = (float)(g % (k / sh.gs) * sh.gs);
+        sh.group_j0[g] = (float)(g / (k / sh.gs) * sh.gs);
+    }
+    sh.footprint = !scanline && !(sh.sw & MS_HPC_OFF_FOOTPRINT);
     sh.all_groups = sh.G == 64 ? UINT64_MAX : (UINT64_C(1) << sh.G) - 1u;
     sh.npk = k * k / LANES;
     sh.n = n;
@@ -915,6 +1276,11 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     sh.gumbra = malloc(n * sizeof *sh.gumbra);
     sh.full = malloc(n);
     sh.slot = malloc(n * sizeof *sh.slot);
+    uint64_t *const gumbra0 = sh.gumbra, *gumbra2 = NULL;   /* by the caller's numbers, by hierarchy order */
+    uint8_t *const full0 = sh.full, *full2 = NULL;
+    int32_t *const slot0 = sh.slot, *slot2 = NULL;
+    uint32_t *orig = NULL, nlive = 0;
+    ms_shadow_query *q2 = NULL;
     uint32_t *idx = malloc(n * sizeof *idx);
     chunk *ch = calloc((size_t)cap, sizeof *ch);
     tri_job *jobs = malloc(BATCH * sizeof *jobs);
@@ -930,7 +1296,6 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
             }
     }
     /* Samples behind the horizon count as blocked from the start (umbra bits: nothing open). */
-    uint32_t nlive = 0;
     for (size_t r = 0; r < n; r++) {
         uint64_t gu = 0;
         const uint64_t *f = front + r * mw;
@@ -953,6 +1318,58 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     for (int i = 0; i < nchunks; i++) failed |= build_tree(&sh, &ch[i]) != 0;
     counters[C_BUILD_US] += (uint64_t)((omp_get_wtime() - t0) * 1e6);
     if (failed) goto done;
+    /* Renumbering in hierarchy order: the chunks' receivers one after another, each chunk's in its leaves'
+     * order, with their queries, umbra bits, flags and slots, so that a leaf reads its points' data from a few
+     * cache lines (the caller's order scatters them: the per-pair loads of umbra bits and masks took a
+     * fifth of a cast on a GRIDS-like scene); the front masks stay the caller's (read once per receiver). */
+    orig = malloc((nlive ? nlive : 1) * sizeof *orig);
+    q2 = malloc((nlive ? nlive : 1) * sizeof *q2);
+    gumbra2 = malloc((nlive ? nlive : 1) * sizeof *gumbra2);
+    full2 = malloc(nlive ? nlive : 1);
+    slot2 = malloc((nlive ? nlive : 1) * sizeof *slot2);
+    if (!orig || !q2 || !gumbra2 || !full2 || !slot2) goto done;
+    {
+        uint32_t pos = 0;
+        for (int i = 0; i < nchunks; i++) {
+            ch[i].base = pos;
+            ch[i].n0 = ch[i].n;
+            for (uint32_t j = 0; j < ch[i].n; j++, pos++) {
+                const uint32_t o = ch[i].idx[j];
+                orig[pos] = o;
+                q2[pos] = q[o];
+                gumbra2[pos] = sh.gumbra[o];
+                full2[pos] = sh.full[o];
+                slot2[pos] = -1;
+                ch[i].idx[j] = pos;
+            }
+        }
+    }
+    sh.orig = orig;
+    sh.q = q2;
+    sh.gumbra = gumbra2;
+    sh.full = full2;
+    sh.slot = slot2;
+    if (sh.footprint && nlive) {
+        /* Each receiver's grid origin, formed once: the footprint test needs its grid for every triangle whose
+         * V_L holds it. The steps are the light's (the same for every pixel, pattern.c); checked bit for bit,
+         * and the grids formed per pair if they ever differ. */
+        ms_grid g0;
+        ms_grid_for_pixel(&ctx->light, k, sh.q[0].px, sh.q[0].py, ctx->seed, &g0);
+        memcpy(sh.grid_ds, g0.ds, sizeof sh.grid_ds);
+        memcpy(sh.grid_dt, g0.dt, sizeof sh.grid_dt);
+        sh.p0 = malloc((size_t)nlive * 4 * sizeof *sh.p0);
+        int same = sh.p0 != NULL;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(& : same)
+        for (size_t r = 0; r < (same ? nlive : 0); r++) {
+            ms_grid g;
+            ms_grid_for_pixel(&ctx->light, k, sh.q[r].px, sh.q[r].py, ctx->seed, &g);
+            memcpy(sh.p0 + 4 * r, g.p0, sizeof g.p0);
+            sh.p0[4 * r + 3] = footprint_rel(&g, sh.q[r].p, k);
+            same &= !memcmp(g.ds, sh.grid_ds, sizeof g.ds) && !memcmp(g.dt, sh.grid_dt, sizeof g.dt);
+        }
+        if (!same) { free(sh.p0); sh.p0 = NULL; }
+        else counters[C_SAMPLE_BYTES] += (uint64_t)nlive * 4u * sizeof *sh.p0;
+    }
     if (sh.sw & MS_HPC_OFF_ON_DEMAND) {   /* D off: every receiver's mask and sample data before any triangle */
         for (int i = 0; i < nchunks; i++)
             for (uint32_t j = 0; j < ch[i].n; j++) {
@@ -960,10 +1377,10 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
                 const int32_t s = slot_get(&sh, &ch[i]);
                 if (s < 0) goto done;
                 ms_grid g;
-                ms_grid_for_pixel(&ctx->light, k, q[r].px, q[r].py, ctx->seed, &g);
+                ms_grid_for_pixel(&ctx->light, k, sh.q[r].px, sh.q[r].py, ctx->seed, &g);
                 sh.slot[r] = s;
-                memcpy(slot_mask(&sh, &ch[i], s), front + (size_t)r * mw, (size_t)mw * sizeof(uint64_t));
-                slot_setup(&sh, &ch[i], s, &q[r], &g);
+                memcpy(slot_mask(&sh, &ch[i], s), front + (size_t)orig[r] * mw, (size_t)mw * sizeof(uint64_t));
+                slot_setup(&sh, &ch[i], s, &sh.q[r], &g);
             }
     }
     t0 = omp_get_wtime();
@@ -986,15 +1403,16 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t r = 0; r < n; r++) {
         uint64_t *v = vis + r * mw;
-        if (sh.full[r]) memset(v, 0, (size_t)mw * sizeof *v);
+        if (full0[r]) memset(v, 0, (size_t)mw * sizeof *v);
         else memcpy(v, front + r * mw, (size_t)mw * sizeof *v);
     }
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int i = 0; i < nchunks; i++) {
         chunk *c = &ch[i];
-        for (uint32_t j = 0; j < c->n; j++) {
-            const uint32_t r = c->idx[j];
-            if (!sh.full[r] && sh.slot[r] >= 0) memcpy(vis + (size_t)r * mw, slot_mask(&sh, c, sh.slot[r]), (size_t)mw * sizeof *vis);
+        for (uint32_t r = c->base; r < c->base + c->n0; r++) {
+            uint64_t *v = vis + (size_t)orig[r] * mw;
+            if (sh.full[r]) memset(v, 0, (size_t)mw * sizeof *v);
+            else if (sh.slot[r] >= 0) memcpy(v, slot_mask(&sh, c, sh.slot[r]), (size_t)mw * sizeof *v);
         }
     }
     rc = 0;
@@ -1013,7 +1431,8 @@ done:
         free(ch[i].free_list);
     }
     /* The hierarchy's per-point arrays: indices, umbra bits, full flags, slot numbers; the groups' masks. */
-    counters[C_HIERARCHY_BYTES] += (uint64_t)n * (sizeof *idx + sizeof *sh.gumbra + 1u + sizeof *sh.slot);
+    counters[C_HIERARCHY_BYTES] += (uint64_t)n * (sizeof *idx + sizeof *sh.gumbra + 1u + sizeof *sh.slot) +
+                                   (uint64_t)nlive * (sizeof *orig + sizeof *q2 + sizeof *gumbra2 + 1u + sizeof *slot2);
     counters[C_SAMPLE_BYTES] += (uint64_t)sh.G * (uint64_t)mw * 8u;
     free(ch);
     free(idx);
@@ -1021,8 +1440,14 @@ done:
     free(tri);
     free(ids);
     free(sh.gmask);
-    free(sh.gumbra);
-    free(sh.full);
-    free(sh.slot);
+    free(gumbra0);
+    free(full0);
+    free(slot0);
+    free(orig);
+    free(q2);
+    free(gumbra2);
+    free(full2);
+    free(slot2);
+    free(sh.p0);
     return rc;
 }
