@@ -12,6 +12,8 @@
 #include "primary/primary.h"
 #include "visibility/receiver.h"
 #include "light/pattern.h"
+#include "visibility/disk_mask.h"
+#include "core/cpu.h"
 #include "accel/bvh.h"
 #include <math.h>
 #include <stdio.h>
@@ -233,7 +235,20 @@ static void test_disk_frames_equal(void **st)
     ms_scene_free(&sc);
 }
 
-/* The grid's disk mask by row intervals equals the per-sample test, at every k and many pixels and seeds. */
+/* The vector-lane disk mask's instances (disk_mask.h) and whether this CPU runs each under the run's cap. */
+static void (*const disk_mask_fn[3])(int k, float u, float v, uint64_t *mask) = {
+    ms_grid_disk_mask_scalar, ms_grid_disk_mask_avx2, ms_grid_disk_mask_avx512
+};
+static int disk_mask_runs(int f)
+{
+    static const ms_isa isa[3] = { MS_ISA_SCALAR, MS_ISA_AVX2, MS_ISA_AVX512 };
+    return isa[f] == MS_ISA_SCALAR || (ms_cpu_isa() >= isa[f] && tu_isa_allowed(isa[f]));
+}
+
+/* The grid's disk mask: the shape mask (sample by sample through the shape's row) equals the reference at
+ * every k and many pixels and seeds, and so does every instance of the vector-lane mask that front masks use
+ * (disk_mask.h) that this CPU runs (under MS_TEST_ISA); each instance also equals the grid's and the disk's
+ * definitions written out here, for random shifts (u, v) and the extremes 0 and 1 - 2^-24. */
 static void test_disk_mask_rows(void **st)
 {
     (void)st;
@@ -250,11 +265,46 @@ static void test_disk_mask_rows(void **st)
                 ms_shape_mask_apply(MS_PATTERN_GRID, &l, k, px, 3 * px + 1, seed, a);
                 ms_shape_mask_reference(MS_PATTERN_GRID, &l, k, px, 3 * px + 1, seed, b);
                 for (int w = 0; w < k * k / 64; w++) assert_true(a[w] == b[w]);
+                float u, v;
+                ms_grid_shift(px, 3 * px + 1, seed, &u, &v);
+                for (int f = 0; f < 3; f++) {
+                    if (!disk_mask_runs(f)) continue;
+                    uint64_t c[64];
+                    memset(c, 0xFF, sizeof c);
+                    disk_mask_fn[f](k, u, v, c);
+                    for (int w = 0; w < k * k / 64; w++) assert_true(c[w] == b[w]);
+                }
                 kept += ms_mask_count(a, k * k / 64);
                 total += k * k;
             }
     /* about pi/4 of the square */
     assert_true(fabs((double)kept / (double)total - M_PI / 4.0) < 0.01);
+    tu_rng rng = { 7 };
+    int ran = 0;
+    for (int f = 0; f < 3; f++) {
+        if (!disk_mask_runs(f)) continue;
+        ran++;
+        for (int k = 16; k <= 64; k *= 2)
+            for (int trial = 0; trial < 200; trial++) {
+                const float top = 1.0f - 1.0f / 16777216.0f;
+                const float u = trial == 0 ? 0.0f : trial == 1 ? top : (float)(tu_rng_next(&rng) >> 40) * (1.0f / 16777216.0f);
+                const float v = trial == 0 ? top : trial == 1 ? 0.0f : (float)(tu_rng_next(&rng) >> 40) * (1.0f / 16777216.0f);
+                uint64_t a[64];
+                memset(a, 0xFF, sizeof a);
+                disk_mask_fn[f](k, u, v, a);
+                const float ik = 1.0f / (float)k;
+                for (int j = 0; j < k; j++)
+                    for (int i = 0; i < k; i++) {
+                        const float s = ((float)i + ((float)(k - 1 - j) + u) * ik) * ik;
+                        const float t = ((float)j + ((float)i + v) * ik) * ik;
+                        const float x = 2.0f * s - 1.0f, y = 2.0f * t - 1.0f;
+                        const int n = j * k + i;
+                        assert_int_equal((int)(a[n >> 6] >> (n & 63) & 1), x * x + y * y < 1.0f);
+                    }
+            }
+    }
+    printf("disk mask: %d vector-lane instance(s) equal the per-sample definition\n", ran);
+    assert_true(ran >= 1);
 }
 
 /* ---- unshadowed irradiance ---- */

@@ -7,6 +7,9 @@
  *     towards it at any distance beyond the near range (no far limit at all);
  *   - bakes (the points API, given the sun unplaced): every method's V, S and front equal raytrace's, and
  *     raytrace's the brute force; points far outside the scene: their segments still reach it;
+ *   - blocks (the micro-rasterization methods take a sun's or a sphere's queries 4x4 at a time): roofs at
+ *     different heights within each block under a wide sun and a large sphere, every method equal to raytrace
+ *     (which is called one query at a time);
  *   - the closed-mesh cull at its limit: a box's face nearly parallel to the sun, kept (every method equals
  *     raytrace, which culls nothing);
  *   - the penumbra: a pole's shadow edge at distance d from the pole is d tan(0.53 deg) wide (within a pixel
@@ -386,6 +389,73 @@ static void test_cull_grazing(void **st)
     ms_scene_free(&sc);
 }
 
+/* ---- blocks of receivers at different heights: each lane its own outline ---- */
+
+/* The micro-rasterization methods take an outlined light's queries a 4x4 block at a time, each pixel on its
+ * own outline (microraster.c, ms_ctx_for_query). A view from above of a "city" of flat roofs 0.5 wide at
+ * heights from 0.2 to 3.2 (neighbouring pixels of a block up to 3 apart) under a bar at height 5 and a wide
+ * sun (60 degrees) or a large sphere near by: a pixel traced with a neighbour's outline would be answered
+ * on samples shifted by the heights' difference (for the sun a direction off by about 3 / D of a cone of
+ * half-angle 30 degrees), which the bar's wide penumbra shows. Every method's V, S and front equal raytrace's
+ * (answered one query at a time), and scanline's blocks hold several pixels each. */
+static void test_block_lanes(void **st)
+{
+    (void)st;
+    enum { C = 12 };   /* C x C roofs */
+    ms_scene sc;
+    memset(&sc, 0, sizeof sc);
+    sc.tri = malloc((2 + 2 * C * C + 12) * 9 * sizeof *sc.tri);
+    assert_non_null(sc.tri);
+    size_t n = put_quad(sc.tri, 0, (float[]){ -8, 0, -8 }, (float[]){ -8, 0, 8 }, (float[]){ 8, 0, 8 }, (float[]){ 8, 0, -8 });
+    for (int i = 0; i < C; i++)
+        for (int j = 0; j < C; j++) {
+            const float x0 = -3.0f + 0.5f * (float)i, z0 = -3.0f + 0.5f * (float)j, x1 = x0 + 0.5f, z1 = z0 + 0.5f;
+            const float h = 0.2f + 0.75f * (float)((7 * i + 3 * j) % 5);
+            n = put_quad(sc.tri, n, (float[]){ x0, h, z0 }, (float[]){ x0, h, z1 }, (float[]){ x1, h, z1 }, (float[]){ x1, h, z0 });
+        }
+    sc.n_tris = put_box(sc.tri, n, (const float[]){ -4, 5, -0.4f }, (const float[]){ 4, 5.3f, 0.4f }, 1);
+    /* 32 x 32 pixels of 0.1875 over the roofs: about 2.7 pixels to a roof, so every block spans several */
+    sc.camera = (ms_camera){ { 0, 20, 0 }, { 0, 0, 0 }, { 0, 0, -1 }, 0, 32, 32, MS_CAMERA_ORTHOGRAPHIC, 0, 6.0f };
+    sc.samples = 256;
+    for (int light = 0; light < 2; light++) {
+        if (light == 0) assert_int_equal(ms_light_sun(&sc.light, (ms_vec3){ 0.3f, 0.8f, 0.5f }, 60.0f), 0);
+        else assert_int_equal(ms_light_sphere(&sc.light, (ms_vec3){ 1.5f, 9.0f, 2.5f }, 3.0f), 0);
+        sc.light.emission = (ms_vec3){ 1, 1, 1 };
+        ms_render_options o;
+        tu_render_options_default(&o);
+        o.threads = 2;
+        o.method = "raytrace";
+        ms_frame ref, fr;
+        tu_render_ok(&sc, &o, &ref);
+        int partial = 0, hit = 0;
+        for (int i = 0; i < 32 * 32; i++) {
+            hit += ref.vis[i] >= 0.0f;
+            partial += ref.vis[i] > 0.0f && ref.vis[i] < 1.0f;
+        }
+        const char *const *names = ms_method_names();
+        for (int mi = 0; names[mi]; mi++) {
+            o.method = names[mi];
+            tu_render_ok(&sc, &o, &fr);
+            const long differ = tu_frame_values_differ(&fr, &ref);
+            if (!strcmp(names[mi], "scanline")) {
+                uint64_t blocks = 0;
+                for (int c = 0; c < fr.stats.n_counters; c++)
+                    if (!strcmp(fr.stats.counter_name[c], "blocks")) blocks = fr.stats.counter[c];
+                printf("%s over roofs: %d of %d pixels in penumbra; scanline traversed %llu blocks\n",
+                       light ? "sphere" : "sun 60 deg", partial, hit, (unsigned long long)blocks);
+                assert_true(blocks > 0 && blocks < (uint64_t)hit / 4);   /* the blocks kept: not one per pixel */
+            }
+            if (differ) fprintf(stderr, "%s over roofs, method %s: %ld pixels differ from raytrace\n",
+                                light ? "sphere" : "sun", names[mi], differ);
+            assert_int_equal(differ, 0);
+            ms_frame_free(&fr);
+        }
+        assert_true(partial > hit / 8);
+        ms_frame_free(&ref);
+    }
+    ms_scene_free(&sc);
+}
+
 /* ---- the penumbra of a pole ---- */
 
 /* A 1 x 80 x 1 pole on a ground of 400 x 400, the sun at 45 degrees towards -x: the shadow runs along +x and
@@ -652,6 +722,7 @@ int main(void)
         cmocka_unit_test(test_bake),
         cmocka_unit_test(test_points_outside),
         cmocka_unit_test(test_cull_grazing),
+        cmocka_unit_test(test_block_lanes),
         cmocka_unit_test(test_penumbra_width),
         cmocka_unit_test(test_sun_irradiance),
         cmocka_unit_test(test_gltf_directional),

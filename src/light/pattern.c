@@ -183,62 +183,11 @@ void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px
     }
 }
 
-/* The grid's per-pixel shift (u, v) in [0,1)^2 (ms_grid_for_pixel). */
-static void grid_shift(uint32_t px, uint32_t py, uint32_t seed, float *u, float *v)
+void ms_grid_shift(uint32_t px, uint32_t py, uint32_t seed, float *u, float *v)
 {
     uint32_t h = ms_hash3(px, py, seed);
     *u = ms_hash_unit(h);
     *v = ms_hash_unit(ms_hash3(h, 0x51ED270Bu, seed));
-}
-
-/* Whether the grid's sample (i, j) is on a disk; its parameters in the order of operations that defines them:
- * s_ij = (i + (k-1-j+u)/k)/k, t_ij = (j + (i+v)/k)/k (the world positions are the affine p0 + i ds + j dt
- * of the same). */
-static inline int grid_inside(ms_light_shape shape, int k, int i, int j, float u, float v)
-{
-    /* k is a power of two: multiplying by 1/k is exactly dividing by k (and needs no divider's latency) */
-    const float ik = 1.0f / (float)k;
-    const float s = ((float)i + ((float)(k - 1 - j) + u) * ik) * ik, t = ((float)j + ((float)i + v) * ik) * ik;
-    (void)shape;   /* the disk: ms_light_shape_contains inlined */
-    const float x = 2.0f * s - 1.0f, y = 2.0f * t - 1.0f;
-    return x * x + y * y < 1.0f;
-}
-
-/* The samples of grid row j on the shape: i in [lo, hi] (lo > hi: none). Along a row (2s-1, 2t-1) is
- * affine in i, so the disk is an interval: the roots of a quadratic in double, then the ends moved until
- * the per-sample float test (grid_inside, the definition) agrees with them: the same set as testing all k
- * samples (tests/test_lights.c compares them), for O(1) tests a row. */
-static void grid_row_span(ms_light_shape shape, int k, int j, float u, float v, int *lo_out, int *hi_out)
-{
-    const double ik = 1.0 / k, a = ((k - 1 - j) + (double)u) * ik;
-    const double al = 2.0 * ik, be = 2.0 * a * ik - 1.0, ga = 2.0 * ik * ik, de = 2.0 * (j + v * ik) * ik - 1.0;
-    const double A = al * al + ga * ga, B = 2.0 * (al * be + ga * de), C = be * be + de * de - 1.0;
-    const double disc = B * B - 4.0 * A * C, i2a = 0.5 / A;
-    int lo, hi;
-    if (disc >= 0.0) {
-        const double q = sqrt(disc);
-        const double r1 = (-B - q) * i2a, r2 = (-B + q) * i2a;
-        /* ceil and floor by truncation (r1, r2 within [0, k] here): no libm calls on the portable build */
-        lo = r1 < 0.0 ? 0 : r1 > k ? k : (int)r1 + ((double)(int)r1 < r1);
-        hi = r2 < 0.0 ? -1 : r2 >= k - 1 ? k - 1 : (int)r2;
-    } else {
-        lo = 0;
-        hi = -1;
-    }
-    if (lo > hi) {
-        /* empty or a sliver the roots missed by rounding: the sample nearest the vertex decides */
-        double c = -B * i2a;
-        int i0 = c < 0.0 ? 0 : c > k - 1 ? k - 1 : (int)(c + 0.5);
-        if (!grid_inside(shape, k, i0, j, u, v)) { *lo_out = 0; *hi_out = -1; return; }
-        lo = hi = i0;
-    }
-    while (lo <= hi && !grid_inside(shape, k, lo, j, u, v)) lo++;
-    while (hi >= lo && !grid_inside(shape, k, hi, j, u, v)) hi--;
-    if (lo > hi) { *lo_out = 0; *hi_out = -1; return; }
-    while (lo > 0 && grid_inside(shape, k, lo - 1, j, u, v)) lo--;
-    while (hi < k - 1 && grid_inside(shape, k, hi + 1, j, u, v)) hi++;
-    *lo_out = lo;
-    *hi_out = hi;
 }
 
 void ms_shape_mask_reference(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
@@ -257,10 +206,11 @@ void ms_shape_mask_apply(ms_pattern p, const ms_light *l, int k, uint32_t px, ui
     const ms_light_shape_ops *shape = ms_light_shape_of(l->shape);
     if (!shape || !shape->contains) return;   /* no mask: the whole parallelogram */
     const int spp = ms_pattern_spp(p, k);
-    if (p == MS_PATTERN_GRID && l->shape != MS_LIGHT_DISK) {
-        /* A shape without a row-span fast path: its samples one by one, (s, t) as grid_inside forms them. */
+    if (p == MS_PATTERN_GRID) {
+        /* Its samples one by one, (s, t) as ms_pattern_st forms them (the grid's disk in vector lanes:
+         * visibility/disk_mask.h, which front masks use). */
         float u, v;
-        grid_shift(px, py, seed, &u, &v);
+        ms_grid_shift(px, py, seed, &u, &v);
         const float ik = 1.0f / (float)k;
         for (int j = 0; j < k; j++)
             for (int i = 0; i < k; i++) {
@@ -268,23 +218,6 @@ void ms_shape_mask_apply(ms_pattern p, const ms_light *l, int k, uint32_t px, ui
                 const int n = j * k + i;
                 if (!shape->contains(s, t)) mask[n >> 6] &= ~(UINT64_C(1) << (n & 63));
             }
-        return;
-    }
-    if (p == MS_PATTERN_GRID) {
-        /* The disk, row by row (grid_row_span). s_ij = (i + (k-1-j+u)/k)/k, t_ij = (j + (i+v)/k)/k, in this
-         * order of operations (the definition of the grid's parameters; the world positions are the affine
-         * p0 + i ds + j dt of the same). */
-        float u, v;
-        grid_shift(px, py, seed, &u, &v);
-        for (int j = 0; j < k; j++) {
-            int lo, hi;
-            grid_row_span(l->shape, k, j, u, v, &lo, &hi);
-            /* keep bits lo..hi of row j (none when lo > hi) */
-            const uint64_t rowbits = k == 64 ? ~UINT64_C(0) : ((UINT64_C(1) << k) - 1);
-            const uint64_t keep = lo > hi ? 0 : (hi - lo == 63 ? ~UINT64_C(0) : ((UINT64_C(1) << (hi - lo + 1)) - 1) << lo);
-            const int n0 = j * k;
-            mask[n0 >> 6] &= ~(rowbits << (n0 & 63)) | (keep << (n0 & 63));
-        }
         return;
     }
     if (p == MS_PATTERN_INTERLEAVED) {
@@ -308,7 +241,7 @@ void ms_pattern_st(ms_pattern p, int k, uint32_t px, uint32_t py, uint32_t seed,
     const int spp = ms_pattern_spp(p, k);
     if (p == MS_PATTERN_GRID) {
         float u, v;
-        grid_shift(px, py, seed, &u, &v);
+        ms_grid_shift(px, py, seed, &u, &v);
         const float ik = 1.0f / (float)k;   /* exact: k is a power of two */
         for (int n = 0; n < spp; n++) {
             const int i = n % k, j = n / k;

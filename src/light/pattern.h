@@ -28,6 +28,8 @@ uint32_t ms_hash3(uint32_t a, uint32_t b, uint32_t c);
 static inline float ms_hash_unit(uint32_t h) { return (float)(h >> 8) * (1.0f / 16777216.0f); }
 
 void ms_grid_for_pixel(const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed, ms_grid *g);
+/* The grid's per-pixel shift (u, v) in [0,1)^2, hashed from the pixel and the seed (the header's s_ij, t_ij). */
+void ms_grid_shift(uint32_t px, uint32_t py, uint32_t seed, float *u, float *v);
 /* Sample positions of a pattern for one pixel: 3*ms_pattern_spp(p, k) floats (k*k samples in all). */
 void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                        float *xyz);
@@ -36,11 +38,11 @@ void ms_pattern_points(ms_pattern p, const ms_light *l, int k, uint32_t px, uint
 void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                              int first, int count, float *xyz);
 /* Light shapes (microshadow.h, ms_light_shape): clears in mask (the pixel's samples, bit n = sample n)
- * every sample whose light parameters (s,t) lie off the light's shape; nothing for a parallelogram. */
+ * every sample whose light parameters (s,t) lie off the light's shape; nothing for a parallelogram. Sample by
+ * sample; front masks take the grid's disk in vector lanes instead (visibility/disk_mask.h). */
 void ms_shape_mask_apply(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                          uint64_t *mask);
-/* The same mask by testing every sample's (s,t) one by one (for tests: ms_shape_mask_apply finds the grid's
- * rows as intervals). */
+/* The same mask from ms_pattern_st's (s,t) and the shape's test (for tests). */
 void ms_shape_mask_reference(ms_pattern p, const ms_light *l, int k, uint32_t px, uint32_t py, uint32_t seed,
                              uint64_t *mask);
 /* The light parameters (s,t) of the pixel's samples, 2 * ms_pattern_spp(p, k) floats: the values the

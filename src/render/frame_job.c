@@ -624,14 +624,19 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     double resolve_thread_s = 0.0;
     int failed = 0;
     const int stratified = ctx.pattern != MS_PATTERN_GRID;   /* sample points listed (not the grid) */
-    /* A sphere light: each receiver has its own light, the sphere's outline disk seen from it (a per-query
-     * light frame: ms_light_sphere_outline). The method is called one query at a time with a context whose
-     * light is that disk, so every method answers on the same per-receiver samples as raytrace, whatever
-     * it sets up per frame (mft re-derives its light frame per call; hpc sets up its light per call, so
-     * a sphere costs it a pass over every triangle per receiver); frame-level entries are not used. The
-     * price is the block traversal's coherence: groups of one. */
+    /* A sphere or a sun: each receiver has its own light, the shape's outline seen from it (a per-query light
+     * frame: ms_light_sphere_outline, ms_light_sun_outline). A method that declares .outlines (the
+     * micro-rasterization methods) takes the tile's queries together, with ctx.outline_per_query, and sets
+     * each query's light itself (ms_ctx_for_query), keeping its 4x4 blocks. Any other is called one query
+     * at a time with a context whose light is that outline, so every method answers on the same
+     * per-receiver samples as raytrace, whatever it sets up per frame (mft re-derives its light frame per
+     * call; hpc sets up its light per call, so an outlined light costs it a pass over every triangle per
+     * receiver); frame-level entries are not used. */
     const ms_light_shape_ops *shape = ms_light_shape_of(ctx.light.shape);
     const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
+    const int batched = outlined && sm->outlines;    /* ... which the method takes a tile at a time */
+    ms_render_ctx bctx = ctx;   /* the batch's context: each query's light its outline */
+    bctx.outline_per_query = 1;
     const int shadow_tiles = sm->visibility_all && !outlined ? 0 : n;   /* a frame-level method: shadow_frame.c */
 #pragma omp parallel num_threads(j->threads)
     {
@@ -686,8 +691,8 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                 if (sm->visibility(interior_state, &ictx, q, nm, front, imask, local)) ok = 0;
                 for (int i = 0; i < nm; i++) q[i].prim = prim[i];
                 if (ok && sm->visibility(sstate, &ctx, q, nm, imask, vmask, local)) ok = 0;
-            } else if (!outlined) {
-                if (nm && ok && sm->visibility(sstate, &ctx, q, nm, front, vmask, local)) ok = 0;
+            } else if (!outlined || batched) {
+                if (nm && ok && sm->visibility(sstate, batched ? &bctx : &ctx, q, nm, front, vmask, local)) ok = 0;
             } else
                 for (int i = 0; i < nm && ok; i++) {
                     shape->outline(&ctx.light, q[i].p, &qc.light);
@@ -699,7 +704,8 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                 ms_render_ctx rc;
                 light_own_ctx(j, l, &rc);
                 for (int i = nm; i < nq; i++) q[i].prim = own[i];
-                if (!outlined) {
+                rc.outline_per_query = batched;
+                if (!outlined || batched) {
                     if (sm->visibility(own_state, &rc, q + nm, nq - nm, front + (size_t)nm * mw, vmask + (size_t)nm * mw, local)) ok = 0;
                 } else
                     for (int i = nm; i < nq && ok; i++) {

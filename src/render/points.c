@@ -301,6 +301,8 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
     const ms_light_shape_ops *shape = ms_light_shape_of(light->shape);
     const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
+    const int batched = outlined && sm->outlines;    /* ... which the method takes a batch at a time (frame_job.c) */
+    ms_render_ctx bctx;   /* the batch's context then: each query's light its outline (ms_ctx_for_query) */
 
     const size_t n = pts->n;
     /* Proximity order: Morton codes in the points' bounding box, ties by index (a total order). */
@@ -340,6 +342,8 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     }
     const uint64_t occ_boxes = occ.interior_boxes;
     if (sm->create(&ctx, &sstate, err, errlen)) { ms_occluders_free(&occ); free(order); free(scene_tri); return MS_ERR_METHOD; }
+    bctx = ctx;
+    bctx.outline_per_query = 1;
     const double setup_s = omp_get_wtime() - t_setup;
 
     const long nbatch = (long)((n + BATCH - 1) / BATCH);
@@ -373,9 +377,10 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
             if (!ok || stop) continue;
             const size_t i0 = (size_t)b * BATCH, i1 = i0 + BATCH < n ? i0 + BATCH : n;
             const int m = (int)(i1 - i0);
-            /* A sphere light: each point has its own light, the sphere's outline disk seen from it, and the
-             * method is called one point at a time with it, exactly as frames do (frame_job.c); a point
-             * inside the sphere has no sample in front (V = S = 0). */
+            /* A sphere or a sun: each point has its own light, the shape's outline seen from it, and the
+             * method takes the batch with each point's outline (.outlines) or is called one point at a time
+             * with it, exactly as frames do (frame_job.c); a point inside a sphere has no sample in front
+             * (V = S = 0). */
             ms_render_ctx qc = ctx;
             int nq = 0;
             size_t where[BATCH];
@@ -395,7 +400,7 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
                 where[nq++] = i;
             }
             int vfail = 0;
-            if (!outlined) vfail = nq && sm->visibility(sstate, &ctx, q, nq, fm, vm, local);
+            if (!outlined || batched) vfail = nq && sm->visibility(sstate, batched ? &bctx : &ctx, q, nq, fm, vm, local);
             else
                 for (int j = 0; j < nq && !vfail; j++) {
                     shape->outline(&ctx.light, q[j].p, &qc.light);

@@ -52,6 +52,11 @@ typedef struct ms_shadow_method {
      * the frame's options (e.g. the traversal); returns their number and sets *names, or -1 for the
      * static ones. */
     int (*counters_used)(const void *state, const char *const **names);
+    /* 1: visibility takes a batch of queries under a light with an outline (the sun, the sphere:
+     * ctx->outline_per_query) and answers each on its own light (ms_ctx_for_query), as it would one query at
+     * a time, so that it keeps what it shares across queries (the micro-rasterization methods' 4x4 blocks).
+     * 0: the drivers call it one query at a time with the query's outline in ctx->light. */
+    int outlines;
 } ms_shadow_method;
 
 /* Known shadow methods, compiled in or not (registry.c). */

@@ -48,6 +48,11 @@ typedef struct ms_render_ctx {
      * one of them meets is occluded; the micro-rasterization methods rasterize them first. */
     const ms_bvh *interior;
     int consistent_primary;            /* bvh primary: the 3D edge-function test (edge3d.h) in its leaves */
+    /* 1: light is a shape with an outline (light_shape.h: the sun, the sphere) and each query's own light is
+     * its outline seen from the query's point (ms_ctx_for_query). Set by the drivers only for a method that
+     * declares .outlines (shadow/method.h); the others are called one query at a time with the outline
+     * itself in light. */
+    int outline_per_query;
 } ms_render_ctx;
 
 /* One visible point: the pixel, its hit point, the unit geometric normal facing the camera (its plane is
@@ -59,6 +64,12 @@ typedef struct ms_shadow_query {
     uint32_t prim;
     uint32_t px, py;
 } ms_shadow_query;
+
+/* The context query q is answered in: ctx itself, or, when ctx->outline_per_query, a copy in *own whose light
+ * is q's own, the outline of ctx->light seen from q->p, made by the same call (the shape's outline hook) on
+ * the same floats as the drivers' one-query-at-a-time path, so own equals the context that path hands the
+ * method, field for field. A query the outline refuses (inside a sphere) never reaches a method. */
+const ms_render_ctx *ms_ctx_for_query(const ms_render_ctx *ctx, const ms_shadow_query *q, ms_render_ctx *own);
 
 /* The prim id a shadow method skips for a receiver on the scene's triangle prim (ctx->prim_map). */
 static inline uint32_t ms_ctx_skip_prim(const ms_render_ctx *ctx, uint32_t prim)

@@ -4,6 +4,8 @@
 #include "light/light_frame.h"
 #include "raster/raster.h"
 #include "core/cpu.h"
+#include "disk_mask.h"
+#include "light/pattern.h"
 #include <math.h>
 #include <string.h>
 
@@ -68,8 +70,19 @@ int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
     const int nf = horizon_mask(ctx, q, pts, front);
     if (ctx->light.shape == MS_LIGHT_RECT || nf == 0) return nf;
     /* A disk: the samples off it neither count nor are traced, exactly like those behind the horizon, so
-     * every method (which starts from or traces only the front mask) honours the shape unchanged. */
-    ms_shape_mask_apply(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, front);
+     * every method (which starts from or traces only the front mask) honours the shape unchanged. The grid's
+     * disk in vector lanes (disk_mask.h): every instance gives the same mask; the context's cap picks one, so
+     * that a capped run (the scalar test suite) runs the portable one. */
+    if (ctx->pattern == MS_PATTERN_GRID && ctx->light.shape == MS_LIGHT_DISK) {
+        float u, v;
+        ms_grid_shift(q->px, q->py, ctx->seed, &u, &v);
+        switch (ms_isa_select(ctx->isa_cap, MS_ISA_ALL)) {
+        case MS_ISA_AVX512: ms_grid_disk_mask_avx512(ctx->k, u, v, front); break;
+        case MS_ISA_AVX2: ms_grid_disk_mask_avx2(ctx->k, u, v, front); break;
+        default: ms_grid_disk_mask_scalar(ctx->k, u, v, front); break;
+        }
+    } else
+        ms_shape_mask_apply(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, front);
     return ms_mask_count(front, ctx->mask_words);
 }
 

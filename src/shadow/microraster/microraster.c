@@ -131,7 +131,9 @@ static int mr_visibility_pixel(const mr_state *s, const ms_render_ctx *ctx, cons
         ms_raster_frame f;
         ms_alpha_pixel ap;
         uint64_t *buf = vis + qi * mw;   /* the k x k occlusion buffer itself (receiver.h) */
-        const int go = mr_start(ctx, &q[qi], front + qi * mw, buf, &f, &ap, &pts, &cnt[MS_FT_TRACED_EDGE_ON]);
+        ms_render_ctx own;   /* an outlined light: the query's own (ms_ctx_for_query) */
+        const int go = mr_start(ms_ctx_for_query(ctx, &q[qi], &own), &q[qi], front + qi * mw, buf, &f, &ap, &pts,
+                                &cnt[MS_FT_TRACED_EDGE_ON]);
         if (go < 0) { free(pts); return -1; }
         if (!go) continue;
         cnt[MS_FT_FRUSTA]++;
@@ -176,7 +178,13 @@ static void interior_pass(const mr_state *s, const ms_render_ctx *ctx, ms_block_
 }
 
 /* The queries grouped by 4x4 pixel block (at most 16 to a group), or 16 consecutive ones when they come
- * in proximity order (the points API), each group traversed together. */
+ * in proximity order (the points API), each group traversed together.
+ * An outlined light (the sun, the sphere: ctx->outline_per_query): each lane's frame is set up from its
+ * query's own light (ms_ctx_for_query, the context the one-query path gets), and nothing in the traversal
+ * mixes lanes: each lane's frustum is its own frame's (block_raster_impl.h, br_corner_dirs), so the node
+ * and leaf tests bound that lane's segments alone, every cull is conservative for that lane's kernel, and
+ * its buffer is its front mask less the union of the kernel's coverage of the triangles its frustum
+ * reaches, in whatever order: the same buffer as a block of one. */
 static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
                                const uint64_t *front, uint64_t *vis, uint64_t *cnt)
 {
@@ -190,12 +198,14 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
         ms_block_input in;
         ms_raster_frame frames[MS_BLOCK_LANES];
         ms_alpha_pixel aps[MS_BLOCK_LANES];
+        ms_render_ctx own[MS_BLOCK_LANES];   /* an outlined light: the lanes' own contexts (aps[] point at them) */
         in.n = 0;
         const int end = ms_block_group_end(ctx, q, order, nq, g);
         for (int e = g; e < end; e++) {
             const int i = order[e];
             uint64_t *buf = vis + (size_t)i * mw;
-            const int go = mr_start(ctx, &q[i], front + (size_t)i * mw, buf, &frames[in.n], &aps[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
+            const int go = mr_start(ms_ctx_for_query(ctx, &q[i], &own[in.n]), &q[i], front + (size_t)i * mw, buf,
+                                    &frames[in.n], &aps[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
             if (go < 0) { rc = -1; break; }
             if (!go) continue;
             in.frame[in.n] = &frames[in.n];
@@ -249,7 +259,7 @@ static void mr_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
         .counter_names = { "frusta", "nodes_visited", "nodes_culled_frustum", "nodes_culled_occluded", \
                            "triangles_rasterized", "pixels_early_out", "pixels_traced_edge_on" },    \
         .create = create_fn, .visibility = mr_visibility, .destroy = mr_destroy, .isa_used = mr_isa_used, \
-        .counters_used = mr_counters_used }
+        .counters_used = mr_counters_used, .outlines = 1 }
 
 MICRORASTER_METHOD(ms_shadow_scanline, "scanline", mr_create_scanline);
 MICRORASTER_METHOD(ms_shadow_bounds, "bounds", mr_create_bounds);

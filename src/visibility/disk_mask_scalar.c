@@ -1,0 +1,2 @@
+/* The portable instance of the grid disk mask (disk_mask_impl.h). */
+#include "disk_mask_impl.h"
