@@ -69,6 +69,7 @@ typedef struct mft_state {
     float cl[4][MS_BLOCK_LANES];      /* their L1 norms */
     float hn[3][MS_BLOCK_LANES];      /* receiver normals */
     int rect[MS_BLOCK_LANES][4];      /* live cells: columns r[0]..r[1], rows r[2]..r[3] */
+    float rectf[4][MS_BLOCK_LANES];   /* the same as floats, by bound (the leaf's vector cut) */
     uint64_t livech[MS_BLOCK_LANES][4]; /* packets (16 samples) with a live ray, one bit each */
     float m[3][3][MS_BLOCK_LANES];    /* cell projections (ms_mft_lane.m) */
     float ml1[3][MS_BLOCK_LANES];
@@ -109,6 +110,7 @@ static void mft_lane_frustum(mft_state *s, int l, int traversal)
     const ms_mft_lane *L = &s->blk->lane[l];
     float d[4][3];
     ms_mft_corners(s->f, L->c, s->rect[l], d);
+    for (int q = 0; q < 4; q++) s->rectf[q][l] = (float)s->rect[l][q];
     for (int c = 0; c < 4; c++) {
         for (int a = 0; a < 3; a++) s->cd[c][a][l] = d[c][a];
         s->cl[c][l] = fabsf(d[c][0]) + fabsf(d[c][1]) + fabsf(d[c][2]);
@@ -273,13 +275,6 @@ static unsigned mft_footprint16(const mft_state *s, const l16 a[3][3], const l16
     return valid;
 }
 
-/* floor of a float in [-1, 64]. */
-static inline int mft_floor(float x)
-{
-    const int i = (int)x;
-    return i - ((float)i > x);
-}
-
 #ifndef MFT_ALPHA_FILTER
 #define MFT_ALPHA_FILTER
 /* The bits of hit (rays of packet ch of lane L that alpha-tested triangle t meets) where t is opaque. */
@@ -295,6 +290,47 @@ static unsigned mft_alpha_filter(const ms_mft_frame *f, const ms_mft_lane *L, in
 }
 #endif
 
+/* One (frustum, triangle) pair on its way through the packets it may hit. */
+typedef struct mft_pair {
+    mft_state *s;
+    ms_mft_lane *L;
+    int l;
+    uint32_t t;
+    const float *tri, *N;
+    float num;
+    int have_v, isec, cleared, done;
+    float V[3][3];                    /* the vertices relative to C, formed at the first test */
+} mft_pair;
+
+/* Tests the live rays `bits` of packet ch against the pair's triangle and clears those it blocks; sets
+ * done when the lane has no live ray left. */
+static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
+{
+    mft_state *s = pr->s;
+    ms_mft_lane *L = pr->L;
+    const ms_mft_frame *f = s->f;
+    if (!pr->have_v) {
+        for (int v = 0; v < 3; v++)
+            for (int x = 0; x < 3; x++) pr->V[v][x] = pr->tri[3 * v + x] - L->c[x];
+        pr->have_v = 1;
+    }
+    if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
+    pr->isec++;
+    unsigned hit = mft_packet(L, ch, bits, pr->tri, pr->N, (const float(*)[3])pr->V, pr->num, f->near, f->far);
+    /* Any hit: an alpha-tested triangle keeps only the rays where it is opaque (alpha.h, the decision
+     * every method shares: the segment from C to the pattern's sample point). */
+    if (hit && f->alpha && f->alpha->flag[pr->t]) hit = mft_alpha_filter(f, L, ch, pr->t, hit);
+    if (!hit) return;
+    const int sh = (ch & 3) * 16;
+    const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
+    L->mask[ch >> 2] &= ~((uint64_t)hit << sh);
+    pr->cleared = 1;
+    if (all & ~hit) return;
+    uint64_t *lc = s->livech[pr->l];
+    lc[ch >> 6] &= ~(UINT64_C(1) << (ch & 63));
+    pr->done = !(lc[0] | lc[1] | lc[2] | lc[3]);
+}
+
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
 {
     ms_block_frusta *fr = s->fr;
@@ -302,8 +338,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     ms_mft_block *blk = s->blk;
     uint64_t *cnt = s->bt_cnt;
     const int k = f->k, cpr = k / 16;
-    /* One bit every cpr bits. */
-    const uint64_t rep = cpr == 1 ? ~UINT64_C(0) : cpr == 2 ? UINT64_C(0x5555555555555555) : UINT64_C(0x1111111111111111);
     /* The pixels whose own triangle is in this leaf. */
     uint32_t skip_tri[MFT_MAX_SKIP];
     unsigned skip_lane[MFT_MAX_SKIP];
@@ -424,80 +458,62 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             c_foot += (uint64_t)ms_bt_popcount16(empty);
             pass &= ~empty;
         }
+        /* Each surviving lane's rectangle of cells: its live rectangle cut to the footprint's box, for
+         * the 16 lanes at once (floor and clamp in vector form, the box being within [-1, k]); an empty
+         * cut drops the pair before any scalar work. */
         float numv[MS_BLOCK_LANES];
         l16_store(numv, num);
+        int32_t rc[4][MS_BLOCK_LANES];
+        {
+            l16 r[4];
+            for (int q = 0; q < 4; q++) r[q] = l16_load(s->rectf[q]);
+            if (foot) {
+                for (int q = 0; q < 4; q += 2) {
+                    const l16 lo = l16_floor(l16_load(box[q])), hi = l16_floor(l16_load(box[q + 1]));
+                    r[q] = l16_select(foot, l16_max(lo, r[q]), r[q]);
+                    r[q + 1] = l16_select(foot, l16_min(hi, r[q + 1]), r[q + 1]);
+                }
+                const unsigned cut = pass & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3]));
+                c_foot += (uint64_t)ms_bt_popcount16(cut);
+                pass &= ~cut;
+            }
+            for (int q = 0; q < 4; q++) l16_store_int(rc[q], r[q]);
+        }
+        if (!pass) continue;
+        tested += (uint64_t)ms_bt_popcount16(pass);
         for (; pass; pass &= pass - 1) {
             const int l = __builtin_ctz(pass);
             ms_mft_lane *L = &blk->lane[l];
-            int x0 = s->rect[l][0], x1 = s->rect[l][1], y0 = s->rect[l][2], y1 = s->rect[l][3];
-            if (foot >> l & 1) {
-                const int fx0 = mft_floor(box[0][l]), fx1 = mft_floor(box[1][l]);
-                const int fy0 = mft_floor(box[2][l]), fy1 = mft_floor(box[3][l]);
-                x0 = fx0 > x0 ? fx0 : x0; x1 = fx1 < x1 ? fx1 : x1;
-                y0 = fy0 > y0 ? fy0 : y0; y1 = fy1 < y1 ? fy1 : y1;
-                if (x0 > x1 || y0 > y1) { c_foot++; continue; }
-            }
-            tested++;
-            float V[3][3];
-            for (int v = 0; v < 3; v++)
-                for (int x = 0; x < 3; x++) V[v][x] = tri[3 * v + x] - L->c[x];
-            /* The live packets of rows y0..y1 that reach columns x0..x1, with the packet's samples there. */
-            int nc = 0, cand[256];
-            unsigned ccols[256];
+            const int x0 = rc[0][l], x1 = rc[1][l], y0 = rc[2][l], y1 = rc[3][l];
+            mft_pair pr = { .s = s, .L = L, .l = l, .t = t, .tri = tri, .N = N, .num = numv[l] };
             if (k >= 16) {
-                /* A row is cpr packets, so the packets of the columns repeat every cpr bits. */
-                const uint64_t rowpat = ((UINT64_C(2) << (x1 >> 4)) - 1) & ~((UINT64_C(1) << (x0 >> 4)) - 1);
-                const uint64_t colpat = rowpat * rep;
-                const int c_lo = y0 * cpr, c_hi = (y1 + 1) * cpr;
-                for (int w = c_lo >> 6; w <= (c_hi - 1) >> 6; w++) {
-                    uint64_t m = s->livech[l][w] & colpat;
-                    const int lo = c_lo - 64 * w, hi = c_hi - 64 * w;
-                    if (lo > 0) m &= ~UINT64_C(0) << lo;
-                    if (hi < 64) m &= (UINT64_C(1) << hi) - 1;
-                    for (; m; m &= m - 1) {
-                        const int ch = 64 * w + __builtin_ctzll(m), col0 = (ch & (cpr - 1)) * 16;
-                        const int clo = (x0 > col0 ? x0 : col0) - col0, chi = (x1 < col0 + 15 ? x1 : col0 + 15) - col0;
-                        cand[nc] = ch;
-                        ccols[nc++] = (0xFFFFu >> (15 - (chi - clo))) << clo;
+                /* Row by row, the live rays of columns x0..x1, one test per 16-sample packet that holds any. */
+                const uint64_t cols = ((UINT64_C(2) << x1) - 1) & ~((UINT64_C(1) << x0) - 1);
+                for (int y = y0; y <= y1 && !pr.done; y++)
+                    for (uint64_t row = mft_row(L->mask, k, y) & cols; row;) {
+                        const int p = __builtin_ctzll(row) >> 4;
+                        const unsigned bits = (unsigned)(row >> 16 * p) & 0xFFFFu;
+                        row &= ~(UINT64_C(0xFFFF) << 16 * p);
+                        mft_pair_packet(&pr, y * cpr + p, bits);
                     }
-                }
             } else {
-                /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (The loop above took k / 16 = 0
-                 * packets per row and tested no ray at all: mft answered the front mask; the known bug of
+                /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (An earlier loop took k / 16 =
+                 * 0 packets per row and tested no ray at all: mft answered the front mask; the known bug of
                  * test_visibility.) */
                 const int rpp = 16 / k;
                 const unsigned rowcols = ((1u << (x1 - x0 + 1)) - 1u) << x0;
                 for (int ch = y0 / rpp; ch <= y1 / rpp; ch++) {
-                    if (!(s->livech[l][0] >> ch & 1)) continue;
                     unsigned cols = 0;
                     for (int r = 0; r < rpp; r++)
                         if (ch * rpp + r >= y0 && ch * rpp + r <= y1) cols |= rowcols << (r * k);
-                    cand[nc] = ch;
-                    ccols[nc++] = cols;
+                    const unsigned bits = (unsigned)(L->mask[ch >> 2] >> (ch & 3) * 16) & cols;
+                    if (bits) mft_pair_packet(&pr, ch, bits);
                 }
             }
-            int cleared = 0, done = 0;
-            for (int ci = 0; ci < nc; ci++) {
-                const int ch = cand[ci], w = ch >> 6, sh = (ch & 3) * 16;
-                const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
-                const unsigned bits = all & ccols[ci];
-                if (!bits) continue;
-                if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
-                isec++;
-                unsigned hit = mft_packet(L, ch, bits, tri, N, V, numv[l], f->near, f->far);
-                /* Any hit: an alpha-tested triangle keeps only the rays where it is opaque (alpha.h, the
-                 * decision every method shares: the segment from C to the pattern's sample point). */
-                if (hit && f->alpha && f->alpha->flag[t]) hit = mft_alpha_filter(f, L, ch, t, hit);
-                if (!hit) continue;
-                L->mask[ch >> 2] &= ~((uint64_t)hit << sh);
-                cleared = 1;
-                if (all & ~hit) continue;
-                s->livech[l][w] &= ~(UINT64_C(1) << (ch & 63));
-                done = !(s->livech[l][0] | s->livech[l][1] | s->livech[l][2] | s->livech[l][3]);
-            }
-            if (!cleared) continue;
+            isec += (uint64_t)pr.isec;
+            if (!pr.cleared) continue;
             terminated |= 1u << l;
-            if (done) { fr->live &= ~(1u << l); early++; }
+            if (pr.done) { fr->live &= ~(1u << l); early++; }
         }
     }
     cnt[MS_MFT_PAIRS] += pairs;
