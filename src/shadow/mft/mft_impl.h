@@ -58,6 +58,9 @@
 
 #define MFT_REL 1e-5f
 #define MFT_MAX_SKIP MS_BLOCK_LANES
+#ifndef MFT_CORNER_AREA
+#define MFT_CORNER_AREA 256.0f
+#endif
 
 typedef struct mft_state {
     ms_block_frusta *fr;
@@ -411,36 +414,12 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         c_plane += (uint64_t)ms_bt_popcount16(pass & plane_out);
         pass &= ~plane_out;
         if (!pass) continue;
-        /* Corner rays against the edge planes through C: a ray hits (t > 0) only inside the cone of
-         * the vertices, where every edge function (a_i x a_j) . d has the sign of det = (a0 x a1) . a2.
-         * Trusted only where |det| clears its own rounding. */
-        l16 e[3][3];
-        for (int q = 0; q < 3; q++) {
-            const l16 *x = a[q], *y = a[q == 2 ? 0 : q + 1];
-            e[q][0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1]));
-            e[q][1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2]));
-            e[q][2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0]));
-        }
-        const l16 det = l16_add(l16_add(l16_mul(e[0][0], a[2][0]), l16_mul(e[0][1], a[2][1])), l16_mul(e[0][2], a[2][2]));
-        const unsigned det_ok = l16_gt(l16_abs(det), l16_mul(l16_mul(l16_mul(la[0], la[1]), la[2]), rel));
-        const unsigned det_pos = l16_gt(det, zero);
-        unsigned corner_out = 0;
-        for (int q = 0; q < 3; q++) {
-            const l16 lq = l16_mul(l16_mul(la[q], la[q == 2 ? 0 : q + 1]), rel);
-            unsigned all = 0xFFFF;
-            for (int r = 0; r < 4; r++) {
-                const l16 ev = l16_add(l16_add(l16_mul(e[q][0], cd[r][0]), l16_mul(e[q][1], cd[r][1])), l16_mul(e[q][2], cd[r][2]));
-                const l16 tol = l16_mul(lq, cl[r]);
-                all &= (det_pos & l16_lt(l16_add(ev, tol), zero)) | (~det_pos & l16_gt(l16_sub(ev, tol), zero));
-            }
-            corner_out |= all;
-        }
-        corner_out &= det_ok;
-        c_corner += (uint64_t)ms_bt_popcount16(pass & corner_out);
-        pass &= ~corner_out;
-        if (!pass) continue;
-        float box[4][MS_BLOCK_LANES];
-        unsigned foot = 0, empty = 0;
+        /* Each surviving lane's rectangle of cells: its live rectangle, cut to the triangle's footprint,
+         * for the 16 lanes at once (floor and clamp in vector form, the box being within [-1, k]); an empty
+         * cut drops the pair before any scalar work. */
+        l16 r[4];
+        for (int q = 0; q < 4; q++) r[q] = l16_load(s->rectf[q]);
+        unsigned foot = 0;
         /* No footprint for a triangle whose plane passes within 1e-4 of its size from C (|num| is C's
          * distance from the plane times |N|): some rays graze it, and the watertight test decides its
          * edges in the plane across the ray, where such a triangle is a sliver, with an error that grows
@@ -454,32 +433,58 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         const unsigned grazing = l16_le(an, l16_mul(lamax, l16_set1(nl1 * 1e-4f)));
         const unsigned foot_lanes = pass & s->has_m & ~grazing;
         if (!(f->flags & MS_MFT_NO_FOOTPRINT) && foot_lanes) {
+            float box[4][MS_BLOCK_LANES];
+            unsigned empty = 0;
             foot = mft_footprint16(s, a, la, foot_lanes, &empty, box);
-            c_foot += (uint64_t)ms_bt_popcount16(empty);
-            pass &= ~empty;
+            for (int q = 0; q < 4; q += 2) {
+                const l16 lo = l16_floor(l16_load(box[q])), hi = l16_floor(l16_load(box[q + 1]));
+                r[q] = l16_select(foot, l16_max(lo, r[q]), r[q]);
+                r[q + 1] = l16_select(foot, l16_min(hi, r[q + 1]), r[q + 1]);
+            }
+            const unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
+            c_foot += (uint64_t)ms_bt_popcount16(pass & out);
+            pass &= ~out;
         }
-        /* Each surviving lane's rectangle of cells: its live rectangle cut to the footprint's box, for
-         * the 16 lanes at once (floor and clamp in vector form, the box being within [-1, k]); an empty
-         * cut drops the pair before any scalar work. */
+        /* Corner rays against the edge planes through C, for the lanes without a footprint only (with
+         * one, the cut above culls nearly every pair this test would: measured, docs/methods.md, session
+         * 11): a ray hits (t > 0) only inside the cone of the vertices, where every edge function
+         * (a_i x a_j) . d has the sign of det = (a0 x a1) . a2. Trusted only where |det| clears its own
+         * rounding. */
+        const l16 one_f = l16_set1(1.0f);
+        const l16 area = l16_mul(l16_add(l16_sub(r[1], r[0]), one_f), l16_add(l16_sub(r[3], r[2]), one_f));
+        const unsigned corner_lanes = pass & (~foot | l16_gt(area, l16_set1(MFT_CORNER_AREA)));
+        if (corner_lanes) {
+            l16 e[3][3];
+            for (int q = 0; q < 3; q++) {
+                const l16 *x = a[q], *y = a[q == 2 ? 0 : q + 1];
+                e[q][0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1]));
+                e[q][1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2]));
+                e[q][2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0]));
+            }
+            const l16 det = l16_add(l16_add(l16_mul(e[0][0], a[2][0]), l16_mul(e[0][1], a[2][1])), l16_mul(e[0][2], a[2][2]));
+            const unsigned det_ok = l16_gt(l16_abs(det), l16_mul(l16_mul(l16_mul(la[0], la[1]), la[2]), rel));
+            const unsigned det_pos = l16_gt(det, zero);
+            unsigned corner_out = 0;
+            for (int q = 0; q < 3; q++) {
+                const l16 lq = l16_mul(l16_mul(la[q], la[q == 2 ? 0 : q + 1]), rel);
+                unsigned all = 0xFFFF;
+                for (int c4 = 0; c4 < 4; c4++) {
+                    const l16 ev = l16_add(l16_add(l16_mul(e[q][0], cd[c4][0]), l16_mul(e[q][1], cd[c4][1])),
+                                           l16_mul(e[q][2], cd[c4][2]));
+                    const l16 tol = l16_mul(lq, cl[c4]);
+                    all &= (det_pos & l16_lt(l16_add(ev, tol), zero)) | (~det_pos & l16_gt(l16_sub(ev, tol), zero));
+                }
+                corner_out |= all;
+            }
+            corner_out &= det_ok & corner_lanes;
+            c_corner += (uint64_t)ms_bt_popcount16(pass & corner_out);
+            pass &= ~corner_out;
+        }
+        if (!pass) continue;
         float numv[MS_BLOCK_LANES];
         l16_store(numv, num);
         int32_t rc[4][MS_BLOCK_LANES];
-        {
-            l16 r[4];
-            for (int q = 0; q < 4; q++) r[q] = l16_load(s->rectf[q]);
-            if (foot) {
-                for (int q = 0; q < 4; q += 2) {
-                    const l16 lo = l16_floor(l16_load(box[q])), hi = l16_floor(l16_load(box[q + 1]));
-                    r[q] = l16_select(foot, l16_max(lo, r[q]), r[q]);
-                    r[q + 1] = l16_select(foot, l16_min(hi, r[q + 1]), r[q + 1]);
-                }
-                const unsigned cut = pass & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3]));
-                c_foot += (uint64_t)ms_bt_popcount16(cut);
-                pass &= ~cut;
-            }
-            for (int q = 0; q < 4; q++) l16_store_int(rc[q], r[q]);
-        }
-        if (!pass) continue;
+        for (int q = 0; q < 4; q++) l16_store_int(rc[q], r[q]);
         tested += (uint64_t)ms_bt_popcount16(pass);
         for (; pass; pass &= pass - 1) {
             const int l = __builtin_ctz(pass);
