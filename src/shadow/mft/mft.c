@@ -134,7 +134,16 @@ static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
 {
     float pts[3 * 16];
-    ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
+    if (f->pattern == MS_PATTERN_GRID) {
+        /* ms_pattern_points_range's grid points, from the lane's grid (the same float operations). */
+        const ms_grid *g = &L->grid;
+        for (int n = ch * 16; n < ch * 16 + 16; n++) {
+            const int i = n % f->k, j = n / f->k;
+            float *o = pts + 3 * (n - ch * 16);
+            for (int c = 0; c < 3; c++) o[c] = g->p0[c] + (float)i * g->ds[c] + (float)j * g->dt[c];
+        }
+    } else
+        ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
     ms_mft_rays_from(L, ch, pts);
 }
 
@@ -170,6 +179,7 @@ static void mft_lane_setup(const ms_mft_frame *f, const ms_shadow_query *q, ms_m
     L->px = q->px;
     L->py = q->py;
     memset(L->ready, 0, sizeof L->ready);
+    if (f->pattern == MS_PATTERN_GRID) ms_grid_for_pixel(&f->light, f->k, L->px, L->py, f->seed, &L->grid);
     double u[3], v[3], w[3], vw[3], wu[3], uv[3];
     for (int a = 0; a < 3; a++) {
         u[a] = f->ls[a] / f->k;

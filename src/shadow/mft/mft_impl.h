@@ -90,9 +90,25 @@ static inline uint64_t mft_row(const uint64_t *m, int k, int j)
     return m[bit >> 6] >> (bit & 63) & ((UINT64_C(1) << k) - 1);
 }
 
-/* The rectangle of the live samples; 0 if none. */
+/* The rectangle of the live samples; 0 if none. For k >= 16 a 64-bit word holds 64 / k whole rows:
+ * the columns from the OR of the words folded to one row, the rows from the first and last live words. */
 static int mft_live_rect(const uint64_t *m, int k, int r[4])
 {
+    if (k >= 16) {
+        const int nw = k * k / 64, rpw = 64 / k;
+        int w0 = -1, w1 = -1;
+        uint64_t acc = 0;
+        for (int w = 0; w < nw; w++)
+            if (m[w]) { if (w0 < 0) w0 = w; w1 = w; acc |= m[w]; }
+        if (w0 < 0) return 0;
+        for (int sh = 32; sh >= k; sh >>= 1) acc |= acc >> sh;
+        const uint64_t row = k == 64 ? acc : acc & ((UINT64_C(1) << k) - 1);
+        r[0] = __builtin_ctzll(row);
+        r[1] = 63 - __builtin_clzll(row);
+        r[2] = w0 * rpw + __builtin_ctzll(m[w0]) / k;
+        r[3] = w1 * rpw + (63 - __builtin_clzll(m[w1])) / k;
+        return 1;
+    }
     uint64_t any = 0;
     int j0 = -1, j1 = -1;
     for (int j = 0; j < k; j++) {
