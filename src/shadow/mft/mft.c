@@ -140,15 +140,9 @@ static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
 {
     float pts[3 * 16];
-    if (f->pattern == MS_PATTERN_GRID) {
-        /* ms_pattern_points_range's grid points, from the lane's grid (the same float operations). */
-        const ms_grid *g = &L->grid;
-        for (int n = ch * 16; n < ch * 16 + 16; n++) {
-            const int i = n % f->k, j = n / f->k;
-            float *o = pts + 3 * (n - ch * 16);
-            for (int c = 0; c < 3; c++) o[c] = g->p0[c] + (float)i * g->ds[c] + (float)j * g->dt[c];
-        }
-    } else
+    if (f->pattern == MS_PATTERN_GRID)
+        ms_grid_points(&L->grid, ch * 16, 16, pts);   /* the lane's grid, formed once (mft_lane_setup) */
+    else
         ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
     ms_mft_rays_from(L, ch, pts);
 }
