@@ -149,11 +149,7 @@ void ms_pattern_points_range(ms_pattern p, const ms_light *l, int k, uint32_t px
     if (p == MS_PATTERN_GRID) {
         ms_grid g;
         ms_grid_for_pixel(l, k, px, py, seed, &g);
-        for (int n = first; n < first + count; n++) {
-            const int i = n % k, j = n / k;
-            float *o = xyz + 3 * (n - first);
-            for (int c = 0; c < 3; c++) o[c] = g.p0[c] + (float)i * g.ds[c] + (float)j * g.dt[c];
-        }
+        ms_grid_points(&g, first, count, xyz);
         return;
     }
     if (p == MS_PATTERN_INTERLEAVED) {

@@ -23,6 +23,17 @@ typedef struct ms_grid {
     int k;
 } ms_grid;
 
+/* Samples first .. first + count - 1 of grid g (sample n = (n % k, n / k)) as xyz triples: the grid's one
+ * definition of its points (ms_pattern_points_range; method mft forms rays from a grid kept per pixel). */
+static inline void ms_grid_points(const ms_grid *g, int first, int count, float *xyz)
+{
+    for (int n = first; n < first + count; n++) {
+        const int i = n % g->k, j = n / g->k;
+        float *o = xyz + 3 * (n - first);
+        for (int c = 0; c < 3; c++) o[c] = g->p0[c] + (float)i * g->ds[c] + (float)j * g->dt[c];
+    }
+}
+
 uint32_t ms_hash3(uint32_t a, uint32_t b, uint32_t c);
 /* A float in [0,1) from a hash. */
 static inline float ms_hash_unit(uint32_t h) { return (float)(h >> 8) * (1.0f / 16777216.0f); }

@@ -24,10 +24,15 @@
 #include <string.h>
 
 /* Largest leaf of the shallow BVH (accel/bvh.h: subtrees of at most this many triangles collapsed into
- * one leaf). Measured (docs/design.md, "mft"): 2, 4 and 8 within 3% of each other on the shared scenes
- * (the leaf culling absorbs the difference); 16 was the slowest on the big light. */
+ * one leaf). Measured (docs/methods.md, session 11): with the per-pair set-up made cheaper, 8 beats 4 by
+ * 4-8% on the statues (ogre, beast, Igea) and is within 3% elsewhere; 16 no better than 8 and 3% worse on
+ * Crytek Sponza; 2 no better than 4. (Before session 11: 2, 4 and 8 within 3%, 16 the slowest.) The
+ * interleaved mode keeps 4 (its own measurement, docs/methods.md; 8 took the bars 6% longer). */
 #ifndef MFT_SHALLOW_LEAF
-#define MFT_SHALLOW_LEAF 4
+#define MFT_SHALLOW_LEAF 8
+#endif
+#ifndef MFT_SHALLOW_LEAF_INTERLEAVED
+#define MFT_SHALLOW_LEAF_INTERLEAVED 4
 #endif
 
 typedef struct mft_method {
@@ -84,7 +89,8 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     if (!s) { snprintf(err, errlen, "out of memory"); return -1; }
     s->block = ms_mft_select(ctx->isa_cap, &s->isa);
     if (s->block) s->groups = mft_groups_isa(s->isa);
-    if (!s->block || ms_bvh_shallow_build(&s->sh, ctx->bvh, MFT_SHALLOW_LEAF)) {
+    const int leaf = ctx->pattern == MS_PATTERN_INTERLEAVED ? MFT_SHALLOW_LEAF_INTERLEAVED : MFT_SHALLOW_LEAF;
+    if (!s->block || ms_bvh_shallow_build(&s->sh, ctx->bvh, leaf)) {
         free(s);
         snprintf(err, errlen, "out of memory for the shallow BVH");
         return -1;
@@ -134,7 +140,10 @@ static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
 {
     float pts[3 * 16];
-    ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
+    if (f->pattern == MS_PATTERN_GRID)
+        ms_grid_points(&L->grid, ch * 16, 16, pts);   /* the lane's grid, formed once (mft_lane_setup) */
+    else
+        ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
     ms_mft_rays_from(L, ch, pts);
 }
 
@@ -170,6 +179,7 @@ static void mft_lane_setup(const ms_mft_frame *f, const ms_shadow_query *q, ms_m
     L->px = q->px;
     L->py = q->py;
     memset(L->ready, 0, sizeof L->ready);
+    if (f->pattern == MS_PATTERN_GRID) ms_grid_for_pixel(&f->light, f->k, L->px, L->py, f->seed, &L->grid);
     double u[3], v[3], w[3], vw[3], wu[3], uv[3];
     for (int a = 0; a < 3; a++) {
         u[a] = f->ls[a] / f->k;

@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include "shadow/microraster/block_traverse.h"
 #include "core/cpu.h"
+#include "light/pattern.h"
 #include "microshadow.h"
 
 /* Per frame, read-only. A lane's live rectangle is in cells of the light's k x k strata: sample (i, j)
@@ -40,6 +41,7 @@ typedef struct ms_mft_lane {
     float c[3], n[3];             /* receiver point and its normal facing the camera */
     uint32_t skip;                /* its own triangle */
     uint32_t px, py;              /* its pixel: its samples */
+    ms_grid grid;                 /* the grid pattern's points of the pixel (ms_grid_for_pixel), once per lane */
     uint64_t *mask;               /* mask_words words: live rays */
     /* Its rays, formed per 16-sample packet when first tested (ms_mft_rays; ready: one bit per packet). */
     float *d[3], *sx, *sy;        /* per sample */

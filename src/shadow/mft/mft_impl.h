@@ -7,15 +7,17 @@
  *      the segment parameter (16 lanes at once): a frustum that cannot reach the box skips the leaf;
  *   1. per triangle, culling of all 16 frusta at once: the receiver's horizon (every vertex behind its
  *      plane by more than 1e-5 of its distance), the triangle's plane (the segment parameter where the
- *      rays cross it, bounded over the frustum by the corner rays, outside [near, far]), the paper's
- *      corner-ray culling (all four corner rays outside one of the triangle's three edge planes through
- *      C), and the footprint: the triangle clipped to c >= near/4 and projected from C onto the light,
- *      in cells of the light's k x k strata (both shared patterns keep sample (i, j) in cell (i, j)),
- *      whose box gives the rows and columns of samples it can cover;
+ *      rays cross it, bounded over the frustum by the corner rays, outside [near, far]), the footprint:
+ *      the triangle clipped to c >= near/4 and projected from C onto the light, in cells of the light's
+ *      k x k strata (both shared patterns keep sample (i, j) in cell (i, j)), whose box cuts the
+ *      frustum's live rectangle to the rows and columns of samples it can cover (an empty cut culls the
+ *      pair), and, where there is no footprint or the cut still spans more than MFT_CORNER_AREA cells,
+ *      the paper's corner-ray culling (all four corner rays outside one of the triangle's three edge
+ *      planes through C);
  *   2. for each surviving frustum, its live rays in those rows and columns, 16 per SIMD operation (a
- *      packet: 16 consecutive samples of a row), only packets that still hold a live ray in the
- *      footprint's columns; one bit per ray: a hit clears it; a frustum with no live ray leaves the
- *      block (early termination) and the block stops when none is left;
+ *      packet: 16 consecutive samples of a row), found row by row from the live mask, only packets
+ *      that still hold a live ray there; one bit per ray: a hit clears it; a frustum with no live ray
+ *      leaves the block (early termination) and the block stops when none is left;
  *   3. after a leaf in which some ray of a frustum terminated, its corner rays are recomputed from the
  *      rectangle of its still-live samples (the paper's CR); with MS_MFT_FS its traversal bounds too
  *      (the paper's FS).
@@ -37,6 +39,9 @@
  *    footprint);
  *  - the paper culls back faces; shadows need both sides (two-sided test), so its back-face test is
  *    replaced by the plane-range test, which also drops the receiver's coplanar neighbours (t ~ 0);
+ *  - the corner-ray culling is applied after the footprint's cut and only where the cut is absent or
+ *    large: on the ogre it culled 0.7% of the pairs, nearly all of which the cut culls too, and cost
+ *    about 8% of the tracer's time (session 11, docs/methods.md);
  *  - the leaf culling (step 0) and the horizon test are ours; the paper's leaf culling (per-packet
  *    ray-AABB tests, Table 2) did not pay on Larrabee; this one tests the 16 frusta at once and removes
  *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
@@ -58,6 +63,11 @@
 
 #define MFT_REL 1e-5f
 #define MFT_MAX_SKIP MS_BLOCK_LANES
+/* Cells of a footprint-cut rectangle above which the corner rays are still tried (64: Dabrovic Sponza
+ * -5%, ogre +2%; 256 and "never" within noise of each other; measured, session 11). */
+#ifndef MFT_CORNER_AREA
+#define MFT_CORNER_AREA 256.0f
+#endif
 
 typedef struct mft_state {
     ms_block_frusta *fr;
@@ -69,6 +79,7 @@ typedef struct mft_state {
     float cl[4][MS_BLOCK_LANES];      /* their L1 norms */
     float hn[3][MS_BLOCK_LANES];      /* receiver normals */
     int rect[MS_BLOCK_LANES][4];      /* live cells: columns r[0]..r[1], rows r[2]..r[3] */
+    float rectf[4][MS_BLOCK_LANES];   /* the same as floats, by bound (the leaf's vector cut) */
     uint64_t livech[MS_BLOCK_LANES][4]; /* packets (16 samples) with a live ray, one bit each */
     float m[3][3][MS_BLOCK_LANES];    /* cell projections (ms_mft_lane.m) */
     float ml1[3][MS_BLOCK_LANES];
@@ -86,9 +97,25 @@ static inline uint64_t mft_row(const uint64_t *m, int k, int j)
     return m[bit >> 6] >> (bit & 63) & ((UINT64_C(1) << k) - 1);
 }
 
-/* The rectangle of the live samples; 0 if none. */
+/* The rectangle of the live samples; 0 if none. For k >= 16 a 64-bit word holds 64 / k whole rows:
+ * the columns from the OR of the words folded to one row, the rows from the first and last live words. */
 static int mft_live_rect(const uint64_t *m, int k, int r[4])
 {
+    if (k >= 16) {
+        const int nw = k * k / 64, rpw = 64 / k;
+        int w0 = -1, w1 = -1;
+        uint64_t acc = 0;
+        for (int w = 0; w < nw; w++)
+            if (m[w]) { if (w0 < 0) w0 = w; w1 = w; acc |= m[w]; }
+        if (w0 < 0) return 0;
+        for (int sh = 32; sh >= k; sh >>= 1) acc |= acc >> sh;
+        const uint64_t row = k == 64 ? acc : acc & ((UINT64_C(1) << k) - 1);
+        r[0] = __builtin_ctzll(row);
+        r[1] = 63 - __builtin_clzll(row);
+        r[2] = w0 * rpw + __builtin_ctzll(m[w0]) / k;
+        r[3] = w1 * rpw + (63 - __builtin_clzll(m[w1])) / k;
+        return 1;
+    }
     uint64_t any = 0;
     int j0 = -1, j1 = -1;
     for (int j = 0; j < k; j++) {
@@ -109,6 +136,7 @@ static void mft_lane_frustum(mft_state *s, int l, int traversal)
     const ms_mft_lane *L = &s->blk->lane[l];
     float d[4][3];
     ms_mft_corners(s->f, L->c, s->rect[l], d);
+    for (int q = 0; q < 4; q++) s->rectf[q][l] = (float)s->rect[l][q];
     for (int c = 0; c < 4; c++) {
         for (int a = 0; a < 3; a++) s->cd[c][a][l] = d[c][a];
         s->cl[c][l] = fabsf(d[c][0]) + fabsf(d[c][1]) + fabsf(d[c][2]);
@@ -273,13 +301,6 @@ static unsigned mft_footprint16(const mft_state *s, const l16 a[3][3], const l16
     return valid;
 }
 
-/* floor of a float in [-1, 64]. */
-static inline int mft_floor(float x)
-{
-    const int i = (int)x;
-    return i - ((float)i > x);
-}
-
 #ifndef MFT_ALPHA_FILTER
 #define MFT_ALPHA_FILTER
 /* The bits of hit (rays of packet ch of lane L that alpha-tested triangle t meets) where t is opaque. */
@@ -295,6 +316,47 @@ static unsigned mft_alpha_filter(const ms_mft_frame *f, const ms_mft_lane *L, in
 }
 #endif
 
+/* One (frustum, triangle) pair on its way through the packets it may hit. */
+typedef struct mft_pair {
+    mft_state *s;
+    ms_mft_lane *L;
+    int l;
+    uint32_t t;
+    const float *tri, *N;
+    float num;
+    int have_v, isec, cleared, done;
+    float V[3][3];                    /* the vertices relative to C, formed at the first test */
+} mft_pair;
+
+/* Tests the live rays `bits` of packet ch against the pair's triangle and clears those it blocks; sets
+ * done when the lane has no live ray left. */
+static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
+{
+    mft_state *s = pr->s;
+    ms_mft_lane *L = pr->L;
+    const ms_mft_frame *f = s->f;
+    if (!pr->have_v) {
+        for (int v = 0; v < 3; v++)
+            for (int x = 0; x < 3; x++) pr->V[v][x] = pr->tri[3 * v + x] - L->c[x];
+        pr->have_v = 1;
+    }
+    if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
+    pr->isec++;
+    unsigned hit = mft_packet(L, ch, bits, pr->tri, pr->N, (const float(*)[3])pr->V, pr->num, f->near, f->far);
+    /* Any hit: an alpha-tested triangle keeps only the rays where it is opaque (alpha.h, the decision
+     * every method shares: the segment from C to the pattern's sample point). */
+    if (hit && f->alpha && f->alpha->flag[pr->t]) hit = mft_alpha_filter(f, L, ch, pr->t, hit);
+    if (!hit) return;
+    const int sh = (ch & 3) * 16;
+    const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
+    L->mask[ch >> 2] &= ~((uint64_t)hit << sh);
+    pr->cleared = 1;
+    if (all & ~hit) return;
+    uint64_t *lc = s->livech[pr->l];
+    lc[ch >> 6] &= ~(UINT64_C(1) << (ch & 63));
+    pr->done = !(lc[0] | lc[1] | lc[2] | lc[3]);
+}
+
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
 {
     ms_block_frusta *fr = s->fr;
@@ -302,8 +364,6 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     ms_mft_block *blk = s->blk;
     uint64_t *cnt = s->bt_cnt;
     const int k = f->k, cpr = k / 16;
-    /* One bit every cpr bits. */
-    const uint64_t rep = cpr == 1 ? ~UINT64_C(0) : cpr == 2 ? UINT64_C(0x5555555555555555) : UINT64_C(0x1111111111111111);
     /* The pixels whose own triangle is in this leaf. */
     uint32_t skip_tri[MFT_MAX_SKIP];
     unsigned skip_lane[MFT_MAX_SKIP];
@@ -377,36 +437,12 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         c_plane += (uint64_t)ms_bt_popcount16(pass & plane_out);
         pass &= ~plane_out;
         if (!pass) continue;
-        /* Corner rays against the edge planes through C: a ray hits (t > 0) only inside the cone of
-         * the vertices, where every edge function (a_i x a_j) . d has the sign of det = (a0 x a1) . a2.
-         * Trusted only where |det| clears its own rounding. */
-        l16 e[3][3];
-        for (int q = 0; q < 3; q++) {
-            const l16 *x = a[q], *y = a[q == 2 ? 0 : q + 1];
-            e[q][0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1]));
-            e[q][1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2]));
-            e[q][2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0]));
-        }
-        const l16 det = l16_add(l16_add(l16_mul(e[0][0], a[2][0]), l16_mul(e[0][1], a[2][1])), l16_mul(e[0][2], a[2][2]));
-        const unsigned det_ok = l16_gt(l16_abs(det), l16_mul(l16_mul(l16_mul(la[0], la[1]), la[2]), rel));
-        const unsigned det_pos = l16_gt(det, zero);
-        unsigned corner_out = 0;
-        for (int q = 0; q < 3; q++) {
-            const l16 lq = l16_mul(l16_mul(la[q], la[q == 2 ? 0 : q + 1]), rel);
-            unsigned all = 0xFFFF;
-            for (int r = 0; r < 4; r++) {
-                const l16 ev = l16_add(l16_add(l16_mul(e[q][0], cd[r][0]), l16_mul(e[q][1], cd[r][1])), l16_mul(e[q][2], cd[r][2]));
-                const l16 tol = l16_mul(lq, cl[r]);
-                all &= (det_pos & l16_lt(l16_add(ev, tol), zero)) | (~det_pos & l16_gt(l16_sub(ev, tol), zero));
-            }
-            corner_out |= all;
-        }
-        corner_out &= det_ok;
-        c_corner += (uint64_t)ms_bt_popcount16(pass & corner_out);
-        pass &= ~corner_out;
-        if (!pass) continue;
-        float box[4][MS_BLOCK_LANES];
-        unsigned foot = 0, empty = 0;
+        /* Each surviving lane's rectangle of cells: its live rectangle, cut to the triangle's footprint,
+         * for the 16 lanes at once (floor and clamp in vector form, the box being within [-1, k]); an empty
+         * cut drops the pair before any scalar work. */
+        l16 r[4];
+        for (int q = 0; q < 4; q++) r[q] = l16_load(s->rectf[q]);
+        unsigned foot = 0;
         /* No footprint for a triangle whose plane passes within 1e-4 of its size from C (|num| is C's
          * distance from the plane times |N|): some rays graze it, and the watertight test decides its
          * edges in the plane across the ray, where such a triangle is a sliver, with an error that grows
@@ -420,84 +456,92 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         const unsigned grazing = l16_le(an, l16_mul(lamax, l16_set1(nl1 * 1e-4f)));
         const unsigned foot_lanes = pass & s->has_m & ~grazing;
         if (!(f->flags & MS_MFT_NO_FOOTPRINT) && foot_lanes) {
+            float box[4][MS_BLOCK_LANES];
+            unsigned empty = 0;
             foot = mft_footprint16(s, a, la, foot_lanes, &empty, box);
-            c_foot += (uint64_t)ms_bt_popcount16(empty);
-            pass &= ~empty;
+            for (int q = 0; q < 4; q += 2) {
+                const l16 lo = l16_floor(l16_load(box[q])), hi = l16_floor(l16_load(box[q + 1]));
+                r[q] = l16_select(foot, l16_max(lo, r[q]), r[q]);
+                r[q + 1] = l16_select(foot, l16_min(hi, r[q + 1]), r[q + 1]);
+            }
+            const unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
+            c_foot += (uint64_t)ms_bt_popcount16(pass & out);
+            pass &= ~out;
         }
+        /* Corner rays against the edge planes through C, for the lanes without a footprint only (with
+         * one, the cut above culls nearly every pair this test would: measured, docs/methods.md, session
+         * 11): a ray hits (t > 0) only inside the cone of the vertices, where every edge function
+         * (a_i x a_j) . d has the sign of det = (a0 x a1) . a2. Trusted only where |det| clears its own
+         * rounding. */
+        const l16 one_f = l16_set1(1.0f);
+        const l16 area = l16_mul(l16_add(l16_sub(r[1], r[0]), one_f), l16_add(l16_sub(r[3], r[2]), one_f));
+        const unsigned corner_lanes = pass & (~foot | l16_gt(area, l16_set1(MFT_CORNER_AREA)));
+        if (corner_lanes) {
+            l16 e[3][3];
+            for (int q = 0; q < 3; q++) {
+                const l16 *x = a[q], *y = a[q == 2 ? 0 : q + 1];
+                e[q][0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1]));
+                e[q][1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2]));
+                e[q][2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0]));
+            }
+            const l16 det = l16_add(l16_add(l16_mul(e[0][0], a[2][0]), l16_mul(e[0][1], a[2][1])), l16_mul(e[0][2], a[2][2]));
+            const unsigned det_ok = l16_gt(l16_abs(det), l16_mul(l16_mul(l16_mul(la[0], la[1]), la[2]), rel));
+            const unsigned det_pos = l16_gt(det, zero);
+            unsigned corner_out = 0;
+            for (int q = 0; q < 3; q++) {
+                const l16 lq = l16_mul(l16_mul(la[q], la[q == 2 ? 0 : q + 1]), rel);
+                unsigned all = 0xFFFF;
+                for (int c4 = 0; c4 < 4; c4++) {
+                    const l16 ev = l16_add(l16_add(l16_mul(e[q][0], cd[c4][0]), l16_mul(e[q][1], cd[c4][1])),
+                                           l16_mul(e[q][2], cd[c4][2]));
+                    const l16 tol = l16_mul(lq, cl[c4]);
+                    all &= (det_pos & l16_lt(l16_add(ev, tol), zero)) | (~det_pos & l16_gt(l16_sub(ev, tol), zero));
+                }
+                corner_out |= all;
+            }
+            corner_out &= det_ok & corner_lanes;
+            c_corner += (uint64_t)ms_bt_popcount16(pass & corner_out);
+            pass &= ~corner_out;
+        }
+        if (!pass) continue;
         float numv[MS_BLOCK_LANES];
         l16_store(numv, num);
+        int32_t rc[4][MS_BLOCK_LANES];
+        for (int q = 0; q < 4; q++) l16_store_int(rc[q], r[q]);
+        tested += (uint64_t)ms_bt_popcount16(pass);
         for (; pass; pass &= pass - 1) {
             const int l = __builtin_ctz(pass);
             ms_mft_lane *L = &blk->lane[l];
-            int x0 = s->rect[l][0], x1 = s->rect[l][1], y0 = s->rect[l][2], y1 = s->rect[l][3];
-            if (foot >> l & 1) {
-                const int fx0 = mft_floor(box[0][l]), fx1 = mft_floor(box[1][l]);
-                const int fy0 = mft_floor(box[2][l]), fy1 = mft_floor(box[3][l]);
-                x0 = fx0 > x0 ? fx0 : x0; x1 = fx1 < x1 ? fx1 : x1;
-                y0 = fy0 > y0 ? fy0 : y0; y1 = fy1 < y1 ? fy1 : y1;
-                if (x0 > x1 || y0 > y1) { c_foot++; continue; }
-            }
-            tested++;
-            float V[3][3];
-            for (int v = 0; v < 3; v++)
-                for (int x = 0; x < 3; x++) V[v][x] = tri[3 * v + x] - L->c[x];
-            /* The live packets of rows y0..y1 that reach columns x0..x1, with the packet's samples there. */
-            int nc = 0, cand[256];
-            unsigned ccols[256];
+            const int x0 = rc[0][l], x1 = rc[1][l], y0 = rc[2][l], y1 = rc[3][l];
+            mft_pair pr = { .s = s, .L = L, .l = l, .t = t, .tri = tri, .N = N, .num = numv[l] };
             if (k >= 16) {
-                /* A row is cpr packets, so the packets of the columns repeat every cpr bits. */
-                const uint64_t rowpat = ((UINT64_C(2) << (x1 >> 4)) - 1) & ~((UINT64_C(1) << (x0 >> 4)) - 1);
-                const uint64_t colpat = rowpat * rep;
-                const int c_lo = y0 * cpr, c_hi = (y1 + 1) * cpr;
-                for (int w = c_lo >> 6; w <= (c_hi - 1) >> 6; w++) {
-                    uint64_t m = s->livech[l][w] & colpat;
-                    const int lo = c_lo - 64 * w, hi = c_hi - 64 * w;
-                    if (lo > 0) m &= ~UINT64_C(0) << lo;
-                    if (hi < 64) m &= (UINT64_C(1) << hi) - 1;
-                    for (; m; m &= m - 1) {
-                        const int ch = 64 * w + __builtin_ctzll(m), col0 = (ch & (cpr - 1)) * 16;
-                        const int clo = (x0 > col0 ? x0 : col0) - col0, chi = (x1 < col0 + 15 ? x1 : col0 + 15) - col0;
-                        cand[nc] = ch;
-                        ccols[nc++] = (0xFFFFu >> (15 - (chi - clo))) << clo;
+                /* Row by row, the live rays of columns x0..x1, one test per 16-sample packet that holds any. */
+                const uint64_t cols = ((UINT64_C(2) << x1) - 1) & ~((UINT64_C(1) << x0) - 1);
+                for (int y = y0; y <= y1 && !pr.done; y++)
+                    for (uint64_t row = mft_row(L->mask, k, y) & cols; row;) {
+                        const int p = __builtin_ctzll(row) >> 4;
+                        const unsigned bits = (unsigned)(row >> 16 * p) & 0xFFFFu;
+                        row &= ~(UINT64_C(0xFFFF) << 16 * p);
+                        mft_pair_packet(&pr, y * cpr + p, bits);
                     }
-                }
             } else {
-                /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (The loop above took k / 16 = 0
-                 * packets per row and tested no ray at all: mft answered the front mask; the known bug of
+                /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (An earlier loop took k / 16 =
+                 * 0 packets per row and tested no ray at all: mft answered the front mask; the known bug of
                  * test_visibility.) */
                 const int rpp = 16 / k;
                 const unsigned rowcols = ((1u << (x1 - x0 + 1)) - 1u) << x0;
                 for (int ch = y0 / rpp; ch <= y1 / rpp; ch++) {
-                    if (!(s->livech[l][0] >> ch & 1)) continue;
                     unsigned cols = 0;
                     for (int r = 0; r < rpp; r++)
                         if (ch * rpp + r >= y0 && ch * rpp + r <= y1) cols |= rowcols << (r * k);
-                    cand[nc] = ch;
-                    ccols[nc++] = cols;
+                    const unsigned bits = (unsigned)(L->mask[ch >> 2] >> (ch & 3) * 16) & cols;
+                    if (bits) mft_pair_packet(&pr, ch, bits);
                 }
             }
-            int cleared = 0, done = 0;
-            for (int ci = 0; ci < nc; ci++) {
-                const int ch = cand[ci], w = ch >> 6, sh = (ch & 3) * 16;
-                const unsigned all = (unsigned)(L->mask[ch >> 2] >> sh) & 0xFFFFu;
-                const unsigned bits = all & ccols[ci];
-                if (!bits) continue;
-                if (!(L->ready[ch >> 6] >> (ch & 63) & 1)) ms_mft_rays(f, L, ch);
-                isec++;
-                unsigned hit = mft_packet(L, ch, bits, tri, N, V, numv[l], f->near, f->far);
-                /* Any hit: an alpha-tested triangle keeps only the rays where it is opaque (alpha.h, the
-                 * decision every method shares: the segment from C to the pattern's sample point). */
-                if (hit && f->alpha && f->alpha->flag[t]) hit = mft_alpha_filter(f, L, ch, t, hit);
-                if (!hit) continue;
-                L->mask[ch >> 2] &= ~((uint64_t)hit << sh);
-                cleared = 1;
-                if (all & ~hit) continue;
-                s->livech[l][w] &= ~(UINT64_C(1) << (ch & 63));
-                done = !(s->livech[l][0] | s->livech[l][1] | s->livech[l][2] | s->livech[l][3]);
-            }
-            if (!cleared) continue;
+            isec += (uint64_t)pr.isec;
+            if (!pr.cleared) continue;
             terminated |= 1u << l;
-            if (done) { fr->live &= ~(1u << l); early++; }
+            if (pr.done) { fr->live &= ~(1u << l); early++; }
         }
     }
     cnt[MS_MFT_PAIRS] += pairs;
