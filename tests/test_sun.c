@@ -372,9 +372,7 @@ static void test_cull_grazing(void **st)
     for (int mi = 0; names[mi]; mi++) {
         o.method = names[mi];
         tu_render_ok(&sc, &o, &fr);
-        long differ = 0;
-        for (int i = 0; i < 64 * 16; i++)
-            differ += fr.vis[i] != ref.vis[i] || fr.shadow[i] != ref.shadow[i] || fr.front[i] != ref.front[i];
+        const long differ = tu_frame_values_differ(&fr, &ref);
         if (!strcmp(names[mi], "scanline")) {
             printf("sun grazing a box's face: %d of %d pixels in penumbra, %d in umbra; scanline culled %llu triangles\n",
                    partial, 64 * 16, dark, (unsigned long long)fr.stats.occluders_culled);
