@@ -73,7 +73,7 @@ int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
      * every method (which starts from or traces only the front mask) honours the shape unchanged. The grid's
      * disk in vector lanes (disk_mask.h): every instance gives the same mask; the context's cap picks one, so
      * that a capped run (the scalar test suite) runs the portable one. */
-    if (ctx->pattern == MS_PATTERN_GRID && ctx->light.shape == MS_LIGHT_DISK) {
+    if (ctx->pattern == MS_PATTERN_GRID && ctx->light.shape == MS_LIGHT_DISK && ctx->k % 16 == 0 && ctx->k <= 64) {   /* its rows: 16-lane chunks */
         float u, v;
         ms_grid_shift(q->px, q->py, ctx->seed, &u, &v);
         switch (ms_isa_select(ctx->isa_cap, MS_ISA_ALL)) {
