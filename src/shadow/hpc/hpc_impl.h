@@ -1359,8 +1359,9 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         memcpy(sh.grid_dt, g0.dt, sizeof sh.grid_dt);
         sh.p0 = malloc((size_t)nlive * 4 * sizeof *sh.p0);
         int same = sh.p0 != NULL;
+        const size_t n_origins = sh.p0 ? nlive : 0;   /* the bound apart from the reduction's variable (TSan) */
 #pragma omp parallel for schedule(static) num_threads(threads) reduction(& : same)
-        for (size_t r = 0; r < (same ? nlive : 0); r++) {
+        for (size_t r = 0; r < n_origins; r++) {
             ms_grid g;
             ms_grid_for_pixel(&ctx->light, k, sh.q[r].px, sh.q[r].py, ctx->seed, &g);
             memcpy(sh.p0 + 4 * r, g.p0, sizeof g.p0);
