@@ -388,21 +388,11 @@ static void test_punctual(void **st)
     o.width = o.height = 24;
     o.samples = 256;
     o.threads = 2;
-    ms_frame ref, f;
-    o.method = "raytrace";
-    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
-    const char *const *names = ms_method_names();
+    ms_frame ref;
+    tu_every_method_as_raytrace(&sc, &o, "punctual lights", &ref, NULL, NULL);
     long lit = 0;
     for (int i = 0; i < 2 * 24 * 24; i++) lit += ref.vis[i] > 0.0f;   /* the sun (light 2) is outside the box */
     assert_true(lit > 24 * 24 / 2);
-    for (int mi = 0; names[mi]; mi++) {
-        o.method = names[mi];
-        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        const long differ = tu_frame_values_differ(&f, &ref);
-        if (differ) fprintf(stderr, "punctual lights, method %s: %ld values differ from raytrace\n", names[mi], differ);
-        assert_int_equal(differ, 0);
-        ms_frame_free(&f);
-    }
     ms_frame_free(&ref);
     ms_scene_free(&sc);
     /* the CLI: one warning line for the spot's cone, none for the directional light */

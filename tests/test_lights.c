@@ -212,17 +212,7 @@ static void test_disk_frames_equal(void **st)
     o.threads = 2;
     char err[256];
     ms_frame ref, f;
-    o.method = "raytrace";
-    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
-    const char *const *names = ms_method_names();
-    for (int mi = 0; names[mi]; mi++) {
-        o.method = names[mi];
-        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        const long differ = tu_frame_values_differ(&f, &ref);
-        if (differ) fprintf(stderr, "disk frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
-        assert_int_equal(differ, 0);
-        ms_frame_free(&f);
-    }
+    tu_every_method_as_raytrace(&sc, &o, "disk frame", &ref, NULL, NULL);
     /* The same square as a parallelogram: more samples in front. */
     sc.light.shape = MS_LIGHT_RECT;
     o.method = "raytrace";
@@ -752,19 +742,8 @@ static void test_textured_rect(void **st)
     tu_render_options_default(&o);
     o.width = o.height = 32;
     o.threads = 2;
-    ms_frame ref, f;
-    o.method = "raytrace";
-    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
-    const char *const *names = ms_method_names();
-    for (int mi = 0; names[mi]; mi++) {
-        o.method = names[mi];
-        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        for (int i = 0; i < 32 * 32; i++) {
-            assert_true(f.vis[i] == ref.vis[i]);
-            assert_true(f.shadow[i] == ref.shadow[i]);
-        }
-        ms_frame_free(&f);
-    }
+    ms_frame ref;
+    tu_every_method_as_raytrace(&sc, &o, "textured rect frame", &ref, NULL, NULL);
     /* The shading's texture factor: E_unshadowed of the whole rect times the weighted mean texel, against
      * the exact irradiance of the right half alone (the polygon formula), at every receiver of the small
      * frame above; the ratio estimator's error shrinks with N (measured here at N = 1024). */
@@ -905,18 +884,8 @@ static void test_sphere_every_method(void **st)
     o.width = o.height = size;
     o.threads = 2;
     char err[256];
-    ms_frame ref, f;
-    o.method = "raytrace";
-    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
-    const char *const *names = ms_method_names();
-    for (int mi = 0; names[mi]; mi++) {
-        o.method = names[mi];
-        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        const long differ = tu_frame_values_differ(&f, &ref);
-        if (differ) fprintf(stderr, "sphere frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
-        assert_int_equal(differ, 0);
-        ms_frame_free(&f);
-    }
+    ms_frame ref;
+    tu_every_method_as_raytrace(&sc, &o, "sphere frame", &ref, NULL, NULL);
     /* brute force at each pixel */
     ms_bvh bvh;
     assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
@@ -999,17 +968,7 @@ static void test_triangle_frames_equal(void **st)
     o.threads = 2;
     char err[256];
     ms_frame ref, f;
-    o.method = "raytrace";
-    assert_int_equal(ms_render(&sc, &o, &ref, err, sizeof err), 0);
-    const char *const *names = ms_method_names();
-    for (int mi = 0; names[mi]; mi++) {
-        o.method = names[mi];
-        assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
-        const long differ = tu_frame_values_differ(&f, &ref);
-        if (differ) fprintf(stderr, "triangle frame, method %s: %ld pixels differ from raytrace\n", names[mi], differ);
-        assert_int_equal(differ, 0);
-        ms_frame_free(&f);
-    }
+    tu_every_method_as_raytrace(&sc, &o, "triangle frame", &ref, NULL, NULL);
     sc.light.shape = MS_LIGHT_RECT;
     assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
     double tri_front = 0.0, rect_front = 0.0;

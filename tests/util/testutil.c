@@ -421,6 +421,22 @@ void tu_render_ok(const ms_scene *sc, const ms_render_options *o, ms_frame *f)
     if (ms_render(sc, o, f, err, sizeof err)) fail_msg("ms_render(%s): %s", o->method ? o->method : MS_DEFAULT_METHOD, err);
 }
 
+void tu_every_method_as_raytrace(const ms_scene *sc, ms_render_options *o, const char *what, ms_frame *ref,
+                                 tu_method_check check, void *user)
+{
+    o->method = "raytrace";
+    tu_render_ok(sc, o, ref);
+    for (const char *const *m = ms_method_names(); *m; m++) {
+        ms_frame f;
+        o->method = *m;
+        tu_render_ok(sc, o, &f);
+        const long differ = tu_frame_values_differ(&f, ref);
+        if (differ) fail_msg("%s, method %s: %ld values differ from raytrace", what, *m, differ);
+        if (check) check(*m, &f, ref, user);
+        ms_frame_free(&f);
+    }
+}
+
 float *tu_render_vis(const ms_scene *sc, const ms_render_options *o, ms_stats *stats)
 {
     ms_frame f;

@@ -108,6 +108,14 @@ static inline uint64_t tu_rng_next(tu_rng *r)
 
 /* ms_render with o into f, failing the test with its message. */
 void tu_render_ok(const ms_scene *sc, const ms_render_options *o, ms_frame *f);
+/* Every method against raytrace on one scene: renders sc with o and method raytrace into *ref (the caller
+ * ms_frame_frees it), then with each method of ms_method_names() in turn, and fails the test (naming `what`,
+ * the method and the count) unless every light's V, S and front count equal raytrace's at every pixel.
+ * `check`, when not NULL, sees each method's frame before it is freed (per-method assertions: counters,
+ * stats). o->method is left at the last method. */
+typedef void (*tu_method_check)(const char *method, const ms_frame *f, const ms_frame *ref, void *user);
+void tu_every_method_as_raytrace(const ms_scene *sc, ms_render_options *o, const char *what, ms_frame *ref,
+                                 tu_method_check check, void *user);
 /* ms_render with o, returning a copy of the frame's V (width x height floats; the caller frees it) and its
  * stats into *stats (NULL: not wanted); the frame itself freed. */
 float *tu_render_vis(const ms_scene *sc, const ms_render_options *o, ms_stats *stats);
