@@ -304,7 +304,13 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
      * sets with one sample per cell (all of them: pattern.c's sets are nets). */
     float *cell_pts = malloc((size_t)ncell * 3 * 16 * sizeof *cell_pts);
     uint16_t *sample_of = malloc((size_t)16 * ncell * sizeof *sample_of);
-    if (!cell_pts || !sample_of) { free(rb.g); free(next); free(scratch); free(cell_pts); free(sample_of); return -1; }
+    float *cell_box = malloc((size_t)ncell * 6 * sizeof *cell_box);   /* per cell: its points' box, lo xyz hi xyz */
+    if (!cell_pts || !sample_of || !cell_box) {
+        free(rb.g); free(next); free(scratch); free(cell_pts); free(sample_of); free(cell_box);
+        return -1;
+    }
+    for (int c = 0; c < ncell; c++)
+        for (int a = 0; a < 3; a++) { cell_box[6 * c + a] = INFINITY; cell_box[6 * c + 3 + a] = -INFINITY; }
     unsigned regular = 0;
     for (int g = 0; g < nq;) {
         const int end = ms_block_group_end(ctx, q, order, nq, g);
@@ -327,19 +333,27 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
                 ok &= !(seen[c >> 5] >> (c & 31) & 1u);
                 seen[c >> 5] |= 1u << (c & 31);
                 sample_of[(size_t)set * ncell + c] = (uint16_t)j;
-                for (int a = 0; a < 3; a++) cell_pts[((size_t)c * 3 + a) * 16 + set] = set_pts[(size_t)set * 3 * n + 3 * j + a];
+                for (int a = 0; a < 3; a++) {
+                    const float x = set_pts[(size_t)set * 3 * n + 3 * j + a];
+                    cell_pts[((size_t)c * 3 + a) * 16 + set] = x;
+                    cell_box[6 * c + a] = x < cell_box[6 * c + a] ? x : cell_box[6 * c + a];
+                    cell_box[6 * c + 3 + a] = x > cell_box[6 * c + 3 + a] ? x : cell_box[6 * c + 3 + a];
+                }
             }
             have_set |= 1u << set;
             regular |= (unsigned)ok << set;
         }
         if (!dup && (sets & ~regular) == 0 && ncell == n) {
-            if (mft_block_by_set(q, order, g, end, front, vis, mw, n, ncell, cell_pts, sample_of, set_cell, &rb))
+            if (mft_block_by_set(q, order, g, end, front, vis, mw, n, ncell, cell_pts, sample_of, set_cell, &rb)) {
+                rb.cell_box = cell_box;   /* every set of the block is formed: the boxes hold its points */
                 s->groups(f, &rb, ctx->bvh, &s->sh, cnt);
+            }
             g = end;
             continue;
         }
         rb.nq = 0;
         rb.n = ncell;
+        rb.cell_box = NULL;
         memset(rb.g, 0, (size_t)ncell * sizeof *rb.g);
         for (int c = 0; c < ncell; c++) next[c] = -1;
         for (int e = g; e < end; e++) {
@@ -373,7 +387,7 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
                                 int *nn = ng ? realloc(next, (size_t)cap * sizeof *nn) : NULL;
                                 if (ng) rb.g = ng;
                                 if (nn) next = nn;
-                                if (!ng || !nn) { free(rb.g); free(next); free(scratch); return -1; }
+                                if (!ng || !nn) { free(rb.g); free(next); free(scratch); free(cell_pts); free(sample_of); free(cell_box); return -1; }
                                 rb.cap = cap;
                             }
                             memset(&rb.g[rb.n], 0, sizeof *rb.g);
@@ -406,6 +420,7 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
     free(scratch);
     free(cell_pts);
     free(sample_of);
+    free(cell_box);
     return 0;
 }
 

@@ -88,6 +88,21 @@ static inline unsigned mftg_ray_box(const mftg_state *s, const ms_mft_group *g, 
     return l16_le(t0, l16_mul(t1, l16_set1(MS_WT_FAR_SCALE))) & g->live;
 }
 
+/* Lane l's frustum from the box of its origins and the box of its points. */
+static void mftg_lane_set(mftg_state *s, int l, const float clo[3], const float chi[3], const float plo[3], const float phi[3])
+{
+    float mag = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        s->oc[a][l] = 0.5f * (clo[a] + chi[a]);
+        s->oh[a][l] = 0.5f * (chi[a] - clo[a]);
+        s->pc[a][l] = 0.5f * (plo[a] + phi[a]);
+        s->ph[a][l] = 0.5f * (phi[a] - plo[a]);
+        for (int e = 0; e < 4; e++) { const float x = fabsf(e == 0 ? clo[a] : e == 1 ? chi[a] : e == 2 ? plo[a] : phi[a]); mag = x > mag ? x : mag; }
+    }
+    s->mag[l] = mag;
+    ms_block_frusta_set_lane_box(s->fr, l, clo, chi, plo, phi, MFTG_REL);
+}
+
 /* Lane l's frustum from its group's live rays. */
 static void mftg_lane_bounds(mftg_state *s, int l)
 {
@@ -105,16 +120,7 @@ static void mftg_lane_bounds(mftg_state *s, int l)
             phi[a] = p > phi[a] ? p : phi[a];
         }
     }
-    float mag = 0.0f;
-    for (int a = 0; a < 3; a++) {
-        s->oc[a][l] = 0.5f * (clo[a] + chi[a]);
-        s->oh[a][l] = 0.5f * (chi[a] - clo[a]);
-        s->pc[a][l] = 0.5f * (plo[a] + phi[a]);
-        s->ph[a][l] = 0.5f * (phi[a] - plo[a]);
-        for (int e = 0; e < 4; e++) { const float x = fabsf(e == 0 ? clo[a] : e == 1 ? chi[a] : e == 2 ? plo[a] : phi[a]); mag = x > mag ? x : mag; }
-    }
-    s->mag[l] = mag;
-    ms_block_frusta_set_lane_box(s->fr, l, clo, chi, plo, phi, MFTG_REL);
+    mftg_lane_set(s, l, clo, chi, plo, phi);
 }
 
 #define BT_STATE mftg_state
@@ -488,13 +494,29 @@ void MS_CAT(ms_mft_groups_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_raybloc
         ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, c, lo, hi);
         for (int a = 0; a < 3; a++) { s.olo[a][q] = lo[a]; s.ohi[a][q] = hi[a]; }
     }
+    /* The box of the present receivers: with the cell's box of points, the starting frustum of every group
+     * whose present slots are all live (most of them), without a pass over its rays. Departure from a
+     * box of the live rays only (the paper's frustum of its rays): the cell's box holds the points of all
+     * 16 sets, so it is at most the cell of the light, and a conservative bound of the group's points. */
+    float blo[3] = { INFINITY, INFINITY, INFINITY }, bhi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (unsigned m = rb->present; m; m &= m - 1) {
+        const int q = __builtin_ctz(m);
+        for (int a = 0; a < 3; a++) {
+            blo[a] = rb->c[a][q] < blo[a] ? rb->c[a][q] : blo[a];
+            bhi[a] = rb->c[a][q] > bhi[a] ? rb->c[a][q] : bhi[a];
+        }
+    }
     for (int g0 = 0; g0 < rb->n; g0 += MS_BLOCK_LANES) {
         ms_block_frusta_init(&fr, &sh->nodes[0], f->near, f->far);
         memset(s.grp, 0, sizeof s.grp);
         for (int l = 0; l < MS_BLOCK_LANES && g0 + l < rb->n; l++) {
             s.grp[l] = &rb->g[g0 + l];
             if (!s.grp[l]->live) continue;
-            mftg_lane_bounds(&s, l);
+            if (rb->cell_box && s.grp[l]->live == rb->present) {
+                const float *cb = rb->cell_box + 6 * (size_t)(g0 + l);
+                mftg_lane_set(&s, l, blo, bhi, cb, cb + 3);
+            } else
+                mftg_lane_bounds(&s, l);
             cnt[MS_MFT_FRUSTA]++;
         }
         if (fr.live) mftg_traverse(&s, sh, f->flags & MS_MFT_ORDER);
