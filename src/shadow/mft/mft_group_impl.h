@@ -451,20 +451,42 @@ static void mftg_form(ms_mft_rayblock *rb)
             kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, &k0);
         }
     }
+    /* n = 16 (256 samples): a slot's 16 samples are one packet, so every group has the slots' axes; they
+     * are found once, and each group's common axis from its live slots by masks. */
+    signed char kq[16];
+    unsigned a1 = 0, a2 = 0, alone = 0;
+    if (n == 16)
+        for (int q = 0; q < 16; q++) {
+            const int k = (rb->present >> q & 1) ? kz[q][0] : 0;
+            kq[q] = (signed char)k;
+            alone |= (unsigned)(k < 0) << q;
+            a1 |= (unsigned)(k == 1) << q;
+            a2 |= (unsigned)(k == 2) << q;
+        }
+    const unsigned a0 = 0xFFFFu & ~(alone | a1 | a2);
     for (int c = 0; c < ncell; c++) {
         ms_mft_group *G = &rb->g[c];
         unsigned k1 = 0, k2 = 0;
-        int kall = -2;
-        G->alone = 0;
-        for (int q = 0; q < 16; q++) {
-            const int k = (rb->present >> q & 1) ? kz[q][G->sample[q] >> 4] : 0;
-            G->kz[q] = (signed char)k;
-            G->alone |= (unsigned)(k < 0) << q;
-            k1 |= (unsigned)(k == 1) << q;
-            k2 |= (unsigned)(k == 2) << q;
-            if ((G->live >> q & 1) && k >= 0) kall = kall == -2 || kall == k ? k : -1;
+        if (n == 16) {
+            memcpy(G->kz, kq, sizeof kq);
+            G->alone = alone;
+            k1 = a1;
+            k2 = a2;
+            const unsigned lv = G->live & ~alone;
+            G->kz_all = !lv || (lv & a0) == lv ? 0 : (lv & a1) == lv ? 1 : (lv & a2) == lv ? 2 : -1;
+        } else {
+            int kall = -2;
+            G->alone = 0;
+            for (int q = 0; q < 16; q++) {
+                const int k = (rb->present >> q & 1) ? kz[q][G->sample[q] >> 4] : 0;
+                G->kz[q] = (signed char)k;
+                G->alone |= (unsigned)(k < 0) << q;
+                k1 |= (unsigned)(k == 1) << q;
+                k2 |= (unsigned)(k == 2) << q;
+                if ((G->live >> q & 1) && k >= 0) kall = kall == -2 || kall == k ? k : -1;
+            }
+            G->kz_all = kall < 0 ? (kall == -2 ? 0 : -1) : kall;
         }
-        G->kz_all = kall < 0 ? (kall == -2 ? 0 : -1) : kall;
         /* kz = 0: (kx, ky) = (1, 2); 1: (2, 0); 2: (0, 1); a slot without an axis (tested alone) takes 0's. */
         l16 d[3], inv[3];
         for (int a = 0; a < 3; a++) { d[a] = l16_load(G->d[a]); inv[a] = l16_load(G->inv[a]); }
