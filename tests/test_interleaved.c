@@ -166,15 +166,23 @@ static void test_filter(void **st)
     for (int kind = 0; kind < 4; kind++) {
         ms_hit h[FW * FH];
         uint16_t front[FW * FH];
-        float v[FW * FH], s[FW * FH], v1[FW * FH], s1[FW * FH];
+        float v[FW * FH], s[FW * FH], v1[FW * FH], s1[FW * FH], sp[FW * FH], sp1[FW * FH], v2[FW * FH], s2[FW * FH];
         filter_frame(kind, h, front, v, s, &rng);
+        for (int i = 0; i < FW * FH; i++) sp[i] = s[i] < 0.0f ? s[i] : (float)(tu_rng_next(&rng) % 1000) / 999.0f;   /* S_spec */
         memcpy(v1, v, sizeof v);
         memcpy(s1, s, sizeof s);
-        assert_int_equal(ms_interleave_filter(FW, FH, h, front, v1, s1, 2), 0);
+        memcpy(sp1, sp, sizeof sp);
+        memcpy(v2, v, sizeof v);
+        memcpy(s2, s, sizeof s);
+        assert_int_equal(ms_interleave_filter(FW, FH, h, front, v1, s1, sp1, 2), 0);
+        /* without S_spec: V and S bit for bit as with it (one pass filters the three) */
+        assert_int_equal(ms_interleave_filter(FW, FH, h, front, v2, s2, NULL, 1), 0);
+        assert_memory_equal(v1, v2, sizeof v1);
+        assert_memory_equal(s1, s2, sizeof s1);
         for (int y = 0; y < FH; y++)
             for (int x = 0; x < FW; x++) {
                 const int i = y * FW + x, right = x >= FW / 2;
-                double wv = 0, ws = 0, w = 0;
+                double wv = 0, ws = 0, wsp = 0, w = 0;
                 for (int dy = -2; dy <= 2; dy++)
                     for (int dx = -2; dx <= 2; dx++) {
                         const int xx = x + dx, yy = y + dy, j = yy * FW + xx;
@@ -183,12 +191,13 @@ static void test_filter(void **st)
                         /* a tilted normal on the points of y = 0: only the neighbours along z are in its plane */
                         if (kind == 2 && right && dx != 0) continue;
                         const double t = (dx == -2 || dx == 2 ? 0.5 : 1.0) * (dy == -2 || dy == 2 ? 0.5 : 1.0) * front[j];
-                        w += t; wv += t * v[j]; ws += t * s[j];
+                        w += t; wv += t * v[j]; ws += t * s[j]; wsp += t * sp[j];
                     }
-                double ev = w > 0 ? wv / w : v[i], es = w > 0 ? ws / w : s[i];
-                if (!front[i]) ev = es = v[i];           /* misses and pixels with nothing in front stay */
-                if (fabs(v1[i] - ev) > 1e-5 || fabs(s1[i] - es) > 1e-5)
-                    fail_msg("kind %d pixel (%d,%d): filtered V %.6f S %.6f, expected %.6f %.6f", kind, x, y, v1[i], s1[i], ev, es);
+                double ev = w > 0 ? wv / w : v[i], es = w > 0 ? ws / w : s[i], esp = w > 0 ? wsp / w : sp[i];
+                if (!front[i]) { ev = es = v[i]; esp = sp[i]; }   /* misses and pixels with nothing in front stay */
+                if (fabs(v1[i] - ev) > 1e-5 || fabs(s1[i] - es) > 1e-5 || fabs(sp1[i] - esp) > 1e-5)
+                    fail_msg("kind %d pixel (%d,%d): filtered V %.6f S %.6f S_spec %.6f, expected %.6f %.6f %.6f", kind, x, y,
+                             v1[i], s1[i], sp1[i], ev, es, esp);
             }
     }
 }

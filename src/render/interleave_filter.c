@@ -38,23 +38,29 @@
 static float tap(int d) { return d == -2 || d == 2 ? 0.5f : 1.0f; }
 
 int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front, float *vis, float *shadow,
-                         int threads)
+                         float *spec, int threads)
 {
     const size_t npix = (size_t)W * H;
     float *v0 = malloc(npix * sizeof *v0), *s0 = malloc(npix * sizeof *s0);
-    if (!v0 || !s0) { free(v0); free(s0); return -1; }
+    float *sp0 = spec ? malloc(npix * sizeof *sp0) : NULL;
+    if (!v0 || !s0 || (spec && !sp0)) { free(v0); free(s0); free(sp0); return -1; }
     memcpy(v0, vis, npix * sizeof *v0);
     memcpy(s0, shadow, npix * sizeof *s0);
-    ms_interleave_filter_rows(W, H, hits, front, v0, s0, 0, H, 0, H, vis, shadow, threads);
+    if (spec) memcpy(sp0, spec, npix * sizeof *sp0);
+    ms_interleave_filter_rows(W, H, hits, front, v0, s0, sp0, 0, H, 0, H, vis, shadow, spec, threads);
     free(v0);
     free(s0);
+    free(sp0);
     return 0;
 }
 
 void ms_interleave_filter_rows(int W, int H, const ms_hit *hits, const uint16_t *front, const float *v0, const float *s0,
-                               int wy0, int wrows, int a, int b, float *vis, float *shadow, int threads)
+                               const float *sp0, int wy0, int wrows, int a, int b, float *vis, float *shadow, float *spec,
+                               int threads)
 {
     (void)wrows;   /* the caller's promise: rows a - 2 .. b + 1 of the frame are in the window */
+    /* S_spec (sp0 -> spec) takes the same weights as V and S, in the same pass: the weights depend on the
+     * hits and the front counts only, and the sums are formed in the same order as a pass of its own. */
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int y = a; y < b; y++)
         for (int x = 0; x < W; x++) {
@@ -64,8 +70,9 @@ void ms_interleave_filter_rows(int W, int H, const ms_hit *hits, const uint16_t 
              * neighbours (facets of a curved surface, within the normal tolerance) see. A miss stays -1. */
             if (vis) vis[o] = v0[i];
             shadow[o] = s0[i];
+            if (spec) spec[o] = sp0[i];
             if (c->prim == UINT32_MAX || !front[i]) continue;
-            float wsum = 0.0f, vsum = 0.0f, ssum = 0.0f;
+            float wsum = 0.0f, vsum = 0.0f, ssum = 0.0f, spsum = 0.0f;
             for (int dy = -2; dy <= 2; dy++) {
                 const int yy = y + dy;
                 if (yy < 0 || yy >= H) continue;
@@ -84,11 +91,13 @@ void ms_interleave_filter_rows(int W, int H, const ms_hit *hits, const uint16_t 
                     wsum += w;
                     vsum += w * v0[j];
                     ssum += w * s0[j];
+                    if (spec) spsum += w * sp0[j];
                 }
             }
             if (wsum > 0.0f) {
                 if (vis) vis[o] = vsum / wsum;
                 shadow[o] = ssum / wsum;
+                if (spec) spec[o] = spsum / wsum;
             }
         }
 }
