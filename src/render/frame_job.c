@@ -947,11 +947,13 @@ int ms_frame_job_band_take(ms_frame_job *j, ms_frame *band, int *y0, float *lum,
     if (j->band_filter) {
         const size_t cap = (size_t)W * (size_t)j->rows_held, bn = (size_t)W * (size_t)(b - a);
         const double tf = omp_get_wtime();
-        for (size_t l = 0; l < j->nlights; l++) {
-            ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow + l * cap,
-                                      f->shadow_spec + l * cap, j->y_base, j->rows_held, a, b, j->band_vis + l * bn,
-                                      j->band_shadow + l * bn, j->band_spec + l * bn, j->threads);
-        }
+        for (size_t l = 0; l < j->nlights; l++)
+            if (ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow + l * cap,
+                                          f->shadow_spec + l * cap, j->y_base, j->rows_held, a, b, j->band_vis + l * bn,
+                                          j->band_shadow + l * bn, j->band_spec + l * bn, j->threads)) {
+                snprintf(err, errlen, "out of memory for the interleaved filter of a %d-pixel-wide band", W);
+                return -1;
+            }
         const double dt = omp_get_wtime() - tf;
         f->stats.filter_s += dt;
         f->stats.shadow_s += dt;
