@@ -18,8 +18,8 @@
  *      (raytrace_impl.h, packet_triangle) with each ray's own shear axis (its pixel's packet's) and
  *      shear, operation for operation, so every ray gets raytrace's answer; one bit per ray, a hit clears
  *      it (in the group and in its pixel's mask); a group with no live ray leaves the traversal;
- *   4. after a leaf in which a group lost rays, its boxes are recomputed from its live rays (the paper's
- *      CR, frustum shrinking, here both for the culling and the traversal).
+ *   4. (off by default, MFTG_CR) after a leaf in which a group lost rays, its boxes recomputed from its
+ *      live rays (the paper's CR, frustum shrinking, for the culling and the traversal).
  *
  * Departures from the paper, and why:
  *  - the paper traces one frustum per pixel, its 16 rays (one interleaved set) spread over the whole light,
@@ -48,12 +48,15 @@
 #define MFTG_REL 1e-5f
 /* Measurement switches (builds with -D..., docs/methods.md): the groups at a triangle from which it is
  * culled for all at once (1: always; with one or two groups the cull cost more than it saved, ogre +18%);
- * CR on or off (within noise). */
+ * CR on or off (session 10: within noise; session 12, with the groups starting from their cell's box, off
+ * is faster: 384^2, CPU s, bars 0.225 -> 0.202, Crytek 0.186 -> 0.176, ogre 0.096 -> 0.093: a recomputation
+ * per group and leaf that lost rays, 514K on the bars, cost more than the tighter boxes saved). Departure
+ * from the paper, which shrinks. */
 #ifndef MFTG_TRI_CULL
 #define MFTG_TRI_CULL 4
 #endif
 #ifndef MFTG_CR
-#define MFTG_CR 1
+#define MFTG_CR 0
 #endif
 
 typedef struct mftg_state {
