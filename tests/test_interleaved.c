@@ -166,15 +166,32 @@ static void test_filter(void **st)
     for (int kind = 0; kind < 4; kind++) {
         ms_hit h[FW * FH];
         uint16_t front[FW * FH];
-        float v[FW * FH], s[FW * FH], v1[FW * FH], s1[FW * FH];
+        float v[FW * FH], s[FW * FH], v1[FW * FH], s1[FW * FH], sp[FW * FH], sp1[FW * FH], v2[FW * FH], s2[FW * FH];
         filter_frame(kind, h, front, v, s, &rng);
+        for (int i = 0; i < FW * FH; i++) sp[i] = s[i] < 0.0f ? s[i] : (float)(tu_rng_next(&rng) % 1000) / 999.0f;   /* S_spec */
         memcpy(v1, v, sizeof v);
         memcpy(s1, s, sizeof s);
-        assert_int_equal(ms_interleave_filter(FW, FH, h, front, v1, s1, 2), 0);
+        memcpy(sp1, sp, sizeof sp);
+        memcpy(v2, v, sizeof v);
+        memcpy(s2, s, sizeof s);
+        assert_int_equal(ms_interleave_filter(FW, FH, h, front, v1, s1, sp1, 2), 0);
+        /* without S_spec: V and S bit for bit as with it (one pass filters the three) */
+        assert_int_equal(ms_interleave_filter(FW, FH, h, front, v2, s2, NULL, 1), 0);
+        assert_memory_equal(v1, v2, sizeof v1);
+        assert_memory_equal(s1, s2, sizeof s1);
+        /* every instance this CPU runs gives the same floats (the frame is narrower than one 16-lane chunk,
+         * so each row is a partial chunk; the scene tests below cover whole ones) */
+        for (ms_isa isa = MS_ISA_SCALAR; isa <= ms_cpu_isa(); isa = (ms_isa)(isa + 1)) {
+            float vi[FW * FH], si[FW * FH], spi[FW * FH];
+            assert_int_equal(ms_interleave_filter_rows_isa(isa, FW, FH, h, front, v, s, sp, 0, FH, 0, FH, vi, si, spi, 1), 0);
+            assert_memory_equal(vi, v1, sizeof vi);
+            assert_memory_equal(si, s1, sizeof si);
+            assert_memory_equal(spi, sp1, sizeof spi);
+        }
         for (int y = 0; y < FH; y++)
             for (int x = 0; x < FW; x++) {
                 const int i = y * FW + x, right = x >= FW / 2;
-                double wv = 0, ws = 0, w = 0;
+                double wv = 0, ws = 0, wsp = 0, w = 0;
                 for (int dy = -2; dy <= 2; dy++)
                     for (int dx = -2; dx <= 2; dx++) {
                         const int xx = x + dx, yy = y + dy, j = yy * FW + xx;
@@ -183,13 +200,61 @@ static void test_filter(void **st)
                         /* a tilted normal on the points of y = 0: only the neighbours along z are in its plane */
                         if (kind == 2 && right && dx != 0) continue;
                         const double t = (dx == -2 || dx == 2 ? 0.5 : 1.0) * (dy == -2 || dy == 2 ? 0.5 : 1.0) * front[j];
-                        w += t; wv += t * v[j]; ws += t * s[j];
+                        w += t; wv += t * v[j]; ws += t * s[j]; wsp += t * sp[j];
                     }
-                double ev = w > 0 ? wv / w : v[i], es = w > 0 ? ws / w : s[i];
-                if (!front[i]) ev = es = v[i];           /* misses and pixels with nothing in front stay */
-                if (fabs(v1[i] - ev) > 1e-5 || fabs(s1[i] - es) > 1e-5)
-                    fail_msg("kind %d pixel (%d,%d): filtered V %.6f S %.6f, expected %.6f %.6f", kind, x, y, v1[i], s1[i], ev, es);
+                double ev = w > 0 ? wv / w : v[i], es = w > 0 ? ws / w : s[i], esp = w > 0 ? wsp / w : sp[i];
+                if (!front[i]) { ev = es = v[i]; esp = sp[i]; }   /* misses and pixels with nothing in front stay */
+                if (fabs(v1[i] - ev) > 1e-5 || fabs(s1[i] - es) > 1e-5 || fabs(sp1[i] - esp) > 1e-5)
+                    fail_msg("kind %d pixel (%d,%d): filtered V %.6f S %.6f S_spec %.6f, expected %.6f %.6f %.6f", kind, x, y,
+                             v1[i], s1[i], sp1[i], ev, es, esp);
             }
+    }
+}
+
+/* The filter's instances on a frame of whole and partial 16-pixel chunks (37 wide): a rough surface with
+ * normals near +y (some neighbours off the tolerances), misses and pixels with nothing in front; every
+ * instance bit for bit as the portable one, with and without S_spec. */
+static void test_filter_instances(void **st)
+{
+    (void)st;
+    enum { W2 = 37, H2 = 9, N2 = W2 * H2 };
+    tu_rng rng = { 7 };
+    ms_hit h[N2];
+    uint16_t front[N2];
+    float v[N2], s[N2], sp[N2];
+    for (int i = 0; i < N2; i++) {
+        const float r = (float)(tu_rng_next(&rng) % 1000) / 1000.0f;
+        h[i].prim = tu_rng_next(&rng) % 17 == 0 ? UINT32_MAX : 0;
+        h[i].p[0] = (float)(i % W2); h[i].p[1] = 0.008f * r; h[i].p[2] = (float)(i / W2);
+        const float r2 = (float)(tu_rng_next(&rng) % 1000) / 1000.0f;
+        h[i].n[0] = 0.012f * r2; h[i].n[1] = 1.0f; h[i].n[2] = -0.004f * r2;
+        front[i] = h[i].prim == UINT32_MAX ? 0 : (uint16_t)(tu_rng_next(&rng) % 17);
+        v[i] = h[i].prim == UINT32_MAX ? -1.0f : (float)(tu_rng_next(&rng) % 1000) / 999.0f;
+        s[i] = h[i].prim == UINT32_MAX ? -1.0f : (float)(tu_rng_next(&rng) % 1000) / 999.0f;
+        sp[i] = h[i].prim == UINT32_MAX ? -1.0f : (float)(tu_rng_next(&rng) % 1000) / 999.0f;
+    }
+    float rv[N2], rs[N2], rsp[N2], vi[N2], si[N2], spi[N2];
+    assert_int_equal(ms_interleave_filter_rows_isa(MS_ISA_SCALAR, W2, H2, h, front, v, s, sp, 0, H2, 0, H2, rv, rs, rsp, 2), 0);
+    int changed = 0, off_plane = 0;
+    for (int i = 0; i < N2; i++) changed += rv[i] != v[i];
+    assert_true(changed > N2 / 2);   /* the filter did average */
+    /* and the frame has horizontal neighbours off each other's tangent plane (the tolerance decides) */
+    for (int i = 0; i + 1 < N2; i++) {
+        const double d[3] = { h[i + 1].p[0] - h[i].p[0], h[i + 1].p[1] - h[i].p[1], h[i + 1].p[2] - h[i].p[2] };
+        off_plane += fabs(d[0] * h[i].n[0] + d[1] * h[i].n[1] + d[2] * h[i].n[2]) > 0.01 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+    if (!(off_plane > 10 && off_plane < N2 - 10)) fail_msg("%d of %d neighbours off the plane", off_plane, N2);
+    for (ms_isa isa = MS_ISA_SCALAR; isa <= ms_cpu_isa(); isa = (ms_isa)(isa + 1)) {
+        assert_int_equal(ms_interleave_filter_rows_isa(isa, W2, H2, h, front, v, s, sp, 0, H2, 0, H2, vi, si, spi, 2), 0);
+        assert_memory_equal(vi, rv, sizeof vi);
+        assert_memory_equal(si, rs, sizeof si);
+        assert_memory_equal(spi, rsp, sizeof spi);
+        /* rows 3 .. 7 alone, from the window of rows 1 .. 8 (a streamed band) */
+        float bv[N2], bs[N2];
+        const size_t w0 = (size_t)1 * W2;
+        assert_int_equal(ms_interleave_filter_rows_isa(isa, W2, H2, h + w0, front + w0, v + w0, s + w0, NULL, 1, 8, 3, 7, bv, bs, NULL, 1), 0);
+        assert_memory_equal(bv, rv + 3 * W2, sizeof(float) * 4 * W2);
+        assert_memory_equal(bs, rs + 3 * W2, sizeof(float) * 4 * W2);
     }
 }
 
@@ -378,6 +443,7 @@ int main(void)
         cmocka_unit_test(test_sets_are_nets),
         cmocka_unit_test(test_pixel_points),
         cmocka_unit_test(test_filter),
+        cmocka_unit_test(test_filter_instances),
         cmocka_unit_test(test_raytrace_embree_agree),
         cmocka_unit_test(test_cli),
         cmocka_unit_test(test_quality),

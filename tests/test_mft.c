@@ -10,9 +10,11 @@
 #include "primary/primary.h"
 #include "visibility/receiver.h"
 #include "accel/bvh.h"
+#include "accel/ray_triangle.h"
 #include "light/pattern.h"
 #include "shadow/microraster/block_traverse.h"
 #include "shadow/mft/mft.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -296,6 +298,94 @@ static void test_interleaved_group_paths(void **state)
     ms_scene_free(&sc);
 }
 
+/* Blocks whose 16 receivers are scattered over the scene (random points and normals low among its
+ * occluders): in one
+ * ray group (a cell of the light, one ray per pixel) the slots then have different shear axes, some are
+ * tested alone, some slots are absent (no sample in front) or partly live. The group tracer must still
+ * give each ray its own pixel's axis, shear, origin and sample (mft_group_impl.h: the slot's axes found
+ * once per block at 256 samples, the groups' first boxes from their cells): raytrace's masks, query for
+ * query, on every instance. */
+static void test_interleaved_scattered_blocks(void **state)
+{
+    (void)state;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
+    enum { BLOCKS = 96, NQ = 16 * BLOCKS };
+    ms_render_ctx ctx;
+    tu_ctx_init(&ctx, &sc, &bvh, 64, 64, 16);
+    tu_ctx_set_pattern(&ctx, MS_PATTERN_INTERLEAVED);
+    const size_t mw = (size_t)ctx.mask_words;
+    ms_shadow_query *q = malloc(NQ * sizeof *q);
+    uint64_t *front = calloc(NQ * mw, sizeof *front), *ref = calloc(NQ * mw, sizeof *ref);
+    float *pts = malloc((size_t)ctx.samples * 3 * sizeof *pts);
+    assert_non_null(q); assert_non_null(front); assert_non_null(ref); assert_non_null(pts);
+    tu_rng rng = { 2026 };
+    const float *lo = bvh.nodes[0].bmin, *hi = bvh.nodes[0].bmax;
+    int mixed = 0, partial = 0, blocked = 0;
+    uint64_t rc[MS_MAX_COUNTERS] = { 0 };
+    for (int b = 0; b < BLOCKS; b++) {
+        int axes = 0;
+        for (int s = 0; s < 16; s++) {
+            ms_shadow_query *Q = &q[16 * b + s];
+            float len = 0.0f;
+            for (int a = 0; a < 3; a++) {
+                /* low over the ground (y up): even slots among the occluders, odd ones anywhere out to the
+                 * sides (their rays' largest axis horizontal) */
+                const float u = (float)(tu_rng_next(&rng) % 10000) / 10000.0f;
+                Q->p[a] = lo[a] + (hi[a] - lo[a]) * (a == 1 ? 0.15f * u : s & 1 ? u : 0.3f + 0.4f * u);
+                Q->n[a] = (float)(tu_rng_next(&rng) % 2001) / 1000.0f - 1.0f;
+                len += Q->n[a] * Q->n[a];
+            }
+            len = len > 0.0f ? 1.0f / sqrtf(len) : 0.0f;
+            for (int a = 0; a < 3; a++) Q->n[a] = len > 0.0f ? Q->n[a] * len : (a == 1 ? 1.0f : 0.0f);
+            Q->prim = UINT32_MAX;
+            Q->px = (uint32_t)(4 * (b % 8) + (s & 3));   /* block b, slot s: the 16 sets */
+            Q->py = (uint32_t)(4 * (b / 8) + (s >> 2));
+            ms_pattern_points(MS_PATTERN_INTERLEAVED, &ctx.light, ctx.k, Q->px, Q->py, ctx.seed, pts);
+            ms_front_mask(&ctx, Q, pts, front + (size_t)(16 * b + s) * mw);
+            ms_raytrace_visible_samples(&ctx, Q, pts, front + (size_t)(16 * b + s) * mw, ref + (size_t)(16 * b + s) * mw, rc);
+            float dx[16], dy[16], dz[16];
+            for (int j = 0; j < 16; j++) {
+                dx[j] = pts[3 * j] - Q->p[0]; dy[j] = pts[3 * j + 1] - Q->p[1]; dz[j] = pts[3 * j + 2] - Q->p[2];
+            }
+            const int kz = ms_wt_packet_axis(dx, dy, dz, 16, NULL);
+            if (front[(size_t)(16 * b + s) * mw]) axes |= 1 << (kz + 1);
+            const int nf = __builtin_popcountll(front[(size_t)(16 * b + s) * mw]);
+            const int nv = __builtin_popcountll(ref[(size_t)(16 * b + s) * mw]);
+            partial += nv > 0 && nv < nf;
+            blocked += nv < nf;
+        }
+        mixed += __builtin_popcount((unsigned)axes) > 1;
+    }
+    printf("scattered interleaved blocks: %d of %d with slots of different shear axes; of %d queries %d with a "
+           "blocked ray, %d partly lit\n", mixed, BLOCKS, NQ, blocked, partial);
+    assert_true(mixed > BLOCKS / 2);
+    assert_true(blocked > NQ / 20);
+    assert_true(partial > 10);
+    const ms_shadow_method *sm = ms_find_shadow_method("mft");
+    assert_non_null(sm);
+    uint64_t *got = calloc(NQ * mw, sizeof *got);
+    assert_non_null(got);
+    for (int cap = MS_ISA_SCALAR; cap <= MS_ISA_AVX512; cap++) {
+        if (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa()) continue;
+        ctx.isa_cap = (ms_isa)cap;
+        char err[256];
+        void *ss = NULL;
+        assert_int_equal(sm->create(&ctx, &ss, err, sizeof err), 0);
+        uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+        assert_int_equal(sm->visibility(ss, &ctx, q, NQ, front, got, cnt), 0);
+        sm->destroy(ss);
+        int differ = 0;
+        for (int i = 0; i < NQ; i++) differ += memcmp(got + (size_t)i * mw, ref + (size_t)i * mw, mw * sizeof *got) != 0;
+        if (differ) fail_msg("ISA cap %d: %d of %d scattered queries differ from raytrace", cap, differ, NQ);
+    }
+    free(got); free(q); free(front); free(ref); free(pts);
+    ms_bvh_free(&bvh);
+    ms_scene_free(&sc);
+}
+
 /* The portable, AVX2 and AVX-512 instances: the same masks and the same counters (every decision is
  * the same IEEE operations, lanes16.h); the portable one reports itself as scalar. */
 static void test_isa_instances_identical(void **state)
@@ -403,6 +493,7 @@ int main(void)
         cmocka_unit_test(test_grazing_sliver_block),
         cmocka_unit_test(test_isa_instances_identical),
         cmocka_unit_test(test_interleaved_group_paths),
+        cmocka_unit_test(test_interleaved_scattered_blocks),
         cmocka_unit_test(test_switches_keep_masks),
         cmocka_unit_test(test_counters_account),
     };

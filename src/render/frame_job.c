@@ -866,17 +866,11 @@ ms_status ms_frame_job_finish(ms_frame_job *j, ms_frame *out, char *err, size_t 
     /* The interleaved pattern's filter belongs to its shadow cost (timed in shadow_s and on its own). */
     if (j->ctx.pattern == MS_PATTERN_INTERLEAVED && !j->opt.no_filter) {
         const double tf = omp_get_wtime(), cf = process_cpu_s();
-        /* S_spec through the same filter, with the same raw V deciding the neighbours. */
-        float *raw_vis = j->surf ? malloc(npix * sizeof *raw_vis) : NULL;
-        int ferr = j->surf && !raw_vis;
-        for (size_t l = 0; l < nl && !ferr; l++) {
-            if (raw_vis) memcpy(raw_vis, f->vis + l * npix, npix * sizeof *raw_vis);
+        /* S_spec through the same filter, with the same raw V deciding the neighbours (one pass for both). */
+        int ferr = 0;
+        for (size_t l = 0; l < nl && !ferr; l++)
             ferr = ms_interleave_filter(W, H, j->hits, f->front + l * npix, f->vis + l * npix, f->shadow + l * npix,
-                                        j->threads) ||
-                   (raw_vis && ms_interleave_filter(W, H, j->hits, f->front + l * npix, raw_vis, f->shadow_spec + l * npix,
-                                                    j->threads));
-        }
-        free(raw_vis);
+                                        j->surf ? f->shadow_spec + l * npix : NULL, j->threads);
         if (ferr) {
             snprintf(err, errlen, "out of memory for the interleaved filter of a %dx%d frame", W, H);
             return MS_ERR_NO_MEMORY;
@@ -953,12 +947,13 @@ int ms_frame_job_band_take(ms_frame_job *j, ms_frame *band, int *y0, float *lum,
     if (j->band_filter) {
         const size_t cap = (size_t)W * (size_t)j->rows_held, bn = (size_t)W * (size_t)(b - a);
         const double tf = omp_get_wtime();
-        for (size_t l = 0; l < j->nlights; l++) {
-            ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow + l * cap, j->y_base,
-                                      j->rows_held, a, b, j->band_vis + l * bn, j->band_shadow + l * bn, j->threads);
-            ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow_spec + l * cap,
-                                      j->y_base, j->rows_held, a, b, NULL, j->band_spec + l * bn, j->threads);
-        }
+        for (size_t l = 0; l < j->nlights; l++)
+            if (ms_interleave_filter_rows(W, j->H, j->hits, f->front + l * cap, f->vis + l * cap, f->shadow + l * cap,
+                                          f->shadow_spec + l * cap, j->y_base, j->rows_held, a, b, j->band_vis + l * bn,
+                                          j->band_shadow + l * bn, j->band_spec + l * bn, j->threads)) {
+                snprintf(err, errlen, "out of memory for the interleaved filter of a %d-pixel-wide band", W);
+                return -1;
+            }
         const double dt = omp_get_wtime() - tf;
         f->stats.filter_s += dt;
         f->stats.shadow_s += dt;

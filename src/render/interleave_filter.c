@@ -25,70 +25,63 @@
  * pixel with none keeps V = S = 0 (its light is behind its plane; on curved surfaces its neighbours within
  * the normal tolerance may see it, which cost sponza 0.0045 of MAE). S is averaged with the same weights.
  *
+ * The per-pixel definition, in the order every instance follows (interleave_filter_impl.h: 16 pixels of a
+ * row in vector lanes, the same operations per lane): for each neighbour (dy, then dx, -2..2) in the frame
+ * with a hit and a sample in front: d = p_j - p_i; off = |d . n_i|; chord = sqrt(d . d); cos = n_j . n_i
+ * (each dot product summed x, y, z in order); skipped unless off <= 0.01 chord and cos >= 0.9; else
+ * w = (tap(dx) tap(dy)) front_j, and wsum, vsum, ssum (and the S_spec sum) += w, w V_j, w S_j. A pixel
+ * with a hit, a sample in front and wsum > 0 takes vsum / wsum, ssum / wsum; every other keeps its raw
+ * values.
+ *
  * What it cannot do: a hard shadow edge on one surface (contact shadows) is blurred over the window like a
  * penumbra; on scenes full of them the filtered error exceeds the raw one at low resolution
  * (docs/design.md, docs/scenes.md). */
 #include "interleave_filter.h"
-#include "primary/primary.h"
-#include <math.h>
-#include <omp.h>
+#include "core/cpu.h"
 #include <stdlib.h>
 #include <string.h>
 
-static float tap(int d) { return d == -2 || d == 2 ? 0.5f : 1.0f; }
-
 int ms_interleave_filter(int W, int H, const ms_hit *hits, const uint16_t *front, float *vis, float *shadow,
-                         int threads)
+                         float *spec, int threads)
 {
     const size_t npix = (size_t)W * H;
     float *v0 = malloc(npix * sizeof *v0), *s0 = malloc(npix * sizeof *s0);
-    if (!v0 || !s0) { free(v0); free(s0); return -1; }
-    memcpy(v0, vis, npix * sizeof *v0);
-    memcpy(s0, shadow, npix * sizeof *s0);
-    ms_interleave_filter_rows(W, H, hits, front, v0, s0, 0, H, 0, H, vis, shadow, threads);
+    float *sp0 = spec ? malloc(npix * sizeof *sp0) : NULL;
+    int rc = -1;
+    if (v0 && s0 && (sp0 || !spec)) {
+        memcpy(v0, vis, npix * sizeof *v0);
+        memcpy(s0, shadow, npix * sizeof *s0);
+        if (spec) memcpy(sp0, spec, npix * sizeof *sp0);
+        rc = ms_interleave_filter_rows(W, H, hits, front, v0, s0, sp0, 0, H, 0, H, vis, shadow, spec, threads);
+    }
     free(v0);
     free(s0);
-    return 0;
+    free(sp0);
+    return rc;
 }
 
-void ms_interleave_filter_rows(int W, int H, const ms_hit *hits, const uint16_t *front, const float *v0, const float *s0,
-                               int wy0, int wrows, int a, int b, float *vis, float *shadow, int threads)
+typedef int (*filter_rows_fn)(int W, int H, const ms_hit *hits, const uint16_t *front, const float *v0, const float *s0,
+                              const float *sp0, int wy0, int a, int b, float *vis, float *shadow, float *spec, int threads);
+
+int ms_interleave_filter_rows_isa(ms_isa isa, int W, int H, const ms_hit *hits, const uint16_t *front, const float *v0,
+                                  const float *s0, const float *sp0, int wy0, int wrows, int a, int b, float *vis,
+                                  float *shadow, float *spec, int threads)
 {
     (void)wrows;   /* the caller's promise: rows a - 2 .. b + 1 of the frame are in the window */
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int y = a; y < b; y++)
-        for (int x = 0; x < W; x++) {
-            const size_t i = (size_t)(y - wy0) * W + x, o = (size_t)(y - a) * W + x;
-            const ms_hit *c = &hits[i];
-            /* A pixel with no sample in front keeps V = S = 0: its light is behind its plane, whatever its
-             * neighbours (facets of a curved surface, within the normal tolerance) see. A miss stays -1. */
-            if (vis) vis[o] = v0[i];
-            shadow[o] = s0[i];
-            if (c->prim == UINT32_MAX || !front[i]) continue;
-            float wsum = 0.0f, vsum = 0.0f, ssum = 0.0f;
-            for (int dy = -2; dy <= 2; dy++) {
-                const int yy = y + dy;
-                if (yy < 0 || yy >= H) continue;
-                for (int dx = -2; dx <= 2; dx++) {
-                    const int xx = x + dx;
-                    if (xx < 0 || xx >= W) continue;
-                    const size_t j = (size_t)(yy - wy0) * W + xx;
-                    const ms_hit *h = &hits[j];
-                    if (h->prim == UINT32_MAX || !front[j]) continue;
-                    const float d[3] = { h->p[0] - c->p[0], h->p[1] - c->p[1], h->p[2] - c->p[2] };
-                    const float off_plane = fabsf(d[0] * c->n[0] + d[1] * c->n[1] + d[2] * c->n[2]);
-                    const float chord = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                    const float cosn = h->n[0] * c->n[0] + h->n[1] * c->n[1] + h->n[2] * c->n[2];
-                    if (!(off_plane <= MS_FILTER_PLANE_TOL * chord) || !(cosn >= MS_FILTER_NORMAL_COS)) continue;
-                    const float w = tap(dx) * tap(dy) * (float)front[j];
-                    wsum += w;
-                    vsum += w * v0[j];
-                    ssum += w * s0[j];
-                }
-            }
-            if (wsum > 0.0f) {
-                if (vis) vis[o] = vsum / wsum;
-                shadow[o] = ssum / wsum;
-            }
-        }
+    static const filter_rows_fn by_isa[] = {
+        [MS_ISA_SCALAR] = ms_interleave_filter_rows_scalar,
+        [MS_ISA_AVX2] = ms_interleave_filter_rows_avx2,
+        [MS_ISA_AVX512] = ms_interleave_filter_rows_avx512,
+    };
+    return by_isa[isa](W, H, hits, front, v0, s0, sp0, wy0, a, b, vis, shadow, spec, threads);
+}
+
+int ms_interleave_filter_rows(int W, int H, const ms_hit *hits, const uint16_t *front, const float *v0, const float *s0,
+                              const float *sp0, int wy0, int wrows, int a, int b, float *vis, float *shadow, float *spec,
+                              int threads)
+{
+    /* Every instance gives the same floats (interleave_filter_impl.h), so no cap applies: the best the CPU
+     * runs, as ms_mask_count. */
+    return ms_interleave_filter_rows_isa(ms_isa_select(MS_ISA_AUTO, MS_ISA_ALL), W, H, hits, front, v0, s0, sp0, wy0,
+                                         wrows, a, b, vis, shadow, spec, threads);
 }

@@ -24,6 +24,7 @@ L16_INLINE l16 l16_div(l16 a, l16 b) { return _mm512_div_ps(a, b); }
 L16_INLINE l16 l16_min(l16 a, l16 b) { return _mm512_min_ps(a, b); }
 L16_INLINE l16 l16_max(l16 a, l16 b) { return _mm512_max_ps(a, b); }
 L16_INLINE l16 l16_abs(l16 a) { return _mm512_abs_ps(a); }
+L16_INLINE l16 l16_sqrt(l16 a) { return _mm512_sqrt_ps(a); }
 L16_INLINE l16 l16_ceil(l16 a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC); }
 L16_INLINE l16 l16_floor(l16 a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
 L16_INLINE void l16_store_int(int32_t *p, l16 a) { _mm512_storeu_si512((void *)p, _mm512_cvttps_epi32(a)); }
@@ -52,6 +53,7 @@ L16_INLINE l16 l16_abs(l16 a)
     const __m256 s = _mm256_set1_ps(-0.0f);
     return (l16){ _mm256_andnot_ps(s, a.lo), _mm256_andnot_ps(s, a.hi) };
 }
+L16_INLINE l16 l16_sqrt(l16 a) { return (l16){ _mm256_sqrt_ps(a.lo), _mm256_sqrt_ps(a.hi) }; }
 L16_INLINE l16 l16_ceil(l16 a) { return (l16){ _mm256_ceil_ps(a.lo), _mm256_ceil_ps(a.hi) }; }
 L16_INLINE l16 l16_floor(l16 a) { return (l16){ _mm256_floor_ps(a.lo), _mm256_floor_ps(a.hi) }; }
 L16_INLINE void l16_store_int(int32_t *p, l16 a)
@@ -80,6 +82,7 @@ L16_INLINE l16 l16_select(unsigned m, l16 a, l16 b)
     return (l16){ _mm256_blendv_ps(b.lo, a.lo, l16_mask8(m & 0xFF)), _mm256_blendv_ps(b.hi, a.hi, l16_mask8(m >> 8)) };
 }
 #else
+#include <math.h>
 typedef struct l16 { float v[16]; } l16;
 #define L16_INLINE static inline
 #define L16_OP(name, expr)                                         \
@@ -99,6 +102,8 @@ L16_OP(l16_div, x / y)
 L16_OP(l16_min, x < y ? x : y)
 L16_OP(l16_max, x > y ? x : y)
 L16_INLINE l16 l16_abs(l16 a) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = a.v[i] < 0.0f ? -a.v[i] : a.v[i] + 0.0f; return r; }
+/* Correctly rounded, as the SSE/AVX square roots (IEEE 754). */
+L16_INLINE l16 l16_sqrt(l16 a) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = sqrtf(a.v[i]); return r; }
 /* Ceiling and floor of values within int range (the callers clamp first): exact by truncation and one
  * step, as ms_ceil_i (ceilf/floorf are library calls without SSE4.1). */
 L16_INLINE l16 l16_ceil(l16 a)

@@ -35,13 +35,82 @@
 #define MFT_SHALLOW_LEAF_INTERLEAVED 4
 #endif
 
+/* The interleaved mode's tables of the 16 sample sets (each set the same in every block, pattern.c): per set
+ * its n = N/16 points and each point's cell of the g x g grid over the light; per cell the points of the
+ * 16 sets [cell][axis][set], the sample of each set in it, and the box of its points (lo xyz, hi xyz);
+ * have: the sets formed; regular: those with one sample per cell (all of pattern.c's sets: nets). */
+typedef struct mft_sets {
+    int n, gside, ncell;
+    unsigned have, regular;
+    float *set_pts, *cell_pts, *cell_box, *st;
+    uint16_t *sample_of;
+    int *set_cell;
+} mft_sets;
+
 typedef struct mft_method {
     ms_mft_fn block;
     ms_mft_group_fn groups;       /* the interleaved mode's tracer (mft_group_impl.h) */
     ms_isa isa;
     ms_bvh_shallow sh;
     ms_mft_frame f;
+    mft_sets sets;                /* the frame light's, all 16 formed by mft_create (interleaved mode) */
 } mft_method;
+
+static void mft_sets_free(mft_sets *T)
+{
+    free(T->set_pts); free(T->cell_pts); free(T->cell_box); free(T->st); free(T->sample_of); free(T->set_cell);
+    memset(T, 0, sizeof *T);
+}
+
+static int mft_sets_alloc(mft_sets *T, int n)
+{
+    memset(T, 0, sizeof *T);
+    T->n = n;
+    T->gside = 1;
+    while (T->gside * T->gside < n) T->gside *= 2;
+    T->ncell = T->gside * T->gside;
+    T->set_pts = malloc((size_t)16 * 3 * n * sizeof *T->set_pts);
+    T->cell_pts = malloc((size_t)T->ncell * 3 * 16 * sizeof *T->cell_pts);
+    T->cell_box = malloc((size_t)T->ncell * 6 * sizeof *T->cell_box);
+    T->st = malloc((size_t)2 * n * sizeof *T->st);
+    T->sample_of = malloc((size_t)16 * T->ncell * sizeof *T->sample_of);
+    T->set_cell = malloc((size_t)16 * n * sizeof *T->set_cell);
+    if (!T->set_pts || !T->cell_pts || !T->cell_box || !T->st || !T->sample_of || !T->set_cell) { mft_sets_free(T); return -1; }
+    for (int c = 0; c < T->ncell; c++)
+        for (int a = 0; a < 3; a++) { T->cell_box[6 * c + a] = INFINITY; T->cell_box[6 * c + 3 + a] = -INFINITY; }
+    return 0;
+}
+
+static int mft_morton(int x, int y);
+
+/* Forms set `set`'s tables for frame f (its light, pattern, k, seed). */
+static void mft_sets_form(mft_sets *T, const ms_mft_frame *f, int set)
+{
+    const int n = T->n, gside = T->gside, ncell = T->ncell;
+    const uint32_t px = (uint32_t)set & 3u, py = (uint32_t)set >> 2;   /* a pixel of the set */
+    float *pts = T->set_pts + (size_t)set * 3 * n, *st = T->st;
+    ms_pattern_points_range(f->pattern, &f->light, f->k, px, py, f->seed, 0, n, pts);
+    ms_pattern_st(f->pattern, f->k, px, py, f->seed, st);
+    unsigned seen[MS_SAMPLES_MAX / 16 / 32] = { 0 };
+    int ok = 1;
+    for (int j = 0; j < n; j++) {
+        const int cx = (int)(st[2 * j] * (float)gside), cy = (int)(st[2 * j + 1] * (float)gside);
+        const int c = mft_morton(cx < gside ? cx : gside - 1, cy < gside ? cy : gside - 1);
+        T->set_cell[(size_t)set * n + j] = c;
+        ok &= !(seen[c >> 5] >> (c & 31) & 1u);
+        seen[c >> 5] |= 1u << (c & 31);
+        T->sample_of[(size_t)set * ncell + c] = (uint16_t)j;
+        for (int a = 0; a < 3; a++) {
+            const float x = pts[3 * j + a];
+            float *lo = &T->cell_box[6 * c + a], *hi = lo + 3;
+            T->cell_pts[((size_t)c * 3 + a) * 16 + set] = x;
+            *lo = x < *lo ? x : *lo;
+            *hi = x > *hi ? x : *hi;
+        }
+    }
+    T->have |= 1u << set;
+    T->regular |= (unsigned)ok << set;
+}
 
 ms_mft_fn ms_mft_isa(ms_isa isa)
 {
@@ -112,6 +181,16 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
 #ifdef MFT_NO_FOOTPRINT
     f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
 #endif
+    /* The 16 sets' tables once for the frame's light (they were formed per call, i.e. per tile). */
+    if (!f->cells) {
+        if (mft_sets_alloc(&s->sets, ms_pattern_spp(f->pattern, f->k))) {
+            ms_bvh_shallow_free(&s->sh);
+            free(s);
+            snprintf(err, errlen, "out of memory for the interleaved sets");
+            return -1;
+        }
+        for (int set = 0; set < 16; set++) mft_sets_form(&s->sets, f, set);
+    }
     *state = s;
     return 0;
 }
@@ -278,68 +357,54 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
 {
     const size_t mw = (size_t)ctx->mask_words;
     const int n = ms_pattern_spp(f->pattern, f->k), np = n / 16;
-    int gside = 1;
-    while (gside * gside < n) gside *= 2;
-    const int ncell = gside * gside;
+    /* The sets' tables: the frame's (formed by mft_create), or for another light (a sphere's outline) this
+     * call's own, formed when a query first needs them. */
+    mft_sets own;
+    memset(&own, 0, sizeof own);
+    const mft_sets *T = &s->sets;
+    if (f != &s->f || s->sets.have != 0xFFFFu) {
+        if (mft_sets_alloc(&own, n)) return -1;
+        T = &own;
+    }
+    const int ncell = T->ncell;
     ms_mft_rayblock rb;
     memset(&rb, 0, sizeof rb);
     rb.cap = ncell + MS_BLOCK_LANES;
     rb.g = malloc((size_t)rb.cap * sizeof *rb.g);
     int *next = malloc((size_t)rb.cap * sizeof *next);
-    /* The points and cells of the 16 sets, each set being the same in every block (pattern.c), formed when
-     * a query first needs them: per set 3n floats, n cells; then st (2n) for the one being formed. */
-    float *scratch = malloc((size_t)n * 8 * sizeof(float) + (size_t)16 * n * 4 * sizeof(float) + (size_t)n * 2 * sizeof(float));
+    float *scratch = malloc((size_t)n * 8 * sizeof(float));   /* a query's rays (the general grouping) */
     signed char kzs[MS_SAMPLES_MAX / 16];
-    if (!rb.g || !next || !scratch) { free(rb.g); free(next); free(scratch); return -1; }
-    unsigned have_set = 0;
+    if (!rb.g || !next || !scratch) { free(rb.g); free(next); free(scratch); mft_sets_free(&own); return -1; }
     ms_mft_lane L;
     memset(&L, 0, sizeof L);
     for (int a = 0; a < 3; a++) { L.d[a] = scratch + (size_t)a * n; L.inv[a] = scratch + (size_t)(3 + a) * n; }
     L.sx = scratch + (size_t)6 * n;
     L.sy = scratch + (size_t)7 * n;
     L.kz = kzs;
-    float *set_pts = scratch + (size_t)8 * n, *st = set_pts + (size_t)16 * 3 * n;
-    int *set_cell = (int *)(st + (size_t)2 * n);
-    /* The sets' points by cell, [cell][axis][set], and the sample of each set in each cell; regular: the
-     * sets with one sample per cell (all of them: pattern.c's sets are nets). */
-    float *cell_pts = malloc((size_t)ncell * 3 * 16 * sizeof *cell_pts);
-    uint16_t *sample_of = malloc((size_t)16 * ncell * sizeof *sample_of);
-    if (!cell_pts || !sample_of) { free(rb.g); free(next); free(scratch); free(cell_pts); free(sample_of); return -1; }
-    unsigned regular = 0;
     for (int g = 0; g < nq;) {
         const int end = ms_block_group_end(ctx, q, order, nq, g);
-        /* The sets' tables, formed when first needed. */
         unsigned sets = 0, dup = 0;
         for (int e = g; e < end; e++) {
             const int set = ms_interleaved_set(q[order[e]].px, q[order[e]].py);
             dup |= sets & 1u << set;
             sets |= 1u << set;
-            if (have_set >> set & 1) continue;
-            ms_pattern_points_range(f->pattern, &f->light, f->k, q[order[e]].px, q[order[e]].py, f->seed, 0, n,
-                                    set_pts + (size_t)set * 3 * n);
-            ms_pattern_st(f->pattern, f->k, q[order[e]].px, q[order[e]].py, f->seed, st);
-            unsigned seen[MS_SAMPLES_MAX / 16 / 32] = { 0 };
-            int ok = 1;
-            for (int j = 0; j < n; j++) {
-                const int cx = (int)(st[2 * j] * (float)gside), cy = (int)(st[2 * j + 1] * (float)gside);
-                const int c = mft_morton(cx < gside ? cx : gside - 1, cy < gside ? cy : gside - 1);
-                set_cell[(size_t)set * n + j] = c;
-                ok &= !(seen[c >> 5] >> (c & 31) & 1u);
-                seen[c >> 5] |= 1u << (c & 31);
-                sample_of[(size_t)set * ncell + c] = (uint16_t)j;
-                for (int a = 0; a < 3; a++) cell_pts[((size_t)c * 3 + a) * 16 + set] = set_pts[(size_t)set * 3 * n + 3 * j + a];
-            }
-            have_set |= 1u << set;
-            regular |= (unsigned)ok << set;
+            if (!(T->have >> set & 1)) mft_sets_form(&own, f, set);   /* T is own here: the frame's has all */
         }
+        const unsigned regular = T->regular;
+        const float *cell_pts = T->cell_pts, *set_pts = T->set_pts;
+        const uint16_t *sample_of = T->sample_of;
+        const int *set_cell = T->set_cell;
         if (!dup && (sets & ~regular) == 0 && ncell == n) {
-            if (mft_block_by_set(q, order, g, end, front, vis, mw, n, ncell, cell_pts, sample_of, set_cell, &rb))
+            if (mft_block_by_set(q, order, g, end, front, vis, mw, n, ncell, cell_pts, sample_of, set_cell, &rb)) {
+                rb.cell_box = T->cell_box;   /* every set of the block is formed: the boxes hold its points */
                 s->groups(f, &rb, ctx->bvh, &s->sh, cnt);
+            }
             g = end;
             continue;
         }
         rb.nq = 0;
         rb.n = ncell;
+        rb.cell_box = NULL;
         memset(rb.g, 0, (size_t)ncell * sizeof *rb.g);
         for (int c = 0; c < ncell; c++) next[c] = -1;
         for (int e = g; e < end; e++) {
@@ -373,7 +438,7 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
                                 int *nn = ng ? realloc(next, (size_t)cap * sizeof *nn) : NULL;
                                 if (ng) rb.g = ng;
                                 if (nn) next = nn;
-                                if (!ng || !nn) { free(rb.g); free(next); free(scratch); return -1; }
+                                if (!ng || !nn) { free(rb.g); free(next); free(scratch); mft_sets_free(&own); return -1; }
                                 rb.cap = cap;
                             }
                             memset(&rb.g[rb.n], 0, sizeof *rb.g);
@@ -404,8 +469,7 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
     free(rb.g);
     free(next);
     free(scratch);
-    free(cell_pts);
-    free(sample_of);
+    mft_sets_free(&own);
     return 0;
 }
 
@@ -476,6 +540,7 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
 static void mft_destroy(void *state)
 {
     mft_method *s = state;
+    mft_sets_free(&s->sets);
     ms_bvh_shallow_free(&s->sh);
     free(s);
 }

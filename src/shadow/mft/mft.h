@@ -91,6 +91,9 @@ typedef struct ms_mft_rayblock {
     const uint16_t *sample_of;
     const int *set_cell;
     unsigned present;
+    /* Per cell, the box of the points of every set formed so far (lo xyz, hi xyz), or NULL: a group whose
+     * every present slot is live starts from it and the box of the present receivers (mft_group_impl.h). */
+    const float *cell_box;
 } ms_mft_rayblock;
 
 /* Counters after the traversal's (block_traverse.h), named in mft.c. */

@@ -18,8 +18,8 @@
  *      (raytrace_impl.h, packet_triangle) with each ray's own shear axis (its pixel's packet's) and
  *      shear, operation for operation, so every ray gets raytrace's answer; one bit per ray, a hit clears
  *      it (in the group and in its pixel's mask); a group with no live ray leaves the traversal;
- *   4. after a leaf in which a group lost rays, its boxes are recomputed from its live rays (the paper's
- *      CR, frustum shrinking, here both for the culling and the traversal).
+ *   4. (off by default, MFTG_CR) after a leaf in which a group lost rays, its boxes recomputed from its
+ *      live rays (the paper's CR, frustum shrinking, for the culling and the traversal).
  *
  * Departures from the paper, and why:
  *  - the paper traces one frustum per pixel, its 16 rays (one interleaved set) spread over the whole light,
@@ -48,12 +48,15 @@
 #define MFTG_REL 1e-5f
 /* Measurement switches (builds with -D..., docs/methods.md): the groups at a triangle from which it is
  * culled for all at once (1: always; with one or two groups the cull cost more than it saved, ogre +18%);
- * CR on or off (within noise). */
+ * CR on or off (session 10: within noise; session 12, with the groups starting from their cell's box, off
+ * is faster: 384^2, CPU s, bars 0.225 -> 0.202, Crytek 0.186 -> 0.176, ogre 0.096 -> 0.093: a recomputation
+ * per group and leaf that lost rays, 514K on the bars, cost more than the tighter boxes saved). Departure
+ * from the paper, which shrinks. */
 #ifndef MFTG_TRI_CULL
 #define MFTG_TRI_CULL 4
 #endif
 #ifndef MFTG_CR
-#define MFTG_CR 1
+#define MFTG_CR 0
 #endif
 
 typedef struct mftg_state {
@@ -88,6 +91,21 @@ static inline unsigned mftg_ray_box(const mftg_state *s, const ms_mft_group *g, 
     return l16_le(t0, l16_mul(t1, l16_set1(MS_WT_FAR_SCALE))) & g->live;
 }
 
+/* Lane l's frustum from the box of its origins and the box of its points. */
+static void mftg_lane_set(mftg_state *s, int l, const float clo[3], const float chi[3], const float plo[3], const float phi[3])
+{
+    float mag = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        s->oc[a][l] = 0.5f * (clo[a] + chi[a]);
+        s->oh[a][l] = 0.5f * (chi[a] - clo[a]);
+        s->pc[a][l] = 0.5f * (plo[a] + phi[a]);
+        s->ph[a][l] = 0.5f * (phi[a] - plo[a]);
+        for (int e = 0; e < 4; e++) { const float x = fabsf(e == 0 ? clo[a] : e == 1 ? chi[a] : e == 2 ? plo[a] : phi[a]); mag = x > mag ? x : mag; }
+    }
+    s->mag[l] = mag;
+    ms_block_frusta_set_lane_box(s->fr, l, clo, chi, plo, phi, MFTG_REL);
+}
+
 /* Lane l's frustum from its group's live rays. */
 static void mftg_lane_bounds(mftg_state *s, int l)
 {
@@ -105,16 +123,7 @@ static void mftg_lane_bounds(mftg_state *s, int l)
             phi[a] = p > phi[a] ? p : phi[a];
         }
     }
-    float mag = 0.0f;
-    for (int a = 0; a < 3; a++) {
-        s->oc[a][l] = 0.5f * (clo[a] + chi[a]);
-        s->oh[a][l] = 0.5f * (chi[a] - clo[a]);
-        s->pc[a][l] = 0.5f * (plo[a] + phi[a]);
-        s->ph[a][l] = 0.5f * (phi[a] - plo[a]);
-        for (int e = 0; e < 4; e++) { const float x = fabsf(e == 0 ? clo[a] : e == 1 ? chi[a] : e == 2 ? plo[a] : phi[a]); mag = x > mag ? x : mag; }
-    }
-    s->mag[l] = mag;
-    ms_block_frusta_set_lane_box(s->fr, l, clo, chi, plo, phi, MFTG_REL);
+    mftg_lane_set(s, l, clo, chi, plo, phi);
 }
 
 #define BT_STATE mftg_state
@@ -445,20 +454,42 @@ static void mftg_form(ms_mft_rayblock *rb)
             kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, &k0);
         }
     }
+    /* n = 16 (256 samples): a slot's 16 samples are one packet, so every group has the slots' axes; they
+     * are found once, and each group's common axis from its live slots by masks. */
+    signed char kq[16];
+    unsigned a1 = 0, a2 = 0, alone = 0;
+    if (n == 16)
+        for (int q = 0; q < 16; q++) {
+            const int k = (rb->present >> q & 1) ? kz[q][0] : 0;
+            kq[q] = (signed char)k;
+            alone |= (unsigned)(k < 0) << q;
+            a1 |= (unsigned)(k == 1) << q;
+            a2 |= (unsigned)(k == 2) << q;
+        }
+    const unsigned a0 = 0xFFFFu & ~(alone | a1 | a2);
     for (int c = 0; c < ncell; c++) {
         ms_mft_group *G = &rb->g[c];
         unsigned k1 = 0, k2 = 0;
-        int kall = -2;
-        G->alone = 0;
-        for (int q = 0; q < 16; q++) {
-            const int k = (rb->present >> q & 1) ? kz[q][G->sample[q] >> 4] : 0;
-            G->kz[q] = (signed char)k;
-            G->alone |= (unsigned)(k < 0) << q;
-            k1 |= (unsigned)(k == 1) << q;
-            k2 |= (unsigned)(k == 2) << q;
-            if ((G->live >> q & 1) && k >= 0) kall = kall == -2 || kall == k ? k : -1;
+        if (n == 16) {
+            memcpy(G->kz, kq, sizeof kq);
+            G->alone = alone;
+            k1 = a1;
+            k2 = a2;
+            const unsigned lv = G->live & ~alone;
+            G->kz_all = !lv || (lv & a0) == lv ? 0 : (lv & a1) == lv ? 1 : (lv & a2) == lv ? 2 : -1;
+        } else {
+            int kall = -2;
+            G->alone = 0;
+            for (int q = 0; q < 16; q++) {
+                const int k = (rb->present >> q & 1) ? kz[q][G->sample[q] >> 4] : 0;
+                G->kz[q] = (signed char)k;
+                G->alone |= (unsigned)(k < 0) << q;
+                k1 |= (unsigned)(k == 1) << q;
+                k2 |= (unsigned)(k == 2) << q;
+                if ((G->live >> q & 1) && k >= 0) kall = kall == -2 || kall == k ? k : -1;
+            }
+            G->kz_all = kall < 0 ? (kall == -2 ? 0 : -1) : kall;
         }
-        G->kz_all = kall < 0 ? (kall == -2 ? 0 : -1) : kall;
         /* kz = 0: (kx, ky) = (1, 2); 1: (2, 0); 2: (0, 1); a slot without an axis (tested alone) takes 0's. */
         l16 d[3], inv[3];
         for (int a = 0; a < 3; a++) { d[a] = l16_load(G->d[a]); inv[a] = l16_load(G->inv[a]); }
@@ -488,13 +519,29 @@ void MS_CAT(ms_mft_groups_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_raybloc
         ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, c, lo, hi);
         for (int a = 0; a < 3; a++) { s.olo[a][q] = lo[a]; s.ohi[a][q] = hi[a]; }
     }
+    /* The box of the present receivers: with the cell's box of points, the starting frustum of every group
+     * whose present slots are all live (most of them), without a pass over its rays. Departure from a
+     * box of the live rays only (the paper's frustum of its rays): the cell's box holds the points of all
+     * 16 sets, so it is at most the cell of the light, and a conservative bound of the group's points. */
+    float blo[3] = { INFINITY, INFINITY, INFINITY }, bhi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (unsigned m = rb->present; m; m &= m - 1) {
+        const int q = __builtin_ctz(m);
+        for (int a = 0; a < 3; a++) {
+            blo[a] = rb->c[a][q] < blo[a] ? rb->c[a][q] : blo[a];
+            bhi[a] = rb->c[a][q] > bhi[a] ? rb->c[a][q] : bhi[a];
+        }
+    }
     for (int g0 = 0; g0 < rb->n; g0 += MS_BLOCK_LANES) {
         ms_block_frusta_init(&fr, &sh->nodes[0], f->near, f->far);
         memset(s.grp, 0, sizeof s.grp);
         for (int l = 0; l < MS_BLOCK_LANES && g0 + l < rb->n; l++) {
             s.grp[l] = &rb->g[g0 + l];
             if (!s.grp[l]->live) continue;
-            mftg_lane_bounds(&s, l);
+            if (rb->cell_box && s.grp[l]->live == rb->present) {
+                const float *cb = rb->cell_box + 6 * (size_t)(g0 + l);
+                mftg_lane_set(&s, l, blo, bhi, cb, cb + 3);
+            } else
+                mftg_lane_bounds(&s, l);
             cnt[MS_MFT_FRUSTA]++;
         }
         if (fr.live) mftg_traverse(&s, sh, f->flags & MS_MFT_ORDER);

@@ -15,8 +15,30 @@ static int cmp_by_block(const void *a, const void *b, void *arg)
 
 int ms_block_order(const ms_render_ctx *ctx, const ms_shadow_query *q, int nq, int *order)
 {
+    if (ctx->queries_in_order || nq <= 1) {
+        for (int i = 0; i < nq; i++) order[i] = i;
+        return 0;
+    }
+    /* A frame's queries cover a rectangle of blocks about as many as the queries / 16: a counting sort by
+     * block (stable: a block's queries in their given order, as the merge sort below leaves them), linear
+     * where the sort was n log n (3% of mft's CPU time on a frame of the Quad). */
+    uint32_t bx0 = UINT32_MAX, bx1 = 0, by0 = UINT32_MAX, by1 = 0;
+    for (int i = 0; i < nq; i++) {
+        const uint32_t bx = q[i].px >> 2, by = q[i].py >> 2;
+        bx0 = bx < bx0 ? bx : bx0; bx1 = bx > bx1 ? bx : bx1;
+        by0 = by < by0 ? by : by0; by1 = by > by1 ? by : by1;
+    }
+    const uint64_t nbx = (uint64_t)(bx1 - bx0) + 1, nblocks = nbx * ((uint64_t)(by1 - by0) + 1);
+    int *start = nblocks <= 4 * (uint64_t)nq + 1024 ? calloc((size_t)nblocks + 1, sizeof *start) : NULL;
+    if (start) {
+        for (int i = 0; i < nq; i++) start[(size_t)((q[i].py >> 2) - by0) * nbx + ((q[i].px >> 2) - bx0) + 1]++;
+        for (size_t b = 0; b < nblocks; b++) start[b + 1] += start[b];
+        for (int i = 0; i < nq; i++) order[start[(size_t)((q[i].py >> 2) - by0) * nbx + ((q[i].px >> 2) - bx0)]++] = i;
+        free(start);
+        return 0;
+    }
     for (int i = 0; i < nq; i++) order[i] = i;
-    if (!ctx->queries_in_order) qsort_r(order, (size_t)nq, sizeof *order, cmp_by_block, (void *)q);
+    qsort_r(order, (size_t)nq, sizeof *order, cmp_by_block, (void *)q);
     return 0;
 }
 

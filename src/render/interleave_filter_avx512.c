@@ -1,0 +1,2 @@
+/* The AVX512 instance of the interleaved filter (interleave_filter_impl.h). */
+#include "interleave_filter_impl.h"

@@ -1,0 +1,2 @@
+/* The portable instance of the interleaved filter (interleave_filter_impl.h). */
+#include "interleave_filter_impl.h"
