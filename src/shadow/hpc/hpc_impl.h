@@ -582,8 +582,8 @@ static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const fl
 }
 
 /* The groups (bit gk) whose samples the footprint may hold, bounding each edge function over the group's
- * gs x gs samples (16 groups per operation). */
-static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
+ * gs x gs samples (16 groups per operation). base: each function at each group's first sample, [e][gk]. */
+static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f, float base[4][64])
 {
     const float span = (float)(sh->gs - 1);
     float dlo[4], dhi[4];   /* each function's least and largest change from a group's first sample */
@@ -597,9 +597,10 @@ static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
         const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
         l16 lo[4], hi[4];
         for (int e = 0; e < 4; e++) {
-            const l16 base = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
-            lo[e] = l16_add(base, l16_set1(dlo[e]));
-            hi[e] = l16_add(base, l16_set1(dhi[e]));
+            const l16 b = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
+            l16_store(base[e] + g0, b);
+            lo[e] = l16_add(b, l16_set1(dlo[e]));
+            hi[e] = l16_add(b, l16_set1(dhi[e]));
         }
         cand |= (uint64_t)footprint_keep(lo, hi, f->s) << g0;
     }
@@ -607,11 +608,13 @@ static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
 }
 
 /* The lanes of the 16-sample block at (i0, j0) the footprint may hold; off[e]: the block's offsets
- * e1 di + e2 dj per lane, made once per pair (footprint_offsets). */
-static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0, int j0)
+ * e1 di + e2 dj per lane, made once per pair (footprint_offsets). gbase: the functions at the block's first
+ * sample when it is a group's first (footprint_groups made them), else NULL. */
+static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0, int j0, const float *gbase, int gk)
 {
     l16 E[4];
-    for (int e = 0; e < 4; e++) E[e] = l16_add(l16_set1(f->e[e][0] + f->e[e][1] * (float)i0 + f->e[e][2] * (float)j0), off[e]);
+    for (int e = 0; e < 4; e++)
+        E[e] = l16_add(l16_set1(gbase ? gbase[64 * e + gk] : f->e[e][0] + f->e[e][1] * (float)i0 + f->e[e][2] * (float)j0), off[e]);
     return footprint_keep(E, E, f->s);
 }
 
@@ -894,8 +897,9 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
     /* The open groups a footprint may touch (a node's umbra groups are its points' too). */
-    uint64_t todo = footprint_groups(sh, &v->fp[0]);
-    if (v->nt > 1) todo |= footprint_groups(sh, &v->fp[1]);
+    float base[2][4][64];   /* each function at each group's first sample (footprint_groups) */
+    uint64_t todo = footprint_groups(sh, &v->fp[0], base[0]);
+    if (v->nt > 1) todo |= footprint_groups(sh, &v->fp[1], base[1]);
     todo &= ~gu;
     if (!todo) return;
     static const float off[2][2][LANES] = {
@@ -916,8 +920,8 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
         const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
         unsigned any = 0;
         for (int jb = j0; jb < j0 + gs; jb += rows) {
-            unsigned lanes[2] = { footprint_lanes(&v->fp[0], foff[0], i0, jb), 0u };
-            if (nt > 1) lanes[1] = footprint_lanes(&v->fp[1], foff[1], i0, jb);
+            unsigned lanes[2] = { footprint_lanes(&v->fp[0], foff[0], i0, jb, jb == j0 ? &base[0][0][0] : NULL, gk), 0u };
+            if (nt > 1) lanes[1] = footprint_lanes(&v->fp[1], foff[1], i0, jb, jb == j0 ? &base[1][0][0] : NULL, gk);
             if (!(lanes[0] | lanes[1])) continue;
             const unsigned ob = block_open(open, k, i0, jb, gs);
             if (!(ob & (lanes[0] | lanes[1]))) continue;
