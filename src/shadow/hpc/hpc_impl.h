@@ -527,7 +527,19 @@ static int alpha_opaque(const shared *sh, const tri_job *t, const ms_shadow_quer
 typedef struct hpc_footprint {
     float e[4][3];   /* per edge function, and their sum (e[3]): e0, e1 (per column i), e2 (per row j) */
     float s[3];      /* per edge function: the slack */
+    float dlo[4], dhi[4];   /* each function's least and largest change over a group from its first sample */
 } hpc_footprint;
+
+/* dlo, dhi of a group of gs x gs samples (span = gs - 1) from the coefficients e1, e2 (footprint_groups);
+ * cast_leaf_footprint forms the same per lane, 16 receivers at once. */
+static void footprint_spans(hpc_footprint *f, float span)
+{
+    for (int e = 0; e < 4; e++) {
+        const float di = f->e[e][1] * span, dj = f->e[e][2] * span;
+        f->dlo[e] = ms_minf(di, 0.0f) + ms_minf(dj, 0.0f);
+        f->dhi[e] = ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f);
+    }
+}
 
 static inline float inf_norm3(const float v[3]) { return ms_maxf(fabsf(v[0]), ms_maxf(fabsf(v[1]), fabsf(v[2]))); }
 
@@ -585,13 +597,7 @@ static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const fl
  * gs x gs samples (16 groups per operation). base: each function at each group's first sample, [e][gk]. */
 static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f, float base[4][64])
 {
-    const float span = (float)(sh->gs - 1);
-    float dlo[4], dhi[4];   /* each function's least and largest change from a group's first sample */
-    for (int e = 0; e < 4; e++) {
-        const float di = f->e[e][1] * span, dj = f->e[e][2] * span;
-        dlo[e] = ms_minf(di, 0.0f) + ms_minf(dj, 0.0f);
-        dhi[e] = ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f);
-    }
+    const float *dlo = f->dlo, *dhi = f->dhi;
     uint64_t cand = 0;
     for (int g0 = 0; g0 < sh->G; g0 += LANES) {
         const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
@@ -854,7 +860,6 @@ typedef struct hpc_view {
     int nt;
     const tri_job *t[2];
     hpc_footprint fp[2];
-    float V[2][3][3];   /* A, B, C of each triangle */
 } hpc_view;
 
 /* The lanes triangle t blocks of the 16-sample block at (i0, jb) of receiver q (live: the lanes to test), with
@@ -911,7 +916,7 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
     for (int u = 0; u < nt; u++) footprint_offsets(&v->fp[u], l16_load(off[wi][0]), l16_load(off[wi][1]), foff[u]);
     int32_t s = sh->slot[r];
     const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
-    float num[2] = { 0.0f, 0.0f };
+    float num[2] = { 0.0f, 0.0f }, V[2][3][3];   /* per triangle at its first exact test: offset, A, B, C */
     int have_num[2] = { 0, 0 };
     const int8_t *kz = NULL;
     const uint64_t gu0 = gu;
@@ -934,9 +939,14 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
             for (int u = 0; u < nt; u++) {
                 const unsigned live = ob & lanes[u] & ~hit;   /* a sample the first blocks needs no second test */
                 if (!live) continue;
-                if (!have_num[u]) { num[u] = ms_wt_offset(q->p, v->t[u]->v, v->t[u]->N); have_num[u] = 1; }
+                if (!have_num[u]) {
+                    num[u] = ms_wt_offset(q->p, v->t[u]->v, v->t[u]->N);
+                    for (int i = 0; i < 3; i++)
+                        for (int a = 0; a < 3; a++) V[u][i][a] = v->t[u]->v[3 * i + a] - q->p[a];
+                    have_num[u] = 1;
+                }
                 c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
-                hit |= block_hits(sh, q, g, kz, i0, jb, live, v->t[u], v->V[u], num[u]);
+                hit |= block_hits(sh, q, g, kz, i0, jb, live, v->t[u], V[u], num[u]);
             }
             if (!hit) continue;
             c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
@@ -969,10 +979,10 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
     hpc_view v;
     v.nt = 1;
     v.t[0] = t;
-    for (int a = 0; a < 3; a++)
-        for (int i = 0; i < 3; i++) v.V[0][i][a] = t->v[3 * i + a] - q->p[a];
-    footprint_setup(&v.fp[0], v.V[0][0], v.V[0][1], v.V[0][2], &g, q->p,
-                    sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
+    footprint_setup(&v.fp[0], A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
+    footprint_spans(&v.fp[0], (float)(sh->gs - 1));
     cast_footprint(sh, c, r, &g, &v);
 }
 
@@ -1037,6 +1047,14 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     record_umbra(sh, c, r, s, gu);
 }
 
+/* footprint_spans per lane: e1, e2 of 16 receivers' function; the least and largest change to dlo, dhi. */
+static inline void spans16(l16 e1, l16 e2, l16 span, l16 zero, float *dlo, float *dhi)
+{
+    const l16 di = l16_mul(e1, span), dj = l16_mul(e2, span);
+    l16_store(dlo, l16_add(l16_min(di, zero), l16_min(dj, zero)));
+    l16_store(dhi, l16_add(l16_max(di, zero), l16_max(dj, zero)));
+}
+
 /* The points of a leaf inside V_L against a job (a triangle, or a pair: pair_batch) with the footprint test,
  * 16 receivers per operation (departure: the paper handles a leaf's points one by one): the point-in-V_L test
  * (POINT-IN-VOLUME, the same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per
@@ -1078,7 +1096,8 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     /* footprint_setup per lane, per triangle */
     const l16 w[3] = { l16_load(W[0]), l16_load(W[1]), l16_load(W[2]) }, rel = l16_load(R);
     static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A */
-    float fe[2][4][3][LANES], fs[2][3][LANES];
+    float fe[2][4][3][LANES], fs[2][3][LANES], fdl[2][4][LANES], fdh[2][4][LANES];
+    const l16 span = l16_set1((float)(sh->gs - 1)), zero = l16_set1(0.0f);
     for (int u = 0; u < nt; u++) {
         l16 Y[3][3], nY[3];
         for (int vtx = 0; vtx < 3; vtx++) {
@@ -1099,12 +1118,14 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             l16_store(fe[u][e][0], c0);
             l16_store(fe[u][e][1], c1);
             l16_store(fe[u][e][2], c2);
+            spans16(c1, c2, span, zero, fdl[u][e], fdh[u][e]);
             l16_store(fs[u][e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
             esum[0] = l16_add(esum[0], c0);
             esum[1] = l16_add(esum[1], c1);
             esum[2] = l16_add(esum[2], c2);
         }
         for (int a = 0; a < 3; a++) l16_store(fe[u][3][a], esum[a]);
+        spans16(esum[1], esum[2], span, zero, fdl[u][3], fdh[u][3]);
     }
     for (unsigned m = act; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
@@ -1118,8 +1139,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             for (int e = 0; e < 4; e++)
                 for (int a = 0; a < 3; a++) view.fp[x].e[e][a] = fe[u][e][a][l];
             for (int e = 0; e < 3; e++) view.fp[x].s[e] = fs[u][e][l];
-            for (int i = 0; i < 3; i++)
-                for (int a = 0; a < 3; a++) view.V[x][i][a] = t[u].v[3 * i + a] - P[a][l];
+            for (int e = 0; e < 4; e++) { view.fp[x].dlo[e] = fdl[u][e][l]; view.fp[x].dhi[e] = fdh[u][e][l]; }
         }
         ms_grid g;
         memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
