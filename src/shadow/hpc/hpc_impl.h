@@ -56,6 +56,13 @@
  *    for hpc-scanline (whose Scanline kernel the slack does not bound) and under MS_HPC_OFF_FOOTPRINT.
  *    A leaf's points (up to 16 for hpc) take the point-in-V_L test and the footprint set-up 16 at a time,
  *    and the receivers are renumbered in hierarchy order so that a leaf's data lie together in memory.
+ *  - hpc casts two triangles that share an edge and a plane (a box's face, a mesh's quad) as one job
+ *    (pair_batch): one traversal, one V_L of their four points (hpc_volume_build_points), one per-receiver
+ *    loop over the groups and blocks, where each triangle's footprint keeps its own lanes and each triangle's
+ *    exact test runs on its own lanes, so the answers stay raytrace's. The paper names this extension
+ *    (sec. 5: "process multiple blocker triangles simultaneously") without doing it; on a GRIDS-like scene 95%
+ *    of the triangles pair up. A convex quad's own four edge functions were not used: on the shared edge they
+ *    would round differently from the two triangles' tests.
  *  - the triangles are ctx->bvh's: with the light's occluders (hpc_method.c), those of closed components
  *    facing away from the whole light are left out (docs/culling.md proves it changes no V or S).
  *  - hpc-scanline: the leaf rasterizes the triangle into the receiver's k x k buffer with the Scanline
