@@ -88,9 +88,10 @@
  *
  * Threads: the receiver points are split into spatially coherent chunks (the top of a middle-split
  * hierarchy, up to 16 per thread, the largest split first: make_chunks), each with its own hierarchy, masks
- * and umbra bits; every batch of triangles is read once, its V_L made once in parallel, and then every chunk processes the whole batch,
- * chunks scheduled dynamically over the threads. No point is shared between chunks, so there are no
- * locks, and the answer (an OR over triangles per relation) does not depend on the split. */
+ * and umbra bits; every batch of triangles is read once, its V_L made once in parallel, and then every chunk
+ * processes the whole batch, chunks scheduled dynamically over the threads. No point is shared between
+ * chunks, so there are no locks, and the answer (an OR over triangles per relation) does not depend on the
+ * split. */
 #include "hpc.h"
 #include "hpc_volume.h"
 #include "shadow/method.h"
