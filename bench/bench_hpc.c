@@ -16,7 +16,8 @@
  * --methods LIST: only these of raytrace, scanline, hpc, hpc-scanline (hpc always runs; absent columns "-").
  * --off LIST: hpc with parts turned off (ms_hpc_switches, src/shadow/hpc/hpc.h), to measure each alone:
  *        umbra (A), planesets (B), lazy (C), ondemand (D), sort, simdsamples, simdplanes, footprint (hpc's
- *        footprint test: the paper's group volumes instead). */
+ *        footprint test: the paper's group volumes instead), pairs (hpc's pairs of triangles sharing an edge:
+ *        each triangle alone). */
 #include "microshadow.h"
 #include "shadow/hpc/hpc.h"
 #include <stdint.h>
@@ -95,10 +96,10 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ","))
                 for (int m = 0; m < NM; m++) run[m] |= !strcmp(t, methods[m]);
         } else if (!strcmp(argv[first], "--off")) {
-            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint" };
+            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs" };
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ",")) {
                 int found = 0;
-                for (int b = 0; b < 8; b++)
+                for (int b = 0; b < (int)(sizeof names / sizeof *names); b++)
                     if (!strcmp(t, names[b])) { ms_hpc_switches |= 1 << b; found = 1; }
                 if (!found) { fprintf(stderr, "bench_hpc: --off: unknown part %s\n", t); return 2; }
             }

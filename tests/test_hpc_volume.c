@@ -107,11 +107,85 @@ static void test_active_planes(void **st)
     assert_true(hpc_volume_box(&v, HPC_ALL_PLANES, lo2, hi2, &out, &tests));
 }
 
+/* A blocker of four points (hpc casts two triangles sharing an edge as one job, hpc_impl.h pair_batch): for
+ * random pairs, flat (a quad, convex or not) and folded along the shared edge, every point either triangle
+ * shadows lies inside the volume of the four points, with margin 0 up to rounding; and the volume still
+ * culls (a point beside the light is outside; the flat pair's volume keeps its cap). The points are given
+ * in pair_batch's order: the first triangle's three, then the second's other vertex. */
+static void test_pair_contains_both_shadows(void **st)
+{
+    (void)st;
+    tu_rng rng = { 0xFA1D };
+    long shadowed = 0, capped = 0, flat = 0;
+    for (int trial = 0; trial < 400; trial++) {
+        const double lx = 0.2 + 2.0 * unitd(&rng), lz = 0.2 + 2.0 * unitd(&rng);
+        const double poly[12] = { -lx, 4, -lz, lx, 4, -lz, lx, 4, lz, -lx, 4, lz };
+        float pts[12];
+        for (int v = 0; v < 3; v++) {
+            pts[3 * v] = (float)(3.0 * unitd(&rng) - 1.5);
+            pts[3 * v + 1] = (float)(0.5 + 3.0 * unitd(&rng));
+            pts[3 * v + 2] = (float)(3.0 * unitd(&rng) - 1.5);
+        }
+        /* the fourth point: across the edge (0, 2) from point 1, in the plane (even trials) or off it */
+        const double m = 0.3 + 0.7 * unitd(&rng), w = 0.2 + unitd(&rng), fold = trial % 2 ? 0.8 * unitd(&rng) - 0.4 : 0.0;
+        double nrm[3], e1[3], e2[3];
+        for (int c = 0; c < 3; c++) { e1[c] = pts[3 + c] - pts[c]; e2[c] = pts[6 + c] - pts[c]; }
+        nrm[0] = e1[1] * e2[2] - e1[2] * e2[1]; nrm[1] = e1[2] * e2[0] - e1[0] * e2[2]; nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        const double nl = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        if (!(nl > 1e-3)) continue;
+        for (int c = 0; c < 3; c++) {
+            const double mid = pts[c] + m * e2[c];
+            pts[9 + c] = (float)(mid - w * (pts[3 + c] - mid) + fold * nrm[c] / nl);
+        }
+        if (!(pts[10] > 0.3f && pts[10] < 3.7f)) continue;   /* below the light, as the triangles */
+        hpc_volume vol;
+        hpc_volume_build_points(&vol, poly, 4, pts, 4, 0.0f);
+        assert_false(vol.unbounded);
+        if (fold == 0.0) {   /* the cap comes last (the blocker's plane): when the first triangle has one */
+            hpc_volume one;
+            hpc_volume_build(&one, poly, 4, pts, 0.0f);
+            const float *c = vol.pl[vol.n - 1], *c1 = one.pl[one.n - 1];
+            const int cap1 = fabs(c1[0] * nrm[0] + c1[1] * nrm[1] + c1[2] * nrm[2]) > 0.999 * nl;
+            flat += cap1;
+            capped += cap1 && fabs(c[0] * nrm[0] + c[1] * nrm[1] + c[2] * nrm[2]) > 0.999 * nl;
+        }
+        static const int tri_of[2][3] = { { 0, 1, 2 }, { 0, 2, 3 } };
+        for (int k = 0; k < 200; k++) {
+            const int *tv = tri_of[k & 1];
+            double a = unitd(&rng), b = unitd(&rng);
+            if (a + b > 1) { a = 1 - a; b = 1 - b; }
+            double l[3] = { -lx + 2 * lx * unitd(&rng), 4, -lz + 2 * lz * unitd(&rng) }, t[3], x[3];
+            for (int c = 0; c < 3; c++)
+                t[c] = pts[3 * tv[0] + c] + a * (pts[3 * tv[1] + c] - pts[3 * tv[0] + c]) + b * (pts[3 * tv[2] + c] - pts[3 * tv[0] + c]);
+            const double s = 1.0 + 5.0 * unitd(&rng);
+            for (int c = 0; c < 3; c++) x[c] = l[c] + s * (t[c] - l[c]);
+            const float p[3] = { (float)x[0], (float)x[1], (float)x[2] };
+            uint64_t tests = 0;
+            vol.eps = 1e-4f;
+            if (!hpc_volume_point(&vol, HPC_ALL_PLANES, p, &tests))
+                fail_msg("trial %d: point (%g %g %g) shadowed by triangle %d outside the pair's volume", trial, x[0], x[1],
+                         x[2], k & 1);
+            shadowed++;
+        }
+        /* beside the light, above the blocker: culled */
+        const float far[3] = { (float)(lx + 3.0), 4.5f, (float)(lz + 3.0) };
+        uint64_t tests = 0;
+        vol.eps = 1e-4f;
+        assert_false(hpc_volume_point(&vol, HPC_ALL_PLANES, far, &tests));
+    }
+    printf("%ld points shadowed by either triangle of a pair all inside its volume; %ld of %ld flat pairs whose "
+           "first triangle has a cap have one\n", shadowed, capped, flat);
+    assert_true(shadowed > 40000);
+    assert_true(flat > 50);
+    assert_int_equal(capped, flat);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_contains_every_shadow),
         cmocka_unit_test(test_active_planes),
+        cmocka_unit_test(test_pair_contains_both_shadows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

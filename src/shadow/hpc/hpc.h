@@ -54,7 +54,8 @@ enum {
     MS_HPC_OFF_SORT = 16,        /* coarse blocker sorting: the scene's order (hpc_method.c) */
     MS_HPC_OFF_SIMD_SAMPLES = 32,/* the 16-lane sample test: one sample at a time (the scalar form) */
     MS_HPC_OFF_SIMD_PLANES = 64, /* the 16-lane volume tests: one plane at a time */
-    MS_HPC_OFF_FOOTPRINT = 128   /* hpc's footprint test (hpc_impl.h): the group volumes V_Gk, as the paper */
+    MS_HPC_OFF_FOOTPRINT = 128,  /* hpc's footprint test (hpc_impl.h): the group volumes V_Gk, as the paper */
+    MS_HPC_OFF_PAIRS = 256       /* hpc's pairs (pair_batch, hpc_impl.h): every triangle cast alone */
 };
 extern int ms_hpc_switches;
 

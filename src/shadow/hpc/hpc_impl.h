@@ -56,6 +56,13 @@
  *    for hpc-scanline (whose Scanline kernel the slack does not bound) and under MS_HPC_OFF_FOOTPRINT.
  *    A leaf's points (up to 16 for hpc) take the point-in-V_L test and the footprint set-up 16 at a time,
  *    and the receivers are renumbered in hierarchy order so that a leaf's data lie together in memory.
+ *  - hpc casts two triangles that share an edge and a plane (a box's face, a mesh's quad) as one job
+ *    (pair_batch): one traversal, one V_L of their four points (hpc_volume_build_points), one per-receiver
+ *    loop over the groups and blocks, where each triangle's footprint keeps its own lanes and each triangle's
+ *    exact test runs on its own lanes, so the answers stay raytrace's. The paper names this extension
+ *    (sec. 5: "process multiple blocker triangles simultaneously") without doing it; on a GRIDS-like scene 95%
+ *    of the triangles pair up. A convex quad's own four edge functions were not used: on the shared edge they
+ *    would round differently from the two triangles' tests.
  *  - the triangles are ctx->bvh's: with the light's occluders (hpc_method.c), those of closed components
  *    facing away from the whole light are left out (docs/culling.md proves it changes no V or S).
  *  - hpc-scanline: the leaf rasterizes the triangle into the receiver's k x k buffer with the Scanline
@@ -80,10 +87,11 @@
  * Measuring switches (ms_hpc_switches, hpc.h) turn off each optimisation of sec. 3.3 and each SIMD form.
  *
  * Threads: the receiver points are split into spatially coherent chunks (the top of a middle-split
- * hierarchy, about 4 per thread), each with its own hierarchy, masks and umbra bits; every batch of
- * triangles is read once, its V_L made once in parallel, and then every chunk processes the whole batch,
- * chunks scheduled dynamically over the threads. No point is shared between chunks, so there are no
- * locks, and the answer (an OR over triangles per relation) does not depend on the split. */
+ * hierarchy, up to 16 per thread, the largest split first: make_chunks), each with its own hierarchy, masks
+ * and umbra bits; every batch of triangles is read once, its V_L made once in parallel, and then every chunk
+ * processes the whole batch, chunks scheduled dynamically over the threads. No point is shared between
+ * chunks, so there are no locks, and the answer (an OR over triangles per relation) does not depend on the
+ * split. */
 #include "hpc.h"
 #include "hpc_volume.h"
 #include "shadow/method.h"
@@ -135,6 +143,8 @@ typedef struct hnode {
 typedef struct tri_job {
     float v[9], N[3];
     uint32_t self;           /* the triangle's id: receivers on it are not blocked by it */
+    int pair;                /* 1: cast together with the next job (a triangle sharing an edge), vl bounds both;
+                              * -1: cast with the previous one (its vl unused); 0: alone (pair_batch) */
     hpc_volume vl;
 } tri_job;
 
@@ -153,6 +163,7 @@ typedef struct shared {
     double group_poly[64][12];
     float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
     int footprint;                   /* hpc (not hpc-scanline) with the footprint test: no V_Gk */
+    int pairs;                       /* footprint with p0: triangles sharing an edge cast in pairs (pair_batch) */
     float grid_ds[3], grid_dt[3];    /* the grid's steps, the same for every pixel (pattern.c) */
     float *p0;                       /* per receiver: its grid's origin and footprint_rel (NULL: formed per pair) */
     float light_lo[3], light_hi[3], scale;
@@ -524,7 +535,19 @@ static int alpha_opaque(const shared *sh, const tri_job *t, const ms_shadow_quer
 typedef struct hpc_footprint {
     float e[4][3];   /* per edge function, and their sum (e[3]): e0, e1 (per column i), e2 (per row j) */
     float s[3];      /* per edge function: the slack */
+    float dlo[4], dhi[4];   /* each function's least and largest change over a group from its first sample */
 } hpc_footprint;
+
+/* dlo, dhi of a group of gs x gs samples (span = gs - 1) from the coefficients e1, e2 (footprint_groups);
+ * cast_leaf_footprint forms the same per lane, 16 receivers at once. */
+static void footprint_spans(hpc_footprint *f, float span)
+{
+    for (int e = 0; e < 4; e++) {
+        const float di = f->e[e][1] * span, dj = f->e[e][2] * span;
+        f->dlo[e] = ms_minf(di, 0.0f) + ms_minf(dj, 0.0f);
+        f->dhi[e] = ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f);
+    }
+}
 
 static inline float inf_norm3(const float v[3]) { return ms_maxf(fabsf(v[0]), ms_maxf(fabsf(v[1]), fabsf(v[2]))); }
 
@@ -579,24 +602,19 @@ static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const fl
 }
 
 /* The groups (bit gk) whose samples the footprint may hold, bounding each edge function over the group's
- * gs x gs samples (16 groups per operation). */
-static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
+ * gs x gs samples (16 groups per operation). base: each function at each group's first sample, [e][gk]. */
+static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f, float base[4][64])
 {
-    const float span = (float)(sh->gs - 1);
-    float dlo[4], dhi[4];   /* each function's least and largest change from a group's first sample */
-    for (int e = 0; e < 4; e++) {
-        const float di = f->e[e][1] * span, dj = f->e[e][2] * span;
-        dlo[e] = ms_minf(di, 0.0f) + ms_minf(dj, 0.0f);
-        dhi[e] = ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f);
-    }
+    const float *dlo = f->dlo, *dhi = f->dhi;
     uint64_t cand = 0;
     for (int g0 = 0; g0 < sh->G; g0 += LANES) {
         const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
         l16 lo[4], hi[4];
         for (int e = 0; e < 4; e++) {
-            const l16 base = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
-            lo[e] = l16_add(base, l16_set1(dlo[e]));
-            hi[e] = l16_add(base, l16_set1(dhi[e]));
+            const l16 b = l16_add(l16_add(l16_set1(f->e[e][0]), l16_mul(l16_set1(f->e[e][1]), gi)), l16_mul(l16_set1(f->e[e][2]), gj));
+            l16_store(base[e] + g0, b);
+            lo[e] = l16_add(b, l16_set1(dlo[e]));
+            hi[e] = l16_add(b, l16_set1(dhi[e]));
         }
         cand |= (uint64_t)footprint_keep(lo, hi, f->s) << g0;
     }
@@ -604,11 +622,13 @@ static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f)
 }
 
 /* The lanes of the 16-sample block at (i0, j0) the footprint may hold; off[e]: the block's offsets
- * e1 di + e2 dj per lane, made once per pair (footprint_offsets). */
-static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0, int j0)
+ * e1 di + e2 dj per lane, made once per pair (footprint_offsets). gbase: the functions at the block's first
+ * sample when it is a group's first (footprint_groups made them), else NULL. */
+static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0, int j0, const float *gbase, int gk)
 {
     l16 E[4];
-    for (int e = 0; e < 4; e++) E[e] = l16_add(l16_set1(f->e[e][0] + f->e[e][1] * (float)i0 + f->e[e][2] * (float)j0), off[e]);
+    for (int e = 0; e < 4; e++)
+        E[e] = l16_add(l16_set1(gbase ? gbase[64 * e + gk] : f->e[e][0] + f->e[e][1] * (float)i0 + f->e[e][2] * (float)j0), off[e]);
     return footprint_keep(E, E, f->s);
 }
 
@@ -842,53 +862,70 @@ static inline unsigned block_open(const uint64_t *open, int k, int i0, int jb, i
            (unsigned)(open[s2 >> 6] >> (s2 & 63) & 15u) << 8 | (unsigned)(open[s3 >> 6] >> (s3 & 63) & 15u) << 12;
 }
 
-/* Receiver r inside V_L against the triangle, with the footprint test in place of V_Gk (above): the groups
- * it may touch, then in each the lanes it may hold, and the exact test only on those that are open. The
- * mask, the packets' shear axes and the plane offset are made only when some lane needs the exact test. */
-static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *g, const float A[3],
-                           const float B[3], const float C[3], const hpc_footprint *fp);
+/* A receiver's view of a job (one triangle, or two sharing an edge cast together: pair_batch): the triangles
+ * that may block it (not its own), each with its footprint and its vertices relative to the receiver. */
+typedef struct hpc_view {
+    int nt;
+    const tri_job *t[2];
+    hpc_footprint fp[2];
+} hpc_view;
 
-static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t)
+/* The lanes triangle t blocks of the 16-sample block at (i0, jb) of receiver q (live: the lanes to test), with
+ * the 16-lane test or, switched off, one lane at a time; alpha-tested triangles only where opaque. */
+static unsigned block_hits(const shared *sh, const ms_shadow_query *q, const ms_grid *g, const int8_t *kz, int i0, int jb,
+                           unsigned live, const tri_job *t, const float V[3][3], float num)
 {
-    const ms_shadow_query *q = &sh->q[r];
-    ms_grid g;
-    if (sh->p0) {
-        memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
-        memcpy(g.ds, sh->grid_ds, sizeof g.ds);
-        memcpy(g.dt, sh->grid_dt, sizeof g.dt);
-        g.k = sh->k;
+    const int k = sh->k, gs = sh->gs;
+    unsigned hit;
+    if (sh->sw & MS_HPC_OFF_SIMD_SAMPLES) {   /* one lane at a time, the scalar form */
+        hit = 0;
+        for (unsigned b = live; b; b &= b - 1) {
+            const int l = __builtin_ctz(b), i = i0 + l % gs, j = jb + l / gs;
+            float d[3];
+            for (int a = 0; a < 3; a++) d[a] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
+            hit |= (unsigned)sample_blocked(q->p, d, kz[(j * k + i) / LANES], t->v, t->N, V[0], V[1], V[2], num,
+                                            sh->ctx->near, sh->ctx->far) << l;
+        }
     } else {
-        ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g);
+        hit = group_block16(sh, q, g, kz, i0, jb, gs, live, t, V[0], V[1], V[2], num);
     }
-    float A[3], B[3], C[3];
-    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
-    hpc_footprint fp;
-    footprint_setup(&fp, A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
-    cast_footprint(sh, c, r, t, &g, A, B, C, &fp);
+    if (hit && ms_alpha_tested(sh->ctx->alpha, t->self))
+        for (unsigned b = hit; b; b &= b - 1) {
+            const int l = __builtin_ctz(b);
+            if (!alpha_opaque(sh, t, q, g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
+        }
+    return hit;
 }
 
-/* Receiver r's samples against the triangle from its footprint fp (made by footprint_setup or, for a leaf's
- * points at once, by cast_leaf_footprint); A, B, C: the vertices relative to it, g: its grid. */
-static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t, const ms_grid *g, const float A[3],
-                           const float B[3], const float C[3], const hpc_footprint *fp)
+/* Receiver r inside V_L against a job's triangles (v), with the footprint test in place of V_Gk (above): the
+ * groups some triangle's footprint may touch, then in each block the lanes each footprint may hold, and the
+ * exact test of each triangle only on those of its lanes that are still open. A sample is blocked when one of
+ * the triangles blocks it, as raytrace's any-hit over both: the pair shares the traversal, the V_L test, the
+ * per-pair set-up and the block loop, never the exact test (a convex quad's own edge functions would round
+ * differently on the shared edge). The mask, the packets' shear axes and the plane offsets are made only
+ * when some lane needs the exact test. */
+static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid *g, const hpc_view *v)
 {
     const ms_shadow_query *q = &sh->q[r];
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
-    /* The open groups the footprint may touch (a node's umbra groups are its points' too). */
-    const uint64_t todo = footprint_groups(sh, fp) & ~gu;
+    /* The open groups a footprint may touch (a node's umbra groups are its points' too). */
+    float base[2][4][64];   /* each function at each group's first sample (footprint_groups) */
+    uint64_t todo = footprint_groups(sh, &v->fp[0], base[0]);
+    if (v->nt > 1) todo |= footprint_groups(sh, &v->fp[1], base[1]);
+    todo &= ~gu;
     if (!todo) return;
     static const float off[2][2][LANES] = {
         { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
         { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
-    const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8;
+    const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8, nt = v->nt;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
-    l16 foff[4];
-    footprint_offsets(fp, l16_load(off[wi][0]), l16_load(off[wi][1]), foff);
-    const int alpha = ms_alpha_tested(sh->ctx->alpha, t->self);
+    l16 foff[2][4];
+    for (int u = 0; u < nt; u++) footprint_offsets(&v->fp[u], l16_load(off[wi][0]), l16_load(off[wi][1]), foff[u]);
     int32_t s = sh->slot[r];
     const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
-    float num = 0.0f;
+    float num[2] = { 0.0f, 0.0f }, V[2][3][3];   /* per triangle at its first exact test: offset, A, B, C */
+    int have_num[2] = { 0, 0 };
     const int8_t *kz = NULL;
     const uint64_t gu0 = gu;
     for (uint64_t m = todo; m; m &= m - 1) {
@@ -896,35 +933,29 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job
         const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
         unsigned any = 0;
         for (int jb = j0; jb < j0 + gs; jb += rows) {
-            const unsigned lanes = footprint_lanes(fp, foff, i0, jb);
-            if (!lanes) continue;
-            const unsigned live = block_open(open, k, i0, jb, gs) & lanes;
-            if (!live) continue;
-            if (!kz) {   /* the first exact test of this pair */
+            unsigned lanes[2] = { footprint_lanes(&v->fp[0], foff[0], i0, jb, jb == j0 ? &base[0][0][0] : NULL, gk), 0u };
+            if (nt > 1) lanes[1] = footprint_lanes(&v->fp[1], foff[1], i0, jb, jb == j0 ? &base[1][0][0] : NULL, gk);
+            if (!(lanes[0] | lanes[1])) continue;
+            const unsigned ob = block_open(open, k, i0, jb, gs);
+            if (!(ob & (lanes[0] | lanes[1]))) continue;
+            if (!kz) {   /* the first exact test of this receiver and job */
                 if (s < 0 && (s = slot_of(sh, c, r, g)) < 0) return;
                 open = slot_mask(sh, c, s);
                 kz = slot_kz(sh, c, s);
-                num = ms_wt_offset(q->p, t->v, t->N);
             }
-            c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
-            unsigned hit;
-            if (sh->sw & MS_HPC_OFF_SIMD_SAMPLES) {   /* one lane at a time, the scalar form */
-                hit = 0;
-                for (unsigned b = live; b; b &= b - 1) {
-                    const int l = __builtin_ctz(b), i = i0 + l % gs, j = jb + l / gs;
-                    float d[3];
-                    for (int a = 0; a < 3; a++) d[a] = (g->p0[a] + (float)i * g->ds[a] + (float)j * g->dt[a]) - q->p[a];
-                    hit |= (unsigned)sample_blocked(q->p, d, kz[(j * k + i) / LANES], t->v, t->N, A, B, C, num, sh->ctx->near,
-                                                    sh->ctx->far) << l;
+            unsigned hit = 0;
+            for (int u = 0; u < nt; u++) {
+                const unsigned live = ob & lanes[u] & ~hit;   /* a sample the first blocks needs no second test */
+                if (!live) continue;
+                if (!have_num[u]) {
+                    num[u] = ms_wt_offset(q->p, v->t[u]->v, v->t[u]->N);
+                    for (int i = 0; i < 3; i++)
+                        for (int a = 0; a < 3; a++) V[u][i][a] = v->t[u]->v[3 * i + a] - q->p[a];
+                    have_num[u] = 1;
                 }
-            } else {
-                hit = group_block16(sh, q, g, kz, i0, jb, gs, live, t, A, B, C, num);
+                c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
+                hit |= block_hits(sh, q, g, kz, i0, jb, live, v->t[u], V[u], num[u]);
             }
-            if (hit && alpha)
-                for (unsigned b = hit; b; b &= b - 1) {
-                    const int l = __builtin_ctz(b);
-                    if (!alpha_opaque(sh, t, q, g, i0 + l % gs, jb + l / gs)) hit &= ~(1u << l);
-                }
             if (!hit) continue;
             c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
             any |= hit;
@@ -937,6 +968,30 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job
         if (any && group_done(sh, open, gk)) gu |= UINT64_C(1) << gk;
     }
     if (gu != gu0) record_umbra(sh, c, r, s, gu);
+}
+
+/* One receiver against one triangle with the footprint test (receivers without their grid origins formed
+ * up front, or in a leaf of more than 16 points). */
+static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const tri_job *t)
+{
+    const ms_shadow_query *q = &sh->q[r];
+    ms_grid g;
+    if (sh->p0) {
+        memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
+        memcpy(g.ds, sh->grid_ds, sizeof g.ds);
+        memcpy(g.dt, sh->grid_dt, sizeof g.dt);
+        g.k = sh->k;
+    } else {
+        ms_grid_for_pixel(&sh->ctx->light, sh->k, q->px, q->py, sh->ctx->seed, &g);
+    }
+    hpc_view v;
+    v.nt = 1;
+    v.t[0] = t;
+    float A[3], B[3], C[3];
+    for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
+    footprint_setup(&v.fp[0], A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
+    footprint_spans(&v.fp[0], (float)(sh->gs - 1));
+    cast_footprint(sh, c, r, &g, &v);
 }
 
 /* One receiver of a leaf against the triangle (L56-L75). */
@@ -1000,20 +1055,31 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
     record_umbra(sh, c, r, s, gu);
 }
 
-/* The points of a leaf inside V_L against the triangle with the footprint test, 16 receivers per operation
- * (departure: the paper handles a leaf's points one by one): the point-in-V_L test (POINT-IN-VOLUME, the
- * same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per lane), then each
- * point's groups and samples (cast_footprint). */
+/* footprint_spans per lane: e1, e2 of 16 receivers' function; the least and largest change to dlo, dhi. */
+static inline void spans16(l16 e1, l16 e2, l16 span, l16 zero, float *dlo, float *dhi)
+{
+    const l16 di = l16_mul(e1, span), dj = l16_mul(e2, span);
+    l16_store(dlo, l16_add(l16_min(di, zero), l16_min(dj, zero)));
+    l16_store(dhi, l16_add(l16_max(di, zero), l16_max(dj, zero)));
+}
+
+/* The points of a leaf inside V_L against a job (a triangle, or a pair: pair_batch) with the footprint test,
+ * 16 receivers per operation (departure: the paper handles a leaf's points one by one): the point-in-V_L test
+ * (POINT-IN-VOLUME, the same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per
+ * lane, per triangle), then each point's groups and samples (cast_footprint). */
 _Static_assert(LEAF_POINTS_FOOTPRINT <= LANES, "a leaf's points fit the lanes");
 static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, const tri_job *t, uint32_t pl)
 {
+    const int nt = t->pair > 0 ? 2 : 1;
     float P[3][LANES] = { { 0 } }, W[3][LANES] = { { 0 } }, R[LANES] = { 0 };
     uint32_t rr[LANES];
-    unsigned act = 0;
+    unsigned act = 0, on[2] = { 0, 0 };   /* on[u]: the lanes triangle u may block (not their own) */
     for (uint32_t i = 0; i < N->count; i++) {
         const uint32_t r = c->idx[N->first + i];
         rr[i] = r;
-        if (sh->full[r] || sh->q[r].prim == t->self) continue;
+        if (sh->full[r]) continue;
+        for (int u = 0; u < nt; u++) on[u] |= (unsigned)(sh->q[r].prim != t[u].self) << i;
+        if (!((on[0] | on[1]) >> i & 1u)) continue;
         act |= 1u << i;
         for (int a = 0; a < 3; a++) { P[a][i] = sh->q[r].p[a]; W[a][i] = sh->p0[4 * (size_t)r + a] - P[a][i]; }
         R[i] = sh->p0[4 * (size_t)r + 3];
@@ -1034,54 +1100,61 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
         act &= ~l16_lt(d, neps);
     }
     if (!act) return;
-    c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act);
-    /* footprint_setup per lane */
-    l16 Y[3][3], nY[3];
-    for (int vtx = 0; vtx < 3; vtx++) {
-        const l16 pc[3] = { px, py, pz };
-        for (int a = 0; a < 3; a++) Y[vtx][a] = l16_sub(l16_set1(t->v[3 * vtx + a]), pc[a]);
-        nY[vtx] = l16_max(l16_abs(Y[vtx][0]), l16_max(l16_abs(Y[vtx][1]), l16_abs(Y[vtx][2])));
-    }
+    c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act & on[0]) + (uint64_t)__builtin_popcount(act & on[1]);
+    /* footprint_setup per lane, per triangle */
     const l16 w[3] = { l16_load(W[0]), l16_load(W[1]), l16_load(W[2]) }, rel = l16_load(R);
     static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A */
-    float fe[4][3][LANES], fs[3][LANES];
-    l16 esum[3];
-    for (int e = 0; e < 3; e++) {
-        const l16 *y1 = Y[pair[e][0]], *y2 = Y[pair[e][1]];
-        const l16 X[3] = { l16_sub(l16_mul(y1[1], y2[2]), l16_mul(y1[2], y2[1])), l16_sub(l16_mul(y1[2], y2[0]), l16_mul(y1[0], y2[2])),
-                           l16_sub(l16_mul(y1[0], y2[1]), l16_mul(y1[1], y2[0])) };
-        const l16 c0 = l16_add(l16_add(l16_mul(X[0], w[0]), l16_mul(X[1], w[1])), l16_mul(X[2], w[2]));
-        const l16 c1 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_ds[0])), l16_mul(X[1], l16_set1(sh->grid_ds[1]))),
-                               l16_mul(X[2], l16_set1(sh->grid_ds[2])));
-        const l16 c2 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_dt[0])), l16_mul(X[1], l16_set1(sh->grid_dt[1]))),
-                               l16_mul(X[2], l16_set1(sh->grid_dt[2])));
-        l16_store(fe[e][0], c0);
-        l16_store(fe[e][1], c1);
-        l16_store(fe[e][2], c2);
-        l16_store(fs[e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
-        if (e == 0) { esum[0] = c0; esum[1] = c1; esum[2] = c2; }
-        else { esum[0] = l16_add(esum[0], c0); esum[1] = l16_add(esum[1], c1); esum[2] = l16_add(esum[2], c2); }
+    float fe[2][4][3][LANES], fs[2][3][LANES], fdl[2][4][LANES], fdh[2][4][LANES];
+    const l16 span = l16_set1((float)(sh->gs - 1)), zero = l16_set1(0.0f);
+    for (int u = 0; u < nt; u++) {
+        l16 Y[3][3], nY[3];
+        for (int vtx = 0; vtx < 3; vtx++) {
+            const l16 pc[3] = { px, py, pz };
+            for (int a = 0; a < 3; a++) Y[vtx][a] = l16_sub(l16_set1(t[u].v[3 * vtx + a]), pc[a]);
+            nY[vtx] = l16_max(l16_abs(Y[vtx][0]), l16_max(l16_abs(Y[vtx][1]), l16_abs(Y[vtx][2])));
+        }
+        l16 esum[3] = { l16_set1(0.0f), l16_set1(0.0f), l16_set1(0.0f) };   /* 0 + x = x */
+        for (int e = 0; e < 3; e++) {
+            const l16 *y1 = Y[pair[e][0]], *y2 = Y[pair[e][1]];
+            const l16 X[3] = { l16_sub(l16_mul(y1[1], y2[2]), l16_mul(y1[2], y2[1])), l16_sub(l16_mul(y1[2], y2[0]), l16_mul(y1[0], y2[2])),
+                               l16_sub(l16_mul(y1[0], y2[1]), l16_mul(y1[1], y2[0])) };
+            const l16 c0 = l16_add(l16_add(l16_mul(X[0], w[0]), l16_mul(X[1], w[1])), l16_mul(X[2], w[2]));
+            const l16 c1 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_ds[0])), l16_mul(X[1], l16_set1(sh->grid_ds[1]))),
+                                   l16_mul(X[2], l16_set1(sh->grid_ds[2])));
+            const l16 c2 = l16_add(l16_add(l16_mul(X[0], l16_set1(sh->grid_dt[0])), l16_mul(X[1], l16_set1(sh->grid_dt[1]))),
+                                   l16_mul(X[2], l16_set1(sh->grid_dt[2])));
+            l16_store(fe[u][e][0], c0);
+            l16_store(fe[u][e][1], c1);
+            l16_store(fe[u][e][2], c2);
+            spans16(c1, c2, span, zero, fdl[u][e], fdh[u][e]);
+            l16_store(fs[u][e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
+            esum[0] = l16_add(esum[0], c0);
+            esum[1] = l16_add(esum[1], c1);
+            esum[2] = l16_add(esum[2], c2);
+        }
+        for (int a = 0; a < 3; a++) l16_store(fe[u][3][a], esum[a]);
+        spans16(esum[1], esum[2], span, zero, fdl[u][3], fdh[u][3]);
     }
-    for (int a = 0; a < 3; a++) l16_store(fe[3][a], esum[a]);
     for (unsigned m = act; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         const uint32_t r = rr[l];
-        hpc_footprint fp;
-        for (int e = 0; e < 4; e++)
-            for (int a = 0; a < 3; a++) fp.e[e][a] = fe[e][a][l];
-        for (int e = 0; e < 3; e++) fp.s[e] = fs[e][l];
+        hpc_view view;
+        view.nt = 0;
+        for (int u = 0; u < nt; u++) {
+            if (!(on[u] >> l & 1u)) continue;
+            const int x = view.nt++;
+            view.t[x] = &t[u];
+            for (int e = 0; e < 4; e++)
+                for (int a = 0; a < 3; a++) view.fp[x].e[e][a] = fe[u][e][a][l];
+            for (int e = 0; e < 3; e++) view.fp[x].s[e] = fs[u][e][l];
+            for (int e = 0; e < 4; e++) { view.fp[x].dlo[e] = fdl[u][e][l]; view.fp[x].dhi[e] = fdh[u][e][l]; }
+        }
         ms_grid g;
         memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
         memcpy(g.ds, sh->grid_ds, sizeof g.ds);
         memcpy(g.dt, sh->grid_dt, sizeof g.dt);
         g.k = sh->k;
-        float Av[3], Bv[3], Cv[3];
-        for (int a = 0; a < 3; a++) {
-            Av[a] = t->v[a] - P[a][l];
-            Bv[a] = t->v[3 + a] - P[a][l];
-            Cv[a] = t->v[6 + a] - P[a][l];
-        }
-        cast_footprint(sh, c, r, t, &g, Av, Bv, Cv, &fp);
+        cast_footprint(sh, c, r, &g, &view);
     }
 }
 
@@ -1114,8 +1187,9 @@ static void cast_node(const shared *sh, chunk *c, uint32_t ni, const tri_job *t,
         N->full = c->nodes[l].full & c->nodes[l + 1].full;
     } else {
         if (sh->footprint && sh->p0 && N->count <= LANES) cast_leaf_footprint(sh, c, N, t, pl2);
-        else
-            for (uint32_t i = N->first; i < N->first + N->count; i++) cast_point(sh, c, c->idx[i], t, pl2, ag2, n2);
+        else   /* a pair's second triangle: its vl is the pair's (prepare_batch); pairs only with the footprint */
+            for (int u = 0; u < (t->pair > 0 ? 2 : 1); u++)
+                for (uint32_t i = N->first; i < N->first + N->count; i++) cast_point(sh, c, c->idx[i], &t[u], pl2, ag2, n2);
         node_bits_from_points(sh, c, N);
     }
 }
@@ -1134,7 +1208,9 @@ static void cast_triangle(const shared *sh, chunk *c, const tri_job *t)
     }
     c->cnt[C_TRI_CHUNK_PASSES]++;
     c->gvol_built = 0;
-    if (sh->sw & MS_HPC_OFF_LAZY) build_group_volumes(sh, c, t);   /* C off: before the traversal */
+    /* C off: before the traversal (not for a pair: the group volumes are one triangle's, and they would cull
+     * nodes for the other; with the footprint test they serve only that node culling) */
+    if ((sh->sw & MS_HPC_OFF_LAZY) && t->pair <= 0) build_group_volumes(sh, c, t);
     act_group ag[64];
     for (int g = 0; g < sh->G; g++) ag[g] = (act_group){ (uint32_t)g, HPC_ALL_PLANES };
     cast_node(sh, c, 0, t, HPC_ALL_PLANES, ag, sh->G);
@@ -1142,36 +1218,101 @@ static void cast_triangle(const shared *sh, chunk *c, const tri_job *t)
 
 /* ---- the frame ---- */
 
-/* Splits the receivers into chunks of at most `target` points by middle splits; returns the count. */
+/* Splits the receivers into at most cap chunks by middle splits, always the one with the most points next,
+ * until every chunk holds at most `target` points; returns the count. Splitting the largest first keeps the
+ * chunks' sizes even when the cap runs out: depth first, empty regions used up the cap and left a GRIDS-like
+ * frame's densest region as one chunk of 28% of the points, which one thread cast alone while the other
+ * waited at the batch's end (at 1024² the last batch took 4.9 s of wall time for 5.0 s of CPU). */
 static int make_chunks(const shared *sh, uint32_t *idx, uint32_t n, uint32_t target, chunk *out, int cap)
 {
     typedef struct { uint32_t b, n; } range;
-    range *st = malloc((size_t)(2 * cap + 64) * sizeof *st);
-    if (!st) return -1;
-    int sp = 0, nc = 0;
-    st[sp++] = (range){ 0, n };
-    while (sp) {
-        const range r = st[--sp];
-        if (r.n <= target || nc + sp + 2 > cap) {
-            out[nc].idx = idx + r.b;
-            out[nc].n = r.n;
-            nc++;
-            continue;
-        }
+    range *r = malloc((size_t)cap * sizeof *r);
+    if (!r) return -1;
+    int nc = 1;
+    r[0] = (range){ 0, n };
+    while (nc < cap) {
+        int big = 0;
+        for (int i = 1; i < nc; i++)
+            if (r[i].n > r[big].n) big = i;
+        if (r[big].n <= target) break;
+        const range x = r[big];
         float lo[3], hi[3];
-        bounds_of(sh, idx + r.b, r.n, lo, hi);
+        bounds_of(sh, idx + x.b, x.n, lo, hi);
         const float ext[3] = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
         const int axis = ext[0] >= ext[1] ? (ext[0] >= ext[2] ? 0 : 2) : (ext[1] >= ext[2] ? 1 : 2);
-        uint32_t m = partition(sh, idx + r.b, r.n, axis, lo[axis] + 0.5f * ext[axis]);
-        if (m == 0 || m == r.n) m = r.n / 2;   /* coincident points: any split */
-        st[sp++] = (range){ r.b + m, r.n - m };
-        st[sp++] = (range){ r.b, m };
+        uint32_t m = partition(sh, idx + x.b, x.n, axis, lo[axis] + 0.5f * ext[axis]);
+        if (m == 0 || m == x.n) m = x.n / 2;   /* coincident points: any split */
+        /* The halves stay next to each other in the list (spatial order, which the renumbering keeps). */
+        memmove(r + big + 2, r + big + 1, (size_t)(nc - big - 1) * sizeof *r);
+        r[big] = (range){ x.b, m };
+        r[big + 1] = (range){ x.b + m, x.n - m };
+        nc++;
     }
-    free(st);
+    for (int i = 0; i < nc; i++) {
+        out[i].idx = idx + r[i].b;
+        out[i].n = r[i].n;
+    }
+    free(r);
     return nc;
 }
 
-static void prepare_batch(const shared *sh, tri_job *jobs, const float *tri, const uint32_t *ids, size_t n)
+/* The vertex of triangle b (9 floats) that triangle a lacks when they share exactly one edge (two vertices
+ * bit for bit) and lie in nearly one plane (normals within about 0.1 degree); else -1. */
+static int pair_vertex(const float *a, const float *b)
+{
+    int shared_v = 0, other = -1;
+    for (int i = 0; i < 3; i++) {
+        int found = 0;
+        for (int j = 0; j < 3; j++) found |= !memcmp(b + 3 * i, a + 3 * j, 3 * sizeof *b);
+        if (found) shared_v++;
+        else other = i;
+    }
+    if (shared_v != 2) return -1;
+    double na[3], nb[3], e1[3], e2[3];
+    for (int x = 0; x < 3; x++) { e1[x] = (double)a[3 + x] - a[x]; e2[x] = (double)a[6 + x] - a[x]; }
+    d3_cross(na, e1, e2);
+    for (int x = 0; x < 3; x++) { e1[x] = (double)b[3 + x] - b[x]; e2[x] = (double)b[6 + x] - b[x]; }
+    d3_cross(nb, e1, e2);
+    const double dot = d3_dot(na, nb), la = d3_dot(na, na), lb = d3_dot(nb, nb);
+    return la > 0.0 && lb > 0.0 && dot * dot >= (1.0 - 4e-6) * la * lb ? other : -1;
+}
+
+/* Departure from the paper: two triangles that share an edge and a plane (a box's face, a mesh's quad) are
+ * cast as one job. Each receiver's exact tests stay per triangle (cast_footprint), so the answers are
+ * raytrace's; what they share is the traversal, one V_L (of their four points) and the per-receiver work
+ * around the samples' tests, which on a GRIDS-like scene (bars of boxes, each face two long thin triangles
+ * with nearly the same footprint) is most of a pair's cost. The batch's triangles are reordered so that a
+ * triangle's partner, looked for among the next PAIR_WINDOW, follows it (any order gives the same answer).
+ * Returns the number of pairs. */
+#define PAIR_WINDOW 16
+static size_t pair_batch(float *tri, uint32_t *ids, int8_t *pairs, size_t n)
+{
+    size_t np = 0;
+    memset(pairs, 0, n);
+    for (size_t i = 0; i + 1 < n; i++) {
+        if (pairs[i]) continue;
+        for (size_t j = i + 1; j < n && j <= i + PAIR_WINDOW; j++) {
+            if (pair_vertex(tri + 9 * i, tri + 9 * j) < 0) continue;
+            if (j != i + 1) {   /* move j next to i */
+                float tmp[9];
+                memcpy(tmp, tri + 9 * (i + 1), sizeof tmp);
+                memcpy(tri + 9 * (i + 1), tri + 9 * j, sizeof tmp);
+                memcpy(tri + 9 * j, tmp, sizeof tmp);
+                const uint32_t id = ids[i + 1];
+                ids[i + 1] = ids[j];
+                ids[j] = id;
+            }
+            pairs[i] = 1;
+            pairs[i + 1] = -1;
+            np++;
+            break;
+        }
+    }
+    return np;
+}
+
+static void prepare_batch(const shared *sh, tri_job *jobs, const float *tri, const uint32_t *ids, const int8_t *pairs,
+                          size_t n)
 {
 #pragma omp parallel for schedule(static) num_threads(sh->ctx->threads)
     for (size_t i = 0; i < n; i++) {
@@ -1179,7 +1320,21 @@ static void prepare_batch(const shared *sh, tri_job *jobs, const float *tri, con
         memcpy(t->v, tri + 9 * i, sizeof t->v);
         ms_wt_normal(t->v, t->N);
         t->self = ids[i];
-        hpc_volume_build(&t->vl, sh->light_poly, 4, t->v, tri_margin(sh, t->v));
+        t->pair = pairs ? pairs[i] : 0;
+        if (t->pair < 0) continue;   /* the pair's vl, made with the first */
+        if (t->pair == 0) {
+            hpc_volume_build(&t->vl, sh->light_poly, 4, t->v, tri_margin(sh, t->v));
+            continue;
+        }
+        /* The pair's volume: of its four points, with the larger of the two margins (a relation either
+         * triangle's exact test calls blocked lies within its margin of that triangle's shadow, which the
+         * pair's contains). */
+        const float *b = tri + 9 * (i + 1);
+        float pts[12];
+        memcpy(pts, t->v, sizeof t->v);
+        memcpy(pts + 9, b + 3 * pair_vertex(t->v, b), 3 * sizeof *pts);
+        hpc_volume_build_points(&t->vl, sh->light_poly, 4, pts, 4, ms_maxf(tri_margin(sh, t->v), tri_margin(sh, b)));
+        jobs[i + 1].vl = t->vl;
     }
 }
 
@@ -1271,7 +1426,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
 
     int rc = -1, nchunks = 0;
     const int threads = ctx->threads > 0 ? ctx->threads : 1;
-    const int cap = 4 * threads;
+    const int cap = 16 * threads;   /* chunks: see make_chunks */
     sh.gmask = calloc((size_t)sh.G * mw, sizeof *sh.gmask);
     sh.gumbra = malloc(n * sizeof *sh.gumbra);
     sh.full = malloc(n);
@@ -1286,7 +1441,8 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     tri_job *jobs = malloc(BATCH * sizeof *jobs);
     float *tri = malloc(BATCH * 9 * sizeof *tri);
     uint32_t *ids = malloc(BATCH * sizeof *ids);
-    if (!sh.gmask || !sh.gumbra || !sh.full || !sh.slot || !idx || !ch || !jobs || !tri || !ids) goto done;
+    int8_t *pairs = malloc(BATCH);
+    if (!sh.gmask || !sh.gumbra || !sh.full || !sh.slot || !idx || !ch || !jobs || !tri || !ids || !pairs) goto done;
     for (int g = 0; g < sh.G; g++) {
         const int gpr = k / sh.gs, i0 = g % gpr * sh.gs, j0 = g / gpr * sh.gs;
         for (int j = j0; j < j0 + sh.gs; j++)
@@ -1295,7 +1451,9 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
                 sh.gmask[(size_t)g * mw + (s >> 6)] |= UINT64_C(1) << (s & 63);
             }
     }
-    /* Samples behind the horizon count as blocked from the start (umbra bits: nothing open). */
+    /* Samples behind the horizon count as blocked from the start (umbra bits: nothing open). In parallel, the
+     * live receivers gathered after (the serial parts of a frame count in its wall time). */
+#pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t r = 0; r < n; r++) {
         uint64_t gu = 0;
         const uint64_t *f = front + r * mw;
@@ -1307,8 +1465,9 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         sh.gumbra[r] = gu;
         sh.full[r] = gu == sh.all_groups;
         sh.slot[r] = -1;
-        if (!sh.full[r]) idx[nlive++] = (uint32_t)r;
     }
+    for (size_t r = 0; r < n; r++)
+        if (!sh.full[r]) idx[nlive++] = (uint32_t)r;
     const uint32_t target = (uint32_t)((nlive + cap - 1) / cap) > 1024u ? (uint32_t)((nlive + cap - 1) / cap) : 1024u;
     nchunks = nlive ? make_chunks(&sh, idx, nlive, target, ch, cap) : 0;
     if (nchunks < 0) goto done;
@@ -1333,17 +1492,20 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         for (int i = 0; i < nchunks; i++) {
             ch[i].base = pos;
             ch[i].n0 = ch[i].n;
-            for (uint32_t j = 0; j < ch[i].n; j++, pos++) {
-                const uint32_t o = ch[i].idx[j];
-                orig[pos] = o;
-                q2[pos] = q[o];
-                gumbra2[pos] = sh.gumbra[o];
-                full2[pos] = sh.full[o];
-                slot2[pos] = -1;
-                ch[i].idx[j] = pos;
-            }
+            pos += ch[i].n;
         }
     }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int i = 0; i < nchunks; i++)
+        for (uint32_t j = 0, pos = ch[i].base; j < ch[i].n; j++, pos++) {
+            const uint32_t o = ch[i].idx[j];
+            orig[pos] = o;
+            q2[pos] = q[o];
+            gumbra2[pos] = sh.gumbra[o];
+            full2[pos] = sh.full[o];
+            slot2[pos] = -1;
+            ch[i].idx[j] = pos;
+        }
     sh.orig = orig;
     sh.q = q2;
     sh.gumbra = gumbra2;
@@ -1370,6 +1532,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         }
         if (!same) { free(sh.p0); sh.p0 = NULL; }
         else counters[C_SAMPLE_BYTES] += (uint64_t)nlive * 4u * sizeof *sh.p0;
+        sh.pairs = sh.p0 && !(sh.sw & MS_HPC_OFF_PAIRS);
     }
     if (sh.sw & MS_HPC_OFF_ON_DEMAND) {   /* D off: every receiver's mask and sample data before any triangle */
         for (int i = 0; i < nchunks; i++)
@@ -1391,11 +1554,13 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         const size_t got = src->next(src->user, tri, ids, BATCH);
         if (got == (size_t)-1) goto done;
         if (!got) break;
-        prepare_batch(&sh, jobs, tri, ids, got);
+        if (sh.pairs) pair_batch(tri, ids, pairs, got);
+        prepare_batch(&sh, jobs, tri, ids, sh.pairs ? pairs : NULL, got);
         counters[C_TRIANGLES] += got;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
         for (int i = 0; i < nchunks; i++)
-            for (size_t t = 0; t < got; t++) cast_triangle(&sh, &ch[i], &jobs[t]);
+            for (size_t t = 0; t < got; t++)
+                if (jobs[t].pair >= 0) cast_triangle(&sh, &ch[i], &jobs[t]);
         for (int i = 0; i < nchunks; i++)
             if (ch[i].failed) goto done;
     }
@@ -1440,6 +1605,7 @@ done:
     free(jobs);
     free(tri);
     free(ids);
+    free(pairs);
     free(sh.gmask);
     free(gumbra0);
     free(full0);

@@ -21,9 +21,9 @@ static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
 /* Adds the plane through e0, e1 and v if it separates the polygon (on its non-positive side) from the
- * triangle; oriented so that the triangle's side is positive. */
+ * blocker's nt points; oriented so that the blocker's side is positive. */
 static void try_plane(hpc_volume *v, const double e0[3], const double e1[3], const double w[3], const double *poly,
-                      int np, const double tv[3][3], double tol)
+                      int np, const double (*tv)[3], int nt, double tol)
 {
     double a[3], b[3], n[3];
     d3_sub(a, e1, e0);
@@ -39,7 +39,7 @@ static void try_plane(hpc_volume *v, const double e0[3], const double e1[3], con
         pmin = dmin(pmin, s);
         pmax = dmax(pmax, s);
     }
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < nt; i++) {
         const double s = d3_dot(n, tv[i]) + d;
         tmin = dmin(tmin, s);
         tmax = dmax(tmax, s);
@@ -58,20 +58,36 @@ static void try_plane(hpc_volume *v, const double e0[3], const double e1[3], con
 
 int hpc_volume_build(hpc_volume *v, const double *poly, int np, const float tri[9], float eps)
 {
+    return hpc_volume_build_points(v, poly, np, tri, 3, eps);
+}
+
+/* Departure: the paper's blocker is a triangle; here it may be nt <= 4 points (hpc casts two triangles that
+ * share an edge as one job, hpc_impl.h), and the candidates span every pair of its points, so that the planes
+ * separate the polygon from the points' convex hull whatever their order or shape. For a triangle the pairs
+ * are its three edges, as before. */
+int hpc_volume_build_points(hpc_volume *v, const double *poly, int np, const float *pts, int nt, float eps)
+{
     memset(v, 0, sizeof *v);
     v->eps = eps;
-    if (!isfinite(eps)) { v->unbounded = 1; return 0; }
-    double tv[3][3], size = 0.0;
-    for (int i = 0; i < 3; i++)
-        for (int a = 0; a < 3; a++) { tv[i][a] = tri[3 * i + a]; size = dmax(size, fabs(tv[i][a])); }
+    if (!isfinite(eps) || nt < 3 || nt > 4) { v->unbounded = 1; return 0; }
+    double tv[4][3], size = 0.0;
+    for (int i = 0; i < nt; i++)
+        for (int a = 0; a < 3; a++) { tv[i][a] = pts[3 * i + a]; size = dmax(size, fabs(tv[i][a])); }
     for (int i = 0; i < 3 * np; i++) size = dmax(size, fabs(poly[i]));
     const double tol = 1e-9 * size;
-    /* Triangle edge x polygon vertex, polygon edge x triangle vertex (every vertex-edge pair). */
-    for (int e = 0; e < 3; e++)
-        for (int i = 0; i < np; i++) try_plane(v, tv[e], tv[(e + 1) % 3], poly + 3 * i, poly, np, tv, tol);
+    /* Blocker edge x polygon vertex (the outline's edges first, then the diagonals), polygon edge x blocker
+     * vertex (every vertex-edge pair). */
+    for (int e = 0; e < nt; e++)
+        for (int i = 0; i < np; i++) try_plane(v, tv[e], tv[(e + 1) % nt], poly + 3 * i, poly, np, tv, nt, tol);
+    for (int e = 0; e + 2 < nt; e++)
+        for (int f = e + 2; f < nt && !(e == 0 && f == nt - 1); f++)
+            for (int i = 0; i < np; i++) try_plane(v, tv[e], tv[f], poly + 3 * i, poly, np, tv, nt, tol);
     for (int e = 0; e < np; e++)
-        for (int i = 0; i < 3; i++) try_plane(v, poly + 3 * e, poly + 3 * ((e + 1) % np), tv[i], poly, np, tv, tol);
-    /* The cap: the triangle's plane, when the polygon lies strictly on one side of it. */
+        for (int i = 0; i < nt; i++) try_plane(v, poly + 3 * e, poly + 3 * ((e + 1) % np), tv[i], poly, np, tv, nt, tol);
+    /* The cap: the plane of the first three points, when the polygon lies strictly on one side of it; moved
+     * towards the polygon by as much as a further point of the blocker lies on the polygon's side (a flat pair
+     * rounded to float leaves its fourth point off the plane by ulps), so that every point of the blocker is on
+     * the inner side: a shadowed point l + s (t - l), s >= 1, then lies at least as far inside as t. */
     double a[3], b[3], n[3];
     d3_sub(a, tv[1], tv[0]);
     d3_sub(b, tv[2], tv[0]);
@@ -87,10 +103,13 @@ int hpc_volume_build(hpc_volume *v, const double *poly, int np, const float tri[
             pmax = dmax(pmax, s);
         }
         const double sign = pmin > tol ? -1.0 : pmax < -tol ? 1.0 : 0.0;   /* inside: away from the polygon */
-        if (sign != 0.0) {
+        double shift = 0.0;   /* how far a further point lies on the polygon's side */
+        for (int i = 3; i < nt; i++) shift = dmax(shift, -sign * (d3_dot(n, tv[i]) + d));
+        const double pnear = sign < 0.0 ? pmin : -pmax;   /* the polygon's nearest distance, on its side */
+        if (sign != 0.0 && pnear - shift > tol) {
             float *p = v->pl[v->n++];
             for (int i = 0; i < 3; i++) p[i] = (float)(sign * n[i]);
-            p[3] = (float)(sign * d);
+            p[3] = (float)(sign * d + shift);
         }
     }
     if (v->n == 0) v->unbounded = 1;

@@ -25,6 +25,10 @@ typedef struct hpc_volume {
  * caller's culling margin (a non-finite eps makes the volume unbounded). Returns the number of planes. */
 int hpc_volume_build(hpc_volume *v, const double *poly, int np, const float tri[9], float eps);
 
+/* The same for a blocker of nt (3 or 4) points pts (3 floats each), any shape: the planes bound the
+ * shadows of the points' convex hull. */
+int hpc_volume_build_points(hpc_volume *v, const double *poly, int np, const float *pts, int nt, float eps);
+
 /* 0 when the box [lo, hi] lies outside a plane of the active set act; else 1 and *out = act less the
  * planes the box lies wholly inside of. *tests counts plane tests. */
 int hpc_volume_box(const hpc_volume *v, uint32_t act, const float lo[3], const float hi[3], uint32_t *out,
