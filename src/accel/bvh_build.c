@@ -71,9 +71,21 @@ static void build_node(build_ctx *c, uint32_t ni, uint32_t first, uint32_t count
     }
     memcpy(node->bmin, nb.lo, sizeof nb.lo);
     memcpy(node->bmax, nb.hi, sizeof nb.hi);
-    if (depth > c->depth) {
+    /* The deepest level so far, shared by the build's tasks: read and written atomically (the check
+     * before the critical section is a read another thread may be writing; TSan reported it). */
+    int seen;
+#pragma omp atomic read
+    seen = c->depth;
+    if (depth > seen) {
 #pragma omp critical(ms_bvh_depth)
-        if (depth > c->depth) c->depth = depth;
+        {
+#pragma omp atomic read
+            seen = c->depth;
+            if (depth > seen) {
+#pragma omp atomic write
+                c->depth = depth;
+            }
+        }
     }
     if (count <= MAX_LEAF || depth >= MS_BVH_STACK - 2) { make_leaf(node, first, count); return; }
 
