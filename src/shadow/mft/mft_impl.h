@@ -87,6 +87,8 @@ typedef struct mft_state {
     unsigned has_m;                   /* lanes with a cell projection */
     float sp[4][3][MS_BLOCK_LANES];   /* the frusta's side planes through C (normals facing in) */
     float olo[3][MS_BLOCK_LANES], ohi[3][MS_BLOCK_LANES];   /* C shifted by the box margin (ms_wt_box_origins) */
+    float goa[MS_BLOCK_LANES], gv[MS_BLOCK_LANES];  /* the grid pattern's (k - 1 + u) / k and v per lane (mft_grid_cols) */
+    int grid_rows;                    /* the grid pattern, k >= 16: the footprint's columns row by row (mft_grid_cols) */
 } mft_state;
 
 /* Row j (k bits) of a sample mask. */
@@ -357,6 +359,41 @@ static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
     pr->done = !(lc[0] | lc[1] | lc[2] | lc[3]);
 }
 
+/* The grid pattern (pattern.c, ms_grid_for_pixel) puts sample (i, j) of a pixel with shift (u, v) at cell
+ * coordinates (i + (k - 1 - j + u) / k, j + (i + v) / k), not anywhere in cell (i, j): so in row j the
+ * samples inside the footprint's box [a0, a1] x [b0, b1] are the columns i with i + (k - 1 - j + u) / k in
+ * [a0, a1] and (i + v) / k in [b0 - j, b1 - j], an interval of columns. The box bounds the exact positions
+ * of the samples whose rays can hit (the bound the floor-cut to cells relies on already, mft_footprint16);
+ * EPS (a thousandth of a cell, far above the float rounding of these few operations on values below
+ * k^2) keeps the interval conservative. A departure from the paper (which has no footprint): the cut to
+ * cells alone leaves about (w + 1)(h + 1) cells for a box of w x h cells, mostly empty of samples for a
+ * small triangle under a big light; this leaves about w h of them. Returns the columns as a row mask. */
+#define MFT_GRID_EPS 1e-3f
+/* Per lane, from its footprint box: ga[0..1] = a0, a1 less (k - 1 + u) / k (widened by EPS), so that row j's
+ * columns from the first condition are ceil(ga[0] + j / k) .. floor(ga[1] + j / k); gb[0..1] = ceil, floor of
+ * k b0 - v, k b1 - v (widened by k EPS), so that from the second they are gb[0] - k j .. gb[1] - k j (k j is
+ * an integer: exact). */
+typedef struct mft_grid_box {
+    float ga[2][MS_BLOCK_LANES], gb[2][MS_BLOCK_LANES];
+    int32_t rows[4][MS_BLOCK_LANES];   /* the cut's first two rows: their columns' first and last */
+} mft_grid_box;
+
+static inline uint64_t mft_grid_cols(const mft_grid_box *g, int l, int k, int j)
+{
+    /* Branch-free (the row's cut is often empty: a branch on it mispredicts), clamped to [0, k - 1]: a
+     * cut beyond the row keeps column 0 or k - 1 at worst, one more test, never a lost one. */
+    const float jk = (float)j * (1.0f / (float)k), kj = (float)(k * j), last = (float)(k - 1);
+    float ia = ceilf(g->ga[0][l] + jk), ib = floorf(g->ga[1][l] + jk);
+    const float ja = g->gb[0][l] - kj, jb = g->gb[1][l] - kj;
+    ia = ia > ja ? ia : ja;
+    ib = ib < jb ? ib : jb;
+    ia = ia < 0.0f ? 0.0f : ia > last ? last : ia;
+    ib = ib < -1.0f ? -1.0f : ib > last ? last : ib;
+    const int i0 = (int)ia, i1 = (int)ib;
+    const uint64_t hi = i1 < 0 ? 0 : ~UINT64_C(0) >> (63 - i1);
+    return hi & (~UINT64_C(0) << i0);
+}
+
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
 {
     ms_block_frusta *fr = s->fr;
@@ -442,7 +479,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
          * cut drops the pair before any scalar work. */
         l16 r[4];
         for (int q = 0; q < 4; q++) r[q] = l16_load(s->rectf[q]);
-        unsigned foot = 0;
+        unsigned foot = 0, grid_rows = 0;
+        mft_grid_box gbox;
         /* No footprint for a triangle whose plane passes within 1e-4 of its size from C (|num| is C's
          * distance from the plane times |N|): some rays graze it, and the watertight test decides its
          * edges in the plane across the ray, where such a triangle is a sliver, with an error that grows
@@ -464,7 +502,32 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                 r[q] = l16_select(foot, l16_max(lo, r[q]), r[q]);
                 r[q + 1] = l16_select(foot, l16_min(hi, r[q + 1]), r[q + 1]);
             }
-            const unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
+            unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
+            if (s->grid_rows && (foot & ~out)) {
+                /* The grid's samples in the box (mft_grid_cols): the columns of the cut's first two rows
+                 * for the 16 lanes at once; a cut of at most two rows with none there drops the pair. */
+                grid_rows = foot & ~out;
+                const l16 kf = l16_set1((float)k), keps = l16_set1((float)k * MFT_GRID_EPS), eps = l16_set1(MFT_GRID_EPS);
+                const l16 oa = l16_load(s->goa), v = l16_load(s->gv);
+                const l16 ga0 = l16_sub(l16_sub(l16_load(box[0]), oa), eps), ga1 = l16_add(l16_sub(l16_load(box[1]), oa), eps);
+                const l16 gb0 = l16_ceil(l16_sub(l16_sub(l16_mul(kf, l16_load(box[2])), keps), v));
+                const l16 gb1 = l16_floor(l16_add(l16_sub(l16_mul(kf, l16_load(box[3])), v), keps));
+                l16_store(gbox.ga[0], ga0);
+                l16_store(gbox.ga[1], ga1);
+                l16_store(gbox.gb[0], gb0);
+                l16_store(gbox.gb[1], gb1);
+                const l16 invk = l16_set1(1.0f / (float)k), one = l16_set1(1.0f);
+                unsigned none = 0xFFFF;
+                for (int q = 0; q < 2; q++) {
+                    const l16 j = q ? l16_add(r[2], one) : r[2], jk = l16_mul(j, invk), kj = l16_mul(j, kf);
+                    const l16 ia = l16_max(l16_max(l16_ceil(l16_add(ga0, jk)), l16_sub(gb0, kj)), r[0]);
+                    const l16 ib = l16_min(l16_min(l16_floor(l16_add(ga1, jk)), l16_sub(gb1, kj)), r[1]);
+                    l16_store_int(gbox.rows[2 * q], ia);
+                    l16_store_int(gbox.rows[2 * q + 1], ib);
+                    none &= l16_gt(ia, ib) | (q ? l16_gt(j, r[3]) : 0u);
+                }
+                out |= grid_rows & none & l16_le(r[3], l16_add(r[2], one));
+            }
             c_foot += (uint64_t)ms_bt_popcount16(pass & out);
             pass &= ~out;
         }
@@ -517,13 +580,24 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             if (k >= 16) {
                 /* Row by row, the live rays of columns x0..x1, one test per 16-sample packet that holds any. */
                 const uint64_t cols = ((UINT64_C(2) << x1) - 1) & ~((UINT64_C(1) << x0) - 1);
-                for (int y = y0; y <= y1 && !pr.done; y++)
-                    for (uint64_t row = mft_row(L->mask, k, y) & cols; row;) {
+                const int fine = grid_rows >> l & 1;
+                for (int y = y0; y <= y1 && !pr.done; y++) {
+                    uint64_t row = mft_row(L->mask, k, y) & cols;
+                    if (row && fine) {
+                        const int q = y - y0;
+                        if (q < 2) {
+                            const int i0 = gbox.rows[2 * q][l], i1 = gbox.rows[2 * q + 1][l];
+                            row = i0 > i1 ? 0 : row & ((UINT64_C(2) << i1) - 1) & ~((UINT64_C(1) << i0) - 1);
+                        } else
+                            row &= mft_grid_cols(&gbox, l, k, y);
+                    }
+                    while (row) {
                         const int p = __builtin_ctzll(row) >> 4;
                         const unsigned bits = (unsigned)(row >> 16 * p) & 0xFFFFu;
                         row &= ~(UINT64_C(0xFFFF) << 16 * p);
                         mft_pair_packet(&pr, y * cpr + p, bits);
                     }
+                }
             } else {
                 /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (An earlier loop took k / 16 =
                  * 0 packets per row and tested no ray at all: mft answered the front mask; the known bug of
@@ -584,9 +658,15 @@ void MS_CAT(ms_mft_block_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_block *b
     s.f = f;
     s.blk = blk;
     s.b = b;
+    s.grid_rows = f->pattern == MS_PATTERN_GRID && f->k >= 16;
     for (int l = 0; l < blk->n; l++) {
         ms_mft_lane *L = &blk->lane[l];
         for (int a = 0; a < 3; a++) s.hn[a][l] = L->n[a];
+        if (s.grid_rows) {
+            float u;
+            ms_grid_shift(L->px, L->py, f->seed, &u, &s.gv[l]);
+            s.goa[l] = ((float)(f->k - 1) + u) / (float)f->k;
+        }
         float olo[3], ohi[3];
         ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, L->c, olo, ohi);
         for (int a = 0; a < 3; a++) { s.olo[a][l] = olo[a]; s.ohi[a][l] = ohi[a]; }
