@@ -47,6 +47,10 @@
  *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
  *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept);
+ *  - on the grid pattern the footprint's box is taken against the samples' own positions in their cells
+ *    (mft_grid_cols: columns per row; the cut's first rows for 16 lanes at once, dropping pairs with no
+ *    sample in the box), not only against whole cells: big-light Sponza half the pairs, a third of the
+ *    16-ray tests (docs/methods.md, session 12);
  *  - the interleaved pattern is traced by mft_group_impl.h (rays regrouped by cell of the light); there
  *    each group's rays take raytrace's box test per node (the paper's "Ray-AABB"). On the grid the same
  *    test (once per leaf and packet) cut the 16-ray tests 1.3-3.6x but not the time (big-light Sponza -7%,
@@ -369,13 +373,16 @@ static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
  * cells alone leaves about (w + 1)(h + 1) cells for a box of w x h cells, mostly empty of samples for a
  * small triangle under a big light; this leaves about w h of them. Returns the columns as a row mask. */
 #define MFT_GRID_EPS 1e-3f
+#ifndef MFT_GRID_ROWS
+#define MFT_GRID_ROWS 2
+#endif
 /* Per lane, from its footprint box: ga[0..1] = a0, a1 less (k - 1 + u) / k (widened by EPS), so that row j's
  * columns from the first condition are ceil(ga[0] + j / k) .. floor(ga[1] + j / k); gb[0..1] = ceil, floor of
  * k b0 - v, k b1 - v (widened by k EPS), so that from the second they are gb[0] - k j .. gb[1] - k j (k j is
  * an integer: exact). */
 typedef struct mft_grid_box {
     float ga[2][MS_BLOCK_LANES], gb[2][MS_BLOCK_LANES];
-    int32_t rows[4][MS_BLOCK_LANES];   /* the cut's first two rows: their columns' first and last */
+    int32_t rows[2 * MFT_GRID_ROWS][MS_BLOCK_LANES];   /* the cut's first rows: their columns' first and last */
 } mft_grid_box;
 
 static inline uint64_t mft_grid_cols(const mft_grid_box *g, int l, int k, int j)
@@ -516,17 +523,17 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                 l16_store(gbox.ga[1], ga1);
                 l16_store(gbox.gb[0], gb0);
                 l16_store(gbox.gb[1], gb1);
-                const l16 invk = l16_set1(1.0f / (float)k), one = l16_set1(1.0f);
+                const l16 invk = l16_set1(1.0f / (float)k);
                 unsigned none = 0xFFFF;
-                for (int q = 0; q < 2; q++) {
-                    const l16 j = q ? l16_add(r[2], one) : r[2], jk = l16_mul(j, invk), kj = l16_mul(j, kf);
+                for (int q = 0; q < MFT_GRID_ROWS; q++) {
+                    const l16 j = l16_add(r[2], l16_set1((float)q)), jk = l16_mul(j, invk), kj = l16_mul(j, kf);
                     const l16 ia = l16_max(l16_max(l16_ceil(l16_add(ga0, jk)), l16_sub(gb0, kj)), r[0]);
                     const l16 ib = l16_min(l16_min(l16_floor(l16_add(ga1, jk)), l16_sub(gb1, kj)), r[1]);
                     l16_store_int(gbox.rows[2 * q], ia);
                     l16_store_int(gbox.rows[2 * q + 1], ib);
                     none &= l16_gt(ia, ib) | (q ? l16_gt(j, r[3]) : 0u);
                 }
-                out |= grid_rows & none & l16_le(r[3], l16_add(r[2], one));
+                out |= grid_rows & none & l16_le(r[3], l16_add(r[2], l16_set1((float)(MFT_GRID_ROWS - 1))));
             }
             c_foot += (uint64_t)ms_bt_popcount16(pass & out);
             pass &= ~out;
@@ -585,7 +592,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                     uint64_t row = mft_row(L->mask, k, y) & cols;
                     if (row && fine) {
                         const int q = y - y0;
-                        if (q < 2) {
+                        if (q < MFT_GRID_ROWS) {
                             const int i0 = gbox.rows[2 * q][l], i1 = gbox.rows[2 * q + 1][l];
                             row = i0 > i1 ? 0 : row & ((UINT64_C(2) << i1) - 1) & ~((UINT64_C(1) << i0) - 1);
                         } else
