@@ -48,9 +48,8 @@
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
  *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept);
  *  - on the grid pattern the footprint's box is taken against the samples' own positions in their cells
- *    (mft_grid_cols: columns per row; the cut's first rows for 16 lanes at once, dropping pairs with no
- *    sample in the box), not only against whole cells: big-light Sponza half the pairs, a third of the
- *    16-ray tests (docs/methods.md, session 12);
+ *    (MFT_GRID_EPS: columns per row of a cut up to MFT_GRID_ROWS rows, 16 lanes at once, dropping pairs
+ *    with no sample in the box), not only against whole cells (docs/methods.md, session 12);
  *  - the interleaved pattern is traced by mft_group_impl.h (rays regrouped by cell of the light); there
  *    each group's rays take raytrace's box test per node (the paper's "Ray-AABB"). On the grid the same
  *    test (once per leaf and packet) cut the 16-ray tests 1.3-3.6x but not the time (big-light Sponza -7%,
@@ -91,8 +90,8 @@ typedef struct mft_state {
     unsigned has_m;                   /* lanes with a cell projection */
     float sp[4][3][MS_BLOCK_LANES];   /* the frusta's side planes through C (normals facing in) */
     float olo[3][MS_BLOCK_LANES], ohi[3][MS_BLOCK_LANES];   /* C shifted by the box margin (ms_wt_box_origins) */
-    float goa[MS_BLOCK_LANES], gv[MS_BLOCK_LANES];  /* the grid pattern's (k - 1 + u) / k and v per lane (mft_grid_cols) */
-    int grid_rows;                    /* the grid pattern, k >= 16: the footprint's columns row by row (mft_grid_cols) */
+    float goa[MS_BLOCK_LANES], gv[MS_BLOCK_LANES];  /* the grid pattern's (k - 1 + u) / k and v per lane */
+    int grid_rows;                    /* the grid pattern, k >= 16: the footprint against the samples (MFT_GRID_EPS) */
 } mft_state;
 
 /* Row j (k bits) of a sample mask. */
@@ -366,40 +365,25 @@ static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
 /* The grid pattern (pattern.c, ms_grid_for_pixel) puts sample (i, j) of a pixel with shift (u, v) at cell
  * coordinates (i + (k - 1 - j + u) / k, j + (i + v) / k), not anywhere in cell (i, j): so in row j the
  * samples inside the footprint's box [a0, a1] x [b0, b1] are the columns i with i + (k - 1 - j + u) / k in
- * [a0, a1] and (i + v) / k in [b0 - j, b1 - j], an interval of columns. The box bounds the exact positions
- * of the samples whose rays can hit (the bound the floor-cut to cells relies on already, mft_footprint16);
- * EPS (a thousandth of a cell, far above the float rounding of these few operations on values below
- * k^2) keeps the interval conservative. A departure from the paper (which has no footprint): the cut to
- * cells alone leaves about (w + 1)(h + 1) cells for a box of w x h cells, mostly empty of samples for a
- * small triangle under a big light; this leaves about w h of them. Returns the columns as a row mask. */
+ * [a0, a1] and (i + v) / k in [b0 - j, b1 - j], an interval of columns:
+ *   ceil(a0 - (k - 1 + u) / k + j / k) .. floor(a1 - (k - 1 + u) / k + j / k), and
+ *   ceil(k b0 - v) - k j .. floor(k b1 - v) - k j (k j an integer: exact).
+ * The box bounds the exact positions of the samples whose rays can hit (the bound the cut to cells relies
+ * on already, mft_footprint16); EPS (a thousandth of a cell, far above the float rounding of these few
+ * operations on values below k^2) keeps the interval conservative. A departure from the paper (which has
+ * no footprint): the cut to cells alone leaves about (w + 1)(h + 1) cells for a box of w x h cells, most of
+ * them without a sample in the box for a small triangle under a big light; this leaves about w h. Done for
+ * cuts of at most MFT_GRID_ROWS rows, 16 lanes at once (taller cuts: the per-row work cost more than it
+ * saved, docs/methods.md, session 12). */
 #define MFT_GRID_EPS 1e-3f
 #ifndef MFT_GRID_ROWS
 #define MFT_GRID_ROWS 2
 #endif
-/* Per lane, from its footprint box: ga[0..1] = a0, a1 less (k - 1 + u) / k (widened by EPS), so that row j's
- * columns from the first condition are ceil(ga[0] + j / k) .. floor(ga[1] + j / k); gb[0..1] = ceil, floor of
- * k b0 - v, k b1 - v (widened by k EPS), so that from the second they are gb[0] - k j .. gb[1] - k j (k j is
- * an integer: exact). */
+/* Per lane, the columns of the cut's first MFT_GRID_ROWS rows that hold a sample in the footprint's box:
+ * first and last, by row. */
 typedef struct mft_grid_box {
-    float ga[2][MS_BLOCK_LANES], gb[2][MS_BLOCK_LANES];
-    int32_t rows[2 * MFT_GRID_ROWS][MS_BLOCK_LANES];   /* the cut's first rows: their columns' first and last */
+    int32_t rows[2 * MFT_GRID_ROWS][MS_BLOCK_LANES];
 } mft_grid_box;
-
-static inline uint64_t mft_grid_cols(const mft_grid_box *g, int l, int k, int j)
-{
-    /* Branch-free (the row's cut is often empty: a branch on it mispredicts), clamped to [0, k - 1]: a
-     * cut beyond the row keeps column 0 or k - 1 at worst, one more test, never a lost one. */
-    const float jk = (float)j * (1.0f / (float)k), kj = (float)(k * j), last = (float)(k - 1);
-    float ia = ceilf(g->ga[0][l] + jk), ib = floorf(g->ga[1][l] + jk);
-    const float ja = g->gb[0][l] - kj, jb = g->gb[1][l] - kj;
-    ia = ia > ja ? ia : ja;
-    ib = ib < jb ? ib : jb;
-    ia = ia < 0.0f ? 0.0f : ia > last ? last : ia;
-    ib = ib < -1.0f ? -1.0f : ib > last ? last : ib;
-    const int i0 = (int)ia, i1 = (int)ib;
-    const uint64_t hi = i1 < 0 ? 0 : ~UINT64_C(0) >> (63 - i1);
-    return hi & (~UINT64_C(0) << i0);
-}
 
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
 {
@@ -510,19 +494,16 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                 r[q + 1] = l16_select(foot, l16_min(hi, r[q + 1]), r[q + 1]);
             }
             unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
-            if (s->grid_rows && (foot & ~out)) {
-                /* The grid's samples in the box (mft_grid_cols): the columns of the cut's first two rows
-                 * for the 16 lanes at once; a cut of at most two rows with none there drops the pair. */
-                grid_rows = foot & ~out;
+            const unsigned short_cut = foot & ~out & l16_le(r[3], l16_add(r[2], l16_set1((float)(MFT_GRID_ROWS - 1))));
+            if (s->grid_rows && short_cut) {
+                /* The grid's samples in the box (above MFT_GRID_EPS): the columns of each row of the short
+                 * cuts, for the 16 lanes at once; a cut with none drops the pair. */
+                grid_rows = short_cut;
                 const l16 kf = l16_set1((float)k), keps = l16_set1((float)k * MFT_GRID_EPS), eps = l16_set1(MFT_GRID_EPS);
                 const l16 oa = l16_load(s->goa), v = l16_load(s->gv);
                 const l16 ga0 = l16_sub(l16_sub(l16_load(box[0]), oa), eps), ga1 = l16_add(l16_sub(l16_load(box[1]), oa), eps);
                 const l16 gb0 = l16_ceil(l16_sub(l16_sub(l16_mul(kf, l16_load(box[2])), keps), v));
                 const l16 gb1 = l16_floor(l16_add(l16_sub(l16_mul(kf, l16_load(box[3])), v), keps));
-                l16_store(gbox.ga[0], ga0);
-                l16_store(gbox.ga[1], ga1);
-                l16_store(gbox.gb[0], gb0);
-                l16_store(gbox.gb[1], gb1);
                 const l16 invk = l16_set1(1.0f / (float)k);
                 unsigned none = 0xFFFF;
                 for (int q = 0; q < MFT_GRID_ROWS; q++) {
@@ -533,7 +514,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                     l16_store_int(gbox.rows[2 * q + 1], ib);
                     none &= l16_gt(ia, ib) | (q ? l16_gt(j, r[3]) : 0u);
                 }
-                out |= grid_rows & none & l16_le(r[3], l16_add(r[2], l16_set1((float)(MFT_GRID_ROWS - 1))));
+                out |= grid_rows & none;
             }
             c_foot += (uint64_t)ms_bt_popcount16(pass & out);
             pass &= ~out;
@@ -591,12 +572,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                 for (int y = y0; y <= y1 && !pr.done; y++) {
                     uint64_t row = mft_row(L->mask, k, y) & cols;
                     if (row && fine) {
-                        const int q = y - y0;
-                        if (q < MFT_GRID_ROWS) {
-                            const int i0 = gbox.rows[2 * q][l], i1 = gbox.rows[2 * q + 1][l];
-                            row = i0 > i1 ? 0 : row & ((UINT64_C(2) << i1) - 1) & ~((UINT64_C(1) << i0) - 1);
-                        } else
-                            row &= mft_grid_cols(&gbox, l, k, y);
+                        const int q = y - y0, i0 = gbox.rows[2 * q][l], i1 = gbox.rows[2 * q + 1][l];
+                        row = i0 > i1 ? 0 : row & ((UINT64_C(2) << i1) - 1) & ~((UINT64_C(1) << i0) - 1);
                     }
                     while (row) {
                         const int p = __builtin_ctzll(row) >> 4;
