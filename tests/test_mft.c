@@ -100,6 +100,53 @@ static void test_default_scene_equals_raytrace(void **state)
     ms_scene_free(&sc);
 }
 
+/* Tiny occluders under a big light (grid pattern): each triangle's footprint on the light is a fraction of a
+ * cell, so mft keeps, row by row, only the columns whose sample (the grid's position inside its cell, per
+ * pixel: mft_grid_cols) lies in the footprint's box, and drops the pairs with none. A wrong position (the
+ * pixel's shift misread, another lane's, u for v) loses hits: V and S must still equal raytrace's bit for bit
+ * at k = 16, 32 and 64, with many penumbra pixels. */
+static void test_tiny_occluders_grid_cut(void **state)
+{
+    (void)state;
+    enum { NT = 3000 };
+    ms_scene sc;
+    memset(&sc, 0, sizeof sc);
+    sc.tri = malloc((size_t)(NT + 2) * 9 * sizeof *sc.tri);
+    assert_non_null(sc.tri);
+    static const float ground[18] = { -10, 0, -10, 10, 0, 10, 10, 0, -10, -10, 0, -10, -10, 0, 10, 10, 0, 10 };
+    memcpy(sc.tri, ground, sizeof ground);
+    uint32_t h = 12345u;
+#define TU_RND() ((h = h * 1664525u + 1013904223u), (float)(h >> 8) * (1.0f / 16777216.0f))
+    for (int i = 0; i < NT; i++) {
+        const float cx = -3.0f + 6.0f * TU_RND(), cy = 0.5f + 3.0f * TU_RND(), cz = -3.0f + 6.0f * TU_RND();
+        const float size = 0.01f + 0.04f * TU_RND();
+        float *t = sc.tri + 9 * (size_t)(i + 2);
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) t[3 * v + a] = (a == 0 ? cx : a == 1 ? cy : cz) + size * (2.0f * TU_RND() - 1.0f);
+    }
+#undef TU_RND
+    sc.n_tris = NT + 2;
+    sc.camera = (ms_camera){ { 0, 9, 7 }, { 0, 0, 0 }, { 0, 1, 0 }, 50.0f, 48, 48, MS_CAMERA_PINHOLE, 0, 0 };
+    sc.light = (ms_light){ { -4, 6, -4 }, { 8, 0, 0 }, { 0, 0, 8 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 };
+    sc.samples = 1024;
+    for (int samples = 256; samples <= 4096; samples *= 4) {
+        ms_frame ref, f;
+        render_ok(&sc, "raytrace", MS_PATTERN_GRID, samples, 48, &ref);
+        render_ok(&sc, "mft", MS_PATTERN_GRID, samples, 48, &f);
+        long partial = 0;
+        for (size_t i = 0; i < 48 * 48; i++) partial += ref.vis[i] > 0.0f && ref.vis[i] < 1.0f;
+        const tu_agreement a = tu_compare_frames(&f, &ref);
+        printf("tiny occluders, big light, grid N=%d: %ld penumbra pixels, mft vs raytrace: %ld pixels differ (V)\n",
+               samples, partial, a.differ);
+        assert_true(partial > 1000);
+        assert_memory_equal(f.vis, ref.vis, 48 * 48 * sizeof *f.vis);
+        assert_memory_equal(f.shadow, ref.shadow, 48 * 48 * sizeof *f.shadow);
+        ms_frame_free(&f);
+        ms_frame_free(&ref);
+    }
+    ms_scene_free(&sc);
+}
+
 static void real_scene(const char *rel, int size)
 {
     if (!tu_have_shared_scenes()) skip();
@@ -487,6 +534,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_equals_raytrace),
         cmocka_unit_test(test_stratified_few_samples),
+        cmocka_unit_test(test_tiny_occluders_grid_cut),
         cmocka_unit_test(test_default_scene_equals_raytrace),
         cmocka_unit_test(test_sponza_biglight_equals),
         cmocka_unit_test(test_bunny_equals),

@@ -47,6 +47,9 @@
  *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
  *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept);
+ *  - on the grid pattern the footprint's box is taken against the samples' own positions in their cells
+ *    (MFT_GRID_EPS: columns per row of a cut up to MFT_GRID_ROWS rows, 16 lanes at once, dropping pairs
+ *    with no sample in the box), not only against whole cells (docs/methods.md, session 12);
  *  - the interleaved pattern is traced by mft_group_impl.h (rays regrouped by cell of the light); there
  *    each group's rays take raytrace's box test per node (the paper's "Ray-AABB"). On the grid the same
  *    test (once per leaf and packet) cut the 16-ray tests 1.3-3.6x but not the time (big-light Sponza -7%,
@@ -87,6 +90,8 @@ typedef struct mft_state {
     unsigned has_m;                   /* lanes with a cell projection */
     float sp[4][3][MS_BLOCK_LANES];   /* the frusta's side planes through C (normals facing in) */
     float olo[3][MS_BLOCK_LANES], ohi[3][MS_BLOCK_LANES];   /* C shifted by the box margin (ms_wt_box_origins) */
+    float goa[MS_BLOCK_LANES], gv[MS_BLOCK_LANES];  /* the grid pattern's (k - 1 + u) / k and v per lane */
+    int grid_rows;                    /* the grid pattern, k >= 16: the footprint against the samples (MFT_GRID_EPS) */
 } mft_state;
 
 /* Row j (k bits) of a sample mask. */
@@ -357,6 +362,29 @@ static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
     pr->done = !(lc[0] | lc[1] | lc[2] | lc[3]);
 }
 
+/* The grid pattern (pattern.c, ms_grid_for_pixel) puts sample (i, j) of a pixel with shift (u, v) at cell
+ * coordinates (i + (k - 1 - j + u) / k, j + (i + v) / k), not anywhere in cell (i, j): so in row j the
+ * samples inside the footprint's box [a0, a1] x [b0, b1] are the columns i with i + (k - 1 - j + u) / k in
+ * [a0, a1] and (i + v) / k in [b0 - j, b1 - j], an interval of columns:
+ *   ceil(a0 - (k - 1 + u) / k + j / k) .. floor(a1 - (k - 1 + u) / k + j / k), and
+ *   ceil(k b0 - v) - k j .. floor(k b1 - v) - k j (k j an integer: exact).
+ * The box bounds the exact positions of the samples whose rays can hit (the bound the cut to cells relies
+ * on already, mft_footprint16); EPS (a thousandth of a cell, far above the float rounding of these few
+ * operations on values below k^2) keeps the interval conservative. A departure from the paper (which has
+ * no footprint): the cut to cells alone leaves about (w + 1)(h + 1) cells for a box of w x h cells, most of
+ * them without a sample in the box for a small triangle under a big light; this leaves about w h. Done for
+ * cuts of at most MFT_GRID_ROWS rows, 16 lanes at once (taller cuts: the per-row work cost more than it
+ * saved, docs/methods.md, session 12). */
+#define MFT_GRID_EPS 1e-3f
+#ifndef MFT_GRID_ROWS
+#define MFT_GRID_ROWS 2
+#endif
+/* Per lane, the columns of the cut's first MFT_GRID_ROWS rows that hold a sample in the footprint's box:
+ * first and last, by row. */
+typedef struct mft_grid_box {
+    int32_t rows[2 * MFT_GRID_ROWS][MS_BLOCK_LANES];
+} mft_grid_box;
+
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
 {
     ms_block_frusta *fr = s->fr;
@@ -442,7 +470,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
          * cut drops the pair before any scalar work. */
         l16 r[4];
         for (int q = 0; q < 4; q++) r[q] = l16_load(s->rectf[q]);
-        unsigned foot = 0;
+        unsigned foot = 0, grid_rows = 0;
+        mft_grid_box gbox;
         /* No footprint for a triangle whose plane passes within 1e-4 of its size from C (|num| is C's
          * distance from the plane times |N|): some rays graze it, and the watertight test decides its
          * edges in the plane across the ray, where such a triangle is a sliver, with an error that grows
@@ -464,7 +493,29 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
                 r[q] = l16_select(foot, l16_max(lo, r[q]), r[q]);
                 r[q + 1] = l16_select(foot, l16_min(hi, r[q + 1]), r[q + 1]);
             }
-            const unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
+            unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
+            const unsigned short_cut = foot & ~out & l16_le(r[3], l16_add(r[2], l16_set1((float)(MFT_GRID_ROWS - 1))));
+            if (s->grid_rows && short_cut) {
+                /* The grid's samples in the box (above MFT_GRID_EPS): the columns of each row of the short
+                 * cuts, for the 16 lanes at once; a cut with none drops the pair. */
+                grid_rows = short_cut;
+                const l16 kf = l16_set1((float)k), keps = l16_set1((float)k * MFT_GRID_EPS), eps = l16_set1(MFT_GRID_EPS);
+                const l16 oa = l16_load(s->goa), v = l16_load(s->gv);
+                const l16 ga0 = l16_sub(l16_sub(l16_load(box[0]), oa), eps), ga1 = l16_add(l16_sub(l16_load(box[1]), oa), eps);
+                const l16 gb0 = l16_ceil(l16_sub(l16_sub(l16_mul(kf, l16_load(box[2])), keps), v));
+                const l16 gb1 = l16_floor(l16_add(l16_sub(l16_mul(kf, l16_load(box[3])), v), keps));
+                const l16 invk = l16_set1(1.0f / (float)k);
+                unsigned none = 0xFFFF;
+                for (int q = 0; q < MFT_GRID_ROWS; q++) {
+                    const l16 j = l16_add(r[2], l16_set1((float)q)), jk = l16_mul(j, invk), kj = l16_mul(j, kf);
+                    const l16 ia = l16_max(l16_max(l16_ceil(l16_add(ga0, jk)), l16_sub(gb0, kj)), r[0]);
+                    const l16 ib = l16_min(l16_min(l16_floor(l16_add(ga1, jk)), l16_sub(gb1, kj)), r[1]);
+                    l16_store_int(gbox.rows[2 * q], ia);
+                    l16_store_int(gbox.rows[2 * q + 1], ib);
+                    none &= l16_gt(ia, ib) | (q ? l16_gt(j, r[3]) : 0u);
+                }
+                out |= grid_rows & none;
+            }
             c_foot += (uint64_t)ms_bt_popcount16(pass & out);
             pass &= ~out;
         }
@@ -517,13 +568,20 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             if (k >= 16) {
                 /* Row by row, the live rays of columns x0..x1, one test per 16-sample packet that holds any. */
                 const uint64_t cols = ((UINT64_C(2) << x1) - 1) & ~((UINT64_C(1) << x0) - 1);
-                for (int y = y0; y <= y1 && !pr.done; y++)
-                    for (uint64_t row = mft_row(L->mask, k, y) & cols; row;) {
+                const int fine = grid_rows >> l & 1;
+                for (int y = y0; y <= y1 && !pr.done; y++) {
+                    uint64_t row = mft_row(L->mask, k, y) & cols;
+                    if (row && fine) {
+                        const int q = y - y0, i0 = gbox.rows[2 * q][l], i1 = gbox.rows[2 * q + 1][l];
+                        row = i0 > i1 ? 0 : row & ((UINT64_C(2) << i1) - 1) & ~((UINT64_C(1) << i0) - 1);
+                    }
+                    while (row) {
                         const int p = __builtin_ctzll(row) >> 4;
                         const unsigned bits = (unsigned)(row >> 16 * p) & 0xFFFFu;
                         row &= ~(UINT64_C(0xFFFF) << 16 * p);
                         mft_pair_packet(&pr, y * cpr + p, bits);
                     }
+                }
             } else {
                 /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (An earlier loop took k / 16 =
                  * 0 packets per row and tested no ray at all: mft answered the front mask; the known bug of
@@ -584,9 +642,15 @@ void MS_CAT(ms_mft_block_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_block *b
     s.f = f;
     s.blk = blk;
     s.b = b;
+    s.grid_rows = f->pattern == MS_PATTERN_GRID && f->k >= 16;
     for (int l = 0; l < blk->n; l++) {
         ms_mft_lane *L = &blk->lane[l];
         for (int a = 0; a < 3; a++) s.hn[a][l] = L->n[a];
+        if (s.grid_rows) {
+            float u;
+            ms_grid_shift(L->px, L->py, f->seed, &u, &s.gv[l]);
+            s.goa[l] = ((float)(f->k - 1) + u) / (float)f->k;
+        }
         float olo[3], ohi[3];
         ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, L->c, olo, ohi);
         for (int a = 0; a < 3; a++) { s.olo[a][l] = olo[a]; s.ohi[a][l] = ohi[a]; }
