@@ -108,8 +108,8 @@ MS_API ms_status ms_layout(const char *structure, const char *field, size_t *off
 #define MS_SAMPLES_MAX 4096
 #define MS_DEFAULT_METHOD "scanline"
 /* A method name that picks the method measured fastest for the options (docs/methods.md, "What to pick"):
- * scanline for the grid pattern, embree (else raytrace) for the stratified and interleaved ones, hpc for a
- * procedural scene that would not fit the memory budget materialised. ms_stats.method names the choice. */
+ * scanline for the grid pattern, mft for the interleaved one, embree (else raytrace) for the stratified one,
+ * hpc for a procedural scene that would not fit the memory budget materialised. ms_stats.method names the choice. */
 #define MS_AUTO_METHOD "auto"
 
 /* Memory budget (docs/memory.md). Frames, bakes and point queries estimate what each phase will allocate

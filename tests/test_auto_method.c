@@ -2,6 +2,7 @@
  * outside. The oracle for each case is the named method run with the same options: "auto" must give its
  * frame byte for byte (V, S, front counts) and name it in the stats.
  *   - the grid pattern: scanline;
+ *   - the interleaved pattern: mft;
  *   - the stratified pattern (micro-raster methods cannot take it): embree when compiled in, else raytrace;
  *   - a procedural scene that does not fit the memory budget materialised: hpc, which streams it, where the
  *     default method is refused (MS_ERR_BUDGET);
@@ -61,6 +62,8 @@ static void test_patterns(void **state)
     o.threads = 2;
     o.pattern = MS_PATTERN_GRID;
     auto_equals(&sc, o, "scanline");
+    o.pattern = MS_PATTERN_INTERLEAVED;
+    auto_equals(&sc, o, "mft");
     o.pattern = MS_PATTERN_STRATIFIED;
     auto_equals(&sc, o, ms_method_available("embree") == 1 ? "embree" : "raytrace");
     ms_scene_free(&sc);
