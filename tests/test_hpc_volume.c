@@ -11,21 +11,30 @@
 
 static double unitd(tu_rng *r) { return (double)(tu_rng_next(r) >> 11) * (1.0 / 9007199254740992.0); }
 
+/* A light rectangle at y = 4 of random size (poly: its four corners) and a triangle between y = 0.5 and
+ * 3.5 (tri: its three vertices). */
+static void random_light_and_triangle(tu_rng *rng, double poly[12], float tri[9])
+{
+    const double lx = 0.2 + 2.0 * unitd(rng), lz = 0.2 + 2.0 * unitd(rng);
+    const double corners[12] = { -lx, 4, -lz, lx, 4, -lz, lx, 4, lz, -lx, 4, lz };
+    memcpy(poly, corners, sizeof corners);
+    for (int v = 0; v < 3; v++) {
+        tri[3 * v] = (float)(3.0 * unitd(rng) - 1.5);
+        tri[3 * v + 1] = (float)(0.5 + 3.0 * unitd(rng));
+        tri[3 * v + 2] = (float)(3.0 * unitd(rng) - 1.5);
+    }
+}
+
 static void test_contains_every_shadow(void **st)
 {
     (void)st;
     tu_rng rng = { 0x5EED };
     long shadowed = 0, inside = 0, inside_and_shadowed = 0, planes = 0;
     for (int trial = 0; trial < 300; trial++) {
-        /* light: a rectangle at y = 4 (random size), triangle between y = 0.5 and 3.5 */
-        const double lx = 0.2 + 2.0 * unitd(&rng), lz = 0.2 + 2.0 * unitd(&rng);
-        const double poly[12] = { -lx, 4, -lz, lx, 4, -lz, lx, 4, lz, -lx, 4, lz };
+        double poly[12];
         float tri[9];
-        for (int v = 0; v < 3; v++) {
-            tri[3 * v] = (float)(3.0 * unitd(&rng) - 1.5);
-            tri[3 * v + 1] = (float)(0.5 + 3.0 * unitd(&rng));
-            tri[3 * v + 2] = (float)(3.0 * unitd(&rng) - 1.5);
-        }
+        random_light_and_triangle(&rng, poly, tri);
+        const double lx = poly[3], lz = poly[8];   /* the light's half sizes */
         hpc_volume vol;
         planes += hpc_volume_build(&vol, poly, 4, tri, 0.0f);
         for (int k = 0; k < 200; k++) {
@@ -118,14 +127,10 @@ static void test_pair_contains_both_shadows(void **st)
     tu_rng rng = { 0xFA1D };
     long shadowed = 0, capped = 0, flat = 0;
     for (int trial = 0; trial < 400; trial++) {
-        const double lx = 0.2 + 2.0 * unitd(&rng), lz = 0.2 + 2.0 * unitd(&rng);
-        const double poly[12] = { -lx, 4, -lz, lx, 4, -lz, lx, 4, lz, -lx, 4, lz };
+        double poly[12];
         float pts[12];
-        for (int v = 0; v < 3; v++) {
-            pts[3 * v] = (float)(3.0 * unitd(&rng) - 1.5);
-            pts[3 * v + 1] = (float)(0.5 + 3.0 * unitd(&rng));
-            pts[3 * v + 2] = (float)(3.0 * unitd(&rng) - 1.5);
-        }
+        random_light_and_triangle(&rng, poly, pts);
+        const double lx = poly[3], lz = poly[8];   /* the light's half sizes */
         /* the fourth point: across the edge (0, 2) from point 1, in the plane (even trials) or off it */
         const double m = 0.3 + 0.7 * unitd(&rng), w = 0.2 + unitd(&rng), fold = trial % 2 ? 0.8 * unitd(&rng) - 0.4 : 0.0;
         double nrm[3], e1[3], e2[3];
