@@ -25,6 +25,17 @@ static void random_light_and_triangle(tu_rng *rng, double poly[12], float tri[9]
     }
 }
 
+/* A random point x shadowed by triangle (v0, v1, v2) from the light of random_light_and_triangle (half sizes
+ * lx, lz): light point l, triangle point t (barycentric), x = l + s (t - l), s >= 1. */
+static void shadowed_point(tu_rng *rng, double lx, double lz, const float *v0, const float *v1, const float *v2, double x[3])
+{
+    double a = unitd(rng), b = unitd(rng);
+    if (a + b > 1) { a = 1 - a; b = 1 - b; }
+    const double l[3] = { -lx + 2 * lx * unitd(rng), 4, -lz + 2 * lz * unitd(rng) };
+    const double s = 1.0 + 5.0 * unitd(rng);
+    for (int c = 0; c < 3; c++) x[c] = l[c] + s * (v0[c] + a * (v1[c] - v0[c]) + b * (v2[c] - v0[c]) - l[c]);
+}
+
 static void test_contains_every_shadow(void **st)
 {
     (void)st;
@@ -38,13 +49,8 @@ static void test_contains_every_shadow(void **st)
         hpc_volume vol;
         planes += hpc_volume_build(&vol, poly, 4, tri, 0.0f);
         for (int k = 0; k < 200; k++) {
-            /* a shadowed point: light point l, triangle point t (barycentric), x = l + s (t - l), s >= 1 */
-            double a = unitd(&rng), b = unitd(&rng);
-            if (a + b > 1) { a = 1 - a; b = 1 - b; }
-            double l[3] = { -lx + 2 * lx * unitd(&rng), 4, -lz + 2 * lz * unitd(&rng) }, t[3], x[3];
-            for (int c = 0; c < 3; c++) t[c] = tri[c] + a * (tri[3 + c] - tri[c]) + b * (tri[6 + c] - tri[c]);
-            const double s = 1.0 + 5.0 * unitd(&rng);
-            for (int c = 0; c < 3; c++) x[c] = l[c] + s * (t[c] - l[c]);
+            double x[3];
+            shadowed_point(&rng, lx, lz, tri, tri + 3, tri + 6, x);
             const float p[3] = { (float)x[0], (float)x[1], (float)x[2] };
             uint64_t tests = 0;
             /* margin: the float rounding of p and of the planes, far below the geometry */
@@ -157,13 +163,8 @@ static void test_pair_contains_both_shadows(void **st)
         static const int tri_of[2][3] = { { 0, 1, 2 }, { 0, 2, 3 } };
         for (int k = 0; k < 200; k++) {
             const int *tv = tri_of[k & 1];
-            double a = unitd(&rng), b = unitd(&rng);
-            if (a + b > 1) { a = 1 - a; b = 1 - b; }
-            double l[3] = { -lx + 2 * lx * unitd(&rng), 4, -lz + 2 * lz * unitd(&rng) }, t[3], x[3];
-            for (int c = 0; c < 3; c++)
-                t[c] = pts[3 * tv[0] + c] + a * (pts[3 * tv[1] + c] - pts[3 * tv[0] + c]) + b * (pts[3 * tv[2] + c] - pts[3 * tv[0] + c]);
-            const double s = 1.0 + 5.0 * unitd(&rng);
-            for (int c = 0; c < 3; c++) x[c] = l[c] + s * (t[c] - l[c]);
+            double x[3];
+            shadowed_point(&rng, lx, lz, pts + 3 * tv[0], pts + 3 * tv[1], pts + 3 * tv[2], x);
             const float p[3] = { (float)x[0], (float)x[1], (float)x[2] };
             uint64_t tests = 0;
             vol.eps = 1e-4f;
