@@ -37,7 +37,7 @@
 
 /* The interleaved mode's tables of the 16 sample sets (each set the same in every block, pattern.c): per set
  * its n = N/16 points and each point's cell of the g x g grid over the light; per cell the points of the
- * 16 sets [cell][axis][set], the sample of each set in it, and the box of its points (lo xyz, hi xyz);
+ * 16 sets [cell][axis][set], the sample of each set in it [cell][set], and the box of its points (lo xyz, hi xyz);
  * have: the sets formed; regular: those with one sample per cell (all of pattern.c's sets: nets). */
 typedef struct mft_sets {
     int n, gside, ncell;
@@ -86,7 +86,7 @@ static int mft_morton(int x, int y);
 /* Forms set `set`'s tables for frame f (its light, pattern, k, seed). */
 static void mft_sets_form(mft_sets *T, const ms_mft_frame *f, int set)
 {
-    const int n = T->n, gside = T->gside, ncell = T->ncell;
+    const int n = T->n, gside = T->gside;
     const uint32_t px = (uint32_t)set & 3u, py = (uint32_t)set >> 2;   /* a pixel of the set */
     float *pts = T->set_pts + (size_t)set * 3 * n, *st = T->st;
     ms_pattern_points_range(f->pattern, &f->light, f->k, px, py, f->seed, 0, n, pts);
@@ -99,7 +99,7 @@ static void mft_sets_form(mft_sets *T, const ms_mft_frame *f, int set)
         T->set_cell[(size_t)set * n + j] = c;
         ok &= !(seen[c >> 5] >> (c & 31) & 1u);
         seen[c >> 5] |= 1u << (c & 31);
-        T->sample_of[(size_t)set * ncell + c] = (uint16_t)j;
+        T->sample_of[(size_t)c * 16 + set] = (uint16_t)j;
         for (int a = 0; a < 3; a++) {
             const float x = pts[3 * j + a];
             float *lo = &T->cell_box[6 * c + a], *hi = lo + 3;

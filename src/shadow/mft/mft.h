@@ -84,7 +84,7 @@ typedef struct ms_mft_rayblock {
     int n, cap;                          /* groups */
     ms_mft_group *g;
     /* form_n > 0: the groups' rays are still to be formed (every query's N/16 = form_n samples one per
-     * cell, slot = set): the points by cell [cell][axis][slot], each slot's sample in each cell, each
+     * cell, slot = set): the points by cell [cell][axis][slot], each slot's sample in each cell [cell][slot], each
      * slot's cell of each sample, and the slots present. */
     int form_n;
     const float *cell_pts;

@@ -73,16 +73,27 @@ typedef struct mftg_state {
     float olo[3][MS_BLOCK_LANES], ohi[3][MS_BLOCK_LANES];   /* them shifted by raytrace's box margin */
 } mftg_state;
 
-/* The rays of group g (bits) that enter box n: method raytrace's box test (raytrace_impl.h, packet_enters)
- * per ray, its widened box and Ize's factor, so it never drops a ray that raytrace's triangle test
- * finds blocked by a triangle in the box. */
-static inline unsigned mftg_ray_box(const mftg_state *s, const ms_mft_group *g, const ms_bvh_node *n)
+/* Child box n against the 16 receivers (slot q in lane q), shared by every group at it: the box's sides
+ * relative to each receiver shifted by raytrace's box margin (A: bmin - olo, B: bmax - ohi), the first
+ * operations of raytrace's slab test (raytrace_impl.h, packet_enters), formed once per child instead of
+ * once per group. */
+static inline void mftg_box_sides(const mftg_state *s, const ms_bvh_node *n, l16 A[3], l16 B[3])
+{
+    for (int a = 0; a < 3; a++) {
+        A[a] = l16_sub(l16_set1(n->bmin[a]), l16_load(s->olo[a]));
+        B[a] = l16_sub(l16_set1(n->bmax[a]), l16_load(s->ohi[a]));
+    }
+}
+
+/* The rays of group g (bits) that enter the box whose sides are A, B (mftg_box_sides): method raytrace's
+ * box test (raytrace_impl.h, packet_enters) per ray, its widened box and Ize's factor, so it never drops a
+ * ray that raytrace's triangle test finds blocked by a triangle in the box. */
+static inline unsigned mftg_ray_box(const mftg_state *s, const ms_mft_group *g, const l16 A[3], const l16 B[3])
 {
     l16 t0 = l16_set1(s->f->near), t1 = l16_set1(s->f->far);
     for (int a = 0; a < 3; a++) {
         const l16 inv = l16_load(g->inv[a]);
-        const l16 x = l16_mul(l16_sub(l16_set1(n->bmin[a]), l16_load(s->olo[a])), inv);
-        const l16 y = l16_mul(l16_sub(l16_set1(n->bmax[a]), l16_load(s->ohi[a])), inv);
+        const l16 x = l16_mul(A[a], inv), y = l16_mul(B[a], inv);
         /* raytrace's compares: mn = x < y ? x : y, mx = x < y ? y : x; a NaN leaves t0, t1 as they were */
         const l16 mn = l16_min(x, y), mx = l16_select(l16_lt(x, y), y, x);
         t0 = l16_max(mn, t0);
@@ -319,15 +330,29 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
     }
 }
 
+/* Of the lanes m whose frustum reaches child n, those with rays entering it (out[l]: the rays; rays[l]:
+ * those that entered the parent). */
+static inline unsigned mftg_child_rays(const mftg_state *s, const ms_bvh_node *n, unsigned m, const uint16_t *rays,
+                                       uint16_t *out, uint64_t *ray_tests)
+{
+    if (!m) return 0;
+    *ray_tests += (uint64_t)ms_bt_popcount16(m);
+    l16 A[3], B[3];
+    mftg_box_sides(s, n, A, B);
+    for (unsigned r = m; r; r &= r - 1) {
+        const int l = __builtin_ctz(r);
+        out[l] = (uint16_t)(mftg_ray_box(s, s->grp[l], A, B) & rays[l]);
+        if (!out[l]) m &= ~(1u << l);
+    }
+    return m;
+}
+
 /* Depth-first over the shallow BVH, as block_traverse_loop.h, with each lane's rays: a child is visited
  * for the lanes whose frustum may reach it (all 16 at once) and, of those, whose rays enter it (one 16-ray
- * box test per lane, raytrace's; from depth MFTG_RAY_DEPTH on, above it the rays pass). The frusta cull
- * the upper levels for 16 groups at a time; the rays the lower ones, where a group's frustum, however
- * thin on the light, is wide against small triangles (measured: the ogre at 256^2, 14.5M lane-leaf visits
- * for 1.5M leaves when only the leaves tested the rays). Departure from the paper (frusta only). */
-#ifndef MFTG_RAY_DEPTH
-#define MFTG_RAY_DEPTH 0
-#endif
+ * box test per lane, raytrace's). The frusta cull the upper levels for 16 groups at a time; the rays the
+ * lower ones, where a group's frustum, however thin on the light, is wide against small triangles
+ * (measured: the ogre at 256^2, 14.5M lane-leaf visits for 1.5M leaves when only the leaves tested the
+ * rays). Departure from the paper (frusta only). */
 static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
 {
     ms_block_frusta *f = s->fr;
@@ -340,10 +365,9 @@ static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
     uint32_t st_node[MS_BVH_STACK];
     unsigned st_mask[MS_BVH_STACK];
     uint16_t st_rays[MS_BVH_STACK][MS_BLOCK_LANES];
-    uint8_t st_depth[MS_BVH_STACK];
     uint16_t rays[MS_BLOCK_LANES], rl[MS_BLOCK_LANES], rr[MS_BLOCK_LANES];
     for (int l = 0; l < MS_BLOCK_LANES; l++) rays[l] = (uint16_t)(s->grp[l] ? s->grp[l]->live : 0u);
-    int sp = 0, depth = 0;
+    int sp = 0;
     uint32_t ni = 0;
     uint64_t tests = 0, ray_tests = 0, lanes_culled = 0;
     for (;;) {
@@ -359,32 +383,16 @@ static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
             unsigned ml = mftg_traverse_node(f, &sh->nodes[c0], &t0) & mask;
             unsigned mr = mftg_traverse_node(f, &sh->nodes[c0 + 1], &t1) & mask;
             tests += 2;
-            const ms_bvh_node *n0 = &sh->nodes[c0], *n1 = &sh->nodes[c0 + 1];
-            const int test_rays = depth + 1 >= MFTG_RAY_DEPTH;
-            for (unsigned m = ml | mr; m; m &= m - 1) {
-                const int l = __builtin_ctz(m);
-                const unsigned live = rays[l] & s->grp[l]->live;
-                if (ml >> l & 1) {
-                    const int t = test_rays;
-                    rl[l] = (uint16_t)(t ? mftg_ray_box(s, s->grp[l], n0) & live : live);
-                    ray_tests += (uint64_t)t;
-                    if (!rl[l]) { ml &= ~(1u << l); lanes_culled++; }
-                }
-                if (mr >> l & 1) {
-                    const int t = test_rays;
-                    rr[l] = (uint16_t)(t ? mftg_ray_box(s, s->grp[l], n1) & live : live);
-                    ray_tests += (uint64_t)t;
-                    if (!rr[l]) { mr &= ~(1u << l); lanes_culled++; }
-                }
-            }
-            depth++;
+            const unsigned reach = (unsigned)(ms_bt_popcount16(ml) + ms_bt_popcount16(mr));
+            ml = mftg_child_rays(s, &sh->nodes[c0], ml, rays, rl, &ray_tests);
+            mr = mftg_child_rays(s, &sh->nodes[c0 + 1], mr, rays, rr, &ray_tests);
+            lanes_culled += reach - (unsigned)(ms_bt_popcount16(ml) + ms_bt_popcount16(mr));
             if (ml && mr) {
                 int right_first = 0;
                 if (order) {
                     const unsigned both = ml & mr;
                     right_first = 2 * ms_bt_popcount16(l16_lt(t1, t0) & both) > ms_bt_popcount16(both);
                 }
-                st_depth[sp] = (uint8_t)depth;
                 if (right_first) {
                     st_node[sp] = c0; st_mask[sp] = ml; memcpy(st_rays[sp++], rl, sizeof rl);
                     ni = c0 + 1; mask = mr; memcpy(rays, rr, sizeof rr);
@@ -404,7 +412,6 @@ static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
             if (mask) break;
         }
         ni = st_node[sp];
-        depth = st_depth[sp];
         memcpy(rays, st_rays[sp], sizeof rays);
     }
 done:
@@ -431,29 +438,60 @@ static void mftg_form(ms_mft_rayblock *rb)
             l16_store(G->d[a], d);
             l16_store(G->inv[a], l16_div(one, d));
         }
-        unsigned live = 0;
-        for (int q = 0; q < 16; q++) {
-            const int j = rb->sample_of[(size_t)q * ncell + c];
-            G->sample[q] = (uint16_t)j;
-            if (rb->present >> q & 1) live |= (unsigned)(rb->mask[q][j >> 6] >> (j & 63) & 1u) << q;
-        }
-        G->live = live;
+        memcpy(G->sample, rb->sample_of + (size_t)c * 16, sizeof G->sample);
+        G->live = 0;
     }
-    signed char kz[16][MS_SAMPLES_MAX / 16 / 16];
-    for (int q = 0; q < 16; q++) {
-        if (!(rb->present >> q & 1)) continue;
-        for (int ch = 0; ch < n / 16; ch++) {
-            float dx[16], dy[16], dz[16];
-            for (int l = 0; l < 16; l++) {
-                const ms_mft_group *G = &rb->g[rb->set_cell[(size_t)q * n + 16 * ch + l]];
-                dx[l] = G->d[0][q];
-                dy[l] = G->d[1][q];
-                dz[l] = G->d[2][q];
+    /* Each group's live slots: a slot's bit where its sample in the group's cell is in its mask. */
+    if (n == 16)   /* a slot's samples are its mask's first 16 bits: only its set bits visited */
+        for (unsigned pm = rb->present; pm; pm &= pm - 1) {
+            const int q = __builtin_ctz(pm);
+            const int *cell = rb->set_cell + (size_t)q * n;
+            for (unsigned m = (unsigned)rb->mask[q][0] & 0xFFFFu; m; m &= m - 1) rb->g[cell[__builtin_ctz(m)]].live |= 1u << q;
+        }
+    else
+        for (int c = 0; c < ncell; c++) {
+            ms_mft_group *G = &rb->g[c];
+            for (unsigned pm = rb->present; pm; pm &= pm - 1) {
+                const int q = __builtin_ctz(pm), j = G->sample[q];
+                G->live |= (unsigned)(rb->mask[q][j >> 6] >> (j & 63) & 1u) << q;
             }
-            int k0;
-            kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, &k0);
         }
-    }
+    /* Each slot's packet axis (ms_wt_packet_axis over its 16-sample packets in sample order). n = 16: one
+     * packet per slot, its samples the slot's lane of the 16 groups, so the 16 slots at once: the axis of
+     * each slot's first sample, then the packet's test over the groups (an AND: order-free). */
+    signed char kz[16][MS_SAMPLES_MAX / 16 / 16];
+    if (n == 16) {
+        unsigned k1 = 0, k2 = 0, ok = 0xFFFFu;
+        for (int q = 0; q < 16; q++) {
+            const ms_mft_group *G = &rb->g[rb->set_cell[(size_t)q * n]];
+            const float d0[3] = { G->d[0][q], G->d[1][q], G->d[2][q] };
+            const int k = ms_wt_max_axis(d0);
+            k1 |= (unsigned)(k == 1) << q;
+            k2 |= (unsigned)(k == 2) << q;
+        }
+        const l16 two = l16_set1(2.0f), zero = l16_set1(0.0f);
+        for (int c = 0; c < ncell; c++) {
+            const ms_mft_group *G = &rb->g[c];
+            const l16 ax = l16_abs(l16_load(G->d[0])), ay = l16_abs(l16_load(G->d[1])), az = l16_abs(l16_load(G->d[2]));
+            const l16 m = l16_max(ax, l16_max(ay, az)), dk = l16_select(k1, ay, l16_select(k2, az, ax));
+            ok &= l16_le(m, l16_mul(two, dk)) & l16_gt(m, zero);
+        }
+        for (int q = 0; q < 16; q++) kz[q][0] = (signed char)(!(ok >> q & 1) ? -1 : k1 >> q & 1 ? 1 : k2 >> q & 1 ? 2 : 0);
+    } else
+        for (int q = 0; q < 16; q++) {
+            if (!(rb->present >> q & 1)) continue;
+            for (int ch = 0; ch < n / 16; ch++) {
+                float dx[16], dy[16], dz[16];
+                for (int l = 0; l < 16; l++) {
+                    const ms_mft_group *G = &rb->g[rb->set_cell[(size_t)q * n + 16 * ch + l]];
+                    dx[l] = G->d[0][q];
+                    dy[l] = G->d[1][q];
+                    dz[l] = G->d[2][q];
+                }
+                int k0;
+                kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, &k0);
+            }
+        }
     /* n = 16 (256 samples): a slot's 16 samples are one packet, so every group has the slots' axes; they
      * are found once, and each group's common axis from its live slots by masks. */
     signed char kq[16];
