@@ -37,7 +37,8 @@
 
 /* The interleaved mode's tables of the 16 sample sets (each set the same in every block, pattern.c): per set
  * its n = N/16 points and each point's cell of the g x g grid over the light; per cell the points of the
- * 16 sets [cell][axis][set], the sample of each set in it [cell][set], and the box of its points (lo xyz, hi xyz);
+ * 16 sets [cell][axis][set], the sample of each set in it [cell][set], and the box of its points ([lo x, y, z,
+ * hi x, y, z][cell]: 16 cells' in a vector);
  * have: the sets formed; regular: those with one sample per cell (all of pattern.c's sets: nets). */
 typedef struct mft_sets {
     int n, gside, ncell;
@@ -77,7 +78,7 @@ static int mft_sets_alloc(mft_sets *T, int n)
     T->set_cell = malloc((size_t)16 * n * sizeof *T->set_cell);
     if (!T->set_pts || !T->cell_pts || !T->cell_box || !T->st || !T->sample_of || !T->set_cell) { mft_sets_free(T); return -1; }
     for (int c = 0; c < T->ncell; c++)
-        for (int a = 0; a < 3; a++) { T->cell_box[6 * c + a] = INFINITY; T->cell_box[6 * c + 3 + a] = -INFINITY; }
+        for (int a = 0; a < 3; a++) { T->cell_box[(size_t)a * T->ncell + c] = INFINITY; T->cell_box[(size_t)(3 + a) * T->ncell + c] = -INFINITY; }
     return 0;
 }
 
@@ -102,7 +103,7 @@ static void mft_sets_form(mft_sets *T, const ms_mft_frame *f, int set)
         T->sample_of[(size_t)c * 16 + set] = (uint16_t)j;
         for (int a = 0; a < 3; a++) {
             const float x = pts[3 * j + a];
-            float *lo = &T->cell_box[6 * c + a], *hi = lo + 3;
+            float *lo = &T->cell_box[(size_t)a * T->ncell + c], *hi = lo + (size_t)3 * T->ncell;
             T->cell_pts[((size_t)c * 3 + a) * 16 + set] = x;
             *lo = x < *lo ? x : *lo;
             *hi = x > *hi ? x : *hi;

@@ -91,8 +91,9 @@ typedef struct ms_mft_rayblock {
     const uint16_t *sample_of;
     const int *set_cell;
     unsigned present;
-    /* Per cell, the box of the points of every set formed so far (lo xyz, hi xyz), or NULL: a group whose
-     * every present slot is live starts from it and the box of the present receivers (mft_group_impl.h). */
+    /* Per cell, the box of the points of every set formed so far ([lo x, y, z, hi x, y, z][cell], n cells), or
+     * NULL: a group whose every present slot is live starts from it and the box of the present receivers
+     * (mft_group_impl.h). */
     const float *cell_box;
 } ms_mft_rayblock;
 

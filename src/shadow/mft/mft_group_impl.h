@@ -58,6 +58,7 @@
 #ifndef MFTG_CR
 #define MFTG_CR 0
 #endif
+#define MFTG_TINY 1e-30f   /* block_traverse.c's stand-in for a zero direction bound (1/TINY finite) */
 
 typedef struct mftg_state {
     ms_block_frusta *fr;
@@ -115,6 +116,40 @@ static void mftg_lane_set(mftg_state *s, int l, const float clo[3], const float 
     }
     s->mag[l] = mag;
     ms_block_frusta_set_lane_box(s->fr, l, clo, chi, plo, phi, MFTG_REL);
+}
+
+/* The lanes `full` of the 16 groups from g0 (rb->n a multiple of 16): their frusta from the box of the
+ * present receivers (lo, hi) and their cells' boxes of points, 16 lanes at once with mftg_lane_set's and
+ * ms_block_frusta_set_lane_box's operations (it was 6 scalar divisions per lane). */
+static void mftg_lanes_set_cells(mftg_state *s, int g0, unsigned full, const float lo[3], const float hi[3])
+{
+    ms_block_frusta *fr = s->fr;
+    const float *cb = s->rb->cell_box;
+    const size_t nc = (size_t)s->rb->n;
+    const l16 half = l16_set1(0.5f), zero = l16_set1(0.0f), one = l16_set1(1.0f), slack = l16_set1(MFTG_REL * 2.0f);
+    const l16 tiny = l16_set1(MFTG_TINY), ntiny = l16_set1(-MFTG_TINY);
+    l16 mag = zero;
+    for (int a = 0; a < 3; a++) {
+        const l16 clo = l16_set1(lo[a]), chi = l16_set1(hi[a]);
+        const l16 plo = l16_load(cb + (size_t)a * nc + g0), phi = l16_load(cb + (size_t)(3 + a) * nc + g0);
+        l16_store(s->oc[a], l16_mul(half, l16_add(clo, chi)));
+        l16_store(s->oh[a], l16_mul(half, l16_sub(chi, clo)));
+        l16_store(s->pc[a], l16_mul(half, l16_add(plo, phi)));
+        l16_store(s->ph[a], l16_mul(half, l16_sub(phi, plo)));
+        const l16 ma = l16_max(l16_max(l16_abs(clo), l16_abs(chi)), l16_max(l16_abs(plo), l16_abs(phi)));
+        mag = l16_max(ma, mag);
+        l16 dlo = l16_sub(l16_sub(plo, clo), l16_mul(slack, ma)), dhi = l16_add(l16_sub(phi, chi), l16_mul(slack, ma));
+        dlo = l16_select(l16_le(dlo, zero) & ~l16_lt(dlo, zero), ntiny, dlo);   /* 0: -TINY */
+        dhi = l16_select(l16_le(dhi, zero) & ~l16_lt(dhi, zero), tiny, dhi);
+        l16_store(fr->c[a], clo);
+        l16_store(fr->chi[a], chi);
+        l16_store(fr->rlo[a], l16_div(one, dlo));
+        l16_store(fr->rhi[a], l16_div(one, dhi));
+        fr->pos_hi[a] = (fr->pos_hi[a] & ~full) | (l16_gt(dhi, zero) & full);
+        fr->neg_lo[a] = (fr->neg_lo[a] & ~full) | (l16_lt(dlo, zero) & full);
+    }
+    l16_store(s->mag, mag);
+    fr->live |= full;
 }
 
 /* Lane l's frustum from its group's live rays. */
@@ -442,13 +477,15 @@ static void mftg_form(ms_mft_rayblock *rb)
         G->live = 0;
     }
     /* Each group's live slots: a slot's bit where its sample in the group's cell is in its mask. */
-    if (n == 16)   /* a slot's samples are its mask's first 16 bits: only its set bits visited */
+    if (n == 16) {   /* a slot's samples are its mask's first 16 bits: only its set bits visited */
+        unsigned lv[16] = { 0 };
         for (unsigned pm = rb->present; pm; pm &= pm - 1) {
             const int q = __builtin_ctz(pm);
             const int *cell = rb->set_cell + (size_t)q * n;
-            for (unsigned m = (unsigned)rb->mask[q][0] & 0xFFFFu; m; m &= m - 1) rb->g[cell[__builtin_ctz(m)]].live |= 1u << q;
+            for (unsigned m = (unsigned)rb->mask[q][0] & 0xFFFFu; m; m &= m - 1) lv[cell[__builtin_ctz(m)]] |= 1u << q;
         }
-    else
+        for (int c = 0; c < 16; c++) rb->g[c].live = lv[c];
+    } else
         for (int c = 0; c < ncell; c++) {
             ms_mft_group *G = &rb->g[c];
             for (unsigned pm = rb->present; pm; pm &= pm - 1) {
@@ -552,10 +589,18 @@ void MS_CAT(ms_mft_groups_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_raybloc
     s.b = b;
     if (rb->form_n) mftg_form(rb);
     for (int a = 0; a < 3; a++) memcpy(s.c[a], rb->c[a], sizeof s.c[a]);
-    for (int q = 0; q < rb->nq; q++) {
-        float c[3] = { rb->c[0][q], rb->c[1][q], rb->c[2][q] }, lo[3], hi[3];
-        ms_wt_box_origins(b->nodes[0].bmin, b->nodes[0].bmax, c, lo, hi);
-        for (int a = 0; a < 3; a++) { s.olo[a][q] = lo[a]; s.ohi[a][q] = hi[a]; }
+    /* Each receiver shifted by raytrace's box margin (ms_wt_box_origins' operations, 16 receivers at once). */
+    l16 om = l16_set1(0.0f);
+    for (int a = 0; a < 3; a++) {
+        const l16 o = l16_load(rb->c[a]);
+        om = l16_max(l16_abs(l16_sub(l16_set1(b->nodes[0].bmin[a]), o)), om);
+        om = l16_max(l16_abs(l16_sub(l16_set1(b->nodes[0].bmax[a]), o)), om);
+        om = l16_max(l16_abs(o), om);
+    }
+    const l16 oe = l16_mul(om, l16_set1(MS_WT_BOX_REL));
+    for (int a = 0; a < 3; a++) {
+        l16_store(s.olo[a], l16_add(l16_load(rb->c[a]), oe));
+        l16_store(s.ohi[a], l16_sub(l16_load(rb->c[a]), oe));
     }
     /* The box of the present receivers: with the cell's box of points, the starting frustum of every group
      * whose present slots are all live (most of them), without a pass over its rays. Departure from a
@@ -572,16 +617,16 @@ void MS_CAT(ms_mft_groups_, MS_ISA_SUFFIX)(const ms_mft_frame *f, ms_mft_raybloc
     for (int g0 = 0; g0 < rb->n; g0 += MS_BLOCK_LANES) {
         ms_block_frusta_init(&fr, &sh->nodes[0], f->near, f->far);
         memset(s.grp, 0, sizeof s.grp);
+        unsigned full = 0;
         for (int l = 0; l < MS_BLOCK_LANES && g0 + l < rb->n; l++) {
             s.grp[l] = &rb->g[g0 + l];
             if (!s.grp[l]->live) continue;
-            if (rb->cell_box && s.grp[l]->live == rb->present) {
-                const float *cb = rb->cell_box + 6 * (size_t)(g0 + l);
-                mftg_lane_set(&s, l, blo, bhi, cb, cb + 3);
-            } else
-                mftg_lane_bounds(&s, l);
+            if (rb->cell_box && s.grp[l]->live == rb->present) full |= 1u << l;
             cnt[MS_MFT_FRUSTA]++;
         }
+        if (full) mftg_lanes_set_cells(&s, g0, full, blo, bhi);
+        for (int l = 0; l < MS_BLOCK_LANES && g0 + l < rb->n; l++)
+            if (s.grp[l]->live && !(full >> l & 1)) mftg_lane_bounds(&s, l);
         if (fr.live) mftg_traverse(&s, sh, f->flags & MS_MFT_ORDER);
     }
 }
