@@ -478,13 +478,15 @@ static void mftg_form(ms_mft_rayblock *rb)
     }
     /* Each group's live slots: a slot's bit where its sample in the group's cell is in its mask. */
     if (n == 16) {   /* a slot's samples are its mask's first 16 bits: only its set bits visited */
-        unsigned lv[16] = { 0 };
-        for (unsigned pm = rb->present; pm; pm &= pm - 1) {
+        unsigned lv[16] = { 0 }, all = 0xFFFFu;
+        for (unsigned pm = rb->present; pm; pm &= pm - 1) all &= (unsigned)rb->mask[__builtin_ctz(pm)][0];
+        /* every present slot's 16 samples in its mask (the usual case): every group has all present slots */
+        for (unsigned pm = all == 0xFFFFu ? 0u : rb->present; pm; pm &= pm - 1) {
             const int q = __builtin_ctz(pm);
             const int *cell = rb->set_cell + (size_t)q * n;
             for (unsigned m = (unsigned)rb->mask[q][0] & 0xFFFFu; m; m &= m - 1) lv[cell[__builtin_ctz(m)]] |= 1u << q;
         }
-        for (int c = 0; c < 16; c++) rb->g[c].live = lv[c];
+        for (int c = 0; c < 16; c++) rb->g[c].live = all == 0xFFFFu ? rb->present : lv[c];
     } else
         for (int c = 0; c < ncell; c++) {
             ms_mft_group *G = &rb->g[c];
