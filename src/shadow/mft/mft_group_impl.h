@@ -256,24 +256,23 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
         if (!lanes) break;
         pairs += (uint64_t)ms_bt_popcount16(lanes);
         const float *tri = s->b->tri + 9 * (size_t)t, *N = s->b->tri_n + 3 * (size_t)t;
-        /* 1. The triangle's box against the groups' segments (the traversal's test), then its plane. */
-        ms_bvh_node tb;
-        float tmag = 0.0f;
-        for (int a = 0; a < 3; a++) {
-            const float x = tri[a], y = tri[3 + a], z = tri[6 + a];
-            tb.bmin[a] = x < y ? (x < z ? x : z) : (y < z ? y : z);
-            tb.bmax[a] = x > y ? (x > z ? x : z) : (y > z ? y : z);
-            tmag = fmaxf(tmag, fmaxf(fabsf(tb.bmin[a]), fabsf(tb.bmax[a])));
-        }
-        l16 tlo;
-        /* Worth its cost (one test for 16 groups) only with several groups at the triangle: measured,
+        /* 1. The triangle's box against the groups' segments (the traversal's test), then its plane.
+         * Worth its cost (one test for 16 groups) only with several groups at the triangle: measured,
          * with one or two it costs more than their 16-ray tests save (the ogre: +18% CPU). */
-        const int cull = ms_bt_popcount16(lanes) >= MFTG_TRI_CULL;
-        const unsigned in_box = cull ? mftg_traverse_node(fr, &tb, &tlo) & lanes : lanes;
-        c_box += (uint64_t)ms_bt_popcount16(lanes & ~in_box);
-        lanes = in_box;
-        if (!lanes) continue;
-        if (cull) {
+        if (ms_bt_popcount16(lanes) >= MFTG_TRI_CULL) {
+            ms_bvh_node tb;
+            float tmag = 0.0f;
+            for (int a = 0; a < 3; a++) {
+                const float x = tri[a], y = tri[3 + a], z = tri[6 + a];
+                tb.bmin[a] = x < y ? (x < z ? x : z) : (y < z ? y : z);
+                tb.bmax[a] = x > y ? (x > z ? x : z) : (y > z ? y : z);
+                tmag = fmaxf(tmag, fmaxf(fabsf(tb.bmin[a]), fabsf(tb.bmax[a])));
+            }
+            l16 tlo;
+            const unsigned in_box = mftg_traverse_node(fr, &tb, &tlo) & lanes;
+            c_box += (uint64_t)ms_bt_popcount16(lanes & ~in_box);
+            lanes = in_box;
+            if (!lanes) continue;
             /* a = (C - v) . N over the origins' box, b = (P - v) . N over the points': the vertices' own
              * offsets span [wlo, whi] (N is rounded). A hit needs the segment to cross the plane at t =
              * a / (a - b) in [near, far]: not both ends on one side, and |a| >= near |a - b|. */
