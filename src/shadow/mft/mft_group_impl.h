@@ -367,16 +367,16 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
 /* Of the lanes m whose frustum reaches child n, those with rays entering it (out[l]: the rays; rays[l]:
  * those that entered the parent). */
 static inline unsigned mftg_child_rays(const mftg_state *s, const ms_bvh_node *n, unsigned m, const uint16_t *rays,
-                                       uint16_t *out, uint64_t *ray_tests)
+                                       uint16_t *out, uint64_t *ray_tests, uint64_t *culled)
 {
     if (!m) return 0;
-    *ray_tests += (uint64_t)ms_bt_popcount16(m);
     l16 A[3], B[3];
     mftg_box_sides(s, n, A, B);
     for (unsigned r = m; r; r &= r - 1) {
         const int l = __builtin_ctz(r);
         out[l] = (uint16_t)(mftg_ray_box(s, s->grp[l], A, B) & rays[l]);
-        if (!out[l]) m &= ~(1u << l);
+        ++*ray_tests;
+        if (!out[l]) { m &= ~(1u << l); ++*culled; }
     }
     return m;
 }
@@ -417,10 +417,8 @@ static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
             unsigned ml = mftg_traverse_node(f, &sh->nodes[c0], &t0) & mask;
             unsigned mr = mftg_traverse_node(f, &sh->nodes[c0 + 1], &t1) & mask;
             tests += 2;
-            const unsigned reach = (unsigned)(ms_bt_popcount16(ml) + ms_bt_popcount16(mr));
-            ml = mftg_child_rays(s, &sh->nodes[c0], ml, rays, rl, &ray_tests);
-            mr = mftg_child_rays(s, &sh->nodes[c0 + 1], mr, rays, rr, &ray_tests);
-            lanes_culled += reach - (unsigned)(ms_bt_popcount16(ml) + ms_bt_popcount16(mr));
+            ml = mftg_child_rays(s, &sh->nodes[c0], ml, rays, rl, &ray_tests, &lanes_culled);
+            mr = mftg_child_rays(s, &sh->nodes[c0 + 1], mr, rays, rr, &ray_tests, &lanes_culled);
             if (ml && mr) {
                 int right_first = 0;
                 if (order) {
