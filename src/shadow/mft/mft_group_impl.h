@@ -6,9 +6,11 @@
  * receivers close together to 16 points in 1/16 of the light (256 samples; 1/64 at 1024). Sixteen groups
  * are sixteen SIMD lanes of the multi-frusta traversal (block_traverse_loop.h's node test, our own loop,
  * mftg_traverse), each bounded by the box of its live rays' origins and the box of their sample points
- * (ms_block_frusta_set_lane_box); below the frusta each lane's rays take raytrace's slab test, 16 in one
- * register, at every child its frustum reaches, and go on with the rays that enter; in a leaf, per
- * triangle:
+ * (ms_block_frusta_set_lane_box; the 16 lanes at once where a group starts from its cell's box), tested
+ * 16 lanes at once where 4 or more lanes reach a node (MFTG_FRUSTUM_MIN); below the frusta each lane's
+ * rays take raytrace's slab test, 16 in one register, at every child its frustum reaches (the child's
+ * sides relative to the 16 receivers formed once for all lanes), and go on with the rays that enter; in
+ * a leaf, per triangle:
  *   1. where 4 or more groups reach it, culling of them all at once: the triangle's box against each
  *      group's segments (the traversal's own interval test), and its plane against the boxes of origins
  *      and points (every segment wholly on one side, or meeting the plane only before the near end);
