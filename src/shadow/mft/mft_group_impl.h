@@ -11,7 +11,7 @@
  * rays take raytrace's slab test, 16 in one register, at every child its frustum reaches (the child's
  * sides relative to the 16 receivers formed once for all lanes), and go on with the rays that enter; in
  * a leaf, per triangle:
- *   1. where 4 or more groups reach it, culling of them all at once: the triangle's box against each
+ *   1. where 8 or more groups reach it, culling of them all at once: the triangle's box against each
  *      group's segments (the traversal's own interval test), and its plane against the boxes of origins
  *      and points (every segment wholly on one side, or meeting the plane only before the near end);
  *   2. the triangle relative to each of the 16 receivers and its plane offset (ms_wt_offset), once per
@@ -49,13 +49,15 @@
 
 #define MFTG_REL 1e-5f
 /* Measurement switches (builds with -D..., docs/methods.md): the groups at a triangle from which it is
- * culled for all at once (1: always; with one or two groups the cull cost more than it saved, ogre +18%);
+ * culled for all at once (1: always; with one or two groups the cull cost more than it saved, ogre +18%;
+ * session 13, with the per-group tests cheaper, 8 against 4: bars 0.289 -> 0.273 s, foliage 0.216 -> 0.211,
+ * ogre 0.120 -> 0.118, 12 alike, never (17) Crytek 0.238 -> 0.251);
  * CR on or off (session 10: within noise; session 12, with the groups starting from their cell's box, off
  * is faster: 384^2, CPU s, bars 0.225 -> 0.202, Crytek 0.186 -> 0.176, ogre 0.096 -> 0.093: a recomputation
  * per group and leaf that lost rays, 514K on the bars, cost more than the tighter boxes saved). Departure
  * from the paper, which shrinks. */
 #ifndef MFTG_TRI_CULL
-#define MFTG_TRI_CULL 4
+#define MFTG_TRI_CULL 8
 #endif
 #ifndef MFTG_CR
 #define MFTG_CR 0
