@@ -224,12 +224,13 @@ typedef struct ms_scan_vec {
     int y0, y1;
 } ms_scan_vec;
 
-/* The SIMD Scanline kernel's row loop over three edges (no clip edge), for a caller that computed the
+/* The SIMD Scanline kernel's row loop over `edges` edge lanes (3: no clip edge; 5: lanes 3 and 4 hold the
+ * near and far clip edges, the constant edge where one is not needed), for a caller that computed the
  * set-up itself with the kernel's operations (the block traversal: one triangle for many pixels at once,
  * block_raster_impl.h): the buffer is then the kernel's bit for bit. NULL when `kernel` is not a SIMD
  * Scanline instance for k (the portable kernels round their rows differently). */
 typedef void (*ms_scan_rows_fn)(const ms_scan_vec *v, void *buf);
-ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k);
+ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k, int edges);
 
 /* The kernel instances (core/perk.h names): portable Scanline, Bounds, Hierarchical; SIMD Scanline for
  * AVX2 + FMA (8 scanlines per instruction) and AVX-512 (16), one source: scanline_simd_impl.h. */
@@ -248,6 +249,8 @@ MS_PERK_DECLARE(void, ms_hier, avx512, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_clear_halfplane, scalar, (const float e[3], void *buf));
 MS_PERK_DECLARE(void, ms_scanline_rows3, avx2, (const ms_scan_vec *v, void *buf));
 MS_PERK_DECLARE(void, ms_scanline_rows3, avx512, (const ms_scan_vec *v, void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows5, avx2, (const ms_scan_vec *v, void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows5, avx512, (const ms_scan_vec *v, void *buf));
 
 /* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
  * (0 when setup rejects it). */

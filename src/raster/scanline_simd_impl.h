@@ -233,9 +233,11 @@ SI void MS_KFN(ms_simd_rows)(const ms_scan_vec *v, const int ne, void *out)
 #endif
 }
 
-/* The row loop alone, three edges, for the block traversal's set-up of one triangle for many pixels
- * (block_raster_impl.h, br_scan_setup): raster_internal.h, ms_raster_rows. */
+/* The row loop alone, three edges or five (with the clip edges' lanes), for the block traversal's set-up
+ * of one triangle for many pixels (block_raster_impl.h, br_scan_setup): raster_internal.h,
+ * ms_raster_rows. */
 void MS_KFN(ms_scanline_rows3)(const ms_scan_vec *v, void *out) { MS_KFN(ms_simd_rows)(v, 3, out); }
+void MS_KFN(ms_scanline_rows5)(const ms_scan_vec *v, void *out) { MS_KFN(ms_simd_rows)(v, 5, out); }
 
 /* Without an active clip edge (the common case) the setup is shorter and the rows evaluate three edge
  * lanes instead of five. */

@@ -50,7 +50,7 @@ typedef struct br_state {
     /* The Scanline kernel's set-up for many pixels at once (br_scan_setup): its row loop, NULL when the
      * kernel is not the SIMD Scanline (or a lane's frame culls back faces), and the lanes' frames' mt,
      * near and far. */
-    ms_scan_rows_fn rows;
+    ms_scan_rows_fn rows, rows5;
     float mt[3][3][MS_BLOCK_LANES];
     float near_l[MS_BLOCK_LANES], far_l[MS_BLOCK_LANES];
 } br_state;
@@ -65,13 +65,15 @@ typedef struct br_state {
 #define BR_LANE_SETUP_MIN 4
 #endif
 
-/* The lanes' Scanline set-ups of one triangle, the output of br_scan_setup. */
+/* The lanes' Scanline set-ups of one triangle, the output of br_scan_setup: edges 0..2 the triangle's,
+ * 3 and 4 the near and far clip edges (filled only for the lanes of `clip`). */
 typedef struct br_setup {
-    float al[3][MS_BLOCK_LANES], bl[3][MS_BLOCK_LANES], au[3][MS_BLOCK_LANES], bu[3][MS_BLOCK_LANES];
+    float al[5][MS_BLOCK_LANES], bl[5][MS_BLOCK_LANES], au[5][MS_BLOCK_LANES], bu[5][MS_BLOCK_LANES];
     int32_t y0[MS_BLOCK_LANES], y1[MS_BLOCK_LANES];
     unsigned rows;       /* lanes with scanlines to clear */
-    unsigned kernel;     /* lanes left to the kernel: a clip edge, an edge parallel to the scanlines, a
-                          * non-finite length (rare) */
+    unsigned clip;       /* of those, the lanes whose row loop takes the five edges */
+    unsigned kernel;     /* lanes left to the kernel: an edge parallel to the scanlines, a non-finite
+                          * length (rare) */
 } br_setup;
 
 /* Issue #29 item 2, "set up each triangle once per block": the SIMD Scanline kernel's set-up
@@ -94,7 +96,9 @@ static inline void br_scan_setup(const br_state *s, const float *tri, unsigned l
                                  br_setup *o)
 {
     const l16 zero = l16_set1(0.0f), kf = l16_set1((float)k);
-    unsigned kernel = lanes & (l16_lt(zmin, l16_load(s->near_l)) | l16_gt(zmax, l16_load(s->far_l)));
+    /* The lanes whose triangle reaches the near resp. far plane: the kernel's clip edges N and F. */
+    const unsigned clip_n = lanes & l16_lt(zmin, l16_load(s->near_l)), clip_f = lanes & l16_gt(zmax, l16_load(s->far_l));
+    unsigned kernel = 0;
     /* World edges w[i] = P_{i+2} - P_{i+1} and their squared lengths (the kernel's lanes 4..6). */
     float w[3][3], el[3];
     for (int i = 0; i < 3; i++) {
@@ -108,7 +112,7 @@ static inline void br_scan_setup(const br_state *s, const float *tri, unsigned l
         kernel |= lanes & ~l16_le(len[v], l16_set1(3.4e38f));   /* NaN or infinite: the kernel decides */
     }
     /* The edge equations: edge i from the two shortest sides of (C, P_{i+1}, P_{i+2}). */
-    l16 ex[3], ey[3], ez[3];
+    l16 ex[5], ey[5], ez[5];
     for (int i = 0; i < 3; i++) {
         const int ia = (i + 1) % 3, ib = (i + 2) % 3;
         const l16 wl = l16_set1(el[i]);
@@ -143,14 +147,37 @@ static inline void br_scan_setup(const br_state *s, const float *tri, unsigned l
     unsigned live = lanes & ~kernel & (l16_lt(d, zero) | l16_gt(d, zero));
     const unsigned dneg = l16_lt(d, zero);
     const l16 flat = l16_set1(MS_FLAT_EDGE), minus1 = l16_set1(-1.0f);
-    for (int i = 0; i < 3 && live; i++) {
+    /* The clip edges (the kernel's lanes 3 and 4): N = -(near s_x, near s_y, near s_z - D) and
+     * F = (far s_x, far s_y, far s_z - D) with s = M^T of the normal, unflipped like the kernel's; the
+     * negation as a product by -1, exact and with the sign of zero the kernel's sign flip gives. Where a
+     * lane needs only one, the other is the constant edge (0, 0, 1), which clips nothing. */
+    const unsigned clip = live & (clip_n | clip_f);
+    int n_edges = 3;
+    if (clip) {
+        l16 sn[3];
+        for (int r = 0; r < 3; r++)
+            sn[r] = l16_add(l16_add(l16_mul(l16_load(s->mt[r][0]), l16_set1(nw[0])), l16_mul(l16_load(s->mt[r][1]), l16_set1(nw[1]))),
+                            l16_mul(l16_load(s->mt[r][2]), l16_set1(nw[2])));
+        const l16 nearv = l16_load(s->near_l), farv = l16_load(s->far_l), onev = l16_set1(1.0f);
+        ex[3] = l16_select(clip_n, l16_mul(l16_mul(nearv, sn[0]), minus1), zero);
+        ey[3] = l16_select(clip_n, l16_mul(l16_mul(nearv, sn[1]), minus1), zero);
+        ez[3] = l16_select(clip_n, l16_mul(l16_sub(l16_mul(nearv, sn[2]), d), minus1), onev);
+        ex[4] = l16_select(clip_f, l16_mul(farv, sn[0]), zero);
+        ey[4] = l16_select(clip_f, l16_mul(farv, sn[1]), zero);
+        ez[4] = l16_select(clip_f, l16_sub(l16_mul(farv, sn[2]), d), onev);
+        n_edges = 5;
+    }
+    for (int i = 0; i < n_edges && live; i++) {
+        /* The lanes where edge i is the triangle's or a clip edge in use (the constant edge is never
+         * flipped, never negative). */
+        const unsigned used = i < 3 ? 0xFFFFu : i == 3 ? clip_n : clip_f;
         const l16 r = l16_div(minus1, ex[i]);
         const l16 ax = l16_mul(l16_abs(ex[i]), kf), ay = l16_mul(l16_abs(ey[i]), kf), az = l16_abs(ez[i]);
         const unsigned steep = l16_gt(ax, l16_mul(flat, l16_max(ay, az)));
         const unsigned flat_y = ~steep & l16_gt(ay, l16_mul(flat, az));
         kernel |= live & flat_y;
         /* Constant and negative over the buffer (after the two-sided flip by D's sign): nothing. */
-        const unsigned neg = (dneg & l16_gt(ez[i], zero)) | (~dneg & l16_lt(ez[i], zero));
+        const unsigned neg = used & ((dneg & l16_gt(ez[i], zero)) | (~dneg & l16_lt(ez[i], zero)));
         live &= ~flat_y & ~(~steep & neg);
         const unsigned lower = steep & ((dneg & l16_lt(ex[i], zero)) | (~dneg & l16_gt(ex[i], zero)));
         const unsigned upper = steep & ~lower;
@@ -181,6 +208,7 @@ static inline void br_scan_setup(const br_state *s, const float *tri, unsigned l
     l16_store_int(o->y0, y0);
     l16_store_int(o->y1, y1);
     o->rows = live;
+    o->clip = live & clip;
     o->kernel = kernel;
 }
 
@@ -419,7 +447,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
     if (!mask) return;
     unsigned rasterized = 0;
-    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_corner = 0, c_cov = 0, c_rast = 0, c_shared = 0;
+    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_corner = 0, c_cov = 0, c_rast = 0, c_shared = 0, c_shared_clip = 0;
     for (uint32_t t = n->first; t < n->first + n->count; t++) {
         unsigned lanes = mask & fr->live;
         if (!lanes) break;
@@ -529,13 +557,15 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
             br_scan_setup(s, tri, cover & ~alpha, av, x, y, z, zmin, zmax, MS_K, &su);
             by_kernel = alpha | su.kernel;
             c_shared += (uint64_t)ms_bt_popcount16(su.rows);
+            c_shared_clip += (uint64_t)ms_bt_popcount16(su.clip);
             for (unsigned p = su.rows; p; p &= p - 1) {
                 const int l = __builtin_ctz(p);
+                const int ne = (su.clip >> l & 1) ? 5 : 3;
                 ms_scan_vec v;
-                for (int i = 0; i < 3; i++) { v.al[i] = su.al[i][l]; v.bl[i] = su.bl[i][l]; v.au[i] = su.au[i][l]; v.bu[i] = su.bu[i][l]; }
+                for (int i = 0; i < ne; i++) { v.al[i] = su.al[i][l]; v.bl[i] = su.bl[i][l]; v.au[i] = su.au[i][l]; v.bu[i] = su.bu[i][l]; }
                 v.y0 = su.y0[l];
                 v.y1 = su.y1[l];
-                s->rows(&v, in->buf[l]);
+                (ne == 5 ? s->rows5 : s->rows)(&v, in->buf[l]);
             }
         }
         for (; by_kernel; by_kernel &= by_kernel - 1) {
@@ -552,6 +582,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_CULLED_COVERAGE] += c_cov;
     cnt[MS_BR_RASTERIZED] += c_rast;
     cnt[MS_BR_SHARED_SETUP] += c_shared;
+    cnt[MS_BR_SHARED_SETUP_CLIP] += c_shared_clip;
     /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */
     const int fs = s->flags & MS_BR_FRUSTUM_SHRINK;
     for (; rasterized; rasterized &= rasterized - 1) {
@@ -583,7 +614,8 @@ void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms
     s.in = in;
     s.raster = raster;
     s.flags = flags;
-    s.rows = (flags & MS_BR_NO_LANE_SETUP) ? NULL : ms_raster_rows(raster, MS_K);
+    s.rows = (flags & MS_BR_NO_LANE_SETUP) ? NULL : ms_raster_rows(raster, MS_K, 3);
+    s.rows5 = ms_raster_rows(raster, MS_K, 5);
     memset(s.m, 0, sizeof s.m);
     memset(s.mabs2, 0, sizeof s.mabs2);
     memset(s.mt, 0, sizeof s.mt);
