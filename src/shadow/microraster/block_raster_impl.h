@@ -72,11 +72,11 @@ typedef struct br_state {
  * alone and 4 broke even or won (ogre -11%). The packed layout sets up every pair that passed the tests. */
 #define BR_LANE_SETUP_MIN 4
 
+_Static_assert(MS_SCAN_LANES == MS_BLOCK_LANES, "the set-up's lanes are the traversal's");
 /* The lanes' Scanline set-ups of one triangle, the output of br_scan_setup: edges 0..2 the triangle's,
  * 3 and 4 the near and far clip edges (filled only for the lanes of `clip`). */
 typedef struct br_setup {
-    float al[5][MS_BLOCK_LANES], bl[5][MS_BLOCK_LANES], au[5][MS_BLOCK_LANES], bu[5][MS_BLOCK_LANES];
-    int32_t y0[MS_BLOCK_LANES], y1[MS_BLOCK_LANES];
+    ms_scan_lanes v;     /* the row loop's data per lane */
     unsigned rows;       /* lanes with scanlines to clear */
     unsigned clip;       /* of those, the lanes whose row loop takes the five edges */
     unsigned kernel;     /* lanes left to the kernel: an edge parallel to the scanlines, a non-finite
@@ -222,10 +222,10 @@ static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri
         const unsigned lower = steep & ((dneg & l16_lt(ex[i], zero)) | (~dneg & l16_gt(ex[i], zero)));
         const unsigned upper = steep & ~lower;
         const l16 av = l16_mul(ey[i], r), bv = l16_mul(ez[i], r);
-        l16_store(o->al[i], l16_select(lower, av, zero));
-        l16_store(o->bl[i], l16_select(lower, bv, zero));
-        l16_store(o->au[i], l16_select(upper, av, zero));
-        l16_store(o->bu[i], l16_select(upper, bv, l16_set1((float)k - 1.0f)));
+        l16_store(o->v.al[i], l16_select(lower, av, zero));
+        l16_store(o->v.bl[i], l16_select(lower, bv, zero));
+        l16_store(o->v.au[i], l16_select(upper, av, zero));
+        l16_store(o->v.bu[i], l16_select(upper, bv, l16_set1((float)k - 1.0f)));
     }
     /* Scanline range: the box of the projected vertices when in front of C (the kernel's division),
      * else the whole buffer. */
@@ -245,8 +245,8 @@ static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri
         y0 = l16_select(front, iy0, y0);
         y1 = l16_select(front, iy1, y1);
     }
-    l16_store_int(o->y0, y0);
-    l16_store_int(o->y1, y1);
+    l16_store_int(o->v.y0, y0);
+    l16_store_int(o->v.y1, y1);
     o->rows = live;
     o->clip = live & clip;
     o->kernel = kernel;
@@ -482,11 +482,7 @@ static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_nod
 static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e, void *buf, br_leaf_ctx *L)
 {
     const int ne = (su->clip >> e & 1) ? 5 : 3;
-    ms_scan_vec v;
-    for (int i = 0; i < ne; i++) { v.al[i] = su->al[i][e]; v.bl[i] = su->bl[i][e]; v.au[i] = su->au[i][e]; v.bu[i] = su->bu[i][e]; }
-    v.y0 = su->y0[e];
-    v.y1 = su->y1[e];
-    (ne == 5 ? s->rows5 : s->rows)(&v, buf);
+    (ne == 5 ? s->rows5 : s->rows)(&su->v, e, buf);
     L->c_shared++;
     L->c_shared_clip += ne == 5;
 }
