@@ -487,8 +487,7 @@ static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e,
     L->c_shared_clip += ne == 5;
 }
 
-static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int32_t pt[MS_BLOCK_LANES],
-                                    const int32_t pl[MS_BLOCK_LANES], int np)
+static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int32_t *pt, const int32_t *pl, int np)
 {
     const ms_block_input *in = s->in;
     const l16 near = l16_set1(s->fr->near), far = l16_set1(s->fr->far), zero = l16_set1(0.0f);
@@ -714,28 +713,36 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
         const float *tri0 = s->b->tri + 9 * (size_t)g;
         for (int q = 0; q < 9; q++) L.tv[q] = l16_gather(tri0 + q, O);
 #endif
-        int32_t pt[MS_BLOCK_LANES] = { 0 }, pl[MS_BLOCK_LANES] = { 0 };
+#if BR_PACK
+        /* All the group's pairs first, then sixteen at a time: the index vectors are then loaded from
+         * stores long done (loaded right after sixteen scalar stores, they waited on store forwarding). */
+        int32_t pt[MS_BLOCK_LANES * MS_BLOCK_LANES + MS_BLOCK_LANES], pl[MS_BLOCK_LANES * MS_BLOCK_LANES + MS_BLOCK_LANES];
         int np = 0;
         for (int j = 0; j < nt; j++) {
             unsigned lanes = live;
             for (int q = 0; q < nskip; q++)
                 if (skip_tri[q] == g + (uint32_t)j) lanes &= ~skip_lane[q];
             tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
-#if BR_PACK
             for (; lanes; lanes &= lanes - 1) {
                 pt[np] = j;
                 pl[np++] = __builtin_ctz(lanes);
-                if (np == MS_BLOCK_LANES) { MS_KFN(br_pairs)(s, &L, pt, pl, np); np = 0; }
             }
+        }
+        if (!np) continue;
+        for (int e = np; e % MS_BLOCK_LANES; e++) { pt[e] = pt[0]; pl[e] = pl[0]; }   /* valid operands, unused */
+        for (int e = 0; e < np; e += MS_BLOCK_LANES)
+            MS_KFN(br_pairs)(s, &L, pt + e, pl + e, np - e < MS_BLOCK_LANES ? np - e : MS_BLOCK_LANES);
 #else
+        int32_t pt[1], pl[1] = { 0 };
+        for (int j = 0; j < nt; j++) {
+            unsigned lanes = live;
+            for (int q = 0; q < nskip; q++)
+                if (skip_tri[q] == g + (uint32_t)j) lanes &= ~skip_lane[q];
+            tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
             pt[0] = j;
             if (lanes) MS_KFN(br_pairs)(s, &L, pt, pl, (int)lanes);
+        }
 #endif
-        }
-        if (np) {
-            for (int e = np; e < MS_BLOCK_LANES; e++) { pt[e] = pt[0]; pl[e] = pl[0]; }   /* valid operands, unused */
-            MS_KFN(br_pairs)(s, &L, pt, pl, np);
-        }
     }
     cnt[MS_BR_TRI_LANES] += tri_lanes;
     cnt[MS_BR_CULLED_DEPTH] += L.c_depth;
