@@ -469,15 +469,6 @@ static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_nod
     return keep;
 }
 
-/* A leaf's (triangle, pixel) pairs, packed sixteen to a vector: the lanes below hold pairs, not pixels.
- * In a leaf a triangle reaches on average a few of the block's pixels (3.4 of 16 on the big-light Sponza),
- * so the per-triangle tests with one pixel per lane left most lanes idle; packed, a leaf of 16 triangles
- * costs a few vector passes instead of 16. Each lane's operands are its pixel's (lane permutations of the
- * pixel-layout vectors) and its triangle's, and every operation is the per-pixel one, so each pair's
- * decisions and set-up are bit for bit those of the pixel layout. The pairs come in triangle order and
- * each is tested against its pixel's buffer (the coverage test) and rasterized before the next, so
- * every decision also sees the same buffer as before. */
-
 /* Lane e's rows from the shared set-up: the kernel's row loop over its three or five edges. */
 static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e, void *buf, br_leaf_ctx *L)
 {
@@ -487,6 +478,15 @@ static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e,
     L->c_shared_clip += ne == 5;
 }
 
+/* The leaf tests of a group of the leaf's triangles. Packed layout (BR_PACK): lane e is the (triangle,
+ * pixel) pair (first + pt[e], pl[e]), e < np, the pairs sixteen to a vector. In a leaf a triangle reaches on
+ * average a few of the block's pixels (3.4 of 16 on the big-light Sponza), so the per-triangle tests with
+ * one pixel per lane left most lanes idle; packed, a leaf of 16 triangles costs a few vector passes
+ * instead of 16. Each lane's operands are its pixel's (lane permutations of the pixel-layout vectors) and
+ * its triangle's, and every operation is the per-pixel one, so each pair's decisions and set-up are bit for
+ * bit those of the pixel layout. The pairs come in triangle order and each is tested against its pixel's
+ * buffer (the coverage test) and rasterized before the next, so every decision also sees the same buffer.
+ * Pixel layout: lane e is pixel e, for triangle first + pt[0] and the pixels of the lane mask np. */
 static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int32_t *pt, const int32_t *pl, int np)
 {
     const ms_block_input *in = s->in;
