@@ -179,10 +179,6 @@ SI int ms_scan_vec_setup(const ms_raster_frame *f, const float tri[9], ms_scan_v
     return y0 <= y1;
 }
 
-/* First and last covered sample of scanlines ybase..ybase+MS_R-1, over the first NE edge lanes, and
- * the rows inside [y0, y1]. No clamping: every bound that is out of range, and NaN, converts to a shift
- * count (l, or width-1-h) of at least the lane width, or to the integer indefinite value, whose shifts
- * give 0 lanes: an empty interval, as clamping would. */
 /* The row data as the rows read it: edge e's coefficients at al[e * st] etc. (st = 1: an ms_scan_vec;
  * st = 16: one lane of an ms_scan_lanes). */
 typedef struct ms_scan_view {
@@ -190,6 +186,10 @@ typedef struct ms_scan_view {
     int st, y0, y1;
 } ms_scan_view;
 
+/* First and last covered sample of scanlines ybase..ybase+MS_R-1, over the first NE edge lanes, and
+ * the rows inside [y0, y1]. No clamping: every bound that is out of range, and NaN, converts to a shift
+ * count (l, or width-1-h) of at least the lane width, or to the integer indefinite value, whose shifts
+ * give 0 lanes: an empty interval, as clamping would. */
 SI void ms_interval(const ms_scan_view *v, const int ne, int ybase, float kf, ri *l, ri *h, rm *rows)
 {
     const ri yi = r_iota(ybase);
@@ -256,9 +256,10 @@ void MS_KFN(ms_scanline_rows5)(const ms_scan_lanes *v, int lane, void *out) { MS
 void MS_KFN(ms_scanline)(const ms_raster_frame *f, const float tri[9], void *out)
 {
     ms_scan_vec v;
-    const ms_scan_view w = { v.al, v.bl, v.au, v.bu, 1, 0, 0 };
     const int r = ms_scan_vec_setup(f, tri, &v, 0);
-    ms_scan_view wv = w;
-    if (r > 0) { wv.y0 = v.y0; wv.y1 = v.y1; MS_KFN(ms_simd_rows)(&wv, 3, out); }
-    else if (r < 0 && ms_scan_vec_setup(f, tri, &v, 1) > 0) { wv.y0 = v.y0; wv.y1 = v.y1; MS_KFN(ms_simd_rows)(&wv, 5, out); }
+    const int ne = r > 0 ? 3 : r < 0 && ms_scan_vec_setup(f, tri, &v, 1) > 0 ? 5 : 0;
+    if (ne) {
+        const ms_scan_view w = { v.al, v.bl, v.au, v.bu, 1, v.y0, v.y1 };
+        MS_KFN(ms_simd_rows)(&w, ne, out);
+    }
 }
