@@ -89,7 +89,8 @@ static uint64_t counter(const masks *m, const char *name)
 /* Block and per-pixel traversal: identical masks for each kernel and k under the run's ISA cap; with
  * all_caps, also under every lower cap the CPU runs (Scanline only: the kernels' ISA variants are the
  * kernels' tests). */
-static void block_equals_pixel(const ms_scene *sc, const char *label, const int *ks, int nk, int size, int all_caps)
+static void block_equals_pixel(const ms_scene *sc, const char *label, const int *ks, int nk, int size, int all_caps,
+                               int want_clipped)
 {
     const int run_cap = (int)ms_isa_capped(tu_isa_cap());
     for (int cap = MS_ISA_SCALAR; cap <= MS_ISA_AVX512; cap++) {
@@ -112,10 +113,14 @@ static void block_equals_pixel(const ms_scene *sc, const char *label, const int 
                 /* The SIMD Scanline kernel's set-up shared by a block's pixels (block_raster_impl.h,
                  * br_scan_setup) must have run, or the comparison above proved nothing about it. */
                 if (m == 0 && cap >= MS_ISA_AVX2) {
-                    const uint64_t shared = counter(&b, "shared_setups");
-                    printf("%-22s %-12s k=%-2d %-6s: %llu of the rasterizations set up for several pixels at once\n",
-                           label, kernels[m], ks[ki], ms_isa_name((ms_isa)cap), (unsigned long long)shared);
+                    const uint64_t shared = counter(&b, "shared_setups"), clipped = counter(&b, "shared_setups_clipped");
+                    printf("%-22s %-12s k=%-2d %-6s: %llu of the rasterizations set up for several pixels at once, "
+                           "%llu of them with a clip edge\n", label, kernels[m], ks[ki], ms_isa_name((ms_isa)cap),
+                           (unsigned long long)shared, (unsigned long long)clipped);
                     assert_true(shared > 0);
+                    /* Likewise the clip edges' lanes of that set-up, wherever the scene has triangles that
+                     * reach the near or far plane. */
+                    if (want_clipped) assert_true(clipped > 0);
                 }
                 free(b.vis);
                 free(p.vis);
@@ -129,7 +134,7 @@ static void test_default_scene(void **state)
     ms_scene sc;
     assert_int_equal(ms_scene_default(&sc), 0);
     const int ks[] = { 16, 32, 64 };
-    block_equals_pixel(&sc, "default", ks, 3, 48, 1);
+    block_equals_pixel(&sc, "default", ks, 3, 48, 1, 1);
     ms_scene_free(&sc);
 }
 
@@ -139,11 +144,11 @@ static void test_quad(void **state)
     ms_scene sc;
     tu_make_quad(&sc);
     const int ks[] = { 16, 32, 64 };
-    block_equals_pixel(&sc, "quad", ks, 3, 48, 1);
+    block_equals_pixel(&sc, "quad", ks, 3, 48, 1, 0);
     ms_scene_free(&sc);
 }
 
-static void real_scene(const char *rel, int size)
+static void real_scene(const char *rel, int size, int want_clipped)
 {
     if (!tu_have_shared_scenes()) skip();
     char path[4096], err[512];
@@ -152,12 +157,12 @@ static void real_scene(const char *rel, int size)
     if (rc) fprintf(stderr, "%s\n", err);
     assert_int_equal(rc, 0);
     const int ks[] = { 32 };
-    block_equals_pixel(&sc, rel, ks, 1, size, 0);
+    block_equals_pixel(&sc, rel, ks, 1, size, 0, want_clipped);
     ms_scene_free(&sc);
 }
 
-static void test_bunny(void **state) { (void)state; real_scene("stanford-bunny/stanford-bunny.json", 64); }
-static void test_biglight(void **state) { (void)state; real_scene("dabrovic-sponza/dabrovic-sponza-biglight.json", 64); }
+static void test_bunny(void **state) { (void)state; real_scene("stanford-bunny/stanford-bunny.json", 64, 0); }
+static void test_biglight(void **state) { (void)state; real_scene("dabrovic-sponza/dabrovic-sponza-biglight.json", 64, 1); }
 
 /* The traversal's instances take the same decisions: under Bounds, whose kernels are bit for bit the
  * same on every ISA, the masks and every counter agree between the portable, AVX2 and AVX-512

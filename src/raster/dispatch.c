@@ -35,13 +35,14 @@ ms_raster_fn ms_raster_kernel(ms_kernel_id id, int k, ms_isa cap, ms_isa *chosen
     return ms_raster_kernel_isa(id, k, isa);
 }
 
-ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k)
+ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k, int edges)
 {
     static const ms_raster_fn kernels[2][3] = { MS_PERK_TABLE(ms_scanline, avx2), MS_PERK_TABLE(ms_scanline, avx512) };
-    static const ms_scan_rows_fn rows[2][3] = { MS_PERK_TABLE(ms_scanline_rows3, avx2), MS_PERK_TABLE(ms_scanline_rows3, avx512) };
+    static const ms_scan_rows_fn rows3[2][3] = { MS_PERK_TABLE(ms_scanline_rows3, avx2), MS_PERK_TABLE(ms_scanline_rows3, avx512) };
+    static const ms_scan_rows_fn rows5[2][3] = { MS_PERK_TABLE(ms_scanline_rows5, avx2), MS_PERK_TABLE(ms_scanline_rows5, avx512) };
     const int w = ms_k_index(k);
-    if (w < 0 || !kernel) return NULL;
+    if (w < 0 || !kernel || (edges != 3 && edges != 5)) return NULL;
     for (int i = 0; i < 2; i++)
-        if (kernel == kernels[i][w]) return rows[i][w];
+        if (kernel == kernels[i][w]) return edges == 3 ? rows3[i][w] : rows5[i][w];
     return NULL;
 }

@@ -224,12 +224,21 @@ typedef struct ms_scan_vec {
     int y0, y1;
 } ms_scan_vec;
 
-/* The SIMD Scanline kernel's row loop over three edges (no clip edge), for a caller that computed the
- * set-up itself with the kernel's operations (the block traversal: one triangle for many pixels at once,
- * block_raster_impl.h): the buffer is then the kernel's bit for bit. NULL when `kernel` is not a SIMD
- * Scanline instance for k (the portable kernels round their rows differently). */
-typedef void (*ms_scan_rows_fn)(const ms_scan_vec *v, void *buf);
-ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k);
+/* The same data for sixteen set-ups side by side (the block traversal's lanes: pixels, or (triangle, pixel)
+ * pairs): edge e of lane l at al[e][l] etc.; edges 3 and 4 the near and far clip edges. */
+#define MS_SCAN_LANES 16
+typedef struct ms_scan_lanes {
+    float al[5][MS_SCAN_LANES], bl[5][MS_SCAN_LANES], au[5][MS_SCAN_LANES], bu[5][MS_SCAN_LANES];
+    int32_t y0[MS_SCAN_LANES], y1[MS_SCAN_LANES];
+} ms_scan_lanes;
+
+/* The SIMD Scanline kernel's row loop for lane `lane` of v over `edges` edge lanes (3: no clip edge; 5:
+ * edges 3 and 4 are the near and far clip edges, the constant edge where one is not needed), for a caller
+ * that computed the set-up itself with the kernel's operations (the block traversal: one triangle for
+ * many pixels at once, block_raster_impl.h): the buffer is then the kernel's bit for bit. NULL when
+ * `kernel` is not a SIMD Scanline instance for k (the portable kernels round their rows differently). */
+typedef void (*ms_scan_rows_fn)(const ms_scan_lanes *v, int lane, void *buf);
+ms_scan_rows_fn ms_raster_rows(ms_raster_fn kernel, int k, int edges);
 
 /* The kernel instances (core/perk.h names): portable Scanline, Bounds, Hierarchical; SIMD Scanline for
  * AVX2 + FMA (8 scanlines per instruction) and AVX-512 (16), one source: scanline_simd_impl.h. */
@@ -246,8 +255,10 @@ MS_PERK_DECLARE(void, ms_hier, avx2, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_bounds, avx512, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_hier, avx512, MS_RASTER_PARAMS);
 MS_PERK_DECLARE(void, ms_clear_halfplane, scalar, (const float e[3], void *buf));
-MS_PERK_DECLARE(void, ms_scanline_rows3, avx2, (const ms_scan_vec *v, void *buf));
-MS_PERK_DECLARE(void, ms_scanline_rows3, avx512, (const ms_scan_vec *v, void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows3, avx2, (const ms_scan_lanes *v, int lane, void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows3, avx512, (const ms_scan_lanes *v, int lane, void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows5, avx2, (const ms_scan_lanes *v, int lane, void *buf));
+MS_PERK_DECLARE(void, ms_scanline_rows5, avx512, (const ms_scan_lanes *v, int lane, void *buf));
 
 /* For the benchmark's cost fit: the scanlines the scalar Scanline kernel iterates for this triangle
  * (0 when setup rejects it). */

@@ -179,18 +179,25 @@ SI int ms_scan_vec_setup(const ms_raster_frame *f, const float tri[9], ms_scan_v
     return y0 <= y1;
 }
 
+/* The row data as the rows read it: edge e's coefficients at al[e * st] etc. (st = 1: an ms_scan_vec;
+ * st = 16: one lane of an ms_scan_lanes). */
+typedef struct ms_scan_view {
+    const float *al, *bl, *au, *bu;
+    int st, y0, y1;
+} ms_scan_view;
+
 /* First and last covered sample of scanlines ybase..ybase+MS_R-1, over the first NE edge lanes, and
  * the rows inside [y0, y1]. No clamping: every bound that is out of range, and NaN, converts to a shift
  * count (l, or width-1-h) of at least the lane width, or to the integer indefinite value, whose shifts
  * give 0 lanes: an empty interval, as clamping would. */
-SI void ms_interval(const ms_scan_vec *v, const int ne, int ybase, float kf, ri *l, ri *h, rm *rows)
+SI void ms_interval(const ms_scan_view *v, const int ne, int ybase, float kf, ri *l, ri *h, rm *rows)
 {
     const ri yi = r_iota(ybase);
     const rf y = r_cvt(yi);
     rf lo[5], hi[5];
     for (int e = 0; e < ne; e++) {
-        lo[e] = r_fmadd(v->al[e], y, v->bl[e]);
-        hi[e] = r_fmadd(v->au[e], y, v->bu[e]);
+        lo[e] = r_fmadd(v->al[e * v->st], y, v->bl[e * v->st]);
+        hi[e] = r_fmadd(v->au[e * v->st], y, v->bu[e * v->st]);
     }
     /* Pairwise, for a short dependency chain; max(x, 0) and min(x, k-1) are the buffer's edges. */
     const rf l01 = r_max(lo[0], lo[1]), h01 = r_min(hi[0], hi[1]);
@@ -206,7 +213,7 @@ SI void ms_interval(const ms_scan_vec *v, const int ne, int ybase, float kf, ri 
 #endif /* MS_SCANLINE_SIMD_COMMON */
 
 /* ---- per k ---- */
-SI void MS_KFN(ms_simd_rows)(const ms_scan_vec *v, const int ne, void *out)
+SI void MS_KFN(ms_simd_rows)(const ms_scan_view *v, const int ne, void *out)
 {
     MS_WORD *buf = (MS_WORD *)out;
 #if MS_K == 16
@@ -233,9 +240,16 @@ SI void MS_KFN(ms_simd_rows)(const ms_scan_vec *v, const int ne, void *out)
 #endif
 }
 
-/* The row loop alone, three edges, for the block traversal's set-up of one triangle for many pixels
- * (block_raster_impl.h, br_scan_setup): raster_internal.h, ms_raster_rows. */
-void MS_KFN(ms_scanline_rows3)(const ms_scan_vec *v, void *out) { MS_KFN(ms_simd_rows)(v, 3, out); }
+/* The row loop alone, three edges or five (with the clip edges' lanes), for the block traversal's set-up
+ * of one triangle for many pixels (block_raster_impl.h, br_scan_setup): raster_internal.h,
+ * ms_raster_rows. */
+SI void MS_KFN(ms_lane_rows)(const ms_scan_lanes *v, int lane, const int ne, void *out)
+{
+    const ms_scan_view w = { &v->al[0][lane], &v->bl[0][lane], &v->au[0][lane], &v->bu[0][lane], MS_SCAN_LANES, v->y0[lane], v->y1[lane] };
+    MS_KFN(ms_simd_rows)(&w, ne, out);
+}
+void MS_KFN(ms_scanline_rows3)(const ms_scan_lanes *v, int lane, void *out) { MS_KFN(ms_lane_rows)(v, lane, 3, out); }
+void MS_KFN(ms_scanline_rows5)(const ms_scan_lanes *v, int lane, void *out) { MS_KFN(ms_lane_rows)(v, lane, 5, out); }
 
 /* Without an active clip edge (the common case) the setup is shorter and the rows evaluate three edge
  * lanes instead of five. */
@@ -243,6 +257,9 @@ void MS_KFN(ms_scanline)(const ms_raster_frame *f, const float tri[9], void *out
 {
     ms_scan_vec v;
     const int r = ms_scan_vec_setup(f, tri, &v, 0);
-    if (r > 0) MS_KFN(ms_simd_rows)(&v, 3, out);
-    else if (r < 0 && ms_scan_vec_setup(f, tri, &v, 1) > 0) MS_KFN(ms_simd_rows)(&v, 5, out);
+    const int ne = r > 0 ? 3 : r < 0 && ms_scan_vec_setup(f, tri, &v, 1) > 0 ? 5 : 0;
+    if (ne) {
+        const ms_scan_view w = { v.al, v.bl, v.au, v.bu, 1, v.y0, v.y1 };
+        MS_KFN(ms_simd_rows)(&w, ne, out);
+    }
 }

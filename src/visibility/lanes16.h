@@ -33,6 +33,13 @@ L16_INLINE unsigned l16_le(l16 a, l16 b) { return _mm512_cmp_ps_mask(a, b, _CMP_
 L16_INLINE unsigned l16_gt(l16 a, l16 b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
 /* Lane i from a where bit i of m is set, else from b. */
 L16_INLINE l16 l16_select(unsigned m, l16 a, l16 b) { return _mm512_mask_blend_ps((__mmask16)m, b, a); }
+/* A lane permutation (indices 0..15), loaded once and applied to many vectors: lane i of l16_perm(a, p)
+ * is lane p[i] of a. */
+typedef __m512i l16i;
+L16_INLINE l16i l16i_load(const int32_t *p) { return _mm512_loadu_si512((const void *)p); }
+L16_INLINE l16 l16_perm(l16 a, l16i p) { return _mm512_permutexvar_ps(p, a); }
+/* Lane i = base[p[i]]. */
+L16_INLINE l16 l16_gather(const float *base, l16i p) { return _mm512_i32gather_ps(p, base, 4); }
 #elif defined(MS_TARGET_AVX2)
 #include <immintrin.h>
 typedef struct l16 { __m256 lo, hi; } l16;
@@ -81,6 +88,20 @@ L16_INLINE l16 l16_select(unsigned m, l16 a, l16 b)
 {
     return (l16){ _mm256_blendv_ps(b.lo, a.lo, l16_mask8(m & 0xFF)), _mm256_blendv_ps(b.hi, a.hi, l16_mask8(m >> 8)) };
 }
+/* Lane permutation: each half picks from both halves (vpermps on each, then a blend on index >= 8). */
+typedef struct l16i { __m256i lo, hi; __m256 up_lo, up_hi; } l16i;
+L16_INLINE l16i l16i_load(const int32_t *p)
+{
+    const __m256i lo = _mm256_loadu_si256((const __m256i *)p), hi = _mm256_loadu_si256((const __m256i *)(p + 8));
+    const __m256i seven = _mm256_set1_epi32(7);
+    return (l16i){ lo, hi, _mm256_castsi256_ps(_mm256_cmpgt_epi32(lo, seven)), _mm256_castsi256_ps(_mm256_cmpgt_epi32(hi, seven)) };
+}
+L16_INLINE l16 l16_perm(l16 a, l16i p)
+{
+    return (l16){ _mm256_blendv_ps(_mm256_permutevar8x32_ps(a.lo, p.lo), _mm256_permutevar8x32_ps(a.hi, p.lo), p.up_lo),
+                  _mm256_blendv_ps(_mm256_permutevar8x32_ps(a.lo, p.hi), _mm256_permutevar8x32_ps(a.hi, p.hi), p.up_hi) };
+}
+L16_INLINE l16 l16_gather(const float *base, l16i p) { return (l16){ _mm256_i32gather_ps(base, p.lo, 4), _mm256_i32gather_ps(base, p.hi, 4) }; }
 #else
 #include <math.h>
 typedef struct l16 { float v[16]; } l16;
@@ -135,6 +156,10 @@ L16_INLINE l16 l16_select(unsigned m, l16 a, l16 b)
     for (int i = 0; i < 16; i++) r.v[i] = (m >> i & 1) ? a.v[i] : b.v[i];
     return r;
 }
+typedef struct l16i { int32_t v[16]; } l16i;
+L16_INLINE l16i l16i_load(const int32_t *p) { l16i r; for (int i = 0; i < 16; i++) r.v[i] = p[i]; return r; }
+L16_INLINE l16 l16_perm(l16 a, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = a.v[p.v[i] & 15]; return r; }
+L16_INLINE l16 l16_gather(const float *base, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = base[p.v[i]]; return r; }
 #endif
 
 #endif

@@ -29,6 +29,7 @@ enum {
     MS_BR_CULLED_DEPTH, MS_BR_CULLED_RECT, MS_BR_CULLED_CORNER, MS_BR_CULLED_COVERAGE,
     MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS,
     MS_BR_SHARED_SETUP,                /* of the rasterizations, those set up for several pixels at once */
+    MS_BR_SHARED_SETUP_CLIP,           /* of those, the ones with a near or far clip edge */
     MS_BR_COUNTERS
 };
 

@@ -50,29 +50,83 @@ typedef struct br_state {
     /* The Scanline kernel's set-up for many pixels at once (br_scan_setup): its row loop, NULL when the
      * kernel is not the SIMD Scanline (or a lane's frame culls back faces), and the lanes' frames' mt,
      * near and far. */
-    ms_scan_rows_fn rows;
+    ms_scan_rows_fn rows, rows5;
     float mt[3][3][MS_BLOCK_LANES];
     float near_l[MS_BLOCK_LANES], far_l[MS_BLOCK_LANES];
 } br_state;
 
-/* Smallest number of a block's pixels that rasterize one triangle for which its set-up is computed for
- * them together (br_scan_setup) rather than by the kernel pixel by pixel. Measured (512², 256 samples, one
- * thread, shadow CPU seconds): with AVX-512 (one register for 16 lanes) 2 is best, 1 and 4 within noise
- * of it; with AVX2 (two halves) 2 cost 5% against the kernel alone and 4 broke even or won (ogre -11%). */
+/* The lanes of the leaf tests (br_pairs). With AVX-512 they hold (triangle, pixel) pairs, packed sixteen to
+ * a vector: in a leaf a triangle reaches on average a few of the block's pixels (3.4 of 16 on the
+ * big-light Sponza), so one pixel per lane left most lanes idle, and a permutation that gives each lane its
+ * pixel's operands is one instruction. With AVX2 (two halves: a permutation is three instructions and a
+ * blend) the packed layout was 11-20% slower (big-light Sponza, beast) and the lanes stay pixels, one
+ * triangle at a time; so in the portable build. */
 #if defined(MS_TARGET_AVX512)
-#define BR_LANE_SETUP_MIN 2
+#define BR_PACK 1
 #else
-#define BR_LANE_SETUP_MIN 4
+#define BR_PACK 0
 #endif
+/* Pixel layout only: the smallest number of a block's pixels that rasterize one triangle for which its
+ * set-up is computed for them together (br_scan_setup) rather than by the kernel pixel by pixel. Measured
+ * (512², 256 samples, one thread, shadow CPU seconds): with AVX2 (two halves) 2 cost 5% against the kernel
+ * alone and 4 broke even or won (ogre -11%). The packed layout sets up every pair that passed the tests. */
+#define BR_LANE_SETUP_MIN 4
 
-/* The lanes' Scanline set-ups of one triangle, the output of br_scan_setup. */
+_Static_assert(MS_SCAN_LANES == MS_BLOCK_LANES, "the set-up's lanes are the traversal's");
+/* The lanes' Scanline set-ups of one triangle, the output of br_scan_setup: edges 0..2 the triangle's,
+ * 3 and 4 the near and far clip edges (filled only for the lanes of `clip`). */
 typedef struct br_setup {
-    float al[3][MS_BLOCK_LANES], bl[3][MS_BLOCK_LANES], au[3][MS_BLOCK_LANES], bu[3][MS_BLOCK_LANES];
-    int32_t y0[MS_BLOCK_LANES], y1[MS_BLOCK_LANES];
+    ms_scan_lanes v;     /* the row loop's data per lane */
     unsigned rows;       /* lanes with scanlines to clear */
-    unsigned kernel;     /* lanes left to the kernel: a clip edge, an edge parallel to the scanlines, a
-                          * non-finite length (rare) */
+    unsigned clip;       /* of those, the lanes whose row loop takes the five edges */
+    unsigned kernel;     /* lanes left to the kernel: an edge parallel to the scanlines, a non-finite
+                          * length (rare) */
 } br_setup;
+
+/* The triangle's own part of the set-up, per lane (the packed layout: one triangle per lane) or broadcast
+ * (the pixel layout): the world edges w[i] = P_{i+2} - P_{i+1}, their squared lengths (the kernel's lanes
+ * 4..6) and the plane normal from the two shortest edges (the longest edge's candidate, ties to the lower
+ * index), with the kernel's operations. */
+typedef struct br_tri {
+    l16 w[3][3], el[3], nw[3];
+} br_tri;
+
+static inline void br_tri_lanes(const l16 v[3][3], br_tri *t)
+{
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) t->w[i][j] = l16_sub(v[(i + 2) % 3][j], v[(i + 1) % 3][j]);
+        t->el[i] = l16_add(l16_add(l16_mul(t->w[i][0], t->w[i][0]), l16_mul(t->w[i][1], t->w[i][1])), l16_mul(t->w[i][2], t->w[i][2]));
+    }
+    const unsigned ge01 = l16_le(t->el[1], t->el[0]), ge02 = l16_le(t->el[2], t->el[0]), ge12 = l16_le(t->el[2], t->el[1]);
+    const unsigned long0 = ge01 & ge02, long1 = ~ge01 & ge12;   /* else edge 2 */
+    l16 sa[3], sb[3];
+    for (int j = 0; j < 3; j++) {
+        sa[j] = l16_select(long0, t->w[1][j], l16_select(long1, t->w[2][j], t->w[0][j]));
+        sb[j] = l16_select(long0, t->w[2][j], l16_select(long1, t->w[0][j], t->w[1][j]));
+    }
+    t->nw[0] = l16_sub(l16_mul(sa[1], sb[2]), l16_mul(sa[2], sb[1]));
+    t->nw[1] = l16_sub(l16_mul(sa[2], sb[0]), l16_mul(sa[0], sb[2]));
+    t->nw[2] = l16_sub(l16_mul(sa[0], sb[1]), l16_mul(sa[1], sb[0]));
+}
+
+/* The same for one triangle in scalar form, broadcast (the same operations, one lane). */
+static inline void br_tri_broadcast(const float *tri, br_tri *t)
+{
+    float w[3][3], el[3];
+    for (int i = 0; i < 3; i++) {
+        const float *p = tri + 3 * ((i + 1) % 3), *q = tri + 3 * ((i + 2) % 3);
+        for (int j = 0; j < 3; j++) w[i][j] = q[j] - p[j];
+        el[i] = w[i][0] * w[i][0] + w[i][1] * w[i][1] + w[i][2] * w[i][2];
+    }
+    const int long_i = el[0] >= el[1] ? (el[0] >= el[2] ? 0 : 2) : (el[1] >= el[2] ? 1 : 2);
+    const float *sa = w[(long_i + 1) % 3], *sb = w[(long_i + 2) % 3];
+    const float nw[3] = { sa[1] * sb[2] - sa[2] * sb[1], sa[2] * sb[0] - sa[0] * sb[2], sa[0] * sb[1] - sa[1] * sb[0] };
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) t->w[i][j] = l16_set1(w[i][j]);
+        t->el[i] = l16_set1(el[i]);
+        t->nw[i] = l16_set1(nw[i]);
+    }
+}
 
 /* Issue #29 item 2, "set up each triangle once per block": the SIMD Scanline kernel's set-up
  * (scanline_simd_impl.h, ms_scan_vec_setup, clip-free instance) laid out with one pixel per lane instead
@@ -89,76 +143,89 @@ typedef struct br_setup {
  * computed once, in scalar form with the same operations.
  * x, y, z: the vertices' light-index coordinates per lane, zmin / zmax their widened depth range (the
  * leaf test's, the kernel's operations); a[v][j] the world vectors P_v - C. */
-static inline void br_scan_setup(const br_state *s, const float *tri, unsigned lanes, const l16 a[3][3],
-                                 const l16 x[3], const l16 y[3], const l16 z[3], l16 zmin, l16 zmax, int k,
+static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri *tr, const l16 mt[3][3], l16 near_l,
+                                 l16 far_l, const l16 x[3], const l16 y[3], const l16 z[3], l16 zmin, l16 zmax, int k,
                                  br_setup *o)
 {
     const l16 zero = l16_set1(0.0f), kf = l16_set1((float)k);
-    unsigned kernel = lanes & (l16_lt(zmin, l16_load(s->near_l)) | l16_gt(zmax, l16_load(s->far_l)));
-    /* World edges w[i] = P_{i+2} - P_{i+1} and their squared lengths (the kernel's lanes 4..6). */
-    float w[3][3], el[3];
-    for (int i = 0; i < 3; i++) {
-        const float *p = tri + 3 * ((i + 1) % 3), *q = tri + 3 * ((i + 2) % 3);
-        for (int j = 0; j < 3; j++) w[i][j] = q[j] - p[j];
-        el[i] = w[i][0] * w[i][0] + w[i][1] * w[i][1] + w[i][2] * w[i][2];
-    }
+    /* The lanes whose triangle reaches the near resp. far plane: the kernel's clip edges N and F. */
+    const unsigned clip_n = lanes & l16_lt(zmin, near_l), clip_f = lanes & l16_gt(zmax, far_l);
+    unsigned kernel = 0;
+    const l16 (*w)[3] = tr->w, *el = tr->el, *nw = tr->nw;
     l16 len[3];
     for (int v = 0; v < 3; v++) {
         len[v] = l16_add(l16_add(l16_mul(a[v][0], a[v][0]), l16_mul(a[v][1], a[v][1])), l16_mul(a[v][2], a[v][2]));
         kernel |= lanes & ~l16_le(len[v], l16_set1(3.4e38f));   /* NaN or infinite: the kernel decides */
     }
     /* The edge equations: edge i from the two shortest sides of (C, P_{i+1}, P_{i+2}). */
-    l16 ex[3], ey[3], ez[3];
+    l16 ex[5], ey[5], ez[5];
     for (int i = 0; i < 3; i++) {
         const int ia = (i + 1) % 3, ib = (i + 2) % 3;
-        const l16 wl = l16_set1(el[i]);
+        const l16 wl = el[i];
         const unsigned va_longest = l16_le(len[ib], len[ia]) & l16_le(wl, len[ia]);
         const unsigned e_longest = ~va_longest & l16_le(len[ib], wl);
         l16 X[3], Y[3];
         for (int j = 0; j < 3; j++) {
             X[j] = l16_select(va_longest, a[ib][j], a[ia][j]);
-            Y[j] = l16_select(e_longest, a[ib][j], l16_set1(w[i][j]));
+            Y[j] = l16_select(e_longest, a[ib][j], w[i][j]);
         }
         const l16 ux = l16_sub(l16_mul(X[1], Y[2]), l16_mul(X[2], Y[1]));
         const l16 uy = l16_sub(l16_mul(X[2], Y[0]), l16_mul(X[0], Y[2]));
         const l16 uz = l16_sub(l16_mul(X[0], Y[1]), l16_mul(X[1], Y[0]));
         l16 e[3];
         for (int r = 0; r < 3; r++)
-            e[r] = l16_add(l16_add(l16_mul(l16_load(s->mt[r][0]), ux), l16_mul(l16_load(s->mt[r][1]), uy)),
-                           l16_mul(l16_load(s->mt[r][2]), uz));
+            e[r] = l16_add(l16_add(l16_mul(mt[r][0], ux), l16_mul(mt[r][1], uy)), l16_mul(mt[r][2], uz));
         ex[i] = e[0]; ey[i] = e[1]; ez[i] = e[2];
     }
     /* The plane normal from the two shortest edges (the longest edge's candidate, ties to the lower
      * index) and D from the vertex nearest C (ties to the lower index), as the kernel picks them. */
-    const int long_i = el[0] >= el[1] ? (el[0] >= el[2] ? 0 : 2) : (el[1] >= el[2] ? 1 : 2);
-    const float *sa = w[(long_i + 1) % 3], *sb = w[(long_i + 2) % 3];
-    const float nw[3] = { sa[1] * sb[2] - sa[2] * sb[1], sa[2] * sb[0] - sa[0] * sb[2], sa[0] * sb[1] - sa[1] * sb[0] };
     const unsigned n0 = l16_le(len[0], len[1]) & l16_le(len[0], len[2]);
     const unsigned n1 = ~l16_le(len[0], len[1]) & l16_le(len[1], len[2]);
     l16 an[3];
     for (int j = 0; j < 3; j++) an[j] = l16_select(n0, a[0][j], l16_select(n1, a[1][j], a[2][j]));
-    const l16 d = l16_add(l16_add(l16_mul(an[0], l16_set1(nw[0])), l16_mul(an[1], l16_set1(nw[1]))),
-                          l16_mul(an[2], l16_set1(nw[2])));
+    const l16 d = l16_add(l16_add(l16_mul(an[0], nw[0]), l16_mul(an[1], nw[1])), l16_mul(an[2], nw[2]));
     /* D = 0: the plane contains C, nothing to rasterize (nor for NaN). */
     unsigned live = lanes & ~kernel & (l16_lt(d, zero) | l16_gt(d, zero));
     const unsigned dneg = l16_lt(d, zero);
     const l16 flat = l16_set1(MS_FLAT_EDGE), minus1 = l16_set1(-1.0f);
-    for (int i = 0; i < 3 && live; i++) {
+    /* The clip edges (the kernel's lanes 3 and 4): N = -(near s_x, near s_y, near s_z - D) and
+     * F = (far s_x, far s_y, far s_z - D) with s = M^T of the normal, unflipped like the kernel's; the
+     * negation as a product by -1, exact and with the sign of zero the kernel's sign flip gives. Where a
+     * lane needs only one, the other is the constant edge (0, 0, 1), which clips nothing. */
+    const unsigned clip = live & (clip_n | clip_f);
+    int n_edges = 3;
+    if (clip) {
+        l16 sn[3];
+        for (int r = 0; r < 3; r++)
+            sn[r] = l16_add(l16_add(l16_mul(mt[r][0], nw[0]), l16_mul(mt[r][1], nw[1])), l16_mul(mt[r][2], nw[2]));
+        const l16 nearv = near_l, farv = far_l, onev = l16_set1(1.0f);
+        ex[3] = l16_select(clip_n, l16_mul(l16_mul(nearv, sn[0]), minus1), zero);
+        ey[3] = l16_select(clip_n, l16_mul(l16_mul(nearv, sn[1]), minus1), zero);
+        ez[3] = l16_select(clip_n, l16_mul(l16_sub(l16_mul(nearv, sn[2]), d), minus1), onev);
+        ex[4] = l16_select(clip_f, l16_mul(farv, sn[0]), zero);
+        ey[4] = l16_select(clip_f, l16_mul(farv, sn[1]), zero);
+        ez[4] = l16_select(clip_f, l16_sub(l16_mul(farv, sn[2]), d), onev);
+        n_edges = 5;
+    }
+    for (int i = 0; i < n_edges && live; i++) {
+        /* The lanes where edge i is the triangle's or a clip edge in use (the constant edge is never
+         * flipped, never negative). */
+        const unsigned used = i < 3 ? 0xFFFFu : i == 3 ? clip_n : clip_f;
         const l16 r = l16_div(minus1, ex[i]);
         const l16 ax = l16_mul(l16_abs(ex[i]), kf), ay = l16_mul(l16_abs(ey[i]), kf), az = l16_abs(ez[i]);
         const unsigned steep = l16_gt(ax, l16_mul(flat, l16_max(ay, az)));
         const unsigned flat_y = ~steep & l16_gt(ay, l16_mul(flat, az));
         kernel |= live & flat_y;
         /* Constant and negative over the buffer (after the two-sided flip by D's sign): nothing. */
-        const unsigned neg = (dneg & l16_gt(ez[i], zero)) | (~dneg & l16_lt(ez[i], zero));
+        const unsigned neg = used & ((dneg & l16_gt(ez[i], zero)) | (~dneg & l16_lt(ez[i], zero)));
         live &= ~flat_y & ~(~steep & neg);
         const unsigned lower = steep & ((dneg & l16_lt(ex[i], zero)) | (~dneg & l16_gt(ex[i], zero)));
         const unsigned upper = steep & ~lower;
         const l16 av = l16_mul(ey[i], r), bv = l16_mul(ez[i], r);
-        l16_store(o->al[i], l16_select(lower, av, zero));
-        l16_store(o->bl[i], l16_select(lower, bv, zero));
-        l16_store(o->au[i], l16_select(upper, av, zero));
-        l16_store(o->bu[i], l16_select(upper, bv, l16_set1((float)k - 1.0f)));
+        l16_store(o->v.al[i], l16_select(lower, av, zero));
+        l16_store(o->v.bl[i], l16_select(lower, bv, zero));
+        l16_store(o->v.au[i], l16_select(upper, av, zero));
+        l16_store(o->v.bu[i], l16_select(upper, bv, l16_set1((float)k - 1.0f)));
     }
     /* Scanline range: the box of the projected vertices when in front of C (the kernel's division),
      * else the whole buffer. */
@@ -178,9 +245,10 @@ static inline void br_scan_setup(const br_state *s, const float *tri, unsigned l
         y0 = l16_select(front, iy0, y0);
         y1 = l16_select(front, iy1, y1);
     }
-    l16_store_int(o->y0, y0);
-    l16_store_int(o->y1, y1);
+    l16_store_int(o->v.y0, y0);
+    l16_store_int(o->v.y1, y1);
     o->rows = live;
+    o->clip = live & clip;
     o->kernel = kernel;
 }
 
@@ -193,6 +261,16 @@ static inline void br_corner_dirs(const ms_raster_frame *f, const int r[4], floa
         for (int a = 0; a < 3; a++) d[c][a] = f->mt[2][a] + i * f->mt[0][a] + j * f->mt[1][a];
     }
 }
+
+/* A leaf's state for its (triangle, pixel) pairs (br_pairs). */
+typedef struct br_leaf_ctx {
+    l16 m[3][3], ma[3], c[3], rx0, rx1, ry0, ry1;   /* the pixels' frames and rectangles (pixel layout) */
+    l16 mt[3][3], near_l, far_l;                    /* the pixels' set-up operands (pixel layout) */
+    l16 tv[9];                                      /* the triangle group's vertices (lane = triangle) */
+    uint32_t first;                                 /* the group's first triangle */
+    unsigned rasterized;                            /* pixels that rasterized something */
+    uint64_t c_depth, c_rect, c_corner, c_cov, c_rast, c_shared, c_shared_clip;
+} br_leaf_ctx;
 #endif
 
 /* The rectangle of the visible samples of a buffer within rows j0..j1 (the others known empty):
@@ -391,6 +469,204 @@ static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_nod
     return keep;
 }
 
+/* Lane e's rows from the shared set-up: the kernel's row loop over its three or five edges. */
+static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e, void *buf, br_leaf_ctx *L)
+{
+    const int ne = (su->clip >> e & 1) ? 5 : 3;
+    (ne == 5 ? s->rows5 : s->rows)(&su->v, e, buf);
+    L->c_shared++;
+    L->c_shared_clip += ne == 5;
+}
+
+/* The leaf tests of a group of the leaf's triangles. Packed layout (BR_PACK): lane e is the (triangle,
+ * pixel) pair (first + pt[e], pl[e]), e < np, the pairs sixteen to a vector. In a leaf a triangle reaches on
+ * average a few of the block's pixels (3.4 of 16 on the big-light Sponza), so the per-triangle tests with
+ * one pixel per lane left most lanes idle; packed, a leaf of 16 triangles costs a few vector passes
+ * instead of 16. Each lane's operands are its pixel's (lane permutations of the pixel-layout vectors) and
+ * its triangle's, and every operation is the per-pixel one, so each pair's decisions and set-up are bit for
+ * bit those of the pixel layout. The pairs come in triangle order and each is tested against its pixel's
+ * buffer (the coverage test) and rasterized before the next, so every decision also sees the same buffer.
+ * Pixel layout: lane e is pixel e, for triangle first + pt[0] and the pixels of the lane mask np. */
+static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int32_t *pt, const int32_t *pl, int np)
+{
+    const ms_block_input *in = s->in;
+    const l16 near = l16_set1(s->fr->near), far = l16_set1(s->fr->far), zero = l16_set1(0.0f);
+    const l16 zrel = l16_set1(MS_Z_REL), slack = l16_set1(MS_BOX_SLACK), one = l16_set1(1.0f);
+    const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+#if BR_PACK
+    /* Lane e: pair e, pixel pl[e] and triangle first + pt[e]; lanes from np on are padding. */
+    const unsigned lanes = np == MS_BLOCK_LANES ? 0xFFFFu : (1u << np) - 1u;
+    const l16i P = l16i_load(pl), T = l16i_load(pt);
+#define BR_PIX(v) l16_perm(v, P)
+#define BR_TRI(q) l16_perm(L->tv[q], T)
+#else
+    /* Lane e: pixel e, triangle first + pt[0] for the pixels of `np` (a lane mask here). */
+    const unsigned lanes = (unsigned)np;
+    const float *tri = s->b->tri + 9 * (size_t)(L->first + (uint32_t)pt[0]);
+    (void)pl;
+#define BR_PIX(v) (v)
+#define BR_TRI(q) l16_set1(tri[q])
+#endif
+    l16 m[3][3], ma[3], c[3];
+    for (int a = 0; a < 3; a++) {
+        c[a] = BR_PIX(L->c[a]);
+        ma[a] = BR_PIX(L->ma[a]);
+        for (int r = 0; r < 3; r++) m[r][a] = BR_PIX(L->m[r][a]);
+    }
+    const l16 rx0 = BR_PIX(L->rx0), rx1 = BR_PIX(L->rx1), ry0 = BR_PIX(L->ry0), ry1 = BR_PIX(L->ry1);
+    l16 tv[3][3];
+    for (int v = 0; v < 3; v++)
+        for (int k = 0; k < 3; k++) tv[v][k] = BR_TRI(3 * v + k);
+    l16 x[3], y[3], z[3], zlo[3], zhi[3], av[3][3];
+    for (int v = 0; v < 3; v++) {
+        l16 *a = av[v], aa[3];
+        for (int k = 0; k < 3; k++) { a[k] = l16_sub(tv[v][k], c[k]); aa[k] = l16_abs(a[k]); }
+        x[v] = l16_add(l16_add(l16_mul(m[0][0], a[0]), l16_mul(m[0][1], a[1])), l16_mul(m[0][2], a[2]));
+        y[v] = l16_add(l16_add(l16_mul(m[1][0], a[0]), l16_mul(m[1][1], a[1])), l16_mul(m[1][2], a[2]));
+        z[v] = l16_add(l16_add(l16_mul(m[2][0], a[0]), l16_mul(m[2][1], a[1])), l16_mul(m[2][2], a[2]));
+        const l16 zerr = l16_mul(l16_add(l16_add(l16_mul(ma[0], aa[0]), l16_mul(ma[1], aa[1])), l16_mul(ma[2], aa[2])), zrel);
+        zlo[v] = l16_sub(z[v], zerr);
+        zhi[v] = l16_add(z[v], zerr);
+    }
+    const l16 zmin = l16_min(l16_min(zlo[0], zlo[1]), zlo[2]);
+    const l16 zmax = l16_max(l16_max(zhi[0], zhi[1]), zhi[2]);
+    const unsigned depth_ok = l16_le(near, zmax) & l16_le(zmin, far);
+    const unsigned front = l16_gt(zmin, zero);
+    l16 xs[3], ys[3];
+    for (int v = 0; v < 3; v++) {
+        const l16 inv = l16_div(one, z[v]);
+        xs[v] = l16_mul(x[v], inv);
+        ys[v] = l16_mul(y[v], inv);
+    }
+    /* The kernel's box: its slack, its clamp, its rounding to sample indices; then within the
+     * rectangle. */
+    const l16 xlo = l16_sub(l16_min(l16_min(xs[0], xs[1]), xs[2]), slack);
+    const l16 xhi = l16_add(l16_max(l16_max(xs[0], xs[1]), xs[2]), slack);
+    const l16 ylo = l16_sub(l16_min(l16_min(ys[0], ys[1]), ys[2]), slack);
+    const l16 yhi = l16_add(l16_max(l16_max(ys[0], ys[1]), ys[2]), slack);
+    const l16 bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), rx0);
+    const l16 bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), rx1);
+    const l16 by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), ry0);
+    const l16 by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), ry1);
+    const unsigned miss = front & (l16_gt(bx0, bx1) | l16_gt(by0, by1));
+    L->c_depth += (uint64_t)ms_bt_popcount16(lanes & ~depth_ok);
+    L->c_rect += (uint64_t)ms_bt_popcount16(lanes & depth_ok & miss);
+    unsigned pass = lanes & depth_ok & ~miss;
+    if (!pass) return;
+    /* Corner rays (the paper's corner-ray culling, in light-index space): a triangle whose box holds
+     * visible samples may still miss the whole rectangle box x rows (a long thin triangle across
+     * it). Its three edge planes through C, oriented towards the opposite vertex: if the four
+     * corners of the rectangle lie outside one of them, no sample inside does (convexity). Worth
+     * its cost only for large rectangles, where the kernel call it saves is dear and the miss likely;
+     * a margin of 1e-5 of the terms' magnitudes leaves any doubt to the kernel. */
+    const l16 cx0 = l16_select(front, bx0, rx0), cx1 = l16_select(front, bx1, rx1);
+    const l16 cy0 = l16_select(front, by0, ry0), cy1 = l16_select(front, by1, ry1);
+    const l16 area = l16_mul(l16_add(l16_sub(cx1, cx0), one), l16_add(l16_sub(cy1, cy0), one));
+    /* Per lane: which lanes share the vector (the block's pixels, or packed pairs) changes no
+     * decision, and no counter. */
+    const unsigned large = pass & l16_gt(area, l16_set1(BR_CORNER_AREA));
+    if (large) {
+        l16 n1[3];
+        for (int v = 0; v < 3; v++) n1[v] = l16_add(l16_add(l16_abs(x[v]), l16_abs(y[v])), l16_abs(z[v]));
+        const l16 pmax = l16_add(l16_add(cx1, cy1), one);   /* |i| + |j| + 1 at any corner */
+        unsigned out = 0;
+        for (int e = 0; e < 3; e++) {
+            const int va = (e + 1) % 3, vb = (e + 2) % 3;
+            const l16 ex = l16_sub(l16_mul(y[va], z[vb]), l16_mul(z[va], y[vb]));
+            const l16 ey = l16_sub(l16_mul(z[va], x[vb]), l16_mul(x[va], z[vb]));
+            const l16 ez = l16_sub(l16_mul(x[va], y[vb]), l16_mul(y[va], x[vb]));
+            const l16 tol = l16_mul(l16_mul(n1[va], n1[vb]), l16_set1(1e-5f));
+            const l16 side = l16_add(l16_add(l16_mul(ex, x[e]), l16_mul(ey, y[e])), l16_mul(ez, z[e]));
+            const l16 tc = l16_mul(tol, n1[e]);
+            const unsigned pos = l16_gt(side, tc), neg = l16_lt(side, l16_sub(zero, tc));
+            const l16 tp = l16_mul(tol, pmax), ntp = l16_sub(zero, tp);
+            unsigned pos_out = pos, neg_out = neg;
+            for (int corner = 0; corner < 4; corner++) {
+                const l16 pi = (corner & 1) ? cx1 : cx0, pj = (corner & 2) ? cy1 : cy0;
+                const l16 val = l16_add(l16_add(l16_mul(ex, pi), l16_mul(ey, pj)), ez);
+                pos_out &= l16_lt(val, ntp);   /* inside is positive: the corner is outside */
+                neg_out &= l16_gt(val, tp);
+            }
+            out |= pos_out | neg_out;
+        }
+        out &= large;
+        L->c_corner += (uint64_t)ms_bt_popcount16(out);
+        pass &= ~out;
+        if (!pass) return;
+    }
+    int32_t ix0[MS_BLOCK_LANES], ix1[MS_BLOCK_LANES], iy0[MS_BLOCK_LANES], iy1[MS_BLOCK_LANES];
+    l16_store_int(ix0, bx0); l16_store_int(ix1, bx1); l16_store_int(iy0, by0); l16_store_int(iy1, by1);
+    br_setup su;
+    su.rows = su.clip = su.kernel = 0;
+#if BR_PACK
+    /* The Scanline set-up of every pair that passed, in one pass (the coverage test below may still drop
+     * a few: cheaper than a second pass over the ones that remain). */
+    if (s->rows) {
+        l16 mt[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int a = 0; a < 3; a++) mt[r][a] = BR_PIX(L->mt[r][a]);
+        br_tri tr;
+        br_tri_lanes(tv, &tr);
+        br_scan_setup(pass, av, &tr, mt, BR_PIX(L->near_l), BR_PIX(L->far_l), x, y, z, zmin, zmax, MS_K, &su);
+    }
+    for (unsigned p = pass; p; p &= p - 1) {
+        const int e = __builtin_ctz(p), l = pl[e];
+        const uint32_t t = L->first + (uint32_t)pt[e];
+        /* Behind C somewhere (front clear): the kernel scans its whole rectangle, which holds visible
+         * samples by construction. */
+        if ((front >> e & 1) && !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], ix0[e], ix1[e], iy0[e], iy1[e])) { L->c_cov++; continue; }
+        L->c_rast++;
+        L->rasterized |= 1u << l;
+        /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel;
+         * a lane the set-up left to the kernel likewise. */
+        if (s->rows && !(su.kernel >> e & 1) && !ms_frame_alpha_tested(in->frame[l], t)) {
+            if (su.rows >> e & 1) MS_KFN(br_rows)(s, &su, e, in->buf[l], L);
+            continue;   /* else the set-up found nothing to clear, as the kernel would */
+        }
+        ms_raster_or_alpha(in->frame[l], s->raster, s->b->tri + 9 * (size_t)t, t, in->buf[l]);
+    }
+#else
+    const uint32_t t = L->first + (uint32_t)pt[0];
+    /* The pixels that pass the coverage test; those set up together below, the others by the kernel. */
+    unsigned cover = 0;
+    for (unsigned p = pass; p; p &= p - 1) {
+        const int l = __builtin_ctz(p);
+        /* Behind C somewhere (front clear): the kernel scans its whole rectangle, which holds visible
+         * samples by construction. */
+        if ((front >> l & 1) && !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], ix0[l], ix1[l], iy0[l], iy1[l])) { L->c_cov++; continue; }
+        cover |= 1u << l;
+    }
+    if (!cover) return;
+    L->c_rast += (uint64_t)ms_bt_popcount16(cover);
+    L->rasterized |= cover;
+    unsigned by_kernel = cover;
+    if (s->rows && ms_bt_popcount16(cover) >= BR_LANE_SETUP_MIN) {
+        /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel. */
+        unsigned alpha = 0;
+        for (unsigned p = cover; p; p &= p - 1) {
+            const int l = __builtin_ctz(p);
+            if (ms_frame_alpha_tested(in->frame[l], t)) alpha |= 1u << l;
+        }
+        br_tri tr;
+        br_tri_broadcast(tri, &tr);
+        br_scan_setup(cover & ~alpha, av, &tr, L->mt, L->near_l, L->far_l, x, y, z, zmin, zmax, MS_K, &su);
+        by_kernel = alpha | su.kernel;
+        for (unsigned p = su.rows; p; p &= p - 1) {
+            const int l = __builtin_ctz(p);
+            MS_KFN(br_rows)(s, &su, l, in->buf[l], L);
+        }
+    }
+    for (; by_kernel; by_kernel &= by_kernel - 1) {
+        const int l = __builtin_ctz(by_kernel);
+        /* An alpha-tested triangle clears only its opaque samples (alpha.h): the rectangle, coverage and
+         * early-out tests that read the buffer afterwards see only what it really occludes. */
+        ms_raster_or_alpha(in->frame[l], s->raster, tri, t, in->buf[l]);
+    }
+#endif
+#undef BR_PIX
+#undef BR_TRI
+}
+
 static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
 {
     ms_block_frusta *fr = s->fr;
@@ -404,156 +680,81 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
         const int l = __builtin_ctz(m);
         if (in->skip[l] - n->first < n->count) { skip_tri[nskip] = in->skip[l]; skip_lane[nskip++] = 1u << l; }
     }
-    const l16 near = l16_set1(fr->near), far = l16_set1(fr->far), zero = l16_set1(0.0f);
-    const l16 zrel = l16_set1(MS_Z_REL), slack = l16_set1(MS_BOX_SLACK), one = l16_set1(1.0f);
-    const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
-    l16 m[3][3], ma[3], c[3];
+    br_leaf_ctx L;
     for (int a = 0; a < 3; a++) {
-        c[a] = l16_load(fr->c[a]);
-        ma[a] = l16_load(s->mabs2[a]);
-        for (int r = 0; r < 3; r++) m[r][a] = l16_load(s->m[r][a]);
+        L.c[a] = l16_load(fr->c[a]);
+        L.ma[a] = l16_load(s->mabs2[a]);
+        for (int r = 0; r < 3; r++) {
+            L.m[r][a] = l16_load(s->m[r][a]);
+            L.mt[r][a] = l16_load(s->mt[r][a]);
+        }
     }
-    const l16 rx0 = l16_load(s->rx0), rx1 = l16_load(s->rx1), ry0 = l16_load(s->ry0), ry1 = l16_load(s->ry1);
     const unsigned before = mask & fr->live;
-    mask = MS_KFN(br_leaf_lanes)(s, n, before, m, c);
+    mask = MS_KFN(br_leaf_lanes)(s, n, before, L.m, L.c);
     cnt[MS_BR_LEAF_LANES_CULLED] += (uint64_t)ms_bt_popcount16(before & ~mask);
     if (!mask) return;
-    unsigned rasterized = 0;
-    uint64_t tri_lanes = 0, c_depth = 0, c_rect = 0, c_corner = 0, c_cov = 0, c_rast = 0, c_shared = 0;
-    for (uint32_t t = n->first; t < n->first + n->count; t++) {
-        unsigned lanes = mask & fr->live;
-        if (!lanes) break;
-        for (int q = 0; q < nskip; q++)
-            if (skip_tri[q] == t) lanes &= ~skip_lane[q];
-        if (!lanes) continue;
-        tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
-        const float *tri = s->b->tri + 9 * (size_t)t;
-        l16 x[3], y[3], z[3], zlo[3], zhi[3], av[3][3];
-        for (int v = 0; v < 3; v++) {
-            l16 *a = av[v], aa[3];
-            for (int k = 0; k < 3; k++) { a[k] = l16_sub(l16_set1(tri[3 * v + k]), c[k]); aa[k] = l16_abs(a[k]); }
-            x[v] = l16_add(l16_add(l16_mul(m[0][0], a[0]), l16_mul(m[0][1], a[1])), l16_mul(m[0][2], a[2]));
-            y[v] = l16_add(l16_add(l16_mul(m[1][0], a[0]), l16_mul(m[1][1], a[1])), l16_mul(m[1][2], a[2]));
-            z[v] = l16_add(l16_add(l16_mul(m[2][0], a[0]), l16_mul(m[2][1], a[1])), l16_mul(m[2][2], a[2]));
-            const l16 zerr = l16_mul(l16_add(l16_add(l16_mul(ma[0], aa[0]), l16_mul(ma[1], aa[1])), l16_mul(ma[2], aa[2])), zrel);
-            zlo[v] = l16_sub(z[v], zerr);
-            zhi[v] = l16_add(z[v], zerr);
-        }
-        const l16 zmin = l16_min(l16_min(zlo[0], zlo[1]), zlo[2]);
-        const l16 zmax = l16_max(l16_max(zhi[0], zhi[1]), zhi[2]);
-        const unsigned depth_ok = l16_le(near, zmax) & l16_le(zmin, far);
-        const unsigned front = l16_gt(zmin, zero);
-        l16 xs[3], ys[3];
-        for (int v = 0; v < 3; v++) {
-            const l16 inv = l16_div(one, z[v]);
-            xs[v] = l16_mul(x[v], inv);
-            ys[v] = l16_mul(y[v], inv);
-        }
-        /* The kernel's box: its slack, its clamp, its rounding to sample indices; then within the
-         * rectangle. */
-        const l16 xlo = l16_sub(l16_min(l16_min(xs[0], xs[1]), xs[2]), slack);
-        const l16 xhi = l16_add(l16_max(l16_max(xs[0], xs[1]), xs[2]), slack);
-        const l16 ylo = l16_sub(l16_min(l16_min(ys[0], ys[1]), ys[2]), slack);
-        const l16 yhi = l16_add(l16_max(l16_max(ys[0], ys[1]), ys[2]), slack);
-        const l16 bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), rx0);
-        const l16 bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), rx1);
-        const l16 by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), ry0);
-        const l16 by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), ry1);
-        const unsigned miss = front & (l16_gt(bx0, bx1) | l16_gt(by0, by1));
-        const unsigned l_depth = lanes & ~depth_ok, l_rect = lanes & depth_ok & miss;
-        c_depth += (uint64_t)ms_bt_popcount16(l_depth);
-        c_rect += (uint64_t)ms_bt_popcount16(l_rect);
-        unsigned pass = lanes & depth_ok & ~miss;
-        if (!pass) continue;
-        /* Corner rays (the paper's corner-ray culling, in light-index space): a triangle whose box holds
-         * visible samples may still miss the whole rectangle box x rows (a long thin triangle across
-         * it). Its three edge planes through C, oriented towards the opposite vertex: if the four
-         * corners of the rectangle lie outside one of them, no sample inside does (convexity). Worth
-         * its cost only for large rectangles, where the kernel call it saves is dear and the miss likely;
-         * a margin of 1e-5 of the terms' magnitudes leaves any doubt to the kernel. */
-        const l16 cx0 = l16_select(front, bx0, rx0), cx1 = l16_select(front, bx1, rx1);
-        const l16 cy0 = l16_select(front, by0, ry0), cy1 = l16_select(front, by1, ry1);
-        const l16 area = l16_mul(l16_add(l16_sub(cx1, cx0), one), l16_add(l16_sub(cy1, cy0), one));
-        if (pass & l16_gt(area, l16_set1(BR_CORNER_AREA))) {
-            l16 n1[3];
-            for (int v = 0; v < 3; v++) n1[v] = l16_add(l16_add(l16_abs(x[v]), l16_abs(y[v])), l16_abs(z[v]));
-            const l16 pmax = l16_add(l16_add(cx1, cy1), one);   /* |i| + |j| + 1 at any corner */
-            unsigned out = 0;
-            for (int e = 0; e < 3; e++) {
-                const int va = (e + 1) % 3, vb = (e + 2) % 3;
-                const l16 ex = l16_sub(l16_mul(y[va], z[vb]), l16_mul(z[va], y[vb]));
-                const l16 ey = l16_sub(l16_mul(z[va], x[vb]), l16_mul(x[va], z[vb]));
-                const l16 ez = l16_sub(l16_mul(x[va], y[vb]), l16_mul(y[va], x[vb]));
-                const l16 tol = l16_mul(l16_mul(n1[va], n1[vb]), l16_set1(1e-5f));
-                const l16 side = l16_add(l16_add(l16_mul(ex, x[e]), l16_mul(ey, y[e])), l16_mul(ez, z[e]));
-                const l16 tc = l16_mul(tol, n1[e]);
-                const unsigned pos = l16_gt(side, tc), neg = l16_lt(side, l16_sub(zero, tc));
-                const l16 tp = l16_mul(tol, pmax), ntp = l16_sub(zero, tp);
-                unsigned pos_out = pos, neg_out = neg;
-                for (int corner = 0; corner < 4; corner++) {
-                    const l16 pi = (corner & 1) ? cx1 : cx0, pj = (corner & 2) ? cy1 : cy0;
-                    const l16 val = l16_add(l16_add(l16_mul(ex, pi), l16_mul(ey, pj)), ez);
-                    pos_out &= l16_lt(val, ntp);   /* inside is positive: the corner is outside */
-                    neg_out &= l16_gt(val, tp);
-                }
-                out |= pos_out | neg_out;
-            }
-            out &= pass;
-            c_corner += (uint64_t)ms_bt_popcount16(out);
-            pass &= ~out;
-            if (!pass) continue;
-        }
-        int32_t ix0[MS_BLOCK_LANES], ix1[MS_BLOCK_LANES], iy0[MS_BLOCK_LANES], iy1[MS_BLOCK_LANES];
-        l16_store_int(ix0, bx0); l16_store_int(ix1, bx1); l16_store_int(iy0, by0); l16_store_int(iy1, by1);
-        /* The pixels that pass the coverage test; those set up together below, the others by the kernel. */
-        unsigned cover = 0;
-        for (unsigned p = pass; p; p &= p - 1) {
-            const int l = __builtin_ctz(p);
-            /* Behind C somewhere (front clear): the kernel scans its whole rectangle, which holds visible
-             * samples by construction. */
-            if ((front >> l & 1) && !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], ix0[l], ix1[l], iy0[l], iy1[l])) { c_cov++; continue; }
-            cover |= 1u << l;
-        }
-        if (!cover) continue;
-        c_rast += (uint64_t)ms_bt_popcount16(cover);
-        rasterized |= cover;
-        unsigned by_kernel = cover;
-        if (s->rows && ms_bt_popcount16(cover) >= BR_LANE_SETUP_MIN) {
-            /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel. */
-            unsigned alpha = 0;
-            for (unsigned p = cover; p; p &= p - 1) {
-                const int l = __builtin_ctz(p);
-                if (ms_frame_alpha_tested(in->frame[l], t)) alpha |= 1u << l;
-            }
-            br_setup su;
-            br_scan_setup(s, tri, cover & ~alpha, av, x, y, z, zmin, zmax, MS_K, &su);
-            by_kernel = alpha | su.kernel;
-            c_shared += (uint64_t)ms_bt_popcount16(su.rows);
-            for (unsigned p = su.rows; p; p &= p - 1) {
-                const int l = __builtin_ctz(p);
-                ms_scan_vec v;
-                for (int i = 0; i < 3; i++) { v.al[i] = su.al[i][l]; v.bl[i] = su.bl[i][l]; v.au[i] = su.au[i][l]; v.bu[i] = su.bu[i][l]; }
-                v.y0 = su.y0[l];
-                v.y1 = su.y1[l];
-                s->rows(&v, in->buf[l]);
+    L.rx0 = l16_load(s->rx0); L.rx1 = l16_load(s->rx1); L.ry0 = l16_load(s->ry0); L.ry1 = l16_load(s->ry1);
+    L.near_l = l16_load(s->near_l);
+    L.far_l = l16_load(s->far_l);
+    L.rasterized = 0;
+    L.c_depth = L.c_rect = L.c_corner = L.c_cov = L.c_rast = L.c_shared = L.c_shared_clip = 0;
+    uint64_t tri_lanes = 0;
+    /* The live pixels do not change within a leaf (a pixel retires after it, below). */
+    const unsigned live = mask & fr->live;
+    const uint32_t end = n->first + n->count;
+    for (uint32_t g = n->first; g < end; g += MS_BLOCK_LANES) {
+        const int nt = end - g < MS_BLOCK_LANES ? (int)(end - g) : MS_BLOCK_LANES;
+        L.first = g;
+#if BR_PACK
+        /* The group's vertices, lane = triangle (lanes past the group repeat its first). */
+        int32_t off[MS_BLOCK_LANES];
+        for (int j = 0; j < MS_BLOCK_LANES; j++) off[j] = 9 * (j < nt ? j : 0);
+        const l16i O = l16i_load(off);
+        const float *tri0 = s->b->tri + 9 * (size_t)g;
+        for (int q = 0; q < 9; q++) L.tv[q] = l16_gather(tri0 + q, O);
+#endif
+#if BR_PACK
+        /* All the group's pairs first, then sixteen at a time: the index vectors are then loaded from
+         * stores long done (loaded right after sixteen scalar stores, they waited on store forwarding). */
+        int32_t pt[MS_BLOCK_LANES * MS_BLOCK_LANES + MS_BLOCK_LANES], pl[MS_BLOCK_LANES * MS_BLOCK_LANES + MS_BLOCK_LANES];
+        int np = 0;
+        for (int j = 0; j < nt; j++) {
+            unsigned lanes = live;
+            for (int q = 0; q < nskip; q++)
+                if (skip_tri[q] == g + (uint32_t)j) lanes &= ~skip_lane[q];
+            tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
+            for (; lanes; lanes &= lanes - 1) {
+                pt[np] = j;
+                pl[np++] = __builtin_ctz(lanes);
             }
         }
-        for (; by_kernel; by_kernel &= by_kernel - 1) {
-            const int l = __builtin_ctz(by_kernel);
-            /* An alpha-tested triangle clears only its opaque samples (alpha.h): the rectangle, coverage and
-             * early-out tests that read the buffer afterwards see only what it really occludes. */
-            ms_raster_or_alpha(in->frame[l], s->raster, tri, t, in->buf[l]);
+        if (!np) continue;
+        for (int e = np; e % MS_BLOCK_LANES; e++) { pt[e] = pt[0]; pl[e] = pl[0]; }   /* valid operands, unused */
+        for (int e = 0; e < np; e += MS_BLOCK_LANES)
+            MS_KFN(br_pairs)(s, &L, pt + e, pl + e, np - e < MS_BLOCK_LANES ? np - e : MS_BLOCK_LANES);
+#else
+        int32_t pt[1], pl[1] = { 0 };
+        for (int j = 0; j < nt; j++) {
+            unsigned lanes = live;
+            for (int q = 0; q < nskip; q++)
+                if (skip_tri[q] == g + (uint32_t)j) lanes &= ~skip_lane[q];
+            tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
+            pt[0] = j;
+            if (lanes) MS_KFN(br_pairs)(s, &L, pt, pl, (int)lanes);
         }
+#endif
     }
     cnt[MS_BR_TRI_LANES] += tri_lanes;
-    cnt[MS_BR_CULLED_DEPTH] += c_depth;
-    cnt[MS_BR_CULLED_RECT] += c_rect;
-    cnt[MS_BR_CULLED_CORNER] += c_corner;
-    cnt[MS_BR_CULLED_COVERAGE] += c_cov;
-    cnt[MS_BR_RASTERIZED] += c_rast;
-    cnt[MS_BR_SHARED_SETUP] += c_shared;
+    cnt[MS_BR_CULLED_DEPTH] += L.c_depth;
+    cnt[MS_BR_CULLED_RECT] += L.c_rect;
+    cnt[MS_BR_CULLED_CORNER] += L.c_corner;
+    cnt[MS_BR_CULLED_COVERAGE] += L.c_cov;
+    cnt[MS_BR_RASTERIZED] += L.c_rast;
+    cnt[MS_BR_SHARED_SETUP] += L.c_shared;
+    cnt[MS_BR_SHARED_SETUP_CLIP] += L.c_shared_clip;
     /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */
     const int fs = s->flags & MS_BR_FRUSTUM_SHRINK;
+    unsigned rasterized = L.rasterized;
     for (; rasterized; rasterized &= rasterized - 1) {
         const int l = __builtin_ctz(rasterized);
         int old[4];
@@ -583,7 +784,8 @@ void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms
     s.in = in;
     s.raster = raster;
     s.flags = flags;
-    s.rows = (flags & MS_BR_NO_LANE_SETUP) ? NULL : ms_raster_rows(raster, MS_K);
+    s.rows = (flags & MS_BR_NO_LANE_SETUP) ? NULL : ms_raster_rows(raster, MS_K, 3);
+    s.rows5 = ms_raster_rows(raster, MS_K, 5);
     memset(s.m, 0, sizeof s.m);
     memset(s.mabs2, 0, sizeof s.mabs2);
     memset(s.mt, 0, sizeof s.mt);
