@@ -118,6 +118,9 @@
 #define MEDIAN_BELOW_DEPTH 40     /* median splits from here: depth at most 40 + log2(points) */
 #define BATCH 16384               /* triangles read and prepared together */
 #define EDGE_ON 1e-3f             /* as microraster.c */
+#ifndef LEAF_FP_MIN
+#define LEAF_FP_MIN 6
+#endif
 #define LANES 16                  /* the reference tracer's packet width (raytrace_impl.h) */
 
 enum {
@@ -128,6 +131,8 @@ enum {
      * memory by kind (bytes allocated at the peak). */
     C_SORT_US, C_BUILD_US, C_REBUILD_THREAD_US, C_CAST_US, C_SAMPLE_BYTES, C_HIERARCHY_BYTES, C_MASK_BYTES,
     C_PAIRS_IN_VL,   /* (receiver, triangle) pairs past the point-in-V_L test: the work the samples' tests start from */
+    C_PAIRS_FOOTPRINT,   /* of those, the pairs that reach the per-receiver footprint (past the leaf footprint) */
+    C_LEAF_CULLS,        /* (leaf, triangle) pairs the leaf footprint rules out for every receiver of the leaf */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -601,6 +606,19 @@ static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const fl
     return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
 }
 
+/* footprint_keep with a slack per lane (16 receivers' functions at one sample). */
+static inline unsigned footprint_keep16(const l16 E[4], const l16 s[3])
+{
+    const l16 s2 = l16_mul(l16_set1(2.0f), l16_add(l16_add(s[0], s[1]), s[2]));
+    const unsigned up = l16_gt(E[3], s2), down = l16_lt(E[3], l16_sub(l16_set1(0.0f), s2));
+    unsigned pos = 0, neg = 0;
+    for (int e = 0; e < 3; e++) {
+        pos |= l16_gt(E[e], s[e]);
+        neg |= l16_lt(E[e], l16_sub(l16_set1(0.0f), s[e]));
+    }
+    return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
+}
+
 /* The groups (bit gk) whose samples the footprint may hold, bounding each edge function over the group's
  * gs x gs samples (16 groups per operation). base: each function at each group's first sample, [e][gk]. */
 static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f, float base[4][64])
@@ -635,6 +653,148 @@ static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0
 static void footprint_offsets(const hpc_footprint *f, l16 oi, l16 oj, l16 off[4])
 {
     for (int e = 0; e < 4; e++) off[e] = l16_add(l16_mul(l16_set1(f->e[e][1]), oi), l16_mul(l16_set1(f->e[e][2]), oj));
+}
+
+/* ---- the leaf footprint (hpc: the footprint test bounded over a whole leaf) ----
+ *
+ * Departure from the paper (whose group volumes V_Gk cull whole light groups at a node): the footprint test's
+ * edge functions bounded over every receiver of a leaf at once, per light sample. The leaf's receivers lie in
+ * a box (centre pc, half extents h) and their grid origins in a box (centre p0c, half extents J); all share
+ * the grid's steps ds, dt. For receiver p = pc + q and origin p0 = p0c + j, with Y1, Y2 an edge's vertices
+ * relative to pc and x' = w + i ds + j dt (w = p0c - pc) the sample relative to pc, the edge function
+ * E = det(Y1 - q, Y2 - q, x' + j - q) is affine in q and in the sample, so, exactly in reals,
+ *     E = X . x' + X . j + g(i, j) . q - q . (D x j),   X = Y1 x Y2, D = Y2 - Y1, g = -(X + D x x'),
+ * and |E - X . x'| <= sum_c h_c |g_c(i, j)| + sum_c |X_c| J_c + sum_c h_c (|D_c+1| J_c+2 + |D_c+2| J_c+1).
+ * g is affine in (i, j), so over a group of gs x gs samples |g_c| <= |g_c(centre)| + (gs-1)/2 (|g_1c| + |g_2c|)
+ * (g_1, g_2 its steps): one bound U per function and group. The sum of the three functions (the side of the
+ * triangle's plane) is Xs . (x' + j - q), Xs = the sum of the X: its bound is sum_c |Xs_c| (J_c + h_c).
+ * footprint_keep then rules a sample out for every receiver of the leaf when E_c - U and E_c + U (E_c = X . x')
+ * are beyond the slacks. The slack is the footprint test's for a receiver anywhere in the box with an origin
+ * anywhere in its box (|Y - p|inf <= |Y1|inf + |h|inf, dmax and S over both boxes), taken twice: it covers the
+ * exact test's rounding as the per-receiver footprint's does, and this bound's own evaluation (E_c is the
+ * footprint's arithmetic at pc; U is a sum of non-negative terms, rounded up by 1e-3 of itself). So no sample
+ * the exact test blocks for any receiver of the leaf is ever ruled out. What it buys: a leaf whose triangle
+ * covers no sample of any receiver (a thin bar whose shadow passes between the sample rows of the leaf's
+ * receivers) is dropped with one test instead of one footprint per receiver, and the candidate samples of
+ * the others bound each receiver's groups and lanes. */
+typedef struct leaf_box { float pc[3], h[3], p0c[3], J[3]; } leaf_box;
+
+/* The samples (bits as a mask's) triangle t may block for some receiver of box b, in cand (mw words); its
+ * groups are returned (0: the triangle blocks no sample of any of them). */
+static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const tri_job *t, uint64_t *cand)
+{
+    const int k = sh->k, gs = sh->gs, rows = LANES / gs;
+    const float *ds = sh->grid_ds, *dt = sh->grid_dt;
+    float w[3], hmax = 0.0f, dmax = 0.0f, S = 0.0f, Y[3][3], nY[3];
+    for (int a = 0; a < 3; a++) {
+        w[a] = b->p0c[a] - b->pc[a];
+        hmax = ms_maxf(hmax, b->h[a]);
+        const float ext = (float)(k - 1) * (fabsf(ds[a]) + fabsf(dt[a]));
+        dmax = ms_maxf(dmax, fabsf(w[a]) + b->J[a] + b->h[a] + ext);
+        S = ms_maxf(S, fabsf(b->p0c[a]) + b->J[a] + ext + fabsf(b->pc[a]) + b->h[a]);
+    }
+    const float rel = 2.0f * 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));
+    for (int v = 0; v < 3; v++) {
+        for (int a = 0; a < 3; a++) Y[v][a] = t->v[3 * v + a] - b->pc[a];
+        nY[v] = inf_norm3(Y[v]) + hmax;
+    }
+    static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A (footprint_setup) */
+    float e[4][3], s[3], gst[3][3][3], ufix[4], uspan[3];   /* gst[e]: g at the grid's origin, per column, per row */
+    float Xs[3] = { 0.0f, 0.0f, 0.0f };
+    for (int f = 0; f < 3; f++) {
+        const float *y1 = Y[pair[f][0]], *y2 = Y[pair[f][1]];
+        float X[3], D[3], Dw[3], Dds[3], Ddt[3];
+        v3_cross(X, y1, y2);
+        e[f][0] = v3_dot(X, w);
+        e[f][1] = v3_dot(X, ds);
+        e[f][2] = v3_dot(X, dt);
+        s[f] = rel * nY[pair[f][0]] * nY[pair[f][1]];
+        for (int a = 0; a < 3; a++) { D[a] = y2[a] - y1[a]; Xs[a] += X[a]; }
+        v3_cross(Dw, D, w);
+        v3_cross(Dds, D, ds);
+        v3_cross(Ddt, D, dt);
+        float jx = 0.0f, kx = 0.0f, sp = 0.0f;
+        for (int a = 0; a < 3; a++) {
+            const int a1 = (a + 1) % 3, a2 = (a + 2) % 3;
+            gst[f][0][a] = -(X[a] + Dw[a]);
+            gst[f][1][a] = -Dds[a];
+            gst[f][2][a] = -Ddt[a];
+            jx += fabsf(X[a]) * b->J[a];
+            kx += b->h[a] * (fabsf(D[a1]) * b->J[a2] + fabsf(D[a2]) * b->J[a1]);
+            sp += b->h[a] * (fabsf(Dds[a]) + fabsf(Ddt[a]));
+        }
+        /* the rounding of g's terms (X + D x w may cancel) and of their affine sums, 20 u of the magnitudes */
+        float mag = fabsf(X[0]) + fabsf(X[1]) + fabsf(X[2]);
+        const float nD = fabsf(D[0]) + fabsf(D[1]) + fabsf(D[2]);
+        for (int a = 0; a < 3; a++) mag += 2.0f * nD * (fabsf(w[a]) + (float)k * (fabsf(ds[a]) + fabsf(dt[a])));
+        ufix[f] = jx + kx + 1.2e-6f * mag * (b->h[0] + b->h[1] + b->h[2]);
+        uspan[f] = 0.5f * (float)(gs - 1) * sp;
+    }
+    for (int c = 0; c < 3; c++) e[3][c] = e[0][c] + e[1][c] + e[2][c];
+    ufix[3] = 0.0f;
+    for (int a = 0; a < 3; a++) ufix[3] += fabsf(Xs[a]) * (b->J[a] + b->h[a]);
+    ufix[3] *= 1.001f;
+    /* the groups: each function at each group's first sample, its change over the group, +- U */
+    float base[4][64], U[3][64];
+    uint64_t groups = 0;
+    const float half = 0.5f * (float)(gs - 1), span = (float)(gs - 1);
+    for (int g0 = 0; g0 < sh->G; g0 += LANES) {
+        const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
+        const l16 ci = l16_add(gi, l16_set1(half)), cj = l16_add(gj, l16_set1(half));
+        l16 lo[4], hi[4];
+        for (int f = 0; f < 4; f++) {
+            const l16 bs = l16_add(l16_add(l16_set1(e[f][0]), l16_mul(l16_set1(e[f][1]), gi)), l16_mul(l16_set1(e[f][2]), gj));
+            l16_store(base[f] + g0, bs);
+            l16 u = l16_set1(ufix[f]);
+            if (f < 3) {
+                l16 acc = l16_set1(ufix[f] + uspan[f]);
+                for (int a = 0; a < 3; a++) {
+                    const l16 ga = l16_add(l16_add(l16_set1(gst[f][0][a]), l16_mul(l16_set1(gst[f][1][a]), ci)),
+                                           l16_mul(l16_set1(gst[f][2][a]), cj));
+                    acc = l16_add(acc, l16_mul(l16_abs(ga), l16_set1(b->h[a])));
+                }
+                u = l16_mul(acc, l16_set1(1.001f));
+                l16_store(U[f] + g0, u);
+            }
+            const float di = e[f][1] * span, dj = e[f][2] * span;
+            lo[f] = l16_sub(l16_add(bs, l16_set1(ms_minf(di, 0.0f) + ms_minf(dj, 0.0f))), u);
+            hi[f] = l16_add(l16_add(bs, l16_set1(ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f))), u);
+        }
+        groups |= (uint64_t)footprint_keep(lo, hi, s) << g0;
+    }
+    groups &= sh->all_groups;
+    memset(cand, 0, (size_t)sh->mw * sizeof *cand);
+    if (!groups) return 0;
+    static const float off[2][2][LANES] = {
+        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+    const int wi = gs == 8;
+    const l16 oi = l16_load(off[wi][0]), oj = l16_load(off[wi][1]);
+    l16 foff[4];
+    for (int f = 0; f < 4; f++) foff[f] = l16_add(l16_mul(l16_set1(e[f][1]), oi), l16_mul(l16_set1(e[f][2]), oj));
+    const uint64_t seg = (UINT64_C(1) << gs) - 1u;
+    uint64_t out = 0;
+    for (uint64_t m = groups; m; m &= m - 1) {
+        const int gk = __builtin_ctzll(m);
+        const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
+        for (int jb = j0; jb < j0 + gs; jb += rows) {
+            l16 lo[4], hi[4];
+            for (int f = 0; f < 4; f++) {
+                const float b0 = jb == j0 ? base[f][gk] : e[f][0] + e[f][1] * (float)i0 + e[f][2] * (float)jb;
+                const l16 E = l16_add(l16_set1(b0), foff[f]), u = l16_set1(f < 3 ? U[f][gk] : ufix[3]);
+                lo[f] = l16_sub(E, u);
+                hi[f] = l16_add(E, u);
+            }
+            const unsigned keep = footprint_keep(lo, hi, s);
+            if (!keep) continue;
+            out |= UINT64_C(1) << gk;
+            for (int rr = 0; rr < rows; rr++) {
+                const int s0 = (jb + rr) * k + i0;
+                cand[s0 >> 6] |= (uint64_t)(keep >> (rr * gs) & seg) << (s0 & 63);
+            }
+        }
+    }
+    return out;
 }
 
 /* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
@@ -868,6 +1028,9 @@ typedef struct hpc_view {
     int nt;
     const tri_job *t[2];
     hpc_footprint fp[2];
+    const uint64_t *ncand[2];   /* direct: per triangle, this receiver's samples the footprint may hold */
+    uint64_t ngroups;           /* direct: groups holding them (a superset), over the triangles */
+    int direct;                 /* 1: ncand and ngroups made by the leaf (cast_leaf_footprint), fp unused */
 } hpc_view;
 
 /* The lanes triangle t blocks of the 16-sample block at (i0, jb) of receiver q (live: the lanes to test), with
@@ -909,10 +1072,15 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
     const ms_shadow_query *q = &sh->q[r];
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
+    c->cnt[C_PAIRS_FOOTPRINT] += (uint64_t)v->nt;
     /* The open groups a footprint may touch (a node's umbra groups are its points' too). */
     float base[2][4][64];   /* each function at each group's first sample (footprint_groups) */
-    uint64_t todo = footprint_groups(sh, &v->fp[0], base[0]);
-    if (v->nt > 1) todo |= footprint_groups(sh, &v->fp[1], base[1]);
+    uint64_t todo;
+    if (v->direct) todo = v->ngroups;
+    else {
+        todo = footprint_groups(sh, &v->fp[0], base[0]);
+        if (v->nt > 1) todo |= footprint_groups(sh, &v->fp[1], base[1]);
+    }
     todo &= ~gu;
     if (!todo) return;
     static const float off[2][2][LANES] = {
@@ -921,7 +1089,7 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
     const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8, nt = v->nt;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
     l16 foff[2][4];
-    for (int u = 0; u < nt; u++) footprint_offsets(&v->fp[u], l16_load(off[wi][0]), l16_load(off[wi][1]), foff[u]);
+    for (int u = 0; u < nt && !v->direct; u++) footprint_offsets(&v->fp[u], l16_load(off[wi][0]), l16_load(off[wi][1]), foff[u]);
     int32_t s = sh->slot[r];
     const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
     float num[2] = { 0.0f, 0.0f }, V[2][3][3];   /* per triangle at its first exact test: offset, A, B, C */
@@ -933,8 +1101,13 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
         const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
         unsigned any = 0;
         for (int jb = j0; jb < j0 + gs; jb += rows) {
-            unsigned lanes[2] = { footprint_lanes(&v->fp[0], foff[0], i0, jb, jb == j0 ? &base[0][0][0] : NULL, gk), 0u };
-            if (nt > 1) lanes[1] = footprint_lanes(&v->fp[1], foff[1], i0, jb, jb == j0 ? &base[1][0][0] : NULL, gk);
+            unsigned lanes[2] = { 0u, 0u };
+            if (v->direct) {
+                for (int u = 0; u < nt; u++) lanes[u] = block_open(v->ncand[u], k, i0, jb, gs);
+            } else {
+                lanes[0] = footprint_lanes(&v->fp[0], foff[0], i0, jb, jb == j0 ? &base[0][0][0] : NULL, gk);
+                if (nt > 1) lanes[1] = footprint_lanes(&v->fp[1], foff[1], i0, jb, jb == j0 ? &base[1][0][0] : NULL, gk);
+            }
             if (!(lanes[0] | lanes[1])) continue;
             const unsigned ob = block_open(open, k, i0, jb, gs);
             if (!(ob & (lanes[0] | lanes[1]))) continue;
@@ -987,6 +1160,7 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
     hpc_view v;
     v.nt = 1;
     v.t[0] = t;
+    v.direct = 0;
     float A[3], B[3], C[3];
     for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
     footprint_setup(&v.fp[0], A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
@@ -1101,6 +1275,36 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     }
     if (!act) return;
     c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act & on[0]) + (uint64_t)__builtin_popcount(act & on[1]);
+    /* the leaf footprint over the receivers left (their box and their grid origins' box) */
+    uint64_t ncand[2][64], ngroups[2] = { ~UINT64_C(0), ~UINT64_C(0) };
+    const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) && __builtin_popcount(act) >= LEAF_FP_MIN;
+    if (leaf_fp) {
+        leaf_box bx;
+        for (int a = 0; a < 3; a++) {
+            float plo = INFINITY, phi = -INFINITY, olo = INFINITY, ohi = -INFINITY;
+            for (unsigned m = act; m; m &= m - 1) {
+                const int l = __builtin_ctz(m);
+                plo = ms_minf(plo, P[a][l]);
+                phi = ms_maxf(phi, P[a][l]);
+                const float p0 = sh->p0[4 * (size_t)rr[l] + a];
+                olo = ms_minf(olo, p0);
+                ohi = ms_maxf(ohi, p0);
+            }
+            /* centres and half extents; the differences rounded up (a float difference is off by u of itself) */
+            bx.pc[a] = 0.5f * (plo + phi);
+            bx.h[a] = ms_maxf(phi - bx.pc[a], bx.pc[a] - plo) * 1.000001f;
+            bx.p0c[a] = 0.5f * (olo + ohi);
+            bx.J[a] = ms_maxf(ohi - bx.p0c[a], bx.p0c[a] - olo) * 1.000001f;
+            if (sh->sw & MS_HPC_BREAK_LEAF_BOUND) bx.h[a] = bx.J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
+        }
+        for (int u = 0; u < nt; u++) {
+            if (!(act & on[u])) continue;
+            ngroups[u] = leaf_footprint(sh, &bx, &t[u], ncand[u]);
+            if (!ngroups[u]) { on[u] = 0; c->cnt[C_LEAF_CULLS]++; }
+        }
+        act &= on[0] | on[1];
+        if (!act) return;
+    }
     /* footprint_setup per lane, per triangle */
     const l16 w[3] = { l16_load(W[0]), l16_load(W[1]), l16_load(W[2]) }, rel = l16_load(R);
     static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A */
@@ -1126,24 +1330,56 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             l16_store(fe[u][e][0], c0);
             l16_store(fe[u][e][1], c1);
             l16_store(fe[u][e][2], c2);
-            spans16(c1, c2, span, zero, fdl[u][e], fdh[u][e]);
+            if (!leaf_fp) spans16(c1, c2, span, zero, fdl[u][e], fdh[u][e]);
             l16_store(fs[u][e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
             esum[0] = l16_add(esum[0], c0);
             esum[1] = l16_add(esum[1], c1);
             esum[2] = l16_add(esum[2], c2);
         }
         for (int a = 0; a < 3; a++) l16_store(fe[u][3][a], esum[a]);
-        spans16(esum[1], esum[2], span, zero, fdl[u][3], fdh[u][3]);
+        if (!leaf_fp) spans16(esum[1], esum[2], span, zero, fdl[u][3], fdh[u][3]);
     }
-    for (unsigned m = act; m; m &= m - 1) {
+    /* With the leaf footprint: each sample it left, tested for the leaf's receivers in the lanes (footprint_keep
+     * per receiver, the footprint_lanes arithmetic with the sample's own indices), giving each receiver its
+     * samples: the work per leaf follows the samples left, which fall as the leaves shrink with resolution. */
+    const int mw = sh->mw;
+    uint64_t rc[2][LANES][64];
+    unsigned has[2] = { 0u, 0u };
+    if (leaf_fp)
+        for (int u = 0; u < nt; u++) {
+            const unsigned lanes_on = act & on[u];
+            if (!lanes_on) continue;
+            for (unsigned m = lanes_on; m; m &= m - 1) memset(rc[u][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
+            l16 c0[4], c1[4], c2[4], sl[3];
+            for (int e = 0; e < 4; e++) { c0[e] = l16_load(fe[u][e][0]); c1[e] = l16_load(fe[u][e][1]); c2[e] = l16_load(fe[u][e][2]); }
+            for (int e = 0; e < 3; e++) sl[e] = l16_load(fs[u][e]);
+            for (int wd = 0; wd < mw; wd++)
+                for (uint64_t bits = ncand[u][wd]; bits; bits &= bits - 1) {
+                    const int sidx = 64 * wd + __builtin_ctzll(bits);
+                    const l16 fi = l16_set1((float)(sidx % sh->k)), fj = l16_set1((float)(sidx / sh->k));
+                    l16 E[4];
+                    for (int e = 0; e < 4; e++) E[e] = l16_add(l16_add(c0[e], l16_mul(c1[e], fi)), l16_mul(c2[e], fj));
+                    const unsigned hitl = footprint_keep16(E, sl) & lanes_on;
+                    has[u] |= hitl;
+                    for (unsigned h2 = hitl; h2; h2 &= h2 - 1) rc[u][__builtin_ctz(h2)][wd] |= UINT64_C(1) << (sidx & 63);
+                }
+        }
+    for (unsigned m = leaf_fp ? act & (has[0] | has[1]) : act; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         const uint32_t r = rr[l];
         hpc_view view;
         view.nt = 0;
+        view.direct = leaf_fp;
+        view.ngroups = 0;
         for (int u = 0; u < nt; u++) {
-            if (!(on[u] >> l & 1u)) continue;
+            if (!((leaf_fp ? has[u] : on[u]) >> l & 1u)) continue;
             const int x = view.nt++;
             view.t[x] = &t[u];
+            if (leaf_fp) {
+                view.ncand[x] = rc[u][l];
+                view.ngroups |= ngroups[u];
+                continue;
+            }
             for (int e = 0; e < 4; e++)
                 for (int a = 0; a < 3; a++) view.fp[x].e[e][a] = fe[u][e][a][l];
             for (int e = 0; e < 3; e++) view.fp[x].s[e] = fs[u][e][l];
