@@ -167,6 +167,7 @@ typedef struct shared {
     double light_poly[12];
     double group_poly[64][12];
     float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
+    float bit_i[64], bit_j[64];      /* bit b of a mask word: its sample's column, and its row from the word's first */
     int footprint;                   /* hpc (not hpc-scanline) with the footprint test: no V_Gk */
     int pairs;                       /* footprint with p0: triangles sharing an edge cast in pairs (pair_batch) */
     float grid_ds[3], grid_dt[3];    /* the grid's steps, the same for every pixel (pattern.c) */
@@ -679,13 +680,20 @@ static void footprint_offsets(const hpc_footprint *f, l16 oi, l16 oj, l16 off[4]
  * the others bound each receiver's groups and lanes. */
 typedef struct leaf_box { float pc[3], h[3], p0c[3], J[3]; } leaf_box;
 
-/* The samples (bits as a mask's) triangle t may block for some receiver of box b, in cand (mw words); its
- * groups are returned (0: the triangle blocks no sample of any of them). */
-static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const tri_job *t, uint64_t *cand)
+/* The bound's terms per edge function of a job's triangles (leaf_setup) and the sum's. */
+typedef struct leaf_fn {
+    float e[4][3], s[3];      /* E_c's coefficients (as hpc_footprint's), the slacks */
+    float gst[3][3][3];       /* per function: g at the grid's origin, per column, per row */
+    float ufix[4], uspan[3];  /* per function: U's terms that do not depend on the group */
+} leaf_fn;
+
+/* leaf_fn of the nt triangles of job t for box b: the three functions of both triangles in the lanes, each
+ * lane the arithmetic the comments above give (IEEE per lane, as everywhere in lanes16.h). */
+static void leaf_setup(const shared *sh, const leaf_box *b, const tri_job *t, int nt, leaf_fn *out)
 {
-    const int k = sh->k, gs = sh->gs, rows = LANES / gs;
+    const int k = sh->k, gs = sh->gs;
     const float *ds = sh->grid_ds, *dt = sh->grid_dt;
-    float w[3], hmax = 0.0f, dmax = 0.0f, S = 0.0f, Y[3][3], nY[3];
+    float w[3], hmax = 0.0f, dmax = 0.0f, S = 0.0f;
     for (int a = 0; a < 3; a++) {
         w[a] = b->p0c[a] - b->pc[a];
         hmax = ms_maxf(hmax, b->h[a]);
@@ -694,46 +702,86 @@ static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const tri_jo
         S = ms_maxf(S, fabsf(b->p0c[a]) + b->J[a] + ext + fabsf(b->pc[a]) + b->h[a]);
     }
     const float rel = 2.0f * 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));
-    for (int v = 0; v < 3; v++) {
-        for (int a = 0; a < 3; a++) Y[v][a] = t->v[3 * v + a] - b->pc[a];
-        nY[v] = inf_norm3(Y[v]) + hmax;
-    }
     static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A (footprint_setup) */
-    float e[4][3], s[3], gst[3][3][3], ufix[4], uspan[3];   /* gst[e]: g at the grid's origin, per column, per row */
-    float Xs[3] = { 0.0f, 0.0f, 0.0f };
-    for (int f = 0; f < 3; f++) {
-        const float *y1 = Y[pair[f][0]], *y2 = Y[pair[f][1]];
-        float X[3], D[3], Dw[3], Dds[3], Ddt[3];
-        v3_cross(X, y1, y2);
-        e[f][0] = v3_dot(X, w);
-        e[f][1] = v3_dot(X, ds);
-        e[f][2] = v3_dot(X, dt);
-        s[f] = rel * nY[pair[f][0]] * nY[pair[f][1]];
-        for (int a = 0; a < 3; a++) { D[a] = y2[a] - y1[a]; Xs[a] += X[a]; }
-        v3_cross(Dw, D, w);
-        v3_cross(Dds, D, ds);
-        v3_cross(Ddt, D, dt);
-        float jx = 0.0f, kx = 0.0f, sp = 0.0f;
-        for (int a = 0; a < 3; a++) {
-            const int a1 = (a + 1) % 3, a2 = (a + 2) % 3;
-            gst[f][0][a] = -(X[a] + Dw[a]);
-            gst[f][1][a] = -Dds[a];
-            gst[f][2][a] = -Ddt[a];
-            jx += fabsf(X[a]) * b->J[a];
-            kx += b->h[a] * (fabsf(D[a1]) * b->J[a2] + fabsf(D[a2]) * b->J[a1]);
-            sp += b->h[a] * (fabsf(Dds[a]) + fabsf(Ddt[a]));
+    float y1[3][LANES] = { { 0 } }, y2[3][LANES] = { { 0 } }, n12[LANES] = { 0 };
+    for (int u = 0; u < nt; u++) {
+        float Y[3][3], nY[3];
+        for (int v = 0; v < 3; v++) {
+            for (int a = 0; a < 3; a++) Y[v][a] = t[u].v[3 * v + a] - b->pc[a];
+            nY[v] = inf_norm3(Y[v]) + hmax;
         }
-        /* the rounding of g's terms (X + D x w may cancel) and of their affine sums, 20 u of the magnitudes */
-        float mag = fabsf(X[0]) + fabsf(X[1]) + fabsf(X[2]);
-        const float nD = fabsf(D[0]) + fabsf(D[1]) + fabsf(D[2]);
-        for (int a = 0; a < 3; a++) mag += 2.0f * nD * (fabsf(w[a]) + (float)k * (fabsf(ds[a]) + fabsf(dt[a])));
-        ufix[f] = jx + kx + 1.2e-6f * mag * (b->h[0] + b->h[1] + b->h[2]);
-        uspan[f] = 0.5f * (float)(gs - 1) * sp;
+        for (int f = 0; f < 3; f++) {
+            const int l = 3 * u + f;
+            for (int a = 0; a < 3; a++) { y1[a][l] = Y[pair[f][0]][a]; y2[a][l] = Y[pair[f][1]][a]; }
+            n12[l] = nY[pair[f][0]] * nY[pair[f][1]];
+        }
     }
-    for (int c = 0; c < 3; c++) e[3][c] = e[0][c] + e[1][c] + e[2][c];
-    ufix[3] = 0.0f;
-    for (int a = 0; a < 3; a++) ufix[3] += fabsf(Xs[a]) * (b->J[a] + b->h[a]);
-    ufix[3] *= 1.001f;
+    l16 Y1[3], Y2[3], X[3], D[3], Dw[3], Dds[3], Ddt[3];
+    for (int a = 0; a < 3; a++) { Y1[a] = l16_load(y1[a]); Y2[a] = l16_load(y2[a]); D[a] = l16_sub(Y2[a], Y1[a]); }
+    const l16 W[3] = { l16_set1(w[0]), l16_set1(w[1]), l16_set1(w[2]) };
+    const l16 DS[3] = { l16_set1(ds[0]), l16_set1(ds[1]), l16_set1(ds[2]) }, DT[3] = { l16_set1(dt[0]), l16_set1(dt[1]), l16_set1(dt[2]) };
+#define HPC_CROSS16(r, x, y)                                                                   \
+    (r[0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1])),                                 \
+     r[1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2])),                                 \
+     r[2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0])))
+#define HPC_DOT16(x, y) l16_add(l16_add(l16_mul(x[0], y[0]), l16_mul(x[1], y[1])), l16_mul(x[2], y[2]))
+    HPC_CROSS16(X, Y1, Y2);
+    HPC_CROSS16(Dw, D, W);
+    HPC_CROSS16(Dds, D, DS);
+    HPC_CROSS16(Ddt, D, DT);
+    float E0[LANES], E1[LANES], E2[LANES], SL[LANES], G[3][3][LANES], UF[LANES], US[LANES], XA[3][LANES];
+    l16_store(E0, HPC_DOT16(X, W));
+    l16_store(E1, HPC_DOT16(X, DS));
+    l16_store(E2, HPC_DOT16(X, DT));
+#undef HPC_CROSS16
+#undef HPC_DOT16
+    l16_store(SL, l16_mul(l16_set1(rel), l16_load(n12)));
+    const l16 zero = l16_set1(0.0f);
+    l16 jx = zero, kx = zero, sp = zero, mag = l16_add(l16_add(l16_abs(X[0]), l16_abs(X[1])), l16_abs(X[2]));
+    const l16 nD = l16_add(l16_add(l16_abs(D[0]), l16_abs(D[1])), l16_abs(D[2]));
+    for (int a = 0; a < 3; a++) {
+        const int a1 = (a + 1) % 3, a2 = (a + 2) % 3;
+        l16_store(G[0][a], l16_sub(zero, l16_add(X[a], Dw[a])));
+        l16_store(G[1][a], l16_sub(zero, Dds[a]));
+        l16_store(G[2][a], l16_sub(zero, Ddt[a]));
+        l16_store(XA[a], X[a]);
+        const l16 h = l16_set1(b->h[a]);
+        jx = l16_add(jx, l16_mul(l16_abs(X[a]), l16_set1(b->J[a])));
+        kx = l16_add(kx, l16_mul(h, l16_add(l16_mul(l16_abs(D[a1]), l16_set1(b->J[a2])), l16_mul(l16_abs(D[a2]), l16_set1(b->J[a1])))));
+        sp = l16_add(sp, l16_mul(h, l16_add(l16_abs(Dds[a]), l16_abs(Ddt[a]))));
+        /* the rounding of g's terms (X + D x w may cancel) and of their affine sums: 20 u of the magnitudes */
+        mag = l16_add(mag, l16_mul(l16_mul(l16_set1(2.0f), nD), l16_set1(fabsf(w[a]) + (float)k * (fabsf(ds[a]) + fabsf(dt[a])))));
+    }
+    l16_store(UF, l16_add(l16_add(jx, kx), l16_mul(l16_set1(1.2e-6f * (b->h[0] + b->h[1] + b->h[2])), mag)));
+    l16_store(US, l16_mul(l16_set1(0.5f * (float)(gs - 1)), sp));
+    for (int u = 0; u < nt; u++) {
+        leaf_fn *o = &out[u];
+        float Xs[3] = { 0.0f, 0.0f, 0.0f };
+        for (int f = 0; f < 3; f++) {
+            const int l = 3 * u + f;
+            o->e[f][0] = E0[l];
+            o->e[f][1] = E1[l];
+            o->e[f][2] = E2[l];
+            o->s[f] = SL[l];
+            for (int q = 0; q < 3; q++)
+                for (int a = 0; a < 3; a++) o->gst[f][q][a] = G[q][a][l];
+            o->ufix[f] = UF[l];
+            o->uspan[f] = US[l];
+            for (int a = 0; a < 3; a++) Xs[a] += XA[a][l];
+        }
+        for (int c = 0; c < 3; c++) o->e[3][c] = o->e[0][c] + o->e[1][c] + o->e[2][c];
+        o->ufix[3] = 0.0f;
+        for (int a = 0; a < 3; a++) o->ufix[3] += fabsf(Xs[a]) * (b->J[a] + b->h[a]);
+        o->ufix[3] *= 1.001f;
+    }
+}
+
+/* The samples (bits as a mask's) a triangle (its leaf_fn) may block for some receiver of box b, in cand (mw
+ * words); its groups are returned (0: the triangle blocks no sample of any of them). */
+static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_fn *fn, uint64_t *cand)
+{
+    const int k = sh->k, gs = sh->gs, rows = LANES / gs;
+    const float (*e)[3] = fn->e, *s = fn->s, *ufix = fn->ufix, *uspan = fn->uspan;
     /* the groups: each function at each group's first sample, its change over the group, +- U */
     float base[4][64], U[3][64];
     uint64_t groups = 0;
@@ -749,8 +797,8 @@ static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const tri_jo
             if (f < 3) {
                 l16 acc = l16_set1(ufix[f] + uspan[f]);
                 for (int a = 0; a < 3; a++) {
-                    const l16 ga = l16_add(l16_add(l16_set1(gst[f][0][a]), l16_mul(l16_set1(gst[f][1][a]), ci)),
-                                           l16_mul(l16_set1(gst[f][2][a]), cj));
+                    const l16 ga = l16_add(l16_add(l16_set1(fn->gst[f][0][a]), l16_mul(l16_set1(fn->gst[f][1][a]), ci)),
+                                           l16_mul(l16_set1(fn->gst[f][2][a]), cj));
                     acc = l16_add(acc, l16_mul(l16_abs(ga), l16_set1(b->h[a])));
                 }
                 u = l16_mul(acc, l16_set1(1.001f));
@@ -1297,9 +1345,11 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             bx.J[a] = ms_maxf(ohi - bx.p0c[a], bx.p0c[a] - olo) * 1.000001f;
             if (sh->sw & MS_HPC_BREAK_LEAF_BOUND) bx.h[a] = bx.J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
         }
+        leaf_fn fn[2];
+        leaf_setup(sh, &bx, t, nt, fn);
         for (int u = 0; u < nt; u++) {
             if (!(act & on[u])) continue;
-            ngroups[u] = leaf_footprint(sh, &bx, &t[u], ncand[u]);
+            ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
             if (!ngroups[u]) { on[u] = 0; c->cnt[C_LEAF_CULLS]++; }
         }
         act &= on[0] | on[1];
@@ -1343,25 +1393,35 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
      * per receiver, the footprint_lanes arithmetic with the sample's own indices), giving each receiver its
      * samples: the work per leaf follows the samples left, which fall as the leaves shrink with resolution. */
     const int mw = sh->mw;
-    uint64_t rc[2][LANES][64];
+    uint64_t rc[2][LANES][64], rg[2][LANES];   /* per triangle and lane: the receiver's samples, their groups */
     unsigned has[2] = { 0u, 0u };
     if (leaf_fp)
         for (int u = 0; u < nt; u++) {
             const unsigned lanes_on = act & on[u];
             if (!lanes_on) continue;
-            for (unsigned m = lanes_on; m; m &= m - 1) memset(rc[u][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
+            for (unsigned m = lanes_on; m; m &= m - 1) {
+                memset(rc[u][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
+                rg[u][__builtin_ctz(m)] = 0;
+            }
             l16 c0[4], c1[4], c2[4], sl[3];
             for (int e = 0; e < 4; e++) { c0[e] = l16_load(fe[u][e][0]); c1[e] = l16_load(fe[u][e][1]); c2[e] = l16_load(fe[u][e][2]); }
             for (int e = 0; e < 3; e++) sl[e] = l16_load(fs[u][e]);
             for (int wd = 0; wd < mw; wd++)
                 for (uint64_t bits = ncand[u][wd]; bits; bits &= bits - 1) {
-                    const int sidx = 64 * wd + __builtin_ctzll(bits);
-                    const l16 fi = l16_set1((float)(sidx % sh->k)), fj = l16_set1((float)(sidx / sh->k));
+                    const int bit = __builtin_ctzll(bits), sidx = 64 * wd + bit;
+                    /* k = 16, 32 or 64 (sh->gs), so a word holds whole rows */
+                    const l16 fi = l16_set1(sh->bit_i[bit]), fj = l16_set1((float)(64 / sh->k * wd) + sh->bit_j[bit]);
                     l16 E[4];
                     for (int e = 0; e < 4; e++) E[e] = l16_add(l16_add(c0[e], l16_mul(c1[e], fi)), l16_mul(c2[e], fj));
                     const unsigned hitl = footprint_keep16(E, sl) & lanes_on;
+                    if (!hitl) continue;
                     has[u] |= hitl;
-                    for (unsigned h2 = hitl; h2; h2 &= h2 - 1) rc[u][__builtin_ctz(h2)][wd] |= UINT64_C(1) << (sidx & 63);
+                    const int gk = (sidx / sh->k / sh->gs) * (sh->k / sh->gs) + (sidx % sh->k) / sh->gs;
+                    for (unsigned h2 = hitl; h2; h2 &= h2 - 1) {
+                        const int l = __builtin_ctz(h2);
+                        rc[u][l][wd] |= UINT64_C(1) << bit;
+                        rg[u][l] |= UINT64_C(1) << gk;
+                    }
                 }
         }
     for (unsigned m = leaf_fp ? act & (has[0] | has[1]) : act; m; m &= m - 1) {
@@ -1377,7 +1437,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             view.t[x] = &t[u];
             if (leaf_fp) {
                 view.ncand[x] = rc[u][l];
-                view.ngroups |= ngroups[u];
+                view.ngroups |= rg[u][l];
                 continue;
             }
             for (int e = 0; e < 4; e++)
@@ -1627,6 +1687,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         sh.group_i0[g] = (float)(g % (k / sh.gs) * sh.gs);
         sh.group_j0[g] = (float)(g / (k / sh.gs) * sh.gs);
     }
+    for (int b = 0; b < 64; b++) { sh.bit_i[b] = (float)(b % k); sh.bit_j[b] = (float)(b / k); }
     sh.footprint = !scanline && !(sh.sw & MS_HPC_OFF_FOOTPRINT);
     sh.all_groups = sh.G == 64 ? UINT64_MAX : (UINT64_C(1) << sh.G) - 1u;
     sh.npk = k * k / LANES;
