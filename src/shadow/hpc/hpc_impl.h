@@ -1343,7 +1343,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             bx.h[a] = ms_maxf(phi - bx.pc[a], bx.pc[a] - plo) * 1.000001f;
             bx.p0c[a] = 0.5f * (olo + ohi);
             bx.J[a] = ms_maxf(ohi - bx.p0c[a], bx.p0c[a] - olo) * 1.000001f;
-            if (sh->sw & MS_HPC_BREAK_LEAF_BOUND) bx.h[a] = bx.J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
+            if (sh->sw & MS_HPC_BREAK_LEAF_BOUND) bx.J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
         }
         leaf_fn fn[2];
         leaf_setup(sh, &bx, t, nt, fn);
