@@ -56,6 +56,13 @@
  *    for hpc-scanline (whose Scanline kernel the slack does not bound) and under MS_HPC_OFF_FOOTPRINT.
  *    A leaf's points (up to 16 for hpc) take the point-in-V_L test and the footprint set-up 16 at a time,
  *    and the receivers are renumbered in hierarchy order so that a leaf's data lie together in memory.
+ *  - hpc bounds the footprint over a whole leaf (below, "the leaf footprint"): per light sample, over every
+ *    receiver position in the leaf's box and every grid origin in its origins' box, with a proven bound and
+ *    the footprint's slack. The samples it leaves (at 1024^2 on a GRIDS-like scene ~11 of 256 per leaf and
+ *    triangle, fewer as the leaves shrink with resolution) are then tested for the leaf's receivers 16 at a
+ *    time, so receivers whose footprint holds none of them cost no per-receiver work. The paper's nodes cull
+ *    whole light groups with V_Gk; a leaf's group of samples is rarely empty here because every pixel has
+ *    its own jittered grid (the paper used 8 sample sets), so the leaf works at the sample level instead.
  *  - hpc casts two triangles that share an edge and a plane (a box's face, a mesh's quad) as one job
  *    (pair_batch): one traversal, one V_L of their four points (hpc_volume_build_points), one per-receiver
  *    loop over the groups and blocks, where each triangle's footprint keeps its own lanes and each triangle's
@@ -200,6 +207,9 @@ typedef struct chunk {
     hpc_volume gvol[64];
     int gvol_built;
     uint64_t cnt[C_COUNT];
+    uint32_t lf_leaves, lf_in, lf_kept, lf_cands;   /* leaves that could use the leaf footprint; of those cast
+                                                     * with it, the receivers, of those the ones with samples
+                                                     * left, and the samples the leaf left (leaf_fp_pays) */
     int failed;
 } chunk;
 
@@ -1285,6 +1295,23 @@ static inline void spans16(l16 e1, l16 e2, l16 span, l16 zero, float *dlo, float
     l16_store(dhi, l16_add(l16_max(di, zero), l16_max(dj, zero)));
 }
 
+/* Whether the leaf footprint pays here, from this chunk's recent leaves cast with it (the counts halved as they
+ * grow, so that they follow the triangles of the moment): only while it has left at most LEAF_FP_KEEP of their
+ * receivers to the per-receiver work and at most LEAF_FP_CANDS samples per receiver to test in the lanes;
+ * one leaf in LEAF_FP_PROBE uses it regardless, to keep the counts current. Per chunk, so the same on every
+ * ISA and run. Measured (1024^2, the leaf footprint on every leaf): on a GRIDS-like scene's bars 58% of the
+ * receivers kept, 2.1 samples per receiver, and it pays; Dabrovic Sponza's large triangles leave 12.5 samples
+ * per receiver (76% kept), a scanned bunny's small ones keep 72% of the receivers (1.9 samples each): there
+ * it cost 20-25%. */
+#define LEAF_FP_PROBE 64u
+#define LEAF_FP_KEEP 0.75f
+#define LEAF_FP_CANDS 6.0f
+static inline int leaf_fp_pays(chunk *c)
+{
+    if (c->lf_leaves++ % LEAF_FP_PROBE == 0) return 1;
+    return (float)c->lf_kept <= LEAF_FP_KEEP * (float)c->lf_in && (float)c->lf_cands <= LEAF_FP_CANDS * (float)c->lf_in;
+}
+
 /* The points of a leaf inside V_L against a job (a triangle, or a pair: pair_batch) with the footprint test,
  * 16 receivers per operation (departure: the paper handles a leaf's points one by one): the point-in-V_L test
  * (POINT-IN-VOLUME, the same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per
@@ -1325,7 +1352,10 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act & on[0]) + (uint64_t)__builtin_popcount(act & on[1]);
     /* the leaf footprint over the receivers left (their box and their grid origins' box) */
     uint64_t ncand[2][64], ngroups[2] = { ~UINT64_C(0), ~UINT64_C(0) };
-    const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) && __builtin_popcount(act) >= LEAF_FP_MIN;
+    /* pairs only: a lone triangle's set-up is shared by half as much work (measured on a scanned bunny, whose
+     * triangles are 91% alone: it cost 5% there even with leaf_fp_pays) */
+    const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) && nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN &&
+                        leaf_fp_pays(c);
     if (leaf_fp) {
         leaf_box bx;
         for (int a = 0; a < 3; a++) {
@@ -1424,6 +1454,13 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
                     }
                 }
         }
+    if (leaf_fp) {
+        c->lf_in += (uint32_t)__builtin_popcount(act);
+        c->lf_kept += (uint32_t)__builtin_popcount(act & (has[0] | has[1]));
+        for (int u = 0; u < nt; u++)
+            for (int wd = 0; wd < mw; wd++) c->lf_cands += (uint32_t)__builtin_popcountll(ncand[u][wd]);
+        if (c->lf_in > 4096u) { c->lf_in >>= 1; c->lf_kept >>= 1; c->lf_cands >>= 1; }   /* the recent leaves count */
+    }
     for (unsigned m = leaf_fp ? act & (has[0] | has[1]) : act; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         const uint32_t r = rr[l];
