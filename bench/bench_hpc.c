@@ -96,7 +96,7 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ","))
                 for (int m = 0; m < NM; m++) run[m] |= !strcmp(t, methods[m]);
         } else if (!strcmp(argv[first], "--off")) {
-            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp" };
+            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule" };
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ",")) {
                 int found = 0;
                 for (int b = 0; b < (int)(sizeof names / sizeof *names); b++)

@@ -57,8 +57,10 @@ enum {
     MS_HPC_OFF_FOOTPRINT = 128,  /* hpc's footprint test (hpc_impl.h): the group volumes V_Gk, as the paper */
     MS_HPC_OFF_PAIRS = 256,      /* hpc's pairs (pair_batch, hpc_impl.h): every triangle cast alone */
     MS_HPC_OFF_LEAF_FOOTPRINT = 512, /* hpc's leaf footprint (hpc_impl.h): every receiver's own footprint only */
-    MS_HPC_BREAK_LEAF_BOUND = 1024   /* not a measurement: the leaf footprint without its bound over the leaf
-                                      * (wrong on purpose), so that test_hpc can show its scene depends on it */
+    MS_HPC_ALL_LEAF_FOOTPRINT = 1024, /* the leaf footprint rule off: on every leaf, not only where it pays (leaf_fp_pays) */
+    MS_HPC_BREAK_LEAF_BOUND = 2048   /* not a measurement: the leaf footprint without its bound over the leaf's
+                                      * grid origins (wrong on purpose), so that test_hpc can show its scene
+                                      * depends on it */
 };
 extern int ms_hpc_switches;
 

@@ -1354,8 +1354,9 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     uint64_t ncand[2][64], ngroups[2] = { ~UINT64_C(0), ~UINT64_C(0) };
     /* pairs only: a lone triangle's set-up is shared by half as much work (measured on a scanned bunny, whose
      * triangles are 91% alone: it cost 5% there even with leaf_fp_pays) */
-    const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) && nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN &&
-                        leaf_fp_pays(c);
+    const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) &&
+                        ((sh->sw & MS_HPC_ALL_LEAF_FOOTPRINT) ||
+                         (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c)));
     if (leaf_fp) {
         leaf_box bx;
         for (int a = 0; a < 3; a++) {
