@@ -63,6 +63,7 @@
  *    time, so receivers whose footprint holds none of them cost no per-receiver work. The paper's nodes cull
  *    whole light groups with V_Gk; a leaf's group of samples is rarely empty here because every pixel has
  *    its own jittered grid (the paper used 8 sample sets), so the leaf works at the sample level instead.
+ *    Used for pairs only, and only where a chunk's recent leaves show it pays (leaf_fp_pays; docs/hpc.md).
  *  - hpc casts two triangles that share an edge and a plane (a box's face, a mesh's quad) as one job
  *    (pair_batch): one traversal, one V_L of their four points (hpc_volume_build_points), one per-receiver
  *    loop over the groups and blocks, where each triangle's footprint keeps its own lanes and each triangle's
