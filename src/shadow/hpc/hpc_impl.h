@@ -683,8 +683,10 @@ static void footprint_offsets(const hpc_footprint *f, l16 oi, l16 oj, l16 off[4]
  * footprint_keep then rules a sample out for every receiver of the leaf when E_c - U and E_c + U (E_c = X . x')
  * are beyond the slacks. The slack is the footprint test's for a receiver anywhere in the box with an origin
  * anywhere in its box (|Y - p|inf <= |Y1|inf + |h|inf, dmax and S over both boxes), taken twice: it covers the
- * exact test's rounding as the per-receiver footprint's does, and this bound's own evaluation (E_c is the
- * footprint's arithmetic at pc; U is a sum of non-negative terms, rounded up by 1e-3 of itself). So no sample
+ * exact test's rounding as the per-receiver footprint's does, the exact test's vertices being v - p rounded
+ * (u of them: at most 12 u |Y1| |Y2| dmax in E, where the bound above is for v - p exact), and this bound's own
+ * evaluation (E_c is the footprint's arithmetic at pc; U is a sum of non-negative terms, rounded up by 1e-3 of
+ * itself, plus 20 u of the magnitudes of g's terms, which may cancel). So no sample
  * the exact test blocks for any receiver of the leaf is ever ruled out. What it buys: a leaf whose triangle
  * covers no sample of any receiver (a thin bar whose shadow passes between the sample rows of the leaf's
  * receivers) is dropped with one test instead of one footprint per receiver, and the candidate samples of
