@@ -561,7 +561,7 @@ MS_API const char *const *ms_method_names(void);
 /* 1 if `name` is a known method compiled into this build, 0 if unknown, -1 if known but not compiled in. */
 MS_API int ms_method_available(const char *name);
 
-#define MS_MAX_COUNTERS 24
+#define MS_MAX_COUNTERS 32
 
 typedef struct ms_stats {
     size_t triangles;

@@ -259,7 +259,7 @@ static void test_isa_instances_and_switches(void **st)
             ran++;
         }
         assert_true(ran >= 1);
-        for (int sw = 1; sw <= MS_HPC_OFF_PAIRS; sw <<= 1) {
+        for (int sw = 1; sw <= MS_HPC_ALL_LEAF_FOOTPRINT; sw <<= 1) {
             perm_source ps2 = { &bvh, area, nt, 0 };
             const hpc_source src = { &ps2, perm_rewind, perm_next };
             uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
@@ -270,7 +270,7 @@ static void test_isa_instances_and_switches(void **st)
             assert_memory_equal(vis, ref, n * mw * sizeof *vis);
         }
         printf("k=%d: %zu points, %d ISA instances equal to raytrace and to each other (masks, counters: %llu sample "
-               "tests); 9 switches equal\n", k, n, ran, (unsigned long long)cnt0[9]);
+               "tests); 11 switches equal\n", k, n, ran, (unsigned long long)cnt0[9]);
         free(front); free(ref); free(vis); free(pts); free(q); free(hits);
     }
     free(area);
@@ -324,7 +324,10 @@ static const char *flowers_json(const char *dir, const char *name, const char *p
  * cell: the samples lie within ulps of the triangles' edges far more often than on the shared scenes, so
  * hpc's footprint test (hpc_impl.h) must keep every sample raytrace's rounding may call blocked (with its
  * slack set to 0, pixels differ here), and half the bars' triangles face away from the light (the
- * closed-component cull, which must leave V and S as they are). */
+ * closed-component cull, which must leave V and S as they are). The leaf footprint (hpc_impl.h) rules out
+ * samples for a whole leaf of receivers at once; its bound over the leaf's grid origins (which differ per
+ * pixel) matters here: without it (MS_HPC_BREAK_LEAF_BOUND, wrong on purpose) pixels differ, so the scene
+ * shows a bound that misses what raytrace blocks. */
 static void test_bars(void **st)
 {
     (void)st;
@@ -385,6 +388,32 @@ static void test_bars(void **st)
     const uint64_t culled = hpc_equals(&sc, "bars", 256, 96, &ref);
     printf("bars: %llu of %zu triangles left out by the closed-component cull\n", (unsigned long long)culled, sc.n_tris);
     assert_true(culled > 0);
+    /* the leaf footprint on every leaf equals raytrace, works here (leaves ruled out, pairs kept from the
+     * per-receiver work), and without its bound over the grid origins the answer is wrong */
+    ms_hpc_switches = MS_HPC_ALL_LEAF_FOOTPRINT;
+    hpc_equals(&sc, "bars, leaf fp", 256, 96, &ref);
+    ms_frame f;
+    render_ok(&sc, "hpc", 256, 96, 0, &f);
+    ms_hpc_switches = 0;
+    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0;
+    for (int c = 0; c < f.stats.n_counters; c++) {
+        if (!strcmp(f.stats.counter_name[c], "pairs_in_vl")) in_vl = f.stats.counter[c];
+        if (!strcmp(f.stats.counter_name[c], "pairs_footprint")) to_fp = f.stats.counter[c];
+        if (!strcmp(f.stats.counter_name[c], "leaf_culls")) leaf_culls = f.stats.counter[c];
+    }
+    ms_frame_free(&f);
+    ms_hpc_switches = MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_LEAF_BOUND;
+    render_ok(&sc, "hpc", 256, 96, 0, &f);
+    ms_hpc_switches = 0;
+    long differ = 0;
+    for (long i = 0; i < 96L * 96L; i++) differ += memcmp(&f.vis[i], &ref.vis[i], sizeof(float)) != 0;
+    ms_frame_free(&f);
+    printf("bars: leaf footprint: %llu of %llu pairs in V_L to the per-receiver test, %llu (leaf, triangle) ruled "
+           "out; without its bound over the grid origins %ld pixels differ\n", (unsigned long long)to_fp,
+           (unsigned long long)in_vl, (unsigned long long)leaf_culls, differ);
+    assert_true(leaf_culls > 0);
+    assert_true(to_fp < in_vl);
+    assert_true(differ > 0);
     ms_frame_free(&ref);
     ms_scene_free(&sc);
 }

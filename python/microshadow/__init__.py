@@ -20,7 +20,7 @@ __all__ = ["Error", "Scene", "Accel", "load", "default_scene", "visibility_point
            "method_names", "light_irradiance", "__version__"]
 
 MAX_UV_SETS = 4
-MAX_COUNTERS = 24
+MAX_COUNTERS = 32
 NO_TRIANGLE = 0xFFFFFFFF
 
 

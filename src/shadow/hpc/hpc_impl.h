@@ -56,6 +56,14 @@
  *    for hpc-scanline (whose Scanline kernel the slack does not bound) and under MS_HPC_OFF_FOOTPRINT.
  *    A leaf's points (up to 16 for hpc) take the point-in-V_L test and the footprint set-up 16 at a time,
  *    and the receivers are renumbered in hierarchy order so that a leaf's data lie together in memory.
+ *  - hpc bounds the footprint over a whole leaf (below, "the leaf footprint"): per light sample, over every
+ *    receiver position in the leaf's box and every grid origin in its origins' box, with a proven bound and
+ *    the footprint's slack. The samples it leaves (at 1024^2 on a GRIDS-like scene ~11 of 256 per leaf and
+ *    triangle, fewer as the leaves shrink with resolution) are then tested for the leaf's receivers 16 at a
+ *    time, so receivers whose footprint holds none of them cost no per-receiver work. The paper's nodes cull
+ *    whole light groups with V_Gk; a leaf's group of samples is rarely empty here because every pixel has
+ *    its own jittered grid (the paper used 8 sample sets), so the leaf works at the sample level instead.
+ *    Used for pairs only, and only where a chunk's recent leaves show it pays (leaf_fp_pays; docs/hpc.md).
  *  - hpc casts two triangles that share an edge and a plane (a box's face, a mesh's quad) as one job
  *    (pair_batch): one traversal, one V_L of their four points (hpc_volume_build_points), one per-receiver
  *    loop over the groups and blocks, where each triangle's footprint keeps its own lanes and each triangle's
@@ -118,6 +126,9 @@
 #define MEDIAN_BELOW_DEPTH 40     /* median splits from here: depth at most 40 + log2(points) */
 #define BATCH 16384               /* triangles read and prepared together */
 #define EDGE_ON 1e-3f             /* as microraster.c */
+#ifndef LEAF_FP_MIN
+#define LEAF_FP_MIN 6
+#endif
 #define LANES 16                  /* the reference tracer's packet width (raytrace_impl.h) */
 
 enum {
@@ -128,6 +139,8 @@ enum {
      * memory by kind (bytes allocated at the peak). */
     C_SORT_US, C_BUILD_US, C_REBUILD_THREAD_US, C_CAST_US, C_SAMPLE_BYTES, C_HIERARCHY_BYTES, C_MASK_BYTES,
     C_PAIRS_IN_VL,   /* (receiver, triangle) pairs past the point-in-V_L test: the work the samples' tests start from */
+    C_PAIRS_FOOTPRINT,   /* of those, the pairs that reach the per-receiver footprint (past the leaf footprint) */
+    C_LEAF_CULLS,        /* (leaf, triangle) pairs the leaf footprint rules out for every receiver of the leaf */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -162,6 +175,7 @@ typedef struct shared {
     double light_poly[12];
     double group_poly[64][12];
     float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
+    float bit_i[64], bit_j[64];      /* bit b of a mask word: its sample's column, and its row from the word's first */
     int footprint;                   /* hpc (not hpc-scanline) with the footprint test: no V_Gk */
     int pairs;                       /* footprint with p0: triangles sharing an edge cast in pairs (pair_batch) */
     float grid_ds[3], grid_dt[3];    /* the grid's steps, the same for every pixel (pattern.c) */
@@ -194,6 +208,9 @@ typedef struct chunk {
     hpc_volume gvol[64];
     int gvol_built;
     uint64_t cnt[C_COUNT];
+    uint32_t lf_leaves, lf_in, lf_kept, lf_cands;   /* leaves that could use the leaf footprint; of those cast
+                                                     * with it, the receivers, of those the ones with samples
+                                                     * left, and the samples the leaf left (leaf_fp_pays) */
     int failed;
 } chunk;
 
@@ -601,6 +618,19 @@ static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const fl
     return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
 }
 
+/* footprint_keep with a slack per lane (16 receivers' functions at one sample). */
+static inline unsigned footprint_keep16(const l16 E[4], const l16 s[3])
+{
+    const l16 s2 = l16_mul(l16_set1(2.0f), l16_add(l16_add(s[0], s[1]), s[2]));
+    const unsigned up = l16_gt(E[3], s2), down = l16_lt(E[3], l16_sub(l16_set1(0.0f), s2));
+    unsigned pos = 0, neg = 0;
+    for (int e = 0; e < 3; e++) {
+        pos |= l16_gt(E[e], s[e]);
+        neg |= l16_lt(E[e], l16_sub(l16_set1(0.0f), s[e]));
+    }
+    return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
+}
+
 /* The groups (bit gk) whose samples the footprint may hold, bounding each edge function over the group's
  * gs x gs samples (16 groups per operation). base: each function at each group's first sample, [e][gk]. */
 static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f, float base[4][64])
@@ -635,6 +665,197 @@ static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0
 static void footprint_offsets(const hpc_footprint *f, l16 oi, l16 oj, l16 off[4])
 {
     for (int e = 0; e < 4; e++) off[e] = l16_add(l16_mul(l16_set1(f->e[e][1]), oi), l16_mul(l16_set1(f->e[e][2]), oj));
+}
+
+/* ---- the leaf footprint (hpc: the footprint test bounded over a whole leaf) ----
+ *
+ * Departure from the paper (whose group volumes V_Gk cull whole light groups at a node): the footprint test's
+ * edge functions bounded over every receiver of a leaf at once, per light sample. The leaf's receivers lie in
+ * a box (centre pc, half extents h) and their grid origins in a box (centre p0c, half extents J); all share
+ * the grid's steps ds, dt. For receiver p = pc + q and origin p0 = p0c + j, with Y1, Y2 an edge's vertices
+ * relative to pc and x' = w + i ds + j dt (w = p0c - pc) the sample relative to pc, the edge function
+ * E = det(Y1 - q, Y2 - q, x' + j - q) is affine in q and in the sample, so, exactly in reals,
+ *     E = X . x' + X . j + g(i, j) . q - q . (D x j),   X = Y1 x Y2, D = Y2 - Y1, g = -(X + D x x'),
+ * and |E - X . x'| <= sum_c h_c |g_c(i, j)| + sum_c |X_c| J_c + sum_c h_c (|D_c+1| J_c+2 + |D_c+2| J_c+1).
+ * g is affine in (i, j), so over a group of gs x gs samples |g_c| <= |g_c(centre)| + (gs-1)/2 (|g_1c| + |g_2c|)
+ * (g_1, g_2 its steps): one bound U per function and group. The sum of the three functions (the side of the
+ * triangle's plane) is Xs . (x' + j - q), Xs = the sum of the X: its bound is sum_c |Xs_c| (J_c + h_c).
+ * footprint_keep then rules a sample out for every receiver of the leaf when E_c - U and E_c + U (E_c = X . x')
+ * are beyond the slacks. The slack is the footprint test's for a receiver anywhere in the box with an origin
+ * anywhere in its box (|Y - p|inf <= |Y1|inf + |h|inf, dmax and S over both boxes), taken twice: it covers the
+ * exact test's rounding as the per-receiver footprint's does, the exact test's vertices being v - p rounded
+ * (u of them: at most 12 u |Y1| |Y2| dmax in E, where the bound above is for v - p exact), and this bound's own
+ * evaluation (E_c is the footprint's arithmetic at pc; U is a sum of non-negative terms, rounded up by 1e-3 of
+ * itself, plus 20 u of the magnitudes of g's terms, which may cancel). So no sample
+ * the exact test blocks for any receiver of the leaf is ever ruled out. What it buys: a leaf whose triangle
+ * covers no sample of any receiver (a thin bar whose shadow passes between the sample rows of the leaf's
+ * receivers) is dropped with one test instead of one footprint per receiver, and the candidate samples of
+ * the others bound each receiver's groups and lanes. */
+typedef struct leaf_box { float pc[3], h[3], p0c[3], J[3]; } leaf_box;
+
+/* The bound's terms per edge function of a job's triangles (leaf_setup) and the sum's. */
+typedef struct leaf_fn {
+    float e[4][3], s[3];      /* E_c's coefficients (as hpc_footprint's), the slacks */
+    float gst[3][3][3];       /* per function: g at the grid's origin, per column, per row */
+    float ufix[4], uspan[3];  /* per function: U's terms that do not depend on the group */
+} leaf_fn;
+
+/* leaf_fn of the nt triangles of job t for box b: the three functions of both triangles in the lanes, each
+ * lane the arithmetic the comments above give (IEEE per lane, as everywhere in lanes16.h). */
+static void leaf_setup(const shared *sh, const leaf_box *b, const tri_job *t, int nt, leaf_fn *out)
+{
+    const int k = sh->k, gs = sh->gs;
+    const float *ds = sh->grid_ds, *dt = sh->grid_dt;
+    float w[3], hmax = 0.0f, dmax = 0.0f, S = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        w[a] = b->p0c[a] - b->pc[a];
+        hmax = ms_maxf(hmax, b->h[a]);
+        const float ext = (float)(k - 1) * (fabsf(ds[a]) + fabsf(dt[a]));
+        dmax = ms_maxf(dmax, fabsf(w[a]) + b->J[a] + b->h[a] + ext);
+        S = ms_maxf(S, fabsf(b->p0c[a]) + b->J[a] + ext + fabsf(b->pc[a]) + b->h[a]);
+    }
+    const float rel = 2.0f * 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));
+    static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A (footprint_setup) */
+    float y1[3][LANES] = { { 0 } }, y2[3][LANES] = { { 0 } }, n12[LANES] = { 0 };
+    for (int u = 0; u < nt; u++) {
+        float Y[3][3], nY[3];
+        for (int v = 0; v < 3; v++) {
+            for (int a = 0; a < 3; a++) Y[v][a] = t[u].v[3 * v + a] - b->pc[a];
+            nY[v] = inf_norm3(Y[v]) + hmax;
+        }
+        for (int f = 0; f < 3; f++) {
+            const int l = 3 * u + f;
+            for (int a = 0; a < 3; a++) { y1[a][l] = Y[pair[f][0]][a]; y2[a][l] = Y[pair[f][1]][a]; }
+            n12[l] = nY[pair[f][0]] * nY[pair[f][1]];
+        }
+    }
+    l16 Y1[3], Y2[3], X[3], D[3], Dw[3], Dds[3], Ddt[3];
+    for (int a = 0; a < 3; a++) { Y1[a] = l16_load(y1[a]); Y2[a] = l16_load(y2[a]); D[a] = l16_sub(Y2[a], Y1[a]); }
+    const l16 W[3] = { l16_set1(w[0]), l16_set1(w[1]), l16_set1(w[2]) };
+    const l16 DS[3] = { l16_set1(ds[0]), l16_set1(ds[1]), l16_set1(ds[2]) }, DT[3] = { l16_set1(dt[0]), l16_set1(dt[1]), l16_set1(dt[2]) };
+#define HPC_CROSS16(r, x, y)                                                                   \
+    (r[0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1])),                                 \
+     r[1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2])),                                 \
+     r[2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0])))
+#define HPC_DOT16(x, y) l16_add(l16_add(l16_mul(x[0], y[0]), l16_mul(x[1], y[1])), l16_mul(x[2], y[2]))
+    HPC_CROSS16(X, Y1, Y2);
+    HPC_CROSS16(Dw, D, W);
+    HPC_CROSS16(Dds, D, DS);
+    HPC_CROSS16(Ddt, D, DT);
+    float E0[LANES], E1[LANES], E2[LANES], SL[LANES], G[3][3][LANES], UF[LANES], US[LANES], XA[3][LANES];
+    l16_store(E0, HPC_DOT16(X, W));
+    l16_store(E1, HPC_DOT16(X, DS));
+    l16_store(E2, HPC_DOT16(X, DT));
+#undef HPC_CROSS16
+#undef HPC_DOT16
+    l16_store(SL, l16_mul(l16_set1(rel), l16_load(n12)));
+    const l16 zero = l16_set1(0.0f);
+    l16 jx = zero, kx = zero, sp = zero, mag = l16_add(l16_add(l16_abs(X[0]), l16_abs(X[1])), l16_abs(X[2]));
+    const l16 nD = l16_add(l16_add(l16_abs(D[0]), l16_abs(D[1])), l16_abs(D[2]));
+    for (int a = 0; a < 3; a++) {
+        const int a1 = (a + 1) % 3, a2 = (a + 2) % 3;
+        l16_store(G[0][a], l16_sub(zero, l16_add(X[a], Dw[a])));
+        l16_store(G[1][a], l16_sub(zero, Dds[a]));
+        l16_store(G[2][a], l16_sub(zero, Ddt[a]));
+        l16_store(XA[a], X[a]);
+        const l16 h = l16_set1(b->h[a]);
+        jx = l16_add(jx, l16_mul(l16_abs(X[a]), l16_set1(b->J[a])));
+        kx = l16_add(kx, l16_mul(h, l16_add(l16_mul(l16_abs(D[a1]), l16_set1(b->J[a2])), l16_mul(l16_abs(D[a2]), l16_set1(b->J[a1])))));
+        sp = l16_add(sp, l16_mul(h, l16_add(l16_abs(Dds[a]), l16_abs(Ddt[a]))));
+        /* the rounding of g's terms (X + D x w may cancel) and of their affine sums: 20 u of the magnitudes */
+        mag = l16_add(mag, l16_mul(l16_mul(l16_set1(2.0f), nD), l16_set1(fabsf(w[a]) + (float)k * (fabsf(ds[a]) + fabsf(dt[a])))));
+    }
+    l16_store(UF, l16_add(l16_add(jx, kx), l16_mul(l16_set1(1.2e-6f * (b->h[0] + b->h[1] + b->h[2])), mag)));
+    l16_store(US, l16_mul(l16_set1(0.5f * (float)(gs - 1)), sp));
+    for (int u = 0; u < nt; u++) {
+        leaf_fn *o = &out[u];
+        float Xs[3] = { 0.0f, 0.0f, 0.0f };
+        for (int f = 0; f < 3; f++) {
+            const int l = 3 * u + f;
+            o->e[f][0] = E0[l];
+            o->e[f][1] = E1[l];
+            o->e[f][2] = E2[l];
+            o->s[f] = SL[l];
+            for (int q = 0; q < 3; q++)
+                for (int a = 0; a < 3; a++) o->gst[f][q][a] = G[q][a][l];
+            o->ufix[f] = UF[l];
+            o->uspan[f] = US[l];
+            for (int a = 0; a < 3; a++) Xs[a] += XA[a][l];
+        }
+        for (int c = 0; c < 3; c++) o->e[3][c] = o->e[0][c] + o->e[1][c] + o->e[2][c];
+        o->ufix[3] = 0.0f;
+        for (int a = 0; a < 3; a++) o->ufix[3] += fabsf(Xs[a]) * (b->J[a] + b->h[a]);
+        o->ufix[3] *= 1.001f;
+    }
+}
+
+/* The samples (bits as a mask's) a triangle (its leaf_fn) may block for some receiver of box b, in cand (mw
+ * words); its groups are returned (0: the triangle blocks no sample of any of them). */
+static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_fn *fn, uint64_t *cand)
+{
+    const int k = sh->k, gs = sh->gs, rows = LANES / gs;
+    const float (*e)[3] = fn->e, *s = fn->s, *ufix = fn->ufix, *uspan = fn->uspan;
+    /* the groups: each function at each group's first sample, its change over the group, +- U */
+    float base[4][64], U[3][64];
+    uint64_t groups = 0;
+    const float half = 0.5f * (float)(gs - 1), span = (float)(gs - 1);
+    for (int g0 = 0; g0 < sh->G; g0 += LANES) {
+        const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
+        const l16 ci = l16_add(gi, l16_set1(half)), cj = l16_add(gj, l16_set1(half));
+        l16 lo[4], hi[4];
+        for (int f = 0; f < 4; f++) {
+            const l16 bs = l16_add(l16_add(l16_set1(e[f][0]), l16_mul(l16_set1(e[f][1]), gi)), l16_mul(l16_set1(e[f][2]), gj));
+            l16_store(base[f] + g0, bs);
+            l16 u = l16_set1(ufix[f]);
+            if (f < 3) {
+                l16 acc = l16_set1(ufix[f] + uspan[f]);
+                for (int a = 0; a < 3; a++) {
+                    const l16 ga = l16_add(l16_add(l16_set1(fn->gst[f][0][a]), l16_mul(l16_set1(fn->gst[f][1][a]), ci)),
+                                           l16_mul(l16_set1(fn->gst[f][2][a]), cj));
+                    acc = l16_add(acc, l16_mul(l16_abs(ga), l16_set1(b->h[a])));
+                }
+                u = l16_mul(acc, l16_set1(1.001f));
+                l16_store(U[f] + g0, u);
+            }
+            const float di = e[f][1] * span, dj = e[f][2] * span;
+            lo[f] = l16_sub(l16_add(bs, l16_set1(ms_minf(di, 0.0f) + ms_minf(dj, 0.0f))), u);
+            hi[f] = l16_add(l16_add(bs, l16_set1(ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f))), u);
+        }
+        groups |= (uint64_t)footprint_keep(lo, hi, s) << g0;
+    }
+    groups &= sh->all_groups;
+    memset(cand, 0, (size_t)sh->mw * sizeof *cand);
+    if (!groups) return 0;
+    static const float off[2][2][LANES] = {
+        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+    const int wi = gs == 8;
+    const l16 oi = l16_load(off[wi][0]), oj = l16_load(off[wi][1]);
+    l16 foff[4];
+    for (int f = 0; f < 4; f++) foff[f] = l16_add(l16_mul(l16_set1(e[f][1]), oi), l16_mul(l16_set1(e[f][2]), oj));
+    const uint64_t seg = (UINT64_C(1) << gs) - 1u;
+    uint64_t out = 0;
+    for (uint64_t m = groups; m; m &= m - 1) {
+        const int gk = __builtin_ctzll(m);
+        const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
+        for (int jb = j0; jb < j0 + gs; jb += rows) {
+            l16 lo[4], hi[4];
+            for (int f = 0; f < 4; f++) {
+                const float b0 = jb == j0 ? base[f][gk] : e[f][0] + e[f][1] * (float)i0 + e[f][2] * (float)jb;
+                const l16 E = l16_add(l16_set1(b0), foff[f]), u = l16_set1(f < 3 ? U[f][gk] : ufix[3]);
+                lo[f] = l16_sub(E, u);
+                hi[f] = l16_add(E, u);
+            }
+            const unsigned keep = footprint_keep(lo, hi, s);
+            if (!keep) continue;
+            out |= UINT64_C(1) << gk;
+            for (int rr = 0; rr < rows; rr++) {
+                const int s0 = (jb + rr) * k + i0;
+                cand[s0 >> 6] |= (uint64_t)(keep >> (rr * gs) & seg) << (s0 & 63);
+            }
+        }
+    }
+    return out;
 }
 
 /* Tests the open samples of group gk of receiver r (L68-L71); returns 1 when none is left open. An
@@ -868,6 +1089,9 @@ typedef struct hpc_view {
     int nt;
     const tri_job *t[2];
     hpc_footprint fp[2];
+    const uint64_t *ncand[2];   /* direct: per triangle, this receiver's samples the footprint may hold */
+    uint64_t ngroups;           /* direct: groups holding them (a superset), over the triangles */
+    int direct;                 /* 1: ncand and ngroups made by the leaf (cast_leaf_footprint), fp unused */
 } hpc_view;
 
 /* The lanes triangle t blocks of the 16-sample block at (i0, jb) of receiver q (live: the lanes to test), with
@@ -909,10 +1133,15 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
     const ms_shadow_query *q = &sh->q[r];
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
+    c->cnt[C_PAIRS_FOOTPRINT] += (uint64_t)v->nt;
     /* The open groups a footprint may touch (a node's umbra groups are its points' too). */
     float base[2][4][64];   /* each function at each group's first sample (footprint_groups) */
-    uint64_t todo = footprint_groups(sh, &v->fp[0], base[0]);
-    if (v->nt > 1) todo |= footprint_groups(sh, &v->fp[1], base[1]);
+    uint64_t todo;
+    if (v->direct) todo = v->ngroups;
+    else {
+        todo = footprint_groups(sh, &v->fp[0], base[0]);
+        if (v->nt > 1) todo |= footprint_groups(sh, &v->fp[1], base[1]);
+    }
     todo &= ~gu;
     if (!todo) return;
     static const float off[2][2][LANES] = {
@@ -921,7 +1150,7 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
     const int k = sh->k, gs = sh->gs, rows = LANES / gs, wi = gs == 8, nt = v->nt;
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
     l16 foff[2][4];
-    for (int u = 0; u < nt; u++) footprint_offsets(&v->fp[u], l16_load(off[wi][0]), l16_load(off[wi][1]), foff[u]);
+    for (int u = 0; u < nt && !v->direct; u++) footprint_offsets(&v->fp[u], l16_load(off[wi][0]), l16_load(off[wi][1]), foff[u]);
     int32_t s = sh->slot[r];
     const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
     float num[2] = { 0.0f, 0.0f }, V[2][3][3];   /* per triangle at its first exact test: offset, A, B, C */
@@ -933,8 +1162,13 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
         const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
         unsigned any = 0;
         for (int jb = j0; jb < j0 + gs; jb += rows) {
-            unsigned lanes[2] = { footprint_lanes(&v->fp[0], foff[0], i0, jb, jb == j0 ? &base[0][0][0] : NULL, gk), 0u };
-            if (nt > 1) lanes[1] = footprint_lanes(&v->fp[1], foff[1], i0, jb, jb == j0 ? &base[1][0][0] : NULL, gk);
+            unsigned lanes[2] = { 0u, 0u };
+            if (v->direct) {
+                for (int u = 0; u < nt; u++) lanes[u] = block_open(v->ncand[u], k, i0, jb, gs);
+            } else {
+                lanes[0] = footprint_lanes(&v->fp[0], foff[0], i0, jb, jb == j0 ? &base[0][0][0] : NULL, gk);
+                if (nt > 1) lanes[1] = footprint_lanes(&v->fp[1], foff[1], i0, jb, jb == j0 ? &base[1][0][0] : NULL, gk);
+            }
             if (!(lanes[0] | lanes[1])) continue;
             const unsigned ob = block_open(open, k, i0, jb, gs);
             if (!(ob & (lanes[0] | lanes[1]))) continue;
@@ -987,6 +1221,7 @@ static void cast_point_footprint(const shared *sh, chunk *c, uint32_t r, const t
     hpc_view v;
     v.nt = 1;
     v.t[0] = t;
+    v.direct = 0;
     float A[3], B[3], C[3];
     for (int a = 0; a < 3; a++) { A[a] = t->v[a] - q->p[a]; B[a] = t->v[3 + a] - q->p[a]; C[a] = t->v[6 + a] - q->p[a]; }
     footprint_setup(&v.fp[0], A, B, C, &g, q->p, sh->p0 ? sh->p0[4 * (size_t)r + 3] : footprint_rel(&g, q->p, sh->k));
@@ -1063,6 +1298,23 @@ static inline void spans16(l16 e1, l16 e2, l16 span, l16 zero, float *dlo, float
     l16_store(dhi, l16_add(l16_max(di, zero), l16_max(dj, zero)));
 }
 
+/* Whether the leaf footprint pays here, from this chunk's recent leaves cast with it (the counts halved as they
+ * grow, so that they follow the triangles of the moment): only while it has left at most LEAF_FP_KEEP of their
+ * receivers to the per-receiver work and at most LEAF_FP_CANDS samples per receiver to test in the lanes;
+ * one leaf in LEAF_FP_PROBE uses it regardless, to keep the counts current. Per chunk, so the same on every
+ * ISA and run. Measured (1024^2, the leaf footprint on every leaf): on a GRIDS-like scene's bars 58% of the
+ * receivers kept, 2.1 samples per receiver, and it pays; Dabrovic Sponza's large triangles leave 12.5 samples
+ * per receiver (76% kept), a scanned bunny's small ones keep 72% of the receivers (1.9 samples each): there
+ * it cost 20-25%. */
+#define LEAF_FP_PROBE 64u
+#define LEAF_FP_KEEP 0.75f
+#define LEAF_FP_CANDS 6.0f
+static inline int leaf_fp_pays(chunk *c)
+{
+    if (c->lf_leaves++ % LEAF_FP_PROBE == 0) return 1;
+    return (float)c->lf_kept <= LEAF_FP_KEEP * (float)c->lf_in && (float)c->lf_cands <= LEAF_FP_CANDS * (float)c->lf_in;
+}
+
 /* The points of a leaf inside V_L against a job (a triangle, or a pair: pair_batch) with the footprint test,
  * 16 receivers per operation (departure: the paper handles a leaf's points one by one): the point-in-V_L test
  * (POINT-IN-VOLUME, the same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per
@@ -1101,6 +1353,42 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     }
     if (!act) return;
     c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act & on[0]) + (uint64_t)__builtin_popcount(act & on[1]);
+    /* the leaf footprint over the receivers left (their box and their grid origins' box) */
+    uint64_t ncand[2][64], ngroups[2] = { ~UINT64_C(0), ~UINT64_C(0) };
+    /* pairs only: a lone triangle's set-up is shared by half as much work (measured on a scanned bunny, whose
+     * triangles are 91% alone: it cost 5% there even with leaf_fp_pays) */
+    const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) &&
+                        ((sh->sw & MS_HPC_ALL_LEAF_FOOTPRINT) ||
+                         (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c)));
+    if (leaf_fp) {
+        leaf_box bx;
+        for (int a = 0; a < 3; a++) {
+            float plo = INFINITY, phi = -INFINITY, olo = INFINITY, ohi = -INFINITY;
+            for (unsigned m = act; m; m &= m - 1) {
+                const int l = __builtin_ctz(m);
+                plo = ms_minf(plo, P[a][l]);
+                phi = ms_maxf(phi, P[a][l]);
+                const float p0 = sh->p0[4 * (size_t)rr[l] + a];
+                olo = ms_minf(olo, p0);
+                ohi = ms_maxf(ohi, p0);
+            }
+            /* centres and half extents; the differences rounded up (a float difference is off by u of itself) */
+            bx.pc[a] = 0.5f * (plo + phi);
+            bx.h[a] = ms_maxf(phi - bx.pc[a], bx.pc[a] - plo) * 1.000001f;
+            bx.p0c[a] = 0.5f * (olo + ohi);
+            bx.J[a] = ms_maxf(ohi - bx.p0c[a], bx.p0c[a] - olo) * 1.000001f;
+            if (sh->sw & MS_HPC_BREAK_LEAF_BOUND) bx.J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
+        }
+        leaf_fn fn[2];
+        leaf_setup(sh, &bx, t, nt, fn);
+        for (int u = 0; u < nt; u++) {
+            if (!(act & on[u])) continue;
+            ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
+            if (!ngroups[u]) { on[u] = 0; c->cnt[C_LEAF_CULLS]++; }
+        }
+        act &= on[0] | on[1];
+        if (!act) return;
+    }
     /* footprint_setup per lane, per triangle */
     const l16 w[3] = { l16_load(W[0]), l16_load(W[1]), l16_load(W[2]) }, rel = l16_load(R);
     static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A */
@@ -1126,24 +1414,73 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             l16_store(fe[u][e][0], c0);
             l16_store(fe[u][e][1], c1);
             l16_store(fe[u][e][2], c2);
-            spans16(c1, c2, span, zero, fdl[u][e], fdh[u][e]);
+            if (!leaf_fp) spans16(c1, c2, span, zero, fdl[u][e], fdh[u][e]);
             l16_store(fs[u][e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
             esum[0] = l16_add(esum[0], c0);
             esum[1] = l16_add(esum[1], c1);
             esum[2] = l16_add(esum[2], c2);
         }
         for (int a = 0; a < 3; a++) l16_store(fe[u][3][a], esum[a]);
-        spans16(esum[1], esum[2], span, zero, fdl[u][3], fdh[u][3]);
+        if (!leaf_fp) spans16(esum[1], esum[2], span, zero, fdl[u][3], fdh[u][3]);
     }
-    for (unsigned m = act; m; m &= m - 1) {
+    /* With the leaf footprint: each sample it left, tested for the leaf's receivers in the lanes (footprint_keep
+     * per receiver, the footprint_lanes arithmetic with the sample's own indices), giving each receiver its
+     * samples: the work per leaf follows the samples left, which fall as the leaves shrink with resolution. */
+    const int mw = sh->mw;
+    uint64_t rc[2][LANES][64], rg[2][LANES];   /* per triangle and lane: the receiver's samples, their groups */
+    unsigned has[2] = { 0u, 0u };
+    if (leaf_fp)
+        for (int u = 0; u < nt; u++) {
+            const unsigned lanes_on = act & on[u];
+            if (!lanes_on) continue;
+            for (unsigned m = lanes_on; m; m &= m - 1) {
+                memset(rc[u][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
+                rg[u][__builtin_ctz(m)] = 0;
+            }
+            l16 c0[4], c1[4], c2[4], sl[3];
+            for (int e = 0; e < 4; e++) { c0[e] = l16_load(fe[u][e][0]); c1[e] = l16_load(fe[u][e][1]); c2[e] = l16_load(fe[u][e][2]); }
+            for (int e = 0; e < 3; e++) sl[e] = l16_load(fs[u][e]);
+            for (int wd = 0; wd < mw; wd++)
+                for (uint64_t bits = ncand[u][wd]; bits; bits &= bits - 1) {
+                    const int bit = __builtin_ctzll(bits), sidx = 64 * wd + bit;
+                    /* k = 16, 32 or 64 (sh->gs), so a word holds whole rows */
+                    const l16 fi = l16_set1(sh->bit_i[bit]), fj = l16_set1((float)(64 / sh->k * wd) + sh->bit_j[bit]);
+                    l16 E[4];
+                    for (int e = 0; e < 4; e++) E[e] = l16_add(l16_add(c0[e], l16_mul(c1[e], fi)), l16_mul(c2[e], fj));
+                    const unsigned hitl = footprint_keep16(E, sl) & lanes_on;
+                    if (!hitl) continue;
+                    has[u] |= hitl;
+                    const int gk = (sidx / sh->k / sh->gs) * (sh->k / sh->gs) + (sidx % sh->k) / sh->gs;
+                    for (unsigned h2 = hitl; h2; h2 &= h2 - 1) {
+                        const int l = __builtin_ctz(h2);
+                        rc[u][l][wd] |= UINT64_C(1) << bit;
+                        rg[u][l] |= UINT64_C(1) << gk;
+                    }
+                }
+        }
+    if (leaf_fp) {
+        c->lf_in += (uint32_t)__builtin_popcount(act);
+        c->lf_kept += (uint32_t)__builtin_popcount(act & (has[0] | has[1]));
+        for (int u = 0; u < nt; u++)
+            for (int wd = 0; wd < mw; wd++) c->lf_cands += (uint32_t)__builtin_popcountll(ncand[u][wd]);
+        if (c->lf_in > 4096u) { c->lf_in >>= 1; c->lf_kept >>= 1; c->lf_cands >>= 1; }   /* the recent leaves count */
+    }
+    for (unsigned m = leaf_fp ? act & (has[0] | has[1]) : act; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         const uint32_t r = rr[l];
         hpc_view view;
         view.nt = 0;
+        view.direct = leaf_fp;
+        view.ngroups = 0;
         for (int u = 0; u < nt; u++) {
-            if (!(on[u] >> l & 1u)) continue;
+            if (!((leaf_fp ? has[u] : on[u]) >> l & 1u)) continue;
             const int x = view.nt++;
             view.t[x] = &t[u];
+            if (leaf_fp) {
+                view.ncand[x] = rc[u][l];
+                view.ngroups |= rg[u][l];
+                continue;
+            }
             for (int e = 0; e < 4; e++)
                 for (int a = 0; a < 3; a++) view.fp[x].e[e][a] = fe[u][e][a][l];
             for (int e = 0; e < 3; e++) view.fp[x].s[e] = fs[u][e][l];
@@ -1391,6 +1728,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         sh.group_i0[g] = (float)(g % (k / sh.gs) * sh.gs);
         sh.group_j0[g] = (float)(g / (k / sh.gs) * sh.gs);
     }
+    for (int b = 0; b < 64; b++) { sh.bit_i[b] = (float)(b % k); sh.bit_j[b] = (float)(b / k); }
     sh.footprint = !scanline && !(sh.sw & MS_HPC_OFF_FOOTPRINT);
     sh.all_groups = sh.G == 64 ? UINT64_MAX : (UINT64_C(1) << sh.G) - 1u;
     sh.npk = k * k / LANES;
