@@ -345,6 +345,29 @@ static void test_interleaved_group_paths(void **state)
     ms_scene_free(&sc);
 }
 
+/* mft's masks for the nq queries q (front masks `front`) on every ISA instance this machine and the test's cap
+ * allow, each equal to raytrace's `ref` query for query; `got` is scratch of nq * mask_words words. */
+static void mft_equals_raytrace_every_isa(ms_render_ctx *ctx, const ms_shadow_query *q, int nq, const uint64_t *front,
+                                          const uint64_t *ref, uint64_t *got, const char *what)
+{
+    const size_t mw = (size_t)ctx->mask_words;
+    const ms_shadow_method *sm = ms_find_shadow_method("mft");
+    assert_non_null(sm);
+    for (int cap = MS_ISA_SCALAR; cap <= MS_ISA_AVX512; cap++) {
+        if (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa()) continue;
+        ctx->isa_cap = (ms_isa)cap;
+        char err[256];
+        void *ss = NULL;
+        assert_int_equal(sm->create(ctx, &ss, err, sizeof err), 0);
+        uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+        assert_int_equal(sm->visibility(ss, ctx, q, nq, front, got, cnt), 0);
+        sm->destroy(ss);
+        int differ = 0;
+        for (int i = 0; i < nq; i++) differ += memcmp(got + (size_t)i * mw, ref + (size_t)i * mw, mw * sizeof *got) != 0;
+        if (differ) fail_msg("%s, ISA cap %d: %d of %d queries differ from raytrace", what, cap, differ, nq);
+    }
+}
+
 /* Blocks whose 16 receivers are scattered over the scene (random points and normals low among its
  * occluders): in one
  * ray group (a cell of the light, one ray per pixel) the slots then have different shear axes, some are
@@ -411,23 +434,9 @@ static void test_interleaved_scattered_blocks(void **state)
     assert_true(mixed > BLOCKS / 2);
     assert_true(blocked > NQ / 20);
     assert_true(partial > 10);
-    const ms_shadow_method *sm = ms_find_shadow_method("mft");
-    assert_non_null(sm);
     uint64_t *got = calloc(NQ * mw, sizeof *got);
     assert_non_null(got);
-    for (int cap = MS_ISA_SCALAR; cap <= MS_ISA_AVX512; cap++) {
-        if (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa()) continue;
-        ctx.isa_cap = (ms_isa)cap;
-        char err[256];
-        void *ss = NULL;
-        assert_int_equal(sm->create(&ctx, &ss, err, sizeof err), 0);
-        uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
-        assert_int_equal(sm->visibility(ss, &ctx, q, NQ, front, got, cnt), 0);
-        sm->destroy(ss);
-        int differ = 0;
-        for (int i = 0; i < NQ; i++) differ += memcmp(got + (size_t)i * mw, ref + (size_t)i * mw, mw * sizeof *got) != 0;
-        if (differ) fail_msg("ISA cap %d: %d of %d scattered queries differ from raytrace", cap, differ, NQ);
-    }
+    mft_equals_raytrace_every_isa(&ctx, q, NQ, front, ref, got, "scattered blocks");
     free(got); free(q); free(front); free(ref); free(pts);
     ms_bvh_free(&bvh);
     ms_scene_free(&sc);
@@ -524,21 +533,9 @@ static void test_interleaved_ray_occluders(void **state)
         assert_true(blocked >= nt * 9 / 10);
         assert_true(partial > NQ / 2);
         assert_true(part_front > NQ / 10);
-        const ms_shadow_method *sm = ms_find_shadow_method("mft");
-        assert_non_null(sm);
-        for (int cap = MS_ISA_SCALAR; cap <= MS_ISA_AVX512; cap++) {
-            if (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa()) continue;
-            ctx.isa_cap = (ms_isa)cap;
-            char err[256];
-            void *ss = NULL;
-            assert_int_equal(sm->create(&ctx, &ss, err, sizeof err), 0);
-            uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
-            assert_int_equal(sm->visibility(ss, &ctx, q, NQ, front, got, cnt), 0);
-            sm->destroy(ss);
-            int differ = 0;
-            for (int i = 0; i < NQ; i++) differ += memcmp(got + (size_t)i * mw, ref + (size_t)i * mw, mw * sizeof *got) != 0;
-            if (differ) fail_msg("N=%d, ISA cap %d: %d of %d queries differ from raytrace", k * k, cap, differ, NQ);
-        }
+        char what[64];
+        snprintf(what, sizeof what, "one occluder per ray, N=%d", k * k);
+        mft_equals_raytrace_every_isa(&ctx, q, NQ, front, ref, got, what);
         ms_bvh_free(&bvh);
         free(q); free(front); free(ref); free(got); free(pts);
         ms_scene_free(&sc);
