@@ -60,8 +60,9 @@ typedef struct br_state {
  * big-light Sponza), so one pixel per lane left most lanes idle, and a permutation that gives each lane its
  * pixel's operands is one instruction. With AVX2 (two halves: a permutation is three instructions and a
  * blend) the packed layout was 11-20% slower (big-light Sponza, beast) and the lanes stay pixels, one
- * triangle at a time; so in the portable build. */
-#if defined(MS_TARGET_AVX512)
+ * triangle at a time; so in the portable build. Measurement switch: -DBR_PACK_AVX2 packs the AVX2 instance
+ * too (lanes16.h's AVX2 permutation and gather serve it). */
+#if defined(MS_TARGET_AVX512) || (defined(MS_TARGET_AVX2) && defined(BR_PACK_AVX2))
 #define BR_PACK 1
 #else
 #define BR_PACK 0
