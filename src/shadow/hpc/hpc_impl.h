@@ -605,30 +605,24 @@ static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3]
  * them) not all three can be <= 0 up to their slacks: all are >= 0, and any E_e < -s_e rules the samples
  * out; alike below. Elsewhere (the plane through the receiver parallel to the triangle crosses these
  * samples) only mixed signs beyond the slacks rule them out. lo, hi: bounds of E_0, E_1, E_2 and E_sum over
- * each lane's samples. Returns the lanes that may be hit. */
-static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const float s[3])
+ * each lane's samples; s: each lane's slacks. Returns the lanes that may be hit. */
+static inline unsigned footprint_keep_lanes(const l16 lo[4], const l16 hi[4], const l16 s[3])
 {
-    const float s2 = 2.0f * (s[0] + s[1] + s[2]);
-    const unsigned up = l16_gt(lo[3], l16_set1(s2)), down = l16_lt(hi[3], l16_set1(-s2));
+    const l16 s2 = l16_mul(l16_set1(2.0f), l16_add(l16_add(s[0], s[1]), s[2]));
+    const unsigned up = l16_gt(lo[3], s2), down = l16_lt(hi[3], l16_sub(l16_set1(0.0f), s2));
     unsigned pos = 0, neg = 0;
     for (int e = 0; e < 3; e++) {
-        pos |= l16_gt(lo[e], l16_set1(s[e]));     /* E_e > s_e throughout */
-        neg |= l16_lt(hi[e], l16_set1(-s[e]));    /* E_e < -s_e throughout */
+        pos |= l16_gt(lo[e], s[e]);                          /* E_e > s_e throughout */
+        neg |= l16_lt(hi[e], l16_sub(l16_set1(0.0f), s[e]));   /* E_e < -s_e throughout */
     }
     return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
 }
 
-/* footprint_keep with a slack per lane (16 receivers' functions at one sample). */
-static inline unsigned footprint_keep16(const l16 E[4], const l16 s[3])
+/* The same with one slack for every lane (a receiver's functions over 16 groups or samples). */
+static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const float s[3])
 {
-    const l16 s2 = l16_mul(l16_set1(2.0f), l16_add(l16_add(s[0], s[1]), s[2]));
-    const unsigned up = l16_gt(E[3], s2), down = l16_lt(E[3], l16_sub(l16_set1(0.0f), s2));
-    unsigned pos = 0, neg = 0;
-    for (int e = 0; e < 3; e++) {
-        pos |= l16_gt(E[e], s[e]);
-        neg |= l16_lt(E[e], l16_sub(l16_set1(0.0f), s[e]));
-    }
-    return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
+    const l16 sl[3] = { l16_set1(s[0]), l16_set1(s[1]), l16_set1(s[2]) };
+    return footprint_keep_lanes(lo, hi, sl);
 }
 
 /* The groups (bit gk) whose samples the footprint may hold, bounding each edge function over the group's
@@ -1447,7 +1441,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
                     const l16 fi = l16_set1(sh->bit_i[bit]), fj = l16_set1((float)(64 / sh->k * wd) + sh->bit_j[bit]);
                     l16 E[4];
                     for (int e = 0; e < 4; e++) E[e] = l16_add(l16_add(c0[e], l16_mul(c1[e], fi)), l16_mul(c2[e], fj));
-                    const unsigned hitl = footprint_keep16(E, sl) & lanes_on;
+                    const unsigned hitl = footprint_keep_lanes(E, E, sl) & lanes_on;
                     if (!hitl) continue;
                     has[u] |= hitl;
                     const int gk = (sidx / sh->k / sh->gs) * (sh->k / sh->gs) + (sidx % sh->k) / sh->gs;
