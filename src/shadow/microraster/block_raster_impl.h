@@ -84,10 +84,10 @@ typedef struct br_setup {
                           * length (rare) */
 } br_setup;
 
-/* The triangle's own part of the set-up, per lane (the packed layout: one triangle per lane) or broadcast
- * (the pixel layout): the world edges w[i] = P_{i+2} - P_{i+1}, their squared lengths (the kernel's lanes
- * 4..6) and the plane normal from the two shortest edges (the longest edge's candidate, ties to the lower
- * index), with the kernel's operations. */
+/* The triangle's own part of the set-up, per lane (the packed layout: one triangle per lane; the pixel
+ * layout: one triangle in every lane): the world edges w[i] = P_{i+2} - P_{i+1}, their squared lengths
+ * (the kernel's lanes 4..6) and the plane normal from the two shortest edges (the longest edge's
+ * candidate, ties to the lower index), with the kernel's operations. */
 typedef struct br_tri {
     l16 w[3][3], el[3], nw[3];
 } br_tri;
@@ -108,25 +108,6 @@ static inline void br_tri_lanes(const l16 v[3][3], br_tri *t)
     t->nw[0] = l16_sub(l16_mul(sa[1], sb[2]), l16_mul(sa[2], sb[1]));
     t->nw[1] = l16_sub(l16_mul(sa[2], sb[0]), l16_mul(sa[0], sb[2]));
     t->nw[2] = l16_sub(l16_mul(sa[0], sb[1]), l16_mul(sa[1], sb[0]));
-}
-
-/* The same for one triangle in scalar form, broadcast (the same operations, one lane). */
-static inline void br_tri_broadcast(const float *tri, br_tri *t)
-{
-    float w[3][3], el[3];
-    for (int i = 0; i < 3; i++) {
-        const float *p = tri + 3 * ((i + 1) % 3), *q = tri + 3 * ((i + 2) % 3);
-        for (int j = 0; j < 3; j++) w[i][j] = q[j] - p[j];
-        el[i] = w[i][0] * w[i][0] + w[i][1] * w[i][1] + w[i][2] * w[i][2];
-    }
-    const int long_i = el[0] >= el[1] ? (el[0] >= el[2] ? 0 : 2) : (el[1] >= el[2] ? 1 : 2);
-    const float *sa = w[(long_i + 1) % 3], *sb = w[(long_i + 2) % 3];
-    const float nw[3] = { sa[1] * sb[2] - sa[2] * sb[1], sa[2] * sb[0] - sa[0] * sb[2], sa[0] * sb[1] - sa[1] * sb[0] };
-    for (int i = 0; i < 3; i++) {
-        for (int j = 0; j < 3; j++) t->w[i][j] = l16_set1(w[i][j]);
-        t->el[i] = l16_set1(el[i]);
-        t->nw[i] = l16_set1(nw[i]);
-    }
 }
 
 /* Issue #29 item 2, "set up each triangle once per block": the SIMD Scanline kernel's set-up
@@ -649,7 +630,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
             if (ms_frame_alpha_tested(in->frame[l], t)) alpha |= 1u << l;
         }
         br_tri tr;
-        br_tri_broadcast(tri, &tr);
+        br_tri_lanes(tv, &tr);
         br_scan_setup(cover & ~alpha, av, &tr, L->mt, L->near_l, L->far_l, x, y, z, zmin, zmax, MS_K, &su);
         by_kernel = alpha | su.kernel;
         for (unsigned p = su.rows; p; p &= p - 1) {
