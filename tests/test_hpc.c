@@ -388,18 +388,20 @@ static void test_bars(void **st)
     const uint64_t culled = hpc_equals(&sc, "bars", 256, 96, &ref);
     printf("bars: %llu of %zu triangles left out by the closed-component cull\n", (unsigned long long)culled, sc.n_tris);
     assert_true(culled > 0);
-    /* the leaf footprint on every leaf equals raytrace, works here (leaves ruled out, pairs kept from the
-     * per-receiver work), and without its bound over the grid origins the answer is wrong */
+    /* the leaf footprint on every leaf equals raytrace, works here (leaves ruled out, leaves whose candidates are
+     * all blocked already skipped, pairs kept from the per-receiver work), and without its bound over the grid
+     * origins the answer is wrong */
     ms_hpc_switches = MS_HPC_ALL_LEAF_FOOTPRINT;
     hpc_equals(&sc, "bars, leaf fp", 256, 96, &ref);
     ms_frame f;
     render_ok(&sc, "hpc", 256, 96, 0, &f);
     ms_hpc_switches = 0;
-    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0;
+    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0;
     for (int c = 0; c < f.stats.n_counters; c++) {
         if (!strcmp(f.stats.counter_name[c], "pairs_in_vl")) in_vl = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "pairs_footprint")) to_fp = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "leaf_culls")) leaf_culls = f.stats.counter[c];
+        if (!strcmp(f.stats.counter_name[c], "leaf_culls_blocked")) culls_blocked = f.stats.counter[c];
     }
     ms_frame_free(&f);
     ms_hpc_switches = MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_LEAF_BOUND;
@@ -409,9 +411,11 @@ static void test_bars(void **st)
     for (long i = 0; i < 96L * 96L; i++) differ += memcmp(&f.vis[i], &ref.vis[i], sizeof(float)) != 0;
     ms_frame_free(&f);
     printf("bars: leaf footprint: %llu of %llu pairs in V_L to the per-receiver test, %llu (leaf, triangle) ruled "
-           "out; without its bound over the grid origins %ld pixels differ\n", (unsigned long long)to_fp,
-           (unsigned long long)in_vl, (unsigned long long)leaf_culls, differ);
+           "out, %llu with every candidate blocked already; without its bound over the grid origins %ld pixels "
+           "differ\n", (unsigned long long)to_fp, (unsigned long long)in_vl, (unsigned long long)leaf_culls,
+           (unsigned long long)culls_blocked, differ);
     assert_true(leaf_culls > 0);
+    assert_true(culls_blocked > 0);
     assert_true(to_fp < in_vl);
     assert_true(differ > 0);
     ms_frame_free(&ref);

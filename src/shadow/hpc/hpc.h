@@ -19,7 +19,7 @@ typedef struct hpc_source {
     size_t (*next)(void *user, float *tri, uint32_t *ids, size_t max);
 } hpc_source;
 
-#define HPC_N_COUNTERS 26
+#define HPC_N_COUNTERS 27
 #define HPC_COUNTER_SORT_US 16   /* filled by the method (hpc_method.c): the sort is the source's */
 
 /* For n receivers with their front masks (receiver.h), writes the visible masks: the front samples that no

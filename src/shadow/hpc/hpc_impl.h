@@ -141,6 +141,7 @@ enum {
     C_PAIRS_IN_VL,   /* (receiver, triangle) pairs past the point-in-V_L test: the work the samples' tests start from */
     C_PAIRS_FOOTPRINT,   /* of those, the pairs that reach the per-receiver footprint (past the leaf footprint) */
     C_LEAF_CULLS,        /* (leaf, triangle) pairs the leaf footprint rules out for every receiver of the leaf */
+    C_LEAF_CULLS_BLOCKED,   /* of the others, those whose candidate samples are blocked already for every receiver */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -1052,6 +1053,13 @@ static void record_umbra(const shared *sh, chunk *c, uint32_t r, int32_t s, uint
     }
 }
 
+/* The samples of receiver r still open: its mask slot's, or its front mask before a triangle first may block it. */
+static inline const uint64_t *open_of(const shared *sh, chunk *c, uint32_t r)
+{
+    const int32_t s = sh->slot[r];
+    return s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
+}
+
 /* The mask and sample data of receiver r (D: made when a triangle first may block it, L59-L64). -1 when out
  * of memory. */
 static int32_t slot_of(const shared *sh, chunk *c, uint32_t r, const ms_grid *g)
@@ -1146,7 +1154,7 @@ static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid
     l16 foff[2][4];
     for (int u = 0; u < nt && !v->direct; u++) footprint_offsets(&v->fp[u], l16_load(off[wi][0]), l16_load(off[wi][1]), foff[u]);
     int32_t s = sh->slot[r];
-    const uint64_t *open = s >= 0 ? slot_mask(sh, c, s) : sh->front + (size_t)sh->orig[r] * sh->mw;
+    const uint64_t *open = open_of(sh, c, r);
     float num[2] = { 0.0f, 0.0f }, V[2][3][3];   /* per triangle at its first exact test: offset, A, B, C */
     int have_num[2] = { 0, 0 };
     const int8_t *kz = NULL;
@@ -1349,6 +1357,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     c->cnt[C_PAIRS_IN_VL] += (uint64_t)__builtin_popcount(act & on[0]) + (uint64_t)__builtin_popcount(act & on[1]);
     /* the leaf footprint over the receivers left (their box and their grid origins' box) */
     uint64_t ncand[2][64], ngroups[2] = { ~UINT64_C(0), ~UINT64_C(0) };
+    const uint64_t *lopen[LANES] = { 0 };   /* with the leaf footprint: each lane's open samples */
     /* pairs only: a lone triangle's set-up is shared by half as much work (measured on a scanned bunny, whose
      * triangles are 91% alone: it cost 5% there even with leaf_fp_pays) */
     const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) &&
@@ -1379,6 +1388,24 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             if (!(act & on[u])) continue;
             ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
             if (!ngroups[u]) { on[u] = 0; c->cnt[C_LEAF_CULLS]++; }
+        }
+        act &= on[0] | on[1];
+        if (!act) return;
+        /* A sample blocked already for every receiver of the leaf needs no test for any (the paper's L21, for a
+         * whole leaf): the candidates masked by the union of the receivers' open samples, and below each
+         * receiver's by its own. Measured (session 14, one thread, 1024²): grids -13%, Sibenik -3 to -9%,
+         * Dabrovic Sponza -3%, the bunny -1 to -6%; on grids 32% fewer pairs reach per-receiver work. */
+        uint64_t any_open[64] = { 0 };
+        for (unsigned m = act; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            lopen[l] = open_of(sh, c, rr[l]);
+            for (int wd = 0; wd < sh->mw; wd++) any_open[wd] |= lopen[l][wd];
+        }
+        for (int u = 0; u < nt; u++) {
+            if (!(act & on[u])) continue;
+            uint64_t left = 0;
+            for (int wd = 0; wd < sh->mw; wd++) left |= ncand[u][wd] &= any_open[wd];
+            if (!left) { on[u] = 0; c->cnt[C_LEAF_CULLS_BLOCKED]++; }
         }
         act &= on[0] | on[1];
         if (!act) return;
@@ -1443,12 +1470,13 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
                     for (int e = 0; e < 4; e++) E[e] = l16_add(l16_add(c0[e], l16_mul(c1[e], fi)), l16_mul(c2[e], fj));
                     const unsigned hitl = footprint_keep_lanes(E, E, sl) & lanes_on;
                     if (!hitl) continue;
-                    has[u] |= hitl;
                     const int gk = (sidx / sh->k / sh->gs) * (sh->k / sh->gs) + (sidx % sh->k) / sh->gs;
                     for (unsigned h2 = hitl; h2; h2 &= h2 - 1) {
                         const int l = __builtin_ctz(h2);
+                        if (!(lopen[l][wd] >> bit & 1u)) continue;   /* blocked already for this receiver */
                         rc[u][l][wd] |= UINT64_C(1) << bit;
                         rg[u][l] |= UINT64_C(1) << gk;
+                        has[u] |= 1u << l;
                     }
                 }
         }
