@@ -36,7 +36,7 @@ enum {
 /* Flags: MS_BR_FRUSTUM_SHRINK also narrows a pixel's traversal frustum to its rectangle (the paper's
  * "FS"); MS_BR_ORDER visits nearer children first; MS_BR_NO_LANE_SETUP leaves every triangle's set-up to
  * the kernel pixel by pixel (to measure and test the shared set-up, block_raster_impl.h br_scan_setup). */
-enum { MS_BR_ORDER = 1, MS_BR_FRUSTUM_SHRINK = 2, MS_BR_NO_LANE_SETUP = 4 };
+enum { MS_BR_ORDER = 1, MS_BR_FRUSTUM_SHRINK = 2, MS_BR_NO_LANE_SETUP = 4, MS_BR_NO_SHORT_ROWS = 8 };
 
 typedef void (*ms_block_raster_fn)(const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh,
                                    ms_raster_fn raster, float near, float far, uint64_t *cnt, int flags);

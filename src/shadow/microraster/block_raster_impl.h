@@ -460,6 +460,54 @@ static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e,
     L->c_shared_clip += ne == 5;
 }
 
+#undef BR_SHORT_ROWS   /* per k: this file is included once per instance */
+#if defined(MS_TARGET_AVX512) && MS_K <= 32
+#define BR_SHORT_ROWS 1
+/* The set-up's lanes that span at most two scanlines (y1 - y0 <= 1), of `lanes`; their coverage words, rows
+ * y0 and y0 + 1 (0 outside y0..y1), into cov[0] and cov[1] per lane. Most rasterizations are short: on the
+ * big-light Sponza (1024 samples) 68% span one or two rows, the shaft's walls and round windows next to the
+ * light, and 70% of those clear nothing. The kernel's row loop (scanline_simd_impl.h, ms_interval and
+ * r_cover32) evaluates sixteen rows of one lane per instruction; here the same operations evaluate one row
+ * of sixteen lanes: the same fused multiply-add a y + b, the same max and min in the same operand order
+ * (so the same NaN and signed-zero outcomes), the same rounding conversions and variable shifts (counts
+ * out of range give 0). Each lane's words are therefore the kernel's bit for bit, and a lane's pixel then
+ * needs two AND-NOTs instead of a call of the row loop. */
+static inline unsigned MS_KFN(br_short_rows)(const br_setup *su, unsigned lanes, uint32_t cov[2][MS_BLOCK_LANES])
+{
+    const __m512i y0 = _mm512_loadu_si512((const void *)su->v.y0), y1 = _mm512_loadu_si512((const void *)su->v.y1);
+    const __m512i one_i = _mm512_set1_epi32(1);
+    const unsigned short_lanes = lanes & (unsigned)_mm512_cmp_epi32_mask(y1, _mm512_add_epi32(y0, one_i), _MM_CMPINT_LE);
+    if (!short_lanes) return 0;
+    const __m512 zero = _mm512_setzero_ps(), kf1 = _mm512_set1_ps((float)MS_K - 1.0f);
+    const __m512i ones = _mm512_set1_epi32(MS_K == 16 ? 0xFFFF : -1), top = _mm512_set1_epi32(MS_K - 1);
+    const __mmask16 clip = (__mmask16)(su->clip & short_lanes);
+    for (int r = 0; r < 2; r++) {
+        const __m512i yi = _mm512_add_epi32(y0, _mm512_set1_epi32(r));
+        const __m512 y = _mm512_cvtepi32_ps(yi);
+        __m512 lo[5], hi[5];
+        const int ne = clip ? 5 : 3;   /* edges 3 and 4 are written only when some lane clips */
+        for (int e = 0; e < ne; e++) {
+            lo[e] = _mm512_fmadd_ps(_mm512_loadu_ps(su->v.al[e]), y, _mm512_loadu_ps(su->v.bl[e]));
+            hi[e] = _mm512_fmadd_ps(_mm512_loadu_ps(su->v.au[e]), y, _mm512_loadu_ps(su->v.bu[e]));
+        }
+        const __m512 l01 = _mm512_max_ps(lo[0], lo[1]), h01 = _mm512_min_ps(hi[0], hi[1]);
+        __m512 l2 = _mm512_max_ps(lo[2], zero), h2 = _mm512_min_ps(hi[2], kf1);
+        if (clip) {   /* the five-edge lanes: their row loop's extra max and min */
+            l2 = _mm512_mask_max_ps(l2, clip, l2, _mm512_max_ps(lo[3], lo[4]));
+            h2 = _mm512_mask_min_ps(h2, clip, h2, _mm512_min_ps(hi[3], hi[4]));
+        }
+        const __m512i l = _mm512_cvt_roundps_epi32(_mm512_max_ps(l01, l2), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
+        const __m512i h = _mm512_cvt_roundps_epi32(_mm512_min_ps(h01, h2), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+        const __mmask16 rows = (__mmask16)short_lanes & _mm512_cmp_epi32_mask(yi, y1, _MM_CMPINT_LE);
+        _mm512_storeu_si512((void *)cov[r], _mm512_maskz_and_epi32(rows, _mm512_sllv_epi32(ones, l),
+                                                                  _mm512_srlv_epi32(ones, _mm512_sub_epi32(top, h))));
+    }
+    return short_lanes;
+}
+#else
+#define BR_SHORT_ROWS 0
+#endif
+
 /* The leaf tests of a group of the leaf's triangles. Packed layout (BR_PACK): lane e is the (triangle,
  * pixel) pair (first + pt[e], pl[e]), e < np, the pairs sixteen to a vector. In a leaf a triangle reaches on
  * average a few of the block's pixels (3.4 of 16 on the big-light Sponza), so the per-triangle tests with
@@ -591,6 +639,10 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         br_tri_lanes(tv, &tr);
         br_scan_setup(pass, av, &tr, mt, BR_PIX(L->near_l), BR_PIX(L->far_l), x, y, z, zmin, zmax, MS_K, &su);
     }
+#if BR_SHORT_ROWS
+    uint32_t cov[2][MS_BLOCK_LANES];
+    const unsigned short_lanes = su.rows && !(s->flags & MS_BR_NO_SHORT_ROWS) ? MS_KFN(br_short_rows)(&su, su.rows, cov) : 0;
+#endif
     for (unsigned p = pass; p; p &= p - 1) {
         const int e = __builtin_ctz(p), l = pl[e];
         const uint32_t t = L->first + (uint32_t)pt[e];
@@ -602,6 +654,17 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel;
          * a lane the set-up left to the kernel likewise. */
         if (s->rows && !(su.kernel >> e & 1) && !ms_frame_alpha_tested(in->frame[l], t)) {
+#if BR_SHORT_ROWS
+            if (short_lanes >> e & 1) {
+                MS_WORD *buf = (MS_WORD *)in->buf[l];
+                const int y0 = su.v.y0[e];
+                buf[y0] &= (MS_WORD)~cov[0][e];
+                if (y0 < MS_K - 1) buf[y0 + 1] &= (MS_WORD)~cov[1][e];   /* 0 when the lane spans one row */
+                L->c_shared++;
+                L->c_shared_clip += su.clip >> e & 1;
+                continue;
+            }
+#endif
             if (su.rows >> e & 1) MS_KFN(br_rows)(s, &su, e, in->buf[l], L);
             continue;   /* else the set-up found nothing to clear, as the kernel would */
         }
