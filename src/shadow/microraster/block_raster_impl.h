@@ -110,6 +110,40 @@ static inline void br_tri_lanes(const l16 v[3][3], br_tri *t)
     t->nw[2] = l16_sub(l16_mul(sa[0], sb[1]), l16_mul(sa[1], sb[0]));
 }
 
+/* The kernel's row or column range of a triangle in front of C, from the leaf test's projections
+ * q_v = fl(c_v fl(1/z_v)) instead of the kernel's fl(c_v / z_v): the lanes (returned mask) where the two
+ * provably give the same i0 = max(ceil(clamp(min_v - slack)), 0) and i1 = min(floor(clamp(max_v + slack)),
+ * k - 1), with those values in i0, i1. Why it holds: q_v and the kernel's p_v are both c_v / z_v times
+ * (1 + e) with |e| <= 2u + u^2 resp. u (u = 2^-24, round to nearest), so |q_v - p_v| < 3.01 u |q_v|, plus
+ * 2^-149 where a product or quotient is subnormal. q_v -+ (2^-20 |q_v| + 2^-100), rounded, therefore
+ * bracket p_v (the rounding of the bracket moves it by at most u of itself, far inside the 16 u); min,
+ * max, the rounded subtraction or addition of the slack, the clamps, ceil and floor are all monotone, so
+ * the kernel's i0 (i1) lies between the values computed from the lower and the upper brackets, and where
+ * those agree it is that value. Lanes with |q_v| > 2^100 or NaN (z tiny, non-finite input) are left to
+ * the division, and so are lanes with z > 2^100 (the caller: there 1 / z may be subnormal). */
+static inline unsigned br_box_bracket(const l16 q[3], l16 slack, l16 minus1, l16 kf, l16 k1, l16 *i0, l16 *i1)
+{
+    const l16 rel = l16_set1(1.0f / 1048576.0f), tiny = l16_set1(0x1p-100f), big = l16_set1(0x1p100f), zero = l16_set1(0.0f);
+    unsigned fin = 0xFFFFu;
+    l16 lo[3], hi[3];
+    for (int v = 0; v < 3; v++) {
+        const l16 aq = l16_abs(q[v]);
+        fin &= l16_le(aq, big);
+        const l16 d = l16_add(l16_mul(aq, rel), tiny);
+        lo[v] = l16_sub(q[v], d);
+        hi[v] = l16_add(q[v], d);
+    }
+    const l16 minl = l16_min(l16_min(lo[0], lo[1]), lo[2]), minh = l16_min(l16_min(hi[0], hi[1]), hi[2]);
+    const l16 maxl = l16_max(l16_max(lo[0], lo[1]), lo[2]), maxh = l16_max(l16_max(hi[0], hi[1]), hi[2]);
+    const l16 a0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(minl, slack), minus1), kf)), zero);
+    const l16 b0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(minh, slack), minus1), kf)), zero);
+    const l16 a1 = l16_min(l16_floor(l16_min(l16_max(l16_add(maxl, slack), minus1), kf)), k1);
+    const l16 b1 = l16_min(l16_floor(l16_min(l16_max(l16_add(maxh, slack), minus1), kf)), k1);
+    *i0 = a0;
+    *i1 = a1;
+    return fin & l16_le(b0, a0) & l16_le(b1, a1);   /* a <= b by monotonicity: equal */
+}
+
 /* Issue #29 item 2, "set up each triangle once per block": the SIMD Scanline kernel's set-up
  * (scanline_simd_impl.h, ms_scan_vec_setup, clip-free instance) laid out with one pixel per lane instead
  * of one vertex or edge per lane, so that a triangle that several pixels of the block rasterize is set up
@@ -126,8 +160,8 @@ static inline void br_tri_lanes(const l16 v[3][3], br_tri *t)
  * x, y, z: the vertices' light-index coordinates per lane, zmin / zmax their widened depth range (the
  * leaf test's, the kernel's operations); a[v][j] the world vectors P_v - C. */
 static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri *tr, const l16 mt[3][3], l16 near_l,
-                                 l16 far_l, const l16 x[3], const l16 y[3], const l16 z[3], l16 zmin, l16 zmax, int k,
-                                 br_setup *o)
+                                 l16 far_l, const l16 x[3], const l16 y[3], const l16 z[3], const l16 *qx, const l16 *qy,
+                                 l16 zmin, l16 zmax, int k, br_setup *o)
 {
     const l16 zero = l16_set1(0.0f), kf = l16_set1((float)k);
     /* The lanes whose triangle reaches the near resp. far plane: the kernel's clip edges N and F. */
@@ -214,15 +248,32 @@ static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri
     const unsigned front = live & l16_gt(zmin, zero);
     l16 y0 = zero, y1 = l16_set1((float)k - 1.0f);
     if (front) {
-        const l16 slack = l16_set1(MS_BOX_SLACK);
-        l16 px[3], py[3];
-        for (int v = 0; v < 3; v++) { px[v] = l16_div(x[v], z[v]); py[v] = l16_div(y[v], z[v]); }
-        const l16 ylo = l16_min(l16_max(l16_sub(l16_min(l16_min(py[0], py[1]), py[2]), slack), minus1), kf);
-        const l16 yhi = l16_min(l16_max(l16_add(l16_max(l16_max(py[0], py[1]), py[2]), slack), minus1), kf);
-        const l16 xlo = l16_min(l16_max(l16_sub(l16_min(l16_min(px[0], px[1]), px[2]), slack), minus1), kf);
-        const l16 xhi = l16_min(l16_max(l16_add(l16_max(l16_max(px[0], px[1]), px[2]), slack), minus1), kf);
-        const l16 iy0 = l16_max(l16_ceil(ylo), zero), iy1 = l16_min(l16_floor(yhi), l16_set1((float)k - 1.0f));
-        const l16 ix0 = l16_max(l16_ceil(xlo), zero), ix1 = l16_min(l16_floor(xhi), l16_set1((float)k - 1.0f));
+        const l16 slack = l16_set1(MS_BOX_SLACK), k1 = l16_set1((float)k - 1.0f);
+        l16 iy0, iy1, ix0, ix1;
+        /* First from the leaf test's projections x (1/z), bracketing the kernel's x / z (br_box_bracket);
+         * the six divisions only for a vector with a lane left in doubt (a bound within a few ulps of an
+         * integer, or out of range). */
+        unsigned sure = 0;
+        if (qx) {
+            l16 bx0, bx1, by0, by1;
+            /* z <= 2^100: 1 / z is a normal number, so its rounding is relative (br_box_bracket). */
+            const l16 zbig = l16_set1(0x1p100f);
+            const unsigned zok = l16_le(z[0], zbig) & l16_le(z[1], zbig) & l16_le(z[2], zbig);
+            sure = front & zok & br_box_bracket(qy, slack, minus1, kf, k1, &by0, &by1) & br_box_bracket(qx, slack, minus1, kf, k1, &bx0, &bx1);
+            iy0 = by0; iy1 = by1; ix0 = bx0; ix1 = bx1;
+        }
+        if (front & ~sure) {
+            l16 px[3], py[3];
+            for (int v = 0; v < 3; v++) { px[v] = l16_div(x[v], z[v]); py[v] = l16_div(y[v], z[v]); }
+            const l16 ylo = l16_min(l16_max(l16_sub(l16_min(l16_min(py[0], py[1]), py[2]), slack), minus1), kf);
+            const l16 yhi = l16_min(l16_max(l16_add(l16_max(l16_max(py[0], py[1]), py[2]), slack), minus1), kf);
+            const l16 xlo = l16_min(l16_max(l16_sub(l16_min(l16_min(px[0], px[1]), px[2]), slack), minus1), kf);
+            const l16 xhi = l16_min(l16_max(l16_add(l16_max(l16_max(px[0], px[1]), px[2]), slack), minus1), kf);
+            iy0 = l16_select(sure, iy0, l16_max(l16_ceil(ylo), zero));
+            iy1 = l16_select(sure, iy1, l16_min(l16_floor(yhi), k1));
+            ix0 = l16_select(sure, ix0, l16_max(l16_ceil(xlo), zero));
+            ix1 = l16_select(sure, ix1, l16_min(l16_floor(xhi), k1));
+        }
         live &= ~(front & (l16_gt(iy0, iy1) | l16_gt(ix0, ix1)));
         y0 = l16_select(front, iy0, y0);
         y1 = l16_select(front, iy1, y1);
@@ -637,7 +688,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
             for (int a = 0; a < 3; a++) mt[r][a] = BR_PIX(L->mt[r][a]);
         br_tri tr;
         br_tri_lanes(tv, &tr);
-        br_scan_setup(pass, av, &tr, mt, BR_PIX(L->near_l), BR_PIX(L->far_l), x, y, z, zmin, zmax, MS_K, &su);
+        br_scan_setup(pass, av, &tr, mt, BR_PIX(L->near_l), BR_PIX(L->far_l), x, y, z, xs, ys, zmin, zmax, MS_K, &su);
     }
 #if BR_SHORT_ROWS
     uint32_t cov[2][MS_BLOCK_LANES];
@@ -694,7 +745,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         }
         br_tri tr;
         br_tri_lanes(tv, &tr);
-        br_scan_setup(cover & ~alpha, av, &tr, L->mt, L->near_l, L->far_l, x, y, z, zmin, zmax, MS_K, &su);
+        br_scan_setup(cover & ~alpha, av, &tr, L->mt, L->near_l, L->far_l, x, y, z, xs, ys, zmin, zmax, MS_K, &su);
         by_kernel = alpha | su.kernel;
         for (unsigned p = su.rows; p; p &= p - 1) {
             const int l = __builtin_ctz(p);
