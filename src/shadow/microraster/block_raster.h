@@ -30,13 +30,14 @@ enum {
     MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS,
     MS_BR_SHARED_SETUP,                /* of the rasterizations, those set up for several pixels at once */
     MS_BR_SHARED_SETUP_CLIP,           /* of those, the ones with a near or far clip edge */
+    MS_BR_SHORT_ROWS,                  /* of those, the ones of one or two rows cleared from the lanes */
     MS_BR_COUNTERS
 };
 
 /* Flags: MS_BR_FRUSTUM_SHRINK also narrows a pixel's traversal frustum to its rectangle (the paper's
  * "FS"); MS_BR_ORDER visits nearer children first; MS_BR_NO_LANE_SETUP leaves every triangle's set-up to
  * the kernel pixel by pixel (to measure and test the shared set-up, block_raster_impl.h br_scan_setup). */
-enum { MS_BR_ORDER = 1, MS_BR_FRUSTUM_SHRINK = 2, MS_BR_NO_LANE_SETUP = 4, MS_BR_NO_SHORT_ROWS = 8 };
+enum { MS_BR_ORDER = 1, MS_BR_FRUSTUM_SHRINK = 2, MS_BR_NO_LANE_SETUP = 4 };
 
 typedef void (*ms_block_raster_fn)(const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh,
                                    ms_raster_fn raster, float near, float far, uint64_t *cnt, int flags);

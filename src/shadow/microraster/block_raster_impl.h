@@ -29,6 +29,7 @@
 #include "visibility/lanes16.h"
 #include "raster/raster_internal.h"
 #include "frustum_traverse.h"   /* MS_TRAV_SIDE_SLACK; alpha.h */
+#include "box_bracket.h"
 
 #ifndef MS_BR_COMMON
 #define MS_BR_COMMON
@@ -108,40 +109,6 @@ static inline void br_tri_lanes(const l16 v[3][3], br_tri *t)
     t->nw[0] = l16_sub(l16_mul(sa[1], sb[2]), l16_mul(sa[2], sb[1]));
     t->nw[1] = l16_sub(l16_mul(sa[2], sb[0]), l16_mul(sa[0], sb[2]));
     t->nw[2] = l16_sub(l16_mul(sa[0], sb[1]), l16_mul(sa[1], sb[0]));
-}
-
-/* The kernel's row or column range of a triangle in front of C, from the leaf test's projections
- * q_v = fl(c_v fl(1/z_v)) instead of the kernel's fl(c_v / z_v): the lanes (returned mask) where the two
- * provably give the same i0 = max(ceil(clamp(min_v - slack)), 0) and i1 = min(floor(clamp(max_v + slack)),
- * k - 1), with those values in i0, i1. Why it holds: q_v and the kernel's p_v are both c_v / z_v times
- * (1 + e) with |e| <= 2u + u^2 resp. u (u = 2^-24, round to nearest), so |q_v - p_v| < 3.01 u |q_v|, plus
- * 2^-149 where a product or quotient is subnormal. q_v -+ (2^-20 |q_v| + 2^-100), rounded, therefore
- * bracket p_v (the rounding of the bracket moves it by at most u of itself, far inside the 16 u); min,
- * max, the rounded subtraction or addition of the slack, the clamps, ceil and floor are all monotone, so
- * the kernel's i0 (i1) lies between the values computed from the lower and the upper brackets, and where
- * those agree it is that value. Lanes with |q_v| > 2^100 or NaN (z tiny, non-finite input) are left to
- * the division, and so are lanes with z > 2^100 (the caller: there 1 / z may be subnormal). */
-static inline unsigned br_box_bracket(const l16 q[3], l16 slack, l16 minus1, l16 kf, l16 k1, l16 *i0, l16 *i1)
-{
-    const l16 rel = l16_set1(1.0f / 1048576.0f), tiny = l16_set1(0x1p-100f), big = l16_set1(0x1p100f), zero = l16_set1(0.0f);
-    unsigned fin = 0xFFFFu;
-    l16 lo[3], hi[3];
-    for (int v = 0; v < 3; v++) {
-        const l16 aq = l16_abs(q[v]);
-        fin &= l16_le(aq, big);
-        const l16 d = l16_add(l16_mul(aq, rel), tiny);
-        lo[v] = l16_sub(q[v], d);
-        hi[v] = l16_add(q[v], d);
-    }
-    const l16 minl = l16_min(l16_min(lo[0], lo[1]), lo[2]), minh = l16_min(l16_min(hi[0], hi[1]), hi[2]);
-    const l16 maxl = l16_max(l16_max(lo[0], lo[1]), lo[2]), maxh = l16_max(l16_max(hi[0], hi[1]), hi[2]);
-    const l16 a0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(minl, slack), minus1), kf)), zero);
-    const l16 b0 = l16_max(l16_ceil(l16_min(l16_max(l16_sub(minh, slack), minus1), kf)), zero);
-    const l16 a1 = l16_min(l16_floor(l16_min(l16_max(l16_add(maxl, slack), minus1), kf)), k1);
-    const l16 b1 = l16_min(l16_floor(l16_min(l16_max(l16_add(maxh, slack), minus1), kf)), k1);
-    *i0 = a0;
-    *i1 = a1;
-    return fin & l16_le(b0, a0) & l16_le(b1, a1);   /* a <= b by monotonicity: equal */
 }
 
 /* Issue #29 item 2, "set up each triangle once per block": the SIMD Scanline kernel's set-up
@@ -302,7 +269,7 @@ typedef struct br_leaf_ctx {
     l16 tv[9];                                      /* the triangle group's vertices (lane = triangle) */
     uint32_t first;                                 /* the group's first triangle */
     unsigned rasterized;                            /* pixels that rasterized something */
-    uint64_t c_depth, c_rect, c_corner, c_cov, c_rast, c_shared, c_shared_clip;
+    uint64_t c_depth, c_rect, c_corner, c_cov, c_rast, c_shared, c_shared_clip, c_short;
 } br_leaf_ctx;
 #endif
 
@@ -692,7 +659,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
     }
 #if BR_SHORT_ROWS
     uint32_t cov[2][MS_BLOCK_LANES];
-    const unsigned short_lanes = su.rows && !(s->flags & MS_BR_NO_SHORT_ROWS) ? MS_KFN(br_short_rows)(&su, su.rows, cov) : 0;
+    const unsigned short_lanes = su.rows ? MS_KFN(br_short_rows)(&su, su.rows, cov) : 0;
 #endif
     for (unsigned p = pass; p; p &= p - 1) {
         const int e = __builtin_ctz(p), l = pl[e];
@@ -713,6 +680,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
                 if (y0 < MS_K - 1) buf[y0 + 1] &= (MS_WORD)~cov[1][e];   /* 0 when the lane spans one row */
                 L->c_shared++;
                 L->c_shared_clip += su.clip >> e & 1;
+                L->c_short++;
                 continue;
             }
 #endif
@@ -793,7 +761,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     L.near_l = l16_load(s->near_l);
     L.far_l = l16_load(s->far_l);
     L.rasterized = 0;
-    L.c_depth = L.c_rect = L.c_corner = L.c_cov = L.c_rast = L.c_shared = L.c_shared_clip = 0;
+    L.c_depth = L.c_rect = L.c_corner = L.c_cov = L.c_rast = L.c_shared = L.c_shared_clip = L.c_short = 0;
     uint64_t tri_lanes = 0;
     /* The live pixels do not change within a leaf (a pixel retires after it, below). */
     const unsigned live = mask & fr->live;
@@ -848,6 +816,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_RASTERIZED] += L.c_rast;
     cnt[MS_BR_SHARED_SETUP] += L.c_shared;
     cnt[MS_BR_SHARED_SETUP_CLIP] += L.c_shared_clip;
+    cnt[MS_BR_SHORT_ROWS] += L.c_short;
     /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */
     const int fs = s->flags & MS_BR_FRUSTUM_SHRINK;
     unsigned rasterized = L.rasterized;
