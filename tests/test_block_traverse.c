@@ -121,14 +121,6 @@ static void block_equals_pixel(const ms_scene *sc, const char *label, const int 
                     /* Likewise the clip edges' lanes of that set-up, wherever the scene has triangles that
                      * reach the near or far plane. */
                     if (want_clipped) assert_true(clipped > 0);
-                    /* And with AVX-512 at k <= 32 the short rasterizations (one or two rows) cleared from
-                     * the set-up's lanes (block_raster_impl.h, br_short_rows). */
-                    if (cap == MS_ISA_AVX512 && ks[ki] <= 32) {
-                        const uint64_t short_rows = counter(&b, "short_rows");
-                        printf("%-22s %-12s k=%-2d %-6s: %llu short rasterizations cleared from the lanes\n", label,
-                               kernels[m], ks[ki], ms_isa_name((ms_isa)cap), (unsigned long long)short_rows);
-                        assert_true(short_rows > 0);
-                    }
                 }
                 free(b.vis);
                 free(p.vis);

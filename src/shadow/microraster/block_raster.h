@@ -30,7 +30,6 @@ enum {
     MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS,
     MS_BR_SHARED_SETUP,                /* of the rasterizations, those set up for several pixels at once */
     MS_BR_SHARED_SETUP_CLIP,           /* of those, the ones with a near or far clip edge */
-    MS_BR_SHORT_ROWS,                  /* of those, the ones of one or two rows cleared from the lanes */
     MS_BR_COUNTERS
 };
 

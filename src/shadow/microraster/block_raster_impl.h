@@ -124,10 +124,11 @@ static inline void br_tri_lanes(const l16 v[3][3], br_tri *t)
  * reaches the near or far plane (clip edges), has an edge parallel to the scanlines, or has a non-finite
  * length goes to the kernel. The world edges and the plane normal do not depend on the pixel: they are
  * computed once, in scalar form with the same operations.
- * x, y, z: the vertices' light-index coordinates per lane, zmin / zmax their widened depth range (the
- * leaf test's, the kernel's operations); a[v][j] the world vectors P_v - C. */
+ * x, y, z: the vertices' light-index coordinates per lane, qx, qy their projections x (1/z), y (1/z),
+ * zmin / zmax their widened depth range (the leaf test's, the kernel's operations); a[v][j] the world
+ * vectors P_v - C. */
 static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri *tr, const l16 mt[3][3], l16 near_l,
-                                 l16 far_l, const l16 x[3], const l16 y[3], const l16 z[3], const l16 *qx, const l16 *qy,
+                                 l16 far_l, const l16 x[3], const l16 y[3], const l16 z[3], const l16 qx[3], const l16 qy[3],
                                  l16 zmin, l16 zmax, int k, br_setup *o)
 {
     const l16 zero = l16_set1(0.0f), kf = l16_set1((float)k);
@@ -220,15 +221,11 @@ static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri
         /* First from the leaf test's projections x (1/z), bracketing the kernel's x / z (br_box_bracket);
          * the six divisions only for a vector with a lane left in doubt (a bound within a few ulps of an
          * integer, or out of range). */
-        unsigned sure = 0;
-        if (qx) {
-            l16 bx0, bx1, by0, by1;
-            /* z <= 2^100: 1 / z is a normal number, so its rounding is relative (br_box_bracket). */
-            const l16 zbig = l16_set1(0x1p100f);
-            const unsigned zok = l16_le(z[0], zbig) & l16_le(z[1], zbig) & l16_le(z[2], zbig);
-            sure = front & zok & br_box_bracket(qy, slack, minus1, kf, k1, &by0, &by1) & br_box_bracket(qx, slack, minus1, kf, k1, &bx0, &bx1);
-            iy0 = by0; iy1 = by1; ix0 = bx0; ix1 = bx1;
-        }
+        /* z <= 2^100: 1 / z is a normal number, so its rounding is relative (br_box_bracket). */
+        const l16 zbig = l16_set1(0x1p100f);
+        const unsigned zok = l16_le(z[0], zbig) & l16_le(z[1], zbig) & l16_le(z[2], zbig);
+        const unsigned sure = front & zok & br_box_bracket(qy, slack, minus1, kf, k1, &iy0, &iy1) &
+                              br_box_bracket(qx, slack, minus1, kf, k1, &ix0, &ix1);
         if (front & ~sure) {
             l16 px[3], py[3];
             for (int v = 0; v < 3; v++) { px[v] = l16_div(x[v], z[v]); py[v] = l16_div(y[v], z[v]); }
@@ -269,7 +266,7 @@ typedef struct br_leaf_ctx {
     l16 tv[9];                                      /* the triangle group's vertices (lane = triangle) */
     uint32_t first;                                 /* the group's first triangle */
     unsigned rasterized;                            /* pixels that rasterized something */
-    uint64_t c_depth, c_rect, c_corner, c_cov, c_rast, c_shared, c_shared_clip, c_short;
+    uint64_t c_depth, c_rect, c_corner, c_cov, c_rast, c_shared, c_shared_clip;
 } br_leaf_ctx;
 #endif
 
@@ -478,54 +475,6 @@ static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e,
     L->c_shared_clip += ne == 5;
 }
 
-#undef BR_SHORT_ROWS   /* per k: this file is included once per instance */
-#if defined(MS_TARGET_AVX512) && MS_K <= 32
-#define BR_SHORT_ROWS 1
-/* The set-up's lanes that span at most two scanlines (y1 - y0 <= 1), of `lanes`; their coverage words, rows
- * y0 and y0 + 1 (0 outside y0..y1), into cov[0] and cov[1] per lane. Most rasterizations are short: on the
- * big-light Sponza (1024 samples) 68% span one or two rows, the shaft's walls and round windows next to the
- * light, and 70% of those clear nothing. The kernel's row loop (scanline_simd_impl.h, ms_interval and
- * r_cover32) evaluates sixteen rows of one lane per instruction; here the same operations evaluate one row
- * of sixteen lanes: the same fused multiply-add a y + b, the same max and min in the same operand order
- * (so the same NaN and signed-zero outcomes), the same rounding conversions and variable shifts (counts
- * out of range give 0). Each lane's words are therefore the kernel's bit for bit, and a lane's pixel then
- * needs two AND-NOTs instead of a call of the row loop. */
-static inline unsigned MS_KFN(br_short_rows)(const br_setup *su, unsigned lanes, uint32_t cov[2][MS_BLOCK_LANES])
-{
-    const __m512i y0 = _mm512_loadu_si512((const void *)su->v.y0), y1 = _mm512_loadu_si512((const void *)su->v.y1);
-    const __m512i one_i = _mm512_set1_epi32(1);
-    const unsigned short_lanes = lanes & (unsigned)_mm512_cmp_epi32_mask(y1, _mm512_add_epi32(y0, one_i), _MM_CMPINT_LE);
-    if (!short_lanes) return 0;
-    const __m512 zero = _mm512_setzero_ps(), kf1 = _mm512_set1_ps((float)MS_K - 1.0f);
-    const __m512i ones = _mm512_set1_epi32(MS_K == 16 ? 0xFFFF : -1), top = _mm512_set1_epi32(MS_K - 1);
-    const __mmask16 clip = (__mmask16)(su->clip & short_lanes);
-    for (int r = 0; r < 2; r++) {
-        const __m512i yi = _mm512_add_epi32(y0, _mm512_set1_epi32(r));
-        const __m512 y = _mm512_cvtepi32_ps(yi);
-        __m512 lo[5], hi[5];
-        const int ne = clip ? 5 : 3;   /* edges 3 and 4 are written only when some lane clips */
-        for (int e = 0; e < ne; e++) {
-            lo[e] = _mm512_fmadd_ps(_mm512_loadu_ps(su->v.al[e]), y, _mm512_loadu_ps(su->v.bl[e]));
-            hi[e] = _mm512_fmadd_ps(_mm512_loadu_ps(su->v.au[e]), y, _mm512_loadu_ps(su->v.bu[e]));
-        }
-        const __m512 l01 = _mm512_max_ps(lo[0], lo[1]), h01 = _mm512_min_ps(hi[0], hi[1]);
-        __m512 l2 = _mm512_max_ps(lo[2], zero), h2 = _mm512_min_ps(hi[2], kf1);
-        if (clip) {   /* the five-edge lanes: their row loop's extra max and min */
-            l2 = _mm512_mask_max_ps(l2, clip, l2, _mm512_max_ps(lo[3], lo[4]));
-            h2 = _mm512_mask_min_ps(h2, clip, h2, _mm512_min_ps(hi[3], hi[4]));
-        }
-        const __m512i l = _mm512_cvt_roundps_epi32(_mm512_max_ps(l01, l2), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
-        const __m512i h = _mm512_cvt_roundps_epi32(_mm512_min_ps(h01, h2), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-        const __mmask16 rows = (__mmask16)short_lanes & _mm512_cmp_epi32_mask(yi, y1, _MM_CMPINT_LE);
-        _mm512_storeu_si512((void *)cov[r], _mm512_maskz_and_epi32(rows, _mm512_sllv_epi32(ones, l),
-                                                                  _mm512_srlv_epi32(ones, _mm512_sub_epi32(top, h))));
-    }
-    return short_lanes;
-}
-#else
-#define BR_SHORT_ROWS 0
-#endif
-
 /* The leaf tests of a group of the leaf's triangles. Packed layout (BR_PACK): lane e is the (triangle,
  * pixel) pair (first + pt[e], pl[e]), e < np, the pairs sixteen to a vector. In a leaf a triangle reaches on
  * average a few of the block's pixels (3.4 of 16 on the big-light Sponza), so the per-triangle tests with
@@ -657,10 +606,6 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         br_tri_lanes(tv, &tr);
         br_scan_setup(pass, av, &tr, mt, BR_PIX(L->near_l), BR_PIX(L->far_l), x, y, z, xs, ys, zmin, zmax, MS_K, &su);
     }
-#if BR_SHORT_ROWS
-    uint32_t cov[2][MS_BLOCK_LANES];
-    const unsigned short_lanes = su.rows ? MS_KFN(br_short_rows)(&su, su.rows, cov) : 0;
-#endif
     for (unsigned p = pass; p; p &= p - 1) {
         const int e = __builtin_ctz(p), l = pl[e];
         const uint32_t t = L->first + (uint32_t)pt[e];
@@ -672,18 +617,6 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel;
          * a lane the set-up left to the kernel likewise. */
         if (s->rows && !(su.kernel >> e & 1) && !ms_frame_alpha_tested(in->frame[l], t)) {
-#if BR_SHORT_ROWS
-            if (short_lanes >> e & 1) {
-                MS_WORD *buf = (MS_WORD *)in->buf[l];
-                const int y0 = su.v.y0[e];
-                buf[y0] &= (MS_WORD)~cov[0][e];
-                if (y0 < MS_K - 1) buf[y0 + 1] &= (MS_WORD)~cov[1][e];   /* 0 when the lane spans one row */
-                L->c_shared++;
-                L->c_shared_clip += su.clip >> e & 1;
-                L->c_short++;
-                continue;
-            }
-#endif
             if (su.rows >> e & 1) MS_KFN(br_rows)(s, &su, e, in->buf[l], L);
             continue;   /* else the set-up found nothing to clear, as the kernel would */
         }
@@ -761,7 +694,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     L.near_l = l16_load(s->near_l);
     L.far_l = l16_load(s->far_l);
     L.rasterized = 0;
-    L.c_depth = L.c_rect = L.c_corner = L.c_cov = L.c_rast = L.c_shared = L.c_shared_clip = L.c_short = 0;
+    L.c_depth = L.c_rect = L.c_corner = L.c_cov = L.c_rast = L.c_shared = L.c_shared_clip = 0;
     uint64_t tri_lanes = 0;
     /* The live pixels do not change within a leaf (a pixel retires after it, below). */
     const unsigned live = mask & fr->live;
@@ -816,7 +749,6 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask)
     cnt[MS_BR_RASTERIZED] += L.c_rast;
     cnt[MS_BR_SHARED_SETUP] += L.c_shared;
     cnt[MS_BR_SHARED_SETUP_CLIP] += L.c_shared_clip;
-    cnt[MS_BR_SHORT_ROWS] += L.c_short;
     /* Shrink the rectangles of the pixels that rasterized (CR), and retire those left with nothing. */
     const int fs = s->flags & MS_BR_FRUSTUM_SHRINK;
     unsigned rasterized = L.rasterized;

@@ -58,7 +58,7 @@ typedef struct mr_state {
 static const char *const block_counter_names[] = {
     "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "leaf_pixels_culled", "tri_pixel_tests",
     "culled_depth", "culled_rect", "culled_corner_rays", "culled_coverage", "triangles_rasterized",
-    "pixels_early_out", "rect_shrinks", "shared_setups", "shared_setups_clipped", "short_rows", "pixels_traced_edge_on", "interior_rasterized", "interior_pixels_emptied"
+    "pixels_early_out", "rect_shrinks", "shared_setups", "shared_setups_clipped", "pixels_traced_edge_on", "interior_rasterized", "interior_pixels_emptied"
 };
 /* The interior boxes' pass adds to every counter above (its work is work) and to its own two. */
 enum { MR_BLOCK_EDGE_ON = MS_BR_COUNTERS, MR_INTERIOR_RASTERIZED, MR_INTERIOR_EMPTIED, MR_BLOCK_COUNTERS };
