@@ -29,7 +29,6 @@
 #include "visibility/lanes16.h"
 #include "raster/raster_internal.h"
 #include "frustum_traverse.h"   /* MS_TRAV_SIDE_SLACK; alpha.h */
-#include "box_bracket.h"
 
 #ifndef MS_BR_COMMON
 #define MS_BR_COMMON
@@ -124,12 +123,11 @@ static inline void br_tri_lanes(const l16 v[3][3], br_tri *t)
  * reaches the near or far plane (clip edges), has an edge parallel to the scanlines, or has a non-finite
  * length goes to the kernel. The world edges and the plane normal do not depend on the pixel: they are
  * computed once, in scalar form with the same operations.
- * x, y, z: the vertices' light-index coordinates per lane, qx, qy their projections x (1/z), y (1/z),
- * zmin / zmax their widened depth range (the leaf test's, the kernel's operations); a[v][j] the world
- * vectors P_v - C. */
+ * x, y, z: the vertices' light-index coordinates per lane, zmin / zmax their widened depth range (the
+ * leaf test's, the kernel's operations); a[v][j] the world vectors P_v - C. */
 static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri *tr, const l16 mt[3][3], l16 near_l,
-                                 l16 far_l, const l16 x[3], const l16 y[3], const l16 z[3], const l16 qx[3], const l16 qy[3],
-                                 l16 zmin, l16 zmax, int k, br_setup *o)
+                                 l16 far_l, const l16 x[3], const l16 y[3], const l16 z[3], l16 zmin, l16 zmax, int k,
+                                 br_setup *o)
 {
     const l16 zero = l16_set1(0.0f), kf = l16_set1((float)k);
     /* The lanes whose triangle reaches the near resp. far plane: the kernel's clip edges N and F. */
@@ -216,28 +214,15 @@ static inline void br_scan_setup(unsigned lanes, const l16 a[3][3], const br_tri
     const unsigned front = live & l16_gt(zmin, zero);
     l16 y0 = zero, y1 = l16_set1((float)k - 1.0f);
     if (front) {
-        const l16 slack = l16_set1(MS_BOX_SLACK), k1 = l16_set1((float)k - 1.0f);
-        l16 iy0, iy1, ix0, ix1;
-        /* First from the leaf test's projections x (1/z), bracketing the kernel's x / z (br_box_bracket);
-         * the six divisions only for a vector with a lane left in doubt (a bound within a few ulps of an
-         * integer, or out of range). */
-        /* z <= 2^100: 1 / z is a normal number, so its rounding is relative (br_box_bracket). */
-        const l16 zbig = l16_set1(0x1p100f);
-        const unsigned zok = l16_le(z[0], zbig) & l16_le(z[1], zbig) & l16_le(z[2], zbig);
-        const unsigned sure = front & zok & br_box_bracket(qy, slack, minus1, kf, k1, &iy0, &iy1) &
-                              br_box_bracket(qx, slack, minus1, kf, k1, &ix0, &ix1);
-        if (front & ~sure) {
-            l16 px[3], py[3];
-            for (int v = 0; v < 3; v++) { px[v] = l16_div(x[v], z[v]); py[v] = l16_div(y[v], z[v]); }
-            const l16 ylo = l16_min(l16_max(l16_sub(l16_min(l16_min(py[0], py[1]), py[2]), slack), minus1), kf);
-            const l16 yhi = l16_min(l16_max(l16_add(l16_max(l16_max(py[0], py[1]), py[2]), slack), minus1), kf);
-            const l16 xlo = l16_min(l16_max(l16_sub(l16_min(l16_min(px[0], px[1]), px[2]), slack), minus1), kf);
-            const l16 xhi = l16_min(l16_max(l16_add(l16_max(l16_max(px[0], px[1]), px[2]), slack), minus1), kf);
-            iy0 = l16_select(sure, iy0, l16_max(l16_ceil(ylo), zero));
-            iy1 = l16_select(sure, iy1, l16_min(l16_floor(yhi), k1));
-            ix0 = l16_select(sure, ix0, l16_max(l16_ceil(xlo), zero));
-            ix1 = l16_select(sure, ix1, l16_min(l16_floor(xhi), k1));
-        }
+        const l16 slack = l16_set1(MS_BOX_SLACK);
+        l16 px[3], py[3];
+        for (int v = 0; v < 3; v++) { px[v] = l16_div(x[v], z[v]); py[v] = l16_div(y[v], z[v]); }
+        const l16 ylo = l16_min(l16_max(l16_sub(l16_min(l16_min(py[0], py[1]), py[2]), slack), minus1), kf);
+        const l16 yhi = l16_min(l16_max(l16_add(l16_max(l16_max(py[0], py[1]), py[2]), slack), minus1), kf);
+        const l16 xlo = l16_min(l16_max(l16_sub(l16_min(l16_min(px[0], px[1]), px[2]), slack), minus1), kf);
+        const l16 xhi = l16_min(l16_max(l16_add(l16_max(l16_max(px[0], px[1]), px[2]), slack), minus1), kf);
+        const l16 iy0 = l16_max(l16_ceil(ylo), zero), iy1 = l16_min(l16_floor(yhi), l16_set1((float)k - 1.0f));
+        const l16 ix0 = l16_max(l16_ceil(xlo), zero), ix1 = l16_min(l16_floor(xhi), l16_set1((float)k - 1.0f));
         live &= ~(front & (l16_gt(iy0, iy1) | l16_gt(ix0, ix1)));
         y0 = l16_select(front, iy0, y0);
         y1 = l16_select(front, iy1, y1);
@@ -604,7 +589,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
             for (int a = 0; a < 3; a++) mt[r][a] = BR_PIX(L->mt[r][a]);
         br_tri tr;
         br_tri_lanes(tv, &tr);
-        br_scan_setup(pass, av, &tr, mt, BR_PIX(L->near_l), BR_PIX(L->far_l), x, y, z, xs, ys, zmin, zmax, MS_K, &su);
+        br_scan_setup(pass, av, &tr, mt, BR_PIX(L->near_l), BR_PIX(L->far_l), x, y, z, zmin, zmax, MS_K, &su);
     }
     for (unsigned p = pass; p; p &= p - 1) {
         const int e = __builtin_ctz(p), l = pl[e];
@@ -646,7 +631,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         }
         br_tri tr;
         br_tri_lanes(tv, &tr);
-        br_scan_setup(cover & ~alpha, av, &tr, L->mt, L->near_l, L->far_l, x, y, z, xs, ys, zmin, zmax, MS_K, &su);
+        br_scan_setup(cover & ~alpha, av, &tr, L->mt, L->near_l, L->far_l, x, y, z, zmin, zmax, MS_K, &su);
         by_kernel = alpha | su.kernel;
         for (unsigned p = su.rows; p; p &= p - 1) {
             const int l = __builtin_ctz(p);
