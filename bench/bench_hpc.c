@@ -96,7 +96,7 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ","))
                 for (int m = 0; m < NM; m++) run[m] |= !strcmp(t, methods[m]);
         } else if (!strcmp(argv[first], "--off")) {
-            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule" };
+            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule", "rect" };
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ",")) {
                 int found = 0;
                 for (int b = 0; b < (int)(sizeof names / sizeof *names); b++)
@@ -112,8 +112,8 @@ int main(int argc, char **argv)
     printf("| scene | light | N | size | raytrace s | scanline s | hpc sort s | hpc build s | hpc cast s | hpc total s "
            "| hpc-scanline total s | raytrace/hpc | raytrace/hpc-scanline | scanline/hpc-scanline | hpc points MB "
            "| hpc hierarchy MB | hpc mask MB | hpc px != raytrace | hpc-scanline px != raytrace | triangles "
-           "| pairs in V_L | pairs to footprint | leaf culls | leaf culls blocked | sample tests | samples blocked | full-umbra points | rebuilds |\n");
-    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+           "| pairs in V_L | pairs to footprint | leaf culls | leaf culls blocked | rect pairs | sample tests | samples blocked | full-umbra points | rebuilds |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int a = first; a < argc; a++) {
         ms_scene sc;
         char err[1024];
@@ -162,7 +162,7 @@ int main(int argc, char **argv)
                     if (have[SL] && have[HPCS]) snprintf(ratio[2], sizeof ratio[2], "%.2f", total_s(&f[SL], SL) / total_s(&f[HPCS], HPCS));
                     const ms_frame *h = &f[HPC];
                     printf("| %s | x%g | %d | %d | %s | %s | %.3f | %.3f | %.3f | %s | %s | %s | %s | %s | %.1f | %.1f | %.1f | %s | %s "
-                           "| %llu | %llu | %llu | %llu | %llu | %llu | %llu | %llu | %llu |\n",
+                           "| %llu | %llu | %llu | %llu | %llu | %llu | %llu | %llu | %llu | %llu |\n",
                            label, (double)(scales[li] * scales[li]), samples[ni], sizes[s], col[RT], col[SL],
                            (double)counter(h, "sort_us") * 1e-6, (double)counter(h, "build_us") * 1e-6,
                            (double)counter(h, "cast_us") * 1e-6, col[HPC], col[HPCS], ratio[0], ratio[1], ratio[2],
@@ -170,7 +170,7 @@ int main(int argc, char **argv)
                            (double)(counter(h, "mask_bytes") + counter(h, "sample_bytes")) / 1048576.0, diff[0], diff[1],
                            (unsigned long long)counter(h, "triangles"), (unsigned long long)counter(h, "pairs_in_vl"),
                            (unsigned long long)counter(h, "pairs_footprint"), (unsigned long long)counter(h, "leaf_culls"),
-                           (unsigned long long)counter(h, "leaf_culls_blocked"),
+                           (unsigned long long)counter(h, "leaf_culls_blocked"), (unsigned long long)counter(h, "rect_pairs"),
                            (unsigned long long)counter(h, "sample_tests"), (unsigned long long)counter(h, "samples_blocked"),
                            (unsigned long long)counter(h, "full_umbra_points"), (unsigned long long)counter(h, "rebuilds"));
                     fflush(stdout);

@@ -149,6 +149,18 @@ static void emit(const rect *r, float *out)
         }
 }
 
+int ms_coplanar_rect_pair(const float *a, const float *b, float corners[12])
+{
+    rect x, y;
+    if (!as_half(a, &x) || !as_half(b, &y) || !same_rect(&x, &y) || (x.mc ^ y.mc) != 3u) return 0;
+    float t[18];   /* emit's two triangles: corners 0 1 2 and 0 2 3, i.e. (u0 v0) (u1 v0) (u1 v1) (u0 v1) */
+    emit(&x, t);
+    static const int at[4] = { 0, 3, 6, 15 }, of_mc[4] = { 0, 1, 3, 2 };   /* a corner in t; mc's corner */
+    const int m = of_mc[x.mc];   /* the corner a leaves out: the last */
+    for (int i = 0; i < 4; i++) memcpy(corners + 3 * i, t + at[(m + 1 + i) % 4], 3 * sizeof *t);
+    return 1;
+}
+
 int ms_coplanar_merge(const float *tri, size_t n, const uint8_t *eligible, float **out, size_t *n_out,
                       uint32_t **of_input, uint32_t **source, uint8_t **merged)
 {

@@ -106,6 +106,7 @@
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
 #include "accel/ray_triangle.h"
+#include "accel/coplanar.h"
 #include "light/pattern.h"
 #include "light/light_frame.h"
 #include "core/vec.h"
@@ -142,6 +143,7 @@ enum {
     C_PAIRS_FOOTPRINT,   /* of those, the pairs that reach the per-receiver footprint (past the leaf footprint) */
     C_LEAF_CULLS,        /* (leaf, triangle) pairs the leaf footprint rules out for every receiver of the leaf */
     C_LEAF_CULLS_BLOCKED,   /* of the others, those whose candidate samples are blocked already for every receiver */
+    C_RECT_PAIRS,        /* (leaf, pair) bounded by the pair's rectangle (one footprint for both triangles) */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -159,6 +161,8 @@ typedef struct tri_job {
     uint32_t self;           /* the triangle's id: receivers on it are not blocked by it */
     int pair;                /* 1: cast together with the next job (a triangle sharing an edge), vl bounds both;
                               * -1: cast with the previous one (its vl unused); 0: alone (pair_batch) */
+    int rect;                /* pair 1 only: the two are the halves of one axis-aligned rectangle, corners rc */
+    float rc[12];
     hpc_volume vl;
 } tri_job;
 
@@ -607,17 +611,22 @@ static void footprint_setup(hpc_footprint *f, const float A[3], const float B[3]
  * out; alike below. Elsewhere (the plane through the receiver parallel to the triangle crosses these
  * samples) only mixed signs beyond the slacks rule them out. lo, hi: bounds of E_0, E_1, E_2 and E_sum over
  * each lane's samples; s: each lane's slacks. Returns the lanes that may be hit. */
-static inline unsigned footprint_keep_lanes(const l16 lo[4], const l16 hi[4], const l16 s[3])
+static inline unsigned footprint_keep_n(const l16 *lo, const l16 *hi, const l16 *s, int n)
 {
-    const l16 s2 = l16_mul(l16_set1(2.0f), l16_add(l16_add(s[0], s[1]), s[2]));
-    const unsigned up = l16_gt(lo[3], s2), down = l16_lt(hi[3], l16_sub(l16_set1(0.0f), s2));
+    l16 ss = s[0];
+    for (int e = 1; e < n; e++) ss = l16_add(ss, s[e]);
+    const l16 s2 = l16_mul(l16_set1(2.0f), ss);
+    const unsigned up = l16_gt(lo[n], s2), down = l16_lt(hi[n], l16_sub(l16_set1(0.0f), s2));
     unsigned pos = 0, neg = 0;
-    for (int e = 0; e < 3; e++) {
+    for (int e = 0; e < n; e++) {
         pos |= l16_gt(lo[e], s[e]);                          /* E_e > s_e throughout */
         neg |= l16_lt(hi[e], l16_sub(l16_set1(0.0f), s[e]));   /* E_e < -s_e throughout */
     }
     return ~((pos & neg) | (up & neg) | (down & pos)) & 0xffffu;
 }
+
+/* A triangle's three functions and their sum (lo[3], hi[3]). */
+static inline unsigned footprint_keep_lanes(const l16 lo[4], const l16 hi[4], const l16 s[3]) { return footprint_keep_n(lo, hi, s, 3); }
 
 /* The same with one slack for every lane (a receiver's functions over 16 groups or samples). */
 static inline unsigned footprint_keep(const l16 lo[4], const l16 hi[4], const float s[3])
@@ -688,16 +697,34 @@ static void footprint_offsets(const hpc_footprint *f, l16 oi, l16 oj, l16 off[4]
  * the others bound each receiver's groups and lanes. */
 typedef struct leaf_box { float pc[3], h[3], p0c[3], J[3]; } leaf_box;
 
-/* The bound's terms per edge function of a job's triangles (leaf_setup) and the sum's. */
+/* The bound's terms per edge function of a shape (leaf_setup: a triangle, or a rectangle pair's rectangle) and
+ * the sum's (at [nf]). */
 typedef struct leaf_fn {
-    float e[4][3], s[3];      /* E_c's coefficients (as hpc_footprint's), the slacks */
-    float gst[3][3][3];       /* per function: g at the grid's origin, per column, per row */
-    float ufix[4], uspan[3];  /* per function: U's terms that do not depend on the group */
+    int nf;                   /* edge functions: 3 (a triangle) or 4 (a rectangle) */
+    float e[5][3], s[4];      /* E_c's coefficients (as hpc_footprint's), the slacks */
+    float gst[4][3][3];       /* per function: g at the grid's origin, per column, per row */
+    float ufix[5], uspan[4];  /* per function: U's terms that do not depend on the group */
 } leaf_fn;
 
-/* leaf_fn of the nt triangles of job t for box b: the three functions of both triangles in the lanes, each
- * lane the arithmetic the comments above give (IEEE per lane, as everywhere in lanes16.h). */
-static void leaf_setup(const shared *sh, const leaf_box *b, const tri_job *t, int nt, leaf_fn *out)
+/* A footprint's shape: a triangle (3 vertices, its own edge functions) or a rectangle pair's rectangle (4
+ * corners in order around it; "rectangle pairs" below). fp_edges: each function's two vertices, Y1 x Y2, the
+ * same orientation for both (C x B, A x C, B x A as footprint_setup; P1 x P0, ..., P0 x P3 around the
+ * rectangle). */
+typedef struct fp_shape { const float *v; int nv; } fp_shape;
+static const int fp_edges[2][4][2] = { { { 2, 1 }, { 0, 2 }, { 1, 0 }, { 0, 0 } }, { { 1, 0 }, { 2, 1 }, { 3, 2 }, { 0, 3 } } };
+
+/* The slack's factor of a rectangle's functions ("rectangle pairs" below): s = RECT_SLACK rel M^2, M the
+ * largest |corner - p|inf (MS_HPC_BREAK_RECT: 0, wrong on purpose). */
+#define RECT_SLACK(sh) ((sh)->sw & MS_HPC_BREAK_RECT ? 0.0f : 2.0f)
+
+/* A rectangle pair's functions per receiver: its four sides and the diagonal P0 x P2 (the first triangle's
+ * third function; the second's is its negation, exactly); rect_tri: each triangle's three of them. */
+static const int rect_fns[5][2] = { { 1, 0 }, { 2, 1 }, { 3, 2 }, { 0, 3 }, { 0, 2 } };
+static const int rect_tri[2][3] = { { 0, 1, 4 }, { 2, 3, 4 } };
+
+/* leaf_fn of the ns shapes shp for box b: the functions of all shapes in the lanes (up to 6), each lane the
+ * arithmetic the comments above give (IEEE per lane, as everywhere in lanes16.h). */
+static void leaf_setup(const shared *sh, const leaf_box *b, const fp_shape *shp, int ns, leaf_fn *out)
 {
     const int k = sh->k, gs = sh->gs;
     const float *ds = sh->grid_ds, *dt = sh->grid_dt;
@@ -710,18 +737,20 @@ static void leaf_setup(const shared *sh, const leaf_box *b, const tri_job *t, in
         S = ms_maxf(S, fabsf(b->p0c[a]) + b->J[a] + ext + fabsf(b->pc[a]) + b->h[a]);
     }
     const float rel = 2.0f * 5.9604645e-08f * (1.01f * (512.0f * dmax + 128.0f * S));
-    static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A (footprint_setup) */
     float y1[3][LANES] = { { 0 } }, y2[3][LANES] = { { 0 } }, n12[LANES] = { 0 };
-    for (int u = 0; u < nt; u++) {
-        float Y[3][3], nY[3];
-        for (int v = 0; v < 3; v++) {
-            for (int a = 0; a < 3; a++) Y[v][a] = t[u].v[3 * v + a] - b->pc[a];
+    int lane0[2];
+    for (int u = 0, l = 0; u < ns; u++) {
+        const int nv = shp[u].nv, (*pair)[2] = fp_edges[nv == 4];
+        float Y[4][3], nY[4], M = 0.0f;
+        for (int v = 0; v < nv; v++) {
+            for (int a = 0; a < 3; a++) Y[v][a] = shp[u].v[3 * v + a] - b->pc[a];
             nY[v] = inf_norm3(Y[v]) + hmax;
+            M = ms_maxf(M, nY[v]);
         }
-        for (int f = 0; f < 3; f++) {
-            const int l = 3 * u + f;
+        lane0[u] = l;
+        for (int f = 0; f < nv; f++, l++) {
             for (int a = 0; a < 3; a++) { y1[a][l] = Y[pair[f][0]][a]; y2[a][l] = Y[pair[f][1]][a]; }
-            n12[l] = nY[pair[f][0]] * nY[pair[f][1]];
+            n12[l] = nv == 4 ? RECT_SLACK(sh) * M * M : nY[pair[f][0]] * nY[pair[f][1]];
         }
     }
     l16 Y1[3], Y2[3], X[3], D[3], Dw[3], Dds[3], Ddt[3];
@@ -762,11 +791,13 @@ static void leaf_setup(const shared *sh, const leaf_box *b, const tri_job *t, in
     }
     l16_store(UF, l16_add(l16_add(jx, kx), l16_mul(l16_set1(1.2e-6f * (b->h[0] + b->h[1] + b->h[2])), mag)));
     l16_store(US, l16_mul(l16_set1(0.5f * (float)(gs - 1)), sp));
-    for (int u = 0; u < nt; u++) {
+    for (int u = 0; u < ns; u++) {
         leaf_fn *o = &out[u];
+        const int nf = shp[u].nv;
+        o->nf = nf;
         float Xs[3] = { 0.0f, 0.0f, 0.0f };
-        for (int f = 0; f < 3; f++) {
-            const int l = 3 * u + f;
+        for (int f = 0; f < nf; f++) {
+            const int l = lane0[u] + f;
             o->e[f][0] = E0[l];
             o->e[f][1] = E1[l];
             o->e[f][2] = E2[l];
@@ -777,10 +808,13 @@ static void leaf_setup(const shared *sh, const leaf_box *b, const tri_job *t, in
             o->uspan[f] = US[l];
             for (int a = 0; a < 3; a++) Xs[a] += XA[a][l];
         }
-        for (int c = 0; c < 3; c++) o->e[3][c] = o->e[0][c] + o->e[1][c] + o->e[2][c];
-        o->ufix[3] = 0.0f;
-        for (int a = 0; a < 3; a++) o->ufix[3] += fabsf(Xs[a]) * (b->J[a] + b->h[a]);
-        o->ufix[3] *= 1.001f;
+        for (int c = 0; c < 3; c++) {
+            o->e[nf][c] = o->e[0][c] + o->e[1][c] + o->e[2][c];
+            if (nf == 4) o->e[nf][c] += o->e[3][c];
+        }
+        o->ufix[nf] = 0.0f;
+        for (int a = 0; a < 3; a++) o->ufix[nf] += fabsf(Xs[a]) * (b->J[a] + b->h[a]);
+        o->ufix[nf] *= 1.001f;
     }
 }
 
@@ -789,20 +823,22 @@ static void leaf_setup(const shared *sh, const leaf_box *b, const tri_job *t, in
 static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_fn *fn, uint64_t *cand)
 {
     const int k = sh->k, gs = sh->gs, rows = LANES / gs;
-    const float (*e)[3] = fn->e, *s = fn->s, *ufix = fn->ufix, *uspan = fn->uspan;
+    const float (*e)[3] = fn->e, *ufix = fn->ufix, *uspan = fn->uspan;
+    const int nf = fn->nf;
+    const l16 s[4] = { l16_set1(fn->s[0]), l16_set1(fn->s[1]), l16_set1(fn->s[2]), l16_set1(nf == 4 ? fn->s[3] : 0.0f) };
     /* the groups: each function at each group's first sample, its change over the group, +- U */
-    float base[4][64], U[3][64];
+    float base[5][64], U[4][64];
     uint64_t groups = 0;
     const float half = 0.5f * (float)(gs - 1), span = (float)(gs - 1);
     for (int g0 = 0; g0 < sh->G; g0 += LANES) {
         const l16 gi = l16_load(sh->group_i0 + g0), gj = l16_load(sh->group_j0 + g0);
         const l16 ci = l16_add(gi, l16_set1(half)), cj = l16_add(gj, l16_set1(half));
-        l16 lo[4], hi[4];
-        for (int f = 0; f < 4; f++) {
+        l16 lo[5], hi[5];
+        for (int f = 0; f <= nf; f++) {
             const l16 bs = l16_add(l16_add(l16_set1(e[f][0]), l16_mul(l16_set1(e[f][1]), gi)), l16_mul(l16_set1(e[f][2]), gj));
             l16_store(base[f] + g0, bs);
             l16 u = l16_set1(ufix[f]);
-            if (f < 3) {
+            if (f < nf) {
                 l16 acc = l16_set1(ufix[f] + uspan[f]);
                 for (int a = 0; a < 3; a++) {
                     const l16 ga = l16_add(l16_add(l16_set1(fn->gst[f][0][a]), l16_mul(l16_set1(fn->gst[f][1][a]), ci)),
@@ -816,7 +852,7 @@ static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_f
             lo[f] = l16_sub(l16_add(bs, l16_set1(ms_minf(di, 0.0f) + ms_minf(dj, 0.0f))), u);
             hi[f] = l16_add(l16_add(bs, l16_set1(ms_maxf(di, 0.0f) + ms_maxf(dj, 0.0f))), u);
         }
-        groups |= (uint64_t)footprint_keep(lo, hi, s) << g0;
+        groups |= (uint64_t)footprint_keep_n(lo, hi, s, nf) << g0;
     }
     groups &= sh->all_groups;
     memset(cand, 0, (size_t)sh->mw * sizeof *cand);
@@ -826,22 +862,22 @@ static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_f
         { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
     const int wi = gs == 8;
     const l16 oi = l16_load(off[wi][0]), oj = l16_load(off[wi][1]);
-    l16 foff[4];
-    for (int f = 0; f < 4; f++) foff[f] = l16_add(l16_mul(l16_set1(e[f][1]), oi), l16_mul(l16_set1(e[f][2]), oj));
+    l16 foff[5];
+    for (int f = 0; f <= nf; f++) foff[f] = l16_add(l16_mul(l16_set1(e[f][1]), oi), l16_mul(l16_set1(e[f][2]), oj));
     const uint64_t seg = (UINT64_C(1) << gs) - 1u;
     uint64_t out = 0;
     for (uint64_t m = groups; m; m &= m - 1) {
         const int gk = __builtin_ctzll(m);
         const int i0 = (int)sh->group_i0[gk], j0 = (int)sh->group_j0[gk];
         for (int jb = j0; jb < j0 + gs; jb += rows) {
-            l16 lo[4], hi[4];
-            for (int f = 0; f < 4; f++) {
+            l16 lo[5], hi[5];
+            for (int f = 0; f <= nf; f++) {
                 const float b0 = jb == j0 ? base[f][gk] : e[f][0] + e[f][1] * (float)i0 + e[f][2] * (float)jb;
-                const l16 E = l16_add(l16_set1(b0), foff[f]), u = l16_set1(f < 3 ? U[f][gk] : ufix[3]);
+                const l16 E = l16_add(l16_set1(b0), foff[f]), u = l16_set1(f < nf ? U[f][gk] : ufix[nf]);
                 lo[f] = l16_sub(E, u);
                 hi[f] = l16_add(E, u);
             }
-            const unsigned keep = footprint_keep(lo, hi, s);
+            const unsigned keep = footprint_keep_n(lo, hi, s, nf);
             if (!keep) continue;
             out |= UINT64_C(1) << gk;
             for (int rr = 0; rr < rows; rr++) {
@@ -1363,6 +1399,11 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) &&
                         ((sh->sw & MS_HPC_ALL_LEAF_FOOTPRINT) ||
                          (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c)));
+    /* The shapes whose footprints are formed: each triangle, or for a rectangle pair under the leaf footprint
+     * its rectangle, standing for both ("rectangle pairs" above). */
+    const int rect = leaf_fp && nt == 2 && t->rect && !(sh->sw & MS_HPC_OFF_RECT), ns = rect ? 1 : nt;
+    fp_shape shape[2];
+    for (int u = 0; u < ns; u++) shape[u] = rect ? (fp_shape){ t->rc, 4 } : (fp_shape){ t[u].v, 3 };
     if (leaf_fp) {
         leaf_box bx;
         for (int a = 0; a < 3; a++) {
@@ -1383,12 +1424,20 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             if (sh->sw & MS_HPC_BREAK_LEAF_BOUND) bx.J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
         }
         leaf_fn fn[2];
-        leaf_setup(sh, &bx, t, nt, fn);
-        for (int u = 0; u < nt; u++) {
-            if (!(act & on[u])) continue;
-            ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
-            if (!ngroups[u]) { on[u] = 0; c->cnt[C_LEAF_CULLS]++; }
-        }
+        leaf_setup(sh, &bx, shape, ns, fn);
+        if (rect) {   /* one footprint for both triangles: shape 0 stands for each */
+            c->cnt[C_RECT_PAIRS]++;
+            ngroups[0] = leaf_footprint(sh, &bx, &fn[0], ncand[0]);
+            if (!ngroups[0]) {
+                c->cnt[C_LEAF_CULLS] += (uint64_t)(((act & on[0]) != 0) + ((act & on[1]) != 0));
+                on[0] = on[1] = 0;
+            }
+        } else
+            for (int u = 0; u < nt; u++) {
+                if (!(act & on[u])) continue;
+                ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
+                if (!ngroups[u]) { on[u] = 0; c->cnt[C_LEAF_CULLS]++; }
+            }
         act &= on[0] | on[1];
         if (!act) return;
         /* A sample blocked already for every receiver of the leaf needs no test for any (the paper's L21, for a
@@ -1401,29 +1450,38 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             lopen[l] = open_of(sh, c, rr[l]);
             for (int wd = 0; wd < sh->mw; wd++) any_open[wd] |= lopen[l][wd];
         }
-        for (int u = 0; u < nt; u++) {
-            if (!(act & on[u])) continue;
+        if (rect) {
             uint64_t left = 0;
-            for (int wd = 0; wd < sh->mw; wd++) left |= ncand[u][wd] &= any_open[wd];
-            if (!left) { on[u] = 0; c->cnt[C_LEAF_CULLS_BLOCKED]++; }
-        }
+            for (int wd = 0; wd < sh->mw; wd++) left |= ncand[0][wd] &= any_open[wd];
+            if (!left) {
+                c->cnt[C_LEAF_CULLS_BLOCKED] += (uint64_t)(((act & on[0]) != 0) + ((act & on[1]) != 0));
+                on[0] = on[1] = 0;
+            }
+        } else
+            for (int u = 0; u < nt; u++) {
+                if (!(act & on[u])) continue;
+                uint64_t left = 0;
+                for (int wd = 0; wd < sh->mw; wd++) left |= ncand[u][wd] &= any_open[wd];
+                if (!left) { on[u] = 0; c->cnt[C_LEAF_CULLS_BLOCKED]++; }
+            }
         act &= on[0] | on[1];
         if (!act) return;
     }
-    /* footprint_setup per lane, per triangle */
+    /* footprint_setup per lane, per triangle; for a rectangle pair its five distinct functions (rect_fns), each
+     * triangle's footprint taken from them below */
     const l16 w[3] = { l16_load(W[0]), l16_load(W[1]), l16_load(W[2]) }, rel = l16_load(R);
-    static const int pair[3][2] = { { 2, 1 }, { 0, 2 }, { 1, 0 } };   /* C x B, A x C, B x A */
-    float fe[2][4][3][LANES], fs[2][3][LANES], fdl[2][4][LANES], fdh[2][4][LANES];
+    float fe[2][5][3][LANES], fs[2][5][LANES], fdl[2][4][LANES], fdh[2][4][LANES];
     const l16 span = l16_set1((float)(sh->gs - 1)), zero = l16_set1(0.0f);
-    for (int u = 0; u < nt; u++) {
-        l16 Y[3][3], nY[3];
-        for (int vtx = 0; vtx < 3; vtx++) {
+    for (int u = 0; u < ns; u++) {
+        const int nv = shape[u].nv, nfn = rect ? 5 : 3, (*pair)[2] = rect ? rect_fns : fp_edges[0];
+        l16 Y[4][3], nY[4];
+        for (int vtx = 0; vtx < nv; vtx++) {
             const l16 pc[3] = { px, py, pz };
-            for (int a = 0; a < 3; a++) Y[vtx][a] = l16_sub(l16_set1(t[u].v[3 * vtx + a]), pc[a]);
+            for (int a = 0; a < 3; a++) Y[vtx][a] = l16_sub(l16_set1(shape[u].v[3 * vtx + a]), pc[a]);
             nY[vtx] = l16_max(l16_abs(Y[vtx][0]), l16_max(l16_abs(Y[vtx][1]), l16_abs(Y[vtx][2])));
         }
         l16 esum[3] = { l16_set1(0.0f), l16_set1(0.0f), l16_set1(0.0f) };   /* 0 + x = x */
-        for (int e = 0; e < 3; e++) {
+        for (int e = 0; e < nfn; e++) {
             const l16 *y1 = Y[pair[e][0]], *y2 = Y[pair[e][1]];
             const l16 X[3] = { l16_sub(l16_mul(y1[1], y2[2]), l16_mul(y1[2], y2[1])), l16_sub(l16_mul(y1[2], y2[0]), l16_mul(y1[0], y2[2])),
                                l16_sub(l16_mul(y1[0], y2[1]), l16_mul(y1[1], y2[0])) };
@@ -1437,53 +1495,73 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             l16_store(fe[u][e][2], c2);
             if (!leaf_fp) spans16(c1, c2, span, zero, fdl[u][e], fdh[u][e]);
             l16_store(fs[u][e], l16_mul(l16_mul(rel, nY[pair[e][0]]), nY[pair[e][1]]));
+            if (rect) continue;
             esum[0] = l16_add(esum[0], c0);
             esum[1] = l16_add(esum[1], c1);
             esum[2] = l16_add(esum[2], c2);
         }
+        if (rect) continue;
         for (int a = 0; a < 3; a++) l16_store(fe[u][3][a], esum[a]);
         if (!leaf_fp) spans16(esum[1], esum[2], span, zero, fdl[u][3], fdh[u][3]);
     }
     /* With the leaf footprint: each sample it left, tested for the leaf's receivers in the lanes (footprint_keep
      * per receiver, the footprint_lanes arithmetic with the sample's own indices), giving each receiver its
-     * samples: the work per leaf follows the samples left, which fall as the leaves shrink with resolution. */
+     * samples: the work per leaf follows the samples left, which fall as the leaves shrink with resolution.
+     * A rectangle pair's samples (its rectangle's, for both triangles) are looped over once, and each
+     * triangle's own footprint is tested on them from the five functions, so that each triangle's exact tests
+     * run on its own candidates only (the rectangle's would double them). */
     const int mw = sh->mw;
     uint64_t rc[2][LANES][64], rg[2][LANES];   /* per triangle and lane: the receiver's samples, their groups */
     unsigned has[2] = { 0u, 0u };
     if (leaf_fp)
-        for (int u = 0; u < nt; u++) {
-            const unsigned lanes_on = act & on[u];
+        for (int u = 0; u < ns; u++) {
+            const unsigned lanes_u[2] = { act & (rect ? on[0] : on[u]), rect ? act & on[1] : 0u };
+            const unsigned lanes_on = lanes_u[0] | lanes_u[1];
             if (!lanes_on) continue;
-            for (unsigned m = lanes_on; m; m &= m - 1) {
-                memset(rc[u][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
-                rg[u][__builtin_ctz(m)] = 0;
-            }
-            l16 c0[4], c1[4], c2[4], sl[3];
-            for (int e = 0; e < 4; e++) { c0[e] = l16_load(fe[u][e][0]); c1[e] = l16_load(fe[u][e][1]); c2[e] = l16_load(fe[u][e][2]); }
-            for (int e = 0; e < 3; e++) sl[e] = l16_load(fs[u][e]);
+            for (int x = 0; x < 1 + rect; x++)
+                for (unsigned m = lanes_u[x]; m; m &= m - 1) {
+                    memset(rc[u + x][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
+                    rg[u + x][__builtin_ctz(m)] = 0;
+                }
+            const int nfn = rect ? 5 : 4;   /* with the triangle's sum */
+            l16 c0[5], c1[5], c2[5], sl[2][3];
+            for (int e = 0; e < nfn; e++) { c0[e] = l16_load(fe[u][e][0]); c1[e] = l16_load(fe[u][e][1]); c2[e] = l16_load(fe[u][e][2]); }
+            for (int x = 0; x < 1 + rect; x++)
+                for (int e = 0; e < 3; e++) sl[x][e] = l16_load(fs[u][rect ? rect_tri[x][e] : e]);
             for (int wd = 0; wd < mw; wd++)
                 for (uint64_t bits = ncand[u][wd]; bits; bits &= bits - 1) {
                     const int bit = __builtin_ctzll(bits), sidx = 64 * wd + bit;
                     /* k = 16, 32 or 64 (sh->gs), so a word holds whole rows */
                     const l16 fi = l16_set1(sh->bit_i[bit]), fj = l16_set1((float)(64 / sh->k * wd) + sh->bit_j[bit]);
-                    l16 E[4];
-                    for (int e = 0; e < 4; e++) E[e] = l16_add(l16_add(c0[e], l16_mul(c1[e], fi)), l16_mul(c2[e], fj));
-                    const unsigned hitl = footprint_keep_lanes(E, E, sl) & lanes_on;
-                    if (!hitl) continue;
-                    const int gk = (sidx / sh->k / sh->gs) * (sh->k / sh->gs) + (sidx % sh->k) / sh->gs;
-                    for (unsigned h2 = hitl; h2; h2 &= h2 - 1) {
-                        const int l = __builtin_ctz(h2);
-                        if (!(lopen[l][wd] >> bit & 1u)) continue;   /* blocked already for this receiver */
-                        rc[u][l][wd] |= UINT64_C(1) << bit;
-                        rg[u][l] |= UINT64_C(1) << gk;
-                        has[u] |= 1u << l;
+                    l16 E[5];
+                    for (int e = 0; e < nfn; e++) E[e] = l16_add(l16_add(c0[e], l16_mul(c1[e], fi)), l16_mul(c2[e], fj));
+                    unsigned hitl[2];
+                    if (rect) {   /* rectangle pairs, above: each triangle's functions and their sum */
+                        const l16 nd = l16_sub(zero, E[4]);
+                        const l16 T0[4] = { E[0], E[1], E[4], l16_add(l16_add(E[0], E[1]), E[4]) };
+                        const l16 T1[4] = { E[2], E[3], nd, l16_add(l16_add(E[2], E[3]), nd) };
+                        hitl[0] = footprint_keep_lanes(T0, T0, sl[0]) & lanes_u[0];
+                        hitl[1] = footprint_keep_lanes(T1, T1, sl[1]) & lanes_u[1];
+                    } else {
+                        hitl[0] = footprint_keep_lanes(E, E, sl[0]) & lanes_u[0];
+                        hitl[1] = 0;
                     }
+                    if (!(hitl[0] | hitl[1])) continue;
+                    const int gk = (sidx / sh->k / sh->gs) * (sh->k / sh->gs) + (sidx % sh->k) / sh->gs;
+                    for (int x = 0; x < 2; x++)
+                        for (unsigned h2 = hitl[x]; h2; h2 &= h2 - 1) {
+                            const int l = __builtin_ctz(h2);
+                            if (!(lopen[l][wd] >> bit & 1u)) continue;   /* blocked already for this receiver */
+                            rc[u + x][l][wd] |= UINT64_C(1) << bit;
+                            rg[u + x][l] |= UINT64_C(1) << gk;
+                            has[u + x] |= 1u << l;
+                        }
                 }
         }
     if (leaf_fp) {
         c->lf_in += (uint32_t)__builtin_popcount(act);
         c->lf_kept += (uint32_t)__builtin_popcount(act & (has[0] | has[1]));
-        for (int u = 0; u < nt; u++)
+        for (int u = 0; u < ns; u++)
             for (int wd = 0; wd < mw; wd++) c->lf_cands += (uint32_t)__builtin_popcountll(ncand[u][wd]);
         if (c->lf_in > 4096u) { c->lf_in >>= 1; c->lf_kept >>= 1; c->lf_cands >>= 1; }   /* the recent leaves count */
     }
@@ -1680,6 +1758,7 @@ static void prepare_batch(const shared *sh, tri_job *jobs, const float *tri, con
         ms_wt_normal(t->v, t->N);
         t->self = ids[i];
         t->pair = pairs ? pairs[i] : 0;
+        t->rect = 0;
         if (t->pair < 0) continue;   /* the pair's vl, made with the first */
         if (t->pair == 0) {
             hpc_volume_build(&t->vl, sh->light_poly, 4, t->v, tri_margin(sh, t->v));
@@ -1689,6 +1768,7 @@ static void prepare_batch(const shared *sh, tri_job *jobs, const float *tri, con
          * triangle's exact test calls blocked lies within its margin of that triangle's shadow, which the
          * pair's contains). */
         const float *b = tri + 9 * (i + 1);
+        t->rect = ms_coplanar_rect_pair(t->v, b, t->rc);
         float pts[12];
         memcpy(pts, t->v, sizeof t->v);
         memcpy(pts + 9, b + 3 * pair_vertex(t->v, b), 3 * sizeof *pts);
