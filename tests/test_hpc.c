@@ -243,23 +243,33 @@ static void test_isa_instances_and_switches(void **st)
             ms_raytrace_visible_samples(&ctx, &q[i], pts, front + i * mw, ref + i * mw, rc);
         }
         int ran = 0;
-        for (int isa = MS_ISA_SCALAR; isa <= MS_ISA_AVX512; isa++) {
-            const ms_hpc_cast_fn fn = ms_hpc_cast_isa((ms_isa)isa);
-            if (!fn || (ctx.isa_cap != MS_ISA_AUTO && isa > (int)ctx.isa_cap)) continue;
-            perm_source ps2 = { &bvh, area, nt, 0 };
-            const hpc_source src = { &ps2, perm_rewind, perm_next };
-            uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
-            memset(vis, 0xA5, n * mw * sizeof *vis);
-            assert_int_equal(fn(&ctx, 0, NULL, q, n, front, vis, &src, cnt), 0);
-            assert_memory_equal(vis, ref, n * mw * sizeof *vis);
-            /* Counters but the wall-clock ones (sort, build, rebuild, cast: microseconds). */
-            cnt[16] = cnt[17] = cnt[18] = cnt[19] = 0;
-            if (!ran) memcpy(cnt0, cnt, sizeof cnt);
-            else assert_memory_equal(cnt, cnt0, sizeof cnt);
-            ran++;
+        uint64_t rect_pairs = 0;
+        /* as designed, and with the leaf footprint (and the rectangle pairs' bound) on every leaf */
+        for (int mode = 1; mode >= 0; mode--) {
+            ran = 0;
+            for (int isa = MS_ISA_SCALAR; isa <= MS_ISA_AVX512; isa++) {
+                const ms_hpc_cast_fn fn = ms_hpc_cast_isa((ms_isa)isa);
+                if (!fn || (ctx.isa_cap != MS_ISA_AUTO && isa > (int)ctx.isa_cap)) continue;
+                perm_source ps2 = { &bvh, area, nt, 0 };
+                const hpc_source src = { &ps2, perm_rewind, perm_next };
+                uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
+                memset(vis, 0xA5, n * mw * sizeof *vis);
+                ms_hpc_switches = mode ? MS_HPC_ALL_LEAF_FOOTPRINT : 0;
+                const int rc1 = fn(&ctx, 0, NULL, q, n, front, vis, &src, cnt);
+                ms_hpc_switches = 0;
+                assert_int_equal(rc1, 0);
+                assert_memory_equal(vis, ref, n * mw * sizeof *vis);
+                /* Counters but the wall-clock ones (sort, build, rebuild, cast: microseconds). */
+                cnt[16] = cnt[17] = cnt[18] = cnt[19] = 0;
+                if (!ran) memcpy(cnt0, cnt, sizeof cnt);
+                else assert_memory_equal(cnt, cnt0, sizeof cnt);
+                ran++;
+            }
+            assert_true(ran >= 1);
+            if (mode) rect_pairs = cnt0[27];
         }
-        assert_true(ran >= 1);
-        for (int sw = 1; sw <= MS_HPC_ALL_LEAF_FOOTPRINT; sw <<= 1) {
+        assert_true(rect_pairs > 0);   /* the rectangle pairs' path ran in the instances compared */
+        for (int sw = 1; sw <= MS_HPC_OFF_RECT; sw <<= 1) {
             perm_source ps2 = { &bvh, area, nt, 0 };
             const hpc_source src = { &ps2, perm_rewind, perm_next };
             uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
@@ -270,7 +280,8 @@ static void test_isa_instances_and_switches(void **st)
             assert_memory_equal(vis, ref, n * mw * sizeof *vis);
         }
         printf("k=%d: %zu points, %d ISA instances equal to raytrace and to each other (masks, counters: %llu sample "
-               "tests); 11 switches equal\n", k, n, ran, (unsigned long long)cnt0[9]);
+               "tests; %llu (leaf, pair) by their rectangle on every leaf); 12 switches equal\n", k, n, ran,
+               (unsigned long long)cnt0[9], (unsigned long long)rect_pairs);
         free(front); free(ref); free(vis); free(pts); free(q); free(hits);
     }
     free(area);
@@ -327,7 +338,9 @@ static const char *flowers_json(const char *dir, const char *name, const char *p
  * closed-component cull, which must leave V and S as they are). The leaf footprint (hpc_impl.h) rules out
  * samples for a whole leaf of receivers at once; its bound over the leaf's grid origins (which differ per
  * pixel) matters here: without it (MS_HPC_BREAK_LEAF_BOUND, wrong on purpose) pixels differ, so the scene
- * shows a bound that misses what raytrace blocks. */
+ * shows a bound that misses what raytrace blocks. Every face of a bar is an axis-aligned rectangle cut into two
+ * triangles, so the pairs' leaf footprint is their rectangle's (hpc_impl.h, "rectangle pairs"): it runs here,
+ * and bounded by its first triangle alone (MS_HPC_BREAK_RECT, wrong on purpose) pixels differ. */
 static void test_bars(void **st)
 {
     (void)st;
@@ -396,8 +409,9 @@ static void test_bars(void **st)
     ms_frame f;
     render_ok(&sc, "hpc", 256, 96, 0, &f);
     ms_hpc_switches = 0;
-    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0;
+    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0;
     for (int c = 0; c < f.stats.n_counters; c++) {
+        if (!strcmp(f.stats.counter_name[c], "rect_pairs")) rect_pairs = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "pairs_in_vl")) in_vl = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "pairs_footprint")) to_fp = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "leaf_culls")) leaf_culls = f.stats.counter[c];
@@ -410,14 +424,24 @@ static void test_bars(void **st)
     long differ = 0;
     for (long i = 0; i < 96L * 96L; i++) differ += memcmp(&f.vis[i], &ref.vis[i], sizeof(float)) != 0;
     ms_frame_free(&f);
+    ms_hpc_switches = MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_RECT;
+    render_ok(&sc, "hpc", 256, 96, 0, &f);
+    ms_hpc_switches = 0;
+    long differ_rect = 0;
+    for (long i = 0; i < 96L * 96L; i++) differ_rect += memcmp(&f.vis[i], &ref.vis[i], sizeof(float)) != 0;
+    ms_frame_free(&f);
     printf("bars: leaf footprint: %llu of %llu pairs in V_L to the per-receiver test, %llu (leaf, triangle) ruled "
            "out, %llu with every candidate blocked already; without its bound over the grid origins %ld pixels "
            "differ\n", (unsigned long long)to_fp, (unsigned long long)in_vl, (unsigned long long)leaf_culls,
            (unsigned long long)culls_blocked, differ);
+    printf("bars: %llu (leaf, pair) bounded by the pair's rectangle; with the rectangle's bound broken %ld pixels differ\n",
+           (unsigned long long)rect_pairs, differ_rect);
     assert_true(leaf_culls > 0);
     assert_true(culls_blocked > 0);
     assert_true(to_fp < in_vl);
     assert_true(differ > 0);
+    assert_true(rect_pairs > 0);
+    assert_true(differ_rect > 0);
     ms_frame_free(&ref);
     ms_scene_free(&sc);
 }

@@ -62,8 +62,8 @@ enum {
     MS_HPC_BREAK_LEAF_BOUND = 4096,  /* not a measurement: the leaf footprint without its bound over the leaf's
                                       * grid origins (wrong on purpose), so that test_hpc can show its scene
                                       * depends on it */
-    MS_HPC_BREAK_RECT = 8192     /* not a measurement: a rectangle pair's footprint without its slack (wrong on
-                                  * purpose), so that test_hpc can show its scene depends on it */
+    MS_HPC_BREAK_RECT = 8192     /* not a measurement: a rectangle pair's leaf footprint from its first triangle
+                                  * alone (wrong on purpose), so that test_hpc can show its scene depends on it */
 };
 extern int ms_hpc_switches;
 

@@ -714,8 +714,8 @@ typedef struct fp_shape { const float *v; int nv; } fp_shape;
 static const int fp_edges[2][4][2] = { { { 2, 1 }, { 0, 2 }, { 1, 0 }, { 0, 0 } }, { { 1, 0 }, { 2, 1 }, { 3, 2 }, { 0, 3 } } };
 
 /* The slack's factor of a rectangle's functions ("rectangle pairs" below): s = RECT_SLACK rel M^2, M the
- * largest |corner - p|inf (MS_HPC_BREAK_RECT: 0, wrong on purpose). */
-#define RECT_SLACK(sh) ((sh)->sw & MS_HPC_BREAK_RECT ? 0.0f : 2.0f)
+ * largest |corner - p|inf. */
+#define RECT_SLACK 2.0f
 
 /* A rectangle pair's functions per receiver: its four sides and the diagonal P0 x P2 (the first triangle's
  * third function; the second's is its negation, exactly); rect_tri: each triangle's three of them. */
@@ -750,7 +750,7 @@ static void leaf_setup(const shared *sh, const leaf_box *b, const fp_shape *shp,
         lane0[u] = l;
         for (int f = 0; f < nv; f++, l++) {
             for (int a = 0; a < 3; a++) { y1[a][l] = Y[pair[f][0]][a]; y2[a][l] = Y[pair[f][1]][a]; }
-            n12[l] = nv == 4 ? RECT_SLACK(sh) * M * M : nY[pair[f][0]] * nY[pair[f][1]];
+            n12[l] = nv == 4 ? RECT_SLACK * M * M : nY[pair[f][0]] * nY[pair[f][1]];
         }
     }
     l16 Y1[3], Y2[3], X[3], D[3], Dw[3], Dds[3], Ddt[3];
@@ -1404,6 +1404,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     const int rect = leaf_fp && nt == 2 && t->rect && !(sh->sw & MS_HPC_OFF_RECT), ns = rect ? 1 : nt;
     fp_shape shape[2];
     for (int u = 0; u < ns; u++) shape[u] = rect ? (fp_shape){ t->rc, 4 } : (fp_shape){ t[u].v, 3 };
+    if (rect && (sh->sw & MS_HPC_BREAK_RECT)) shape[0].nv = 3;   /* wrong on purpose: the first triangle for both */
     if (leaf_fp) {
         leaf_box bx;
         for (int a = 0; a < 3; a++) {
@@ -1473,7 +1474,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     float fe[2][5][3][LANES], fs[2][5][LANES], fdl[2][4][LANES], fdh[2][4][LANES];
     const l16 span = l16_set1((float)(sh->gs - 1)), zero = l16_set1(0.0f);
     for (int u = 0; u < ns; u++) {
-        const int nv = shape[u].nv, nfn = rect ? 5 : 3, (*pair)[2] = rect ? rect_fns : fp_edges[0];
+        const int nv = rect ? 4 : 3, nfn = rect ? 5 : 3, (*pair)[2] = rect ? rect_fns : fp_edges[0];
         l16 Y[4][3], nY[4];
         for (int vtx = 0; vtx < nv; vtx++) {
             const l16 pc[3] = { px, py, pz };
