@@ -17,7 +17,8 @@
  * --off LIST: hpc with parts turned off (ms_hpc_switches, src/shadow/hpc/hpc.h), to measure each alone:
  *        umbra (A), planesets (B), lazy (C), ondemand (D), sort, simdsamples, simdplanes, footprint (hpc's
  *        footprint test: the paper's group volumes instead), pairs (hpc's pairs of triangles sharing an edge:
- *        each triangle alone). */
+ *        each triangle alone), leaffp (hpc's leaf footprint), leaffp-rule (the leaf footprint on every leaf),
+ *        rect (hpc's rectangle pairs: each triangle of a pair with its own leaf footprint). */
 #include "microshadow.h"
 #include "shadow/hpc/hpc.h"
 #include <stdint.h>
