@@ -1438,7 +1438,11 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     /* The shapes whose footprints are formed: each triangle, or for a rectangle pair under the leaf footprint
      * its rectangle, standing for both ("rectangle pairs" above; measured on grids, one thread, 1024^2: the
      * cast 9.42 -> 8.71 s). */
-    const int rect = leaf_fp && nt == 2 && t->rect && !(sh->sw & MS_HPC_OFF_RECT), ns = rect ? 1 : nt;
+    /* Not where a receiver lies on one of the two (its own is not cast against it): the other, coplanar with it,
+     * rules out every sample by mixed signs, while the rectangle around the receiver rules out none (on the
+     * Quad's ground, with the leaf footprint on every leaf, the cast went 0.26 -> 0.85 s). */
+    const int rect = leaf_fp && nt == 2 && t->rect && !(sh->sw & MS_HPC_OFF_RECT) && (act & on[0] & on[1]) == act,
+              ns = rect ? 1 : nt;
     fp_shape shape[2];
     for (int u = 0; u < ns; u++) shape[u] = rect ? (fp_shape){ t->rc, 4 } : (fp_shape){ t[u].v, 3 };
     if (rect && (sh->sw & MS_HPC_BREAK_RECT)) shape[0].nv = 3;   /* wrong on purpose: the first triangle for both */
