@@ -213,11 +213,66 @@ static void test_merged_frames(void **st)
     ms_scene_free(&sc);
 }
 
+/* ms_coplanar_rect_pair (hpc's rectangle pairs): the halves of an axis-aligned rectangle, in any vertex order and
+ * either diagonal, give its four corners in order around it, the first triangle's vertices being corners 0, 1, 2
+ * and the second's 0, 2, 3 (checked as sets, bitwise); a pair that is not such a rectangle is refused. */
+static int has_vertex(const float *t, const float *c)
+{
+    for (int k = 0; k < 3; k++)
+        if (t[3 * k] == c[0] && t[3 * k + 1] == c[1] && t[3 * k + 2] == c[2]) return 1;
+    return 0;
+}
+
+static void test_rect_pair(void **st)
+{
+    (void)st;
+    /* the rectangle x = 0.5, y in [-1, 2], z in [0.25, 3], corners in order around it */
+    const float R[4][3] = { { 0.5f, -1, 0.25f }, { 0.5f, 2, 0.25f }, { 0.5f, 2, 3 }, { 0.5f, -1, 3 } };
+    for (int diag = 0; diag < 2; diag++)
+        for (int rot = 0; rot < 3; rot++)
+            for (int flip = 0; flip < 2; flip++) {
+                /* halves along the diagonal R[diag] R[diag + 2]: (d, d+1, d+2) and (d, d+2, d+3), rotated and wound */
+                const int ia[3] = { diag, diag + 1, diag + 2 }, ib[3] = { diag, diag + 2, (diag + 3) % 4 };
+                float a[9], b[9], c[12];
+                for (int k = 0; k < 3; k++) {
+                    const int ka = flip ? 2 - (k + rot) % 3 : (k + rot) % 3, kb = (k + rot) % 3;
+                    memcpy(a + 3 * k, R[ia[ka]], sizeof R[0]);
+                    memcpy(b + 3 * k, R[ib[kb]], sizeof R[0]);
+                }
+                assert_int_equal(ms_coplanar_rect_pair(a, b, c), 1);
+                for (int k = 0; k < 3; k++) {
+                    assert_true(has_vertex(a, c + 3 * k));
+                    assert_true(has_vertex(b, c + 3 * (k ? k + 1 : 0)));
+                }
+                assert_false(has_vertex(a, c + 9));
+                /* in order around the rectangle: consecutive corners differ in one coordinate */
+                for (int k = 0; k < 4; k++) {
+                    int same = 0;
+                    for (int x = 0; x < 3; x++) same += c[3 * k + x] == c[3 * ((k + 1) % 4) + x];
+                    assert_int_equal(same, 2);
+                }
+            }
+    /* refused: the same triangle twice, a half and a triangle off the plane, a non-rectangle quad */
+    float a[9], b[9], c[12];
+    for (int k = 0; k < 3; k++) { memcpy(a + 3 * k, R[k], sizeof R[0]); memcpy(b + 3 * k, R[k], sizeof R[0]); }
+    assert_int_equal(ms_coplanar_rect_pair(a, b, c), 0);
+    memcpy(b, R[0], sizeof R[0]);
+    memcpy(b + 3, R[2], sizeof R[0]);
+    memcpy(b + 6, R[3], sizeof R[0]);
+    assert_int_equal(ms_coplanar_rect_pair(a, b, c), 1);
+    b[6] = 0.5000001f;   /* off the plane by one ulp */
+    assert_int_equal(ms_coplanar_rect_pair(a, b, c), 0);
+    b[6] = 0.5f;
+    b[8] = 2.9999998f;   /* not a rectangle by one ulp */
+    assert_int_equal(ms_coplanar_rect_pair(a, b, c), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_merge),
         cmocka_unit_test(test_merged_frames),
+        cmocka_unit_test(test_rect_pair),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
