@@ -1437,7 +1437,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
                          (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c)));
     /* The shapes whose footprints are formed: each triangle, or for a rectangle pair under the leaf footprint
      * its rectangle, standing for both ("rectangle pairs" above; measured on grids, one thread, 1024^2: the
-     * cast 9.42 -> 8.71 s). */
+     * cast 9.42 -> 8.71 s, 7%; the other scenes within noise: docs/hpc.md). */
     /* Not where a receiver lies on one of the two (its own is not cast against it): the other, coplanar with it,
      * rules out every sample by mixed signs, while the rectangle around the receiver rules out none (on the
      * Quad's ground, with the leaf footprint on every leaf, the cast went 0.26 -> 0.85 s). */
