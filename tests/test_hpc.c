@@ -329,6 +329,20 @@ static const char *flowers_json(const char *dir, const char *name, const char *p
     return path;
 }
 
+/* The pixels whose V differs from ref's (96 x 96, 256 samples) when hpc runs with the given switches (a
+ * deliberate fault among them shows that the bound it breaks is needed). */
+static long hpc_pixels_off(const ms_scene *sc, int switches, const ms_frame *ref)
+{
+    ms_frame f;
+    ms_hpc_switches = switches;
+    render_ok(sc, "hpc", 256, 96, 0, &f);
+    ms_hpc_switches = 0;
+    long differ = 0;
+    for (long i = 0; i < 96L * 96L; i++) differ += memcmp(&f.vis[i], &ref->vis[i], sizeof(float)) != 0;
+    ms_frame_free(&f);
+    return differ;
+}
+
 /* A GRIDS-like scene (the paper's; /work/dense/grids at full size): two layers of thin bars, closed boxes
  * in segments, crossing over a ground under a square light, seen from above. Every receiver on the ground
  * is in the penumbra of many bars whose shadows, from one receiver, are strips narrower than a sample
@@ -418,18 +432,8 @@ static void test_bars(void **st)
         if (!strcmp(f.stats.counter_name[c], "leaf_culls_blocked")) culls_blocked = f.stats.counter[c];
     }
     ms_frame_free(&f);
-    ms_hpc_switches = MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_LEAF_BOUND;
-    render_ok(&sc, "hpc", 256, 96, 0, &f);
-    ms_hpc_switches = 0;
-    long differ = 0;
-    for (long i = 0; i < 96L * 96L; i++) differ += memcmp(&f.vis[i], &ref.vis[i], sizeof(float)) != 0;
-    ms_frame_free(&f);
-    ms_hpc_switches = MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_RECT;
-    render_ok(&sc, "hpc", 256, 96, 0, &f);
-    ms_hpc_switches = 0;
-    long differ_rect = 0;
-    for (long i = 0; i < 96L * 96L; i++) differ_rect += memcmp(&f.vis[i], &ref.vis[i], sizeof(float)) != 0;
-    ms_frame_free(&f);
+    const long differ = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_LEAF_BOUND, &ref);
+    const long differ_rect = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_RECT, &ref);
     printf("bars: leaf footprint: %llu of %llu pairs in V_L to the per-receiver test, %llu (leaf, triangle) ruled "
            "out, %llu with every candidate blocked already; without its bound over the grid origins %ld pixels "
            "differ\n", (unsigned long long)to_fp, (unsigned long long)in_vl, (unsigned long long)leaf_culls,
