@@ -28,14 +28,14 @@
  * triangle, an input triangle it came from; *merged: per input triangle, 1 when it is part of a rectangle
  * merged from two or more pairs (a single pair stays as it was). 0, or -1 when out of memory (outputs
  * NULL). */
+int ms_coplanar_merge(const float *tri, size_t n, const uint8_t *eligible, float **out, size_t *n_out,
+                      uint32_t **of_input, uint32_t **source, uint8_t **merged);
+
 /* Whether triangles a and b (9 floats each) are the two halves of one axis-aligned rectangle, by the test the
  * merge uses (every vertex on one plane x, y or z = c and the corners a rectangle in the other two axes, all
  * bitwise; the halves leave out opposite corners). 1 and corners (12 floats: the rectangle's four corners in
  * order around it, each a vertex of a or b bit for bit up to the sign of a zero, the last the one a lacks, so
  * that a's vertices are corners 0, 1, 2 and b's 0, 2, 3), else 0. */
 int ms_coplanar_rect_pair(const float *a, const float *b, float corners[12]);
-
-int ms_coplanar_merge(const float *tri, size_t n, const uint8_t *eligible, float **out, size_t *n_out,
-                      uint32_t **of_input, uint32_t **source, uint8_t **merged);
 
 #endif
