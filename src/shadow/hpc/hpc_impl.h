@@ -1394,6 +1394,16 @@ static inline int leaf_fp_pays(chunk *c)
  * (POINT-IN-VOLUME, the same arithmetic as vol_point per lane) and footprint_setup (the same arithmetic per
  * lane, per triangle), then each point's groups and samples (cast_footprint). */
 _Static_assert(LEAF_POINTS_FOOTPRINT <= LANES, "a leaf's points fit the lanes");
+/* A leaf's shape u ruled out (counter cnt): the triangles it stands for (both for a rectangle pair, else
+ * triangle u) leave the leaf, each counted when it had a receiver there. */
+static inline void shape_off(chunk *c, int cnt, unsigned act, unsigned on[2], int u, int rect)
+{
+    for (int x = u; x <= (rect ? 1 : u); x++) {
+        c->cnt[cnt] += (uint64_t)((act & on[x]) != 0);
+        on[x] = 0;
+    }
+}
+
 static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, const tri_job *t, uint32_t pl)
 {
     const int nt = t->pair > 0 ? 2 : 1;
@@ -1467,19 +1477,12 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
         }
         leaf_fn fn[2];
         leaf_setup(sh, &bx, shape, ns, fn);
-        if (rect) {   /* one footprint for both triangles: shape 0 stands for each */
-            c->cnt[C_RECT_PAIRS]++;
-            ngroups[0] = leaf_footprint(sh, &bx, &fn[0], ncand[0]);
-            if (!ngroups[0]) {
-                c->cnt[C_LEAF_CULLS] += (uint64_t)(((act & on[0]) != 0) + ((act & on[1]) != 0));
-                on[0] = on[1] = 0;
-            }
-        } else
-            for (int u = 0; u < nt; u++) {
-                if (!(act & on[u])) continue;
-                ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
-                if (!ngroups[u]) { on[u] = 0; c->cnt[C_LEAF_CULLS]++; }
-            }
+        c->cnt[C_RECT_PAIRS] += (uint64_t)rect;
+        for (int u = 0; u < ns; u++) {   /* a rectangle: shape 0 stands for both triangles (on[0] covers act) */
+            if (!(act & on[u])) continue;
+            ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
+            if (!ngroups[u]) shape_off(c, C_LEAF_CULLS, act, on, u, rect);
+        }
         act &= on[0] | on[1];
         if (!act) return;
         /* A sample blocked already for every receiver of the leaf needs no test for any (the paper's L21, for a
@@ -1492,20 +1495,12 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             lopen[l] = open_of(sh, c, rr[l]);
             for (int wd = 0; wd < sh->mw; wd++) any_open[wd] |= lopen[l][wd];
         }
-        if (rect) {
+        for (int u = 0; u < ns; u++) {
+            if (!(act & on[u])) continue;
             uint64_t left = 0;
-            for (int wd = 0; wd < sh->mw; wd++) left |= ncand[0][wd] &= any_open[wd];
-            if (!left) {
-                c->cnt[C_LEAF_CULLS_BLOCKED] += (uint64_t)(((act & on[0]) != 0) + ((act & on[1]) != 0));
-                on[0] = on[1] = 0;
-            }
-        } else
-            for (int u = 0; u < nt; u++) {
-                if (!(act & on[u])) continue;
-                uint64_t left = 0;
-                for (int wd = 0; wd < sh->mw; wd++) left |= ncand[u][wd] &= any_open[wd];
-                if (!left) { on[u] = 0; c->cnt[C_LEAF_CULLS_BLOCKED]++; }
-            }
+            for (int wd = 0; wd < sh->mw; wd++) left |= ncand[u][wd] &= any_open[wd];
+            if (!left) shape_off(c, C_LEAF_CULLS_BLOCKED, act, on, u, rect);
+        }
         act &= on[0] | on[1];
         if (!act) return;
     }
