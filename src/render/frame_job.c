@@ -757,9 +757,12 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     for (int x = x0; x < x1; x++) pixels[np++] = (size_t)y * W + x;
             }
         }
+        ms_render_ctx own_ctx;
+        light_own_ctx(j, l, &own_ctx);
         if (!failed)
-            failed = ms_shadow_frame_whole(sm, sstate, &ctx, hits, surf, W, j->H, pixels, np, vis, shadow, spec, fr,
-                                           p->counters, &visible, &penumbra, &segments, &resolve_thread_s) != 0;
+            failed = ms_shadow_frame_whole(sm, sstate, &ctx, own_state, &own_ctx, hits, surf, W, j->H, pixels, np, vis,
+                                           shadow, spec, fr, p->counters, &visible, &penumbra, &segments, &on_merged,
+                                           &resolve_thread_s) != 0;
         free(pixels);
     }
     p->visible += visible;

@@ -4,14 +4,25 @@
 #include "primary/primary.h"
 #include "light/pattern.h"
 #include "visibility/receiver.h"
+#include "visibility/occluders.h"
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
-int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, const ms_hit *hits,
+/* 1 when the receiver of hit h must be answered over the scene's own triangles (own_ctx): it lies on a
+ * merged coplanar face where the merge could answer otherwise (frame_job.c's merged_last, the same test). */
+static int on_merged_face(const ms_render_ctx *ctx, const ms_render_ctx *own_ctx, const ms_hit *h,
+                          const float (*hull)[3], int n_hull)
+{
+    return own_ctx && ctx->prim_merged && ctx->prim_merged[h->prim] &&
+           !ms_merged_receiver_ok(own_ctx->bvh->tri + 9 * (size_t)h->prim, h->p, hull, n_hull);
+}
+
+int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, void *own_state,
+                          const ms_render_ctx *own_ctx, const ms_hit *hits,
                           const ms_surface *surf, int W, int H, const size_t *pixels, size_t npixels, float *vis_out, float *shadow_out, float *spec_out,
                           uint16_t *front_out, uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
-                          uint64_t *segments, double *resolve_thread_s)
+                          uint64_t *segments, uint64_t *on_merged, double *resolve_thread_s)
 {
     const size_t npix = pixels ? npixels : (size_t)W * H, mw = (size_t)ctx->mask_words;
     (void)H;
@@ -24,14 +35,28 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
     uint64_t *vis = malloc((n ? n : 1) * mw * sizeof *vis);
     int rc = -1;
     if (!q || !where || !front || !vis) goto done;
+    float hull[8][3], hull_box[6];
+    const int n_hull = own_state ? ms_light_hull(&ctx->light, hull, hull_box) : 0;
+    if (!own_state) own_ctx = NULL;
+    /* The receivers the merged faces answer first, then (pass 1) those on merged faces that go to the
+     * scene's own triangles (own_state), named there by their own prims. */
     n = 0;
-    for (size_t j = 0; j < npix; j++) {
-        const size_t i = pixels ? pixels[j] : j;
-        const ms_hit *h = &hits[i];
-        if (h->prim == UINT32_MAX) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; continue; }
-        ms_query_from_hit(&q[n], h, (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
-        q[n].prim = ms_ctx_skip_prim(ctx, h->prim);
-        where[n++] = i;
+    size_t n_main = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t j = 0; j < npix; j++) {
+            const size_t i = pixels ? pixels[j] : j;
+            const ms_hit *h = &hits[i];
+            if (h->prim == UINT32_MAX) {
+                if (!pass) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; }
+                continue;
+            }
+            if (on_merged_face(ctx, own_ctx, h, (const float (*)[3])hull, n_hull) != pass) continue;
+            ms_query_from_hit(&q[n], h, (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
+            q[n].prim = pass ? h->prim : ms_ctx_skip_prim(ctx, h->prim);
+            where[n++] = i;
+        }
+        if (!pass) n_main = n;
+        if (!own_ctx) break;
     }
     int failed = 0;
     uint64_t seg = 0;
@@ -49,7 +74,10 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
         }
         free(pts);
     }
-    if (failed || sm->visibility_all(sstate, ctx, q, n, front, vis, counters)) goto done;
+    if (failed || sm->visibility_all(sstate, ctx, q, n_main, front, vis, counters)) goto done;
+    if (n > n_main && sm->visibility_all(own_state, own_ctx, q + n_main, n - n_main, front + n_main * mw,
+                                         vis + n_main * mw, counters))
+        goto done;
     const double tr = omp_get_wtime();
     uint64_t pen = 0;
 #pragma omp parallel num_threads(ctx->threads) reduction(+ : pen) reduction(| : failed)
@@ -73,6 +101,7 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
     *visible += n;
     *penumbra += pen;
     *segments += seg;
+    *on_merged += n - n_main;
     rc = 0;
 done:
     free(q);

@@ -11,11 +11,15 @@
  * resolves V and S with ms_resolve_vs exactly as the tiled path does (and S_spec where surf, per pixel or
  * NULL, has a specular lobe); writes vis, shadow, spec and front (W x H each) and adds to counters and the
  * frame's totals. pixels: NULL for the whole frame in row-major order, else only those npixels pixel
- * indices, in that order (a part of the frame: frame_job.c). 0, or -1 out of memory or when the method
- * fails. */
-int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, const ms_hit *hits,
+ * indices, in that order (a part of the frame: frame_job.c). own_state (NULL: none): the method's state
+ * over the scene's own triangles (own_ctx) when ctx's occluders merge coplanar faces (ctx->prim_merged);
+ * the receivers on merged faces that the merge could answer otherwise (ms_merged_receiver_ok) are then
+ * answered by a second call over it, as the tiled path does, and counted in on_merged. 0, or -1 out of
+ * memory or when the method fails. */
+int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, void *own_state,
+                          const ms_render_ctx *own_ctx, const ms_hit *hits,
                           const ms_surface *surf, int W, int H, const size_t *pixels, size_t npixels, float *vis, float *shadow, float *spec, uint16_t *front,
                           uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
-                          uint64_t *segments, double *resolve_thread_s);
+                          uint64_t *segments, uint64_t *on_merged, double *resolve_thread_s);
 
 #endif

@@ -6,7 +6,12 @@
  * triangles less those of closed components that face away from the whole light, which provably decide no
  * segment (same V and S); the driver names a receiver's own triangle in that set (ms_ctx_skip_prim). The
  * paper has no such cull; on a GRIDS-like scene (closed bars) it removes 32,640 of 74,880 triangles and
- * 37% of the time (docs/hpc.md). A procedural scene is streamed: generated batch by batch, its primary hits
+ * 37% of the time (docs/hpc.md). hpc also takes the occluders' merge of coplanar rectangles (MS_OCC_MERGE,
+ * accel/coplanar.h: the same points, ties on the rectangles' outer sides aside), as the micro-raster methods
+ * and mft do: the bars' faces, 32 segments each, become one rectangle (42,242 -> 1,322 triangles), and the
+ * cost per pair, which bounds hpc (docs/hpc.md, session 14), is paid 30 times less often. The receivers on
+ * merged faces that the merge could answer otherwise are answered over the scene's own triangles by a second
+ * call (shadow_frame.c); hpc-scanline keeps the triangles as they are. A procedural scene is streamed: generated batch by batch, its primary hits
  * from the depth pass (primary_depth.c), no BVH at all, no cull. The per-tile entry runs the same
  * algorithm over the tile's points, for callers that drive methods per tile. */
 #include "hpc.h"
@@ -162,7 +167,8 @@ static void hpc_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
       "pairs_footprint", "leaf_culls", "leaf_culls_blocked", "rect_pairs" }
 
 const ms_shadow_method ms_shadow_hpc = {
-    .name = "hpc", .primary = "bvh", .needs_grid = 1, .streams = 1, .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT,
+    .name = "hpc", .primary = "bvh", .needs_grid = 1, .streams = 1,
+    .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_MERGE,
     .n_counters = HPC_N_COUNTERS,
     .counter_names = HPC_COUNTER_NAMES,
     .create = hpc_create, .visibility = hpc_tile, .visibility_all = hpc_all, .split_exact = 1, .destroy = hpc_destroy,
