@@ -269,7 +269,7 @@ static void test_isa_instances_and_switches(void **st)
             if (mode) rect_pairs = cnt0[27];
         }
         assert_true(rect_pairs > 0);   /* the rectangle pairs' path ran in the instances compared */
-        for (int sw = 1; sw <= MS_HPC_OFF_RECT; sw <<= 1) {
+        for (int sw = 1; sw <= MS_HPC_OFF_SURE; sw <<= 1) {
             perm_source ps2 = { &bvh, area, nt, 0 };
             const hpc_source src = { &ps2, perm_rewind, perm_next };
             uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
@@ -280,7 +280,7 @@ static void test_isa_instances_and_switches(void **st)
             assert_memory_equal(vis, ref, n * mw * sizeof *vis);
         }
         printf("k=%d: %zu points, %d ISA instances equal to raytrace and to each other (masks, counters: %llu sample "
-               "tests; %llu (leaf, pair) by their rectangle on every leaf); 12 switches equal\n", k, n, ran,
+               "tests; %llu (leaf, pair) by their rectangle on every leaf); 13 switches equal\n", k, n, ran,
                (unsigned long long)cnt0[9], (unsigned long long)rect_pairs);
         free(front); free(ref); free(vis); free(pts); free(q); free(hits);
     }
@@ -354,7 +354,10 @@ static long hpc_pixels_off(const ms_scene *sc, int switches, const ms_frame *ref
  * pixel) matters here: without it (MS_HPC_BREAK_LEAF_BOUND, wrong on purpose) pixels differ, so the scene
  * shows a bound that misses what raytrace blocks. Every face of a bar is an axis-aligned rectangle cut into two
  * triangles, so the pairs' leaf footprint is their rectangle's (hpc_impl.h, "rectangle pairs"): it runs here,
- * and bounded by its first triangle alone (MS_HPC_BREAK_RECT, wrong on purpose) pixels differ. */
+ * and bounded by its first triangle alone (MS_HPC_BREAK_RECT, wrong on purpose) pixels differ. Most samples a
+ * bar blocks lie well inside its footprint, where only the t range is tested (footprint_sure_lanes): that
+ * runs here, and with the sure lanes' margin on the wrong side of the edges (MS_HPC_BREAK_SURE, wrong on
+ * purpose) pixels differ. (With that margin at 0 none does: the samples on a bar's edge are blocked either way.) */
 static void test_bars(void **st)
 {
     (void)st;
@@ -423,8 +426,10 @@ static void test_bars(void **st)
     ms_frame f;
     render_ok(&sc, "hpc", 256, 96, 0, &f);
     ms_hpc_switches = 0;
-    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0;
+    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0, sure = 0, tests = 0;
     for (int c = 0; c < f.stats.n_counters; c++) {
+        if (!strcmp(f.stats.counter_name[c], "samples_sure")) sure = f.stats.counter[c];
+        if (!strcmp(f.stats.counter_name[c], "sample_tests")) tests = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "rect_pairs")) rect_pairs = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "pairs_in_vl")) in_vl = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "pairs_footprint")) to_fp = f.stats.counter[c];
@@ -434,18 +439,26 @@ static void test_bars(void **st)
     ms_frame_free(&f);
     const long differ = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_LEAF_BOUND, &ref);
     const long differ_rect = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_RECT, &ref);
+    const long differ_sure = hpc_pixels_off(&sc, MS_HPC_BREAK_SURE, &ref);
+    const long differ_sure_leaf = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_SURE, &ref);
     printf("bars: leaf footprint: %llu of %llu pairs in V_L to the per-receiver test, %llu (leaf, triangle) ruled "
            "out, %llu with every candidate blocked already; without its bound over the grid origins %ld pixels "
            "differ\n", (unsigned long long)to_fp, (unsigned long long)in_vl, (unsigned long long)leaf_culls,
            (unsigned long long)culls_blocked, differ);
     printf("bars: %llu (leaf, pair) bounded by the pair's rectangle; with the rectangle's bound broken %ld pixels differ\n",
            (unsigned long long)rect_pairs, differ_rect);
+    printf("bars: %llu of %llu sample tests on the t range alone; with the sure lanes' margin on the wrong side %ld pixels differ "
+           "(%ld with the leaf footprint on every leaf)\n", (unsigned long long)sure, (unsigned long long)tests, differ_sure,
+           differ_sure_leaf);
     assert_true(leaf_culls > 0);
     assert_true(culls_blocked > 0);
     assert_true(to_fp < in_vl);
     assert_true(differ > 0);
     assert_true(rect_pairs > 0);
     assert_true(differ_rect > 0);
+    assert_true(sure > 0);
+    assert_true(differ_sure > 0);
+    assert_true(differ_sure_leaf > 0);
     ms_frame_free(&ref);
     ms_scene_free(&sc);
 }
