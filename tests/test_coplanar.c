@@ -7,9 +7,11 @@
  * (the tiled and the frame-level paths) with the merge, without it, and raytrace agree within the tie
  * tolerance of the other method tests (at most a sample on a few pixels; hpc without the merge bit for bit),
  * receivers on merged faces seen at grazing angles included (answered on the scene's own triangles,
- * counted). */
+ * counted; which of them need it, per sample, against the crossing worked out in the test). */
 #include "testutil.h"
 #include "accel/coplanar.h"
+#include "visibility/occluders.h"
+#include "visibility/context.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -225,6 +227,36 @@ static void test_merged_frames(void **st)
     ms_scene_free(&sc);
 }
 
+/* ms_merged_receiver_ok_samples against the segment-plane crossing worked out here: a receiver a little behind
+ * the face x = 1 (d = 1e-6) with samples in front, the crossing parameter d / (d + e) for a sample e in front of
+ * the plane. A sample whose crossing lies at or beyond half the near range refuses the receiver, unless front
+ * leaves it out; samples on the receiver's side never cross; a face off the axes is never merged. */
+static void test_receiver_ok_samples(void **st)
+{
+    (void)st;
+    const float tri[9] = { 1, 0, 0, 1, 1, 0, 1, 0, 1 };
+    const float p[3] = { 1.0f - 1e-6f, 0.5f, 0.2f };
+    const double d = 1.0 - (double)p[0];
+    float pts[4 * 3] = { 3, 1, 1, 2, 0, 1, 0.5f, 2, 2, 0.25f, 0, 0 };   /* two far in front, two on p's side */
+    uint64_t front = 15;
+    assert_int_equal(ms_merged_receiver_ok_samples(tri, p, pts, &front, 4), 1);
+    /* a sample in front so close to the plane that the segment meets it beyond half the near range */
+    const double e_cross = d * (1.0 / (0.5 * (double)MS_SEGMENT_NEAR) - 1.0);   /* crossing at exactly near / 2 */
+    pts[0] = (float)(1.0 + 0.5 * e_cross);
+    assert_true(d / (d + ((double)pts[0] - 1.0)) > 0.5 * (double)MS_SEGMENT_NEAR);
+    assert_int_equal(ms_merged_receiver_ok_samples(tri, p, pts, &front, 4), 0);
+    front = 14;   /* that sample behind the receiver: it does not count */
+    assert_int_equal(ms_merged_receiver_ok_samples(tri, p, pts, &front, 4), 1);
+    front = 15;
+    pts[0] = (float)(1.0 + 4.0 * e_cross);   /* far enough: the crossing below near / 4 */
+    assert_true(d / (d + ((double)pts[0] - 1.0)) < 0.25 * (double)MS_SEGMENT_NEAR);
+    assert_int_equal(ms_merged_receiver_ok_samples(tri, p, pts, &front, 4), 1);
+    pts[3] = 1.0f;   /* a sample on the plane itself: the segment ends in it */
+    assert_int_equal(ms_merged_receiver_ok_samples(tri, p, pts, &front, 4), 0);
+    const float slanted[9] = { 1, 0, 0, 1.5f, 1, 0, 1, 0, 1 };
+    assert_int_equal(ms_merged_receiver_ok_samples(slanted, p, pts, &front, 4), 1);
+}
+
 /* ms_coplanar_rect_pair (hpc's rectangle pairs): the halves of an axis-aligned rectangle, in any vertex order and
  * either diagonal, give its four corners in order around it, the first triangle's vertices being corners 0, 1, 2
  * and the second's 0, 2, 3 (checked as sets, bitwise); a pair that is not such a rectangle is refused. */
@@ -284,6 +316,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_merge),
         cmocka_unit_test(test_merged_frames),
+        cmocka_unit_test(test_receiver_ok_samples),
         cmocka_unit_test(test_rect_pair),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -575,14 +575,20 @@ typedef struct pass_sums {
 
 /* Moves the queries whose receiver lies on a merged coplanar face (ctx->prim_merged; own: their prims in
  * the scene's BVH b) where the merged faces could answer otherwise than the scene's own triangles
- * (ms_merged_receiver_ok: a grazing segment meeting its own plane beyond the near range) after the others,
- * with their front masks and pixels; returns how many come first. */
+ * (ms_merged_receiver_ok: a grazing segment meeting its own plane beyond the near range; for the light as a
+ * whole, then, with pts (3 * ctx->samples floats of scratch; NULL: not), for the receiver's own samples in
+ * front) after the others, with their front masks and pixels; returns how many come first. */
 static int merged_last(const ms_render_ctx *ctx, const ms_bvh *b, const float (*hull)[3], int n_hull, ms_shadow_query *q,
-                       size_t *where, uint32_t *own, uint64_t *front, size_t mw, int nq)
+                       size_t *where, uint32_t *own, uint64_t *front, size_t mw, int nq, float *pts)
 {
     int w = 0;
     for (int i = 0; i < nq; i++) {
-        if (ctx->prim_merged[own[i]] && !ms_merged_receiver_ok(b->tri + 9 * (size_t)own[i], q[i].p, hull, n_hull)) continue;
+        const float *tri = b->tri + 9 * (size_t)own[i];
+        if (ctx->prim_merged[own[i]] && !ms_merged_receiver_ok(tri, q[i].p, hull, n_hull)) {
+            if (!pts) continue;
+            ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
+            if (!ms_merged_receiver_ok_samples(tri, q[i].p, pts, front + (size_t)i * mw, ctx->samples)) continue;
+        }
         if (w != i) {
             const ms_shadow_query tq = q[w]; q[w] = q[i]; q[i] = tq;
             const size_t tw = where[w]; where[w] = where[i]; where[i] = tw;
@@ -649,9 +655,11 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
         /* The samples the interior boxes leave (MS_OCC_INTERIOR_PASS). */
         uint64_t *imask = interior_state ? aligned_alloc(64, TILE * TILE * mw * sizeof *imask) : NULL;
         float *pts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *pts) : NULL;
+        /* merged_last's scratch: the frame's one light (an outlined light's samples are the query's own) */
+        float *mpts = ctx.prim_merged && !outlined ? malloc((size_t)ctx.samples * 3 * sizeof *mpts) : NULL;
         float hull[8][3], hull_box[6];
         const int n_hull = ms_light_hull(&ctx.light, hull, hull_box);
-        int ok = front && vmask && (pts || !stratified) && (imask || !interior_state);
+        int ok = front && vmask && (pts || !stratified) && (imask || !interior_state) && (mpts || !ctx.prim_merged || outlined);
 #pragma omp for schedule(dynamic, 1)
         for (int ti = 0; ti < shadow_tiles; ti++) {
             if (cancelled(j)) continue;
@@ -682,7 +690,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     local_segments += (uint64_t)nf;
                     where[nq++] = i;
                 }
-            const int nm = ctx.prim_merged && ok ? merged_last(&ctx, &j->bvh, (const float (*)[3])hull, n_hull, q, where, own, front, mw, nq) : nq;
+            const int nm = ctx.prim_merged && ok ? merged_last(&ctx, &j->bvh, (const float (*)[3])hull, n_hull, q, where, own, front, mw, nq, mpts) : nq;
             if (!outlined && interior_state && nm && ok) {
                 /* The interior boxes first (no receiver on them: no prim to skip), then the triangles
                  * with the samples they left. */
@@ -734,6 +742,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
         free(vmask);
         free(imask);
         free(pts);
+        free(mpts);
 #pragma omp critical(ms_counters)
         {
             for (int c = 0; c < MS_MAX_COUNTERS; c++) p->counters[c] += local[c];

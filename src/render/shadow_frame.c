@@ -9,8 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* 1 when the receiver of hit h must be answered over the scene's own triangles (own_ctx): it lies on a
- * merged coplanar face where the merge could answer otherwise (frame_job.c's merged_last, the same test). */
+/* 1 when the receiver of hit h may have to be answered over the scene's own triangles (own_ctx): it lies on a
+ * merged coplanar face where the light as a whole does not rule out that the merge answers otherwise
+ * (ms_merged_receiver_ok); its own samples decide (ms_merged_receiver_ok_samples, below). */
 static int on_merged_face(const ms_render_ctx *ctx, const ms_render_ctx *own_ctx, const ms_hit *h,
                           const float (*hull)[3], int n_hull)
 {
@@ -33,48 +34,66 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
     size_t *where = malloc((n ? n : 1) * sizeof *where);
     uint64_t *front = malloc((n ? n : 1) * mw * sizeof *front);
     uint64_t *vis = malloc((n ? n : 1) * mw * sizeof *vis);
+    uint8_t *own = own_state ? malloc(n ? n : 1) : NULL;   /* 1: answered over the scene's own triangles */
     int rc = -1;
-    if (!q || !where || !front || !vis) goto done;
+    if (!q || !where || !front || !vis || (own_state && !own)) goto done;
     float hull[8][3], hull_box[6];
     const int n_hull = own_state ? ms_light_hull(&ctx->light, hull, hull_box) : 0;
     if (!own_state) own_ctx = NULL;
-    /* The receivers the merged faces answer first, then (pass 1) those on merged faces that go to the
-     * scene's own triangles (own_state), named there by their own prims. */
     n = 0;
-    size_t n_main = 0;
-    for (int pass = 0; pass < 2; pass++) {
-        for (size_t j = 0; j < npix; j++) {
-            const size_t i = pixels ? pixels[j] : j;
-            const ms_hit *h = &hits[i];
-            if (h->prim == UINT32_MAX) {
-                if (!pass) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; }
-                continue;
-            }
-            if (on_merged_face(ctx, own_ctx, h, (const float (*)[3])hull, n_hull) != pass) continue;
-            ms_query_from_hit(&q[n], h, (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
-            q[n].prim = pass ? h->prim : ms_ctx_skip_prim(ctx, h->prim);
-            where[n++] = i;
-        }
-        if (!pass) n_main = n;
-        if (!own_ctx) break;
+    for (size_t j = 0; j < npix; j++) {
+        const size_t i = pixels ? pixels[j] : j;
+        const ms_hit *h = &hits[i];
+        if (h->prim == UINT32_MAX) { vis_out[i] = shadow_out[i] = spec_out[i] = -1.0f; front_out[i] = 0; continue; }
+        if (own) own[n] = (uint8_t)on_merged_face(ctx, own_ctx, h, (const float (*)[3])hull, n_hull);
+        ms_query_from_hit(&q[n], h, (uint32_t)(i % (size_t)W), (uint32_t)(i / (size_t)W));
+        q[n].prim = ms_ctx_skip_prim(ctx, h->prim);
+        where[n++] = i;
     }
     int failed = 0;
     uint64_t seg = 0;
 #pragma omp parallel num_threads(ctx->threads) reduction(+ : seg) reduction(| : failed)
     {
-        float *pts = stratified ? malloc((size_t)ctx->samples * 3 * sizeof *pts) : NULL;
-        failed |= stratified && !pts;
+        const int need_pts = stratified || own;
+        float *pts = need_pts ? malloc((size_t)ctx->samples * 3 * sizeof *pts) : NULL;
+        failed |= need_pts && !pts;
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             if (failed) continue;
-            if (pts) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
-            const int nf = ms_front_mask(ctx, &q[i], pts, front + i * mw);
+            if (stratified || (own && own[i])) ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
+            const int nf = ms_front_mask(ctx, &q[i], stratified ? pts : NULL, front + i * mw);
             front_out[where[i]] = (uint16_t)nf;
             seg += (uint64_t)nf;
+            /* the receiver's own samples in front may rule the difference out after all */
+            if (own && own[i] && ms_merged_receiver_ok_samples(own_ctx->bvh->tri + 9 * (size_t)hits[where[i]].prim, q[i].p, pts,
+                                                                front + i * mw, ctx->samples))
+                own[i] = 0;
         }
         free(pts);
     }
-    if (failed || sm->visibility_all(sstate, ctx, q, n_main, front, vis, counters)) goto done;
+    if (failed) goto done;
+    /* The receivers the merged faces answer first (in their order), then those on merged faces that go to the
+     * scene's own triangles (own_state), named there by their own prims. */
+    size_t n_main = n;
+    if (own) {
+        n_main = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (own[i]) continue;
+            if (n_main != i) {
+                const ms_shadow_query tq = q[n_main]; q[n_main] = q[i]; q[i] = tq;
+                const size_t tw = where[n_main]; where[n_main] = where[i]; where[i] = tw;
+                const uint8_t to = own[n_main]; own[n_main] = own[i]; own[i] = to;
+                for (size_t k = 0; k < mw; k++) {
+                    const uint64_t tf = front[n_main * mw + k];
+                    front[n_main * mw + k] = front[i * mw + k];
+                    front[i * mw + k] = tf;
+                }
+            }
+            n_main++;
+        }
+        for (size_t i = n_main; i < n; i++) q[i].prim = hits[where[i]].prim;
+    }
+    if (sm->visibility_all(sstate, ctx, q, n_main, front, vis, counters)) goto done;
     if (n > n_main && sm->visibility_all(own_state, own_ctx, q + n_main, n - n_main, front + n_main * mw,
                                          vis + n_main * mw, counters))
         goto done;
@@ -108,5 +127,6 @@ done:
     free(where);
     free(front);
     free(vis);
+    free(own);
     return rc;
 }

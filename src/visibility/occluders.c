@@ -305,3 +305,19 @@ int ms_merged_receiver_ok(const float tri[9], const float p[3], const float (*hu
     }
     return !(above && below) && lmin > 0.0 && d < 0.5 * (double)MS_SEGMENT_NEAR * lmin;
 }
+
+int ms_merged_receiver_ok_samples(const float tri[9], const float p[3], const float *pts, const uint64_t *front, int n)
+{
+    int a = -1;
+    for (int k = 0; k < 3 && a < 0; k++)
+        if (tri[k] == tri[3 + k] && tri[k] == tri[6 + k]) a = k;
+    if (a < 0) return 1;
+    const double c = tri[a], dp = (double)p[a] - c, d = fabs(dp), need = d / (0.5 * (double)MS_SEGMENT_NEAR);
+    for (int i = 0; i < n; i++) {
+        if (!(front[i >> 6] >> (i & 63) & 1u)) continue;
+        const double e = (double)pts[3 * i + a] - c;
+        if (e * dp > 0.0) continue;             /* both strictly on one side: the segment never meets the plane */
+        if (!(fabs(e) > need)) return 0;        /* it may meet it beyond half the near range */
+    }
+    return 1;
+}

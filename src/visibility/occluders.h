@@ -72,6 +72,13 @@ int ms_light_hull(const ms_light *l, float pts[8][3], float box[6]);
  * (|p_a - c| < 0.5 near |L_a - c|): then neither tiling of the face is ever met beyond the near range. */
 int ms_merged_receiver_ok(const float tri[9], const float p[3], const float (*hull)[3], int n_hull);
 
+/* The same per sample, for a receiver the light as a whole fails (a face whose plane crosses the light: a bar's
+ * side under a light above): 1 when every sample point pts[i] (3 floats each, i < n) that front holds is either
+ * strictly on p's side of tri's plane (the segment never meets it) or so far on the other that the segment meets
+ * it below half the near range (|p_a - c| < 0.5 near |pts_a - c|, as above). Only the receiver's own samples in
+ * front count: the others are blocked for every method from the start. */
+int ms_merged_receiver_ok_samples(const float tri[9], const float p[3], const float *pts, const uint64_t *front, int n);
+
 /* The clearance interior boxes need so that every light of the scene may use them (docs/culling.md):
  * 2.5 times the near range (MS_SEGMENT_NEAR) times the longest segment, the diagonal of the scene's and
  * the lights' boxes together. */
