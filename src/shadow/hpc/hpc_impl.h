@@ -1282,6 +1282,228 @@ static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q,
     return hit;
 }
 
+/* 1 when every sample of receiver p's grid g passes the exact test's t range for triangle t (normal N, offset num
+ * as the exact test has it), so that no sample needs it evaluated. The test's decision, per lane, is |den| > 0,
+ * near |den| <= ns <= far |den|, with den the float d . N and ns = num signed by den. d . N is affine in the
+ * sample's indices, c0 + i ci + j cj (d = p0 + i ds + j dt - p), so over the grid (0 <= i, j <= k - 1) its real
+ * value lies in [c0 + (k-1) (min(ci, 0) + min(cj, 0)), c0 + (k-1) (max(ci, 0) + max(cj, 0))], taken here in
+ * double (float inputs: every product and difference exact to 1e-16 of itself; 1e-12 of the terms covers it).
+ * The float den differs from the real one by at most |N|_1 (5 u S + 3.01 u dmax) (the direction's 5 u S per
+ * component, footprint_rel's S and dmax, and the three products and two sums; u = 2^-24), with 1% more. If that
+ * range has one sign sigma beyond the error and sigma num > 0, every lane has |den| in [Dlo, Dhi] and
+ * ns = |num|, and the float products near |den| <= near Dhi (1 + u) and far |den| >= far Dlo (1 - u) (one
+ * rounding each) leave |num| within them when near Dhi (1 + 1e-6) <= |num| <= far Dlo (1 - 1e-6). Triangles
+ * well between the receiver and the light, not seen edge-on from it, pass. Plain compares, no libm calls. */
+static int pair_t_sure(const shared *sh, const ms_grid *g, const float p[3], const float N[3], float num)
+{
+    const double km = (double)(sh->k - 1);
+    double c0 = 0.0, ci = 0.0, cj = 0.0, terms = 0.0, n1 = 0.0, dmax = 0.0, S = 0.0;
+    for (int a = 0; a < 3; a++) {
+        const double w = (double)g->p0[a] - (double)p[a], na = N[a] < 0.0f ? -(double)N[a] : (double)N[a];
+        const double ds = g->ds[a] < 0.0f ? -(double)g->ds[a] : (double)g->ds[a], dt = g->dt[a] < 0.0f ? -(double)g->dt[a] : (double)g->dt[a];
+        const double aw = w < 0.0 ? -w : w, ext = km * (ds + dt);
+        const double p0a = g->p0[a] < 0.0f ? -(double)g->p0[a] : (double)g->p0[a], pa = p[a] < 0.0f ? -(double)p[a] : (double)p[a];
+        c0 += w * N[a];
+        ci += (double)g->ds[a] * N[a];
+        cj += (double)g->dt[a] * N[a];
+        terms += (aw + ext) * na;
+        n1 += na;
+        dmax = aw + ext > dmax ? aw + ext : dmax;
+        S = p0a + ext + pa > S ? p0a + ext + pa : S;
+    }
+    const double lo = c0 + km * ((ci < 0.0 ? ci : 0.0) + (cj < 0.0 ? cj : 0.0));
+    const double hi = c0 + km * ((ci > 0.0 ? ci : 0.0) + (cj > 0.0 ? cj : 0.0));
+    const double err = 1.01 * 5.9604645e-08 * n1 * (5.0 * S + 3.01 * dmax) + 1e-12 * terms;
+    double Dlo, Dhi;
+    if (lo - err > 0.0 && num > 0.0f) { Dlo = lo - err; Dhi = hi + err; }
+    else if (hi + err < 0.0 && num < 0.0f) { Dlo = -(hi + err); Dhi = -(lo - err); }
+    else return 0;
+    const double an = num < 0.0f ? -(double)num : (double)num;
+    return (double)sh->ctx->near * Dhi * (1.0 + 1e-6) <= an && an <= (double)sh->ctx->far * Dlo * (1.0 - 1e-6);
+}
+
+/* ---- row masks (hpc, k = 16 or 32: the footprint rasterized row by row) ----
+ *
+ * Departure (after Woop's scanline micro-rasterization, whose kernel gives each scanline of the light's grid one
+ * machine word): a receiver's footprint of a triangle, E_e(i, j) = e0 + e1 i + e2 j for its three edge
+ * functions (footprint_setup), is turned into bit masks per row of the grid, sixteen rows to a vector: along
+ * row j, E_e > s_e is a half-line of i (i > t or i < t, t = (s_e - e0 - e2 j) / e1, by e1's sign), and so is
+ * E_e < -s_e. Each half-line is taken conservatively: with A = fl(e0 + fl(e2 j)) (off the real A by at most
+ * 2.01 u (|e0| + |e2| j)), x = fl(s - A) and t = fl(x fl(1 / e1)), the real threshold is within
+ * |1/e1| (that + 2.1 u (|s| + |A|)) + u |t| of t, and the mask keeps only the samples beyond twice that plus 1e-6
+ * (one more rounding when it is added), so a sample in the half-line has the real E_e (of the float coefficients)
+ * beyond s_e; e1 = 0 makes it all or none of the row by A alone. Then per row: sure = the samples beyond the
+ * slacks with one sign for all three functions (footprint_sure_lanes' condition: the exact test's edge
+ * functions pass there), miss = some beyond s and some beyond -s (footprint_keep's mixed signs: the exact test
+ * fails there). The slack argument is the footprint's (above): the real E_e is within s_e / 2 of the exact
+ * test's U_e d[kz]. What is neither (within a slack of an edge, or where only the plane-side rule of
+ * footprint_keep_n would rule a sample out) goes to the exact test (group_block16), and so do a row's samples
+ * whose packet has no shared shear axis (the exact test's own-axis form decides its t differently). The sure
+ * samples are blocked outright when the whole grid passes the t range (pair_t_sure), else tested. So the
+ * receiver's candidate samples come from a handful of vector operations per triangle instead of the groups'
+ * bounds and a 16-lane evaluation per block, and the exact test runs only near the edges. */
+
+/* The samples of rows j0 .. j0 + 15 (lanes) where the real E = e0 + e1 i + e2 j surely exceeds s (*gt) and where
+ * it is surely below -s (*lt), as bit masks of k bits (above). */
+L16_INLINE void row_halflines(const float e[3], float s, int j0, int k, l16u *gt, l16u *lt)
+{
+    static const float lane_j[LANES] = { 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15 };
+    const float u = 5.9604645e-08f;
+    const l16 jv = l16_add(l16_set1((float)j0), l16_load(lane_j)), zero = l16_set1(0.0f), kf = l16_set1((float)k);
+    const l16u full = l16u_set1(k == 32 ? 0xffffffffu : (1u << k) - 1u);
+    const l16 A = l16_add(l16_set1(e[0]), l16_mul(l16_set1(e[2]), jv));
+    const l16 epsA = l16_mul(l16_set1(2.01f * u), l16_add(l16_set1(fabsf(e[0])), l16_mul(l16_set1(fabsf(e[2])), jv)));
+    const l16 xs[2] = { l16_sub(l16_set1(s), A), l16_sub(l16_set1(-s), A) };   /* E > s: e1 i > xs[0]; E < -s: e1 i < xs[1] */
+    const l16 ex = l16_add(epsA, l16_mul(l16_set1(2.1f * u), l16_add(l16_set1(fabsf(s)), l16_abs(A))));   /* x's error */
+    if (e[1] == 0.0f) {   /* E = A along the row: all of it or none, a shift by 0 or by 32 */
+        const l16 m = l16_mul(l16_set1(1.1f), ex), k32 = l16_set1(32.0f);
+        *gt = l16u_and(full, l16u_shl(full, l16u_from(l16_select(l16_gt(l16_sub(zero, xs[0]), m), zero, k32))));
+        *lt = l16u_and(full, l16u_shl(full, l16u_from(l16_select(l16_gt(xs[1], m), zero, k32))));
+        return;
+    }
+    /* A row wholly beyond s (or -s): E's least (largest) value along it, A + min(0, e1 (k - 1)), with x's error and
+     * that product's. Where e1 is small against e0 and e2 (an edge nearly along the rows: the bars lie along the
+     * grid's axes) the threshold's error below grows as 1 / e1; this keeps such rows decided. */
+    const float run = e[1] * (float)(k - 1), erun = 2.1f * u * fabsf(run);
+    const l16 m_row = l16_add(l16_mul(l16_set1(1.1f), ex), l16_set1(erun));
+    const l16 k32 = l16_set1(32.0f);
+    const l16u row_gt = l16u_and(full, l16u_shl(full, l16u_from(l16_select(l16_gt(l16_sub(l16_sub(zero, xs[0]), l16_set1(fabsf(run))), m_row), zero, k32))));
+    const l16u row_lt = l16u_and(full, l16u_shl(full, l16u_from(l16_select(l16_gt(l16_sub(xs[1], l16_set1(fabsf(run))), m_row), zero, k32))));
+    const float r = 1.0f / e[1], ar = fabsf(r);
+    l16u out[2];
+    for (int h = 0; h < 2; h++) {
+        const l16 t = l16_mul(xs[h], l16_set1(r));
+        const l16 D = l16_add(l16_mul(l16_set1(2.0f), l16_add(l16_mul(l16_set1(ar), ex), l16_mul(l16_set1(u), l16_abs(t)))),
+                              l16_set1(1e-6f));
+        const unsigned valid = l16_lt(l16_abs(t), l16_set1(1e6f)) & l16_lt(D, l16_set1(1e6f));   /* beyond: all or none, robustly */
+        /* h = 0 (E > s): i > t for e1 > 0, i < t for e1 < 0; h = 1 (E < -s): the other way */
+        const int above = (h == 0) == (e[1] > 0.0f);
+        if (above) {   /* bits i >= floor(t + D) + 1 */
+            const l16 y = l16_min(l16_max(l16_add(t, D), l16_set1(-1.0f)), kf);
+            const l16 m = l16_select(valid, l16_min(l16_max(l16_add(l16_floor(y), l16_set1(1.0f)), zero), kf), kf);
+            out[h] = l16u_and(full, l16u_shl(full, l16u_from(m)));
+        } else {       /* bits i < ceil(t - D) */
+            const l16 y = l16_min(l16_max(l16_sub(t, D), l16_set1(-1.0f)), kf);
+            const l16 m = l16_select(valid, l16_min(l16_max(l16_ceil(y), zero), kf), zero);
+            out[h] = l16u_andnot(l16u_shl(full, l16u_from(m)), full);
+        }
+    }
+    *gt = l16u_or(out[0], row_gt);
+    *lt = l16u_or(out[1], row_lt);
+}
+
+/* A receiver's sure and miss masks of one triangle's footprint f, k = 16: lane j is row j (above); broken: the
+ * sure samples' slack negated (MS_HPC_BREAK_SURE, wrong on purpose). */
+L16_INLINE void footprint_rows16(const hpc_footprint *f, int broken, l16u *sure, l16u *miss)
+{
+    l16u gt[3], lt[3];
+    for (int e = 0; e < 3; e++) row_halflines(f->e[e], f->s[e], 0, 16, &gt[e], &lt[e]);
+    *miss = l16u_and(l16u_or(l16u_or(gt[0], gt[1]), gt[2]), l16u_or(l16u_or(lt[0], lt[1]), lt[2]));
+    if (broken)
+        for (int e = 0; e < 3; e++) row_halflines(f->e[e], -f->s[e], 0, 16, &gt[e], &lt[e]);
+    *sure = l16u_or(l16u_and(l16u_and(gt[0], gt[1]), gt[2]), l16u_and(l16u_and(lt[0], lt[1]), lt[2]));
+    /* footprint_slack_ok: a slack below the normal range proves nothing */
+    if (!(f->s[0] > 1e-30f && f->s[1] > 1e-30f && f->s[2] > 1e-30f)) *sure = l16u_set1(0u);
+}
+
+/* The bits of sixteen 16-bit rows (k = 16: a receiver's 256 samples). */
+static inline int rows16_popcount(const uint16_t r[16])
+{
+    uint64_t w[4];
+    memcpy(w, r, sizeof w);
+    return __builtin_popcountll(w[0]) + __builtin_popcountll(w[1]) + __builtin_popcountll(w[2]) + __builtin_popcountll(w[3]);
+}
+
+/* Receiver r against a job's triangles by row masks (k = 16, no alpha, per-receiver footprints: above), the rows
+ * in the lanes. The same answers as cast_footprint's blocks: every sample it blocks the exact test blocks, and
+ * every sample it leaves open the exact test leaves open (sure samples under pair_t_sure, else by the t range;
+ * the rest by the exact test). */
+static void cast_rows16(const shared *sh, chunk *c, uint32_t r, const ms_grid *g, const hpc_view *v)
+{
+    const ms_shadow_query *q = &sh->q[r];
+    const int nt = v->nt;
+    c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~sh->gumbra[r]);
+    c->cnt[C_PAIRS_FOOTPRINT] += (uint64_t)nt;
+    l16u S[2], M[2];
+    const int brk = !!(sh->sw & MS_HPC_BREAK_SURE);
+    for (int u = 0; u < nt; u++) footprint_rows16(&v->fp[u], brk, &S[u], &M[u]);
+    int32_t s = sh->slot[r];
+    uint16_t orow[16];   /* the open samples, row j = bits 16 j .. 16 j + 15 of the mask */
+    memcpy(orow, open_of(sh, c, r), sizeof orow);
+    const l16u O = l16u_load16(orow);
+    l16u cand = l16u_andnot(M[0], O);
+    if (nt > 1) cand = l16u_or(cand, l16u_andnot(M[1], O));
+    if (!l16u_nonzero(cand)) return;
+    if (s < 0 && (s = slot_of(sh, c, r, g)) < 0) return;
+    uint64_t *w = slot_mask(sh, c, s);
+    const int8_t *kz = slot_kz(sh, c, s);
+    /* the rows whose packet has no shared shear axis: their samples go to the exact test */
+    unsigned na = 0;
+    for (int j = 0; j < 16; j++) na |= (unsigned)(kz[j] < 0) << j;
+    const l16u NA = l16u_masked(na, 0xffffu);
+    l16u H = l16u_set1(0u);
+    for (int u = 0; u < nt; u++) {
+        const tri_job *t = v->t[u];
+        const l16u live = l16u_andnot(H, l16u_andnot(M[u], O));
+        if (!l16u_nonzero(live)) continue;
+        const l16u su = l16u_and(live, l16u_andnot(NA, S[u])), band = l16u_andnot(su, live);
+        uint16_t lr[16], sr[16];
+        l16u_store16(lr, live);
+        c->cnt[C_SAMPLE_TESTS] += (uint64_t)rows16_popcount(lr);
+        const float num = ms_wt_offset(q->p, t->v, t->N);
+        const unsigned su_rows = l16u_nonzero(su);
+        int ts = 0;
+        if (su_rows) {
+            l16u_store16(sr, su);
+            c->cnt[C_SAMPLES_SURE] += (uint64_t)rows16_popcount(sr);
+            ts = pair_t_sure(sh, g, q->p, t->N, num);
+            if (ts) H = l16u_or(H, su);
+        }
+        const unsigned band_rows = l16u_nonzero(band);
+        if (!band_rows && (ts || !su_rows)) continue;
+        /* the blocks holding samples for the exact test, or for the t range alone */
+        uint16_t br[16], hr[16] = { 0 };
+        l16u_store16(br, band);
+        if (ts || !su_rows) memset(sr, 0, sizeof sr);
+        float V[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int a = 0; a < 3; a++) V[i][a] = t->v[3 * i + a] - q->p[a];
+        for (int j0 = 0; j0 < 16; j0 += 4) {
+            const unsigned bor = (unsigned)(br[j0] | br[j0 + 1] | br[j0 + 2] | br[j0 + 3]);
+            const unsigned sor = (unsigned)(sr[j0] | sr[j0 + 1] | sr[j0 + 2] | sr[j0 + 3]);
+            for (int i0 = 0; i0 < 16; i0 += 4) {
+                if (!((bor | sor) >> i0 & 15u)) continue;
+                unsigned lb = 0, ls = 0;
+                for (int rr = 0; rr < 4; rr++) {
+                    lb |= ((unsigned)br[j0 + rr] >> i0 & 15u) << (4 * rr);
+                    ls |= ((unsigned)sr[j0 + rr] >> i0 & 15u) << (4 * rr);
+                }
+                unsigned h = 0;
+                if (lb) h |= group_block16(sh, q, g, kz, i0, j0, 4, lb, t, V[0], V[1], V[2], num);
+                if (ls) h |= block_t_range(sh, q, g, i0, j0, ls, t, num);
+                for (int rr = 0; rr < 4; rr++) hr[j0 + rr] |= (uint16_t)((h >> (4 * rr) & 15u) << i0);
+            }
+        }
+        H = l16u_or(H, l16u_load16(hr));
+    }
+    if (!l16u_nonzero(H)) return;
+    uint16_t hrow[16], nrow[16];
+    l16u_store16(hrow, H);
+    l16u_store16(nrow, l16u_andnot(H, O));
+    memcpy(w, nrow, sizeof nrow);
+    c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)rows16_popcount(hrow);
+    /* the groups (4 x 4 samples: 4 per row of groups) with a sample blocked and none left open */
+    uint64_t gu = sh->gumbra[r];
+    const uint64_t gu0 = gu;
+    for (int jb = 0; jb < 4; jb++) {
+        const unsigned hor = (unsigned)(hrow[4 * jb] | hrow[4 * jb + 1] | hrow[4 * jb + 2] | hrow[4 * jb + 3]);
+        const unsigned oor = (unsigned)(nrow[4 * jb] | nrow[4 * jb + 1] | nrow[4 * jb + 2] | nrow[4 * jb + 3]);
+        for (int ib = 0; ib < 4; ib++)
+            if ((hor >> (4 * ib) & 15u) && !(oor >> (4 * ib) & 15u)) gu |= UINT64_C(1) << (4 * jb + ib);
+    }
+    if (gu != gu0) record_umbra(sh, c, r, s, gu);
+}
+
 /* Receiver r inside V_L against a job's triangles (v), with the footprint test in place of V_Gk (above): the
  * groups some triangle's footprint may touch, then in each block the lanes each footprint may hold, and the
  * exact test of each triangle only on those of its lanes that are still open. A sample is blocked when one of
@@ -1291,6 +1513,11 @@ static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q,
  * when some lane needs the exact test. */
 static void cast_footprint(const shared *sh, chunk *c, uint32_t r, const ms_grid *g, const hpc_view *v)
 {
+    if (!v->direct && sh->k == 16 && !(sh->sw & (MS_HPC_OFF_ROWS | MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES)) &&
+        !ms_alpha_tested(sh->ctx->alpha, v->t[0]->self) && !(v->nt > 1 && ms_alpha_tested(sh->ctx->alpha, v->t[1]->self))) {
+        cast_rows16(sh, c, r, g, v);
+        return;
+    }
     const ms_shadow_query *q = &sh->q[r];
     uint64_t gu = sh->gumbra[r];
     c->cnt[C_GROUP_POINT_TESTS] += (uint64_t)__builtin_popcountll(sh->all_groups & ~gu);
