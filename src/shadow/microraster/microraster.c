@@ -156,6 +156,7 @@ static int mr_visibility_pixel(const mr_state *s, const ms_render_ctx *ctx, cons
 static void interior_pass(const mr_state *s, const ms_render_ctx *ctx, ms_block_input *in, size_t mw, uint64_t *cnt)
 {
     ms_block_input vin = *in;
+    vin.cache = NULL;   /* the cache's leaves are the scene BVH's */
     const void *alpha[MS_BLOCK_LANES];
     for (int l = 0; l < in->n; l++) {
         vin.skip[l] = UINT32_MAX;
@@ -193,6 +194,9 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
     int *order = malloc((size_t)nq * sizeof *order);
     if (!order) return -1;
     ms_block_order(ctx, q, nq, order);
+    ms_block_leaf_cache cache = { 0 };
+    cache.pre_bits = calloc(((size_t)s->shallow.n_nodes + 63) / 64, sizeof *cache.pre_bits);
+    if (!cache.pre_bits) { free(order); return -1; }
     int rc = 0;
     for (int g = 0; g < nq && !rc;) {
         ms_block_input in;
@@ -200,6 +204,7 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
         ms_alpha_pixel aps[MS_BLOCK_LANES];
         ms_render_ctx own[MS_BLOCK_LANES];   /* an outlined light: the lanes' own contexts (aps[] point at them) */
         in.n = 0;
+        in.cache = &cache;
         const int end = ms_block_group_end(ctx, q, order, nq, g);
         for (int e = g; e < end; e++) {
             const int i = order[e];
@@ -219,6 +224,7 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
     }
     free(order);
     free(pts);
+    free(cache.pre_bits);
     return rc;
 }
 
