@@ -19,7 +19,7 @@
  *        footprint test: the paper's group volumes instead), pairs (hpc's pairs of triangles sharing an edge:
  *        each triangle alone), leaffp (hpc's leaf footprint), leaffp-rule (the leaf footprint on every leaf),
  *        rect (hpc's rectangle pairs: each triangle of a pair with its own leaf footprint), sure (hpc's sure lanes:
- *        every candidate sample to the exact test), rows (hpc's row masks: the footprint block by block). */
+ *        every candidate sample to the exact test). */
 #include "microshadow.h"
 #include "shadow/hpc/hpc.h"
 #include <stdint.h>
@@ -98,7 +98,7 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ","))
                 for (int m = 0; m < NM; m++) run[m] |= !strcmp(t, methods[m]);
         } else if (!strcmp(argv[first], "--off")) {
-            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule", "rect", "sure", "rows" };
+            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule", "rect", "sure" };
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ",")) {
                 int found = 0;
                 for (int b = 0; b < (int)(sizeof names / sizeof *names); b++)

@@ -40,22 +40,6 @@ L16_INLINE l16i l16i_load(const int32_t *p) { return _mm512_loadu_si512((const v
 L16_INLINE l16 l16_perm(l16 a, l16i p) { return _mm512_permutexvar_ps(p, a); }
 /* Lane i = base[p[i]]. */
 L16_INLINE l16 l16_gather(const float *base, l16i p) { return _mm512_i32gather_ps(p, base, 4); }
-/* Sixteen 32-bit unsigned lanes for bit masks built per lane (hpc's row masks): from a float lane (truncated;
- * the callers clamp into 0..32 first), shifts by a lane count (32 or more gives 0), and, or, and-not. */
-typedef __m512i l16u;
-L16_INLINE l16u l16u_from(l16 a) { return _mm512_cvttps_epi32(a); }
-L16_INLINE l16u l16u_set1(uint32_t x) { return _mm512_set1_epi32((int)x); }
-L16_INLINE l16u l16u_shl(l16u a, l16u n) { return _mm512_sllv_epi32(a, n); }
-L16_INLINE l16u l16u_and(l16u a, l16u b) { return _mm512_and_si512(a, b); }
-L16_INLINE l16u l16u_or(l16u a, l16u b) { return _mm512_or_si512(a, b); }
-L16_INLINE l16u l16u_andnot(l16u a, l16u b) { return _mm512_andnot_si512(a, b); }   /* ~a & b */
-L16_INLINE void l16u_store(uint32_t *p, l16u a) { _mm512_storeu_si512((void *)p, a); }
-/* Sixteen 16-bit values to and from the lanes (zero-extended; stored truncated: the lanes hold 16-bit values). */
-L16_INLINE l16u l16u_load16(const uint16_t *p) { return _mm512_cvtepu16_epi32(_mm256_loadu_si256((const __m256i *)p)); }
-L16_INLINE void l16u_store16(uint16_t *p, l16u a) { _mm256_storeu_si256((__m256i *)p, _mm512_cvtepi32_epi16(a)); }
-/* The lanes that are not 0, and v in the lanes of m (0 elsewhere). */
-L16_INLINE unsigned l16u_nonzero(l16u a) { return _mm512_test_epi32_mask(a, a); }
-L16_INLINE l16u l16u_masked(unsigned m, uint32_t v) { return _mm512_maskz_set1_epi32((__mmask16)m, (int)v); }
 #elif defined(MS_TARGET_AVX2)
 #include <immintrin.h>
 typedef struct l16 { __m256 lo, hi; } l16;
@@ -118,38 +102,6 @@ L16_INLINE l16 l16_perm(l16 a, l16i p)
                   _mm256_blendv_ps(_mm256_permutevar8x32_ps(a.lo, p.hi), _mm256_permutevar8x32_ps(a.hi, p.hi), p.up_hi) };
 }
 L16_INLINE l16 l16_gather(const float *base, l16i p) { return (l16){ _mm256_i32gather_ps(base, p.lo, 4), _mm256_i32gather_ps(base, p.hi, 4) }; }
-typedef struct l16u { __m256i lo, hi; } l16u;
-L16_INLINE l16u l16u_from(l16 a) { return (l16u){ _mm256_cvttps_epi32(a.lo), _mm256_cvttps_epi32(a.hi) }; }
-L16_INLINE l16u l16u_set1(uint32_t x) { return (l16u){ _mm256_set1_epi32((int)x), _mm256_set1_epi32((int)x) }; }
-L16_INLINE l16u l16u_shl(l16u a, l16u n) { return (l16u){ _mm256_sllv_epi32(a.lo, n.lo), _mm256_sllv_epi32(a.hi, n.hi) }; }
-L16_INLINE l16u l16u_and(l16u a, l16u b) { return (l16u){ _mm256_and_si256(a.lo, b.lo), _mm256_and_si256(a.hi, b.hi) }; }
-L16_INLINE l16u l16u_or(l16u a, l16u b) { return (l16u){ _mm256_or_si256(a.lo, b.lo), _mm256_or_si256(a.hi, b.hi) }; }
-L16_INLINE l16u l16u_andnot(l16u a, l16u b) { return (l16u){ _mm256_andnot_si256(a.lo, b.lo), _mm256_andnot_si256(a.hi, b.hi) }; }
-L16_INLINE void l16u_store(uint32_t *p, l16u a)
-{
-    _mm256_storeu_si256((__m256i *)p, a.lo);
-    _mm256_storeu_si256((__m256i *)(p + 8), a.hi);
-}
-L16_INLINE l16u l16u_load16(const uint16_t *p)
-{
-    return (l16u){ _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)p)), _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(p + 8))) };
-}
-L16_INLINE void l16u_store16(uint16_t *p, l16u a)
-{
-    /* packus interleaves the 128-bit halves: lanes 0-3, 8-11, 4-7, 12-15; the permutation restores the order */
-    _mm256_storeu_si256((__m256i *)p, _mm256_permute4x64_epi64(_mm256_packus_epi32(a.lo, a.hi), 0xD8));
-}
-L16_INLINE unsigned l16u_nonzero(l16u a)
-{
-    const __m256i z = _mm256_setzero_si256();
-    return (~(unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(a.lo, z))) & 0xFFu) |
-           (~(unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(a.hi, z))) & 0xFFu) << 8;
-}
-L16_INLINE l16u l16u_masked(unsigned m, uint32_t v)
-{
-    const __m256i vv = _mm256_set1_epi32((int)v);
-    return (l16u){ _mm256_and_si256(vv, _mm256_castps_si256(l16_mask8(m & 0xFF))), _mm256_and_si256(vv, _mm256_castps_si256(l16_mask8(m >> 8))) };
-}
 #else
 #include <math.h>
 typedef struct l16 { float v[16]; } l16;
@@ -208,24 +160,6 @@ typedef struct l16i { int32_t v[16]; } l16i;
 L16_INLINE l16i l16i_load(const int32_t *p) { l16i r; for (int i = 0; i < 16; i++) r.v[i] = p[i]; return r; }
 L16_INLINE l16 l16_perm(l16 a, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = a.v[p.v[i] & 15]; return r; }
 L16_INLINE l16 l16_gather(const float *base, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = base[p.v[i]]; return r; }
-typedef struct l16u { uint32_t v[16]; } l16u;
-/* as cvttps: truncation, out of range (or NaN) 0x80000000 */
-L16_INLINE l16u l16u_from(l16 a)
-{
-    l16u r;
-    for (int i = 0; i < 16; i++) r.v[i] = a.v[i] > -2147483648.0f && a.v[i] < 2147483648.0f ? (uint32_t)(int32_t)a.v[i] : 0x80000000u;
-    return r;
-}
-L16_INLINE l16u l16u_set1(uint32_t x) { l16u r; for (int i = 0; i < 16; i++) r.v[i] = x; return r; }
-L16_INLINE l16u l16u_shl(l16u a, l16u n) { l16u r; for (int i = 0; i < 16; i++) r.v[i] = n.v[i] < 32u ? a.v[i] << n.v[i] : 0u; return r; }
-L16_INLINE l16u l16u_and(l16u a, l16u b) { l16u r; for (int i = 0; i < 16; i++) r.v[i] = a.v[i] & b.v[i]; return r; }
-L16_INLINE l16u l16u_or(l16u a, l16u b) { l16u r; for (int i = 0; i < 16; i++) r.v[i] = a.v[i] | b.v[i]; return r; }
-L16_INLINE l16u l16u_andnot(l16u a, l16u b) { l16u r; for (int i = 0; i < 16; i++) r.v[i] = ~a.v[i] & b.v[i]; return r; }
-L16_INLINE void l16u_store(uint32_t *p, l16u a) { for (int i = 0; i < 16; i++) p[i] = a.v[i]; }
-L16_INLINE l16u l16u_load16(const uint16_t *p) { l16u r; for (int i = 0; i < 16; i++) r.v[i] = p[i]; return r; }
-L16_INLINE void l16u_store16(uint16_t *p, l16u a) { for (int i = 0; i < 16; i++) p[i] = (uint16_t)a.v[i]; }
-L16_INLINE unsigned l16u_nonzero(l16u a) { unsigned m = 0; for (int i = 0; i < 16; i++) m |= (unsigned)(a.v[i] != 0) << i; return m; }
-L16_INLINE l16u l16u_masked(unsigned m, uint32_t v) { l16u r; for (int i = 0; i < 16; i++) r.v[i] = (m >> i & 1) ? v : 0u; return r; }
 #endif
 
 #endif

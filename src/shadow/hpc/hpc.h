@@ -60,13 +60,12 @@ enum {
     MS_HPC_ALL_LEAF_FOOTPRINT = 1024, /* the leaf footprint rule off: on every leaf, not only where it pays (leaf_fp_pays) */
     MS_HPC_OFF_RECT = 2048,      /* hpc's rectangle pairs (hpc_impl.h): each triangle of such a pair bounded alone */
     MS_HPC_OFF_SURE = 4096,      /* hpc's sure lanes (footprint_sure_lanes): every candidate sample to the exact test */
-    MS_HPC_OFF_ROWS = 8192,      /* hpc's row masks (cast_rows): the per-receiver footprint block by block */
-    MS_HPC_BREAK_LEAF_BOUND = 16384,  /* not a measurement: the leaf footprint without its bound over the leaf's
+    MS_HPC_BREAK_LEAF_BOUND = 8192,  /* not a measurement: the leaf footprint without its bound over the leaf's
                                       * grid origins (wrong on purpose), so that test_hpc can show its scene
                                       * depends on it */
-    MS_HPC_BREAK_RECT = 32768,   /* not a measurement: a rectangle pair's leaf footprint from its first triangle
+    MS_HPC_BREAK_RECT = 16384,   /* not a measurement: a rectangle pair's leaf footprint from its first triangle
                                   * alone (wrong on purpose), so that test_hpc can show its scene depends on it */
-    MS_HPC_BREAK_SURE = 65536    /* not a measurement: the sure lanes (footprint_sure_lanes) with their margin on
+    MS_HPC_BREAK_SURE = 32768    /* not a measurement: the sure lanes (footprint_sure_lanes) with their margin on
                                   * the wrong side of the edges, -s (wrong on purpose), so that test_hpc can show
                                   * its scene depends on it */
 };
