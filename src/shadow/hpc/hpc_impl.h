@@ -77,8 +77,9 @@
  *    slacks with one sign passes the exact test's edge functions (footprint_sure_lanes), so a block whose
  *    candidates are all such samples is decided by the exact test's t range alone (block_t_range, its own
  *    operations). The paper has no such step: every open relation of an active group is tested against its
- *    hard shadow volume (L22); here the functions the footprint already evaluated decide most of them. On the merged bars (1,322 large rectangles) 70M of 90M
- *    sample tests take it, and the cast is 12% faster (docs/hpc.md, session 15).
+ *    hard shadow volume (L22); here the functions the footprint already evaluated decide most of them. On the
+ *    merged bars (1,322 large rectangles) 70M of 90M sample tests take it and the cast is 10% faster; only
+ *    footprints over several groups take it (cast_blocks; docs/hpc.md, session 15).
  *  - the triangles are ctx->bvh's: with the light's occluders (hpc_method.c), those of closed components
  *    facing away from the whole light are left out (docs/culling.md proves it changes no V or S), and
  *    axis-aligned coplanar rectangles are merged (accel/coplanar.h: the same points; ties on their outer
@@ -711,7 +712,7 @@ static uint64_t footprint_groups(const shared *sh, const hpc_footprint *f, float
  * sample when it is a group's first (footprint_groups made them), else NULL. E: the functions per lane, for
  * the sure lanes (footprint_sure_lanes), which the caller asks only of blocks with lanes to test. */
 static unsigned footprint_lanes(const hpc_footprint *f, const l16 off[4], int i0, int j0, const float *gbase, int gk,
-                            l16 E[4])
+                                l16 E[4])
 {
     for (int e = 0; e < 4; e++)
         E[e] = l16_add(l16_set1(gbase ? gbase[64 * e + gk] : f->e[e][0] + f->e[e][1] * (float)i0 + f->e[e][2] * (float)j0), off[e]);
@@ -1279,8 +1280,8 @@ static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q,
     return hit;
 }
 
-/* cast_footprint's loop over the groups and blocks (below: its comment), written once and instantiated twice: with the sure
- * lanes (with_sure, a constant) for footprints over several groups, without for the others. A small
+/* cast_footprint's loop over the groups and blocks (below: its comment), written once and instantiated twice:
+ * with the sure lanes (with_sure, a constant) for footprints over several groups, without for the others. A small
  * triangle's footprint rarely holds a whole block's live lanes, and there merely having the sure test in the
  * loop (its functions kept per block, its branch) cost more than it saved: the bunny (512², 256 samples, one
  * thread) 4.30-4.35 s without it against 4.72-4.80 s with it in the loop, taken or not. */
