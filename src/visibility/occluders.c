@@ -288,11 +288,17 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
     return rc;
 }
 
+/* The axis a of an axis-aligned triangle's plane x_a = c (its three vertices' a equal bitwise), or -1. */
+static int face_axis(const float tri[9])
+{
+    for (int a = 0; a < 3; a++)
+        if (tri[a] == tri[3 + a] && tri[a] == tri[6 + a]) return a;
+    return -1;
+}
+
 int ms_merged_receiver_ok(const float tri[9], const float p[3], const float (*hull)[3], int n_hull)
 {
-    int a = -1;
-    for (int k = 0; k < 3 && a < 0; k++)
-        if (tri[k] == tri[3 + k] && tri[k] == tri[6 + k]) a = k;
+    const int a = face_axis(tri);
     if (a < 0) return 1;   /* not on an axis-aligned face: never merged */
     const double c = tri[a], d = fabs((double)p[a] - c);
     double lmin = INFINITY;
@@ -308,9 +314,7 @@ int ms_merged_receiver_ok(const float tri[9], const float p[3], const float (*hu
 
 int ms_merged_receiver_ok_samples(const float tri[9], const float p[3], const float *pts, const uint64_t *front, int n)
 {
-    int a = -1;
-    for (int k = 0; k < 3 && a < 0; k++)
-        if (tri[k] == tri[3 + k] && tri[k] == tri[6 + k]) a = k;
+    const int a = face_axis(tri);
     if (a < 0) return 1;
     const double c = tri[a], dp = (double)p[a] - c, d = fabs(dp), need = d / (0.5 * (double)MS_SEGMENT_NEAR);
     for (int i = 0; i < n; i++) {
