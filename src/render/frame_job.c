@@ -573,35 +573,26 @@ typedef struct pass_sums {
     double resolve_thread_s;
 } pass_sums;
 
-/* Moves the queries whose receiver lies on a merged coplanar face (ctx->prim_merged; own: their prims in
- * the scene's BVH b) where the merged faces could answer otherwise than the scene's own triangles
- * (ms_merged_receiver_ok: a grazing segment meeting its own plane beyond the near range; for the light as a
- * whole, then, with pts (3 * ctx->samples floats of scratch; NULL: not), for the receiver's own samples in
- * front) after the others, with their front masks and pixels; returns how many come first. */
-static int merged_last(const ms_render_ctx *ctx, const ms_bvh *b, const float (*hull)[3], int n_hull, ms_shadow_query *q,
-                       size_t *where, uint32_t *own, uint64_t *front, size_t mw, int nq, float *pts)
+/* Moves the queries whose receiver lies on a merged coplanar face (ctx->prim_merged; their prims in the
+ * scene's BVH b: hits[where[i]].prim) where the merged faces could answer otherwise than the scene's own
+ * triangles (ms_merged_receiver_ok: a grazing segment meeting its own plane beyond the near range; for the light
+ * as a whole, then, with pts (3 * ctx->samples floats of scratch; NULL: not), for the receiver's own samples in
+ * front) after the others, with their front masks and pixels (ms_queries_move_last); returns how many come
+ * first. */
+static int merged_last(const ms_render_ctx *ctx, const ms_bvh *b, const ms_hit *hits, const float (*hull)[3], int n_hull,
+                       ms_shadow_query *q, size_t *where, uint64_t *front, size_t mw, int nq, float *pts)
 {
-    int w = 0;
+    uint8_t last[TILE * TILE];
     for (int i = 0; i < nq; i++) {
-        const float *tri = b->tri + 9 * (size_t)own[i];
-        if (ctx->prim_merged[own[i]] && !ms_merged_receiver_ok(tri, q[i].p, hull, n_hull)) {
-            if (!pts) continue;
+        const uint32_t own = hits[where[i]].prim;
+        const float *tri = b->tri + 9 * (size_t)own;
+        last[i] = ctx->prim_merged[own] && !ms_merged_receiver_ok(tri, q[i].p, hull, n_hull);
+        if (last[i] && pts) {
             ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q[i].px, q[i].py, ctx->seed, pts);
-            if (!ms_merged_receiver_ok_samples(tri, q[i].p, pts, front + (size_t)i * mw, ctx->samples)) continue;
+            last[i] = !ms_merged_receiver_ok_samples(tri, q[i].p, pts, front + (size_t)i * mw, ctx->samples);
         }
-        if (w != i) {
-            const ms_shadow_query tq = q[w]; q[w] = q[i]; q[i] = tq;
-            const size_t tw = where[w]; where[w] = where[i]; where[i] = tw;
-            const uint32_t to = own[w]; own[w] = own[i]; own[i] = to;
-            for (size_t k = 0; k < mw; k++) {
-                const uint64_t tf = front[(size_t)w * mw + k];
-                front[(size_t)w * mw + k] = front[(size_t)i * mw + k];
-                front[(size_t)i * mw + k] = tf;
-            }
-        }
-        w++;
     }
-    return w;
+    return (int)ms_queries_move_last(q, where, front, mw, (size_t)nq, last);
 }
 
 /* The shadow phase of light l over tiles[0..n) (tiles == NULL: 0..n-1; whole: the frame's first and only
@@ -667,7 +658,6 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
             tile_rect(j, tiles ? tiles[ti] : ti, &x0, &y0, &x1, &y1);
             ms_shadow_query q[TILE * TILE];
             size_t where[TILE * TILE];
-            uint32_t own[TILE * TILE];   /* the receivers' prims in the scene's BVH */
             ms_render_ctx qc = ctx;   /* the query's context: the frame's, or with a sphere's outline disk */
             int nq = 0;
             for (int y = y0; y < y1 && ok; y++)
@@ -677,7 +667,6 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     if (h->prim == UINT32_MAX) { vis[i] = shadow[i] = spec[i] = -1.0f; fr[i] = 0; continue; }
                     ms_query_from_hit(&q[nq], h, (uint32_t)x, (uint32_t)y);
                     q[nq].prim = ms_ctx_skip_prim(&ctx, h->prim);
-                    own[nq] = h->prim;
                     if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
                         vis[i] = shadow[i] = spec[i] = 0.0f;   /* inside the sphere: no sample counts */
                         fr[i] = 0;
@@ -690,7 +679,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     local_segments += (uint64_t)nf;
                     where[nq++] = i;
                 }
-            const int nm = ctx.prim_merged && ok ? merged_last(&ctx, &j->bvh, (const float (*)[3])hull, n_hull, q, where, own, front, mw, nq, mpts) : nq;
+            const int nm = ctx.prim_merged && ok ? merged_last(&ctx, &j->bvh, hits, (const float (*)[3])hull, n_hull, q, where, front, mw, nq, mpts) : nq;
             if (!outlined && interior_state && nm && ok) {
                 /* The interior boxes first (no receiver on them: no prim to skip), then the triangles
                  * with the samples they left. */
@@ -711,7 +700,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
             if (nm < nq && ok) {
                 ms_render_ctx rc;
                 light_own_ctx(j, l, &rc);
-                for (int i = nm; i < nq; i++) q[i].prim = own[i];
+                for (int i = nm; i < nq; i++) q[i].prim = hits[where[i]].prim;   /* the receivers' own prims */
                 rc.outline_per_query = batched;
                 if (!outlined || batched) {
                     if (sm->visibility(own_state, &rc, q + nm, nq - nm, front + (size_t)nm * mw, vmask + (size_t)nm * mw, local)) ok = 0;

@@ -19,6 +19,26 @@ static int on_merged_face(const ms_render_ctx *ctx, const ms_render_ctx *own_ctx
            !ms_merged_receiver_ok(own_ctx->bvh->tri + 9 * (size_t)h->prim, h->p, hull, n_hull);
 }
 
+size_t ms_queries_move_last(ms_shadow_query *q, size_t *where, uint64_t *front, size_t mw, size_t n, const uint8_t *last)
+{
+    /* Position i still holds query i when it is read: only positions up to i are written before. */
+    size_t w = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (last[i]) continue;
+        if (w != i) {
+            const ms_shadow_query tq = q[w]; q[w] = q[i]; q[i] = tq;
+            const size_t tw = where[w]; where[w] = where[i]; where[i] = tw;
+            for (size_t k = 0; k < mw; k++) {
+                const uint64_t tf = front[w * mw + k];
+                front[w * mw + k] = front[i * mw + k];
+                front[i * mw + k] = tf;
+            }
+        }
+        w++;
+    }
+    return w;
+}
+
 int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, void *own_state,
                           const ms_render_ctx *own_ctx, const ms_hit *hits,
                           const ms_surface *surf, int W, int H, const size_t *pixels, size_t npixels, float *vis_out, float *shadow_out, float *spec_out,
@@ -74,25 +94,8 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
     if (failed) goto done;
     /* The receivers the merged faces answer first (in their order), then those on merged faces that go to the
      * scene's own triangles (own_state), named there by their own prims. */
-    size_t n_main = n;
-    if (own) {
-        n_main = 0;
-        for (size_t i = 0; i < n; i++) {
-            if (own[i]) continue;
-            if (n_main != i) {
-                const ms_shadow_query tq = q[n_main]; q[n_main] = q[i]; q[i] = tq;
-                const size_t tw = where[n_main]; where[n_main] = where[i]; where[i] = tw;
-                const uint8_t to = own[n_main]; own[n_main] = own[i]; own[i] = to;
-                for (size_t k = 0; k < mw; k++) {
-                    const uint64_t tf = front[n_main * mw + k];
-                    front[n_main * mw + k] = front[i * mw + k];
-                    front[i * mw + k] = tf;
-                }
-            }
-            n_main++;
-        }
-        for (size_t i = n_main; i < n; i++) q[i].prim = hits[where[i]].prim;
-    }
+    const size_t n_main = own ? ms_queries_move_last(q, where, front, mw, n, own) : n;
+    for (size_t i = n_main; i < n; i++) q[i].prim = hits[where[i]].prim;
     if (sm->visibility_all(sstate, ctx, q, n_main, front, vis, counters)) goto done;
     if (n > n_main && sm->visibility_all(own_state, own_ctx, q + n_main, n - n_main, front + n_main * mw,
                                          vis + n_main * mw, counters))
