@@ -19,7 +19,8 @@
  *        footprint test: the paper's group volumes instead), pairs (hpc's pairs of triangles sharing an edge:
  *        each triangle alone), leaffp (hpc's leaf footprint), leaffp-rule (the leaf footprint on every leaf),
  *        rect (hpc's rectangle pairs: each triangle of a pair with its own leaf footprint), sure (hpc's sure lanes:
- *        every candidate sample to the exact test). */
+ *        every candidate sample to the exact test), leaflanes (hpc's leaf lanes: each receiver of a leaf given
+ *        its samples in turn). */
 #include "microshadow.h"
 #include "shadow/hpc/hpc.h"
 #include <stdint.h>
@@ -98,11 +99,12 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ","))
                 for (int m = 0; m < NM; m++) run[m] |= !strcmp(t, methods[m]);
         } else if (!strcmp(argv[first], "--off")) {
-            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule", "rect", "sure" };
+            static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule", "rect", "sure",
+                                                 NULL, NULL, NULL, "leaflanes" };   /* bits 13-15: faults, not parts */
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ",")) {
                 int found = 0;
                 for (int b = 0; b < (int)(sizeof names / sizeof *names); b++)
-                    if (!strcmp(t, names[b])) { ms_hpc_switches |= 1 << b; found = 1; }
+                    if (names[b] && !strcmp(t, names[b])) { ms_hpc_switches |= 1 << b; found = 1; }
                 if (!found) { fprintf(stderr, "bench_hpc: --off: unknown part %s\n", t); return 2; }
             }
         } else { fprintf(stderr, "bench_hpc: unknown option %s\n", argv[first]); return 2; }

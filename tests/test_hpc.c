@@ -244,8 +244,12 @@ static void test_isa_instances_and_switches(void **st)
         }
         int ran = 0;
         uint64_t rect_pairs = 0;
-        /* as designed, and with the leaf footprint (and the rectangle pairs' bound) on every leaf */
-        for (int mode = 1; mode >= 0; mode--) {
+        /* as designed, with the leaf footprint (and the rectangle pairs' bound) on every leaf, and that without
+         * the leaf lanes (each receiver given its samples in turn) */
+        static const int modes[3] = { MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_OFF_LEAF_LANES, MS_HPC_ALL_LEAF_FOOTPRINT, 0 };
+        uint64_t lane_tests = 0;
+        for (int mi = 0; mi < 3; mi++) {
+            const int mode = modes[mi];
             ran = 0;
             for (int isa = MS_ISA_SCALAR; isa <= MS_ISA_AVX512; isa++) {
                 const ms_hpc_cast_fn fn = ms_hpc_cast_isa((ms_isa)isa);
@@ -254,7 +258,7 @@ static void test_isa_instances_and_switches(void **st)
                 const hpc_source src = { &ps2, perm_rewind, perm_next };
                 uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
                 memset(vis, 0xA5, n * mw * sizeof *vis);
-                ms_hpc_switches = mode ? MS_HPC_ALL_LEAF_FOOTPRINT : 0;
+                ms_hpc_switches = mode;
                 const int rc1 = fn(&ctx, 0, NULL, q, n, front, vis, &src, cnt);
                 ms_hpc_switches = 0;
                 assert_int_equal(rc1, 0);
@@ -266,10 +270,14 @@ static void test_isa_instances_and_switches(void **st)
                 ran++;
             }
             assert_true(ran >= 1);
-            if (mode) rect_pairs = cnt0[27];
+            if (mode == MS_HPC_ALL_LEAF_FOOTPRINT) { rect_pairs = cnt0[27]; lane_tests = cnt0[29]; }
+            if (mode & MS_HPC_OFF_LEAF_LANES) assert_int_equal(cnt0[29], 0);
         }
         assert_true(rect_pairs > 0);   /* the rectangle pairs' path ran in the instances compared */
-        for (int sw = 1; sw <= MS_HPC_OFF_SURE; sw <<= 1) {
+        assert_true(lane_tests > 0);   /* and the leaf lanes */
+        static const int switches[] = { 1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, MS_HPC_OFF_LEAF_LANES };
+        for (size_t si = 0; si < sizeof switches / sizeof *switches; si++) {
+            const int sw = switches[si];
             perm_source ps2 = { &bvh, area, nt, 0 };
             const hpc_source src = { &ps2, perm_rewind, perm_next };
             uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
@@ -280,8 +288,9 @@ static void test_isa_instances_and_switches(void **st)
             assert_memory_equal(vis, ref, n * mw * sizeof *vis);
         }
         printf("k=%d: %zu points, %d ISA instances equal to raytrace and to each other (masks, counters: %llu sample "
-               "tests; %llu (leaf, pair) by their rectangle on every leaf); 13 switches equal\n", k, n, ran,
-               (unsigned long long)cnt0[9], (unsigned long long)rect_pairs);
+               "tests; %llu (leaf, pair) by their rectangle and %llu sample tests in the leaf lanes on every leaf); "
+               "14 switches equal\n", k, n, ran, (unsigned long long)cnt0[9], (unsigned long long)rect_pairs,
+               (unsigned long long)lane_tests);
         free(front); free(ref); free(vis); free(pts); free(q); free(hits);
     }
     free(area);
@@ -426,8 +435,9 @@ static void test_bars(void **st)
     ms_frame f;
     render_ok(&sc, "hpc", 256, 96, 0, &f);
     ms_hpc_switches = 0;
-    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0, sure = 0, tests = 0;
+    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0, sure = 0, tests = 0, lane_tests = 0;
     for (int c = 0; c < f.stats.n_counters; c++) {
+        if (!strcmp(f.stats.counter_name[c], "leaf_lane_tests")) lane_tests = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "samples_sure")) sure = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "sample_tests")) tests = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "rect_pairs")) rect_pairs = f.stats.counter[c];
@@ -450,6 +460,8 @@ static void test_bars(void **st)
     printf("bars: %llu of %llu sample tests on the t range alone; with the sure lanes' margin on the wrong side %ld pixels differ "
            "(%ld with the leaf footprint on every leaf)\n", (unsigned long long)sure, (unsigned long long)tests, differ_sure,
            differ_sure_leaf);
+    printf("bars: %llu of the sample tests in the leaf lanes (a leaf's receivers at one sample)\n", (unsigned long long)lane_tests);
+    assert_true(lane_tests > tests / 2);
     assert_true(leaf_culls > 0);
     assert_true(culls_blocked > 0);
     assert_true(to_fp < in_vl);

@@ -138,7 +138,7 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
      * exposure's luminances, textured lights' mean texels; the PNG writer's 3 bytes after it). */
     uint64_t shadow_pp = 0;
     if (s->whole_frame) {
-        const uint64_t slot = (mw8 + (s->scanline_slots ? HPC_RASTER_FRAME : 0) + (uint64_t)s->npk + 63u) / 64u * 64u;
+        const uint64_t slot = (mw8 + (s->scanline_slots ? HPC_RASTER_FRAME : 0) + (uint64_t)s->npk + 1u + 63u) / 64u * 64u;
         shadow_pp = sizeof(ms_shadow_query) + sizeof(size_t) + 1u + 2u * mw8 + HPC_PER_RECEIVER + slot;   /* 1: the merged-face flag */
     }
     /* frame_shade.c: the luminances and glibc qsort's merge buffer of as many; textured lights' mean texels. */

@@ -40,6 +40,20 @@ L16_INLINE l16i l16i_load(const int32_t *p) { return _mm512_loadu_si512((const v
 L16_INLINE l16 l16_perm(l16 a, l16i p) { return _mm512_permutexvar_ps(p, a); }
 /* Lane i = base[p[i]]. */
 L16_INLINE l16 l16_gather(const float *base, l16i p) { return _mm512_i32gather_ps(p, base, 4); }
+/* Sixteen 64-bit words, one per lane (bit sets, e.g. 16 receivers' open samples of one mask word): which lanes
+ * have bit b, and bit b cleared on lanes m. */
+typedef struct l16w { __m512i lo, hi; } l16w;
+L16_INLINE l16w l16w_load(const uint64_t *p) { return (l16w){ _mm512_loadu_si512((const void *)p), _mm512_loadu_si512((const void *)(p + 8)) }; }
+L16_INLINE unsigned l16w_bit(l16w w, int b)
+{
+    const __m512i m = _mm512_set1_epi64((long long)(UINT64_C(1) << b));
+    return (unsigned)_mm512_test_epi64_mask(w.lo, m) | (unsigned)_mm512_test_epi64_mask(w.hi, m) << 8;
+}
+L16_INLINE l16w l16w_clear(l16w w, unsigned m, int b)
+{
+    const __m512i x = _mm512_set1_epi64((long long)(UINT64_C(1) << b));
+    return (l16w){ _mm512_mask_andnot_epi64(w.lo, (__mmask8)(m & 0xffu), x, w.lo), _mm512_mask_andnot_epi64(w.hi, (__mmask8)(m >> 8), x, w.hi) };
+}
 #elif defined(MS_TARGET_AVX2)
 #include <immintrin.h>
 typedef struct l16 { __m256 lo, hi; } l16;
@@ -160,6 +174,24 @@ typedef struct l16i { int32_t v[16]; } l16i;
 L16_INLINE l16i l16i_load(const int32_t *p) { l16i r; for (int i = 0; i < 16; i++) r.v[i] = p[i]; return r; }
 L16_INLINE l16 l16_perm(l16 a, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = a.v[p.v[i] & 15]; return r; }
 L16_INLINE l16 l16_gather(const float *base, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = base[p.v[i]]; return r; }
+#endif
+
+#if !defined(MS_TARGET_AVX512)
+/* l16w (above) as plain words: AVX2 has no 64-bit mask compares worth the shuffles, and integer bits are the same
+ * on every path. */
+typedef struct l16w { uint64_t w[16]; } l16w;
+static inline l16w l16w_load(const uint64_t *p) { l16w r; for (int i = 0; i < 16; i++) r.w[i] = p[i]; return r; }
+static inline unsigned l16w_bit(l16w w, int b)
+{
+    unsigned m = 0;
+    for (int i = 0; i < 16; i++) m |= (unsigned)(w.w[i] >> b & 1u) << i;
+    return m;
+}
+static inline l16w l16w_clear(l16w w, unsigned m, int b)
+{
+    for (int i = 0; i < 16; i++) w.w[i] &= ~((uint64_t)(m >> i & 1u) << b);
+    return w;
+}
 #endif
 
 #endif

@@ -75,7 +75,7 @@
  *    proven to keep every sample either triangle's exact test blocks).
  *  - the footprint's slack also proves the other way: a sample whose three edge functions lie beyond their
  *    slacks with one sign passes the exact test's edge functions (footprint_sure_lanes), so a block whose
- *    candidates are all such samples is decided by the exact test's t range alone (block_t_range, its own
+ *    candidates are all such samples is decided by the exact test's t range alone (t_range16, its own
  *    operations). The paper has no such step: every open relation of an active group is tested against its
  *    hard shadow volume (L22); here the functions the footprint already evaluated decide most of them. On the
  *    merged bars (1,322 large rectangles) 70M of 90M sample tests take it and the cast is 10% faster; only
@@ -159,6 +159,7 @@ enum {
     C_LEAF_CULLS_BLOCKED,   /* of the others, those whose candidate samples are blocked already for every receiver */
     C_RECT_PAIRS,        /* (leaf, pair) bounded by the pair's rectangle (one footprint for both triangles) */
     C_SAMPLES_SURE,      /* of the sample tests, those decided on the t range alone (footprint_sure_lanes) */
+    C_LEAF_LANE_TESTS,   /* of the sample tests, those made for a leaf's receivers in the lanes (leaf_lanes_sample) */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -431,6 +432,10 @@ static void slot_setup(const shared *sh, chunk *c, int32_t s, const ms_shadow_qu
         const unsigned ok = l16_le(m, l16_mul(two, ad[z])) & l16_gt(m, zero);
         kz[pk] = (int8_t)(ok == 0xffffu ? z : -1);
     }
+    /* kz[npk]: the axis every packet shares, or -1 (leaf_lanes_sample then needs no per-packet look-up) */
+    int8_t uni = kz[0];
+    for (int pk = 1; pk < sh->npk && uni >= 0; pk++) uni = kz[pk] == uni ? uni : -1;
+    kz[sh->npk] = uni;
     if (sh->scanline) {
         ms_raster_frame *f = slot_frame(sh, c, s);
         float n[3], rel[3];
@@ -811,7 +816,7 @@ static const int rect_tri[2][3] = { { 0, 1, 4 }, { 2, 3, 4 } };
 
 /* leaf_fn of the ns shapes shp for box b: the functions of all shapes in the lanes (up to 6), each lane the
  * arithmetic the comments above give (IEEE per lane, as everywhere in lanes16.h). */
-static void leaf_setup(const shared *sh, const leaf_box *b, const fp_shape *shp, int ns, leaf_fn *out)
+__attribute__((noinline)) static void leaf_setup(const shared *sh, const leaf_box *b, const fp_shape *shp, int ns, leaf_fn *out)
 {
     const int k = sh->k, gs = sh->gs;
     const float *ds = sh->grid_ds, *dt = sh->grid_dt;
@@ -907,7 +912,7 @@ static void leaf_setup(const shared *sh, const leaf_box *b, const fp_shape *shp,
 
 /* The samples (bits as a mask's) a triangle (its leaf_fn) may block for some receiver of box b, in cand (mw
  * words); its groups are returned (0: the triangle blocks no sample of any of them). */
-static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_fn *fn, uint64_t *cand)
+__attribute__((noinline)) static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_fn *fn, uint64_t *cand)
 {
     const int k = sh->k, gs = sh->gs, rows = LANES / gs;
     const float (*e)[3] = fn->e, *ufix = fn->ufix, *uspan = fn->uspan;
@@ -1010,21 +1015,98 @@ static int cast_group(const shared *sh, chunk *c, uint64_t *open, const int8_t *
 /* sel3(m0, m1, x0, x1, x2): per lane x0 where m0, x1 where m1, else x2 (a lane's component by its axis). */
 static inline l16 sel3(unsigned m0, unsigned m1, l16 x0, l16 x1, l16 x2) { return l16_select(m0, x0, l16_select(m1, x1, x2)); }
 
+/* The hard-shadow test (L70) of 16 rays in the lanes, each lane what sample_blocked computes for its ray, in the
+ * same order: ray l from its receiver P[l] along d[l] (formed by the caller as sample_blocked forms it), sheared
+ * along its packet's axis (one packet = 16 consecutive samples of a row of that receiver's grid, raytrace's):
+ * axis 0 on lanes m0, 1 on m1, none on mneg (raytrace tests those lanes one by one: the scalar form), 2 on the
+ * others; z0 >= 0: every lane's axis is z0 (no per-lane selection). V: the triangle's vertices relative to each
+ * lane's receiver (world axes); num: each lane's plane offset (ms_wt_offset). Lanes with an edge function
+ * exactly 0 go to the scalar form too (as raytrace's lanes do). Returns the lanes of live triangle t blocks.
+ * Written once for both layouts: a receiver's 16 samples (group_block16) and a leaf's 16 receivers at one
+ * sample (leaf_lanes_sample). */
+static unsigned exact16(const shared *sh, const tri_job *t, const l16 P[3], const l16 V[3][3], const l16 d[3], l16 num,
+                        unsigned m0, unsigned m1, unsigned mneg, int z0, unsigned live)
+{
+    /* kz = 0: kx = 1, ky = 2; kz = 1: kx = 2, ky = 0; kz = 2: kx = 0, ky = 1 */
+    l16 dz, dx, dy, V3[3][3];
+    if (z0 >= 0) {
+        const int zx = z0 + 1 == 3 ? 0 : z0 + 1, zy = zx + 1 == 3 ? 0 : zx + 1;
+        dz = d[z0]; dx = d[zx]; dy = d[zy];
+        for (int v = 0; v < 3; v++) { V3[v][0] = V[v][zx]; V3[v][1] = V[v][zy]; V3[v][2] = V[v][z0]; }
+    } else {
+        dz = sel3(m0, m1, d[0], d[1], d[2]); dx = sel3(m0, m1, d[1], d[2], d[0]); dy = sel3(m0, m1, d[2], d[0], d[1]);
+        for (int v = 0; v < 3; v++) {
+            V3[v][0] = sel3(m0, m1, V[v][1], V[v][2], V[v][0]);
+            V3[v][1] = sel3(m0, m1, V[v][2], V[v][0], V[v][1]);
+            V3[v][2] = sel3(m0, m1, V[v][0], V[v][1], V[v][2]);
+        }
+    }
+    const l16 inv = l16_div(l16_set1(1.0f), dz), sx = l16_mul(dx, inv), sy = l16_mul(dy, inv);
+    const float *N = t->N, near = sh->ctx->near, far = sh->ctx->far;
+    unsigned z;
+    unsigned hit = ms_wt_rays16(V3, sx, sy, d, N, num, near, far, live & ~mneg, &z);
+    const unsigned rest = (live & mneg) | z;
+    if (rest) {
+        float dv[3][LANES], pv[3][LANES], vv[3][3][LANES], sxv[LANES], syv[LANES], nv[LANES];
+        for (int a = 0; a < 3; a++) {
+            l16_store(dv[a], d[a]);
+            l16_store(pv[a], P[a]);
+            for (int v = 0; v < 3; v++) l16_store(vv[v][a], V[v][a]);
+        }
+        l16_store(sxv, sx);
+        l16_store(syv, sy);
+        l16_store(nv, num);
+        for (unsigned m = rest; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            const float dl[3] = { dv[0][l], dv[1][l], dv[2][l] }, pl[3] = { pv[0][l], pv[1][l], pv[2][l] };
+            const float A[3] = { vv[0][0][l], vv[0][1][l], vv[0][2][l] }, B[3] = { vv[1][0][l], vv[1][1][l], vv[1][2][l] };
+            const float C[3] = { vv[2][0][l], vv[2][1][l], vv[2][2][l] };
+            const int kl = (mneg >> l & 1) ? -1 : (m0 >> l & 1) ? 0 : (m1 >> l & 1) ? 1 : 2;
+            const int b = kl < 0 ? ms_wt_segment(pl, dl, t->v, N, near, far)
+                                 : ms_wt_segment_sheared(A, B, C, kl, sxv[l], syv[l], dl, N, nv[l], near, far);
+            hit |= (unsigned)b << l;
+        }
+    }
+    return hit;
+}
+
+/* The lanes of live whose ray (d from its receiver, num its plane offset) meets triangle t's plane within [near,
+ * far], by the exact test's own operations (ms_wt_rays16's tail: d . N, the signed offset num against near and far
+ * times |d . N|): for lanes whose edge functions surely pass (footprint_sure_lanes) this is the whole of the exact
+ * test's answer, bit for bit, without the shear and the edge functions. */
+static unsigned t_range16(const shared *sh, const tri_job *t, const l16 d[3], l16 num, unsigned live)
+{
+    const float *N = t->N;
+    const l16 zero = l16_set1(0.0f);
+    const l16 den = l16_add(l16_add(l16_mul(d[0], l16_set1(N[0])), l16_mul(d[1], l16_set1(N[1]))), l16_mul(d[2], l16_set1(N[2])));
+    const l16 ns = l16_select(l16_lt(den, zero), l16_sub(zero, num), num), aden = l16_abs(den);
+    return live & l16_gt(aden, zero) & l16_le(l16_mul(l16_set1(sh->ctx->near), aden), ns) &
+           l16_le(ns, l16_mul(l16_set1(sh->ctx->far), aden));
+}
+
+/* The directions of receiver q's 16 samples (i0 + l % w, j0 + l / w) of its grid g (w = 4 or 8 columns), formed
+ * as sample_blocked forms them. */
+static void block_dirs(const ms_shadow_query *q, const ms_grid *g, int i0, int j0, int w, l16 d[3])
+{
+    /* Lane l's column and row offsets in the block (small integers: exact in float). */
+    static const float off[2][2][LANES] = {
+        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
+        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
+    const int wi = w == 8;
+    const l16 li = l16_add(l16_set1((float)i0), l16_load(off[wi][0])), lj = l16_add(l16_set1((float)j0), l16_load(off[wi][1]));
+    for (int a = 0; a < 3; a++)
+        d[a] = l16_sub(l16_add(l16_add(l16_set1(g->p0[a]), l16_mul(li, l16_set1(g->ds[a]))), l16_mul(lj, l16_set1(g->dt[a]))),
+                       l16_set1(q->p[a]));
+}
+
 /* The hard-shadow test of 16 samples of receiver q at once (L70): lane l is sample (i0 + l % w, j0 + l / w) of
- * its grid g (w = 4 or 8 columns); live: the lanes to test. Returns the lanes triangle t blocks. Every lane
- * computes what sample_blocked computes for its sample, in the same order: its point and direction, the
- * shear with its packet's axis kz (one packet = 16 consecutive samples of a row, raytrace's), the edge
- * functions of the vertices A, B, C (relative to q), the plane-distance range with num. Lanes with an edge
- * function exactly 0, or whose packet has no shared axis, go to the scalar form (as raytrace's lanes do). */
+ * its grid g (w = 4 or 8 columns); live: the lanes to test; A, B, C: the vertices relative to q; num: q's plane
+ * offset. Returns the lanes triangle t blocks (exact16). */
 static unsigned group_block16(const shared *sh, const ms_shadow_query *q, const ms_grid *g, const int8_t *kz, int i0,
                               int j0, int w, unsigned live, const tri_job *t, const float A[3], const float B[3],
                               const float C[3], float num)
 {
-    /* Lane l's column and row offsets in the block, w = 4 or 8 columns (small integers: exact in float). */
-    static const float off[2][2][LANES] = {
-        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
-        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
-    const int k = sh->k, wi = w == 8, rows = LANES / w;
+    const int k = sh->k, rows = LANES / w;
     /* A group lies within one 16-sample packet per row: the row's packet gives its lanes' shear axis. */
     unsigned m0 = 0, m1 = 0, mneg = 0;
     const unsigned rowbits = (1u << w) - 1u;
@@ -1036,52 +1118,13 @@ static unsigned group_block16(const shared *sh, const ms_shadow_query *q, const 
         m1 |= (z == 1 ? rowbits : 0u) << (r * w);
         mneg |= (z < 0 ? rowbits : 0u) << (r * w);
     }
-    const l16 li = l16_add(l16_set1((float)i0), l16_load(off[wi][0])), lj = l16_add(l16_set1((float)j0), l16_load(off[wi][1]));
     l16 d[3];
-    for (int a = 0; a < 3; a++)
-        d[a] = l16_sub(l16_add(l16_add(l16_set1(g->p0[a]), l16_mul(li, l16_set1(g->ds[a]))), l16_mul(lj, l16_set1(g->dt[a]))),
-                       l16_set1(q->p[a]));
-    /* kz = 0: kx = 1, ky = 2; kz = 1: kx = 2, ky = 0; kz = 2: kx = 0, ky = 1. One axis for every lane (the
-     * rule): no per-lane selection. */
-    l16 dz, dx, dy, Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz;
-    if (uniform) {
-        const int zx = z0 + 1 == 3 ? 0 : z0 + 1, zy = zx + 1 == 3 ? 0 : zx + 1;
-        dz = d[z0]; dx = d[zx]; dy = d[zy];
-        Ax = l16_set1(A[zx]); Ay = l16_set1(A[zy]); Az = l16_set1(A[z0]);
-        Bx = l16_set1(B[zx]); By = l16_set1(B[zy]); Bz = l16_set1(B[z0]);
-        Cx = l16_set1(C[zx]); Cy = l16_set1(C[zy]); Cz = l16_set1(C[z0]);
-    } else {
-        dz = sel3(m0, m1, d[0], d[1], d[2]); dx = sel3(m0, m1, d[1], d[2], d[0]); dy = sel3(m0, m1, d[2], d[0], d[1]);
-#define HPC_VCOMP(V, x, y, zz)                                                                                 \
-        x = sel3(m0, m1, l16_set1(V[1]), l16_set1(V[2]), l16_set1(V[0]));                                      \
-        y = sel3(m0, m1, l16_set1(V[2]), l16_set1(V[0]), l16_set1(V[1]));                                      \
-        zz = sel3(m0, m1, l16_set1(V[0]), l16_set1(V[1]), l16_set1(V[2]))
-        HPC_VCOMP(A, Ax, Ay, Az);
-        HPC_VCOMP(B, Bx, By, Bz);
-        HPC_VCOMP(C, Cx, Cy, Cz);
-#undef HPC_VCOMP
-    }
-    const l16 inv = l16_div(l16_set1(1.0f), dz), sx = l16_mul(dx, inv), sy = l16_mul(dy, inv);
-    const float *N = t->N, near = sh->ctx->near, far = sh->ctx->far;
-    const l16 V3[3][3] = { { Ax, Ay, Az }, { Bx, By, Bz }, { Cx, Cy, Cz } };
-    unsigned z;
-    unsigned hit = ms_wt_rays16(V3, sx, sy, d, N, l16_set1(num), near, far, live & ~mneg, &z);
-    const unsigned rest = (live & mneg) | z;
-    if (rest) {
-        float dv[3][LANES], sxv[LANES], syv[LANES];
-        for (int a = 0; a < 3; a++) l16_store(dv[a], d[a]);
-        l16_store(sxv, sx);
-        l16_store(syv, sy);
-        for (unsigned m = rest; m; m &= m - 1) {
-            const int l = __builtin_ctz(m);
-            const float dl[3] = { dv[0][l], dv[1][l], dv[2][l] };
-            const int kl = (mneg >> l & 1) ? -1 : (m0 >> l & 1) ? 0 : (m1 >> l & 1) ? 1 : 2;
-            const int b = kl < 0 ? ms_wt_segment(q->p, dl, t->v, N, near, far)
-                                 : ms_wt_segment_sheared(A, B, C, kl, sxv[l], syv[l], dl, N, num, near, far);
-            hit |= (unsigned)b << l;
-        }
-    }
-    return hit;
+    block_dirs(q, g, i0, j0, w, d);
+    const l16 P[3] = { l16_set1(q->p[0]), l16_set1(q->p[1]), l16_set1(q->p[2]) };
+    const l16 V[3][3] = { { l16_set1(A[0]), l16_set1(A[1]), l16_set1(A[2]) },
+                          { l16_set1(B[0]), l16_set1(B[1]), l16_set1(B[2]) },
+                          { l16_set1(C[0]), l16_set1(C[1]), l16_set1(C[2]) } };
+    return exact16(sh, t, P, V, d, l16_set1(num), m0, m1, mneg, uniform ? z0 : -1, live);
 }
 
 /* cast_group with the 16-lane test: the group's open samples 16 at a time. */
@@ -1220,30 +1263,6 @@ typedef struct hpc_view {
     int direct;                 /* 1: ncand and ngroups made by the leaf (cast_leaf_footprint), fp unused */
 } hpc_view;
 
-/* The lanes of live whose segment meets triangle t's plane within [near, far], by the exact test's own
- * operations (ms_wt_rays16's tail: the direction formed as group_block16 forms it, d . N, the signed offset
- * num against near and far times |d . N|): for lanes whose edge functions surely pass (footprint_sure_lanes)
- * this is the whole of the exact test's answer, bit for bit, without the shear and the edge functions. */
-static unsigned block_t_range(const shared *sh, const ms_shadow_query *q, const ms_grid *g, int i0, int jb, unsigned live,
-                              const tri_job *t, float num)
-{
-    static const float off[2][2][LANES] = {
-        { { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 }, { 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3 } },
-        { { 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7 }, { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1 } } };
-    const int wi = sh->gs == 8;
-    const l16 li = l16_add(l16_set1((float)i0), l16_load(off[wi][0])), lj = l16_add(l16_set1((float)jb), l16_load(off[wi][1]));
-    l16 d[3];
-    for (int a = 0; a < 3; a++)
-        d[a] = l16_sub(l16_add(l16_add(l16_set1(g->p0[a]), l16_mul(li, l16_set1(g->ds[a]))), l16_mul(lj, l16_set1(g->dt[a]))),
-                       l16_set1(q->p[a]));
-    const float *N = t->N;
-    const l16 zero = l16_set1(0.0f), nm = l16_set1(num);
-    const l16 den = l16_add(l16_add(l16_mul(d[0], l16_set1(N[0])), l16_mul(d[1], l16_set1(N[1]))), l16_mul(d[2], l16_set1(N[2])));
-    const l16 ns = l16_select(l16_lt(den, zero), l16_sub(zero, nm), nm), aden = l16_abs(den);
-    return live & l16_gt(aden, zero) & l16_le(l16_mul(l16_set1(sh->ctx->near), aden), ns) &
-           l16_le(ns, l16_mul(l16_set1(sh->ctx->far), aden));
-}
-
 /* The lanes triangle t blocks of the 16-sample block at (i0, jb) of receiver q (live: the lanes to test), with
  * the 16-lane test or, switched off, one lane at a time; alpha-tested triangles only where opaque. sure: lanes
  * whose edge functions surely pass (footprint_sure_lanes): when they are all of live, and no row of the block
@@ -1259,7 +1278,9 @@ static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q,
         for (int r = 0; r < LANES / gs; r++) shared_axis &= kz[((jb + r) * k + i0) / LANES] >= 0;
     if (!(live & ~sure) && shared_axis && !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES))) {
         c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
-        hit = block_t_range(sh, q, g, i0, jb, live, t, num);
+        l16 d[3];
+        block_dirs(q, g, i0, jb, gs, d);
+        hit = t_range16(sh, t, d, l16_set1(num), live);
     } else if (sh->sw & MS_HPC_OFF_SIMD_SAMPLES) {   /* one lane at a time, the scalar form */
         hit = 0;
         for (unsigned b = live; b; b &= b - 1) {
@@ -1482,20 +1503,22 @@ static inline void spans16(l16 e1, l16 e2, l16 span, l16 zero, float *dlo, float
 }
 
 /* Whether the leaf footprint pays here, from this chunk's recent leaves cast with it (the counts halved as they
- * grow, so that they follow the triangles of the moment): only while it has left at most LEAF_FP_KEEP of their
- * receivers to the per-receiver work and at most LEAF_FP_CANDS samples per receiver to test in the lanes;
- * one leaf in LEAF_FP_PROBE uses it regardless, to keep the counts current. Per chunk, so the same on every
- * ISA and run. Measured (1024^2, the leaf footprint on every leaf): on a GRIDS-like scene's bars 58% of the
- * receivers kept, 2.1 samples per receiver, and it pays; Dabrovic Sponza's large triangles leave 12.5 samples
- * per receiver (76% kept), a scanned bunny's small ones keep 72% of the receivers (1.9 samples each): there
- * it cost 20-25%. */
+ * grow, so that they follow the triangles of the moment): only while it has left at most LEAF_FP_CANDS samples
+ * per receiver to test in the lanes and, where its samples go to each receiver in turn (not lanes: the leaf lanes
+ * off, or alpha), at most LEAF_FP_KEEP of the receivers to that per-receiver work; one leaf in LEAF_FP_PROBE uses
+ * it regardless, to keep the counts current. Per chunk, so the same on every ISA and run. Measured (1024^2, the
+ * leaf footprint on every leaf, before the leaf lanes): on a GRIDS-like scene's bars 58% of the receivers kept,
+ * 2.1 samples per receiver, and it pays; Dabrovic Sponza's large triangles leave 12.5 samples per receiver (76%
+ * kept), a scanned bunny's small ones keep 72% of the receivers (1.9 samples each): there it cost 20-25%. With
+ * the leaf lanes a kept receiver costs no work of its own, and the keep rule off took the bars' cast 2.54 ->
+ * 2.32 s (two threads), Sibenik, Dabrovic Sponza and the bunny within noise (docs/hpc.md, session 16). */
 #define LEAF_FP_PROBE 64u
 #define LEAF_FP_KEEP 0.75f
 #define LEAF_FP_CANDS 6.0f
-static inline int leaf_fp_pays(chunk *c)
+static inline int leaf_fp_pays(chunk *c, int lanes)
 {
     if (c->lf_leaves++ % LEAF_FP_PROBE == 0) return 1;
-    return (float)c->lf_kept <= LEAF_FP_KEEP * (float)c->lf_in && (float)c->lf_cands <= LEAF_FP_CANDS * (float)c->lf_in;
+    return (lanes || (float)c->lf_kept <= LEAF_FP_KEEP * (float)c->lf_in) && (float)c->lf_cands <= LEAF_FP_CANDS * (float)c->lf_in;
 }
 
 /* The points of a leaf inside V_L against a job (a triangle, or a pair: pair_batch) with the footprint test,
@@ -1510,6 +1533,161 @@ static inline void shape_off(chunk *c, int cnt, unsigned act, unsigned on[2], in
     for (int x = u; x <= (rect ? 1 : u); x++) {
         c->cnt[cnt] += (uint64_t)((act & on[x]) != 0);
         on[x] = 0;
+    }
+}
+
+/* ---- the leaf's receivers in the lanes (hpc: the exact test of one sample for 16 receivers at once) ----
+ *
+ * Departure from the paper, whose leaf tests its points one by one (L56-L75). With the leaf footprint, every
+ * sample it leaves is tested for the leaf's receivers in the lanes: lane l is receiver l's ray to its own sample
+ * (i, j) (its own grid origin, its own packet's shear axis, its own vertices relative to it and plane offset),
+ * each lane exactly what sample_blocked computes for it (exact16, the same operations as for a receiver's 16
+ * samples), so the answers stay raytrace's bit for bit. What it removes is the per-receiver work: handing each
+ * receiver its candidate samples, then its groups and blocks (cast_footprint), which on the merged bars cost
+ * about 400 cycles per (receiver, triangle) for 4 samples tested. Per (leaf, triangle) the work is now one
+ * 16-lane test per sample the leaf footprint leaves open, which as leaves shrink with resolution approaches the
+ * receivers' own samples. MS_HPC_OFF_LEAF_LANES: the per-receiver form. */
+typedef struct leaf_lanes {
+    uint32_t rr[LANES];             /* each lane's receiver */
+    unsigned act;                   /* the lanes in play */
+    const uint64_t *open[LANES];    /* each lane's open samples: its mask, or its front mask before it has one */
+    const int8_t *kz[LANES];        /* ready lanes: their packets' shear axes (slot_kz) */
+    l16 p[3], p0[3];                /* each lane's receiver and grid origin */
+    unsigned ready;                 /* lanes whose mask exists (and with it the packets' shear axes) */
+    unsigned axis[3], mixed;        /* of those, the lanes whose every packet has shear axis 0, 1, 2; the others */
+    l16w ow;                        /* the lanes' open samples in the current mask word (leaf_lanes_word) */
+    unsigned have;                  /* bit u: triangle u's per-lane vertices and offset made */
+    l16 V[2][3][3], num[2];         /* per triangle: its vertices relative to each lane's receiver, its offset */
+    uint64_t touched[LANES];        /* per lane: the groups where it lost samples */
+    unsigned has[2];                /* per triangle: the lanes it was tested for */
+} leaf_lanes;
+
+/* ms_wt_offset per lane: the plane offset from the vertex nearest each lane's receiver (V: the vertices
+ * relative to it), the same operations and the same choice on ties. */
+static l16 offset16(const l16 V[3][3], const float n[3])
+{
+    l16 lv[3], dn[3];
+    for (int i = 0; i < 3; i++) {
+        lv[i] = l16_add(l16_add(l16_mul(V[i][0], V[i][0]), l16_mul(V[i][1], V[i][1])), l16_mul(V[i][2], V[i][2]));
+        dn[i] = l16_add(l16_add(l16_mul(V[i][0], l16_set1(n[0])), l16_mul(V[i][1], l16_set1(n[1]))), l16_mul(V[i][2], l16_set1(n[2])));
+    }
+    /* nr = lv0 <= lv1 ? (lv0 <= lv2 ? 0 : 2) : (lv1 <= lv2 ? 1 : 2) */
+    const unsigned c01 = l16_le(lv[0], lv[1]), c02 = l16_le(lv[0], lv[2]), c12 = l16_le(lv[1], lv[2]);
+    return l16_select(c01 & c02, dn[0], l16_select(~c01 & c12, dn[1], dn[2]));
+}
+
+/* Files ready lane l under the axis all its packets share (slot_setup), or under mixed. */
+static inline void leaf_lanes_axis(const shared *sh, const chunk *c, leaf_lanes *L, int l)
+{
+    L->kz[l] = slot_kz(sh, c, sh->slot[L->rr[l]]);
+    const int z = L->kz[l][sh->npk];
+    if (z >= 0) L->axis[z] |= 1u << l;
+    else L->mixed |= 1u << l;
+}
+
+/* The lanes' open samples of mask word wd, before its samples are tested. */
+static inline void leaf_lanes_word(leaf_lanes *L, int wd)
+{
+    uint64_t w[LANES] = { 0 };
+    for (unsigned m = L->act; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        w[l] = L->open[l][wd];
+    }
+    L->ow = l16w_load(w);
+}
+
+/* Gives lanes need a mask (and the packets' shear axes: slot_of); the masks may move (the pool grows), so every
+ * lane's open pointer is taken again. 0 when out of memory. */
+static int leaf_lanes_ready(const shared *sh, chunk *c, leaf_lanes *L, unsigned need)
+{
+    for (unsigned m = need & ~L->ready; m; m &= m - 1) {
+        const uint32_t r = L->rr[__builtin_ctz(m)];
+        ms_grid g;
+        memcpy(g.p0, sh->p0 + 4 * (size_t)r, sizeof g.p0);
+        memcpy(g.ds, sh->grid_ds, sizeof g.ds);
+        memcpy(g.dt, sh->grid_dt, sizeof g.dt);
+        g.k = sh->k;
+        if (slot_of(sh, c, r, &g) < 0) return 0;
+    }
+    for (unsigned m = need & ~L->ready; m; m &= m - 1) leaf_lanes_axis(sh, c, L, __builtin_ctz(m));
+    L->ready |= need;
+    for (unsigned m = L->act; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        L->open[l] = open_of(sh, c, L->rr[l]);
+        if (L->ready >> l & 1u) L->kz[l] = slot_kz(sh, c, sh->slot[L->rr[l]]);
+    }
+    return 1;
+}
+
+/* Sample sidx (bit b of mask word wd) for the leaf's lanes: cand[x] the lanes whose footprint of triangle tu[x]
+ * may hold it, sure[x] those whose edge functions surely pass (footprint_sure_lanes); the triangles in turn,
+ * the second only on lanes the first left open (raytrace's any hit). The lanes it blocks lose the sample.
+ * 0 when out of memory. */
+__attribute__((noinline)) static int leaf_lanes_sample(const shared *sh, chunk *c, const tri_job *t, leaf_lanes *L, const int tu[2], int nx,
+                             int wd, int b, const unsigned cand[2], const unsigned sure[2])
+{
+    const unsigned open = l16w_bit(L->ow, b) & (cand[0] | cand[1]);
+    if (!open) return 1;
+    const int k = sh->k, sidx = 64 * wd + b, i = sidx % k, j = sidx / k, pk = sidx / LANES;
+    l16 d[3];
+    for (int a = 0; a < 3; a++)
+        d[a] = l16_sub(l16_add(l16_add(L->p0[a], l16_set1((float)i * sh->grid_ds[a])), l16_set1((float)j * sh->grid_dt[a])), L->p[a]);
+    unsigned hit = 0;
+    for (int x = 0; x < nx; x++) {
+        const unsigned live = cand[x] & open & ~hit;
+        if (!live) continue;
+        const int u = tu[x];
+        const tri_job *tr = &t[u];
+        if ((live & ~L->ready) && !leaf_lanes_ready(sh, c, L, live)) return 0;
+        if (!(L->have >> u & 1u)) {
+            for (int v = 0; v < 3; v++)
+                for (int a = 0; a < 3; a++) L->V[u][v][a] = l16_sub(l16_set1(tr->v[3 * v + a]), L->p[a]);
+            L->num[u] = offset16(L->V[u], tr->N);
+            L->have |= 1u << u;
+        }
+        L->has[u] |= live;
+        unsigned m0 = L->axis[0] & live, m1 = L->axis[1] & live, mneg = 0;
+        for (unsigned m = live & L->mixed; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            const int z = L->kz[l][pk];
+            m0 |= (unsigned)(z == 0) << l;
+            m1 |= (unsigned)(z == 1) << l;
+            mneg |= (unsigned)(z < 0) << l;
+        }
+        c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
+        c->cnt[C_LEAF_LANE_TESTS] += (uint64_t)__builtin_popcount(live);
+        if (!(live & ~sure[x]) && !mneg && !(sh->sw & MS_HPC_OFF_SURE)) {
+            c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
+            hit |= t_range16(sh, tr, d, L->num[u], live);
+        } else {
+            hit |= exact16(sh, tr, L->p, L->V[u], d, L->num[u], m0, m1, mneg, -1, live);
+        }
+    }
+    if (!hit) return 1;
+    c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
+    const int gk = (j / sh->gs) * (k / sh->gs) + i / sh->gs;
+    L->ow = l16w_clear(L->ow, hit, b);
+    for (unsigned m = hit; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        ((uint64_t *)L->open[l])[wd] &= ~(UINT64_C(1) << b);   /* a lane it blocks is ready: its own mask */
+        L->touched[l] |= UINT64_C(1) << gk;
+    }
+    return 1;
+}
+
+/* After the leaf's samples: each lane's groups left without an open sample, its umbra bits (record_umbra). */
+static void leaf_lanes_umbra(const shared *sh, chunk *c, const leaf_lanes *L)
+{
+    for (unsigned m = L->act; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        if (!L->touched[l]) continue;
+        const uint32_t r = L->rr[l];
+        const int32_t s = sh->slot[r];
+        const uint64_t gu0 = sh->gumbra[r];
+        uint64_t gu = gu0;
+        for (uint64_t g = L->touched[l]; g; g &= g - 1)
+            if (group_done(sh, slot_mask(sh, c, s), __builtin_ctzll(g))) gu |= g & -g;
+        if (gu != gu0) record_umbra(sh, c, r, s, gu);
     }
 }
 
@@ -1551,9 +1729,13 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     const uint64_t *lopen[LANES] = { 0 };   /* with the leaf footprint: each lane's open samples */
     /* pairs only: a lone triangle's set-up is shared by half as much work (measured on a scanned bunny, whose
      * triangles are 91% alone: it cost 5% there even with leaf_fp_pays) */
+    /* the leaf's receivers in the lanes (leaf_lanes, above): not for alpha-tested triangles (their opacity is
+     * looked up per hit, alpha_opaque) nor with the 16-lane sample test off */
+    int lanes_ok = !(sh->sw & (MS_HPC_OFF_LEAF_LANES | MS_HPC_OFF_SIMD_SAMPLES));
+    for (int u = 0; u < nt && lanes_ok; u++) lanes_ok = !ms_alpha_tested(sh->ctx->alpha, t[u].self);
     const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) &&
                         ((sh->sw & MS_HPC_ALL_LEAF_FOOTPRINT) ||
-                         (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c)));
+                         (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c, lanes_ok)));
     /* The shapes whose footprints are formed: each triangle, or for a rectangle pair under the leaf footprint
      * its rectangle, standing for both ("rectangle pairs" above; measured on grids, one thread, 1024^2: the
      * cast 9.42 -> 8.71 s, 7%; the other scenes within noise: docs/hpc.md). */
@@ -1660,12 +1842,32 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     uint64_t rc[2][LANES][64], rg[2][LANES];   /* per triangle and lane: the receiver's samples, their groups */
     uint64_t rsu[2][LANES][64];                /* of rc, the samples whose edge functions surely pass */
     unsigned has[2] = { 0u, 0u };
+    const int lanes = leaf_fp && lanes_ok;
+    leaf_lanes L;
+    if (lanes) {
+        L.act = act;
+        L.ready = L.have = L.mixed = 0;
+        L.axis[0] = L.axis[1] = L.axis[2] = 0;
+        L.has[0] = L.has[1] = 0;
+        float p0[3][LANES] = { { 0 } };
+        for (unsigned m = act; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            L.rr[l] = rr[l];
+            L.open[l] = lopen[l];
+            L.touched[l] = 0;
+            L.ready |= (unsigned)(sh->slot[rr[l]] >= 0) << l;
+            for (int a = 0; a < 3; a++) p0[a][l] = sh->p0[4 * (size_t)rr[l] + a];
+        }
+        for (unsigned m = L.ready; m; m &= m - 1) leaf_lanes_axis(sh, c, &L, __builtin_ctz(m));
+        for (int a = 0; a < 3; a++) { L.p[a] = l16_load(P[a]); L.p0[a] = l16_load(p0[a]); }
+    }
     if (leaf_fp)
         for (int u = 0; u < ns; u++) {
             const unsigned lanes_u[2] = { act & (rect ? on[0] : on[u]), rect ? act & on[1] : 0u };
             const unsigned lanes_on = lanes_u[0] | lanes_u[1];
             if (!lanes_on) continue;
-            for (int x = 0; x < 1 + rect; x++)
+            const int tu[2] = { u, u + 1 };   /* the triangles of the shape: u, or both of a rectangle pair */
+            for (int x = 0; x < 1 + rect && !lanes; x++)
                 for (unsigned m = lanes_u[x]; m; m &= m - 1) {
                     memset(rc[u + x][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
                     memset(rsu[u + x][__builtin_ctz(m)], 0, (size_t)mw * sizeof(uint64_t));
@@ -1683,7 +1885,8 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
                 }
                 slok[x] = footprint_slack_ok(sl[x]);
             }
-            for (int wd = 0; wd < mw; wd++)
+            for (int wd = 0; wd < mw; wd++) {
+                if (lanes && ncand[u][wd]) leaf_lanes_word(&L, wd);
                 for (uint64_t bits = ncand[u][wd]; bits; bits &= bits - 1) {
                     const int bit = __builtin_ctzll(bits), sidx = 64 * wd + bit;
                     /* k = 16, 32 or 64 (sh->gs), so a word holds whole rows */
@@ -1706,6 +1909,10 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
                         surel[1] = 0;
                     }
                     if (!(hitl[0] | hitl[1])) continue;
+                    if (lanes) {
+                        if (!leaf_lanes_sample(sh, c, t, &L, tu, 1 + rect, wd, bit, hitl, surel)) return;
+                        continue;
+                    }
                     const int gk = (sidx / sh->k / sh->gs) * (sh->k / sh->gs) + (sidx % sh->k) / sh->gs;
                     for (int x = 0; x < 2; x++)
                         for (unsigned h2 = hitl[x]; h2; h2 &= h2 - 1) {
@@ -1717,7 +1924,14 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
                             has[u + x] |= 1u << l;
                         }
                 }
+            }
         }
+    if (lanes) {
+        has[0] = L.has[0];
+        has[1] = L.has[1];
+        c->cnt[C_PAIRS_FOOTPRINT] += (uint64_t)(__builtin_popcount(has[0]) + __builtin_popcount(has[1]));
+        leaf_lanes_umbra(sh, c, &L);
+    }
     if (leaf_fp) {
         c->lf_in += (uint32_t)__builtin_popcount(act);
         c->lf_kept += (uint32_t)__builtin_popcount(act & (has[0] | has[1]));
@@ -1725,6 +1939,7 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
             for (int wd = 0; wd < mw; wd++) c->lf_cands += (uint32_t)__builtin_popcountll(ncand[u][wd]);
         if (c->lf_in > 4096u) { c->lf_in >>= 1; c->lf_kept >>= 1; c->lf_cands >>= 1; }   /* the recent leaves count */
     }
+    if (lanes) return;
     for (unsigned m = leaf_fp ? act & (has[0] | has[1]) : act; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         const uint32_t r = rr[l];
@@ -2000,7 +2215,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     sh.front = front;
     sh.frame_off = (size_t)mw * sizeof(uint64_t);
     sh.kz_off = sh.frame_off + (scanline ? sizeof(ms_raster_frame) : 0);
-    sh.slot_bytes = (sh.kz_off + (size_t)sh.npk + 63) / 64 * 64;
+    sh.slot_bytes = (sh.kz_off + (size_t)sh.npk + 1 + 63) / 64 * 64;   /* + 1: the shared axis (slot_setup) */
     {
         ms_light_frame F;
         ms_light_frame_of(&ctx->light, &F);
