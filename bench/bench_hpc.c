@@ -20,7 +20,7 @@
  *        each triangle alone), leaffp (hpc's leaf footprint), leaffp-rule (the leaf footprint on every leaf),
  *        rect (hpc's rectangle pairs: each triangle of a pair with its own leaf footprint), sure (hpc's sure lanes:
  *        every candidate sample to the exact test), leaflanes (hpc's leaf lanes: each receiver of a leaf given
- *        its samples in turn). */
+ *        its samples in turn), tsure (hpc's t_sure: the sure lanes' t range always tested). */
 #include "microshadow.h"
 #include "shadow/hpc/hpc.h"
 #include <stdint.h>
@@ -100,7 +100,7 @@ int main(int argc, char **argv)
                 for (int m = 0; m < NM; m++) run[m] |= !strcmp(t, methods[m]);
         } else if (!strcmp(argv[first], "--off")) {
             static const char *const names[] = { "umbra", "planesets", "lazy", "ondemand", "sort", "simdsamples", "simdplanes", "footprint", "pairs", "leaffp", "leaffp-rule", "rect", "sure",
-                                                 NULL, NULL, NULL, "leaflanes" };   /* bits 13-15: faults, not parts */
+                                                 NULL, NULL, NULL, "leaflanes", "tsure" };   /* bits 13-15: faults, not parts */
             for (char *t = strtok(argv[first + 1], ","); t; t = strtok(NULL, ",")) {
                 int found = 0;
                 for (int b = 0; b < (int)(sizeof names / sizeof *names); b++)

@@ -275,7 +275,8 @@ static void test_isa_instances_and_switches(void **st)
         }
         assert_true(rect_pairs > 0);   /* the rectangle pairs' path ran in the instances compared */
         assert_true(lane_tests > 0);   /* and the leaf lanes */
-        static const int switches[] = { 1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, MS_HPC_OFF_LEAF_LANES };
+        static const int switches[] = { 1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, MS_HPC_OFF_LEAF_LANES,
+                                        MS_HPC_OFF_TSURE };
         for (size_t si = 0; si < sizeof switches / sizeof *switches; si++) {
             const int sw = switches[si];
             perm_source ps2 = { &bvh, area, nt, 0 };
@@ -289,7 +290,7 @@ static void test_isa_instances_and_switches(void **st)
         }
         printf("k=%d: %zu points, %d ISA instances equal to raytrace and to each other (masks, counters: %llu sample "
                "tests; %llu (leaf, pair) by their rectangle and %llu sample tests in the leaf lanes on every leaf); "
-               "14 switches equal\n", k, n, ran, (unsigned long long)cnt0[9], (unsigned long long)rect_pairs,
+               "15 switches equal\n", k, n, ran, (unsigned long long)cnt0[9], (unsigned long long)rect_pairs,
                (unsigned long long)lane_tests);
         free(front); free(ref); free(vis); free(pts); free(q); free(hits);
     }
@@ -366,7 +367,11 @@ static long hpc_pixels_off(const ms_scene *sc, int switches, const ms_frame *ref
  * and bounded by its first triangle alone (MS_HPC_BREAK_RECT, wrong on purpose) pixels differ. Most samples a
  * bar blocks lie well inside its footprint, where only the t range is tested (footprint_sure_lanes): that
  * runs here, and with the sure lanes' margin on the wrong side of the edges (MS_HPC_BREAK_SURE, wrong on
- * purpose) pixels differ. (With that margin at 0 none does: the samples on a bar's edge are blocked either way.) */
+ * purpose) pixels differ. (With that margin at 0 none does: the samples on a bar's edge are blocked either way.)
+ * Where the bars lie well between the receivers and the light even the t range needs no test (t_sure): that runs
+ * here, and with t_sure true everywhere (MS_HPC_BREAK_TSURE, wrong on purpose) pixels differ, the receivers on the
+ * bars whose segments meet another bar's plane outside [near, far]. Most sample tests are made for a leaf's 16
+ * receivers at once (the leaf lanes), and the leaf footprint on every leaf equals raytrace too. */
 static void test_bars(void **st)
 {
     (void)st;
@@ -435,9 +440,10 @@ static void test_bars(void **st)
     ms_frame f;
     render_ok(&sc, "hpc", 256, 96, 0, &f);
     ms_hpc_switches = 0;
-    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0, sure = 0, tests = 0, lane_tests = 0;
+    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0, sure = 0, tests = 0, lane_tests = 0, tsure = 0;
     for (int c = 0; c < f.stats.n_counters; c++) {
         if (!strcmp(f.stats.counter_name[c], "leaf_lane_tests")) lane_tests = f.stats.counter[c];
+        if (!strcmp(f.stats.counter_name[c], "samples_t_sure")) tsure = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "samples_sure")) sure = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "sample_tests")) tests = f.stats.counter[c];
         if (!strcmp(f.stats.counter_name[c], "rect_pairs")) rect_pairs = f.stats.counter[c];
@@ -451,6 +457,7 @@ static void test_bars(void **st)
     const long differ_rect = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_RECT, &ref);
     const long differ_sure = hpc_pixels_off(&sc, MS_HPC_BREAK_SURE, &ref);
     const long differ_sure_leaf = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_SURE, &ref);
+    const long differ_tsure = hpc_pixels_off(&sc, MS_HPC_BREAK_TSURE, &ref);
     printf("bars: leaf footprint: %llu of %llu pairs in V_L to the per-receiver test, %llu (leaf, triangle) ruled "
            "out, %llu with every candidate blocked already; without its bound over the grid origins %ld pixels "
            "differ\n", (unsigned long long)to_fp, (unsigned long long)in_vl, (unsigned long long)leaf_culls,
@@ -461,6 +468,10 @@ static void test_bars(void **st)
            "(%ld with the leaf footprint on every leaf)\n", (unsigned long long)sure, (unsigned long long)tests, differ_sure,
            differ_sure_leaf);
     printf("bars: %llu of the sample tests in the leaf lanes (a leaf's receivers at one sample)\n", (unsigned long long)lane_tests);
+    printf("bars: %llu of the sure samples blocked without their t range (t_sure); with t_sure true everywhere %ld pixels "
+           "differ\n", (unsigned long long)tsure, differ_tsure);
+    assert_true(tsure > sure / 4);
+    assert_true(differ_tsure > 0);
     assert_true(lane_tests > tests / 2);
     assert_true(leaf_culls > 0);
     assert_true(culls_blocked > 0);

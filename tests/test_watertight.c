@@ -37,6 +37,9 @@
 #include "shadow/method.h"
 #include "primary/primary.h"
 #include "raster/raster.h"
+#include "accel/ray_triangle.h"
+#include "visibility/lanes16.h"
+#include "visibility/wt_rays16.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -119,6 +122,81 @@ static void test_triangle_oracle(void **st)
     }
     print_message("watertight triangle test vs double oracle: %d hits, %d misses\n", hits, misses);
     assert_true(hits > 2000 && misses > 2000);
+}
+
+/* The 16-lane forms of the segment test (visibility/wt_rays16.h, here in lanes16.h's portable C: the ISA forms are
+ * the same IEEE operations, compared with it through the methods' ISA instances in test_hpc and test_mft):
+ * ms_wt_rays16_own, each ray with its own shear axis, against the scalar ms_wt_segment bit for bit, and
+ * ms_wt_offset16 against ms_wt_offset. The rays go every way (each axis the largest, either sign, so the winding
+ * swap ms_wt_rays16_own leaves out happens), half of them aimed at the triangle's vertices, at float points of its
+ * edges or along its edges' lines (ties, exact zeros: the double fall-back the caller redoes), the rest near it;
+ * origins on the triangle's plane, near it, far; segments ending short of the plane (t beyond far) or starting
+ * past it. */
+#define LANES 16
+static void test_rays16_lanes(void **st)
+{
+    (void)st;
+    tu_rng g = { 97 };
+    const float near = 1e-4f, far = 1.0f - 1e-4f;
+    long hits = 0, tested = 0, zeros = 0, swapped = 0, axes[3] = { 0, 0, 0 };
+    for (int it = 0; it < 4000; it++) {
+        float tri[9], N[3];
+        const float scale = it % 3 == 0 ? 1e-2f : it % 3 == 1 ? 1.0f : 100.0f, off = it % 7 == 0 ? 500.0f : 0.0f;
+        for (int k = 0; k < 9; k++) tri[k] = off + scale * rndf(&g, -1, 1);
+        if (it % 5 == 0) tri[1] = tri[4] = tri[7];   /* an axis-aligned plane: exact zeros along its lines */
+        ms_wt_normal(tri, N);
+        float O[3][LANES], D[3][LANES];
+        l16 V[3][3];
+        float vv[3][3][LANES];
+        for (int l = 0; l < LANES; l++) {
+            float o[3], target[3];
+            const int kind = (int)(tu_rng_next(&g) % 6);
+            const int e = (int)(tu_rng_next(&g) % 3), e2 = (e + 1) % 3;
+            const float s = rndf(&g, -0.5f, 1.5f);
+            for (int a = 0; a < 3; a++) {
+                const float A = tri[3 * e + a], B = tri[3 * e2 + a];
+                target[a] = kind == 0 ? A                                   /* a vertex */
+                          : kind == 1 ? A + 0.5f * (B - A)                   /* a float point of an edge */
+                          : kind == 2 ? A + s * (B - A)                      /* on the edge's line */
+                          : off + scale * rndf(&g, -1.2f, 1.2f);             /* near the triangle */
+                o[a] = off + scale * rndf(&g, -3, 3);
+            }
+            if (l % 4 == 0) for (int a = 0; a < 3; a++) o[a] = tri[a] + 0.25f * (tri[3 + a] - tri[a]) + 0.25f * (tri[6 + a] - tri[a]);
+            const float reach = l % 3 == 0 ? 0.5f : l % 3 == 1 ? 2.0f : 1.0f;   /* short of the plane, past it, at it */
+            for (int a = 0; a < 3; a++) { O[a][l] = o[a]; D[a][l] = reach * (target[a] - o[a]); }
+            if (l % 5 == 1) for (int a = 0; a < 3; a++) D[a][l] = -D[a][l];
+            for (int v = 0; v < 3; v++)
+                for (int a = 0; a < 3; a++) vv[v][a][l] = tri[3 * v + a] - o[a];
+        }
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) V[v][a] = l16_load(vv[v][a]);
+        const l16 d[3] = { l16_load(D[0]), l16_load(D[1]), l16_load(D[2]) };
+        const l16 num = ms_wt_offset16((const l16 (*)[3])V, N);
+        float numv[LANES];
+        l16_store(numv, num);
+        unsigned zero;
+        const unsigned hit = ms_wt_rays16_own((const l16 (*)[3])V, d, N, num, near, far, 0xffffu, &zero);
+        for (int l = 0; l < LANES; l++) {
+            const float o[3] = { O[0][l], O[1][l], O[2][l] }, dl[3] = { D[0][l], D[1][l], D[2][l] };
+            const float num1 = ms_wt_offset(o, tri, N);
+            assert_memory_equal(&numv[l], &num1, sizeof num1);
+            const int want = ms_wt_segment(o, dl, tri, N, near, far);
+            const int kz = ms_wt_max_axis(dl);
+            axes[kz]++;
+            swapped += dl[kz] < 0.0f;
+            tested++;
+            if (zero >> l & 1u) { zeros++; continue; }   /* the caller's: ms_wt_segment itself */
+            if ((int)(hit >> l & 1u) != want)
+                print_message("it %d lane %d: lanes %u, scalar %d\n", it, l, hit >> l & 1u, want);
+            assert_int_equal((int)(hit >> l & 1u), want);
+            hits += want;
+        }
+    }
+    print_message("ms_wt_rays16_own = ms_wt_segment on %ld rays (%ld hits; %ld with an edge exactly 0, left to the caller; "
+                  "largest axis x %ld, y %ld, z %ld; %ld with d[kz] < 0)\n", tested - zeros, hits, zeros, axes[0], axes[1],
+                  axes[2], swapped);
+    assert_true(hits > 2000 && tested - zeros - hits > 5000);
+    assert_true(zeros > 100 && swapped > 10000 && axes[0] > 10000 && axes[1] > 10000 && axes[2] > 10000);
 }
 
 /* Rays grazing long triangles from just beside their plane (a receiver next to a crease): t must be
@@ -702,6 +780,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_triangle_oracle),
         cmocka_unit_test(test_grazing_t),
+        cmocka_unit_test(test_rays16_lanes),
         cmocka_unit_test(test_fan_vertex_and_edges),
         cmocka_unit_test(test_flat_grid_vertices),
         cmocka_unit_test(test_kernels_shared_edges),

@@ -19,7 +19,7 @@ typedef struct hpc_source {
     size_t (*next)(void *user, float *tri, uint32_t *ids, size_t max);
 } hpc_source;
 
-#define HPC_N_COUNTERS 30
+#define HPC_N_COUNTERS 31
 #define HPC_COUNTER_SORT_US 16   /* filled by the method (hpc_method.c): the sort is the source's */
 
 /* For n receivers with their front masks (receiver.h), writes the visible masks: the front samples that no
@@ -68,8 +68,11 @@ enum {
     MS_HPC_BREAK_SURE = 32768,   /* not a measurement: the sure lanes (footprint_sure_lanes) with their margin on
                                   * the wrong side of the edges, -s (wrong on purpose), so that test_hpc can show
                                   * its scene depends on it */
-    MS_HPC_OFF_LEAF_LANES = 65536 /* hpc's leaf lanes (hpc_impl.h): a leaf's samples handed to each receiver in turn
-                                   * instead of tested for its 16 receivers at once */
+    MS_HPC_OFF_LEAF_LANES = 65536, /* hpc's leaf lanes (hpc_impl.h): a leaf's samples handed to each receiver in turn
+                                    * instead of tested for its 16 receivers at once */
+    MS_HPC_OFF_TSURE = 131072,   /* hpc's t_sure (hpc_impl.h): the sure lanes' t range tested, never proven */
+    MS_HPC_BREAK_TSURE = 262144  /* not a measurement: t_sure true for every receiver and triangle (wrong on
+                                  * purpose), so that test_hpc can show its scene depends on it */
 };
 extern int ms_hpc_switches;
 

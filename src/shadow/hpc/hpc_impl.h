@@ -160,6 +160,7 @@ enum {
     C_RECT_PAIRS,        /* (leaf, pair) bounded by the pair's rectangle (one footprint for both triangles) */
     C_SAMPLES_SURE,      /* of the sample tests, those decided on the t range alone (footprint_sure_lanes) */
     C_LEAF_LANE_TESTS,   /* of the sample tests, those made for a leaf's receivers in the lanes (leaf_lanes_sample) */
+    C_SAMPLES_TSURE,     /* of samples_sure, those blocked without the t range's operations (t_sure) */
     C_COUNT
 };
 _Static_assert(C_COUNT == HPC_N_COUNTERS, "hpc.h names the counters");
@@ -1018,7 +1019,7 @@ static inline l16 sel3(unsigned m0, unsigned m1, l16 x0, l16 x1, l16 x2) { retur
 /* The hard-shadow test (L70) of 16 rays in the lanes, each lane what sample_blocked computes for its ray, in the
  * same order: ray l from its receiver P[l] along d[l] (formed by the caller as sample_blocked forms it), sheared
  * along its packet's axis (one packet = 16 consecutive samples of a row of that receiver's grid, raytrace's):
- * axis 0 on lanes m0, 1 on m1, none on mneg (raytrace tests those lanes one by one: the scalar form), 2 on the
+ * axis 0 on lanes m0, 1 on m1, none on mneg (each its own, ms_wt_rays16_own: raytrace's ms_wt_segment), 2 on the
  * others; z0 >= 0: every lane's axis is z0 (no per-lane selection). V: the triangle's vertices relative to each
  * lane's receiver (world axes); num: each lane's plane offset (ms_wt_offset). Lanes with an edge function
  * exactly 0 go to the scalar form too (as raytrace's lanes do). Returns the lanes of live triangle t blocks.
@@ -1043,9 +1044,10 @@ static unsigned exact16(const shared *sh, const tri_job *t, const l16 P[3], cons
     }
     const l16 inv = l16_div(l16_set1(1.0f), dz), sx = l16_mul(dx, inv), sy = l16_mul(dy, inv);
     const float *N = t->N, near = sh->ctx->near, far = sh->ctx->far;
-    unsigned z;
+    unsigned z, zown = 0;
     unsigned hit = ms_wt_rays16(V3, sx, sy, d, N, num, near, far, live & ~mneg, &z);
-    const unsigned rest = (live & mneg) | z;
+    if (live & mneg) hit |= ms_wt_rays16_own(V, d, N, num, near, far, live & mneg, &zown);
+    const unsigned rest = z | zown;
     if (rest) {
         float dv[3][LANES], pv[3][LANES], vv[3][3][LANES], sxv[LANES], syv[LANES], nv[LANES];
         for (int a = 0; a < 3; a++) {
@@ -1263,20 +1265,80 @@ typedef struct hpc_view {
     int direct;                 /* 1: ncand and ngroups made by the leaf (cast_leaf_footprint), fp unused */
 } hpc_view;
 
+/* Whether every segment from a receiver in the box pc +- h to a sample of the light meets triangle t's plane well
+ * inside the exact test's range, so that wherever the exact test's edge functions surely pass
+ * (footprint_sure_lanes) it reports a hit, whatever its shear axis, without its t range's operations. With
+ * alpha = N . p, xi = N . x (x the sample) and gamma = N . v (v any vertex: N, ms_wt_normal's, is not exactly
+ * normal to the third edge), the exact test's t is (gamma - alpha) / (xi - alpha) up to its rounding: the plane
+ * offset num = (v - p) . N from a vertex rounded relative to p (at most 5 u M |N|_1, M >= |v - p|inf) and d . N
+ * from the direction formed in float (at most 3 u S |N|_1 for the product and 4 u S |N|_1 for d itself, S >=
+ * |p0| + |p| bounds every partial sum, the grid's points lying on the light). So when the ranges of alpha over
+ * the box, gamma over the vertices and xi over the light's polygon (the samples' cells, pattern.h) are
+ * separated in that order (or its reverse), with gamma - alpha >= 2 near D + E and xi - gamma >= 2 (1 - far) D +
+ * E, D >= |xi - alpha|, E = 16 u (M + S) |N|_1 above all those errors, the computed test lies in [near, far]
+ * for every lane: ms_wt_rays16's plane-distance form, and the scalar form's division clamped to the vertices'
+ * depths (ms_wt_hit_t: the exact hit lies within them, the clamp moves t by rounding only). In double. */
+static inline int tsure_on(const shared *sh) { return !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_TSURE)); }
+
+static int t_sure(const shared *sh, const float pc[3], const float h[3], const tri_job *t)
+{
+    const float *N = t->N;
+    double n1 = 0.0, a0 = 0.0, ah = 0.0, hmax = 0.0, pmax = 0.0, lmax = 0.0, M = 0.0;
+    for (int a = 0; a < 3; a++) {
+        n1 += fabs((double)N[a]);
+        a0 += (double)N[a] * pc[a];
+        ah += fabs((double)N[a]) * h[a];
+        hmax = fmax(hmax, h[a]);
+        pmax = fmax(pmax, fabs((double)pc[a]));
+    }
+    double gl = INFINITY, gh = -INFINITY, xl = INFINITY, xh = -INFINITY;
+    for (int v = 0; v < 3; v++) {
+        double gv = 0.0, mv = 0.0;
+        for (int a = 0; a < 3; a++) {
+            gv += (double)N[a] * t->v[3 * v + a];
+            mv = fmax(mv, fabs((double)t->v[3 * v + a] - pc[a]));
+        }
+        gl = fmin(gl, gv);
+        gh = fmax(gh, gv);
+        M = fmax(M, mv + hmax);
+    }
+    for (int v = 0; v < 4; v++) {
+        double xv = 0.0;
+        for (int a = 0; a < 3; a++) {
+            xv += (double)N[a] * sh->light_poly[3 * v + a];
+            lmax = fmax(lmax, fabs(sh->light_poly[3 * v + a]));
+        }
+        xl = fmin(xl, xv);
+        xh = fmax(xh, xv);
+    }
+    const double S = 2.0 * (lmax + pmax + hmax), E = 1.01 * 16.0 * 0x1p-24 * (M + S) * n1;
+    const double al = a0 - ah, au = a0 + ah;
+    const double D = fmax(xh, au) - fmin(xl, al);
+    const double nearm = 2.0 * (double)sh->ctx->near * D + E, farm = 2.0 * (1.0 - (double)sh->ctx->far) * D + E;
+    if (au < gl && gh < xl) return gl - au >= nearm && xl - gh >= farm;   /* receivers, plane, light in order */
+    if (xh < gl && gh < al) return al - gh >= nearm && gl - xh >= farm;   /* and in reverse */
+    return 0;
+}
+
 /* The lanes triangle t blocks of the 16-sample block at (i0, jb) of receiver q (live: the lanes to test), with
  * the 16-lane test or, switched off, one lane at a time; alpha-tested triangles only where opaque. sure: lanes
  * whose edge functions surely pass (footprint_sure_lanes): when they are all of live, and no row of the block
  * leaves its lanes to the scalar form (a packet without a shared axis, kz < 0: ms_wt_segment, its own shear
  * and t), only the t range is tested (counter samples_sure). */
 static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q, const ms_grid *g, const int8_t *kz, int i0,
-                           int jb, unsigned live, unsigned sure, const tri_job *t, const float V[3][3], float num)
+                           int jb, unsigned live, unsigned sure, int tsure, const tri_job *t, const float V[3][3], float num)
 {
     const int k = sh->k, gs = sh->gs;
     unsigned hit;
     int shared_axis = 1;
-    if (!(live & ~sure) && !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES)))
+    const int all_sure = !(live & ~sure) && !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES));
+    if (all_sure && !tsure)
         for (int r = 0; r < LANES / gs; r++) shared_axis &= kz[((jb + r) * k + i0) / LANES] >= 0;
-    if (!(live & ~sure) && shared_axis && !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES))) {
+    if (all_sure && tsure) {   /* t_sure: the t range passes too, on any axis */
+        c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
+        c->cnt[C_SAMPLES_TSURE] += (uint64_t)__builtin_popcount(live);
+        hit = live;
+    } else if (all_sure && shared_axis) {
         c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
         l16 d[3];
         block_dirs(q, g, i0, jb, gs, d);
@@ -1329,6 +1391,7 @@ static inline __attribute__((always_inline)) void cast_blocks(const shared *sh, 
     int32_t s = sh->slot[r];
     const uint64_t *open = open_of(sh, c, r);
     float num[2] = { 0.0f, 0.0f }, V[2][3][3];   /* per triangle at its first exact test: offset, A, B, C */
+    int tsure[2] = { 0, 0 };                      /* and t_sure for this receiver */
     int have_num[2] = { 0, 0 };
     const int8_t *kz = NULL;
     const uint64_t gu0 = gu;
@@ -1360,13 +1423,15 @@ static inline __attribute__((always_inline)) void cast_blocks(const shared *sh, 
                 if (with_sure)
                     sure[u] = v->direct ? block_open(v->nsure[u], k, i0, jb, gs) : footprint_sure_lanes(E[u], ssl[u], sok[u]);
                 if (!have_num[u]) {
+                    static const float zero3[3] = { 0.0f, 0.0f, 0.0f };
+                    tsure[u] = with_sure && tsure_on(sh) && ((sh->sw & MS_HPC_BREAK_TSURE) || t_sure(sh, q->p, zero3, v->t[u]));
                     num[u] = ms_wt_offset(q->p, v->t[u]->v, v->t[u]->N);
                     for (int i = 0; i < 3; i++)
                         for (int a = 0; a < 3; a++) V[u][i][a] = v->t[u]->v[3 * i + a] - q->p[a];
                     have_num[u] = 1;
                 }
                 c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
-                hit |= block_hits(sh, c, q, g, kz, i0, jb, live, sure[u], v->t[u], V[u], num[u]);
+                hit |= block_hits(sh, c, q, g, kz, i0, jb, live, sure[u], tsure[u], v->t[u], V[u], num[u]);
             }
             if (!hit) continue;
             c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
@@ -1557,24 +1622,12 @@ typedef struct leaf_lanes {
     unsigned axis[3], mixed;        /* of those, the lanes whose every packet has shear axis 0, 1, 2; the others */
     l16w ow;                        /* the lanes' open samples in the current mask word (leaf_lanes_word) */
     unsigned have;                  /* bit u: triangle u's per-lane vertices and offset made */
+    unsigned tsure;                 /* bit u: t_sure of triangle u over the leaf's box */
+    float pc[3], h[3];              /* the leaf's box (cast_leaf_footprint's) */
     l16 V[2][3][3], num[2];         /* per triangle: its vertices relative to each lane's receiver, its offset */
     uint64_t touched[LANES];        /* per lane: the groups where it lost samples */
     unsigned has[2];                /* per triangle: the lanes it was tested for */
 } leaf_lanes;
-
-/* ms_wt_offset per lane: the plane offset from the vertex nearest each lane's receiver (V: the vertices
- * relative to it), the same operations and the same choice on ties. */
-static l16 offset16(const l16 V[3][3], const float n[3])
-{
-    l16 lv[3], dn[3];
-    for (int i = 0; i < 3; i++) {
-        lv[i] = l16_add(l16_add(l16_mul(V[i][0], V[i][0]), l16_mul(V[i][1], V[i][1])), l16_mul(V[i][2], V[i][2]));
-        dn[i] = l16_add(l16_add(l16_mul(V[i][0], l16_set1(n[0])), l16_mul(V[i][1], l16_set1(n[1]))), l16_mul(V[i][2], l16_set1(n[2])));
-    }
-    /* nr = lv0 <= lv1 ? (lv0 <= lv2 ? 0 : 2) : (lv1 <= lv2 ? 1 : 2) */
-    const unsigned c01 = l16_le(lv[0], lv[1]), c02 = l16_le(lv[0], lv[2]), c12 = l16_le(lv[1], lv[2]);
-    return l16_select(c01 & c02, dn[0], l16_select(~c01 & c12, dn[1], dn[2]));
-}
 
 /* Files ready lane l under the axis all its packets share (slot_setup), or under mixed. */
 static inline void leaf_lanes_axis(const shared *sh, const chunk *c, leaf_lanes *L, int l)
@@ -1630,8 +1683,7 @@ __attribute__((noinline)) static int leaf_lanes_sample(const shared *sh, chunk *
     if (!open) return 1;
     const int k = sh->k, sidx = 64 * wd + b, i = sidx % k, j = sidx / k, pk = sidx / LANES;
     l16 d[3];
-    for (int a = 0; a < 3; a++)
-        d[a] = l16_sub(l16_add(l16_add(L->p0[a], l16_set1((float)i * sh->grid_ds[a])), l16_set1((float)j * sh->grid_dt[a])), L->p[a]);
+    int have_d = 0;
     unsigned hit = 0;
     for (int x = 0; x < nx; x++) {
         const unsigned live = cand[x] & open & ~hit;
@@ -1642,10 +1694,25 @@ __attribute__((noinline)) static int leaf_lanes_sample(const shared *sh, chunk *
         if (!(L->have >> u & 1u)) {
             for (int v = 0; v < 3; v++)
                 for (int a = 0; a < 3; a++) L->V[u][v][a] = l16_sub(l16_set1(tr->v[3 * v + a]), L->p[a]);
-            L->num[u] = offset16(L->V[u], tr->N);
+            L->num[u] = ms_wt_offset16((const l16 (*)[3])L->V[u], tr->N);
             L->have |= 1u << u;
+            if (tsure_on(sh) && ((sh->sw & MS_HPC_BREAK_TSURE) || t_sure(sh, L->pc, L->h, tr))) L->tsure |= 1u << u;
         }
         L->has[u] |= live;
+        c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
+        c->cnt[C_LEAF_LANE_TESTS] += (uint64_t)__builtin_popcount(live);
+        if (!(live & ~sure[x]) && (L->tsure >> u & 1u)) {   /* blocked on every lane: no test (t_sure) */
+            c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
+            c->cnt[C_SAMPLES_TSURE] += (uint64_t)__builtin_popcount(live);
+            hit |= live;
+            continue;
+        }
+        if (!have_d) {
+            for (int a = 0; a < 3; a++)
+                d[a] = l16_sub(l16_add(l16_add(L->p0[a], l16_set1((float)i * sh->grid_ds[a])), l16_set1((float)j * sh->grid_dt[a])),
+                               L->p[a]);
+            have_d = 1;
+        }
         unsigned m0 = L->axis[0] & live, m1 = L->axis[1] & live, mneg = 0;
         for (unsigned m = live & L->mixed; m; m &= m - 1) {
             const int l = __builtin_ctz(m);
@@ -1654,8 +1721,6 @@ __attribute__((noinline)) static int leaf_lanes_sample(const shared *sh, chunk *
             m1 |= (unsigned)(z == 1) << l;
             mneg |= (unsigned)(z < 0) << l;
         }
-        c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
-        c->cnt[C_LEAF_LANE_TESTS] += (uint64_t)__builtin_popcount(live);
         if (!(live & ~sure[x]) && !mneg && !(sh->sw & MS_HPC_OFF_SURE)) {
             c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
             hit |= t_range16(sh, tr, d, L->num[u], live);
@@ -1747,8 +1812,8 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     fp_shape shape[2];
     for (int u = 0; u < ns; u++) shape[u] = rect ? (fp_shape){ t->rc, 4 } : (fp_shape){ t[u].v, 3 };
     if (rect && (sh->sw & MS_HPC_BREAK_RECT)) shape[0].nv = 3;   /* wrong on purpose: the first triangle for both */
+    leaf_box bx;   /* with the leaf footprint: the receivers' box and their grid origins' */
     if (leaf_fp) {
-        leaf_box bx;
         for (int a = 0; a < 3; a++) {
             float plo = INFINITY, phi = -INFINITY, olo = INFINITY, ohi = -INFINITY;
             for (unsigned m = act; m; m &= m - 1) {
@@ -1846,7 +1911,9 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
     leaf_lanes L;
     if (lanes) {
         L.act = act;
-        L.ready = L.have = L.mixed = 0;
+        L.ready = L.have = L.mixed = L.tsure = 0;
+        memcpy(L.pc, bx.pc, sizeof L.pc);
+        memcpy(L.h, bx.h, sizeof L.h);
         L.axis[0] = L.axis[1] = L.axis[2] = 0;
         L.has[0] = L.has[1] = 0;
         float p0[3][LANES] = { { 0 } };

@@ -165,7 +165,7 @@ static void hpc_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
       "full_umbra_points", "raster_calls", "sort_us", "build_us", "rebuild_thread_us", "cast_us",      \
       "sample_bytes", "hierarchy_bytes", "mask_bytes", "pairs_in_vl",  \
       "pairs_footprint", "leaf_culls", "leaf_culls_blocked", "rect_pairs", "samples_sure",          \
-      "leaf_lane_tests" }
+      "leaf_lane_tests", "samples_t_sure" }
 
 const ms_shadow_method ms_shadow_hpc = {
     .name = "hpc", .primary = "bvh", .needs_grid = 1, .streams = 1,

@@ -206,10 +206,15 @@ static unsigned mftg_rays(const mftg_state *s, const ms_mft_group *g, unsigned b
     const ms_mft_frame *f = s->f;
     const unsigned alone = bits & g->alone;
     unsigned hit = 0;
-    for (unsigned m = alone; m; m &= m - 1) {
-        const int q = __builtin_ctz(m);
-        const float o[3] = { s->rb->c[0][q], s->rb->c[1][q], s->rb->c[2][q] }, d[3] = { g->d[0][q], g->d[1][q], g->d[2][q] };
-        if (ms_wt_segment(o, d, tri, N, f->near, f->far)) hit |= 1u << q;
+    if (alone) {   /* slots whose packet shares no axis: each ray its own (ms_wt_segment, 16 lanes at once) */
+        const l16 dir[3] = { l16_load(g->d[0]), l16_load(g->d[1]), l16_load(g->d[2]) };
+        unsigned z;
+        hit = ms_wt_rays16_own(V, dir, N, num, f->near, f->far, alone, &z);
+        for (unsigned m = z; m; m &= m - 1) {   /* an edge function exactly 0: in double */
+            const int q = __builtin_ctz(m);
+            const float o[3] = { s->rb->c[0][q], s->rb->c[1][q], s->rb->c[2][q] }, d[3] = { g->d[0][q], g->d[1][q], g->d[2][q] };
+            if (ms_wt_segment(o, d, tri, N, f->near, f->far)) hit |= 1u << q;
+        }
     }
     bits &= ~alone;
     if (!bits) return hit;
@@ -328,16 +333,10 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
         for (int q = 0; q < nskip; q++)
             if (skip_tri[q] == t) skip |= skip_slot[q];
         /* 2. The triangle relative to each receiver (slot q in lane q) and ms_wt_offset, bit for bit. */
-        l16 V[3][3], lv[3];
-        for (int v = 0; v < 3; v++) {
+        l16 V[3][3];
+        for (int v = 0; v < 3; v++)
             for (int x = 0; x < 3; x++) V[v][x] = l16_sub(l16_set1(tri[3 * v + x]), cq[x]);
-            lv[v] = l16_add(l16_add(l16_mul(V[v][0], V[v][0]), l16_mul(V[v][1], V[v][1])), l16_mul(V[v][2], V[v][2]));
-        }
-        /* nr = lv0 <= lv1 ? (lv0 <= lv2 ? 0 : 2) : (lv1 <= lv2 ? 1 : 2) */
-        const unsigned le01 = l16_le(lv[0], lv[1]), p0 = le01 & l16_le(lv[0], lv[2]), p1 = ~le01 & l16_le(lv[1], lv[2]);
-        l16 vn[3];
-        for (int x = 0; x < 3; x++) vn[x] = l16_select(p0, V[0][x], l16_select(p1, V[1][x], V[2][x]));
-        const l16 num = l16_add(l16_add(l16_mul(vn[0], l16_set1(N[0])), l16_mul(vn[1], l16_set1(N[1]))), l16_mul(vn[2], l16_set1(N[2])));
+        const l16 num = ms_wt_offset16((const l16 (*)[3])V, N);
         float numv[MS_BLOCK_LANES];
         l16_store(numv, num);
         /* 3. Each surviving group's rays, 16 in one operation. */

@@ -215,8 +215,14 @@ static unsigned mft_packet(const ms_mft_lane *L, int ch, unsigned bits, const fl
 {
     const int kz = L->kz[ch], base = ch * 16;
     unsigned hit = 0;
-    if (kz < 0) {
-        for (unsigned m = bits; m; m &= m - 1) {
+    if (kz < 0) {   /* each ray its own axis: ms_wt_segment, 16 lanes at once */
+        const l16 Vs[3][3] = { { l16_set1(V[0][0]), l16_set1(V[0][1]), l16_set1(V[0][2]) },
+                               { l16_set1(V[1][0]), l16_set1(V[1][1]), l16_set1(V[1][2]) },
+                               { l16_set1(V[2][0]), l16_set1(V[2][1]), l16_set1(V[2][2]) } };
+        const l16 dir[3] = { l16_load(L->d[0] + base), l16_load(L->d[1] + base), l16_load(L->d[2] + base) };
+        unsigned z;
+        hit = ms_wt_rays16_own(Vs, dir, N, l16_set1(num), near, far, bits, &z);
+        for (unsigned m = z; m; m &= m - 1) {   /* an edge function exactly 0: in double */
             const int l = __builtin_ctz(m);
             const float d[3] = { L->d[0][base + l], L->d[1][base + l], L->d[2][base + l] };
             if (ms_wt_segment(L->c, d, tri, N, near, far)) hit |= 1u << l;

@@ -10,6 +10,8 @@
 #include "light/pattern.h"
 #include "core/vec.h"
 #include "accel/ray_triangle.h"
+#include "visibility/lanes16.h"
+#include "visibility/wt_rays16.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -85,11 +87,22 @@ static int packet_enters(const packet *pk, const ms_bvh_node *n)
  * (as ms_wt_evaluate does); it is rarely taken. */
 static void packet_triangle(packet *pk, const float *tri, const float N[3])
 {
-    if (pk->kz < 0) {
+    if (pk->kz < 0) {   /* each lane its own axis: ms_wt_segment, 16 lanes at once (ms_wt_rays16_own) */
+        unsigned live = 0, zero;
+        for (int l = 0; l < LANES; l++) live |= (unsigned)(pk->live[l] != 0) << l;
+        if (!live) return;
+        l16 A[3][3];
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) A[v][a] = l16_set1(tri[3 * v + a] - pk->o[a]);
+        const l16 d[3] = { l16_load(pk->d[0]), l16_load(pk->d[1]), l16_load(pk->d[2]) };
+        const unsigned hit = ms_wt_rays16_own(A, d, N, l16_set1(ms_wt_offset(pk->o, tri, N)), pk->tmin, pk->tmax, live, &zero);
         for (int l = 0; l < LANES; l++) {
-            if (!pk->live[l]) continue;
-            const float d[3] = { pk->d[0][l], pk->d[1][l], pk->d[2][l] };
-            pk->live[l] = !ms_wt_segment(pk->o, d, tri, N, pk->tmin, pk->tmax);
+            if ((zero >> l & 1u) == 0) {
+                if (hit >> l & 1u) pk->live[l] = 0;
+                continue;
+            }
+            const float dl[3] = { pk->d[0][l], pk->d[1][l], pk->d[2][l] };   /* an edge exactly 0: in double */
+            pk->live[l] = !ms_wt_segment(pk->o, dl, tri, N, pk->tmin, pk->tmax);
         }
         return;
     }
