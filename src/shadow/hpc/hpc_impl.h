@@ -194,6 +194,7 @@ typedef struct shared {
     int k, mw, gs, G, npk;
     uint64_t all_groups;
     uint64_t *gmask;                 /* G x mw: the samples of each group */
+    int gw0[64], gw1[64];            /* each group's first and last mask word (its rows lie in those only) */
     double light_poly[12];
     double group_poly[64][12];
     float group_i0[64], group_j0[64]; /* each group's first sample column and row (the footprint test) */
@@ -1200,7 +1201,7 @@ static int vol_point(const shared *sh, const hpc_volume *v, uint32_t act, const 
 static int group_done(const shared *sh, const uint64_t *open, int gk)
 {
     const uint64_t *m = sh->gmask + (size_t)gk * sh->mw;
-    for (int w = 0; w < sh->mw; w++)
+    for (int w = sh->gw0[gk]; w <= sh->gw1[gk]; w++)
         if (open[w] & m[w]) return 0;
     return 1;
 }
@@ -1835,7 +1836,10 @@ static void cast_leaf_footprint(const shared *sh, chunk *c, const hnode *N, cons
         leaf_setup(sh, &bx, shape, ns, fn);
         c->cnt[C_RECT_PAIRS] += (uint64_t)rect;
         for (int u = 0; u < ns; u++) {   /* a rectangle: shape 0 stands for both triangles (on[0] covers act) */
-            if (!(act & on[u])) continue;
+            if (!(act & on[u])) {   /* no receiver for it: no samples (read by the rule's counts below) */
+                memset(ncand[u], 0, (size_t)sh->mw * sizeof ncand[u][0]);
+                continue;
+            }
             ngroups[u] = leaf_footprint(sh, &bx, &fn[u], ncand[u]);
             if (!ngroups[u]) shape_off(c, C_LEAF_CULLS, act, on, u, rect);
         }
@@ -2103,11 +2107,58 @@ static void cast_triangle(const shared *sh, chunk *c, const tri_job *t)
  * chunks' sizes even when the cap runs out: depth first, empty regions used up the cap and left a GRIDS-like
  * frame's densest region as one chunk of 28% of the points, which one thread cast alone while the other
  * waited at the batch's end (at 1024² the last batch took 4.9 s of wall time for 5.0 s of CPU). */
-static int make_chunks(const shared *sh, uint32_t *idx, uint32_t n, uint32_t target, chunk *out, int cap)
+/* make_chunks' split of idx[0..n) at split on axis, over the threads: the points below it first, both sides in
+ * their order (a stable partition, so the result does not depend on the threads); tmp: n entries. Returns the
+ * number below. */
+static uint32_t partition_parallel(const shared *sh, uint32_t *idx, uint32_t n, int axis, float split, uint32_t *tmp,
+                                   int threads)
+{
+    enum { MAX_T = 256 };
+    uint32_t below[MAX_T + 1] = { 0 };
+    const int nt = threads < MAX_T ? threads : MAX_T;
+    const uint32_t per = (n + (uint32_t)nt - 1) / (uint32_t)nt;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int t = 0; t < nt; t++) {
+        const uint32_t b = (uint32_t)t * per, e = b + per < n ? b + per : n;
+        uint32_t c = 0;
+        for (uint32_t i = b; i < e; i++) c += sh->q[idx[i]].p[axis] < split;
+        below[t + 1] = c;
+    }
+    for (int t = 0; t < nt; t++) below[t + 1] += below[t];
+    const uint32_t m = below[nt];
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int t = 0; t < nt; t++) {
+        const uint32_t b = (uint32_t)t * per, e = b + per < n ? b + per : n;
+        uint32_t lo = below[t], hi = m + (b < n ? b : n) - below[t];
+        for (uint32_t i = b; i < e; i++) {
+            if (sh->q[idx[i]].p[axis] < split) tmp[lo++] = idx[i];
+            else tmp[hi++] = idx[i];
+        }
+    }
+    memcpy(idx, tmp, (size_t)n * sizeof *idx);
+    return m;
+}
+
+/* bounds_of over the threads (min and max are exact, so the order does not matter). */
+static void bounds_parallel(const shared *sh, const uint32_t *idx, uint32_t n, float lo[3], float hi[3], int threads)
+{
+    float l0 = INFINITY, l1 = INFINITY, l2 = INFINITY, h0 = -INFINITY, h1 = -INFINITY, h2 = -INFINITY;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(min : l0, l1, l2) reduction(max : h0, h1, h2)
+    for (uint32_t i = 0; i < n; i++) {
+        const float *p = sh->q[idx[i]].p;
+        l0 = ms_minf(l0, p[0]); l1 = ms_minf(l1, p[1]); l2 = ms_minf(l2, p[2]);
+        h0 = ms_maxf(h0, p[0]); h1 = ms_maxf(h1, p[1]); h2 = ms_maxf(h2, p[2]);
+    }
+    lo[0] = l0; lo[1] = l1; lo[2] = l2;
+    hi[0] = h0; hi[1] = h1; hi[2] = h2;
+}
+
+static int make_chunks(const shared *sh, uint32_t *idx, uint32_t n, uint32_t target, chunk *out, int cap, int threads)
 {
     typedef struct { uint32_t b, n; } range;
     range *r = malloc((size_t)cap * sizeof *r);
-    if (!r) return -1;
+    uint32_t *tmp = malloc((size_t)n * sizeof *tmp);
+    if (!r || !tmp) { free(r); free(tmp); return -1; }
     int nc = 1;
     r[0] = (range){ 0, n };
     while (nc < cap) {
@@ -2117,10 +2168,10 @@ static int make_chunks(const shared *sh, uint32_t *idx, uint32_t n, uint32_t tar
         if (r[big].n <= target) break;
         const range x = r[big];
         float lo[3], hi[3];
-        bounds_of(sh, idx + x.b, x.n, lo, hi);
+        bounds_parallel(sh, idx + x.b, x.n, lo, hi, threads);
         const float ext[3] = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
         const int axis = ext[0] >= ext[1] ? (ext[0] >= ext[2] ? 0 : 2) : (ext[1] >= ext[2] ? 1 : 2);
-        uint32_t m = partition(sh, idx + x.b, x.n, axis, lo[axis] + 0.5f * ext[axis]);
+        uint32_t m = partition_parallel(sh, idx + x.b, x.n, axis, lo[axis] + 0.5f * ext[axis], tmp, threads);
         if (m == 0 || m == x.n) m = x.n / 2;   /* coincident points: any split */
         /* The halves stay next to each other in the list (spatial order, which the renumbering keeps). */
         memmove(r + big + 2, r + big + 1, (size_t)(nc - big - 1) * sizeof *r);
@@ -2133,6 +2184,7 @@ static int make_chunks(const shared *sh, uint32_t *idx, uint32_t n, uint32_t tar
         out[i].n = r[i].n;
     }
     free(r);
+    free(tmp);
     return nc;
 }
 
@@ -2292,15 +2344,21 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
             for (int v = 0; v < 4; v++) sh.scale = ms_maxf(sh.scale, 2.0f * fabsf(c[v]));
         }
     }
-    for (size_t i = 0; i < n; i++)
-        for (int a = 0; a < 3; a++) sh.scale = ms_maxf(sh.scale, fabsf(q[i].p[a]));
+    const int threads = ctx->threads > 0 ? ctx->threads : 1;
+    /* the receivers' box, and their largest coordinate in sh.scale (in parallel: the serial parts of a frame
+     * count in its wall time; max and min are exact, so the order does not matter) */
+    float lo0 = INFINITY, lo1 = INFINITY, lo2 = INFINITY, hi0 = -INFINITY, hi1 = -INFINITY, hi2 = -INFINITY, pmax = 0.0f;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(min : lo0, lo1, lo2) reduction(max : hi0, hi1, hi2, pmax)
+    for (size_t i = 0; i < n; i++) {
+        const float *p = q[i].p;
+        lo0 = ms_minf(lo0, p[0]); lo1 = ms_minf(lo1, p[1]); lo2 = ms_minf(lo2, p[2]);
+        hi0 = ms_maxf(hi0, p[0]); hi1 = ms_maxf(hi1, p[1]); hi2 = ms_maxf(hi2, p[2]);
+        pmax = ms_maxf(pmax, ms_maxf(fabsf(p[0]), ms_maxf(fabsf(p[1]), fabsf(p[2]))));
+    }
+    sh.scale = ms_maxf(sh.scale, pmax);
     setup_light(&sh);
-    float rlo[3] = { INFINITY, INFINITY, INFINITY }, rhi[3] = { -INFINITY, -INFINITY, -INFINITY }, reach2 = 0.0f;
-    for (size_t i = 0; i < n; i++)
-        for (int a = 0; a < 3; a++) {
-            rlo[a] = ms_minf(rlo[a], q[i].p[a]);
-            rhi[a] = ms_maxf(rhi[a], q[i].p[a]);
-        }
+    const float rlo[3] = { lo0, lo1, lo2 }, rhi[3] = { hi0, hi1, hi2 };
+    float reach2 = 0.0f;
     for (int a = 0; a < 3 && n; a++) {
         const float e = ms_maxf(fabsf(rhi[a] - sh.light_lo[a]), fabsf(sh.light_hi[a] - rlo[a]));
         reach2 += e * e;
@@ -2308,7 +2366,6 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     sh.reach = sqrtf(reach2);
 
     int rc = -1, nchunks = 0;
-    const int threads = ctx->threads > 0 ? ctx->threads : 1;
     const int cap = 16 * threads;   /* chunks: see make_chunks */
     sh.gmask = calloc((size_t)sh.G * mw, sizeof *sh.gmask);
     sh.gumbra = malloc(n * sizeof *sh.gumbra);
@@ -2333,6 +2390,8 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
                 const int s = j * k + i;
                 sh.gmask[(size_t)g * mw + (s >> 6)] |= UINT64_C(1) << (s & 63);
             }
+        sh.gw0[g] = (j0 * k + i0) >> 6;
+        sh.gw1[g] = ((j0 + sh.gs - 1) * k + i0 + sh.gs - 1) >> 6;
     }
     /* Samples behind the horizon count as blocked from the start (umbra bits: nothing open). In parallel, the
      * live receivers gathered after (the serial parts of a frame count in its wall time). */
@@ -2342,7 +2401,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
         const uint64_t *f = front + r * mw;
         for (int g = 0; g < sh.G; g++) {
             int open = 0;
-            for (int w = 0; w < mw; w++) open |= (f[w] & sh.gmask[(size_t)g * mw + w]) != 0;
+            for (int w = sh.gw0[g]; w <= sh.gw1[g]; w++) open |= (f[w] & sh.gmask[(size_t)g * mw + w]) != 0;
             if (!open) gu |= UINT64_C(1) << g;
         }
         sh.gumbra[r] = gu;
@@ -2352,7 +2411,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     for (size_t r = 0; r < n; r++)
         if (!sh.full[r]) idx[nlive++] = (uint32_t)r;
     const uint32_t target = (uint32_t)((nlive + cap - 1) / cap) > 1024u ? (uint32_t)((nlive + cap - 1) / cap) : 1024u;
-    nchunks = nlive ? make_chunks(&sh, idx, nlive, target, ch, cap) : 0;
+    nchunks = nlive ? make_chunks(&sh, idx, nlive, target, ch, cap, threads) : 0;
     if (nchunks < 0) goto done;
     int failed = 0;
     double t0 = omp_get_wtime();
