@@ -1327,15 +1327,19 @@ static int t_sure(const shared *sh, const float pc[3], const float h[3], const t
  * leaves its lanes to the scalar form (a packet without a shared axis, kz < 0: ms_wt_segment, its own shear
  * and t), only the t range is tested (counter samples_sure). */
 static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q, const ms_grid *g, const int8_t *kz, int i0,
-                           int jb, unsigned live, unsigned sure, int tsure, const tri_job *t, const float V[3][3], float num)
+                           int jb, unsigned live, unsigned sure, int *tsure, const tri_job *t, const float V[3][3], float num)
 {
     const int k = sh->k, gs = sh->gs;
     unsigned hit;
     int shared_axis = 1;
     const int all_sure = !(live & ~sure) && !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES));
-    if (all_sure && !tsure)
+    if (all_sure && *tsure < 0) {   /* t_sure for this receiver, once a block could use it (-1: not yet known) */
+        static const float zero3[3] = { 0.0f, 0.0f, 0.0f };
+        *tsure = tsure_on(sh) && ((sh->sw & MS_HPC_BREAK_TSURE) || t_sure(sh, q->p, zero3, t));
+    }
+    if (all_sure && !*tsure)
         for (int r = 0; r < LANES / gs; r++) shared_axis &= kz[((jb + r) * k + i0) / LANES] >= 0;
-    if (all_sure && tsure) {   /* t_sure: the t range passes too, on any axis */
+    if (all_sure && *tsure) {   /* t_sure: the t range passes too, on any axis */
         c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
         c->cnt[C_SAMPLES_TSURE] += (uint64_t)__builtin_popcount(live);
         hit = live;
@@ -1392,7 +1396,7 @@ static inline __attribute__((always_inline)) void cast_blocks(const shared *sh, 
     int32_t s = sh->slot[r];
     const uint64_t *open = open_of(sh, c, r);
     float num[2] = { 0.0f, 0.0f }, V[2][3][3];   /* per triangle at its first exact test: offset, A, B, C */
-    int tsure[2] = { 0, 0 };                      /* and t_sure for this receiver */
+    int tsure[2] = { -1, -1 };                    /* and t_sure for this receiver (-1: not yet known) */
     int have_num[2] = { 0, 0 };
     const int8_t *kz = NULL;
     const uint64_t gu0 = gu;
@@ -1424,15 +1428,13 @@ static inline __attribute__((always_inline)) void cast_blocks(const shared *sh, 
                 if (with_sure)
                     sure[u] = v->direct ? block_open(v->nsure[u], k, i0, jb, gs) : footprint_sure_lanes(E[u], ssl[u], sok[u]);
                 if (!have_num[u]) {
-                    static const float zero3[3] = { 0.0f, 0.0f, 0.0f };
-                    tsure[u] = with_sure && tsure_on(sh) && ((sh->sw & MS_HPC_BREAK_TSURE) || t_sure(sh, q->p, zero3, v->t[u]));
                     num[u] = ms_wt_offset(q->p, v->t[u]->v, v->t[u]->N);
                     for (int i = 0; i < 3; i++)
                         for (int a = 0; a < 3; a++) V[u][i][a] = v->t[u]->v[3 * i + a] - q->p[a];
                     have_num[u] = 1;
                 }
                 c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
-                hit |= block_hits(sh, c, q, g, kz, i0, jb, live, sure[u], tsure[u], v->t[u], V[u], num[u]);
+                hit |= block_hits(sh, c, q, g, kz, i0, jb, live, sure[u], &tsure[u], v->t[u], V[u], num[u]);
             }
             if (!hit) continue;
             c->cnt[C_SAMPLES_BLOCKED] += (uint64_t)__builtin_popcount(hit);
