@@ -31,11 +31,11 @@
 #define R3_SETUP_PER_TRI 200u
 /* hpc (hpc.c) per receiver: umbra bits 8, full 1, slot 4, index 4; its receiver tree (leaves of up to 16
  * points: counted as one 48-byte node per receiver) and the build's stack (16); the copies in hierarchy
- * order made beside the caller's (hpc_impl.h: original number 4, query 36, umbra bits 8, full 1, slot 4) and
- * the receivers' grid origins (16); its mask slots (mask, packet axes, for hpc-scanline a raster frame) come on
- * top, counted as if every receiver held one at once (the masks on demand's worst case: measured peaks are
- * 1.4-2.2x below). */
-#define HPC_PER_RECEIVER (8u + 1u + 4u + 4u + 48u + 16u + 4u + 36u + 8u + 1u + 4u + 16u)
+ * order made beside the caller's (hpc_impl.h: original number 4, query 36, umbra bits 8, full 1, slot 4),
+ * the receivers' grid origins (16) and the chunks' partition buffer (4, make_chunks); its mask slots (mask,
+ * packet axes, for hpc-scanline a raster frame) come on top, counted as if every receiver held one at once
+ * (the masks on demand's worst case: measured peaks are 1.4-2.2x below). */
+#define HPC_PER_RECEIVER (8u + 1u + 4u + 4u + 48u + 16u + 4u + 36u + 8u + 1u + 4u + 16u + 4u)
 #define HPC_RASTER_FRAME 112u
 /* Closed components (accel/closed.c, ms_closed_find) while they are found: the weld's hash table of a power
  * of two >= 6n vertex slots (4 bytes), corner ids 12, the directed edges grouped by first vertex (offsets at

@@ -79,7 +79,12 @@
  *    operations). The paper has no such step: every open relation of an active group is tested against its
  *    hard shadow volume (L22); here the functions the footprint already evaluated decide most of them. On the
  *    merged bars (1,322 large rectangles) 70M of 90M sample tests take it and the cast is 10% faster; only
- *    footprints over several groups take it (cast_blocks; docs/hpc.md, session 15).
+ *    footprints over several groups take it (cast_blocks; docs/hpc.md, session 15). Where the triangle lies
+ *    well between every receiver of a leaf (or the one receiver) and the light, even the t range is proven
+ *    (t_sure), and such samples are blocked without any test.
+ *  - with the leaf footprint, the samples it leaves are tested for the leaf's receivers in the lanes, one
+ *    sample for 16 receivers per operation (below, "the leaf's receivers in the lanes"), instead of being
+ *    handed to each receiver's groups and blocks: the paper's leaf handles its points one by one (L56-L75).
  *  - the triangles are ctx->bvh's: with the light's occluders (hpc_method.c), those of closed components
  *    facing away from the whole light are left out (docs/culling.md proves it changes no V or S), and
  *    axis-aligned coplanar rectangles are merged (accel/coplanar.h: the same points; ties on their outer
