@@ -11,8 +11,9 @@
  * num: (v - origin) . N per ray (ms_wt_offset). The rays of bits that the triangle blocks within [near, far];
  * *edge0: those with an edge function exactly 0, which the caller redoes in double as raytrace does (rare).
  * Shared by mft's packets and groups (mft_impl.h, mft_group_impl.h) and hpc's 16-sample test (hpc_impl.h). */
-static inline unsigned ms_wt_rays16(const l16 A[3][3], l16 sx, l16 sy, const l16 d[3], const float N[3], l16 num,
-                                    float near, float far, unsigned bits, unsigned *edge0)
+/* The sheared vertices' three edge functions U, V, W (ray_triangle.h's ms_wt_edge of the sheared pairs) and which
+ * rays have one exactly 0 (*zero) or strictly mixed signs (*mixed); A, sx, sy as below. */
+static inline void ms_wt_edges16(const l16 A[3][3], l16 sx, l16 sy, l16 uvw[3], unsigned *zero, unsigned *mixed)
 {
     const l16 ax = l16_sub(A[0][0], l16_mul(sx, A[0][2])), ay = l16_sub(A[0][1], l16_mul(sy, A[0][2]));
     const l16 bx = l16_sub(A[1][0], l16_mul(sx, A[1][2])), by = l16_sub(A[1][1], l16_mul(sy, A[1][2]));
@@ -20,10 +21,20 @@ static inline unsigned ms_wt_rays16(const l16 A[3][3], l16 sx, l16 sy, const l16
     const l16 u = l16_sub(l16_mul(cx, by), l16_mul(cy, bx));
     const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
     const l16 w = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
+    const l16 z0 = l16_set1(0.0f);
+    *zero = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(w)), z0);
+    *mixed = l16_lt(l16_min(l16_min(u, v), w), z0) & l16_gt(l16_max(l16_max(u, v), w), z0);
+    uvw[0] = u; uvw[1] = v; uvw[2] = w;
+}
+
+static inline unsigned ms_wt_rays16(const l16 A[3][3], l16 sx, l16 sy, const l16 d[3], const float N[3], l16 num,
+                                    float near, float far, unsigned bits, unsigned *edge0)
+{
+    l16 uvw[3];
+    unsigned z, mixed;
+    ms_wt_edges16(A, sx, sy, uvw, &z, &mixed);
     const l16 zero = l16_set1(0.0f);
-    const unsigned z = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(w)), zero);
-    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), w), zero) & l16_gt(l16_max(l16_max(u, v), w), zero);
-    const l16 det = l16_add(l16_add(u, v), w);
+    const l16 det = l16_add(l16_add(uvw[0], uvw[1]), uvw[2]);
     const l16 den = l16_add(l16_add(l16_mul(d[0], l16_set1(N[0])), l16_mul(d[1], l16_set1(N[1]))), l16_mul(d[2], l16_set1(N[2])));
     const l16 ns = l16_select(l16_lt(den, zero), l16_sub(zero, num), num), aden = l16_abs(den);
     *edge0 = bits & z;
@@ -72,15 +83,10 @@ static inline unsigned ms_wt_rays16_own(const l16 A[3][3], const l16 d[3], const
         zv[v] = l16_mul(sz, P[v][2]);
     }
 #undef MS_SEL3
-    const l16 ax = l16_sub(P[0][0], l16_mul(sx, P[0][2])), ay = l16_sub(P[0][1], l16_mul(sy, P[0][2]));
-    const l16 bx = l16_sub(P[1][0], l16_mul(sx, P[1][2])), by = l16_sub(P[1][1], l16_mul(sy, P[1][2]));
-    const l16 cx = l16_sub(P[2][0], l16_mul(sx, P[2][2])), cy = l16_sub(P[2][1], l16_mul(sy, P[2][2]));
-    const l16 u = l16_sub(l16_mul(cx, by), l16_mul(cy, bx));
-    const l16 v = l16_sub(l16_mul(ax, cy), l16_mul(ay, cx));
-    const l16 w = l16_sub(l16_mul(bx, ay), l16_mul(by, ax));
-    const unsigned ez = l16_le(l16_min(l16_min(l16_abs(u), l16_abs(v)), l16_abs(w)), zero);
-    const unsigned mixed = l16_lt(l16_min(l16_min(u, v), w), zero) & l16_gt(l16_max(l16_max(u, v), w), zero);
-    const l16 det = l16_add(l16_add(u, v), w);
+    l16 uvw[3];
+    unsigned ez, mixed;
+    ms_wt_edges16((const l16 (*)[3])P, sx, sy, uvw, &ez, &mixed);
+    const l16 det = l16_add(l16_add(uvw[0], uvw[1]), uvw[2]);
     const l16 den = l16_add(l16_add(l16_mul(d[0], l16_set1(N[0])), l16_mul(d[1], l16_set1(N[1]))), l16_mul(d[2], l16_set1(N[2])));
     const l16 t = l16_div(num, den);
     /* ms_wt_hit_t: lo = za < zb ? (za < zc ? za : zc) : (zb < zc ? zb : zc), hi alike with >; NaN goes to lo */

@@ -823,7 +823,7 @@ static const int rect_tri[2][3] = { { 0, 1, 4 }, { 2, 3, 4 } };
 
 /* leaf_fn of the ns shapes shp for box b: the functions of all shapes in the lanes (up to 6), each lane the
  * arithmetic the comments above give (IEEE per lane, as everywhere in lanes16.h). */
-__attribute__((noinline)) static void leaf_setup(const shared *sh, const leaf_box *b, const fp_shape *shp, int ns, leaf_fn *out)
+static void leaf_setup(const shared *sh, const leaf_box *b, const fp_shape *shp, int ns, leaf_fn *out)
 {
     const int k = sh->k, gs = sh->gs;
     const float *ds = sh->grid_ds, *dt = sh->grid_dt;
@@ -919,7 +919,7 @@ __attribute__((noinline)) static void leaf_setup(const shared *sh, const leaf_bo
 
 /* The samples (bits as a mask's) a triangle (its leaf_fn) may block for some receiver of box b, in cand (mw
  * words); its groups are returned (0: the triangle blocks no sample of any of them). */
-__attribute__((noinline)) static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_fn *fn, uint64_t *cand)
+static uint64_t leaf_footprint(const shared *sh, const leaf_box *b, const leaf_fn *fn, uint64_t *cand)
 {
     const int k = sh->k, gs = sh->gs, rows = LANES / gs;
     const float (*e)[3] = fn->e, *ufix = fn->ufix, *uspan = fn->uspan;
@@ -1328,9 +1328,10 @@ static int t_sure(const shared *sh, const float pc[3], const float h[3], const t
 
 /* The lanes triangle t blocks of the 16-sample block at (i0, jb) of receiver q (live: the lanes to test), with
  * the 16-lane test or, switched off, one lane at a time; alpha-tested triangles only where opaque. sure: lanes
- * whose edge functions surely pass (footprint_sure_lanes): when they are all of live, and no row of the block
- * leaves its lanes to the scalar form (a packet without a shared axis, kz < 0: ms_wt_segment, its own shear
- * and t), only the t range is tested (counter samples_sure). */
+ * whose edge functions surely pass (footprint_sure_lanes): when they are all of live, they are blocked outright
+ * where t_sure holds for this receiver (*tsure: -1 until first asked, then 0 or 1), else, when no row of the
+ * block leaves its lanes to the own-axis form (a packet without a shared axis, kz < 0: ms_wt_segment, its own
+ * shear and t), only the t range is tested (counter samples_sure). */
 static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q, const ms_grid *g, const int8_t *kz, int i0,
                            int jb, unsigned live, unsigned sure, int *tsure, const tri_job *t, const float V[3][3], float num)
 {
@@ -1684,7 +1685,7 @@ static int leaf_lanes_ready(const shared *sh, chunk *c, leaf_lanes *L, unsigned 
  * may hold it, sure[x] those whose edge functions surely pass (footprint_sure_lanes); the triangles in turn,
  * the second only on lanes the first left open (raytrace's any hit). The lanes it blocks lose the sample.
  * 0 when out of memory. */
-__attribute__((noinline)) static int leaf_lanes_sample(const shared *sh, chunk *c, const tri_job *t, leaf_lanes *L, const int tu[2], int nx,
+static int leaf_lanes_sample(const shared *sh, chunk *c, const tri_job *t, leaf_lanes *L, const int tu[2], int nx,
                              int wd, int b, const unsigned cand[2], const unsigned sure[2])
 {
     const unsigned open = l16w_bit(L->ow, b) & (cand[0] | cand[1]);
