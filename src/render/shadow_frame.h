@@ -7,6 +7,11 @@
 #include "primary/primary.h"
 #include "shade.h"
 
+/* Moves the queries i with last[i] set after the others, with their pixels (where) and front masks (mw words
+ * each), keeping the others' order; returns how many come first. (The receivers on merged faces that go to the
+ * scene's own triangles: here and in frame_job.c's tiles.) */
+size_t ms_queries_move_last(ms_shadow_query *q, size_t *where, uint64_t *front, size_t mw, size_t n, const uint8_t *last);
+
 /* Gathers every visible pixel of hits (W x H) as a query with its front mask, calls the method once, and
  * resolves V and S with ms_resolve_vs exactly as the tiled path does (and S_spec where surf, per pixel or
  * NULL, has a specular lobe); writes vis, shadow, spec and front (W x H each) and adds to counters and the
@@ -16,11 +21,6 @@
  * the receivers on merged faces that the merge could answer otherwise (ms_merged_receiver_ok) are then
  * answered by a second call over it, as the tiled path does, and counted in on_merged. 0, or -1 out of
  * memory or when the method fails. */
-/* Moves the queries i with last[i] set after the others, with their pixels (where) and front masks (mw words
- * each), keeping the others' order; returns how many come first. (The receivers on merged faces that go to the
- * scene's own triangles: here and in frame_job.c's tiles.) */
-size_t ms_queries_move_last(ms_shadow_query *q, size_t *where, uint64_t *front, size_t mw, size_t n, const uint8_t *last);
-
 int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, void *own_state,
                           const ms_render_ctx *own_ctx, const ms_hit *hits,
                           const ms_surface *surf, int W, int H, const size_t *pixels, size_t npixels, float *vis, float *shadow, float *spec, uint16_t *front,

@@ -12,8 +12,8 @@
  * cost per pair, which bounds hpc (docs/hpc.md, session 14), is paid 30 times less often. The receivers on
  * merged faces that the merge could answer otherwise are answered over the scene's own triangles by a second
  * call (shadow_frame.c); hpc-scanline keeps the triangles as they are. A procedural scene is streamed:
- * generated batch by batch, its primary hits from the depth pass (primary_depth.c), no BVH at all, no cull. The per-tile entry runs the same
- * algorithm over the tile's points, for callers that drive methods per tile. */
+ * generated batch by batch, its primary hits from the depth pass (primary_depth.c), no BVH at all, no cull.
+ * The per-tile entry runs the same algorithm over the tile's points, for callers that drive methods per tile. */
 #include "hpc.h"
 #include "visibility/receiver.h"
 #include "visibility/occluders.h"
