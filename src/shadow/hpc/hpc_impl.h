@@ -1284,6 +1284,10 @@ typedef struct hpc_view {
  * E, D >= |xi - alpha|, E = 16 u (M + S) |N|_1 above all those errors, the computed test lies in [near, far]
  * for every lane: ms_wt_rays16's plane-distance form, and the scalar form's division clamped to the vertices'
  * depths (ms_wt_hit_t: the exact hit lies within them, the clamp moves t by rounding only). In double. */
+/* fmin and fmax are library calls without -ffast-math (as hpc_volume.c notes); the values here are finite. */
+static inline double tmin_d(double a, double b) { return a < b ? a : b; }
+static inline double tmax_d(double a, double b) { return a > b ? a : b; }
+
 static inline int tsure_on(const shared *sh) { return !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_TSURE)); }
 
 static int t_sure(const shared *sh, const float pc[3], const float h[3], const tri_job *t)
@@ -1294,32 +1298,32 @@ static int t_sure(const shared *sh, const float pc[3], const float h[3], const t
         n1 += fabs((double)N[a]);
         a0 += (double)N[a] * pc[a];
         ah += fabs((double)N[a]) * h[a];
-        hmax = fmax(hmax, h[a]);
-        pmax = fmax(pmax, fabs((double)pc[a]));
+        hmax = tmax_d(hmax, h[a]);
+        pmax = tmax_d(pmax, fabs((double)pc[a]));
     }
     double gl = INFINITY, gh = -INFINITY, xl = INFINITY, xh = -INFINITY;
     for (int v = 0; v < 3; v++) {
         double gv = 0.0, mv = 0.0;
         for (int a = 0; a < 3; a++) {
             gv += (double)N[a] * t->v[3 * v + a];
-            mv = fmax(mv, fabs((double)t->v[3 * v + a] - pc[a]));
+            mv = tmax_d(mv, fabs((double)t->v[3 * v + a] - pc[a]));
         }
-        gl = fmin(gl, gv);
-        gh = fmax(gh, gv);
-        M = fmax(M, mv + hmax);
+        gl = tmin_d(gl, gv);
+        gh = tmax_d(gh, gv);
+        M = tmax_d(M, mv + hmax);
     }
     for (int v = 0; v < 4; v++) {
         double xv = 0.0;
         for (int a = 0; a < 3; a++) {
             xv += (double)N[a] * sh->light_poly[3 * v + a];
-            lmax = fmax(lmax, fabs(sh->light_poly[3 * v + a]));
+            lmax = tmax_d(lmax, fabs(sh->light_poly[3 * v + a]));
         }
-        xl = fmin(xl, xv);
-        xh = fmax(xh, xv);
+        xl = tmin_d(xl, xv);
+        xh = tmax_d(xh, xv);
     }
     const double S = 2.0 * (lmax + pmax + hmax), E = 1.01 * 16.0 * 0x1p-24 * (M + S) * n1;
     const double al = a0 - ah, au = a0 + ah;
-    const double D = fmax(xh, au) - fmin(xl, al);
+    const double D = tmax_d(xh, au) - tmin_d(xl, al);
     const double nearm = 2.0 * (double)sh->ctx->near * D + E, farm = 2.0 * (1.0 - (double)sh->ctx->far) * D + E;
     if (au < gl && gh < xl) return gl - au >= nearm && xl - gh >= farm;   /* receivers, plane, light in order */
     if (xh < gl && gh < al) return al - gh >= nearm && gl - xh >= farm;   /* and in reverse */
