@@ -112,7 +112,8 @@ static void test_merge(void **st)
     size_t no;
     uint32_t *of, *src;
     uint8_t *merged;
-    assert_int_equal(ms_coplanar_merge(s.t, n, NULL, &out, &no, &of, &src, &merged), 0);
+    unsigned axes;
+    assert_int_equal(ms_coplanar_merge(s.t, n, NULL, -1, &out, &no, &of, &src, &merged, &axes), 0);
     /* the bar's four faces: one rectangle each (2 triangles); the caps are single pairs (unchanged); the
      * ground one rectangle; the tilted triangle */
     assert_int_equal(no, 4 * 2 + 4 + 2 + 1);
@@ -145,7 +146,7 @@ static void test_merge(void **st)
     free(out); free(of); free(src); free(merged);
     /* eligible: nothing merged where nothing may be */
     uint8_t *none = calloc(n, 1);
-    assert_int_equal(ms_coplanar_merge(s.t, n, none, &out, &no, &of, &src, &merged), 0);
+    assert_int_equal(ms_coplanar_merge(s.t, n, none, -1, &out, &no, &of, &src, &merged, &axes), 0);
     assert_int_equal(no, n);
     assert_memory_equal(out, s.t, n * 9 * sizeof(float));
     free(none); free(out); free(of); free(src); free(merged);

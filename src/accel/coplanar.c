@@ -96,17 +96,19 @@ static int as_half(const float *t, rect *h)
     return 1;
 }
 
-/* Merges sorted runs of rects (by cmp) whose extents continue each other along u (along_u) or v; writes
- * the merged ones back into r, map[i] = the merged index of r's old i; returns their number. */
-static size_t merge_runs(rect *r, size_t n, int along_u, uint32_t *map, uint32_t *order)
+/* Merges sorted runs of rects (by cmp) whose extents continue each other along u (along_u) or v, but not
+ * along the world axis no_axis (-1: any); writes the merged ones back into r, map[i] = the merged index of
+ * r's old i; returns their number and adds to *axes the world axes along which two or more were merged. */
+static size_t merge_runs(rect *r, size_t n, int along_u, int no_axis, unsigned *axes, uint32_t *map, uint32_t *order)
 {
     /* order: the original index of each sorted position (r is sorted together with it by the caller) */
     size_t m = 0;
     for (size_t i = 0; i < n;) {
         rect cur = r[i];
         map[order[i]] = (uint32_t)m;
+        const int axis = (cur.a + (along_u ? 1 : 2)) % 3;
         size_t j = i + 1;
-        for (; j < n; j++) {
+        for (; j < n && axis != no_axis; j++) {
             const rect *x = &r[j];
             const int same = x->a == cur.a && fbits(x->c) == fbits(cur.c) &&
                              (along_u ? fbits(x->v0) == fbits(cur.v0) && fbits(x->v1) == fbits(cur.v1) && fbits(x->u0) == fbits(cur.u1)
@@ -116,6 +118,7 @@ static size_t merge_runs(rect *r, size_t n, int along_u, uint32_t *map, uint32_t
             else cur.v1 = x->v1;
             map[order[j]] = (uint32_t)m;
         }
+        if (j > i + 1) *axes |= 1u << axis;
         r[m++] = cur;
         i = j;
     }
@@ -161,9 +164,10 @@ int ms_coplanar_rect_pair(const float *a, const float *b, float corners[12])
     return 1;
 }
 
-int ms_coplanar_merge(const float *tri, size_t n, const uint8_t *eligible, float **out, size_t *n_out,
-                      uint32_t **of_input, uint32_t **source, uint8_t **merged)
+int ms_coplanar_merge(const float *tri, size_t n, const uint8_t *eligible, int no_axis, float **out, size_t *n_out,
+                      uint32_t **of_input, uint32_t **source, uint8_t **merged, unsigned *merged_axes)
 {
+    *merged_axes = 0;
     *out = NULL;
     *of_input = *source = NULL;
     *merged = NULL;
@@ -206,10 +210,10 @@ int ms_coplanar_merge(const float *tri, size_t n, const uint8_t *eligible, float
     if (!final) goto done;
     for (size_t i = 0; i < nr; i++) order[i] = (uint32_t)i;
     if (sort_with(r, order, nr, cmp_rows)) { free(final); goto done; }
-    size_t m1 = merge_runs(r, nr, 1, final, order);
+    size_t m1 = merge_runs(r, nr, 1, no_axis, merged_axes, final, order);
     for (size_t i = 0; i < m1; i++) order[i] = (uint32_t)i;
     if (sort_with(r, order, m1, cmp_cols)) { free(final); goto done; }
-    const size_t m2 = merge_runs(r, m1, 0, map, order);
+    const size_t m2 = merge_runs(r, m1, 0, no_axis, merged_axes, map, order);
     for (size_t i = 0; i < nr; i++) final[i] = map[final[i]];
     /* A rectangle of one pair stays as its two triangles (its diagonal may not be the one emit draws):
      * only rectangles merged from two or more pairs change anything. pos: a merged rectangle's output. */

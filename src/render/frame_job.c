@@ -21,6 +21,7 @@
 #include "visibility/occluders.h"
 #include "frame_shade.h"
 #include "shadow_frame.h"
+#include "exact_split.h"
 #include "shade.h"
 #include "render_materialise.h"
 #include "interleave_filter.h"
@@ -52,6 +53,8 @@ struct ms_frame_job {
     void **sstate;                /* per light */
     void **own_sstate;            /* per light whose occluders merge coplanar faces: the method over the scene's
                                    * own triangles, for the receivers on merged faces (merged_last) */
+    void **axis_sstate;           /* per light and axis (3 per light), for a method with MS_OCC_MERGE_EXACT: the
+                                   * method over the light's set exact for that axis (occluders.h, for_axis) */
     void **interior_sstate;       /* per light with interior boxes, for a method with MS_OCC_INTERIOR_PASS: the
                                    * method over the boxes' triangles, run before the scene's */
     ms_occluders *occ;            /* per light: its occluders (sm->occluders, occluder_what), else NULL */
@@ -122,6 +125,9 @@ void ms_frame_job_free(ms_frame_job *j)
     for (size_t l = 0; j->own_sstate && l < j->nlights; l++)
         if (j->own_sstate[l]) j->sm->destroy(j->own_sstate[l]);
     free(j->own_sstate);
+    for (size_t l = 0; j->axis_sstate && l < 3 * j->nlights; l++)
+        if (j->axis_sstate[l]) j->sm->destroy(j->axis_sstate[l]);
+    free(j->axis_sstate);
     for (size_t l = 0; j->interior_sstate && l < j->nlights; l++)
         if (j->interior_sstate[l]) j->sm->destroy(j->interior_sstate[l]);
     free(j->interior_sstate);
@@ -174,6 +180,37 @@ static void light_own_ctx(const ms_frame_job *j, size_t l, ms_render_ctx *c)
     c->alpha = j->alpha;
     c->prim_map = NULL;
     c->prim_merged = NULL;
+}
+
+/* Light l's context over its set exact for segments sheared along axis a (occluders.h, for_axis). */
+static void light_axis_ctx(const ms_frame_job *j, size_t l, int a, ms_render_ctx *c)
+{
+    const ms_occluders *s = j->occ[l].for_axis[a];
+    light_ctx(j, l, c);
+    c->bvh = &s->bvh;
+    c->alpha = s->alpha;
+    c->prim_map = s->prim_map;
+    c->prim_merged = NULL;
+}
+
+/* Light l's split of the samples among its exact sets (exact_split.h): the axes its merge is not exact for,
+ * each with the state over its set exact for it, or over the scene's own triangles. axes 0: no split (a
+ * method that need not equal raytrace, or nothing merged). */
+static void light_split(const ms_frame_job *j, size_t l, ms_exact_split *sp)
+{
+    memset(sp, 0, sizeof *sp);
+    if (!(j->sm->occluders & MS_OCC_MERGE_EXACT) || !j->occ || !j->occ[l].active) return;
+    sp->axes = j->occ[l].merged_axes;
+    for (int a = 0; a < 3; a++) {
+        if (!(sp->axes >> a & 1u)) continue;
+        ms_render_ctx c;
+        if (j->occ[l].for_axis[a]) light_axis_ctx(j, l, a, &c);
+        else light_own_ctx(j, l, &c);
+        sp->state[a] = j->occ[l].for_axis[a] ? j->axis_sstate[3 * l + (size_t)a] : j->own_sstate[l];
+        sp->bvh[a] = c.bvh;
+        sp->alpha[a] = c.alpha;
+        sp->prim_map[a] = c.prim_map;
+    }
 }
 
 /* Light l's context over its interior boxes alone, for a method that takes them as occluders of its own
@@ -422,6 +459,7 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
     j->traced = calloc((size_t)j->ntiles, 1);
     j->sstate = calloc(nl, sizeof *j->sstate);
     j->own_sstate = calloc(nl, sizeof *j->own_sstate);
+    j->axis_sstate = calloc(3 * nl, sizeof *j->axis_sstate);
     j->interior_sstate = calloc(nl, sizeof *j->interior_sstate);
     ms_frame *f = &j->frame;
     f->vis = malloc(nl * npix * sizeof(float));
@@ -430,7 +468,7 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
     f->front = calloc(nl * npix, sizeof *f->front);
     f->rgb = malloc(npix * 3 * sizeof(float));
     f->n_lights = (int)nl;
-    if (!j->hits || !j->traced || !j->sstate || !j->own_sstate || !j->interior_sstate || !f->vis || !f->shadow || !f->shadow_spec || !f->front || !f->rgb) {
+    if (!j->hits || !j->traced || !j->sstate || !j->own_sstate || !j->axis_sstate || !j->interior_sstate || !f->vis || !f->shadow || !f->shadow_spec || !f->front || !f->rgb) {
         snprintf(err, errlen, "out of memory for a %dx%d frame", W, H);
         rc = MS_ERR_NO_MEMORY;
         goto fail;
@@ -464,6 +502,12 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
         if (lc.prim_merged) {
             light_own_ctx(j, l, &lc);
             if (sm->create(&lc, &j->own_sstate[l], err, errlen)) { j->own_sstate[l] = NULL; rc = MS_ERR_METHOD; goto fail; }
+        }
+        for (int a = 0; a < 3 && (sm->occluders & MS_OCC_MERGE_EXACT) && j->occ && j->occ[l].active; a++) {
+            if (!j->occ[l].for_axis[a]) continue;
+            light_axis_ctx(j, l, a, &lc);
+            void **st = &j->axis_sstate[3 * l + (size_t)a];
+            if (sm->create(&lc, st, err, errlen)) { *st = NULL; rc = MS_ERR_METHOD; goto fail; }
         }
         light_ctx(j, l, &lc);
         if ((sm->occluders & MS_OCC_INTERIOR_PASS) && lc.interior) {
@@ -595,6 +639,16 @@ static int merged_last(const ms_render_ctx *ctx, const ms_bvh *b, const ms_hit *
     return (int)ms_queries_move_last(q, where, front, mw, (size_t)nq, last);
 }
 
+/* The method's visible masks for a tile's queries (method.h, visibility), each sample on a set exact for it
+ * when the light's merge asks for the split (exact_split.h). */
+static int visibility_of(const ms_shadow_method *sm, void *state, const ms_render_ctx *ctx, const ms_exact_split *split,
+                         const ms_shadow_query *q, const uint32_t *scene_prim, int n, const uint64_t *front, uint64_t *vis,
+                         uint64_t *counters)
+{
+    if (!split->axes) return sm->visibility(state, ctx, q, n, front, vis, counters);
+    return ms_exact_split_visibility(sm, state, ctx, split, q, scene_prim, (size_t)n, front, vis, 0, 1, counters);
+}
+
 /* The shadow phase of light l over tiles[0..n) (tiles == NULL: 0..n-1; whole: the frame's first and only
  * call): front masks, the method's visible masks, V, S and S_spec into light l's planes, over 16x16 tiles
  * (or the method's frame-level entry). Adds to p. 0, or -1 out of memory or when the method fails. */
@@ -635,6 +689,11 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
     ms_render_ctx bctx = ctx;   /* the batch's context: each query's light its outline */
     bctx.outline_per_query = 1;
     const int shadow_tiles = sm->visibility_all && !outlined ? 0 : n;   /* a frame-level method: shadow_frame.c */
+    /* The samples of the axes the merged set is not exact for go to the sets that are (exact_split.h); not for
+     * a batch of outlined lights (the micro-rasterization methods, which do not equal raytrace anyway). */
+    ms_exact_split split;
+    light_split(j, l, &split);
+    if (batched) split.axes = 0;
 #pragma omp parallel num_threads(j->threads)
     {
         uint64_t local[MS_MAX_COUNTERS] = { 0 };
@@ -680,6 +739,8 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                     where[nq++] = i;
                 }
             const int nm = ctx.prim_merged && ok ? merged_last(&ctx, &j->bvh, hits, (const float (*)[3])hull, n_hull, q, where, front, mw, nq, mpts) : nq;
+            uint32_t scene_prim[TILE * TILE];   /* the receivers' hit triangles, for the exact split */
+            for (int i = 0; i < nm && split.axes; i++) scene_prim[i] = hits[where[i]].prim;
             if (!outlined && interior_state && nm && ok) {
                 /* The interior boxes first (no receiver on them: no prim to skip), then the triangles
                  * with the samples they left. */
@@ -687,13 +748,13 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
                 for (int i = 0; i < nm; i++) { prim[i] = q[i].prim; q[i].prim = UINT32_MAX; }
                 if (sm->visibility(interior_state, &ictx, q, nm, front, imask, local)) ok = 0;
                 for (int i = 0; i < nm; i++) q[i].prim = prim[i];
-                if (ok && sm->visibility(sstate, &ctx, q, nm, imask, vmask, local)) ok = 0;
+                if (ok && visibility_of(sm, sstate, &ctx, &split, q, scene_prim, nm, imask, vmask, local)) ok = 0;
             } else if (!outlined || batched) {
-                if (nm && ok && sm->visibility(sstate, batched ? &bctx : &ctx, q, nm, front, vmask, local)) ok = 0;
+                if (nm && ok && visibility_of(sm, sstate, batched ? &bctx : &ctx, &split, q, scene_prim, nm, front, vmask, local)) ok = 0;
             } else
                 for (int i = 0; i < nm && ok; i++) {
                     shape->outline(&ctx.light, q[i].p, &qc.light);
-                    if (sm->visibility(sstate, &qc, &q[i], 1, front + (size_t)i * mw, vmask + (size_t)i * mw, local)) ok = 0;
+                    if (visibility_of(sm, sstate, &qc, &split, &q[i], scene_prim + i, 1, front + (size_t)i * mw, vmask + (size_t)i * mw, local)) ok = 0;
                 }
             /* Receivers on merged faces that the merge could answer otherwise: the same method over the
              * scene's own triangles (was: the reference tracer, 19% of the grid of bars' shadow time). */
@@ -758,7 +819,7 @@ static int shadow_pass(ms_frame_job *j, size_t l, const int *tiles, int n, int w
         ms_render_ctx own_ctx;
         light_own_ctx(j, l, &own_ctx);
         if (!failed)
-            failed = ms_shadow_frame_whole(sm, sstate, &ctx, own_state, &own_ctx, hits, surf, W, j->H, pixels, np, vis,
+            failed = ms_shadow_frame_whole(sm, sstate, &ctx, &split, own_state, &own_ctx, hits, surf, W, j->H, pixels, np, vis,
                                            shadow, spec, fr, p->counters, &visible, &penumbra, &segments, &on_merged,
                                            &resolve_thread_s) != 0;
         free(pixels);

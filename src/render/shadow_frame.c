@@ -39,7 +39,7 @@ size_t ms_queries_move_last(ms_shadow_query *q, size_t *where, uint64_t *front, 
     return w;
 }
 
-int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, void *own_state,
+int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_render_ctx *ctx, const ms_exact_split *split, void *own_state,
                           const ms_render_ctx *own_ctx, const ms_hit *hits,
                           const ms_surface *surf, int W, int H, const size_t *pixels, size_t npixels, float *vis_out, float *shadow_out, float *spec_out,
                           uint16_t *front_out, uint64_t *counters, uint64_t *visible, uint64_t *penumbra,
@@ -96,7 +96,15 @@ int ms_shadow_frame_whole(const ms_shadow_method *sm, void *sstate, const ms_ren
      * scene's own triangles (own_state), named there by their own prims. */
     const size_t n_main = own ? ms_queries_move_last(q, where, front, mw, n, own) : n;
     for (size_t i = n_main; i < n; i++) q[i].prim = hits[where[i]].prim;
-    if (sm->visibility_all(sstate, ctx, q, n_main, front, vis, counters)) goto done;
+    if (split->axes) {   /* each sample on a set exact for its segment's shear axis (exact_split.h) */
+        uint32_t *prim = malloc((n_main ? n_main : 1) * sizeof *prim);
+        if (!prim) goto done;
+        for (size_t i = 0; i < n_main; i++) prim[i] = hits[where[i]].prim;
+        const int r = ms_exact_split_visibility(sm, sstate, ctx, split, q, prim, n_main, front, vis, 1, ctx->threads, counters);
+        free(prim);
+        if (r) goto done;
+    } else if (sm->visibility_all(sstate, ctx, q, n_main, front, vis, counters))
+        goto done;
     if (n > n_main && sm->visibility_all(own_state, own_ctx, q + n_main, n - n_main, front + n_main * mw,
                                          vis + n_main * mw, counters))
         goto done;

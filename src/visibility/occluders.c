@@ -40,6 +40,8 @@ int ms_light_hull(const ms_light *l, float pts[8][3], float box[6])
 
 void ms_occluders_free(ms_occluders *o)
 {
+    for (int a = 0; a < 3; a++)
+        if (o->for_axis[a]) { ms_occluders_free(o->for_axis[a]); free(o->for_axis[a]); }
     ms_bvh_free(&o->bvh);
     ms_alpha_free(o->alpha);
     free(o->prim_map);
@@ -137,7 +139,7 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
 /* The triangles kept by the cull (keep NULL: all), with coplanar rectangles merged when `merge` (alpha-tested
  * triangles left alone), into o->bvh, o->alpha, o->prim_map; o->active = 0 when that changes nothing. */
 static int set_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const uint8_t *keep, size_t culled,
-                     int merge, const struct ms_alpha *scene_alpha, int threads)
+                     int merge, int no_axis, const struct ms_alpha *scene_alpha, int threads)
 {
     const size_t n = scene->n_tris;
     if (culled == n || (!culled && !merge)) return 0;   /* all culled: only degenerate inputs; keep it simple */
@@ -161,7 +163,7 @@ static int set_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene
     size_t nb = nk;
     const float *btri = tri;
     if (merge) {
-        if (ms_coplanar_merge(tri, nk, opaque, &mtri, &nb, &of_kept, &msrc, &mflag)) goto done;
+        if (ms_coplanar_merge(tri, nk, opaque, no_axis, &mtri, &nb, &of_kept, &msrc, &mflag, &o->merged_axes)) goto done;
         if (!culled && nb == nk) { rc = 0; goto done; }   /* nothing merged, nothing culled */
         btri = mtri;
         o->merged = nk - nb;
@@ -214,9 +216,26 @@ done:
         o->prim_map = NULL;
         o->prim_merged = NULL;
         o->merged = o->culled = 0;
+        o->merged_axes = 0;
         o->active = 0;
     }
     return rc;
+}
+
+/* The sets exact for the axes along which o merged (occluders.h, for_axis): the same cull, no merge along that
+ * axis; their receivers on merged faces join o's. */
+static int axis_sets_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene_bvh, const uint8_t *keep,
+                           size_t culled, const struct ms_alpha *scene_alpha, int threads)
+{
+    for (int a = 0; a < 3; a++) {
+        if (!(o->merged_axes >> a & 1u)) continue;
+        ms_occluders *s = calloc(1, sizeof *s);
+        if (!s || set_build(s, scene, scene_bvh, keep, culled, 1, a, scene_alpha, threads)) { free(s); return -1; }
+        if (!s->active) { free(s); continue; }   /* nothing culled or merged: the scene's own triangles serve */
+        for (uint32_t i = 0; s->prim_merged && i < scene_bvh->n_tris; i++) o->prim_merged[i] |= s->prim_merged[i];
+        o->for_axis[a] = s;
+    }
+    return 0;
 }
 
 /* The cull's keep flags (docs/culling.md); returns the triangles culled (0 with *keep NULL when nothing). */
@@ -281,7 +300,9 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
         free(porous);
     }
     if (!rc && (culled || (what & MS_OCC_MERGE)))
-        rc = set_build(o, scene, scene_bvh, keep, culled, (what & MS_OCC_MERGE) != 0, scene_alpha, threads);
+        rc = set_build(o, scene, scene_bvh, keep, culled, (what & MS_OCC_MERGE) != 0, -1, scene_alpha, threads);
+    if (!rc && (what & MS_OCC_MERGE_EXACT) && o->merged_axes)
+        rc = axis_sets_build(o, scene, scene_bvh, keep, culled, scene_alpha, threads);
     free(keep);
     free(boxed);
     if (rc) ms_occluders_free(o);

@@ -35,6 +35,12 @@ typedef struct ms_occluders {
     size_t merged;              /* triangles saved by merging coplanar rectangles (accel/coplanar.h) */
     uint8_t *prim_merged;       /* per prim of the scene's BVH: 1 when its triangle is part of a merged face,
                                  * whose receivers are answered on the scene's own triangles; NULL: none */
+    unsigned merged_axes;       /* bit a: rectangles were merged along axis a, so a segment whose watertight test
+                                 * shears along a may be decided otherwise than on the scene's own triangles
+                                 * (accel/coplanar.h); a segment sheared along any other axis never is */
+    struct ms_occluders *for_axis[3];   /* with MS_OCC_MERGE_EXACT, per bit of merged_axes: the same cull, merged
+                                 * along every axis but a, for the segments sheared along a; NULL: the scene's
+                                 * own triangles serve them. Its receivers on merged faces are in prim_merged */
     int active;                 /* 0: nothing culled, use the scene's BVH (the fields above empty) */
     ms_bvh interior;            /* the interior boxes' triangles (n_tris 0: none) */
     size_t interior_boxes;
@@ -48,8 +54,11 @@ typedef struct ms_occluders {
 /* What a light's occluders are built with (ms_shadow_method.occluders). MS_OCC_INTERIOR_PASS (with
  * MS_OCC_INTERIOR): a method that does not rasterize the interior boxes itself is run by the frame's driver
  * over them first (a second state whose BVH is the boxes' triangles), then over the scene's triangles with
- * the samples the boxes left (frame_job.c). */
-enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4, MS_OCC_MERGE = 8, MS_OCC_INTERIOR_PASS = 16 };
+ * the samples the boxes left (frame_job.c).
+ * MS_OCC_MERGE_EXACT (with MS_OCC_MERGE): the method must answer as raytrace does (mft, hpc), so the driver
+ * gives each sample to the set exact for its segment's shear axis (for_axis; frame_job.c, shadow_frame.c). */
+enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4, MS_OCC_MERGE = 8, MS_OCC_INTERIOR_PASS = 16,
+       MS_OCC_MERGE_EXACT = 32 };
 
 /* The occluders of light l (every shape: its hull is its parallelogram, or a sphere's box) for the scene
  * whose BVH is `scene_bvh` and closed components `closed` (found over scene->tri), with alpha-tested

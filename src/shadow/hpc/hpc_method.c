@@ -169,7 +169,7 @@ static void hpc_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
 
 const ms_shadow_method ms_shadow_hpc = {
     .name = "hpc", .primary = "bvh", .needs_grid = 1, .streams = 1,
-    .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_MERGE,
+    .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_MERGE | MS_OCC_MERGE_EXACT,
     .n_counters = HPC_N_COUNTERS,
     .counter_names = HPC_COUNTER_NAMES,
     .create = hpc_create, .visibility = hpc_tile, .visibility_all = hpc_all, .split_exact = 1, .destroy = hpc_destroy,

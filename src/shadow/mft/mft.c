@@ -558,7 +558,7 @@ const ms_shadow_method ms_shadow_mft = {
     .needs_grid = 0,
     /* the closed cull by default since its interior boxes (session 11, docs/culling.md): ogre and bars 1.24x,
      * the rest within 4% */
-    .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS | MS_OCC_MERGE,
+    .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS | MS_OCC_MERGE | MS_OCC_MERGE_EXACT,
     .n_counters = MS_MFT_COUNTERS,
     .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",
                        "leaf_frusta_culled", "tri_frustum_pairs", "culled_horizon", "culled_plane", "culled_corner_rays",
