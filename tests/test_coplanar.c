@@ -10,6 +10,11 @@
  * counted; which of them need it, per sample, against the crossing worked out in the test). */
 #include "testutil.h"
 #include "accel/coplanar.h"
+#include "accel/ray_triangle.h"
+#include "accel/bvh.h"
+#include "light/light_frame.h"
+#include "visibility/receiver.h"
+#include "render/exact_split.h"
 #include "visibility/occluders.h"
 #include "visibility/context.h"
 #include <math.h>
@@ -203,9 +208,10 @@ static void test_merged_frames(void **st)
     int shadowed = 0;
     for (int i = 0; i < np; i++) shadowed += vr[i] >= 0 && vr[i] < 1;
     assert_true(shadowed > np / 10);
-    /* scanline through the micro-raster path's tiles, hpc through the frame-level entry (shadow_frame.c) */
-    static const char *const methods[] = { "scanline", "hpc" };
-    for (int mi = 0; mi < 2; mi++) {
+    /* scanline through the micro-raster path's tiles, mft through them with the exact split, hpc through the
+     * frame-level entry (shadow_frame.c) */
+    static const char *const methods[] = { "scanline", "mft", "hpc" };
+    for (int mi = 0; mi < 3; mi++) {
         ms_stats sm, sn;
         float *vm = vis_of(&sc, methods[mi], 0, &sm), *vn = vis_of(&sc, methods[mi], 1, &sn);
         assert_true(sm.occluders_merged > 0);
@@ -219,12 +225,150 @@ static void test_merged_frames(void **st)
         /* the tie tolerance of the method tests: at most a sample, on under 1% of the pixels */
         assert_true(dm <= 1.0 && pm <= np / 100);
         assert_true(dn <= 1.0 && pn <= np / 100);
-        /* hpc's per-sample test is raytrace's (docs/hpc.md): on the scene's own triangles, bit for bit */
-        if (!strcmp(methods[mi], "hpc")) assert_int_equal(pn, 0);
+        /* mft's and hpc's per-sample test is raytrace's (docs/hpc.md): on the scene's own triangles bit for bit,
+         * and on the merged ones too, each sample on a set exact for its shear axis (render/exact_split.c) */
+        if (strcmp(methods[mi], "scanline")) {
+            assert_int_equal(pn, 0);
+            assert_int_equal(pm, 0);
+        }
         free(vm);
         free(vn);
     }
     free(vr);
+    ms_scene_free(&sc);
+}
+
+/* 1 when the segment o -> o + d meets one of the n triangles tri (9 floats each) under the watertight test with
+ * shear axis kz (ms_wt_segment_sheared, the shear sx = d[kx] / d[kz] as the methods form it). */
+static int meets(const float *tri, size_t n, const float o[3], const float d[3], int kz)
+{
+    const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+    const float inv = 1.0f / d[kz], sx = d[kx] * inv, sy = d[ky] * inv;
+    for (size_t t = 0; t < n; t++) {
+        const float *v = tri + 9 * t;
+        float A[3], B[3], C[3], N[3];
+        for (int a = 0; a < 3; a++) { A[a] = v[a] - o[a]; B[a] = v[3 + a] - o[a]; C[a] = v[6 + a] - o[a]; }
+        ms_wt_normal(v, N);
+        if (ms_wt_segment_sheared(A, B, C, kz, sx, sy, d, N, ms_wt_offset(o, v, N), 1e-4f, 1.0f)) return 1;
+    }
+    return 0;
+}
+
+/* The claim coplanar.h rests the exact split on: a strip of pieces along x in the plane y = c, merged into one
+ * rectangle, is decided by the watertight test exactly as its pieces for every segment sheared along y (the
+ * plane's axis) or z (the axis it was not merged along), and only along x may the merged side, a chord of the
+ * pieces' rounded polyline, decide otherwise. Segments from random origins to points within ulps of the strip's
+ * long sides (where the two could differ) and its cross seams, each tested with all three axes that keep the
+ * shear bounded. */
+static void test_merged_axes_exact(void **st)
+{
+    (void)st;
+    soup s = { 0 };
+    const float c = 1.37f, z0 = -0.213f, z1 = 0.171f;
+    float x[18];
+    for (int i = 0; i < 18; i++) x[i] = -2.9f + 0.3413f * (float)i + 0.0007f * (float)(i * i % 5);
+    for (int i = 0; i < 17; i++) {
+        const float a[3] = { x[i], c, z0 }, b[3] = { x[i + 1], c, z0 }, e[3] = { x[i + 1], c, z1 }, f[3] = { x[i], c, z1 };
+        add(&s, a, b, e);
+        add(&s, a, e, f);
+    }
+    float *out;
+    size_t no;
+    uint32_t *of, *src;
+    uint8_t *merged;
+    unsigned axes;
+    assert_int_equal(ms_coplanar_merge(s.t, s.n, NULL, -1, &out, &no, &of, &src, &merged, &axes), 0);
+    assert_int_equal(no, 2);
+    assert_int_equal(axes, 1u);   /* merged along x only */
+    unsigned rng = 7;
+    long tested[3] = { 0 }, differ_axis[3] = { 0 };
+    for (int r = 0; r < 400000; r++) {
+        /* an origin below, off to a side, far enough in x that x may be the segment's largest axis */
+        const float o[3] = { (float)(urand(&rng) * 16.0 - 8.0), c - 0.2f - (float)(urand(&rng) * 2.0),
+                             (float)(urand(&rng) * 3.0 - 1.5) };
+        /* a target on a long side, a hair off it, or on a cross seam */
+        const int kind = (int)(urand(&rng) * 3.0);
+        float tx = (float)(urand(&rng) * 5.6 - 2.8), tz = kind == 0 ? z0 : kind == 1 ? z1 : (float)(urand(&rng) * 0.38 - 0.21);
+        if (kind == 2) tx = x[1 + (int)(urand(&rng) * 15.0)];
+        else tz = nextafterf(tz, (urand(&rng) < 0.5 ? -1.0f : 1.0f) * 10.0f);
+        const float e = (float)(urand(&rng) * 1e-6);
+        const float tgt[3] = { tx + e, c, tz - e };
+        float d[3];
+        for (int a = 0; a < 3; a++) d[a] = 2.0f * (tgt[a] - o[a]);   /* the plane at half the segment */
+        const float m = fmaxf(fabsf(d[0]), fmaxf(fabsf(d[1]), fabsf(d[2])));
+        for (int kz = 0; kz < 3; kz++) {
+            if (!(2.0f * fabsf(d[kz]) >= m)) continue;   /* the packet rule's bound on the shear */
+            tested[kz]++;
+            differ_axis[kz] += meets(s.t, s.n, o, d, kz) != meets(out, no, o, d, kz);
+        }
+    }
+    print_message("segments decided otherwise by the merged strip: %ld of %ld sheared along x, %ld of %ld along y, "
+                  "%ld of %ld along z\n", differ_axis[0], tested[0], differ_axis[1], tested[1], differ_axis[2], tested[2]);
+    assert_true(tested[0] > 10000 && tested[1] > 10000 && tested[2] > 10000);
+    assert_int_equal(differ_axis[1], 0);
+    assert_int_equal(differ_axis[2], 0);
+    assert_true(differ_axis[0] > 0);   /* the ties exist, and this test finds them */
+    free(out); free(of); free(src); free(merged);
+    free(s.t);
+}
+
+/* ms_receiver_axes, which proves most receivers' and packets' shear axes from the light's hull, against the rule
+ * itself on every sample point (ms_pattern_points, ms_segment_axes): receivers all around a level and a tilted
+ * light, near and far, on the grid and the stratified pattern, 256 and 1024 samples. */
+static void test_receiver_axes(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    tu_make_quad(&sc);
+    ms_bvh bvh;
+    assert_int_equal(ms_bvh_build(&bvh, sc.tri, sc.n_tris, 1), 0);
+    static const ms_light lights[2] = {
+        { { -1.5f, 4, -1.5f }, { 3, 0, 0 }, { 0, 0, 3 }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 },
+        { { -1.0f, 3, -0.5f }, { 2.2f, 1.3f, 0.4f }, { -0.3f, 0.9f, 2.1f }, { 1, 1, 1 }, MS_LIGHT_RECT, NULL, 0, 0, { 0, 0, 0 }, 0 },
+    };
+    unsigned rng = 11;
+    long receivers = 0, mixed = 0;
+    for (int li = 0; li < 2; li++)
+        for (int k = 16; k <= 32; k += 16)
+            for (int pat = 0; pat < 2; pat++) {
+                ms_render_ctx ctx;
+                tu_ctx_init(&ctx, &sc, &bvh, 64, 64, k);
+                if (pat) tu_ctx_set_pattern(&ctx, MS_PATTERN_STRATIFIED);
+                ctx.light = lights[li];
+                const int mw = ctx.mask_words, pref = ms_light_shear_axis(&ctx.light);
+                float hull[8][3], box[6], *pts = malloc((size_t)ctx.samples * 3 * sizeof *pts);
+                uint64_t fast[3 * 16], brute[3 * 16];
+                assert_non_null(pts);
+                const int n_hull = ms_light_hull(&ctx.light, hull, box);
+                for (int r = 0; r < 3000; r++) {
+                    ms_shadow_query q = { 0 };
+                    const double reach = r % 3 == 0 ? 2.0 : r % 3 == 1 ? 8.0 : 30.0;
+                    for (int a = 0; a < 3; a++) q.p[a] = (float)((urand(&rng) * 2.0 - 1.0) * reach);
+                    q.px = (uint32_t)(urand(&rng) * 4096.0);
+                    q.py = (uint32_t)(urand(&rng) * 4096.0);
+                    ms_receiver_axes(&ctx, &q, (const float (*)[3])hull, n_hull, pref, pts, fast);
+                    ms_pattern_points(ctx.pattern, &ctx.light, ctx.k, q.px, q.py, ctx.seed, pts);
+                    memset(brute, 0, sizeof brute);
+                    ms_segment_axes(q.p, pts, 0, ctx.samples, pref, mw, brute);
+                    int used = 0;
+                    for (int a = 0; a < 3; a++) {
+                        uint64_t any = 0;
+                        for (int w = 0; w < mw; w++) {
+                            const uint64_t valid = ctx.samples - 64 * w >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << (ctx.samples - 64 * w)) - 1;
+                            assert_true((fast[a * mw + w] & valid) == brute[a * mw + w]);
+                            any |= brute[a * mw + w];
+                        }
+                        used += any != 0;
+                    }
+                    receivers++;
+                    mixed += used > 1;
+                }
+                free(pts);
+            }
+    print_message("ms_receiver_axes equals the rule on all %ld receivers, %ld of them with segments on more than one "
+                  "axis\n", receivers, mixed);
+    assert_true(mixed > receivers / 20);
+    ms_bvh_free(&bvh);
     ms_scene_free(&sc);
 }
 
@@ -317,6 +461,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_merge),
         cmocka_unit_test(test_merged_frames),
+        cmocka_unit_test(test_merged_axes_exact),
+        cmocka_unit_test(test_receiver_axes),
         cmocka_unit_test(test_receiver_ok_samples),
         cmocka_unit_test(test_rect_pair),
     };

@@ -12,6 +12,7 @@
 #include "accel/bvh.h"
 #include "accel/ray_triangle.h"
 #include "light/pattern.h"
+#include "light/light_frame.h"
 #include "shadow/microraster/block_traverse.h"
 #include "shadow/mft/mft.h"
 #include <math.h>
@@ -401,10 +402,11 @@ static void test_interleaved_scattered_blocks(void **state)
             ms_shadow_query *Q = &q[16 * b + s];
             float len = 0.0f;
             for (int a = 0; a < 3; a++) {
-                /* low over the ground (y up): even slots among the occluders, odd ones anywhere out to the
-                 * sides (their rays' largest axis horizontal) */
+                /* low over the ground (y up): even slots among the occluders, odd ones anywhere out to three
+                 * times the scene's width (their rays' largest axis horizontal, and more than twice the
+                 * vertical for the farthest: the light's own axis y no longer serves, ms_wt_packet_axis) */
                 const float u = (float)(tu_rng_next(&rng) % 10000) / 10000.0f;
-                Q->p[a] = lo[a] + (hi[a] - lo[a]) * (a == 1 ? 0.15f * u : s & 1 ? u : 0.3f + 0.4f * u);
+                Q->p[a] = lo[a] + (hi[a] - lo[a]) * (a == 1 ? 0.15f * u : s & 1 ? 6.0f * u - 2.5f : 0.3f + 0.4f * u);
                 Q->n[a] = (float)(tu_rng_next(&rng) % 2001) / 1000.0f - 1.0f;
                 len += Q->n[a] * Q->n[a];
             }
@@ -420,7 +422,7 @@ static void test_interleaved_scattered_blocks(void **state)
             for (int j = 0; j < 16; j++) {
                 dx[j] = pts[3 * j] - Q->p[0]; dy[j] = pts[3 * j + 1] - Q->p[1]; dz[j] = pts[3 * j + 2] - Q->p[2];
             }
-            const int kz = ms_wt_packet_axis(dx, dy, dz, 16, NULL);
+            const int kz = ms_wt_packet_axis(dx, dy, dz, 16, ms_light_shear_axis(&ctx.light), NULL);
             if (front[(size_t)(16 * b + s) * mw]) axes |= 1 << (kz + 1);
             const int nf = __builtin_popcountll(front[(size_t)(16 * b + s) * mw]);
             const int nv = __builtin_popcountll(ref[(size_t)(16 * b + s) * mw]);

@@ -167,21 +167,28 @@ static inline int ms_wt_intersect(const ms_wt_ray *r, const float tri[9], const 
 /* The shear axis one packet of n rays shares (raytrace, mft and hpc choose it alike, so that their
  * answers agree bit for bit). Any kz with d[kz] != 0 keeps the test watertight (the per-ray choice of the
  * largest |d| only bounds the shear); the rays of a packet point at one small light, so one axis usually
- * serves all lanes: lane 0's largest, provided every lane has |d[kz]| >= max|d| / 2 (|Sx|, |Sy| <= 2: as
- * accurate as the per-ray choice within a factor of 2); else -1, and the lanes are tested one by one
- * (ms_wt_segment). dx, dy, dz: the lanes' direction components. *kz0: lane 0's largest axis either way. */
-static inline int ms_wt_packet_axis(const float *dx, const float *dy, const float *dz, int n, int *kz0)
+ * serves all lanes. The rule: the light's own axis pref (ms_light_shear_axis: the largest component of its
+ * normal; -1: none) when every lane has |d[pref]| >= max|d| / 2, else lane 0's largest under the same
+ * condition, else -1 and the lanes are tested one by one (ms_wt_segment). Either way |Sx|, |Sy| <= 2: as
+ * accurate as the per-ray choice within a factor of 2. pref comes first so that segments to one light are
+ * sheared alike wherever they start: axis-aligned rectangles merged along the other axes are then decided
+ * exactly as their pieces (accel/coplanar.h), which the per-ray largest axis would not give the many
+ * segments that leave a light sideways. dx, dy, dz: the lanes' direction components. *kz0: the packet's axis,
+ * or lane 0's largest when it has none. */
+static inline int ms_wt_packet_axis(const float *dx, const float *dy, const float *dz, int n, int pref, int *kz0)
 {
     const float d0[3] = { dx[0], dy[0], dz[0] };
     const float *const d[3] = { dx, dy, dz };
-    const int kz = ms_wt_max_axis(d0);
-    int ok = 1;
+    const int k0 = ms_wt_max_axis(d0);
+    int okp = pref >= 0, ok0 = 1;
     for (int l = 0; l < n; l++) {
         const float m = ms_maxf(fabsf(dx[l]), ms_maxf(fabsf(dy[l]), fabsf(dz[l])));
-        ok &= 2.0f * fabsf(d[kz][l]) >= m && m > 0.0f;
+        if (pref >= 0) okp &= 2.0f * fabsf(d[pref][l]) >= m && m > 0.0f;
+        ok0 &= 2.0f * fabsf(d[k0][l]) >= m && m > 0.0f;
     }
-    if (kz0) *kz0 = kz;
-    return ok ? kz : -1;
+    const int kz = okp ? pref : ok0 ? k0 : -1;
+    if (kz0) *kz0 = kz >= 0 ? kz : k0;
+    return kz;
 }
 
 /* 1 if the triangle blocks the segment from o to o + d at a parameter in [tmin, tmax], with the ray's own

@@ -5,12 +5,26 @@
 #ifndef MS_LIGHT_FRAME_H
 #define MS_LIGHT_FRAME_H
 #include "microshadow.h"
+#include <math.h>
 #include "core/vec.h"
 
 typedef struct ms_light_frame {
     float corner[3], edge_s[3], edge_t[3];
     float normal[3];
 } ms_light_frame;
+
+/* The shear axis the segments to light l prefer (accel/ray_triangle.h, ms_wt_packet_axis): the largest component
+ * of its plane's normal edge_s x edge_t (the first on ties), -1 when the light has no plane (a sphere before its
+ * outline: zero edges). Every method's segments to one light share it. */
+static inline int ms_light_shear_axis(const ms_light *l)
+{
+    const float n[3] = { l->edge_s.y * l->edge_t.z - l->edge_s.z * l->edge_t.y,
+                         l->edge_s.z * l->edge_t.x - l->edge_s.x * l->edge_t.z,
+                         l->edge_s.x * l->edge_t.y - l->edge_s.y * l->edge_t.x };
+    const float x = fabsf(n[0]), y = fabsf(n[1]), z = fabsf(n[2]);
+    if (!(x + y + z > 0.0f) || !isfinite(x + y + z)) return -1;
+    return x >= y ? (x >= z ? 0 : 2) : (y >= z ? 1 : 2);
+}
 
 static inline void ms_light_frame_of(const ms_light *l, ms_light_frame *f)
 {

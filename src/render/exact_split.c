@@ -3,61 +3,48 @@
 #include "visibility/receiver.h"
 #include "light/pattern.h"
 #include "visibility/occluders.h"
+#include "light/light_frame.h"
+#include "accel/ray_triangle.h"
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* The axis every segment from p to the light is sheared along (ms_segment_axes), when the light's hull (its n
- * points) proves it, else -1: d = L - p is affine over the light, so where d_a keeps one strict sign |d_a| is
- * affine too (its least value at a hull point), and every |d_c| is convex (its greatest value at a hull point);
- * where d_c keeps one sign as well, |d_a| - |d_c| is affine and is checked at each hull point. It must exceed a
- * margin far above the rounding of the sample points and of d (ulps of the coordinates): then every sample's
- * largest axis is a, and so is every packet's (ms_wt_packet_axis: lane 0's largest, every lane within a factor
- * 2). */
-static int one_axis(const float p[3], const float (*hull)[3], int n)
+/* 1 when every segment from p to a point of the hull of pts (n points) has 2 |d_a| > |d_c| for both other axes c,
+ * by a margin far above the rounding of the sample points and of d = L - p (ulps of the coordinates), so that
+ * ms_wt_packet_axis keeps a for every packet of those segments once a is its candidate. d is affine over the
+ * hull; where d_a keeps one strict sign, 2 |d_a| - |d_c| = min(2 |d_a| - d_c, 2 |d_a| + d_c) is the least of two
+ * affine functions, each least at a hull point, so checking it at the hull points proves it everywhere. */
+static int proves_axis(const float p[3], const float (*pts)[3], int n, int a)
 {
-    double mag = 0.0, d[8][3], lo[3], hi[3];
-    int fixed[3];   /* 1: d_c has one strict sign over the hull */
-    for (int c = 0; c < 3; c++) {
-        mag = fmax(mag, fabs((double)p[c]));
-        lo[c] = INFINITY;
-        hi[c] = 0.0;
-        fixed[c] = 1;
-        for (int h = 0; h < n; h++) {
-            mag = fmax(mag, fabs((double)hull[h][c]));
-            d[h][c] = (double)hull[h][c] - (double)p[c];
-            lo[c] = fmin(lo[c], fabs(d[h][c]));
-            hi[c] = fmax(hi[c], fabs(d[h][c]));
-            fixed[c] &= d[h][c] * d[0][c] > 0.0;
+    double mag = 0.0, d[8][3];
+    for (int h = 0; h < n; h++)
+        for (int c = 0; c < 3; c++) {
+            mag = fmax(mag, fabs((double)pts[h][c]) + fabs((double)p[c]));
+            d[h][c] = (double)pts[h][c] - (double)p[c];
         }
-    }
     const double margin = 1e-5 * mag;
-    for (int a = 0; a < 3; a++) {
-        if (!fixed[a]) continue;
-        int ok = 1;
-        for (int c = 0; c < 3 && ok; c++) {
-            if (c == a) continue;
-            if (!fixed[c]) { ok = lo[a] - hi[c] > margin; continue; }
-            for (int h = 0; h < n && ok; h++) ok = fabs(d[h][a]) - fabs(d[h][c]) > margin;
-        }
-        if (ok) return a;
+    for (int h = 0; h < n; h++) {
+        if (!(d[h][a] * d[0][a] > 0.0)) return 0;   /* d_a changes sign (or is 0) over the hull */
+        for (int c = 0; c < 3; c++)
+            if (c != a && !(2.0 * fabs(d[h][a]) - fabs(d[h][c]) > margin)) return 0;
     }
-    return -1;
+    return 1;
 }
 
-/* Query q's segments by shear axis (ms_segment_axes: bit s of ax + a * mask_words), pts scratch for its sample
- * points. Proved for the whole light where one_axis can, else per packet of 16 samples: on the grid a packet
- * is 16 points of one row, p0 + i ds + j dt, whose segment's two ends bound it as the hull does the light;
- * the packets one_axis cannot prove take the rule itself on their points. */
-static void receiver_axes(const ms_render_ctx *ctx, const ms_shadow_query *q, const float (*hull)[3], int n_hull,
-                          float *pts, uint64_t *ax)
+/* ms_receiver_axes (exact_split.h): the rule (ms_wt_packet_axis) takes pref wherever every lane of a packet
+ * allows it, so a receiver whose whole light proves pref (proves_axis over the light's hull) has every segment
+ * on it; else per packet of 16 samples: on the grid a packet is 16 points of one row, p0 + i ds + j dt, bounded
+ * by the row segment's two ends as the light is by its hull, so pref (or, without one, lane 0's largest axis,
+ * computed as the methods compute it) is proved there; the packets no proof settles take the rule itself on
+ * their points. */
+void ms_receiver_axes(const ms_render_ctx *ctx, const ms_shadow_query *q, const float (*hull)[3], int n_hull,
+                      int pref, float *pts, uint64_t *ax)
 {
     const size_t mw = (size_t)ctx->mask_words;
     memset(ax, 0, 3 * mw * sizeof *ax);
-    const int a = one_axis(q->p, hull, n_hull);
-    if (a >= 0) {
-        memset(ax + (size_t)a * mw, 0xff, mw * sizeof *ax);   /* bits past samples: the front masks clear them */
+    if (pref >= 0 && proves_axis(q->p, hull, n_hull, pref)) {
+        memset(ax + (size_t)pref * mw, 0xff, mw * sizeof *ax);   /* bits past samples: the front masks clear them */
         return;
     }
     ms_grid g;
@@ -69,14 +56,18 @@ static void receiver_axes(const ms_render_ctx *ctx, const ms_shadow_query *q, co
             float ends[2][3];
             ms_grid_points(&g, first, 1, ends[0]);
             ms_grid_points(&g, first + 15, 1, ends[1]);
-            const int pa = one_axis(q->p, (const float (*)[3])ends, 2);
-            if (pa >= 0) {
-                ax[(size_t)pa * mw + (size_t)(first >> 6)] |= UINT64_C(0xffff) << (first & 63);
+            int a = pref;
+            if (a < 0) {
+                const float d0[3] = { ends[0][0] - q->p[0], ends[0][1] - q->p[1], ends[0][2] - q->p[2] };
+                a = ms_wt_max_axis(d0);
+            }
+            if (proves_axis(q->p, (const float (*)[3])ends, 2, a)) {
+                ax[(size_t)a * mw + (size_t)(first >> 6)] |= UINT64_C(0xffff) << (first & 63);
                 continue;
             }
             ms_grid_points(&g, first, 16, pts + 3 * first);
         }
-        ms_segment_axes(q->p, pts + 3 * first, first, 16, (int)mw, ax);
+        ms_segment_axes(q->p, pts + 3 * first, first, 16, pref, (int)mw, ax);
     }
 }
 
@@ -141,7 +132,7 @@ int ms_exact_split_visibility(const ms_shadow_method *sm, void *state, const ms_
     size_t *idx = malloc(nn * sizeof *idx);
     int failed = !axes || !sel || !cfront || !cvis || !cq || !idx;
     float hull[8][3], hull_box[6];
-    const int n_hull = ms_light_hull(&ctx->light, hull, hull_box);
+    const int n_hull = ms_light_hull(&ctx->light, hull, hull_box), pref = ms_light_shear_axis(&ctx->light);
     if (!failed) {
         memset(vis, 0, n * mw * sizeof *vis);
 #pragma omp parallel num_threads(whole ? threads : 1) reduction(| : failed)
@@ -151,7 +142,7 @@ int ms_exact_split_visibility(const ms_shadow_method *sm, void *state, const ms_
 #pragma omp for schedule(static)
             for (size_t i = 0; i < n; i++) {
                 if (!pts) continue;
-                receiver_axes(ctx, &q[i], (const float (*)[3])hull, n_hull, pts, axes + i * 3 * mw);
+                ms_receiver_axes(ctx, &q[i], (const float (*)[3])hull, n_hull, pref, pts, axes + i * 3 * mw);
             }
             free(pts);
         }

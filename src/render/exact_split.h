@@ -32,4 +32,11 @@ int ms_exact_split_visibility(const ms_shadow_method *sm, void *state, const ms_
                               size_t n, const uint64_t *front, uint64_t *vis, int whole, int threads,
                               uint64_t *counters);
 
+/* Query q's segments by shear axis, as ms_segment_axes gives them over its ctx->samples sample points (bit s of
+ * ax + a * ctx->mask_words; bits past the samples may be set), mostly proved from the light's hull (hull, n_hull:
+ * ms_light_hull of ctx->light; pref: its ms_light_shear_axis) without forming the points. pts: scratch of
+ * 3 * ctx->samples floats. */
+void ms_receiver_axes(const ms_render_ctx *ctx, const ms_shadow_query *q, const float (*hull)[3], int n_hull,
+                      int pref, float *pts, uint64_t *ax);
+
 #endif

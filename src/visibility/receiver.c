@@ -185,13 +185,13 @@ int ms_resolve_vs(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
     return 1;
 }
 
-void ms_segment_axes(const float p[3], const float *pts, int first, int n, int mw, uint64_t *axes)
+void ms_segment_axes(const float p[3], const float *pts, int first, int n, int pref, int mw, uint64_t *axes)
 {
     for (int base = first; base < first + n; base += 16) {
         float d[3][16];
         for (int l = 0; l < 16; l++)
             for (int a = 0; a < 3; a++) d[a][l] = pts[3 * (base - first + l) + a] - p[a];
-        const int kz = ms_wt_packet_axis(d[0], d[1], d[2], 16, NULL);
+        const int kz = ms_wt_packet_axis(d[0], d[1], d[2], 16, pref, NULL);
         for (int l = 0; l < 16; l++) {
             const float dl[3] = { d[0][l], d[1][l], d[2][l] };
             const int s = base + l, a = kz >= 0 ? kz : ms_wt_max_axis(dl);

@@ -36,11 +36,11 @@ int ms_front_mask(const ms_render_ctx *ctx, const ms_shadow_query *q, const floa
 
 /* The shear axis of the watertight test (accel/ray_triangle.h) for the n segments from p to samples first ..
  * first + n - 1 (pts: their points, 3 floats each), as raytrace, mft and hpc choose it: the axis its
- * 16-sample packet shares (ms_wt_packet_axis over samples 16j .. 16j + 15, the directions pts - p in float),
- * else the segment's own largest. Sets bit s of axes + a * mw when segment s is sheared along axis a (mw words
+ * 16-sample packet shares (ms_wt_packet_axis over samples 16j .. 16j + 15, the directions pts - p in float,
+ * pref the light's ms_light_shear_axis), else the segment's own largest. Sets bit s of axes + a * mw when segment s is sheared along axis a (mw words
  * each; other bits untouched). For the sets exact per axis (visibility/occluders.h, for_axis). first and n:
  * multiples of 16. */
-void ms_segment_axes(const float p[3], const float *pts, int first, int n, int mw, uint64_t *axes);
+void ms_segment_axes(const float p[3], const float *pts, int first, int n, int pref, int mw, uint64_t *axes);
 
 /* V and S from the front and visible masks (pts as above). Returns 1 when the weights had to be evaluated
  * (penumbra: some but not all front samples visible), 0 when S follows from the counts. */

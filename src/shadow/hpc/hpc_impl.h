@@ -197,6 +197,7 @@ typedef struct shared {
     int scanline;
     ms_raster_fn raster;
     int k, mw, gs, G, npk;
+    int shear_axis;                  /* the light's (ms_light_shear_axis): the packets' preferred axis */
     uint64_t all_groups;
     uint64_t *gmask;                 /* G x mw: the samples of each group */
     int gw0[64], gw1[64];            /* each group's first and last mask word (its rows lie in those only) */
@@ -418,7 +419,8 @@ static void slot_setup(const shared *sh, chunk *c, int32_t s, const ms_shadow_qu
     int8_t *kz = slot_kz(sh, c, s);
     /* ms_wt_packet_axis in the lanes (it was 9% of the cast on the merged bars in scalar form): a packet is
      * 16 consecutive samples of one row (k >= 16), its directions formed as group_block16 forms them, the
-     * axis lane 0's largest, kept when every lane's |d| on it is at least half its largest. */
+     * axis the light's (sh->shear_axis) or else lane 0's largest, kept when every lane's |d| on it is at
+     * least half its largest. */
     static const float lane_i[LANES] = { 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15 };
     const l16 li0 = l16_load(lane_i), two = l16_set1(2.0f), zero = l16_set1(0.0f);
     for (int pk = 0; pk < sh->npk; pk++) {
@@ -434,10 +436,11 @@ static void slot_setup(const shared *sh, chunk *c, int32_t s, const ms_shadow_qu
             l16_store(tmp, d[a]);
             d0[a] = tmp[0];
         }
-        const int z = ms_wt_max_axis(d0);
+        const int z = ms_wt_max_axis(d0), pref = sh->shear_axis;
         const l16 m = l16_max(ad[0], l16_max(ad[1], ad[2]));
         const unsigned ok = l16_le(m, l16_mul(two, ad[z])) & l16_gt(m, zero);
-        kz[pk] = (int8_t)(ok == 0xffffu ? z : -1);
+        const unsigned okp = pref >= 0 ? l16_le(m, l16_mul(two, ad[pref])) & l16_gt(m, zero) : 0u;
+        kz[pk] = (int8_t)(okp == 0xffffu ? pref : ok == 0xffffu ? z : -1);
     }
     /* kz[npk]: the axis every packet shares, or -1 (leaf_lanes_sample then needs no per-packet look-up) */
     int8_t uni = kz[0];
@@ -2288,6 +2291,7 @@ static void prepare_batch(const shared *sh, tri_job *jobs, const float *tri, con
 static void setup_light(shared *sh)
 {
     const ms_light *L = &sh->ctx->light;
+    sh->shear_axis = ms_light_shear_axis(L);
     const double P[3] = { L->corner.x, L->corner.y, L->corner.z };
     const double S[3] = { L->edge_s.x, L->edge_s.y, L->edge_s.z }, T[3] = { L->edge_t.x, L->edge_t.y, L->edge_t.z };
     const int k = sh->k, gpr = k / sh->gs;

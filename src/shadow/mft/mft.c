@@ -12,6 +12,7 @@
 #include "shadow/method.h"
 #include "visibility/occluders.h"
 #include "mft.h"
+#include "light/light_frame.h"
 #include "visibility/receiver.h"
 #include "light/pattern.h"
 #include "shadow/microraster/block_group.h"
@@ -215,6 +216,7 @@ static void mft_frame_light(ms_mft_frame *f, const ms_light *l)
     const double h = d3_len(n) / fmax(d3_len(S), d3_len(T));
     f->margin = 0.01 + (h > 0.0 ? 64.0 * FLT_EPSILON * mag * f->k / h : 0.0);
     f->light = *l;
+    f->shear_axis = ms_light_shear_axis(l);
 }
 
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
@@ -224,10 +226,10 @@ void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch)
         ms_grid_points(&L->grid, ch * 16, 16, pts);   /* the lane's grid, formed once (mft_lane_setup) */
     else
         ms_pattern_points_range(f->pattern, &f->light, f->k, L->px, L->py, f->seed, ch * 16, 16, pts);
-    ms_mft_rays_from(L, ch, pts);
+    ms_mft_rays_from(f, L, ch, pts);
 }
 
-void ms_mft_rays_from(ms_mft_lane *L, int ch, const float *pts)
+void ms_mft_rays_from(const ms_mft_frame *f, ms_mft_lane *L, int ch, const float *pts)
 {
     const int base = ch * 16;
     for (int l = 0; l < 16; l++)
@@ -237,7 +239,7 @@ void ms_mft_rays_from(ms_mft_lane *L, int ch, const float *pts)
         }
     /* The shear axis raytrace shares over a packet (ms_wt_packet_axis), sx = d[kx] * (1 / d[kz]). */
     int kz;
-    L->kz[ch] = (signed char)ms_wt_packet_axis(L->d[0] + base, L->d[1] + base, L->d[2] + base, 16, &kz);
+    L->kz[ch] = (signed char)ms_wt_packet_axis(L->d[0] + base, L->d[1] + base, L->d[2] + base, 16, f->shear_axis, &kz);
     const int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
     for (int l = base; l < base + 16; l++) {
         const float inv = 1.0f / L->d[kz][l];
@@ -370,6 +372,7 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
     const int ncell = T->ncell;
     ms_mft_rayblock rb;
     memset(&rb, 0, sizeof rb);
+    rb.shear_axis = f->shear_axis;
     rb.cap = ncell + MS_BLOCK_LANES;
     rb.g = malloc((size_t)rb.cap * sizeof *rb.g);
     int *next = malloc((size_t)rb.cap * sizeof *next);
@@ -427,7 +430,7 @@ static int mft_visibility_groups(const mft_method *s, const ms_mft_frame *f, con
             for (int ch = 0; ch < np; ch++) {
                 unsigned live = (unsigned)(m[ch >> 2] >> (ch & 3) * 16) & 0xFFFFu;
                 if (!live) continue;
-                ms_mft_rays_from(&L, ch, pts + 3 * 16 * ch);
+                ms_mft_rays_from(f, &L, ch, pts + 3 * 16 * ch);
                 for (; live; live &= live - 1) {
                     const int j = 16 * ch + __builtin_ctz(live);
                     int gi = cell_of[j];

@@ -28,6 +28,7 @@ typedef struct ms_mft_frame {
     int cells;                    /* 1: sample (i, j) lies in cell (i, j) (grid, stratified); 0: interleaved
                                    * (N/16 points per pixel, the whole light as rectangle, no footprints) */
     ms_light light;
+    int shear_axis;               /* the light's preferred shear axis (ms_light_shear_axis), ms_wt_packet_axis's pref */
     uint32_t seed;
     const struct ms_alpha *alpha; /* alpha-tested triangles (alpha.h), NULL: none */
 } ms_mft_frame;
@@ -95,6 +96,7 @@ typedef struct ms_mft_rayblock {
      * NULL: a group whose every present slot is live starts from it and the box of the present receivers
      * (mft_group_impl.h). */
     const float *cell_box;
+    int shear_axis;                      /* the frame's (ms_mft_frame), for the packets' axes */
 } ms_mft_rayblock;
 
 /* Counters after the traversal's (block_traverse.h), named in mft.c. */
@@ -111,7 +113,7 @@ void ms_mft_corners(const ms_mft_frame *f, const float c[3], const int r[4], flo
 /* Forms packet ch (samples 16 ch .. 16 ch + 15) of lane L's rays, as method raytrace forms them. */
 void ms_mft_rays(const ms_mft_frame *f, ms_mft_lane *L, int ch);
 /* The same from the packet's 16 sample points (the pattern's, ms_pattern_points_range). */
-void ms_mft_rays_from(ms_mft_lane *L, int ch, const float *pts);
+void ms_mft_rays_from(const ms_mft_frame *f, ms_mft_lane *L, int ch, const float *pts);
 
 typedef void (*ms_mft_fn)(const ms_mft_frame *f, ms_mft_block *blk, const ms_bvh *b, const ms_bvh_shallow *sh,
                           uint64_t *cnt);

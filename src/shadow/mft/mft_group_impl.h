@@ -521,8 +521,9 @@ static void mftg_form(ms_mft_rayblock *rb)
      * packet per slot, its samples the slot's lane of the 16 groups, so the 16 slots at once: the axis of
      * each slot's first sample, then the packet's test over the groups (an AND: order-free). */
     signed char kz[16][MS_SAMPLES_MAX / 16 / 16];
+    const int pref = rb->shear_axis;
     if (n == 16) {
-        unsigned k1 = 0, k2 = 0, ok = 0xFFFFu;
+        unsigned k1 = 0, k2 = 0, ok = 0xFFFFu, okp = pref >= 0 ? 0xFFFFu : 0u;
         for (int q = 0; q < 16; q++) {
             const ms_mft_group *G = &rb->g[rb->set_cell[(size_t)q * n]];
             const float d0[3] = { G->d[0][q], G->d[1][q], G->d[2][q] };
@@ -536,8 +537,10 @@ static void mftg_form(ms_mft_rayblock *rb)
             const l16 ax = l16_abs(l16_load(G->d[0])), ay = l16_abs(l16_load(G->d[1])), az = l16_abs(l16_load(G->d[2]));
             const l16 m = l16_max(ax, l16_max(ay, az)), dk = l16_select(k1, ay, l16_select(k2, az, ax));
             ok &= l16_le(m, l16_mul(two, dk)) & l16_gt(m, zero);
+            if (pref >= 0) okp &= l16_le(m, l16_mul(two, pref == 0 ? ax : pref == 1 ? ay : az)) & l16_gt(m, zero);
         }
-        for (int q = 0; q < 16; q++) kz[q][0] = (signed char)(!(ok >> q & 1) ? -1 : k1 >> q & 1 ? 1 : k2 >> q & 1 ? 2 : 0);
+        for (int q = 0; q < 16; q++)
+            kz[q][0] = (signed char)(okp >> q & 1 ? pref : !(ok >> q & 1) ? -1 : k1 >> q & 1 ? 1 : k2 >> q & 1 ? 2 : 0);
     } else
         for (int q = 0; q < 16; q++) {
             if (!(rb->present >> q & 1)) continue;
@@ -550,7 +553,7 @@ static void mftg_form(ms_mft_rayblock *rb)
                     dz[l] = G->d[2][q];
                 }
                 int k0;
-                kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, &k0);
+                kz[q][ch] = (signed char)ms_wt_packet_axis(dx, dy, dz, 16, pref, &k0);
             }
         }
     /* n = 16 (256 samples): a slot's 16 samples are one packet, so every group has the slots' axes; they

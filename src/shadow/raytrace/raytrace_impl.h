@@ -8,6 +8,7 @@
 #include "visibility/alpha.h"
 #include "core/perk.h"
 #include "light/pattern.h"
+#include "light/light_frame.h"
 #include "core/vec.h"
 #include "accel/ray_triangle.h"
 #include "visibility/lanes16.h"
@@ -29,6 +30,7 @@ typedef struct packet {
      * origin is common, so each triangle is translated and permuted once per packet), per-lane
      * shear; kz < 0 when no axis suits every lane and lanes are tested one by one. */
     int kx, ky, kz;
+    int pref;               /* the light's shear axis (ms_light_shear_axis) */
     float sx[LANES], sy[LANES];
     float o_lo[3], o_hi[3]; /* the origin shifted by the box margin (ms_wt_box_origins), set by trace_packet */
 } packet;
@@ -39,7 +41,7 @@ typedef struct packet {
 static void packet_shear(packet *pk)
 {
     int kz;
-    pk->kz = ms_wt_packet_axis(pk->d[0], pk->d[1], pk->d[2], LANES, &kz);
+    pk->kz = ms_wt_packet_axis(pk->d[0], pk->d[1], pk->d[2], LANES, pk->pref, &kz);
     pk->kx = kz + 1 == 3 ? 0 : kz + 1;
     pk->ky = pk->kx + 1 == 3 ? 0 : pk->kx + 1;
     for (int l = 0; l < LANES; l++) {
@@ -184,6 +186,7 @@ int MS_CAT(ms_raytrace_samples_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, const 
     ms_pattern_points(ctx->pattern, &ctx->light, ctx->k, q->px, q->py, ctx->seed, pts);
     memset(vis, 0, (size_t)ctx->mask_words * sizeof *vis);
     int visible = 0;
+    const int pref = ms_light_shear_axis(&ctx->light);
     for (int base = 0; base < ns; base += LANES) {
         /* Samples behind the receiver's plane are not traced (LANES divides 64: one word holds them). */
         const uint64_t lanes = front[base >> 6] >> (base & 63) & ((UINT64_C(1) << LANES) - 1);
@@ -192,6 +195,7 @@ int MS_CAT(ms_raytrace_samples_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, const 
         for (int a = 0; a < 3; a++) pk.o[a] = q->p[a];
         pk.tmin = ctx->near;
         pk.tmax = ctx->far;
+        pk.pref = pref;
         for (int l = 0; l < LANES; l++) {
             for (int a = 0; a < 3; a++) {
                 pk.d[a][l] = pts[3 * (base + l) + a] - pk.o[a];
