@@ -140,6 +140,9 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     if (s->whole_frame) {
         const uint64_t slot = (mw8 + (s->scanline_slots ? HPC_RASTER_FRAME : 0) + (uint64_t)s->npk + 1u + 63u) / 64u * 64u;
         shadow_pp = sizeof(ms_shadow_query) + sizeof(size_t) + 1u + 2u * mw8 + HPC_PER_RECEIVER + slot;   /* 1: the merged-face flag */
+        /* exact_split.c: the axes (3 masks), the selected, compacted front and visible masks, the compacted
+         * query, its index and its scene prim */
+        if (s->exact_sets) shadow_pp += 6u * mw8 + sizeof(ms_shadow_query) + sizeof(size_t) + 4u;
     }
     /* frame_shade.c: the luminances and glibc qsort's merge buffer of as many; textured lights' mean texels. */
     uint64_t finish_pp = 8u + (s->textured ? mul(12u, s->nl) : 0);
@@ -159,6 +162,8 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     /* The lights' occluders stay; the closed components' search, or the last light's build, come on top. */
     if (s->bvh && s->occluders) {
         ms_need_add(need, "per-light occluder BVHs", mul(mul(n, OCCLUDERS_PER_TRI), s->nl));
+        /* the sets exact per axis: at most one per axis, each at most every triangle */
+        if (s->exact_sets) ms_need_add(need, "per-light occluder sets exact per axis", mul(mul(n, 3u * OCCLUDERS_PER_TRI), s->nl));
         const uint64_t find = closed_find_bytes(n), build_occ = mul(n, 8u + OCCLUDERS_BUILD_PER_TRI);
         ms_need_add(need, "closed components", find > build_occ ? find : build_occ);
     }

@@ -45,6 +45,8 @@ typedef struct ms_frame_shape {
     int filter;             /* the interleaved pattern's filter runs in finish */
     int textured;           /* some light is textured (finish keeps a mean texel per light and pixel) */
     int occluders;          /* per-light occluders (visibility/occluders.h): closed components, culled BVHs */
+    int exact_sets;         /* with them, the sets exact per shear axis (for_axis, MS_OCC_MERGE_EXACT): up to 3 more
+                             * per light, and the exact split's per-receiver scratch (render/exact_split.c) */
     int threads;
     /* Streamed outputs (frame_stream.c): the planes hold band_rows rows at a time (0: the whole frame); when the
      * frame is not streamed, stream_rows is what a streamed one would hold (0: it cannot be streamed), for the

@@ -359,6 +359,7 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
         for (size_t l = 0; l < j->nlights; l++) fs.textured |= j->lights[l].texture != NULL;
         fs.threads = j->threads;
         fs.occluders = occluder_what(sm, opt) != 0;
+        fs.exact_sets = (occluder_what(sm, opt) & (MS_OCC_MERGE | MS_OCC_MERGE_EXACT)) == (MS_OCC_MERGE | MS_OCC_MERGE_EXACT);
         /* Streamed outputs: bands of whole tile rows, by default about 512 tiles (and 16 per thread): a parallel
          * region per band and light costs a barrier, which on a loaded machine means waiting for a time slice
          * (bands of 128 tiles at 2048 wide took twice as long as the whole frame with the load at 11 on 2

@@ -87,8 +87,9 @@
  *    handed to each receiver's groups and blocks: the paper's leaf handles its points one by one (L56-L75).
  *  - the triangles are ctx->bvh's: with the light's occluders (hpc_method.c), those of closed components
  *    facing away from the whole light are left out (docs/culling.md proves it changes no V or S), and
- *    axis-aligned coplanar rectangles are merged (accel/coplanar.h: the same points; ties on their outer
- *    sides may fall the other way, within the method tests' tie tolerance).
+ *    axis-aligned coplanar rectangles are merged (accel/coplanar.h: the same points; the driver gives each
+ *    sample to a set merged only where it decides as the pieces do, render/exact_split.c, so V and S stay
+ *    raytrace's bit for bit).
  *  - hpc-scanline: the leaf rasterizes the triangle into the receiver's k x k buffer with the Scanline
  *    kernel (Woop 2010; src/raster) once some active group's volume holds the point, instead of testing
  *    the samples one by one (points that see the light nearly edge-on are tested per sample, as

@@ -7,7 +7,8 @@
  * segment (same V and S); the driver names a receiver's own triangle in that set (ms_ctx_skip_prim). The
  * paper has no such cull; on a GRIDS-like scene (closed bars) it removes 32,640 of 74,880 triangles and
  * 37% of the time (docs/hpc.md). hpc also takes the occluders' merge of coplanar rectangles (MS_OCC_MERGE,
- * accel/coplanar.h: the same points, ties on the rectangles' outer sides aside), as the micro-raster methods
+ * accel/coplanar.h: the same points; with MS_OCC_MERGE_EXACT each sample on a set that decides it as the pieces
+ * do, render/exact_split.c), as the micro-raster methods
  * and mft do: the bars' faces, 32 segments each, become one rectangle (42,242 -> 1,322 triangles), and the
  * cost per pair, which bounds hpc (docs/hpc.md, session 14), is paid 30 times less often. The receivers on
  * merged faces that the merge could answer otherwise are answered over the scene's own triangles by a second
