@@ -71,47 +71,20 @@ void ms_receiver_axes(const ms_render_ctx *ctx, const ms_shadow_query *q, const 
     }
 }
 
-/* The method over the queries of q whose `sel` masks (their front masks restricted to one set's axes) hold
- * any sample, compacted; their visible masks ORed into vis. */
-static int run_set(const ms_shadow_method *sm, void *state, const ms_render_ctx *ctx, const ms_shadow_query *q,
-                   const uint32_t *scene_prim, size_t n, const uint64_t *sel, uint64_t *vis, int whole,
-                   uint64_t *counters, ms_shadow_query *cq, size_t *idx, uint64_t *cfront, uint64_t *cvis)
-{
-    const size_t mw = (size_t)ctx->mask_words;
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++) {
-        uint64_t any = 0;
-        for (size_t w = 0; w < mw; w++) any |= sel[i * mw + w];
-        if (!any) continue;
-        cq[m] = q[i];
-        cq[m].prim = ms_ctx_skip_prim(ctx, scene_prim[i]);
-        memcpy(cfront + m * mw, sel + i * mw, mw * sizeof *cfront);
-        idx[m++] = i;
-    }
-    if (!m) return 0;
-    if (whole ? sm->visibility_all(state, ctx, cq, m, cfront, cvis, counters)
-              : sm->visibility(state, ctx, cq, (int)m, cfront, cvis, counters))
-        return -1;
-    for (size_t c = 0; c < m; c++)
-        for (size_t w = 0; w < mw; w++) vis[idx[c] * mw + w] |= cvis[c * mw + w];
-    return 0;
-}
-
 int ms_exact_split_visibility(const ms_shadow_method *sm, void *state, const ms_render_ctx *ctx,
                               const ms_exact_split *split, const ms_shadow_query *q, const uint32_t *scene_prim,
                               size_t n, const uint64_t *front, uint64_t *vis, int whole, int threads,
                               uint64_t *counters)
 {
     const size_t mw = (size_t)ctx->mask_words;
-    /* The sets: 0 the merged one, then one per axis of split->axes, the axes whose state is one set's joined. */
-    void *set_state[4] = { state };
-    ms_render_ctx set_ctx[4];
-    set_ctx[0] = *ctx;
-    unsigned set_axes[4] = { 7u & ~split->axes };
-    int ns = 1;
+    /* The sets besides the merged one: one per axis of split->axes, the axes whose state is one set's joined. */
+    void *set_state[3];
+    ms_render_ctx set_ctx[3];
+    unsigned set_axes[3];
+    int ns = 0;
     for (int a = 0; a < 3; a++) {
         if (!(split->axes >> a & 1u)) continue;
-        int s = 1;
+        int s = 0;
         while (s < ns && set_state[s] != split->state[a]) s++;
         if (s == ns) {
             set_state[s] = split->state[a];
@@ -125,43 +98,101 @@ int ms_exact_split_visibility(const ms_shadow_method *sm, void *state, const ms_
         }
         set_axes[s] |= 1u << a;
     }
+    /* The merged set's samples: the front masks less the samples of the split axes, for every query in place
+     * (most have all their samples there); the queries with samples elsewhere flagged. */
     const size_t nn = n ? n : 1;
-    uint64_t *axes = malloc(nn * 3 * mw * sizeof *axes), *sel = malloc(nn * mw * sizeof *sel);
-    uint64_t *cfront = malloc(nn * mw * sizeof *cfront), *cvis = malloc(nn * mw * sizeof *cvis);
-    ms_shadow_query *cq = malloc(nn * sizeof *cq);
-    size_t *idx = malloc(nn * sizeof *idx);
-    int failed = !axes || !sel || !cfront || !cvis || !cq || !idx;
+    uint64_t *sel = malloc(nn * mw * sizeof *sel);
+    uint8_t *other = malloc(nn);
+    int failed = !sel || !other;
     float hull[8][3], hull_box[6];
     const int n_hull = ms_light_hull(&ctx->light, hull, hull_box), pref = ms_light_shear_axis(&ctx->light);
-    if (!failed) {
-        memset(vis, 0, n * mw * sizeof *vis);
+#pragma omp parallel num_threads(whole ? threads : 1) reduction(| : failed) if (sel && other)
+    {
+        float *pts = sel && other ? malloc((size_t)ctx->samples * 3 * sizeof *pts) : NULL;
+        uint64_t ax[3 * (MS_SAMPLES_MAX / 64)];
+        failed |= !pts;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (!pts) continue;
+            ms_receiver_axes(ctx, &q[i], (const float (*)[3])hull, n_hull, pref, pts, ax);
+            uint64_t out = 0;
+            for (size_t w = 0; w < mw; w++) {
+                uint64_t m = 0;
+                for (int a = 0; a < 3; a++)
+                    if (split->axes >> a & 1u) m |= ax[(size_t)a * mw + w];
+                sel[i * mw + w] = front[i * mw + w] & ~m;
+                out |= front[i * mw + w] & m;
+            }
+            other[i] = out != 0;
+        }
+        free(pts);
+    }
+    if (!failed)
+        failed = whole ? sm->visibility_all(state, ctx, q, n, sel, vis, counters) != 0
+                       : sm->visibility(state, ctx, q, (int)n, sel, vis, counters) != 0;
+    /* The flagged queries, compacted, over each other set with the samples of its axes; ORed into vis. */
+    size_t m = 0;
+    for (size_t i = 0; i < n && !failed; i++) m += other[i];
+    const size_t mm = m ? m : 1;
+    ms_shadow_query *cq = NULL;
+    size_t *idx = NULL, *cidx = NULL;
+    uint64_t *axes = NULL, *cfront = NULL, *cvis = NULL;
+    if (!failed && m) {
+        cq = malloc(mm * sizeof *cq);
+        idx = malloc(mm * sizeof *idx);
+        cidx = malloc(mm * sizeof *cidx);
+        axes = malloc(mm * 3 * mw * sizeof *axes);
+        cfront = malloc(mm * mw * sizeof *cfront);
+        cvis = malloc(mm * mw * sizeof *cvis);
+        failed = !cq || !idx || !cidx || !axes || !cfront || !cvis;
+    }
+    if (!failed && m) {
+        m = 0;
+        for (size_t i = 0; i < n; i++)
+            if (other[i]) idx[m++] = i;
 #pragma omp parallel num_threads(whole ? threads : 1) reduction(| : failed)
         {
             float *pts = malloc((size_t)ctx->samples * 3 * sizeof *pts);
             failed |= !pts;
 #pragma omp for schedule(static)
-            for (size_t i = 0; i < n; i++) {
-                if (!pts) continue;
-                ms_receiver_axes(ctx, &q[i], (const float (*)[3])hull, n_hull, pref, pts, axes + i * 3 * mw);
-            }
+            for (size_t c = 0; c < m; c++)
+                if (pts) ms_receiver_axes(ctx, &q[idx[c]], (const float (*)[3])hull, n_hull, pref, pts, axes + c * 3 * mw);
             free(pts);
         }
     }
-    for (int s = 0; s < ns && !failed; s++) {
-        for (size_t i = 0; i < n; i++)
+    for (int s = 0; s < ns && !failed && m; s++) {
+        size_t k = 0;
+        for (size_t c = 0; c < m; c++) {
+            const size_t i = idx[c];
+            uint64_t any = 0;
             for (size_t w = 0; w < mw; w++) {
-                uint64_t m = 0;
+                uint64_t msk = 0;
                 for (int a = 0; a < 3; a++)
-                    if (set_axes[s] >> a & 1u) m |= axes[(i * 3 + (size_t)a) * mw + w];
-                sel[i * mw + w] = front[i * mw + w] & m;
+                    if (set_axes[s] >> a & 1u) msk |= axes[(c * 3 + (size_t)a) * mw + w];
+                cfront[k * mw + w] = front[i * mw + w] & msk;
+                any |= cfront[k * mw + w];
             }
-        failed = run_set(sm, set_state[s], &set_ctx[s], q, scene_prim, n, sel, vis, whole, counters, cq, idx, cfront, cvis) != 0;
+            if (!any) continue;
+            cq[k] = q[i];
+            cq[k].prim = ms_ctx_skip_prim(&set_ctx[s], scene_prim[i]);
+            cidx[k++] = i;
+        }
+        if (!k) continue;
+        if (whole ? sm->visibility_all(set_state[s], &set_ctx[s], cq, k, cfront, cvis, counters)
+                  : sm->visibility(set_state[s], &set_ctx[s], cq, (int)k, cfront, cvis, counters)) {
+            failed = 1;
+            break;
+        }
+        for (size_t c = 0; c < k; c++)
+            for (size_t w = 0; w < mw; w++) vis[cidx[c] * mw + w] |= cvis[c * mw + w];
     }
-    free(axes);
     free(sel);
-    free(cfront);
-    free(cvis);
+    free(other);
     free(cq);
     free(idx);
+    free(cidx);
+    free(axes);
+    free(cfront);
+    free(cvis);
     return failed ? -1 : 0;
 }
