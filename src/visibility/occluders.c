@@ -4,6 +4,7 @@
 #include "alpha.h"
 #include "context.h"
 #include "light/light_shape.h"
+#include "light/light_frame.h"
 #include "accel/coplanar.h"
 #include <math.h>
 #include <stdlib.h>
@@ -300,7 +301,10 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
         free(porous);
     }
     if (!rc && (culled || (what & MS_OCC_MERGE)))
-        rc = set_build(o, scene, scene_bvh, keep, culled, (what & MS_OCC_MERGE) != 0, -1, scene_alpha, threads);
+        /* A method that must equal raytrace gets no merge along the light's preferred shear axis: most segments are
+         * sheared along it (ms_wt_packet_axis), and so stay on this set (exact_split.h) */
+        rc = set_build(o, scene, scene_bvh, keep, culled, (what & MS_OCC_MERGE) != 0,
+                       (what & MS_OCC_MERGE_EXACT) ? ms_light_shear_axis(l) : -1, scene_alpha, threads);
     if (!rc && (what & MS_OCC_MERGE_EXACT) && o->merged_axes)
         rc = axis_sets_build(o, scene, scene_bvh, keep, culled, scene_alpha, threads);
     free(keep);
