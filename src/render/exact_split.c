@@ -20,7 +20,8 @@ static int proves_axis(const float p[3], const float (*pts)[3], int n, int a)
     double mag = 0.0, d[8][3];
     for (int h = 0; h < n; h++)
         for (int c = 0; c < 3; c++) {
-            mag = fmax(mag, fabs((double)pts[h][c]) + fabs((double)p[c]));
+            const double m = fabs((double)pts[h][c]) + fabs((double)p[c]);   /* no fmax: a call without -ffast-math */
+            mag = m > mag ? m : mag;
             d[h][c] = (double)pts[h][c] - (double)p[c];
         }
     const double margin = 1e-5 * mag;
