@@ -531,9 +531,11 @@ typedef struct ms_render_options {
                              * never culls */
     int no_interior;        /* micro-raster methods: no interior boxes (virtual occluders inside closed meshes,
                              * docs/culling.md: the same V and S); to measure what they buy */
-    int no_merge;           /* micro-raster methods: occluders as given, without merging the two halves of
-                             * axis-aligned rectangles and rectangles sharing a side into one (docs/culling.md:
-                             * the same points, so the same V and S up to ties on the rectangles' sides) */
+    int no_merge;           /* micro-raster methods, mft, hpc: occluders as given, without merging the two halves
+                             * of axis-aligned rectangles and rectangles sharing a side into one (docs/culling.md:
+                             * the same points; the same V and S for mft and hpc, which take each sample from a
+                             * set that decides it as the pieces do, and up to ties on the rectangles' sides for
+                             * the micro-raster methods) */
     uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
     ms_stream_mode stream;  /* ms_render_outputs only (ms_render always holds the whole frame) */
     int stream_rows;        /* streamed: rows per band, a multiple of MS_TILE_SIZE; 0: about 512 tiles' worth, fewer
