@@ -100,84 +100,87 @@ int ms_exact_split_visibility(const ms_shadow_method *sm, void *state, const ms_
         set_axes[s] |= 1u << a;
     }
     /* The merged set's samples: the front masks less the samples of the split axes, for every query in place
-     * (most have all their samples there); the queries with samples elsewhere flagged. */
-    const size_t nn = n ? n : 1;
+     * (most have all their samples there); the queries with samples elsewhere kept with their axes, per thread. */
+    const size_t nn = n ? n : 1, rec = 3 * mw;   /* a kept query: its axes (3 masks) */
+    const int nt = whole && threads > 1 ? threads : 1;
     uint64_t *sel = malloc(nn * mw * sizeof *sel);
-    uint8_t *other = malloc(nn);
-    int failed = !sel || !other;
+    size_t *kept_n = calloc((size_t)nt, sizeof *kept_n), *kept_cap = calloc((size_t)nt, sizeof *kept_cap);
+    size_t **kept_i = calloc((size_t)nt, sizeof *kept_i);
+    uint64_t **kept_ax = calloc((size_t)nt, sizeof *kept_ax);
+    int failed = !sel || !kept_n || !kept_cap || !kept_i || !kept_ax;
     float hull[8][3], hull_box[6];
     const int n_hull = ms_light_hull(&ctx->light, hull, hull_box), pref = ms_light_shear_axis(&ctx->light);
-#pragma omp parallel num_threads(whole ? threads : 1) reduction(| : failed) if (sel && other)
-    {
-        float *pts = sel && other ? malloc((size_t)ctx->samples * 3 * sizeof *pts) : NULL;
-        uint64_t ax[3 * (MS_SAMPLES_MAX / 64)];
-        failed |= !pts;
+    if (!failed) {
+#pragma omp parallel num_threads(nt) reduction(| : failed)
+        {
+            const int t = omp_get_thread_num();
+            float *pts = malloc((size_t)ctx->samples * 3 * sizeof *pts);
+            uint64_t ax[3 * (MS_SAMPLES_MAX / 64)];
+            failed |= !pts;
 #pragma omp for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            if (!pts) continue;
-            ms_receiver_axes(ctx, &q[i], (const float (*)[3])hull, n_hull, pref, pts, ax);
-            uint64_t out = 0;
-            for (size_t w = 0; w < mw; w++) {
-                uint64_t m = 0;
-                for (int a = 0; a < 3; a++)
-                    if (split->axes >> a & 1u) m |= ax[(size_t)a * mw + w];
-                sel[i * mw + w] = front[i * mw + w] & ~m;
-                out |= front[i * mw + w] & m;
+            for (size_t i = 0; i < n; i++) {
+                if (!pts) continue;
+                ms_receiver_axes(ctx, &q[i], (const float (*)[3])hull, n_hull, pref, pts, ax);
+                uint64_t out = 0;
+                for (size_t w = 0; w < mw; w++) {
+                    uint64_t m = 0;
+                    for (int a = 0; a < 3; a++)
+                        if (split->axes >> a & 1u) m |= ax[(size_t)a * mw + w];
+                    sel[i * mw + w] = front[i * mw + w] & ~m;
+                    out |= front[i * mw + w] & m;
+                }
+                if (!out) continue;
+                if (kept_n[t] == kept_cap[t]) {
+                    const size_t cap = kept_cap[t] ? 2 * kept_cap[t] : 256;
+                    size_t *ni = realloc(kept_i[t], cap * sizeof *ni);
+                    if (ni) kept_i[t] = ni;
+                    uint64_t *na = ni ? realloc(kept_ax[t], cap * rec * sizeof *na) : NULL;
+                    if (na) kept_ax[t] = na;
+                    if (!ni || !na) { free(pts); pts = NULL; failed = 1; continue; }
+                    kept_cap[t] = cap;
+                }
+                kept_i[t][kept_n[t]] = i;
+                memcpy(kept_ax[t] + kept_n[t]++ * rec, ax, rec * sizeof *ax);
             }
-            other[i] = out != 0;
+            free(pts);
         }
-        free(pts);
     }
     if (!failed)
         failed = whole ? sm->visibility_all(state, ctx, q, n, sel, vis, counters) != 0
                        : sm->visibility(state, ctx, q, (int)n, sel, vis, counters) != 0;
-    /* The flagged queries, compacted, over each other set with the samples of its axes; ORed into vis. */
+    /* The kept queries, compacted, over each other set with the samples of its axes; ORed into vis. */
     size_t m = 0;
-    for (size_t i = 0; i < n && !failed; i++) m += other[i];
+    for (int t = 0; t < nt && !failed; t++) m += kept_n[t];
     const size_t mm = m ? m : 1;
     ms_shadow_query *cq = NULL;
-    size_t *idx = NULL, *cidx = NULL;
-    uint64_t *axes = NULL, *cfront = NULL, *cvis = NULL;
+    size_t *cidx = NULL;
+    uint64_t *cfront = NULL, *cvis = NULL;
     if (!failed && m) {
         cq = malloc(mm * sizeof *cq);
-        idx = malloc(mm * sizeof *idx);
         cidx = malloc(mm * sizeof *cidx);
-        axes = malloc(mm * 3 * mw * sizeof *axes);
         cfront = malloc(mm * mw * sizeof *cfront);
         cvis = malloc(mm * mw * sizeof *cvis);
-        failed = !cq || !idx || !cidx || !axes || !cfront || !cvis;
-    }
-    if (!failed && m) {
-        m = 0;
-        for (size_t i = 0; i < n; i++)
-            if (other[i]) idx[m++] = i;
-#pragma omp parallel num_threads(whole ? threads : 1) reduction(| : failed)
-        {
-            float *pts = malloc((size_t)ctx->samples * 3 * sizeof *pts);
-            failed |= !pts;
-#pragma omp for schedule(static)
-            for (size_t c = 0; c < m; c++)
-                if (pts) ms_receiver_axes(ctx, &q[idx[c]], (const float (*)[3])hull, n_hull, pref, pts, axes + c * 3 * mw);
-            free(pts);
-        }
+        failed = !cq || !cidx || !cfront || !cvis;
     }
     for (int s = 0; s < ns && !failed && m; s++) {
         size_t k = 0;
-        for (size_t c = 0; c < m; c++) {
-            const size_t i = idx[c];
-            uint64_t any = 0;
-            for (size_t w = 0; w < mw; w++) {
-                uint64_t msk = 0;
-                for (int a = 0; a < 3; a++)
-                    if (set_axes[s] >> a & 1u) msk |= axes[(c * 3 + (size_t)a) * mw + w];
-                cfront[k * mw + w] = front[i * mw + w] & msk;
-                any |= cfront[k * mw + w];
+        for (int t = 0; t < nt; t++)
+            for (size_t c = 0; c < kept_n[t]; c++) {
+                const size_t i = kept_i[t][c];
+                const uint64_t *ax = kept_ax[t] + c * rec;
+                uint64_t any = 0;
+                for (size_t w = 0; w < mw; w++) {
+                    uint64_t msk = 0;
+                    for (int a = 0; a < 3; a++)
+                        if (set_axes[s] >> a & 1u) msk |= ax[(size_t)a * mw + w];
+                    cfront[k * mw + w] = front[i * mw + w] & msk;
+                    any |= cfront[k * mw + w];
+                }
+                if (!any) continue;
+                cq[k] = q[i];
+                cq[k].prim = ms_ctx_skip_prim(&set_ctx[s], scene_prim[i]);
+                cidx[k++] = i;
             }
-            if (!any) continue;
-            cq[k] = q[i];
-            cq[k].prim = ms_ctx_skip_prim(&set_ctx[s], scene_prim[i]);
-            cidx[k++] = i;
-        }
         if (!k) continue;
         if (whole ? sm->visibility_all(set_state[s], &set_ctx[s], cq, k, cfront, cvis, counters)
                   : sm->visibility(set_state[s], &set_ctx[s], cq, (int)k, cfront, cvis, counters)) {
@@ -188,11 +191,14 @@ int ms_exact_split_visibility(const ms_shadow_method *sm, void *state, const ms_
             for (size_t w = 0; w < mw; w++) vis[cidx[c] * mw + w] |= cvis[c * mw + w];
     }
     free(sel);
-    free(other);
+    for (int t = 0; kept_i && t < nt; t++) free(kept_i[t]);
+    for (int t = 0; kept_ax && t < nt; t++) free(kept_ax[t]);
+    free(kept_i);
+    free(kept_ax);
+    free(kept_n);
+    free(kept_cap);
     free(cq);
-    free(idx);
     free(cidx);
-    free(axes);
     free(cfront);
     free(cvis);
     return failed ? -1 : 0;
