@@ -27,6 +27,12 @@ ASSETS = {
     "ogre": ("ogre.obj", 1, 1, "game character, 124K triangles"),
     "igea": ("igea.ply", 1, 1, "scanned head, 269K triangles in triangle strips"),
     "beast": ("beast.obj", 1, 1, "game model, 32K quads (65K triangles)"),
+    "bunny": ("stanford-bunny.obj", 1, 1, "scanned statue, 69K triangles"),
+    "dragon": ("dragon.obj", 1, 1, "scanned statue, 100K triangles"),
+    "buddha": ("buddha.obj", 1, 1, "scanned statue, 113K triangles"),
+    "armadillo": ("armadillo.obj", 1, 1, "scanned statue, 50K triangles"),
+    "bird": ("bird.obj", 2, 1, "game model, 61K triangles"),
+    "aspen": ("tree_aspen.obj", 1, 1, "tree with leaf cards, open surfaces"),
 }
 
 

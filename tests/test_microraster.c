@@ -317,6 +317,67 @@ static void test_sponza_agrees(void **state) { (void)state; real_scene("dabrovic
 static void test_sibenik_agrees(void **state) { (void)state; real_scene("sibenik/sibenik.json", 96); }
 static void test_bunny_agrees(void **state) { (void)state; real_scene("stanford-bunny/stanford-bunny.json", 96); }
 
+static uint64_t stat_counter(const ms_stats *st, const char *name)
+{
+    for (int c = 0; c < st->n_counters; c++)
+        if (!strcmp(st->counter_name[c], name)) return st->counter[c];
+    fail_msg("no counter %s", name);
+    return 0;
+}
+
+/* The pixel-class counters of the block traversal against the frame's own planes: a pixel is lit when V = 1,
+ * in umbra when V = 0 with front samples, in penumbra otherwise, facing away with no front sample (the
+ * frame's front count); the classes' tests and rasterizations add up to the method's totals, and only
+ * penumbra and umbra pixels rasterize. On the bunny (a closed scanned mesh with its shadow on a ground) at
+ * 256 and 1024 samples. */
+static void test_pixel_class_counters(void **state)
+{
+    (void)state;
+    if (!tu_have_shared_scenes()) skip();
+    char path[4096], err[512];
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(tu_shared_scene(path, sizeof path, "stanford-bunny/stanford-bunny.json"), &sc, err, sizeof err), 0);
+    const int samples[] = { 256, 1024 };
+    for (int si = 0; si < 2; si++) {
+        ms_frame f;
+        ms_render_options o;
+        tu_render_options_default(&o);
+        o.method = "scanline";
+        o.samples = samples[si];
+        o.width = o.height = 64;
+        tu_render_ok(&sc, &o, &f);
+        uint64_t lit = 0, umbra = 0, pen = 0, away = 0;
+        for (size_t i = 0; i < (size_t)f.width * (size_t)f.height; i++) {
+            if (f.vis[i] < 0.0f) continue;
+            if (!f.front[i]) away++;
+            else if (f.vis[i] == 1.0f) lit++;
+            else if (f.vis[i] == 0.0f) umbra++;
+            else pen++;
+        }
+        const ms_stats *st = &f.stats;
+        assert_int_equal(stat_counter(st, "pixels_traced_edge_on"), 0);
+        assert_int_equal(stat_counter(st, "pixels_lit"), lit);
+        assert_int_equal(stat_counter(st, "pixels_umbra"), umbra);
+        assert_int_equal(stat_counter(st, "pixels_penumbra"), pen);
+        assert_int_equal(stat_counter(st, "pixels_facing_away"), away);
+        assert_true(pen > 0 && umbra > 0 && lit > 0);
+        const uint64_t tests = stat_counter(st, "tests_lit") + stat_counter(st, "tests_umbra") + stat_counter(st, "tests_penumbra");
+        const uint64_t rast = stat_counter(st, "rasterized_lit") + stat_counter(st, "rasterized_umbra") +
+                              stat_counter(st, "rasterized_penumbra");
+        assert_int_equal(tests, stat_counter(st, "tri_pixel_tests"));
+        assert_int_equal(rast, stat_counter(st, "triangles_rasterized"));
+        /* A rasterization that cleared a sample leaves the pixel short of lit; one that cleared none is possible
+         * anywhere, but a lit pixel rasterizes only such. */
+        assert_true(stat_counter(st, "rasterized_penumbra") > 0 && stat_counter(st, "rasterized_umbra") > 0);
+        printf("bunny N=%d: lit %llu, umbra %llu, penumbra %llu, facing away %llu pixels; tests per pixel %.1f / %.1f / %.1f\n",
+               samples[si], (unsigned long long)lit, (unsigned long long)umbra, (unsigned long long)pen, (unsigned long long)away,
+               (double)stat_counter(st, "tests_lit") / (double)lit, (double)stat_counter(st, "tests_umbra") / (double)umbra,
+               (double)stat_counter(st, "tests_penumbra") / (double)pen);
+        ms_frame_free(&f);
+    }
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -329,6 +390,7 @@ int main(void)
         cmocka_unit_test(test_sponza_agrees),
         cmocka_unit_test(test_sibenik_agrees),
         cmocka_unit_test(test_bunny_agrees),
+        cmocka_unit_test(test_pixel_class_counters),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

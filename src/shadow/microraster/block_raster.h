@@ -44,6 +44,9 @@ typedef struct ms_block_input {
     void *buf[MS_BLOCK_LANES];
     uint32_t skip[MS_BLOCK_LANES];
     ms_block_leaf_cache *cache;   /* NULL: none */
+    /* Per lane, added to (NULL: not counted): the (triangle, pixel) pairs that reached the leaf tests and the
+     * triangles rasterized, for the cost of each pixel class (microraster.c). */
+    uint32_t *lane_tests, *lane_rast;
 } ms_block_input;
 
 enum {

@@ -632,6 +632,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         if ((front >> e & 1) && !MS_KFN(br_covers)((const MS_WORD *)in->buf[l], ix0[e], ix1[e], iy0[e], iy1[e])) { L->c_cov++; continue; }
         L->c_rast++;
         L->rasterized |= 1u << l;
+        if (in->lane_rast) in->lane_rast[l]++;
         /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel;
          * a lane the set-up left to the kernel likewise. */
         if (s->rows && !(su.kernel >> e & 1) && !ms_frame_alpha_tested(in->frame[l], t)) {
@@ -654,6 +655,8 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
     if (!cover) return;
     L->c_rast += (uint64_t)ms_bt_popcount16(cover);
     L->rasterized |= cover;
+    if (in->lane_rast)
+        for (unsigned p = cover; p; p &= p - 1) in->lane_rast[__builtin_ctz(p)]++;
     unsigned by_kernel = cover;
     if (s->rows && ms_bt_popcount16(cover) >= BR_LANE_SETUP_MIN) {
         /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel. */
@@ -753,6 +756,8 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
             }
         }
         if (!np) continue;
+        if (in->lane_tests)
+            for (int e = 0; e < np; e++) in->lane_tests[pl[e]]++;
         for (int e = np; e % MS_BLOCK_LANES; e++) { pt[e] = pt[0]; pl[e] = pl[0]; }   /* valid operands, unused */
         for (int e = 0; e < np; e += MS_BLOCK_LANES)
             MS_KFN(br_pairs)(s, &L, pt + e, pl + e, np - e < MS_BLOCK_LANES ? np - e : MS_BLOCK_LANES);
@@ -763,6 +768,8 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
             for (int q = 0; q < nskip; q++)
                 if (skip_tri[q] == g + (uint32_t)j) lanes &= ~skip_lane[q];
             tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
+            if (in->lane_tests)
+                for (unsigned p = lanes; p; p &= p - 1) in->lane_tests[__builtin_ctz(p)]++;
             pt[0] = j;
             if (lanes) MS_KFN(br_pairs)(s, &L, pt, pl, (int)lanes);
         }

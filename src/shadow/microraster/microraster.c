@@ -31,6 +31,7 @@
 #include "visibility/receiver.h"
 #include "visibility/alpha.h"
 #include <math.h>
+#include <omp.h>
 #include "core/vec.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,10 +59,19 @@ typedef struct mr_state {
 static const char *const block_counter_names[] = {
     "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "leaf_pixels_culled", "tri_pixel_tests",
     "culled_depth", "culled_rect", "culled_corner_rays", "culled_coverage", "triangles_rasterized",
-    "pixels_early_out", "rect_shrinks", "shared_setups", "shared_setups_clipped", "pixels_traced_edge_on", "interior_rasterized", "interior_pixels_emptied"
+    "pixels_early_out", "rect_shrinks", "shared_setups", "shared_setups_clipped", "pixels_traced_edge_on", "interior_rasterized", "interior_pixels_emptied",
+    "pixels_lit", "pixels_umbra", "pixels_penumbra", "pixels_facing_away", "tests_lit", "tests_umbra", "tests_penumbra",
+    "rasterized_lit", "rasterized_umbra", "rasterized_penumbra", "ns_lit", "ns_umbra", "ns_penumbra"
 };
 /* The interior boxes' pass adds to every counter above (its work is work) and to its own two. */
-enum { MR_BLOCK_EDGE_ON = MS_BR_COUNTERS, MR_INTERIOR_RASTERIZED, MR_INTERIOR_EMPTIED, MR_BLOCK_COUNTERS };
+/* Then where the time goes, by the class of each pixel's answer (lit: every front sample visible; umbra:
+ * none; penumbra: some; facing away: no front sample, decided before any traversal): the pixels, their
+ * (triangle, pixel) tests and rasterizations (interior boxes included), and the nanoseconds of their blocks'
+ * traversals, each block's shared among its pixels in proportion to 1 + tests + rasterizations. */
+enum { MR_BLOCK_EDGE_ON = MS_BR_COUNTERS, MR_INTERIOR_RASTERIZED, MR_INTERIOR_EMPTIED, MR_PIXELS_CLASS,
+       MR_FACING_AWAY = MR_PIXELS_CLASS + 3, MR_TESTS_CLASS, MR_RAST_CLASS = MR_TESTS_CLASS + 3,
+       MR_NS_CLASS = MR_RAST_CLASS + 3, MR_BLOCK_COUNTERS = MR_NS_CLASS + 3 };
+_Static_assert(MR_BLOCK_COUNTERS <= MS_MAX_COUNTERS, "counters");
 
 static int mr_create_kernel(ms_kernel_id id, const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
 {
@@ -153,7 +163,8 @@ static int mr_visibility_pixel(const mr_state *s, const ms_render_ctx *ctx, cons
 
 /* The block's pass over the interior boxes (occluders.h): the same traversal over their BVH, with no
  * receiver's triangle to skip and no alpha test; the pixels it empties leave the block. */
-static void interior_pass(const mr_state *s, const ms_render_ctx *ctx, ms_block_input *in, size_t mw, uint64_t *cnt)
+static void interior_pass(const mr_state *s, const ms_render_ctx *ctx, ms_block_input *in, int *orig, size_t mw,
+                          uint64_t *cnt)
 {
     ms_block_input vin = *in;
     vin.cache = NULL;   /* the cache's leaves are the scene BVH's */
@@ -173,9 +184,27 @@ static void interior_pass(const mr_state *s, const ms_render_ctx *ctx, ms_block_
         in->frame[n] = in->frame[l];
         in->buf[n] = in->buf[l];
         in->skip[n] = in->skip[l];
+        orig[n] = orig[l];
         n++;
     }
     in->n = n;
+}
+
+/* The pixel-class counters of one block's `n` lanes (MR_PIXELS_CLASS): each lane's class from its front mask and
+ * its final buffer, its work, and its share of the block's seconds. */
+static void count_classes(uint64_t *cnt, int n, const uint64_t *const *front, uint64_t *const *buf, const uint32_t *tests,
+                          const uint32_t *rast, double seconds, size_t mw)
+{
+    double weight[MS_BLOCK_LANES], total = 0.0;
+    for (int l = 0; l < n; l++) total += weight[l] = 1.0 + tests[l] + rast[l];
+    for (int l = 0; l < n; l++) {
+        const int v = ms_mask_count(buf[l], (int)mw), f = ms_mask_count(front[l], (int)mw);
+        const int c = v == f ? 0 : v == 0 ? 1 : 2;
+        cnt[MR_PIXELS_CLASS + c]++;
+        cnt[MR_TESTS_CLASS + c] += tests[l];
+        cnt[MR_RAST_CLASS + c] += rast[l];
+        cnt[MR_NS_CLASS + c] += (uint64_t)(seconds * 1e9 * weight[l] / total + 0.5);
+    }
 }
 
 /* The queries grouped by 4x4 pixel block (at most 16 to a group), or 16 consecutive ones when they come
@@ -203,8 +232,16 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
         ms_raster_frame frames[MS_BLOCK_LANES];
         ms_alpha_pixel aps[MS_BLOCK_LANES];
         ms_render_ctx own[MS_BLOCK_LANES];   /* an outlined light: the lanes' own contexts (aps[] point at them) */
+        /* Per lane of the block as formed (orig: a lane's index there after the interior pass compacts). */
+        const uint64_t *lane_front[MS_BLOCK_LANES];
+        uint32_t tests[MS_BLOCK_LANES] = { 0 }, rast[MS_BLOCK_LANES] = { 0 };
+        uint32_t all_tests[MS_BLOCK_LANES] = { 0 }, all_rast[MS_BLOCK_LANES] = { 0 };
+        uint64_t *lane_buf[MS_BLOCK_LANES];
+        int orig[MS_BLOCK_LANES];
         in.n = 0;
         in.cache = &cache;
+        in.lane_tests = tests;
+        in.lane_rast = rast;
         const int end = ms_block_group_end(ctx, q, order, nq, g);
         for (int e = g; e < end; e++) {
             const int i = order[e];
@@ -212,14 +249,36 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
             const int go = mr_start(ms_ctx_for_query(ctx, &q[i], &own[in.n]), &q[i], front + (size_t)i * mw, buf,
                                     &frames[in.n], &aps[in.n], &pts, &cnt[MR_BLOCK_EDGE_ON]);
             if (go < 0) { rc = -1; break; }
-            if (!go) continue;
+            if (!go) {
+                cnt[MR_FACING_AWAY] += ms_mask_count(front + (size_t)i * mw, (int)mw) == 0;
+                continue;
+            }
             in.frame[in.n] = &frames[in.n];
             in.buf[in.n] = buf;
             in.skip[in.n] = q[i].prim;
+            lane_front[in.n] = front + (size_t)i * mw;
+            lane_buf[in.n] = buf;
+            orig[in.n] = in.n;
             in.n++;
         }
-        if (!rc && in.n && ctx->interior) interior_pass(s, ctx, &in, mw, cnt);
-        if (!rc && in.n) s->block(&in, ctx->bvh, &s->shallow, s->raster, ctx->near, ctx->far, cnt, s->block_flags);
+        const int formed = in.n;
+        const double t0 = formed ? omp_get_wtime() : 0.0;
+        if (!rc && in.n && ctx->interior) {
+            interior_pass(s, ctx, &in, orig, mw, cnt);   /* lanes counted as formed, then compacted */
+            for (int l = 0; l < formed; l++) {
+                all_tests[l] = tests[l];
+                all_rast[l] = rast[l];
+                tests[l] = rast[l] = 0;
+            }
+        }
+        if (!rc && in.n) {
+            s->block(&in, ctx->bvh, &s->shallow, s->raster, ctx->near, ctx->far, cnt, s->block_flags);
+            for (int l = 0; l < in.n; l++) {
+                all_tests[orig[l]] += tests[l];
+                all_rast[orig[l]] += rast[l];
+            }
+        }
+        if (!rc && formed) count_classes(cnt, formed, lane_front, lane_buf, all_tests, all_rast, omp_get_wtime() - t0, mw);
         g = end;
     }
     free(order);
