@@ -538,8 +538,9 @@ typedef struct ms_render_options {
                              * the micro-raster methods) */
     uint64_t max_memory;    /* the memory budget in bytes (ms_memory_budget); 0: the default */
     ms_stream_mode stream;  /* ms_render_outputs only (ms_render always holds the whole frame) */
-    int stream_rows;        /* streamed: rows per band, a multiple of MS_TILE_SIZE; 0: about 512 tiles' worth, fewer
-                             * (down to one tile row) when the budget needs */
+    int stream_rows;        /* streamed: rows per band of the rendered frame (with anti-aliasing s times the output's,
+                             * s = sqrt aa), a multiple of s * MS_TILE_SIZE; 0: about 512 tiles' worth, fewer (down to
+                             * s tile rows) when the budget needs */
     /* Pixel anti-aliasing (docs/antialiasing.md): K = aa primary samples per pixel (1, 4, 9 or 16; 0: the
      * scene's render.aa, else 1), on the s x s grid of the pixel's strata centres (s = sqrt K). Each has its own
      * hit, front mask and shadow query (every method answers each as a pixel of an s-times larger frame, on
@@ -601,7 +602,7 @@ typedef struct ms_stats {
                                     * the reference tracer (docs/culling.md), summed over the lights */
     uint64_t memory_need;          /* bytes the call estimated it would allocate, checked against its memory budget */
     uint64_t memory_budget;        /* that budget (max_memory, or the default: ms_memory_budget) */
-    int stream_rows;               /* ms_render_outputs: the rows of a band when the outputs were streamed, else 0 */
+    int stream_rows;               /* ms_render_outputs: the output rows of a band when the outputs were streamed, else 0 */
 } ms_stats;
 
 typedef struct ms_frame {

@@ -220,9 +220,16 @@ static void test_bad_values(void **st)
     o.samples = 256;
     assert_int_not_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
     assert_non_null(strstr(err, "aa_split"));
-    o.width = MS_MAX_IMAGE_SIZE / 2;   /* too wide once 4 times larger */
+    /* The output is at most MS_MAX_IMAGE_SIZE wide; the frame rendered for it may be 4 times that. */
+    o.width = MS_MAX_IMAGE_SIZE;
+    o.height = 1;
     o.aa = 16;
     o.aa_split = 0;
+    assert_int_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
+    assert_int_equal(f.width, MS_MAX_IMAGE_SIZE);
+    assert_int_equal(f.height, 1);
+    ms_frame_free(&f);
+    o.width = MS_MAX_IMAGE_SIZE + 1;
     assert_int_not_equal(ms_render(&sc, &o, &f, err, sizeof err), 0);
     assert_non_null(strstr(err, "width and height"));
     ms_scene_free(&sc);

@@ -174,6 +174,44 @@ static void test_streamed_equals_whole(void **state)
     ms_scene_free(&sc);
 }
 
+/* Anti-aliased frames streamed: each band of the s-times larger frame is resolved into whole output rows (several
+ * bands, the last short), byte for byte the whole frame's files, for aa 4, 9 and 16, on the grid pattern
+ * (scanline) and the interleaved one (raytrace: its filter reads rows beyond a band); a band size that is not
+ * a multiple of s tiles is refused. */
+static void test_streamed_antialiased(void **state)
+{
+    (void)state;
+    const char *dir = tu_tmpdir("test_stream_aa");
+    ms_scene sc;
+    two_light_scene(&sc);
+    ms_render_options o;
+    options(&o);
+    o.width = 70;
+    o.height = 90;   /* rendered 140 x 180, 210 x 270, 280 x 360 */
+    char err[1024], tag[32];
+    ms_stats whole, streamed;
+    for (int s = 2; s <= 4; s++)
+        for (int exr_rgb = 0; exr_rgb < 2; exr_rgb++) {
+            o.aa = s * s;
+            o.method = exr_rgb ? NULL : "raytrace";
+            o.pattern = exr_rgb ? MS_PATTERN_GRID : MS_PATTERN_INTERLEAVED;
+            o.stream_rows = 2 * s * MS_TILE_SIZE;   /* 32 output rows a band */
+            o.stream = MS_STREAM_OFF;
+            snprintf(tag, sizeof tag, "whole%d", s);
+            if (render_to(&sc, &o, dir, tag, exr_rgb, &whole, err, sizeof err)) fail_msg("whole, aa %d: %s", s * s, err);
+            o.stream = MS_STREAM_ON;
+            char tag2[32];
+            snprintf(tag2, sizeof tag2, "streamed%d", s);
+            if (render_to(&sc, &o, dir, tag2, exr_rgb, &streamed, err, sizeof err)) fail_msg("streamed, aa %d: %s", s * s, err);
+            assert_int_equal(streamed.stream_rows, 32);
+            assert_same_outputs(dir, tag, tag2, exr_rgb);
+            o.stream_rows = s * MS_TILE_SIZE + MS_TILE_SIZE;   /* not whole output blocks */
+            assert_int_equal(render_to(&sc, &o, dir, "bad", exr_rgb, &streamed, err, sizeof err), MS_ERR_INVALID);
+            assert_non_null(strstr(err, "stream_rows"));
+        }
+    ms_scene_free(&sc);
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
@@ -258,6 +296,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_streamed_equals_whole),
+        cmocka_unit_test(test_streamed_antialiased),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_cli),
     };

@@ -153,9 +153,13 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
          * the miss test, 16), textured lights' mean texels, the filtered V, S, S_spec per light; the writers' buffers (frame_stream.c): an EXR's
          * 16-row block of every channel (at most R, G, B and V, S twice per light over the outputs) as given,
          * packed and compressed, and the exposure's 65536-bucket histogram. */
-        ms_need_add(need, "finishing (filter, exposure)", mul(band_px, 36u + (s->textured ? mul(12u, s->nl) : 0) +
-                                                                 (s->filter ? mul(12u, s->nl) : 0)));
-        ms_need_add(need, "streamed outputs", mul(mul((uint64_t)s->W, 16u * 4u * 3u), 3u + 4u * (uint64_t)s->nl) + (1u << 20));
+        /* Anti-aliased, the records and the band written are the resolved band's (band_px / s^2 pixels), which
+         * holds rgb and per light V, S, S_spec and front (12 + 14 nl bytes a pixel) besides. */
+        const uint64_t as = s->aa_s > 1 ? (uint64_t)s->aa_s : 1u, out_px = band_px / (as * as) + 1u;
+        ms_need_add(need, "finishing (filter, exposure)", mul(band_px, 4u + (s->textured ? mul(12u, s->nl) : 0) +
+                                                                 (s->filter ? mul(12u, s->nl) : 0)) +
+                                                             mul(out_px, 32u + (as > 1 ? 12u + mul(14u, s->nl) : 0)));
+        ms_need_add(need, "streamed outputs", mul(mul((uint64_t)s->W / as + 1u, 16u * 4u * 3u), 3u + 4u * (uint64_t)s->nl) + (1u << 20));
     } else
         ms_need_add(need, "finishing (filter, exposure)", mul(P, finish_pp));
     ms_need_add(need, "threads", mul((uint64_t)(s->threads > 0 ? s->threads : 1), PER_THREAD + 512u * mw8) + FIXED);
@@ -179,9 +183,10 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
 int ms_frame_band_rows(const ms_frame_shape *s, int rows, uint64_t budget)
 {
     ms_frame_shape t = *s;
-    for (t.band_rows = rows; t.band_rows > MS_TILE_SIZE; t.band_rows = t.band_rows / 2 / MS_TILE_SIZE * MS_TILE_SIZE)
+    const int unit = (s->aa_s > 1 ? s->aa_s : 1) * MS_TILE_SIZE;
+    for (t.band_rows = rows; t.band_rows > unit; t.band_rows = t.band_rows / 2 / unit * unit)
         if (ms_frame_need(&t, NULL) <= budget) return t.band_rows;
-    return MS_TILE_SIZE;
+    return unit;
 }
 
 /* One line of the parts, largest first: "frame planes 9.0 GiB, per-light planes 3.5 GiB". */

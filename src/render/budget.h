@@ -52,10 +52,12 @@ typedef struct ms_frame_shape {
      * frame is not streamed, stream_rows is what a streamed one would hold (0: it cannot be streamed), for the
      * hint. */
     int band_rows, stream_rows;
+    int aa_s;               /* anti-aliasing: W, H are s times the output's (0 or 1: none); a band is resolved
+                             * into output rows before it is written, and holds a multiple of s tiles' rows */
 } ms_frame_shape;
 
-/* Streamed: the largest band of rows (rows, then halves of it, each a multiple of MS_TILE_SIZE) whose frame fits
- * budget, or MS_TILE_SIZE when none does. */
+/* Streamed: the largest band of rows (rows, then halves of it, each a multiple of MS_TILE_SIZE times the
+ * anti-aliasing scale aa_s) whose frame fits budget, or the smallest such band when none does. */
 int ms_frame_band_rows(const ms_frame_shape *s, int rows, uint64_t budget);
 
 /* The frame's estimated peak in bytes, its parts into need (may be NULL). */

@@ -2,19 +2,11 @@
 #include "frame_aa.h"
 #include <stdlib.h>
 
-int ms_frame_aa_resolve(ms_frame *f, int s, int front_scale)
+void ms_frame_aa_resolve_into(const ms_frame *f, int s, int front_scale, ms_frame *out)
 {
     const int W = f->width / s, H = f->height / s, Ws = f->width;
     const size_t npix = (size_t)W * H, nsub = (size_t)f->width * f->height;
     const size_t nl = f->n_lights > 0 ? (size_t)f->n_lights : 1;
-    float *rgb = malloc(npix * 3 * sizeof *rgb);
-    float *vis = malloc(nl * npix * sizeof *vis), *shadow = malloc(nl * npix * sizeof *shadow);
-    float *spec = malloc(nl * npix * sizeof *spec);
-    uint16_t *front = malloc(nl * npix * sizeof *front);
-    if (!rgb || !vis || !shadow || !spec || !front) {
-        free(rgb); free(vis); free(shadow); free(spec); free(front);
-        return -1;
-    }
     const double inv_k = 1.0 / (double)(s * s);
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
@@ -26,10 +18,11 @@ int ms_frame_aa_resolve(ms_frame *f, int s, int front_scale)
                     const float *src = f->rgb + 3 * ((size_t)(y * s + j) * Ws + (size_t)(x * s + i));
                     for (int k = 0; k < 3; k++) c[k] += src[k];
                 }
-            for (int k = 0; k < 3; k++) rgb[3 * o + k] = (float)(c[k] * inv_k);
+            for (int k = 0; k < 3; k++) out->rgb[3 * o + k] = (float)(c[k] * inv_k);
             for (size_t l = 0; l < nl; l++) {
-                const float *v = f->vis + l * nsub, *sh = f->shadow + l * nsub, *sp = f->shadow_spec + l * nsub;
-                const uint16_t *fr = f->front + l * nsub;
+                const float *v = f->vis + l * nsub, *sh = f->shadow + l * nsub;
+                const float *sp = f->shadow_spec ? f->shadow_spec + l * nsub : NULL;
+                const uint16_t *fr = f->front ? f->front + l * nsub : NULL;
                 double sv = 0.0, ss = 0.0, ssp = 0.0, sf = 0.0;
                 int hits = 0;
                 for (int j = 0; j < s; j++)
@@ -38,30 +31,49 @@ int ms_frame_aa_resolve(ms_frame *f, int s, int front_scale)
                         if (v[q] < 0.0f) continue;   /* a miss: no V, S of its own */
                         sv += v[q];
                         ss += sh[q];
-                        ssp += sp[q];
-                        sf += fr[q];
+                        if (sp) ssp += sp[q];
+                        if (fr) sf += fr[q];
                         hits++;
                     }
                 const size_t d = l * npix + o;
                 if (!hits) {
-                    vis[d] = shadow[d] = spec[d] = -1.0f;
-                    front[d] = 0;
+                    out->vis[d] = out->shadow[d] = -1.0f;
+                    if (sp) out->shadow_spec[d] = -1.0f;
+                    if (fr) out->front[d] = 0;
                     continue;
                 }
-                vis[d] = (float)(sv / hits);
-                shadow[d] = (float)(ss / hits);
-                spec[d] = (float)(ssp / hits);
-                const double fm = sf / hits * front_scale + 0.5;
-                front[d] = (uint16_t)(fm < 65535.0 ? fm : 65535.0);
+                out->vis[d] = (float)(sv / hits);
+                out->shadow[d] = (float)(ss / hits);
+                if (sp) out->shadow_spec[d] = (float)(ssp / hits);
+                if (fr) {
+                    const double fm = sf / hits * front_scale + 0.5;
+                    out->front[d] = (uint16_t)(fm < 65535.0 ? fm : 65535.0);
+                }
             }
         }
+    out->width = W;
+    out->height = H;
+    out->n_lights = f->n_lights;
+    out->exposure = f->exposure;
+    out->stats = f->stats;
+}
+
+int ms_frame_aa_resolve(ms_frame *f, int s, int front_scale)
+{
+    const size_t npix = (size_t)(f->width / s) * (size_t)(f->height / s);
+    const size_t nl = f->n_lights > 0 ? (size_t)f->n_lights : 1;
+    ms_frame r = *f;
+    r.rgb = malloc(npix * 3 * sizeof *r.rgb);
+    r.vis = malloc(nl * npix * sizeof *r.vis);
+    r.shadow = malloc(nl * npix * sizeof *r.shadow);
+    r.shadow_spec = malloc(nl * npix * sizeof *r.shadow_spec);
+    r.front = malloc(nl * npix * sizeof *r.front);
+    if (!r.rgb || !r.vis || !r.shadow || !r.shadow_spec || !r.front) {
+        free(r.rgb); free(r.vis); free(r.shadow); free(r.shadow_spec); free(r.front);
+        return -1;
+    }
+    ms_frame_aa_resolve_into(f, s, front_scale, &r);
     free(f->rgb); free(f->vis); free(f->shadow); free(f->shadow_spec); free(f->front);
-    f->rgb = rgb;
-    f->vis = vis;
-    f->shadow = shadow;
-    f->shadow_spec = spec;
-    f->front = front;
-    f->width = W;
-    f->height = H;
+    *f = r;
     return 0;
 }

@@ -10,4 +10,8 @@
  * front_scale (1 when every hit has the pixel's N samples, s*s when they split them). 0, or -1 out of memory
  * (f unchanged). */
 int ms_frame_aa_resolve(ms_frame *f, int s, int front_scale);
+/* The same into out's planes (allocated by the caller for f's width / s by height / s, light by light), for a
+ * streamed band (frame_stream.c); f's shadow_spec or front may be NULL (then out's are not written). Sets out's
+ * size, lights, exposure and stats from f. */
+void ms_frame_aa_resolve_into(const ms_frame *f, int s, int front_scale, ms_frame *out);
 #endif

@@ -328,9 +328,10 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
     }
     const int W_out = opt->width > 0 ? opt->width : scene->camera.width;
     const int H_out = opt->height > 0 ? opt->height : scene->camera.height;
-    if (W_out < 1 || H_out < 1 || W_out > MS_MAX_IMAGE_SIZE / aa_s || H_out > MS_MAX_IMAGE_SIZE / aa_s) {
-        if (aa_s > 1) snprintf(err, errlen, "width and height must be in [1, %d] with aa %d", MS_MAX_IMAGE_SIZE / aa_s, aa);
-        else snprintf(err, errlen, "width and height must be in [1, %d]", MS_MAX_IMAGE_SIZE);
+    /* The output's size; the s-times larger frame the methods render may exceed it (streamed, it is held a band
+     * at a time, and the memory budget decides either way). */
+    if (W_out < 1 || H_out < 1 || W_out > MS_MAX_IMAGE_SIZE || H_out > MS_MAX_IMAGE_SIZE) {
+        snprintf(err, errlen, "width and height must be in [1, %d]", MS_MAX_IMAGE_SIZE);
         goto fail;
     }
     const int W = W_out * aa_s, H = H_out * aa_s;
@@ -366,17 +367,19 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
          * cores); fewer rows when the budget needs. Not for frame-level methods (their receivers are the
          * whole frame). */
         const int tiles_x = (W + TILE - 1) / TILE, want = 16 * j->threads > 512 ? 16 * j->threads : 512;
-        /* Anti-aliasing resolves the s-times larger frame once it is whole (frame_aa.c): not banded yet. */
-        const int streamable = !sm->visibility_all && aa_s == 1;
-        if (opt->stream_rows < 0 || opt->stream_rows % TILE) {
-            snprintf(err, errlen, "stream_rows %d is not a multiple of %d", opt->stream_rows, TILE);
+        /* Anti-aliased, a band holds whole blocks of output rows (frame_stream.c resolves each band; the EXR
+         * writer takes 16-row blocks): its rows of the s-times larger frame are a multiple of s tiles. */
+        const int unit = aa_s * TILE;
+        fs.aa_s = aa_s;
+        const int streamable = !sm->visibility_all;
+        if (opt->stream_rows < 0 || opt->stream_rows % unit) {
+            snprintf(err, errlen, "stream_rows %d is not a multiple of %d%s", opt->stream_rows, unit, aa_s > 1 ? " (with anti-aliasing: the tile times its scale)" : "");
             goto fail;
         }
-        fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : TILE * ((want + tiles_x - 1) / tiles_x);
+        fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : unit * ((want + tiles_x * (unit / TILE) - 1) / (tiles_x * (unit / TILE)));
         const uint64_t budget = ms_memory_budget(opt->max_memory);
         if (stream == MS_STREAM_ON && !streamable) {
-            if (aa_s > 1) snprintf(err, errlen, "streamed outputs: anti-aliasing (aa %d) resolves the whole frame; stream with aa 1", aa);
-            else snprintf(err, errlen, "streamed outputs: the method takes the whole frame at once (its receivers are all of the frame's pixels)");
+            snprintf(err, errlen, "streamed outputs: the method takes the whole frame at once (its receivers are all of the frame's pixels)");
             goto fail;
         }
         /* AUTO streams only when that fits where the whole frame does not: else the whole frame's refusal names
@@ -1043,4 +1046,10 @@ void ms_frame_job_size(const ms_frame_job *j, int *W, int *H)
 {
     *W = j->W;
     *H = j->H;
+}
+
+void ms_frame_job_aa(const ms_frame_job *j, int *s, int *front_scale)
+{
+    *s = j->aa_s;
+    *front_scale = j->aa_split ? j->aa_s * j->aa_s : 1;
 }

@@ -9,8 +9,11 @@
  * for a whole frame (then render and finish it as usual). */
 int ms_frame_job_create_stream(const ms_scene *scene, const ms_render_options *opt, int stream, ms_frame_job **job,
                                int *band_rows, char *err, size_t errlen);
-/* The frame's size. */
+/* The frame's size: the rendered frame's, s times the output's with anti-aliasing. */
 void ms_frame_job_size(const ms_frame_job *job, int *W, int *H);
+/* Anti-aliasing: *s the frame's scale (1: none) and the front counts' scale of its resolve (frame_aa.h). A
+ * banded job's bands are whole output rows (a multiple of s rows of the frame). */
+void ms_frame_job_aa(const ms_frame_job *job, int *s, int *front_scale);
 /* A banded job: renders rows y0 .. y0 + rows (the rows after those rendered before; y0 a multiple of
  * MS_TILE_SIZE, rows at most the band's and a multiple of MS_TILE_SIZE unless the frame ends there) for every
  * light. 0, or -1 / MS_ERR_CANCELLED with a message. */
