@@ -374,7 +374,7 @@ int main(int argc, char **argv)
             for (int o = 0; o < 2; o++) {
                 if (!outs[o]) continue;
                 fprintf(outs[o], "| %s | %zu |", base_name(scenes[s]), sc.n_tris);
-                for (int m = 0; m < n_methods; m++) fprintf(outs[o], " %.2f |", secs[m]);
+                for (int m = 0; m < n_methods; m++) fprintf(outs[o], " %.3f |", secs[m]);
                 for (int m = 0; m < n_methods; m++) fprintf(outs[o], scan >= 0 ? " %.2f |" : " - |", scan >= 0 ? secs[m] / secs[scan] : 0.0);
                 for (int m = 0; m < n_methods; m++) fprintf(outs[o], emb >= 0 ? " %.2f |" : " - |", emb >= 0 ? secs[m] / secs[emb] : 0.0);
                 fprintf(outs[o], " %s | %.1f%% | %.4f | %.2f%% |\n", agree, 100.0 * s_cost, mean_sv, 100.0 * big_sv);

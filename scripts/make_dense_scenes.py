@@ -5,10 +5,12 @@ a 72K-triangle foliage scene, each as OUT/NAME/NAME.json with its meshes beside 
 
     scripts/make_dense_scenes.py OUT [--assets DIR]
 
-The scanned meshes are not part of the repository: DIR holds them as fetched from the public collection of
-common 3D test models (github alecjacobson/common-3d-test-models, data/): nefertiti.obj, ogre.obj,
-beast.obj, igea.ply, and horse.ply (from horse.zip). Missing ones are skipped with a message; the generated
-scenes (grids, foliage) need nothing. Each mesh is rewritten as a Y-up OBJ standing on y = 0 (its own
+The meshes are not part of the repository: DIR holds them as fetched from public repositories: the collection
+of common 3D test models (github alecjacobson/common-3d-test-models, data/): nefertiti.obj, ogre.obj,
+beast.obj, igea.ply, horse.ply (from horse.zip) and stanford-bunny.obj; dragon.obj (100K triangles) from
+github LukeMcCulloch/meshes; buddha.obj, bird.obj and tree_aspen.obj from github nshoang0808/CS373;
+armadillo.obj (50K triangles) from github rohan-sawhney/mesh-saliency. Missing ones are skipped with a
+message; the generated scenes (grids, foliage) need nothing. Each mesh is rewritten as a Y-up OBJ standing on y = 0 (its own
 reader here, so the benchmark does not depend on the loader it measures), with a ground quad four times
 its footprint, a pinhole camera at a three-quarter view and a rect light of a third of its height
 above and to the side: a penumbra on the ground and self-shadowing on the statue.
