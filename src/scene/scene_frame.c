@@ -11,14 +11,15 @@
 #include <stdlib.h>
 
 /* The origin: per axis, the centre c of the bounds rounded to a multiple of s, the smallest power of two
- * not below the half-extent e (the largest over the axes); zero on an axis where |c| <= 16 s, i.e. where
- * the scene lies within 16 of its sizes of the origin: there centring would win at most 5 bits and the
- * bounds derived from coordinates are at most 2^-12 of the scene (ray_triangle.h), below a fine mesh's
- * triangles, while a scene placed near the origin keeps its world coordinates (and its floats bit for bit).
- * Then every local coordinate is below 34e in magnitude (|x| <= |c| + e <= 17s, or |x - o| <= e + s/2),
- * whatever the distance. A multiple of a power of two >= the spacing of the floats near the scene makes
- * world -> local exact for float positions near the geometry (ms_visibility_points) and local -> world
- * exact in double. */
+ * not below the half-extent e (the largest over the axes); zero on an axis where |c| <= 2 s, i.e. where
+ * the scene lies within 2 of its sizes of the origin: there centring would win at most 2 bits, while a
+ * scene placed about the origin keeps its world coordinates (and its floats bit for bit). Beyond that the
+ * scene is centred, so that the bounds derived from coordinates (ray_triangle.h; hpc's slacks and culling
+ * margins, the most sensitive: they grow with the largest coordinate, and a scene left 10 of its sizes out
+ * gets margins 10 times its own) stay those of a scene at home. Every local coordinate is below 6e in magnitude
+ * (|x| <= |c| + e <= 3s, or |x - o| <= e + s/2), whatever the distance. A multiple of a power of two >= the
+ * spacing of the floats near the scene makes world -> local exact for float positions near the geometry
+ * (ms_visibility_points) and local -> world exact in double. */
 void ms_scene_frame_origin(const double *tri_d, size_t n, double origin[3])
 {
     double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
@@ -35,7 +36,7 @@ void ms_scene_frame_origin(const double *tri_d, size_t n, double origin[3])
     const double s = ldexp(1.0, ex - 1) == e ? e : ldexp(1.0, ex);
     for (int a = 0; a < 3; a++) {
         const double c = 0.5 * (lo[a] + hi[a]);
-        if (fabs(c) > 16.0 * s) origin[a] = s * nearbyint(c / s);
+        if (fabs(c) > 2.0 * s) origin[a] = s * nearbyint(c / s);
     }
 }
 

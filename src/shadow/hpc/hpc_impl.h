@@ -535,7 +535,7 @@ static double tri_light_gap(const shared *sh, const float v[9])
  * the triangle moves the shadow at the receiver by up to reach / D. The samples' own rounding is absorbed
  * by the polygons (setup_light), the plane evaluation's by ulps of the coordinates. 256 ulps of each for
  * safety; a triangle that may touch the light: infinite (no culling). The coordinates (sc, sh->scale) are
- * the scene frame's (scene_frame.c), within 34 half-extents of the geometry at any distance from the
+ * the scene frame's (scene_frame.c), within 6 half-extents of the geometry at any distance from the
  * world's origin, so the margin and the volumes' planes cull as they do at home. */
 static float tri_margin(const shared *sh, const float v[9])
 {

@@ -17,7 +17,7 @@ void ms_block_frusta_init(ms_block_frusta *f, const ms_bvh_node *root, float nea
     for (int a = 0; a < 3; a++) ext = ms_maxf(ext, ms_maxf(fabsf(root->bmin[a]), fabsf(root->bmax[a])));
     /* 2^-20 of the largest coordinate: 8 ulps of any coordinate or of C (a point of the scene), which
      * bounds the rounding of bmin - margin - C below the exact bmin - C. In the scene's frame (scene_frame.c)
-     * the largest coordinate is at most 34 half-extents of the geometry: a fixed fraction of the scene at any
+     * the largest coordinate is at most 6 half-extents of the geometry: a fixed fraction of the scene at any
      * distance from the world's origin. */
     f->margin = ext * (1.0f / 1048576.0f) + 1e-30f;
 }
