@@ -272,7 +272,7 @@ typedef struct ms_procedural {
  * eye and target, the lights' corners and centres, and so ms_scene_lights and ms_accel_lights - is local,
  * world = local + origin (in double). ms_scene_load puts a scene that lies far from the world's origin into a
  * frame centred on its geometry, subtracting in double before rounding to float, so that a model 100 km out
- * keeps the detail and the speed it has at home; a scene within 16 of its sizes of the origin keeps origin = 0
+ * keeps the detail and the speed it has at home; a scene within 2 of its sizes of the origin keeps origin = 0
  * and its floats as they were. Scenes built by the caller (zeroed origin; ms_scene_localize moves them), the
  * built-in and the procedural scenes are in world coordinates (origin 0). Frames are images and need no conversion; ms_visibility_points takes world
  * positions (converted with the origin of the accel's scene, ms_accel_origin); ms_lightmap.position is in

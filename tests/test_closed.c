@@ -529,14 +529,6 @@ static float *frame_vis(const ms_scene *sc, const char *method, ms_traversal tra
     return tu_render_vis(sc, &o, stats);
 }
 
-static uint64_t counter(const ms_stats *s, const char *name)
-{
-    for (int i = 0; i < s->n_counters; i++)
-        if (!strcmp(s->counter_name[i], name)) return s->counter[i];
-    fail_msg("no counter %s", name);
-    return 0;
-}
-
 static void test_interior_frames(void **st)
 {
     (void)st;
@@ -580,10 +572,10 @@ static void test_interior_frames(void **st)
         assert_true(light == 0 ? s_rtc.occluders_culled > 1000 : s_rtc.occluders_culled <= 12);
         if (light == 0) {
             assert_true(s_int.interior_boxes > 0);
-            assert_true(counter(&s_int, "interior_rasterized") > 0);
+            assert_true(tu_stat_counter(&s_int, "interior_rasterized") > 0);
             assert_int_equal(s_mft.interior_boxes, s_int.interior_boxes);
             /* the pass ran: the blocks of the boxes' pass come before those of the triangles' */
-            assert_true(counter(&s_mft, "blocks") > counter(&s_mft_no, "blocks"));
+            assert_true(tu_stat_counter(&s_mft, "blocks") > tu_stat_counter(&s_mft_no, "blocks"));
         } else {
             assert_int_equal(s_int.interior_boxes, 0);
             assert_int_equal(s_mft.interior_boxes, 0);

@@ -81,9 +81,9 @@ static void box_of(const ms_scene *sc, double lo[3], double hi[3])
 {
     for (int c = 0; c < 3; c++) { lo[c] = INFINITY; hi[c] = -INFINITY; }
     for (size_t i = 0; i < 3 * sc->n_tris; i++)
-        for (int c = 0; c < 3; c++) {
-            lo[c] = fmin(lo[c], sc->tri[3 * i + c]);
-            hi[c] = fmax(hi[c], sc->tri[3 * i + c]);
+        for (int c = 0; c < 3; c++) {   /* in the world: the scene's frame may have moved it (world = local + origin) */
+            lo[c] = fmin(lo[c], sc->tri[3 * i + c] + sc->origin[c]);
+            hi[c] = fmax(hi[c], sc->tri[3 * i + c] + sc->origin[c]);
         }
 }
 
@@ -545,7 +545,7 @@ static void expect_outward(const char *what, const ms_scene *sc, const double c[
         for (int d = 0; d < 3; d++) {
             e1[d] = p[3 + d] - p[d];
             e2[d] = p[6 + d] - p[d];
-            m[d] = (p[d] + p[3 + d] + p[6 + d]) / 3 - c[d];
+            m[d] = (p[d] + p[3 + d] + p[6 + d]) / 3 + sc->origin[d] - c[d];   /* world = local + origin */
         }
         nn[0] = e1[1] * e2[2] - e1[2] * e2[1];
         nn[1] = e1[2] * e2[0] - e1[0] * e2[2];

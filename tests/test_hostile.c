@@ -190,7 +190,8 @@ static void test_gltf_node_expansion(void **st)
     const char *sp = scene("gltf2.json", "chain.gltf", NULL, NULL);
     if (ms_scene_load(sp, &s, err, sizeof err)) fail_msg("%s", err);
     assert_int_equal(s.n_tris, 1);
-    assert_true(s.tri[1] == 1.0f && s.tri[3] == 1.0f && s.tri[7] == 2.0f);   /* translated by the last node */
+    /* translated by the last node (in the world: world = local + origin, the scene's frame) */
+    assert_true(s.tri[1] + s.origin[1] == 1.0 && s.tri[3] + s.origin[0] == 1.0 && s.tri[7] + s.origin[1] == 2.0);
     ms_scene_free(&s);
 }
 

@@ -607,14 +607,6 @@ static void test_switches_keep_masks(void **state)
 /* The counters reach ms_stats (and --stats) by name, and account for every triangle-frustum pair: each is
  * culled by exactly one test (horizon, plane, corner rays, footprint) or tested, and tests at most N/16
  * packets; blocks hold at most 16 frusta, and a frustum ends early at most once. */
-static uint64_t counter(const ms_stats *st, const char *name)
-{
-    for (int i = 0; i < st->n_counters; i++)
-        if (!strcmp(st->counter_name[i], name)) return st->counter[i];
-    fail_msg("no counter %s", name);
-    return 0;
-}
-
 static void test_counters_account(void **state)
 {
     (void)state;
@@ -625,17 +617,17 @@ static void test_counters_account(void **state)
     const ms_stats *st = &f.stats;
     assert_int_equal(st->n_counters, ms_find_shadow_method("mft")->n_counters);
     assert_true(st->n_counters >= 16);   /* the block traversal's and the leaf's counters, all reported */
-    const uint64_t pairs = counter(st, "tri_frustum_pairs"), tested = counter(st, "pairs_tested");
+    const uint64_t pairs = tu_stat_counter(st, "tri_frustum_pairs"), tested = tu_stat_counter(st, "pairs_tested");
     printf("default scene 64x64: %llu AABB tests, %llu triangles accessed, %llu pairs, %llu tested, %llu 16-ray tests\n",
-           (unsigned long long)counter(st, "aabb_tests"), (unsigned long long)counter(st, "tris_accessed"),
-           (unsigned long long)pairs, (unsigned long long)tested, (unsigned long long)counter(st, "isec_tests16"));
+           (unsigned long long)tu_stat_counter(st, "aabb_tests"), (unsigned long long)tu_stat_counter(st, "tris_accessed"),
+           (unsigned long long)pairs, (unsigned long long)tested, (unsigned long long)tu_stat_counter(st, "isec_tests16"));
     assert_true(tested > 0);
-    assert_int_equal(pairs, counter(st, "culled_horizon") + counter(st, "culled_plane") + counter(st, "culled_corner_rays") +
-                                counter(st, "culled_footprint") + tested);
-    assert_true(counter(st, "isec_tests16") <= tested * (1024 / 16));   /* a pair tests at most N/16 packets */
-    assert_true(counter(st, "frusta") <= 16 * counter(st, "blocks"));
-    assert_true(counter(st, "frusta") <= st->visible_pixels);
-    assert_true(counter(st, "frusta_early_out") <= counter(st, "frusta"));
+    assert_int_equal(pairs, tu_stat_counter(st, "culled_horizon") + tu_stat_counter(st, "culled_plane") + tu_stat_counter(st, "culled_corner_rays") +
+                                tu_stat_counter(st, "culled_footprint") + tested);
+    assert_true(tu_stat_counter(st, "isec_tests16") <= tested * (1024 / 16));   /* a pair tests at most N/16 packets */
+    assert_true(tu_stat_counter(st, "frusta") <= 16 * tu_stat_counter(st, "blocks"));
+    assert_true(tu_stat_counter(st, "frusta") <= st->visible_pixels);
+    assert_true(tu_stat_counter(st, "frusta_early_out") <= tu_stat_counter(st, "frusta"));
     ms_frame_free(&f);
     ms_scene_free(&sc);
 }

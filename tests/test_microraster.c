@@ -317,14 +317,6 @@ static void test_sponza_agrees(void **state) { (void)state; real_scene("dabrovic
 static void test_sibenik_agrees(void **state) { (void)state; real_scene("sibenik/sibenik.json", 96); }
 static void test_bunny_agrees(void **state) { (void)state; real_scene("stanford-bunny/stanford-bunny.json", 96); }
 
-static uint64_t stat_counter(const ms_stats *st, const char *name)
-{
-    for (int c = 0; c < st->n_counters; c++)
-        if (!strcmp(st->counter_name[c], name)) return st->counter[c];
-    fail_msg("no counter %s", name);
-    return 0;
-}
-
 /* The pixel-class counters of the block traversal against the frame's own planes: a pixel is lit when V = 1,
  * in umbra when V = 0 with front samples, in penumbra otherwise, facing away with no front sample (the
  * frame's front count); the classes' tests and rasterizations add up to the method's totals, and only
@@ -355,24 +347,24 @@ static void test_pixel_class_counters(void **state)
             else pen++;
         }
         const ms_stats *st = &f.stats;
-        assert_int_equal(stat_counter(st, "pixels_traced_edge_on"), 0);
-        assert_int_equal(stat_counter(st, "pixels_lit"), lit);
-        assert_int_equal(stat_counter(st, "pixels_umbra"), umbra);
-        assert_int_equal(stat_counter(st, "pixels_penumbra"), pen);
-        assert_int_equal(stat_counter(st, "pixels_facing_away"), away);
+        assert_int_equal(tu_stat_counter(st, "pixels_traced_edge_on"), 0);
+        assert_int_equal(tu_stat_counter(st, "pixels_lit"), lit);
+        assert_int_equal(tu_stat_counter(st, "pixels_umbra"), umbra);
+        assert_int_equal(tu_stat_counter(st, "pixels_penumbra"), pen);
+        assert_int_equal(tu_stat_counter(st, "pixels_facing_away"), away);
         assert_true(pen > 0 && umbra > 0 && lit > 0);
-        const uint64_t tests = stat_counter(st, "tests_lit") + stat_counter(st, "tests_umbra") + stat_counter(st, "tests_penumbra");
-        const uint64_t rast = stat_counter(st, "rasterized_lit") + stat_counter(st, "rasterized_umbra") +
-                              stat_counter(st, "rasterized_penumbra");
-        assert_int_equal(tests, stat_counter(st, "tri_pixel_tests"));
-        assert_int_equal(rast, stat_counter(st, "triangles_rasterized"));
+        const uint64_t tests = tu_stat_counter(st, "tests_lit") + tu_stat_counter(st, "tests_umbra") + tu_stat_counter(st, "tests_penumbra");
+        const uint64_t rast = tu_stat_counter(st, "rasterized_lit") + tu_stat_counter(st, "rasterized_umbra") +
+                              tu_stat_counter(st, "rasterized_penumbra");
+        assert_int_equal(tests, tu_stat_counter(st, "tri_pixel_tests"));
+        assert_int_equal(rast, tu_stat_counter(st, "triangles_rasterized"));
         /* A rasterization that cleared a sample leaves the pixel short of lit; one that cleared none is possible
          * anywhere, but a lit pixel rasterizes only such. */
-        assert_true(stat_counter(st, "rasterized_penumbra") > 0 && stat_counter(st, "rasterized_umbra") > 0);
+        assert_true(tu_stat_counter(st, "rasterized_penumbra") > 0 && tu_stat_counter(st, "rasterized_umbra") > 0);
         printf("bunny N=%d: lit %llu, umbra %llu, penumbra %llu, facing away %llu pixels; tests per pixel %.1f / %.1f / %.1f\n",
                samples[si], (unsigned long long)lit, (unsigned long long)umbra, (unsigned long long)pen, (unsigned long long)away,
-               (double)stat_counter(st, "tests_lit") / (double)lit, (double)stat_counter(st, "tests_umbra") / (double)umbra,
-               (double)stat_counter(st, "tests_penumbra") / (double)pen);
+               (double)tu_stat_counter(st, "tests_lit") / (double)lit, (double)tu_stat_counter(st, "tests_umbra") / (double)umbra,
+               (double)tu_stat_counter(st, "tests_penumbra") / (double)pen);
         ms_frame_free(&f);
     }
     ms_scene_free(&sc);

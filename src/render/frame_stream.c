@@ -3,7 +3,7 @@
  *
  * Streamed, the float outputs (PFM, EXR) take each band's rows as they finish. The PNG cannot: its exposure
  * maps the 99th percentile of the whole frame's unshadowed luminance to white. The choice: each band's
- * radiance and luminance go to a scratch file beside the PNG (16 bytes a pixel on disk, none in memory), a
+ * radiance and luminance go to a scratch file beside the PNG (20 bytes a pixel on disk, none in memory), a
  * histogram of the luminances' upper 16 bits is gathered meanwhile; at the end one pass over the scratch file
  * counts the lower 16 bits inside the bucket that holds the percentile's rank, which gives the exact value
  * (the same float the whole frame's sort picks), and a second pass writes the PNG's rows. */

@@ -537,3 +537,11 @@ void tu_base64(const unsigned char *in, size_t n, char *out)
     }
     out[o] = 0;
 }
+
+uint64_t tu_stat_counter(const ms_stats *st, const char *name)
+{
+    for (int i = 0; i < st->n_counters; i++)
+        if (!strcmp(st->counter_name[i], name)) return st->counter[i];
+    fail_msg("no counter %s", name);
+    return 0;
+}

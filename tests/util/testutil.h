@@ -119,6 +119,8 @@ void tu_every_method_as_raytrace(const ms_scene *sc, ms_render_options *o, const
 /* ms_render with o, returning a copy of the frame's V (width x height floats; the caller frees it) and its
  * stats into *stats (NULL: not wanted); the frame itself freed. */
 float *tu_render_vis(const ms_scene *sc, const ms_render_options *o, ms_stats *stats);
+/* The stats' counter of that name, failing the test when the method has none. */
+uint64_t tu_stat_counter(const ms_stats *st, const char *name);
 
 /* The unit icosphere subdivided `levels` times: n_verts vertices on the unit sphere (3 doubles each; shared
  * vertices once, midpoints looked up per edge) and n_tris triangles (3 vertex indices each); the caller

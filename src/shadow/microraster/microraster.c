@@ -61,7 +61,7 @@ static const char *const block_counter_names[] = {
     "culled_depth", "culled_rect", "culled_corner_rays", "culled_coverage", "triangles_rasterized",
     "pixels_early_out", "rect_shrinks", "shared_setups", "shared_setups_clipped", "pixels_traced_edge_on", "interior_rasterized", "interior_pixels_emptied",
     "pixels_lit", "pixels_umbra", "pixels_penumbra", "pixels_facing_away", "tests_lit", "tests_umbra", "tests_penumbra",
-    "rasterized_lit", "rasterized_umbra", "rasterized_penumbra", "ns_lit", "ns_umbra", "ns_penumbra"
+    "rasterized_lit", "rasterized_umbra", "rasterized_penumbra", "lit_ns", "umbra_ns", "penumbra_ns"
 };
 /* The interior boxes' pass adds to every counter above (its work is work) and to its own two. */
 /* Then where the time goes, by the class of each pixel's answer (lit: every front sample visible; umbra:
