@@ -376,7 +376,8 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
             snprintf(err, errlen, "stream_rows %d is not a multiple of %d%s", opt->stream_rows, unit, aa_s > 1 ? " (with anti-aliasing: the tile times its scale)" : "");
             goto fail;
         }
-        fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : unit * ((want + tiles_x * (unit / TILE) - 1) / (tiles_x * (unit / TILE)));
+        const int unit_tiles = tiles_x * aa_s;   /* the tiles of one band unit */
+        fs.stream_rows = !streamable ? 0 : opt->stream_rows ? opt->stream_rows : unit * ((want + unit_tiles - 1) / unit_tiles);
         const uint64_t budget = ms_memory_budget(opt->max_memory);
         if (stream == MS_STREAM_ON && !streamable) {
             snprintf(err, errlen, "streamed outputs: the method takes the whole frame at once (its receivers are all of the frame's pixels)");
