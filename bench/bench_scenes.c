@@ -279,8 +279,8 @@ int main(int argc, char **argv)
         fprintf(outs[o], "Shadow seconds per method (primary visibility, shading and BVH build excluded), %dx%d, "
                 "%s pattern, seed 0, threads %s, measured %s by `build/bench_scenes",
                 size, size, pattern_name, threads ? "as given" : "= all cores", date);
-        fprintf(outs[o], "%s`. What the figures mean and how they moved: docs/scenes-notes.md (by hand; this file is "
-                "regenerated).\n\n", cmdline);
+        fprintf(outs[o], "%s`. What the figures mean and how they moved: the lab notebook, "
+                "docs/notebook/README.md (by hand; this file is regenerated).\n\n", cmdline);
     }
     double log_scan[MAX_METHODS] = { 0 }, log_emb[MAX_METHODS] = { 0 };
     int n_scan[MAX_METHODS] = { 0 }, n_emb[MAX_METHODS] = { 0 }, n_lines = 0;
