@@ -242,8 +242,8 @@ static inline int ms_wt_segment_sheared(const float A[3], const float B[3], cons
  * The coordinates are the scene's frame's (docs/design.md, "The scene's frame"): a loaded scene's lie within
  * 6 half-extents h of the origin wherever it is in the world (src/scene/scene_frame.c), so for a shadow
  * ray, whose origin is on the geometry and whose root box is the scene's, e <= 2^-16 (6h + |light|) is a
- * fixed fraction of the scene, as tight 100 km out as at home. (In world coordinates the |o| term grew
- * with the distance: 1.5 at 1e5, wider than the whole dragon of issue 33, and nothing was culled.) */
+ * fixed fraction of the scene, as tight 100 km out as at home. (In world coordinates the |o| term would grow
+ * with the distance: at 1e5 it is wider than a 0.2-wide model, and nothing is culled.) */
 #define MS_WT_BOX_REL (1.0f / 65536.0f)
 
 /* The shifted origins for a ray from o in a BVH whose root box is [lo, hi]. */

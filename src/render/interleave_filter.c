@@ -14,16 +14,16 @@
  * MS_FILTER_PLANE_TOL (0.01, about 0.6 degrees) of the pixel's tangent plane as seen from the pixel, i.e.
  * |(p_j - p_i) . n_i| <= 0.01 |p_j - p_i|. A relative depth threshold cannot serve both ends: on a plane
  * seen at a grazing angle the depth changes by several percent per pixel at 256x256, while a ledge or
- * step 1% of the camera distance high is another surface whose shadow differs. Measured at 256x256 against
- * 4096-sample frames (MAE of V): "within 1% of the camera distance" gave dabrovic-sponza 0.0197, 0.05% of
- * it 0.0117, the slope test 0.0110 at 0.02 and about the same at 0.01, which also did best on the bunny
- * (0.0091) and crytek (0.024). Normals: within about 25 degrees (MS_FILTER_NORMAL_COS = 0.9; the facets of
- * a tessellated curved surface differ by a few degrees, a crease or a box on a floor by 90; 0.97 changed
- * nothing measurable). Each neighbour is weighted by its number of samples in front of its plane, so V
- * becomes (sum of visible) / (sum of front samples) over the window: the ratio estimator over the union of
- * the sets, as if the pixel had traced them all; a neighbour with no sample in front adds nothing, and a
- * pixel with none keeps V = S = 0 (its light is behind its plane; on curved surfaces its neighbours within
- * the normal tolerance may see it, which cost sponza 0.0045 of MAE). S is averaged with the same weights.
+ * step 1% of the camera distance high is another surface whose shadow differs. Measured against 4096-sample
+ * frames, the slope test at 0.01 gave the least error of the depth tests tried (figures:
+ * docs/notebook/2026-11-29-source-comment-figures.md). Normals: within about 25 degrees
+ * (MS_FILTER_NORMAL_COS = 0.9; the facets of a tessellated curved surface differ by a few degrees, a crease
+ * or a box on a floor by 90; 0.97 changed nothing measurable). Each neighbour is weighted by its number of
+ * samples in front of its plane, so V becomes (sum of visible) / (sum of front samples) over the window: the
+ * ratio estimator over the union of the sets, as if the pixel had traced them all; a neighbour with no sample
+ * in front adds nothing, and a pixel with none keeps V = S = 0 (its light is behind its plane; on curved
+ * surfaces its neighbours within the normal tolerance may see it, which costs measurable error on Sponza). S
+ * is averaged with the same weights.
  *
  * The per-pixel definition, in the order every instance follows (interleave_filter_impl.h: 16 pixels of a
  * row in vector lanes, the same operations per lane): for each neighbour (dy, then dx, -2..2) in the frame

@@ -46,16 +46,15 @@ int ms_method_available(const char *name)
     return 0;
 }
 
-/* The rule behind "auto" (issue 28, from the measurements in docs/methods.md and docs/scenes.md; every
- * method gives the same V and S, so the choice is speed only):
- *   - the grid pattern: scanline, the fastest method on every benchmark scene at 1024 samples (3.4-61x the
- *     faster Embree mode, 13 scenes) and at 256;
- *   - the interleaved pattern (16 rays per pixel): mft, since session 12 faster than raytrace on all 13
- *     benchmark scenes and than Embree's 16-ray packets on 12 of them at 1024² with 2 threads (0.97x on
- *     Dabrovic Sponza, 2.6x on Igea; 1.13x in the geometric mean at 384² with one thread), and exact;
+/* The rule behind "auto" (docs/methods.md, "What to pick"; the figures behind it are in the lab notebook,
+ * docs/notebook/2026-11-26-what-to-pick-figures.md; every method gives the same V and S, so the choice is
+ * speed only):
+ *   - the grid pattern: scanline, the fastest method on every benchmark scene at 1024 samples and at 256;
+ *   - the interleaved pattern (16 rays per pixel): mft, faster than raytrace on every benchmark scene and
+ *     than Embree's 16-ray packets on nearly all, and exact;
  *   - the stratified pattern: Embree when compiled in, else raytrace. mft is faster in the geometric mean
- *     there too (1.3x, 384²), but 0.57-0.70x Embree with the big light and on the game models, which the
- *     scene alone does not tell.
+ *     there too, but slower than Embree with the big light and on the game models, which the scene alone
+ *     does not tell.
  * A procedural scene too big for the memory budget once materialised goes to hpc, the streaming method
  * (frame_job.c: the budget decides, after this choice). */
 const char *ms_auto_method(ms_pattern pattern)

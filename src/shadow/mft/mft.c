@@ -25,10 +25,8 @@
 #include <string.h>
 
 /* Largest leaf of the shallow BVH (accel/bvh.h: subtrees of at most this many triangles collapsed into
- * one leaf). Measured (docs/methods.md, session 11): with the per-pair set-up made cheaper, 8 beats 4 by
- * 4-8% on the statues (ogre, beast, Igea) and is within 3% elsewhere; 16 no better than 8 and 3% worse on
- * Crytek Sponza; 2 no better than 4. (Before session 11: 2, 4 and 8 within 3%, 16 the slowest.) The
- * interleaved mode keeps 4 (its own measurement, docs/methods.md; 8 took the bars 6% longer). */
+ * one leaf). 8 measured fastest for the grid and stratified tracer (faster on the statues, no slower
+ * elsewhere), 4 for the interleaved one (figures: docs/notebook/2026-11-29-source-comment-figures.md). */
 #ifndef MFT_SHALLOW_LEAF
 #define MFT_SHALLOW_LEAF 8
 #endif
@@ -484,7 +482,7 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
     const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
 #ifdef MFT_NULL_MEASURE
     /* Measurement builds only: no ray traced (every front sample visible), to measure what the frame
-     * costs around the method (front masks, V and S, the filter: docs/methods.md). */
+     * costs around the method (front masks, V and S, the filter). */
     memcpy(vis, front, (size_t)nq * mw * sizeof *vis);
     (void)s; (void)ns; (void)cnt; (void)q;
     return 0;
@@ -559,8 +557,8 @@ const ms_shadow_method ms_shadow_mft = {
     .name = "mft",
     .primary = "bvh",
     .needs_grid = 0,
-    /* the closed cull by default since its interior boxes (session 11, docs/culling.md): ogre and bars 1.24x,
-     * the rest within 4% */
+    /* the closed cull by default: with the interior boxes it pays on thin closed parts and costs nothing
+     * measurable elsewhere (docs/culling.md) */
     .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS | MS_OCC_MERGE | MS_OCC_MERGE_EXACT,
     .n_counters = MS_MFT_COUNTERS,
     .counter_names = { "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "frusta",

@@ -25,16 +25,16 @@
  *
  * Departures from the paper, and why:
  *  - the paper traces one frustum per pixel, its 16 rays (one interleaved set) spread over the whole light,
- *    so each frustum spans the whole light and culls little (measured here: bunny 256^2, 11.4M 16-ray tests
- *    against raytrace's 0.57M before the per-ray box test, then a traversal as costly as raytrace's,
- *    docs/methods.md). Grouping the same 256 rays of a block by cell instead gives 16 frusta each 1/4 of
- *    the light across, from a 4x4-pixel patch of receivers: the rays and the answers are the same;
+ *    so each frustum spans the whole light and culls little (measured: many times raytrace's ray tests,
+ *    docs/notebook/2026-11-29-source-comment-figures.md). Grouping the same 256 rays of a block by cell
+ *    instead gives 16 frusta each 1/4 of the light across, from a 4x4-pixel patch of receivers: the rays
+ *    and the answers are the same;
  *  - a group has 16 apexes, so it has no corner rays: the paper's corner-ray culling (the triangle's edge
  *    planes through the apex) is replaced by the triangle-box and plane tests of step 1, which hold for a
  *    box of apexes; the paper's back-face culling is not used (shadows need both sides);
  *  - the per-ray box test at every node (the paper's "Ray-AABB" at the leaves only, which did not pay on
  *    Larrabee): a group's rays are a quarter of the light apart, wider than small triangles, so its
- *    frustum alone reached 10x the leaves its rays enter (ogre 256^2; docs/methods.md);
+ *    frustum alone reached about 10x the leaves its rays enter;
  *  - the rays are formed once per block (not on demand from delta vectors): the exact agreement with
  *    raytrace needs its shear (one division per ray) and its shared packet axis.
  * Culling is conservative: each test carries a relative slack of 1e-5 of the magnitudes involved (about
@@ -48,14 +48,11 @@
 #include "visibility/alpha.h"
 
 #define MFTG_REL 1e-5f
-/* Measurement switches (builds with -D..., docs/methods.md): the groups at a triangle from which it is
- * culled for all at once (1: always; with one or two groups the cull cost more than it saved, ogre +18%;
- * session 13, with the per-group tests cheaper, 8 against 4: bars 0.289 -> 0.273 s, foliage 0.216 -> 0.211,
- * ogre 0.120 -> 0.118, 12 alike, never (17) Crytek 0.238 -> 0.251);
- * CR on or off (session 10: within noise; session 12, with the groups starting from their cell's box, off
- * is faster: 384^2, CPU s, bars 0.225 -> 0.202, Crytek 0.186 -> 0.176, ogre 0.096 -> 0.093: a recomputation
- * per group and leaf that lost rays, 514K on the bars, cost more than the tighter boxes saved). Departure
- * from the paper, which shrinks. */
+/* Measurement switches (builds with -D...; their figures: docs/notebook/2026-11-29-source-comment-figures.md):
+ * the groups at a triangle from which it is culled for all at once (with one or two groups the cull costs
+ * more than it saves; 8 measured a little faster than 4, and never culling slower);
+ * CR on or off (off: with the groups starting from their cell's box, a recomputation per group and leaf
+ * that lost rays costs more than the tighter boxes save). Departure from the paper, which shrinks. */
 #ifndef MFTG_TRI_CULL
 #define MFTG_TRI_CULL 8
 #endif
@@ -63,10 +60,9 @@
 #define MFTG_CR 0
 #endif
 /* The frusta's node test for 16 lanes at once only where MFTG_FRUSTUM_MIN or more lanes reach the parent;
- * with fewer, their per-ray tests alone are cheaper (session 13, 512^2 one thread: 0 (always) against 4:
- * bunny 0.120 -> 0.114 s, Crytek 0.240 -> 0.233, ogre 0.125 -> 0.121, bars 0.293 -> 0.289; never (17):
- * Sibenik 0.137 -> 0.152). Without the frusta's entry distances, the children are ordered along the
- * block's direction to the light (MFTG_DIR_ORDER: always so; within noise of the frusta's majority vote). */
+ * with fewer, their per-ray tests alone are cheaper (measured against always and never). Without the
+ * frusta's entry distances, the children are ordered along the block's direction to the light
+ * (MFTG_DIR_ORDER: always so; within noise of the frusta's majority vote). */
 #ifndef MFTG_FRUSTUM_MIN
 #define MFTG_FRUSTUM_MIN 4
 #endif
@@ -279,7 +275,7 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
         const float *tri = s->b->tri + 9 * (size_t)t, *N = s->b->tri_n + 3 * (size_t)t;
         /* 1. The triangle's box against the groups' segments (the traversal's test), then its plane.
          * Worth its cost (one test for 16 groups) only with several groups at the triangle: measured,
-         * with one or two it costs more than their 16-ray tests save (the ogre: +18% CPU). */
+         * with one or two it costs more than their 16-ray tests save. */
         if (ms_bt_popcount16(lanes) >= MFTG_TRI_CULL) {
             ms_bvh_node tb;
             float tmag = 0.0f;
@@ -400,8 +396,8 @@ static inline unsigned mftg_child_rays(const mftg_state *s, const ms_bvh_node *n
  * for the lanes whose frustum may reach it (all 16 at once) and, of those, whose rays enter it (one 16-ray
  * box test per lane, raytrace's). The frusta cull the upper levels for 16 groups at a time; the rays the
  * lower ones, where a group's frustum, however thin on the light, is wide against small triangles
- * (measured: the ogre at 256^2, 14.5M lane-leaf visits for 1.5M leaves when only the leaves tested the
- * rays). Departure from the paper (frusta only). */
+ * (measured: when only the leaves tested the rays, about ten lane-leaf visits per leaf the rays enter).
+ * Departure from the paper (frusta only). */
 static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
 {
     ms_block_frusta *f = s->fr;

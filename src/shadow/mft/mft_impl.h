@@ -40,20 +40,20 @@
  *  - the paper culls back faces; shadows need both sides (two-sided test), so its back-face test is
  *    replaced by the plane-range test, which also drops the receiver's coplanar neighbours (t ~ 0);
  *  - the corner-ray culling is applied after the footprint's cut and only where the cut is absent or
- *    large: on the ogre it culled 0.7% of the pairs, nearly all of which the cut culls too, and cost
- *    about 8% of the tracer's time (session 11, docs/methods.md);
+ *    large: after the cut it culls few pairs that the cut does not, for a measurable share of the
+ *    tracer's time;
  *  - the leaf culling (step 0) and the horizon test are ours; the paper's leaf culling (per-packet
  *    ray-AABB tests, Table 2) did not pay on Larrabee; this one tests the 16 frusta at once and removes
- *    more than half of the triangle-frustum pairs on the big-light Sponza (docs/design.md, "mft");
+ *    more than half of the triangle-frustum pairs on the big-light Sponza;
  *  - a finer footprint (the triangle's span per row, from its edge functions along the light) cut the
  *    16-ray tests by a quarter but cost more in scalar set-up than it saved (measured, not kept);
  *  - on the grid pattern the footprint's box is taken against the samples' own positions in their cells
  *    (MFT_GRID_EPS: columns per row of a cut up to MFT_GRID_ROWS rows, 16 lanes at once, dropping pairs
- *    with no sample in the box), not only against whole cells (docs/methods.md, session 12);
+ *    with no sample in the box), not only against whole cells;
  *  - the interleaved pattern is traced by mft_group_impl.h (rays regrouped by cell of the light); there
  *    each group's rays take raytrace's box test per node (the paper's "Ray-AABB"). On the grid the same
- *    test (once per leaf and packet) cut the 16-ray tests 1.3-3.6x but not the time (big-light Sponza -7%,
- *    GRIDS-like bars and ogre +4-7% CPU): not kept (docs/design.md, "mft"). */
+ *    test (once per leaf and packet) cut the 16-ray tests but not the time: not kept
+ *    (docs/notebook/2026-11-22-mft-choices-and-first-results.md). */
 #include <math.h>
 #include <string.h>
 #include "mft.h"
@@ -66,8 +66,8 @@
 
 #define MFT_REL 1e-5f
 #define MFT_MAX_SKIP MS_BLOCK_LANES
-/* Cells of a footprint-cut rectangle above which the corner rays are still tried (64: Dabrovic Sponza
- * -5%, ogre +2%; 256 and "never" within noise of each other; measured, session 11). */
+/* Cells of a footprint-cut rectangle above which the corner rays are still tried (measured against 64 and
+ * "never"). */
 #ifndef MFT_CORNER_AREA
 #define MFT_CORNER_AREA 256.0f
 #endif
@@ -380,7 +380,7 @@ static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
  * no footprint): the cut to cells alone leaves about (w + 1)(h + 1) cells for a box of w x h cells, most of
  * them without a sample in the box for a small triangle under a big light; this leaves about w h. Done for
  * cuts of at most MFT_GRID_ROWS rows, 16 lanes at once (taller cuts: the per-row work cost more than it
- * saved, docs/methods.md, session 12). */
+ * saved; docs/notebook/2026-11-26-mft-grid-setup-and-footprint.md). */
 #define MFT_GRID_EPS 1e-3f
 #ifndef MFT_GRID_ROWS
 #define MFT_GRID_ROWS 2
@@ -485,8 +485,8 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
          * sliver 3e-5 off the receiver's plane, which raytrace finds hit by a ray passing 2.5e-4 outside
          * it (exact rational arithmetic); mft must give raytrace's answer, so it tests such triangles
          * over the whole live rectangle. (|det| as the corner rays use it would also catch it, but it is
-         * small for every small, far triangle: that frame took 4.5x the time; 1e-2 of the size doubled its
-         * 16-ray tests, 1e-4 adds 20% of them there, 6% of the CPU time.) */
+         * small for every small, far triangle; the threshold 1e-4 of the size costs a modest share of extra
+         * 16-ray tests there, where 1e-2 cost many more.) */
         const l16 lamax = l16_max(la[0], l16_max(la[1], la[2]));
         const unsigned grazing = l16_le(an, l16_mul(lamax, l16_set1(nl1 * 1e-4f)));
         const unsigned foot_lanes = pass & s->has_m & ~grazing;
@@ -526,9 +526,9 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             pass &= ~out;
         }
         /* Corner rays against the edge planes through C, for the lanes without a footprint only (with
-         * one, the cut above culls nearly every pair this test would: measured, docs/methods.md, session
-         * 11): a ray hits (t > 0) only inside the cone of the vertices, where every edge function
-         * (a_i x a_j) . d has the sign of det = (a0 x a1) . a2. Trusted only where |det| clears its own
+         * one, the cut above culls nearly every pair this test would: measured): a ray hits (t > 0)
+         * only inside the cone of the vertices, where every edge function (a_i x a_j) . d has the sign of
+         * det = (a0 x a1) . a2. Trusted only where |det| clears its own
          * rounding. */
         const l16 one_f = l16_set1(1.0f);
         const l16 area = l16_mul(l16_add(l16_sub(r[1], r[0]), one_f), l16_add(l16_sub(r[3], r[2]), one_f));
