@@ -21,7 +21,7 @@ int ms_block_order(const ms_render_ctx *ctx, const ms_shadow_query *q, int nq, i
     }
     /* A frame's queries cover a rectangle of blocks about as many as the queries / 16: a counting sort by
      * block (stable: a block's queries in their given order, as the merge sort below leaves them), linear
-     * where the sort was n log n (3% of mft's CPU time on a frame of the Quad). */
+     * where a sort would be n log n. */
     uint32_t bx0 = UINT32_MAX, bx1 = 0, by0 = UINT32_MAX, by1 = 0;
     for (int i = 0; i < nq; i++) {
         const uint32_t bx = q[i].px >> 2, by = q[i].py >> 2;

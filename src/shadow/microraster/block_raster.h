@@ -14,17 +14,14 @@
 #include "raster/raster.h"
 #include "core/perk.h"
 
-/* The occluder cache of issue #29: the shallow-BVH leaves that cleared the most samples in the caller's
+/* The occluder cache: the shallow-BVH leaves that cleared the most samples in the caller's
  * previous block (the blocks of one call come in spatial order, so their occluders are much the same),
  * processed first in the next block, before the traversal, which then skips them. Exact: a buffer loses
  * the union of what its triangles clear, in any order, and every leaf is still processed once. What it
  * buys is order: the near-first traversal meets the big occluders late where they are near the light
  * (the big-light Sponza's shaft), and until then the rectangle and coverage tests have little to cull.
- * Measured (384², one thread, shadow s, min of 5 alternated, docs/scenes-notes.md session 15): the
- * big-light Sponza 0.672 -> 0.550 at 1024 samples and 0.506 -> 0.420 at 256 ((triangle, pixel) tests
- * 36.7M -> 25.3M); ogre -3%, beast +1%; the bars +5% and the partial Crytek +2% (there the same tests in
- * another order, resp. 3% more rasterizations, plus the bookkeeping). 32 leaves: 4, 16 and 64 gave 32.2M,
- * 27.1M and 24.8M tests on the big light. */
+ * 32 leaves: fewer cut fewer tests, more cost more bookkeeping than they saved (figures in the lab
+ * notebook, docs/notebook/2026-11-26-block-traversal-row-scans-and-order.md). */
 #define MS_BLOCK_CACHE 32
 typedef struct ms_block_leaf_cache {
     int n;                              /* the leaves to process first (shallow node indices), best first */

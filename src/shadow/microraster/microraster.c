@@ -39,11 +39,9 @@
 
 #define EDGE_ON 1e-3f
 
-/* Largest leaf of the shallow BVH of the block traversal (accel/bvh.h). 8 was measured best on the shared
- * scenes before the interior boxes; on dense meshes (issue 29, 256x256, 256 samples, shadow CPU s) 16
- * halves the node tests for 1.3x the triangle tests and is faster: grid of bars 0.457 -> 0.425, beast
- * 0.317 -> 0.260, ogre 0.255 -> 0.201, igea 0.156 -> 0.143 (12 and 24 in between or worse on the bars);
- * on the shared scenes within noise (the big-light Sponza 0.48 -> 0.44, the small ones +0.01 s). */
+/* Largest leaf of the shallow BVH of the block traversal (accel/bvh.h). On dense meshes 16 halves the node
+ * tests of 8 for 1.3x the triangle tests, and is faster; 12 and 24 were slower (the lab notebook,
+ * docs/notebook/2026-11-25-dense-meshes.md and 2026-11-29-penumbra-cost.md). */
 #define MR_SHALLOW_LEAF 16
 
 typedef struct mr_state {
