@@ -419,7 +419,7 @@ static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_light
     }
     if (!o->no_seam_stitch) {
         const double t0 = omp_get_wtime();
-        const int rc = ms_bake_stitch(&lm->frame, list, n, threads, &lm->stitched_texels);
+        const int rc = ms_bake_stitch(&lm->frame, lm->uv, lm->triangle, list, n, threads, &lm->stitched_texels);
         lm->stitch_s = omp_get_wtime() - t0;
         if (rc) {
             free(list);
