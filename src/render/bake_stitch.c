@@ -8,12 +8,14 @@
  *   - the seam energy is sampled at PER_TEXEL points per texel of the edge, each weighted by the length it
  *     stands for, instead of integrated exactly per bilinear piece: simpler, and as close at that density;
  *   - Jacobi-preconditioned conjugate gradients instead of a sparse direct factorisation: no solver
- *     library, and the systems are tiny beside the bake;
+ *     library; the system falls apart into groups of texels joined by seams, each solved alone (in
+ *     parallel, each by one thread, so the result does not depend on the thread count);
  *   - only seams on smooth edges (bake_seams.c): across a hard edge the two sides differ by right;
  *   - the pull lam towards the baked value is weaker on texels whose centre lies off their triangle: the
  *     paper's texels are all equally trusted, ours off the triangles are stand-ins (see below). */
 #include "bake_stitch.h"
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -31,10 +33,6 @@
  * value at the 99th percentile on real assets; tighter costs several times the iterations for little. */
 #define CG_TOL 1e-4
 #define CG_MAX 1000
-/* Dot products are summed in fixed chunks, in order, so the result does not depend on the thread count. */
-#define CHUNK 4096
-/* Below this many rows an iteration takes microseconds: threads would wait on each other at every step. */
-#define PARALLEL_ROWS 65536
 
 typedef struct row {
     int32_t var[8];   /* side A's 4 texels, then side B's */
@@ -49,7 +47,9 @@ typedef struct stitch_sys {
     float *tw;
     double *lam;     /* per variable: its pull towards the baked value (LAMBDA, or less off the triangles) */
     double *diag;    /* of C^T C + diag(lam), the preconditioner */
-    int threads;
+    /* Independent systems: the texels of component c (joined by the rows that read them) are variables
+     * comp_v[c] .. comp_v[c+1], its rows comp_r[c] .. comp_r[c+1]. */
+    size_t ncomp, *comp_v, *comp_r;
 } stitch_sys;
 
 /* The four texels and weights of the clamped bilinear lookup at (u, v) (bake_seams.c's convention). */
@@ -66,66 +66,118 @@ static void taps(int W, int H, double u, double v, size_t idx[4], double w[4])
     }
 }
 
-/* y = (C^T C + diag(lam)) p; cp: scratch of nr. */
-static void apply(const stitch_sys *s, const double *p, double *cp, double *y)
+/* y = (C^T C + diag(lam)) p over component c's variables; cp: C p over its rows. */
+static void apply(const stitch_sys *s, size_t c, const double *p, double *cp, double *y)
 {
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (size_t r = 0; r < s->nr; r++) {
+    for (size_t r = s->comp_r[c]; r < s->comp_r[c + 1]; r++) {
         double a = 0.0;
         for (int j = 0; j < 8; j++) a += s->rows[r].w[j] * p[s->rows[r].var[j]];
         cp[r] = a;
     }
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (size_t k = 0; k < s->nv; k++) {
+    for (size_t k = s->comp_v[c]; k < s->comp_v[c + 1]; k++) {
         double a = s->lam[k] * p[k];
         for (size_t e = s->start[k]; e < s->start[k + 1]; e++) a += s->tw[e] * cp[s->trow[e]];
         y[k] = a;
     }
 }
 
-static double dot(const stitch_sys *s, const double *a, const double *b, double *part)
+static double dot(const stitch_sys *s, size_t c, const double *a, const double *b)
 {
-    const size_t nc = (s->nv + CHUNK - 1) / CHUNK;
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (size_t c = 0; c < nc; c++) {
-        double t = 0.0;
-        const size_t e = (c + 1) * CHUNK < s->nv ? (c + 1) * CHUNK : s->nv;
-        for (size_t k = c * CHUNK; k < e; k++) t += a[k] * b[k];
-        part[c] = t;
-    }
     double t = 0.0;
-    for (size_t c = 0; c < nc; c++) t += part[c];
+    for (size_t k = s->comp_v[c]; k < s->comp_v[c + 1]; k++) t += a[k] * b[k];
     return t;
 }
 
-/* Solves (C^T C + diag(lam)) d = -C^T C x0 for the change d of one channel (preconditioned CG from d = 0). */
-static void solve(const stitch_sys *s, const double *x0, double *d, double *r, double *z, double *p, double *q, double *cp,
-                  double *part)
+/* Solves (C^T C + diag(lam)) d = -C^T C x0 for the change d of one channel over component c (preconditioned CG
+ * from d = 0); every array indexed by the global variable and row numbers, only c's touched. */
+static void solve(const stitch_sys *s, size_t c, const double *x0, double *d, double *r, double *z, double *p, double *q,
+                  double *cp)
 {
-    apply(s, x0, cp, q);
-    for (size_t k = 0; k < s->nv; k++) {
+    const size_t v0 = s->comp_v[c], v1 = s->comp_v[c + 1];
+    apply(s, c, x0, cp, q);
+    for (size_t k = v0; k < v1; k++) {
         r[k] = -(q[k] - s->lam[k] * x0[k]);
         d[k] = 0.0;
         z[k] = r[k] / s->diag[k];
         p[k] = z[k];
     }
-    double rz = dot(s, r, z, part);
+    double rz = dot(s, c, r, z);
     const double rz0 = rz;
     for (int it = 0; it < CG_MAX && rz > CG_TOL * CG_TOL * rz0 && rz > 0.0; it++) {
-        apply(s, p, cp, q);
-        const double pq = dot(s, p, q, part);
+        apply(s, c, p, cp, q);
+        const double pq = dot(s, c, p, q);
         if (!(pq > 0.0)) break;
         const double alpha = rz / pq;
-        for (size_t k = 0; k < s->nv; k++) {
+        for (size_t k = v0; k < v1; k++) {
             d[k] += alpha * p[k];
             r[k] -= alpha * q[k];
             z[k] = r[k] / s->diag[k];
         }
-        const double rz1 = dot(s, r, z, part);
+        const double rz1 = dot(s, c, r, z);
         const double beta = rz1 / rz;
         rz = rz1;
-        for (size_t k = 0; k < s->nv; k++) p[k] = z[k] + beta * p[k];
+        for (size_t k = v0; k < v1; k++) p[k] = z[k] + beta * p[k];
     }
+}
+
+static uint32_t find(uint32_t *par, uint32_t a)
+{
+    while (par[a] != a) a = par[a] = par[par[a]];
+    return a;
+}
+
+/* Splits the system into its connected components (texels joined by a row): renumbers the variables and
+ * orders the rows so that each component's are contiguous, in the order of their first variable. */
+static int split(stitch_sys *s, size_t *texel_of)
+{
+    const size_t nv = s->nv, nr = s->nr;
+    uint32_t *par = malloc((nv ? nv : 1) * sizeof *par), *comp = malloc((nv ? nv : 1) * sizeof *comp);
+    uint32_t *newi = malloc((nv ? nv : 1) * sizeof *newi);
+    size_t *tex = malloc((nv ? nv : 1) * sizeof *tex);
+    row *rows = malloc((nr ? nr : 1) * sizeof *rows);
+    int rc = -1;
+    if (!par || !comp || !newi || !tex || !rows) goto done;
+    for (size_t k = 0; k < nv; k++) par[k] = (uint32_t)k;
+    for (size_t r = 0; r < nr; r++)
+        for (int j = 1; j < 8; j++) {
+            const uint32_t a = find(par, (uint32_t)s->rows[r].var[0]), b = find(par, (uint32_t)s->rows[r].var[j]);
+            if (a < b) par[b] = a; else par[a] = b;
+        }
+    s->ncomp = 0;
+    for (size_t k = 0; k < nv; k++) {   /* a root is its own smallest member: numbered when first met */
+        const uint32_t root = find(par, (uint32_t)k);
+        comp[k] = root == k ? (uint32_t)s->ncomp++ : comp[root];
+    }
+    s->comp_v = calloc(s->ncomp + 1, sizeof *s->comp_v);
+    s->comp_r = calloc(s->ncomp + 1, sizeof *s->comp_r);
+    if (!s->comp_v || !s->comp_r) goto done;
+    for (size_t k = 0; k < nv; k++) s->comp_v[comp[k] + 1]++;
+    for (size_t r = 0; r < nr; r++) s->comp_r[comp[s->rows[r].var[0]] + 1]++;
+    for (size_t c = 0; c < s->ncomp; c++) { s->comp_v[c + 1] += s->comp_v[c]; s->comp_r[c + 1] += s->comp_r[c]; }
+    /* placed through the starts, then the starts restored */
+    for (size_t k = 0; k < nv; k++) {
+        newi[k] = (uint32_t)s->comp_v[comp[k]]++;
+        tex[newi[k]] = texel_of[k];
+    }
+    for (size_t r = 0; r < nr; r++) {
+        row *t = &rows[s->comp_r[comp[s->rows[r].var[0]]]++];
+        *t = s->rows[r];
+        for (int j = 0; j < 8; j++) t->var[j] = (int32_t)newi[t->var[j]];
+    }
+    for (size_t c = s->ncomp; c > 0; c--) { s->comp_v[c] = s->comp_v[c - 1]; s->comp_r[c] = s->comp_r[c - 1]; }
+    s->comp_v[0] = s->comp_r[0] = 0;
+    memcpy(texel_of, tex, nv * sizeof *tex);
+    free(s->rows);
+    s->rows = rows;
+    rows = NULL;
+    rc = 0;
+done:
+    free(par);
+    free(comp);
+    free(newi);
+    free(tex);
+    free(rows);
+    return rc;
 }
 
 /* Whether texel i's centre lies on its triangle's UV image (its value is the surface's there). */
@@ -219,37 +271,37 @@ int ms_bake_stitch(ms_frame *f, const float *uv, const uint32_t *triangle, const
     const size_t nl = f->n_lights > 1 ? (size_t)f->n_lights : 1;
     stitch_sys s;
     memset(&s, 0, sizeof s);
-    s.threads = threads > 0 ? threads : 1;
     int32_t *var_of = malloc(np * sizeof *var_of);
     size_t *texel_of = NULL;
     double *work = NULL;
     int rc = -1;
     if (!var_of) goto done;
     for (size_t i = 0; i < np; i++) var_of[i] = -1;
-    if (build_rows(f, seams, n, var_of, &s, &texel_of)) goto done;
+    if (build_rows(f, seams, n, var_of, &s, &texel_of) || split(&s, texel_of)) goto done;
     s.lam = malloc((s.nv ? s.nv : 1) * sizeof *s.lam);
     if (!s.lam) goto done;
     for (size_t k = 0; k < s.nv; k++)
         s.lam[k] = centre_on_triangle(uv, triangle, f->width, texel_of[k]) ? LAMBDA : LAMBDA * LAMBDA_OFF_SCALE;
     if (build_transpose(&s)) goto done;
-    if (s.nr < PARALLEL_ROWS) s.threads = 1;
-    const size_t nv = s.nv, nc = (nv + CHUNK - 1) / CHUNK + 1;
-    /* x0, d, r, z, p, q per variable; the new values of every channel; C p per row; the chunks' sums */
-    const size_t nch = 3 + nl;
-    work = malloc(((6 + nch) * nv + s.nr + nc + 1) * sizeof *work);
+    const size_t nv = s.nv, nch = 3 + nl;
+    /* x0, d, r, z, p, q per variable; the new values of every channel; C p per row */
+    work = malloc(((6 + nch) * nv + s.nr + 1) * sizeof *work);
     if (!work) goto done;
     double *x0 = work, *d = x0 + nv, *r = d + nv, *z = r + nv, *p = z + nv, *q = p + nv, *val = q + nv;
-    double *cp = val + nch * nv, *part = cp + s.nr;
-    for (size_t c = 0; c < nch; c++) {
-        for (size_t k = 0; k < nv; k++)
-            x0[k] = c < 3 ? f->rgb[3 * texel_of[k] + c] : f->shadow[(c - 3) * np + texel_of[k]];
-        solve(&s, x0, d, r, z, p, q, cp, part);
-        /* irradiance stays >= 0, S within [0, 1] */
-        for (size_t k = 0; k < nv; k++) {
-            const double v = x0[k] + d[k];
-            val[c * nv + k] = c < 3 ? fmax(v, 0.0) : fmin(fmax(v, 0.0), 1.0);
+    double *cp = val + nch * nv;
+    /* Each component alone, by one thread: the result does not depend on the thread count. */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads > 0 ? threads : 1)
+    for (size_t c = 0; c < s.ncomp; c++)
+        for (size_t ch = 0; ch < nch; ch++) {
+            for (size_t k = s.comp_v[c]; k < s.comp_v[c + 1]; k++)
+                x0[k] = ch < 3 ? f->rgb[3 * texel_of[k] + ch] : f->shadow[(ch - 3) * np + texel_of[k]];
+            solve(&s, c, x0, d, r, z, p, q, cp);
+            /* irradiance stays >= 0, S within [0, 1] */
+            for (size_t k = s.comp_v[c]; k < s.comp_v[c + 1]; k++) {
+                const double v = x0[k] + d[k];
+                val[ch * nv + k] = ch < 3 ? fmax(v, 0.0) : fmin(fmax(v, 0.0), 1.0);
+            }
         }
-    }
     for (size_t k = 0; k < nv; k++) {
         int changed = 0;
         for (size_t c = 0; c < nch; c++) {
@@ -271,5 +323,7 @@ done:
     free(s.tw);
     free(s.diag);
     free(s.lam);
+    free(s.comp_v);
+    free(s.comp_r);
     return rc;
 }
