@@ -810,9 +810,12 @@ static inline ms_status ms_visibility_points(const ms_accel *a, const ms_light *
  * normal is the triangle's, by its winding (cross(b - a, c - a)). V and S there come from
  * ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
  * E_unshadowed * S * emission (ms_light_irradiance). Texels no triangle touches are filled by dilation
- * from their neighbours (across chart seams) so that bilinear lookups do not bleed black. */
+ * from their neighbours (across chart seams) so that bilinear lookups do not bleed black. Then the seams
+ * are stitched (unless no_seam_stitch): along every UV seam of a smooth edge the texels that bilinear
+ * lookups from its two sides read are moved, by least squares, until both sides' lookups agree (the
+ * irradiance and every light's S; V stays as baked); no other texel changes (docs/baking.md, "Seams"). */
 /* Called at the end of each pass of a bake, from the calling thread, with its name ("UVs", "texels", "leak
- * test", "acceleration structure", "light 1/3", ..., "irradiance, dilation and seams") and its seconds: one
+ * test", "acceleration structure", "light 1/3", ..., "irradiance and dilation", "seam stitching", "seams") and its seconds: one
  * progress line per pass for a command line (the points' progress callback goes on within the lights). */
 typedef void (*ms_bake_pass_fn)(void *user, const char *pass, double seconds);
 typedef struct ms_bake_options {
@@ -826,6 +829,7 @@ typedef struct ms_bake_options {
     int no_leak_fix;           /* 1: texels inside geometry keep their points (docs/baking.md, "Quality"); 0: moved */
     ms_bake_pass_fn pass;      /* may be NULL */
     void *pass_user;
+    int no_seam_stitch;        /* 1: the seams keep the baked texels; 0: stitched (docs/baking.md, "Seams") */
 } ms_bake_options;
 
 typedef struct ms_lightmap {
@@ -845,12 +849,17 @@ typedef struct ms_lightmap {
     double unwrap_s, raster_s; /* seconds in xatlas and in the texel rasterization */
     size_t texels_moved;       /* texels whose centre lay inside geometry, moved to the visible side */
     double leak_s;             /* seconds finding them */
-    /* Chart seams (ms_bake_finish): where two triangles share an edge in space but not in UVs and their planes
-     * meet within 8 degrees (a smooth surface; across a crease the sides differ by right), the lightmap
-     * sampled bilinearly on both sides at 8 points of the edge; the difference of the irradiance's largest
-     * channel relative to the lightmap's largest value, mean and max over the points, and their number. */
+    /* Chart seams (ms_bake_finish), after any stitching: where two triangles share an edge in space but not
+     * in UVs on a smooth surface (their shading normals the same at both ends, or without shading normals
+     * their planes within 8 degrees: across a crease the sides differ by right), the lightmap sampled
+     * bilinearly on both sides at 2 points per texel of the edge; the difference of the irradiance's
+     * largest channel relative to the lightmap's largest value, mean and max over the points, and their
+     * number; seam_p99 their 99th percentile. */
     double seam_mean, seam_max;
     size_t seam_points;
+    double seam_p99;
+    size_t stitched_texels;    /* texels the seam stitching changed (0 with no_seam_stitch) */
+    double stitch_s;           /* seconds stitching */
 } ms_lightmap;
 
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at

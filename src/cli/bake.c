@@ -37,6 +37,8 @@ static void usage(FILE *f)
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
         "  --padding N         texels between charts and regions (default 4)\n"
         "  --no-leak-fix       keep the points of texels whose centre lies inside geometry\n"
+        "  --no-seam-stitch    keep the baked texels along UV seams (default: stitched by least squares so that\n"
+        "                      bilinear lookups from both sides of a seam on a smooth surface agree)\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I, --max-memory SIZE   as for frames\n"
         "  --quiet             no progress or summary on stderr\n"
         "  --verbose           every warning in full (e.g. each unusable material file or texture)\n"
@@ -90,7 +92,8 @@ static void pass_line_plain(void *user, const char *pass, double seconds)
 int ms_cli_bake(int argc, char **argv)
 {
     enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX };
+           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX,
+           O_NO_SEAM_STITCH };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -102,6 +105,7 @@ int ms_cli_bake(int argc, char **argv)
         { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
         { "verbose", no_argument, 0, O_VERBOSE }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
         { "gltf", required_argument, 0, O_GLTF }, { "no-leak-fix", no_argument, 0, O_NO_LEAK_FIX },
+        { "no-seam-stitch", no_argument, 0, O_NO_SEAM_STITCH },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -170,6 +174,7 @@ int ms_cli_bake(int argc, char **argv)
         case O_SHADOW: outs[4].path = optarg; break;
         case O_GLTF: outs[5].path = optarg; break;
         case O_NO_LEAK_FIX: bo.no_leak_fix = 1; break;
+        case O_NO_SEAM_STITCH: bo.no_seam_stitch = 1; break;
         case O_QUIET: quiet = 1; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &bo.points.max_memory)) return EXIT_BAD_INPUT; break;
         case O_VERBOSE: ms_set_warning_verbose(1); break;
@@ -247,13 +252,17 @@ int ms_cli_bake(int argc, char **argv)
     if (!quiet && !rc) {
         const ms_stats *s = &lm.frame.stats;
         const int nl = lm.frame.n_lights > 1 ? lm.frame.n_lights : 1;
+        char stitched[96];
+        if (bo.no_seam_stitch) snprintf(stitched, sizeof stitched, "not stitched");
+        else snprintf(stitched, sizeof stitched, "stitched: %zu texels in %.3fs", lm.stitched_texels, lm.stitch_s);
         fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
                 "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
-                "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, max %.4f of the largest irradiance -> %s%s%s\n",
+                "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, p99 %.4f, max %.4f of the largest irradiance (%s) -> "
+                "%s%s%s\n",
                 scene_path ? scene_path : "built-in scene", s->triangles, lm.unwrapped_tris, lm.unwrap_s, lm.frame.width,
                 lm.frame.height, lm.texels, lm.raster_s, lm.texels_moved, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads,
                 s->shadow_s, s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, lm.seam_points, lm.seam_mean,
-                lm.seam_max, outs[0].path, outs[5].path ? ", " : "", outs[5].path ? outs[5].path : "");
+                lm.seam_p99, lm.seam_max, stitched, outs[0].path, outs[5].path ? ", " : "", outs[5].path ? outs[5].path : "");
     }
     ms_lightmap_free(&lm);
     ms_scene_free(&scene);

@@ -1,13 +1,15 @@
 /* Lightmap baking (microshadow.h, "Lightmap baking"): UVs (the scene's set, xatlas for the rest), texels
  * rasterized conservatively onto the triangles' UV images and carried to world points, V and S there
  * through ms_visibility_points (so every method bakes, on the frames' sample patterns keyed by texel),
- * irradiance from the exact unshadowed value times S, then dilation across chart seams. */
+ * irradiance from the exact unshadowed value times S, then dilation across chart seams and the seams
+ * stitched (bake_stitch.c). */
 #include "microshadow.h"
 #include "core/abi.h"
 #include "points.h"
 #include "bake_uvs.h"
 #include "bake_leaks.h"
 #include "bake_seams.h"
+#include "bake_stitch.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -406,6 +408,39 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
     return st;
 }
 
+/* The seams of smooth edges (bake_seams.c): stitched (bake_stitch.c) unless o->no_seam_stitch, then measured. */
+static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_lightmap *lm, int threads, char *err, size_t errlen)
+{
+    ms_seam *list = NULL;
+    size_t n = 0;
+    if (ms_bake_seam_list(scene, lm->uv, &list, &n)) {
+        snprintf(err, errlen, "out of memory finding the lightmap's seams");
+        return MS_ERR_NO_MEMORY;
+    }
+    if (!o->no_seam_stitch) {
+        const double t0 = omp_get_wtime();
+        const int rc = ms_bake_stitch(&lm->frame, lm->uv, lm->triangle, list, n, threads, &lm->stitched_texels);
+        lm->stitch_s = omp_get_wtime() - t0;
+        if (rc) {
+            free(list);
+            snprintf(err, errlen, "out of memory stitching the lightmap's seams");
+            return MS_ERR_NO_MEMORY;
+        }
+        if (o->pass) o->pass(o->pass_user, "seam stitching", lm->stitch_s);
+    }
+    const double t0 = omp_get_wtime();
+    ms_seam_error se;
+    const int rc = ms_bake_seams(&lm->frame, list, n, &se);
+    free(list);
+    if (rc) { snprintf(err, errlen, "out of memory measuring the lightmap's seams"); return MS_ERR_NO_MEMORY; }
+    lm->seam_mean = se.mean;
+    lm->seam_p99 = se.p99;
+    lm->seam_max = se.max;
+    lm->seam_points = se.points;
+    if (o->pass) o->pass(o->pass_user, "seams", omp_get_wtime() - t0);
+    return MS_OK;
+}
+
 ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *lm, char *err, size_t errlen)
 {
     ms_bake_options zero;
@@ -474,17 +509,17 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     }
     free(lum);
     if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); return MS_ERR_NO_MEMORY; }
-    if (ms_bake_seams(scene, lm, &lm->seam_mean, &lm->seam_max, &lm->seam_points)) {
-        snprintf(err, errlen, "out of memory measuring the lightmap's seams");
-        return MS_ERR_NO_MEMORY;
-    }
-    /* A NaN or infinite texel is an error, never a lightmap (microshadow.h: MS_MAX_RADIANCE). */
+    /* A NaN or infinite texel is an error, never a lightmap (microshadow.h: MS_MAX_RADIANCE); checked before
+     * the stitching would spread it. */
     if (ms_frame_check_finite(f, "the lightmap", err, errlen)) return MS_ERR_INVALID;
-    if (o->pass) o->pass(o->pass_user, "irradiance, dilation and seams", omp_get_wtime() - t_finish);
+    if (o->pass) o->pass(o->pass_user, "irradiance and dilation", omp_get_wtime() - t_finish);
+    ms_status st = seams(scene, o, lm, threads, err, errlen);
+    if (st) return st;
     f->stats.width = f->stats.height = size;
     f->stats.triangles = scene->n_tris;
     f->stats.load_s = scene->load_s;
-    f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + lm->leak_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s;
+    f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + lm->leak_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s +
+                        lm->stitch_s;
     return MS_OK;
 }
 
