@@ -64,10 +64,11 @@ static void write_scene(const char *dir, int n, int smooth, char *json, size_t l
         "\"light\":{\"corner\":[-0.25,3.5,-0.25],\"edge_s\":[0.5,0,0],\"edge_t\":[0,0,0.5],\"emission\":[1,1,1]}}"), 0);
 }
 
-static void bake(const ms_scene *sc, int size, int no_stitch, ms_lightmap *lm)
+static void bake_budget(const ms_scene *sc, int size, int no_stitch, uint64_t max_memory, ms_lightmap *lm)
 {
     ms_bake_options bo;
     memset(&bo, 0, sizeof bo);
+    bo.points.max_memory = max_memory;
     bo.size = size;
     bo.uv_set = 0;
     bo.points.samples = SAMPLES;
@@ -76,6 +77,8 @@ static void bake(const ms_scene *sc, int size, int no_stitch, ms_lightmap *lm)
     char err[512] = "";
     assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
 }
+
+static void bake(const ms_scene *sc, int size, int no_stitch, ms_lightmap *lm) { bake_budget(sc, size, no_stitch, 0, lm); }
 
 /* Plane (plane = -1: the irradiance's green channel; else light plane's S) bilinear at (u, v), clamped. */
 static double lookup(const ms_frame *f, int plane, double u, double v)
@@ -353,11 +356,51 @@ static void test_hard_edges(void **st)
     }
 }
 
+static char warned[1024];
+static void catch_warning(void *user, const char *message)
+{
+    (void)user;
+    snprintf(warned, sizeof warned, "%s", message);
+}
+
+/* The stitch's memory counts in the budget: with a budget that holds the bake but not the stitch beside it,
+ * the bake runs, says that it skipped the stitch, and gives the unstitched lightmap bit for bit. */
+static void test_stitch_over_budget(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_seams_budget");
+    char json[1024], err[512] = "";
+    write_scene(dir, 256, 1, json, sizeof json);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), MS_OK);
+    ms_lightmap free_run, bare, tight;
+    bake(&sc, 64, 0, &free_run);
+    bake(&sc, 64, 1, &bare);
+    assert_true(free_run.stitched_texels > 0);
+    const uint64_t need = free_run.frame.stats.memory_need;
+    assert_true(need > 0);
+    warned[0] = 0;
+    ms_set_warning_handler(catch_warning, NULL);
+    bake_budget(&sc, 64, 0, need, &tight);
+    ms_set_warning_handler(NULL, NULL);
+    printf("warning: %s\n", warned);
+    assert_non_null(strstr(warned, "seam stitching skipped"));
+    assert_int_equal(tight.stitched_texels, 0);
+    const size_t np = (size_t)64 * 64;
+    assert_memory_equal(tight.frame.rgb, bare.frame.rgb, 3 * np * sizeof *bare.frame.rgb);
+    assert_memory_equal(tight.frame.shadow, bare.frame.shadow, np * sizeof *bare.frame.shadow);
+    ms_lightmap_free(&free_run);
+    ms_lightmap_free(&bare);
+    ms_lightmap_free(&tight);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cylinder),
         cmocka_unit_test(test_hard_edges),
+        cmocka_unit_test(test_stitch_over_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

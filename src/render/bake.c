@@ -15,6 +15,7 @@
 #include "light/light_shape.h"
 #include "visibility/receiver.h"
 #include "shadow/method.h"
+#include "scene/scene_internal.h"   /* ms_warn */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -417,7 +418,22 @@ static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_light
         snprintf(err, errlen, "out of memory finding the lightmap's seams");
         return MS_ERR_NO_MEMORY;
     }
-    if (!o->no_seam_stitch) {
+    /* The stitch's memory is known only now, with the seams: checked against what the budget leaves beside
+     * the bake's own estimate; over it, the lightmap stays unstitched (correct, with its seams), and says so. */
+    int stitch = !o->no_seam_stitch;
+    if (stitch) {
+        uint64_t bake_need = 0;
+        char ignored[8];
+        bake_budget(scene, o, lm->frame.width, 1, &bake_need, ignored, sizeof ignored);
+        const uint64_t need = ms_bake_stitch_need(&lm->frame, list, n), budget = ms_memory_budget(o->points.max_memory);
+        if (bake_need + need > budget) {
+            ms_warn("seam stitching skipped: it needs %.1f MiB beside the bake's %.1f MiB, over the memory budget of "
+                    "%.1f MiB (raise it, or pass --no-seam-stitch to silence this)",
+                    need / 1048576.0, bake_need / 1048576.0, budget / 1048576.0);
+            stitch = 0;
+        }
+    }
+    if (stitch) {
         const double t0 = omp_get_wtime();
         const int rc = ms_bake_stitch(&lm->frame, lm->uv, lm->triangle, list, n, threads, &lm->stitched_texels);
         lm->stitch_s = omp_get_wtime() - t0;

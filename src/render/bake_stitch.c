@@ -262,6 +262,23 @@ static int build_transpose(stitch_sys *s)
     return 0;
 }
 
+uint64_t ms_bake_stitch_need(const ms_frame *f, const ms_seam *seams, size_t n)
+{
+    if (!n) return 0;
+    const uint64_t np = (uint64_t)f->width * (uint64_t)f->height;
+    const uint64_t nch = 3u + (f->n_lights > 1 ? (uint64_t)f->n_lights : 1u);
+    uint64_t nr = 0;   /* the rows: build_rows's capacity */
+    for (size_t i = 0; i < n; i++) nr += (uint64_t)ms_seam_samples(ms_seam_len_texels(&seams[i], f->width), PER_TEXEL);
+    const uint64_t nv = 8u * nr < np ? 8u * nr + 1u : np;   /* variables: texels read by some row */
+    const uint64_t base = np * sizeof(int32_t) + nr * sizeof(row) + nv * sizeof(size_t);   /* var_of, rows, texel_of */
+    /* split's copies (its union-find, renumbering and a second row array; the component starts at most one
+     * per variable), then the transpose, the preconditioner, lam and the solver's work, which outlive it */
+    const uint64_t split_peak = nv * (3u * sizeof(uint32_t) + sizeof(size_t)) + nr * sizeof(row) + 2u * (nv + 1u) * sizeof(size_t);
+    const uint64_t solve = (nv + 1u) * sizeof(size_t) + 8u * nr * (sizeof(uint32_t) + sizeof(float)) + nv * (2u * sizeof(double) + sizeof(size_t)) +
+                           nv * sizeof(double) + ((6u + nch) * nv + nr + 1u) * sizeof(double) + 2u * (nv + 1u) * sizeof(size_t);
+    return base + (split_peak > solve ? split_peak : solve);
+}
+
 int ms_bake_stitch(ms_frame *f, const float *uv, const uint32_t *triangle, const ms_seam *seams, size_t n, int threads,
                    size_t *texels)
 {

@@ -12,4 +12,8 @@
 int ms_bake_stitch(ms_frame *f, const float *uv, const uint32_t *triangle, const ms_seam *seams, size_t n, int threads,
                    size_t *texels);
 
+/* An upper bound of the bytes ms_bake_stitch allocates for these seams on f (its peak), for the bake's
+ * memory budget: the seams are known only once the layout is, after the budget's first check. */
+uint64_t ms_bake_stitch_need(const ms_frame *f, const ms_seam *seams, size_t n);
+
 #endif
