@@ -807,9 +807,11 @@ static inline ms_status ms_visibility_points(const ms_accel *a, const ms_light *
  * touches (conservative rasterization) is carried to the triangle's surface: its centre's barycentric
  * coordinates, moved to the nearest point of the triangle when the centre lies outside (a texel several
  * triangles touch takes the one containing its centre, else the nearest), give the world position; the
- * normal is the triangle's, by its winding (cross(b - a, c - a)). V and S there come from
- * ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
- * E_unshadowed * S * emission (ms_light_irradiance). Texels no triangle touches are filled by dilation
+ * normal (ms_lightmap.normal) is the triangle's, by its winding (cross(b - a, c - a)). V and S there come
+ * from ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
+ * E_unshadowed * S * emission (ms_light_irradiance), E_unshadowed's cosine taken with the shading normal as
+ * frames shade (the vertex normals interpolated, turned to the winding's side; the triangle's where the mesh
+ * has none), so that smooth surfaces bake smooth. Texels no triangle touches are filled by dilation
  * from their neighbours (across chart seams) so that bilinear lookups do not bleed black. */
 /* Called at the end of each pass of a bake, from the calling thread, with its name ("UVs", "texels", "leak
  * test", "acceleration structure", "light 1/3", ..., "irradiance, dilation and seams") and its seconds: one

@@ -140,8 +140,7 @@ static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_m
     v3_normalize(n, out);
 }
 
-/* Barycentric coordinates of p (on the triangle's plane) in tri. */
-static void barycentric(const float *tri, const float p[3], float b[3])
+void ms_barycentric(const float *tri, const float p[3], float b[3])
 {
     float e1[3], e2[3], d[3], n[3], c1[3], c2[3];
     v3_sub(e1, tri + 3, tri);
@@ -157,6 +156,17 @@ static void barycentric(const float *tri, const float p[3], float b[3])
     b[0] = 1.0f - b[1] - b[2];
 }
 
+int ms_interpolated_normal(const ms_scene *s, size_t t, const float b[3], float n[3])
+{
+    if (!s->tri_normal) return 0;
+    const float *vn = s->tri_normal + 9 * t;
+    float ni[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; k++) v3_madd(ni, ni, vn + 3 * k, b[k]);
+    if (!(v3_finite(ni) && v3_len(ni) > 1e-12f)) return 0;
+    v3_normalize(n, ni);
+    return 1;
+}
+
 void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out)
 {
     memset(out, 0, sizeof *out);
@@ -170,15 +180,10 @@ void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const 
     const uint32_t mi = s->tri_material ? s->tri_material[t] : MS_NO_MATERIAL;
     const ms_material *m = mi < s->n_materials ? &s->materials[mi] : NULL;
     float b[3];
-    barycentric(s->tri + 9 * t, h->p, b);
+    ms_barycentric(s->tri + 9 * t, h->p, b);
     float ns[3];
     memcpy(ns, h->n, sizeof ns);
-    if (s->tri_normal) {
-        const float *vn = s->tri_normal + 9 * t;
-        float ni[3] = { 0, 0, 0 };
-        for (int k = 0; k < 3; k++) v3_madd(ni, ni, vn + 3 * k, b[k]);
-        if (v3_finite(ni) && v3_len(ni) > 1e-12f) v3_normalize(ns, ni);
-    }
+    ms_interpolated_normal(s, t, b, ns);
     /* The normal map perturbs the interpolated normal on its own side of the surface; then the result is
      * turned to the eye's side of the surface like h->n. */
     if (m && m->normal_map) normal_map(s, t, b, m, ns);

@@ -23,6 +23,14 @@ typedef struct ms_surface {
     float emissive[3];   /* emitted radiance (material emission x strength x texture), added once per pixel */
 } ms_surface;
 
+/* Barycentric coordinates b of p (on the triangle's plane) in tri (9 floats). */
+void ms_barycentric(const float *tri, const float p[3], float b[3]);
+
+/* The shading normal of scene triangle t at barycentrics b: its vertex normals (ms_scene.tri_normal)
+ * interpolated and normalised into n, as frames shade (before any normal map; on the side the file gave it).
+ * 1, or 0 with n untouched where the triangle has no usable vertex normals. */
+int ms_interpolated_normal(const ms_scene *s, size_t t, const float b[3], float n[3]);
+
 /* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye. */
 void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out);
 
