@@ -6,6 +6,7 @@
 #include "core/abi.h"
 #include "image/png_encode.h"
 #include "scene/scene_internal.h"
+#include "shade.h"
 #include "light/light_shape.h"
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -311,8 +312,8 @@ static int cmp_key(const void *pa, const void *pb)
     return (a->tri > b->tri) - (a->tri < b->tri);
 }
 
-/* One vertex: position, normal, UV 0, UV 1. */
-typedef struct vert { float p[3], n[3], uv0[2], uv1[2]; } vert;
+/* One vertex: position, normal, UV 0, UV 1, tangent (zero where the primitive has none). */
+typedef struct vert { float p[3], n[3], uv0[2], uv1[2], t[4]; } vert;
 
 static uint64_t hash_vert(const vert *v)
 {
@@ -340,6 +341,35 @@ static int face_normal(const float *t, float n[3])
     return 1;
 }
 
+/* The TANGENT of corner c of triangle t (unit normal n as written): the scene's (the asset's, or MikkTSpace's
+ * made at load, as the renderer reads them), else the triangle's UV frame the renderer falls back on
+ * (ms_uv_tangent); made orthogonal to n and unit, w = +-1 (the validator's rules). */
+static void vertex_tangent(const ms_scene *sc, size_t t, int c, int32_t set, const float n[3], float out[4])
+{
+    const float *tg = sc->tri_tangent ? sc->tri_tangent + 12 * t : NULL;
+    for (int k = 0; tg && k < 12; k++)
+        if (!isfinite(tg[k])) tg = NULL;
+    float T[3] = { 0, 0, 0 }, w = 1.0f;
+    if (tg) {
+        memcpy(T, tg + 4 * c, sizeof T);
+        w = tg[4 * c + 3] < 0.0f ? -1.0f : 1.0f;
+    } else if (set < 0 || set >= MS_MAX_UV_SETS || !sc->tri_uv[set] || !ms_uv_tangent(sc, t, set, n, T, &w))
+        memset(T, 0, sizeof T);
+    double d = (double)T[0] * n[0] + (double)T[1] * n[1] + (double)T[2] * n[2], o[3], len = 0.0;
+    for (int k = 0; k < 3; k++) { o[k] = T[k] - d * n[k]; len += o[k] * o[k]; }
+    len = sqrt(len);
+    if (!(len > 1e-12) || !isfinite(len)) {   /* no frame: any unit vector orthogonal to n */
+        const int a = fabsf(n[0]) < 0.9f ? 0 : 1;
+        const double e[3] = { a == 0, a == 1, 0 };
+        d = e[0] * n[0] + e[1] * n[1];
+        len = 0.0;
+        for (int k = 0; k < 3; k++) { o[k] = e[k] - d * n[k]; len += o[k] * o[k]; }
+        len = sqrt(len);
+    }
+    for (int k = 0; k < 3; k++) out[k] = (float)(o[k] / len);
+    out[3] = w;
+}
+
 /* One primitive of the triangles keys[0..n) (one group), welded; its JSON, or NULL on error. */
 static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
 {
@@ -356,6 +386,12 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
         return NULL;
     }
     memset(slot, 0xff, cap * sizeof *slot);
+    /* The material first: a normal texture carried into the file needs TANGENT on the vertices. */
+    const int mat = material_for(w, keys[0].material, var);
+    if (mat < 0) { free(vs); free(idx); free(slot); return NULL; }
+    const uint32_t sm = keys[0].material;
+    const int tangents = cJSON_GetObjectItem(cJSON_GetArrayItem(w->materials, mat), "normalTexture") != NULL;
+    const int32_t tset = sm < sc->n_materials ? sc->materials[sm].normal_uv : 0;
     size_t nv = 0;
     for (size_t k = 0; k < n; k++) {
         const size_t t = keys[k].tri;
@@ -371,6 +407,7 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
             for (int d = 0; d < 3; d++) v.n[d] = sl > 0.0 ? (float)(sn[d] / sl) : fn[d];
             if (var & VAR_UV0) memcpy(v.uv0, sc->tri_uv[0] + 6 * t + 2 * c, sizeof v.uv0);
             if (var & VAR_BAKED) memcpy(v.uv1, w->lm->uv + 6 * t + 2 * c, sizeof v.uv1);
+            if (tangents) vertex_tangent(sc, t, c, tset, v.n, v.t);
             size_t h = (size_t)(hash_vert(&v) & (cap - 1));
             while (slot[h] != UINT32_MAX && memcmp(&vs[slot[h]], &v, sizeof v)) h = (h + 1) & (cap - 1);
             if (slot[h] == UINT32_MAX) { slot[h] = (uint32_t)nv; vs[nv++] = v; }
@@ -379,13 +416,17 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     }
     free(slot);
     /* attribute arrays out of the interleaved vertices */
-    float *a = malloc(nv * 3 * sizeof *a);
+    float *a = malloc(nv * 4 * sizeof *a);
     if (!a) { free(vs); free(idx); snprintf(w->err, w->errlen, "out of memory for a primitive"); return NULL; }
     cJSON *prim = cJSON_CreateObject(), *attr = cJSON_AddObjectToObject(prim, "attributes");
     for (size_t i = 0; i < nv; i++) memcpy(a + 3 * i, vs[i].p, 3 * sizeof(float));
     cJSON_AddNumberToObject(attr, "POSITION", add_accessor(w, a, nv, 3, 1));
     for (size_t i = 0; i < nv; i++) memcpy(a + 3 * i, vs[i].n, 3 * sizeof(float));
     cJSON_AddNumberToObject(attr, "NORMAL", add_accessor(w, a, nv, 3, 0));
+    if (tangents) {
+        for (size_t i = 0; i < nv; i++) memcpy(a + 4 * i, vs[i].t, 4 * sizeof(float));
+        cJSON_AddNumberToObject(attr, "TANGENT", add_accessor(w, a, nv, 4, 0));
+    }
     if (var & VAR_UV0) {
         for (size_t i = 0; i < nv; i++) memcpy(a + 2 * i, vs[i].uv0, 2 * sizeof(float));
         cJSON_AddNumberToObject(attr, "TEXCOORD_0", add_accessor(w, a, nv, 2, 0));
@@ -403,8 +444,6 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     free(a);
     free(vs);
     free(idx);
-    const int mat = material_for(w, keys[0].material, var);
-    if (mat < 0) { cJSON_Delete(prim); return NULL; }
     cJSON_AddNumberToObject(prim, "material", mat);
     cJSON_AddNumberToObject(prim, "mode", 4);
     return prim;

@@ -94,6 +94,25 @@ static int lookup(const ms_scene *s, size_t t, const float b[3], int32_t tex, in
     return texture_rgba(tx, sm, u, v, srgb, out);
 }
 
+int ms_uv_tangent(const ms_scene *s, size_t t, int32_t set, const float n[3], float T[3], float *w)
+{
+    float B[3], nb[3];
+    const float *p = s->tri + 9 * t, *uv = s->tri_uv[set] + 6 * t;
+    float e1[3], e2[3];
+    v3_sub(e1, p + 3, p);
+    v3_sub(e2, p + 6, p);
+    const float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
+    const float r = du1 * dv2 - du2 * dv1;
+    if (!(fabsf(r) > 0.0f)) return 0;
+    for (int c = 0; c < 3; c++) {
+        T[c] = (e1[c] * dv2 - e2[c] * dv1) / r;   /* dP/du */
+        B[c] = (e1[c] * du2 - e2[c] * du1) / r;   /* -dP/dv: up the image */
+    }
+    v3_cross(nb, n, T);
+    *w = v3_dot(nb, B) < 0.0f ? -1.0f : 1.0f;
+    return 1;
+}
+
 /* The normal map's perturbation of the unit shading normal n (before it is turned to the eye): texel t ->
  * (x, y, z) = 2 t - 1 (linear), x and y times the scale; n' = normalize(x T + y B + z n) with T the tangent
  * made orthogonal to n and B = w n x T (glTF). The tangent: the scene's (the asset's TANGENT, or MikkTSpace
@@ -104,7 +123,7 @@ static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_m
 {
     float tex[4];
     if (!lookup(s, t, b, m->normal_texture, m->normal_uv, &m->normal_sampling, 0, tex)) return;
-    float T[3] = { 0, 0, 0 }, B[3], nb[3], tn[3], out[3];
+    float T[3] = { 0, 0, 0 }, nb[3], tn[3], out[3];
     const float *tg = s->tri_tangent ? s->tri_tangent + 12 * t : NULL;
     for (int k = 0; tg && k < 12; k++)
         if (!isfinite(tg[k])) tg = NULL;
@@ -112,21 +131,8 @@ static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_m
     if (tg) {
         for (int k = 0; k < 3; k++) v3_madd(T, T, tg + 4 * k, b[k]);
         w = tg[3] < 0.0f ? -1.0f : 1.0f;
-    } else {
-        const float *p = s->tri + 9 * t, *uv = s->tri_uv[m->normal_uv] + 6 * t;
-        float e1[3], e2[3];
-        v3_sub(e1, p + 3, p);
-        v3_sub(e2, p + 6, p);
-        const float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
-        const float r = du1 * dv2 - du2 * dv1;
-        if (!(fabsf(r) > 0.0f)) return;   /* degenerate UVs: no tangent frame */
-        for (int c = 0; c < 3; c++) {
-            T[c] = (e1[c] * dv2 - e2[c] * dv1) / r;   /* dP/du */
-            B[c] = (e1[c] * du2 - e2[c] * du1) / r;   /* -dP/dv: up the image */
-        }
-        v3_cross(nb, n, T);
-        if (v3_dot(nb, B) < 0.0f) w = -1.0f;
-    }
+    } else if (!ms_uv_tangent(s, t, m->normal_uv, n, T, &w))
+        return;   /* degenerate UVs: no tangent frame */
     v3_madd(T, T, n, -v3_dot(n, T));
     if (!v3_finite(T) || !(v3_len(T) > 1e-20f)) return;
     v3_normalize(T, T);

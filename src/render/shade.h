@@ -31,6 +31,11 @@ void ms_barycentric(const float *tri, const float p[3], float b[3]);
  * 1, or 0 with n untouched where the triangle has no usable vertex normals. */
 int ms_interpolated_normal(const ms_scene *s, size_t t, const float b[3], float n[3]);
 
+/* The tangent frame of scene triangle t where its mesh has no tangents: T = dP/du over UV set `set` (not
+ * normalised) and w (+-1) such that w n x T runs up the image (towards decreasing glTF v), as normal maps
+ * read it (docs/shading.md). 1, or 0 for degenerate UVs. */
+int ms_uv_tangent(const ms_scene *s, size_t t, int32_t set, const float n[3], float T[3], float *w);
+
 /* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye. */
 void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out);
 
