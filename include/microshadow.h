@@ -853,6 +853,11 @@ typedef struct ms_lightmap {
      * channel relative to the lightmap's largest value, mean and max over the points, and their number. */
     double seam_mean, seam_max;
     size_t seam_points;
+    /* Triangles left out of the lightmap (ms_bake_layout): excluded_tris of meshes with "lightmap": false (as
+     * asked: reported, not warned about); unbaked_tris for any other reason - no area, no UVs (xatlas leaves out
+     * triangles of area at most FLT_EPSILON), UVs without area or outside the lightmap - each reason a warning
+     * with its count (ms_set_warning_handler). The glb names their primitives and materials after the reason. */
+    size_t excluded_tris, unbaked_tris;
 } ms_lightmap;
 
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at

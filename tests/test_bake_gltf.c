@@ -430,10 +430,100 @@ static void test_cli(void **st)
     assert_false(tu_file_exists(exr));
 }
 
+/* The warnings of one bake, kept for the test to read. */
+static char g_warnings[8192];
+
+static void keep_warning(void *user, const char *msg)
+{
+    (void)user;
+    const size_t n = strlen(g_warnings);
+    snprintf(g_warnings + n, sizeof g_warnings - n, "%s\n", msg);
+}
+
+/* The primitive whose extras.name is `name`: its extras.triangles and its material's name, or -1. */
+static int unbaked_primitive(const tu_glb *g, const char *name, char *material, size_t n)
+{
+    for (int m = 0; tu_glb_item(g, "meshes", m); m++) {
+        const cJSON *prims = cJSON_GetObjectItem(tu_glb_item(g, "meshes", m), "primitives");
+        for (int p = 0; p < cJSON_GetArraySize(prims); p++) {
+            const cJSON *pr = cJSON_GetArrayItem(prims, p), *ex = cJSON_GetObjectItem(pr, "extras");
+            const cJSON *nm = cJSON_GetObjectItem(ex, "name");
+            if (!cJSON_IsString(nm) || strcmp(nm->valuestring, name) != 0) continue;
+            const cJSON *mn = cJSON_GetObjectItem(tu_glb_item(g, "materials", geti(pr, "material")), "name");
+            snprintf(material, n, "%s", cJSON_IsString(mn) ? mn->valuestring : "");
+            assert_int_equal(geti(pr, "TEXCOORD_1"), -1);
+            return geti(ex, "triangles");
+        }
+    }
+    return -1;
+}
+
+/* Every triangle baked or named: a ground, a crumb of area 1e-8 (below xatlas's FLT_EPSILON: it charts it
+ * not), a triangle without area, a box with "lightmap": false. The bake warns once per reason with its
+ * count (not for "lightmap": false, which it counts), the glb names the primitives and materials, and the
+ * CLI says the same on stderr. */
+static void test_unbaked_named(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_gltf_unbaked");
+    char p[1024], json[1024], glb[1024], exr[1024], err[512] = "";
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "ground.obj"), "v -2 0 -2\nv -2 0 2\nv 2 0 2\nv 2 0 -2\nf 1 2 3 4\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "bits.obj"),
+        "v 0 0.5 0\nv 0.0001 0.5 0\nv 0 0.5 0.0002\nv 1 1 1\nv 1.5 1 1\nv 2 1 1\nf 1 2 3\nf 4 5 6\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "box.obj"),
+        "v 0.5 0 -0.5\nv 1.5 0 -0.5\nv 1.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 -0.5\nv 1.5 1 -0.5\nv 1.5 1 0.5\nv 0.5 1 0.5\n"
+        "f 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(json, sizeof json, dir, "scene.json"),
+        "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"bits.obj\"},{\"file\":\"box.obj\",\"lightmap\":false}],"
+        "\"camera\":{\"eye\":[0,5,5],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":32,\"height\":32},"
+        "\"light\":{\"corner\":[-0.5,4,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1],\"emission\":[1,1,1]}}"), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = 64;
+    bo.uv_set = -1;
+    bo.points.samples = 256;
+    bo.points.isa = tu_isa_cap();
+    ms_lightmap lm;
+    g_warnings[0] = 0;
+    ms_set_warning_handler(keep_warning, NULL);
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    tu_path(glb, sizeof glb, dir, "unbaked.glb");
+    assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, glb, err, sizeof err), MS_OK);
+    ms_set_warning_handler(NULL, NULL);
+    printf("%s", g_warnings);
+    assert_non_null(strstr(g_warnings, "1 triangle not baked: no UVs (xatlas leaves out triangles of area at most"));
+    assert_non_null(strstr(g_warnings, "1 triangle not baked: no area"));
+    assert_null(strstr(g_warnings, "lightmap false"));   /* asked for: counted, not warned about */
+    assert_int_equal(lm.excluded_tris, 12);
+    assert_int_equal(lm.unbaked_tris, 2);
+    tu_glb g;
+    assert_int_equal(tu_glb_read(glb, &g), 0);
+    char mat[128];
+    assert_int_equal(unbaked_primitive(&g, "not baked: no UVs", mat, sizeof mat), 1);
+    assert_non_null(strstr(mat, "(not baked: no UVs)"));
+    assert_int_equal(unbaked_primitive(&g, "not baked: lightmap false", mat, sizeof mat), 12);
+    assert_non_null(strstr(mat, "(not baked: lightmap false)"));
+    assert_int_equal(unbaked_primitive(&g, "not baked: no area", mat, sizeof mat), -1);   /* left out of the file */
+    tu_glb_free(&g);
+    /* the CLI: the same warnings and the count of "lightmap": false on the terminal */
+    tu_path(exr, sizeof exr, dir, "cli.exr");
+    const char *args[] = { "bake", json, "--uv", "xatlas", "--size", "64", "--samples", "256", "-o", exr, NULL };
+    char all[8192];
+    assert_int_equal(tu_run_cli_ex(args, NULL, all, sizeof all, NULL), 0);
+    assert_non_null(strstr(all, "warning: 1 triangle not baked: no UVs"));
+    assert_non_null(strstr(all, "warning: 1 triangle not baked: no area"));
+    assert_non_null(strstr(all, "bake: 14 triangles not baked: 12 of meshes with \"lightmap\": false, 2 for the reasons warned about"));
+    ms_lightmap_free(&lm);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_glb_reads_back),
+        cmocka_unit_test(test_unbaked_named),
         cmocka_unit_test(test_validator),
         cmocka_unit_test(test_cli),
     };

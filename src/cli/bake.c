@@ -247,6 +247,9 @@ int ms_cli_bake(int argc, char **argv)
     if (!quiet && !rc) {
         const ms_stats *s = &lm.frame.stats;
         const int nl = lm.frame.n_lights > 1 ? lm.frame.n_lights : 1;
+        if (lm.excluded_tris || lm.unbaked_tris)   /* each reason other than "lightmap": false was a warning */
+            fprintf(stderr, "bake: %zu triangles not baked: %zu of meshes with \"lightmap\": false, %zu for the reasons "
+                    "warned about\n", lm.excluded_tris + lm.unbaked_tris, lm.excluded_tris, lm.unbaked_tris);
         fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
                 "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
                 "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, max %.4f of the largest irradiance -> %s%s%s\n",

@@ -63,7 +63,7 @@ static const layout_row rows[] = {
     FIELD(ms_lightmap, triangle), FIELD(ms_lightmap, uv), FIELD(ms_lightmap, n_tris), FIELD(ms_lightmap, texels),
     FIELD(ms_lightmap, unwrapped_tris), FIELD(ms_lightmap, unwrap_s), FIELD(ms_lightmap, raster_s),
     FIELD(ms_lightmap, texels_moved), FIELD(ms_lightmap, leak_s), FIELD(ms_lightmap, seam_mean), FIELD(ms_lightmap, seam_max),
-    FIELD(ms_lightmap, seam_points),
+    FIELD(ms_lightmap, seam_points), FIELD(ms_lightmap, excluded_tris), FIELD(ms_lightmap, unbaked_tris),
     STRUCT(ms_bake_gltf_options), FIELD(ms_bake_gltf_options, no_textures), FIELD(ms_bake_gltf_options, no_shadowmask),
 };
 

@@ -9,6 +9,7 @@
 #include "bake_leaks.h"
 #include "bake_seams.h"
 #include "shade.h"
+#include "bake_unbaked.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -283,6 +284,12 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
     const double t_raster = omp_get_wtime();
     if (!st) st = rasterize(scene, size, out, err, errlen);
     out->raster_s = omp_get_wtime() - t_raster;
+    if (!st) {   /* every triangle baked or named */
+        size_t count[MS_UNBAKED_REASONS];
+        ms_bake_report_unbaked(scene, out, size, count);
+        out->excluded_tris = count[MS_UNBAKED_EXCLUDED];
+        for (int r = MS_UNBAKED_NO_AREA; r < MS_UNBAKED_REASONS; r++) out->unbaked_tris += count[r];
+    }
     if (!st && o->pass) o->pass(o->pass_user, "texels", out->raster_s);
     const double t_leak = omp_get_wtime();
     if (!st && !o->no_leak_fix &&

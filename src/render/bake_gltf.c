@@ -7,6 +7,7 @@
 #include "image/png_encode.h"
 #include "scene/scene_internal.h"
 #include "shade.h"
+#include "bake_unbaked.h"
 #include "light/light_shape.h"
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -52,7 +53,8 @@ typedef struct writer {
     int *image_of;          /* scene texture -> glTF image, -1 until made */
     int lightmap_tex, shadowmask_tex;
     double intensity;       /* the lightmap's scale I */
-    int *material_of;       /* (scene material + 1) * 4 + variant -> glTF material, -1 until made */
+    int *material_of;       /* ((scene material + 1) * 4 + variant) * MS_UNBAKED_REASONS + reason -> glTF material,
+                             * -1 until made */
     int used_emissive_strength, dropped_transform, dropped_uv_set;
     char *err;
     size_t errlen;
@@ -180,10 +182,11 @@ static const char *shape_name(ms_light_shape s)
 /* Variants of a material: baked (TEXCOORD_1 and the lightmap), with TEXCOORD_0 (its textures). */
 enum { VAR_BAKED = 1, VAR_UV0 = 2 };
 
-/* The glTF material of scene material m (MS_NO_MATERIAL: the default grey) in variant var; -1 on error. */
-static int material_for(writer *w, uint32_t m, int var)
+/* The glTF material of scene material m (MS_NO_MATERIAL: the default grey) in variant var, named after the
+ * reason its triangles were not baked when they were not; -1 on error. */
+static int material_for(writer *w, uint32_t m, int var, ms_unbaked why)
 {
-    const size_t slot = (m == MS_NO_MATERIAL ? 0 : (size_t)m + 1) * 4 + (size_t)var;
+    const size_t slot = ((m == MS_NO_MATERIAL ? 0 : (size_t)m + 1) * 4 + (size_t)var) * MS_UNBAKED_REASONS + (size_t)why;
     if (w->material_of[slot] >= 0) return w->material_of[slot];
     ms_material def;
     memset(&def, 0, sizeof def);
@@ -193,9 +196,10 @@ static int material_for(writer *w, uint32_t m, int var)
     def.base_color_texture = def.alpha_texture = def.normal_texture = def.emissive_texture = def.mr_texture = -1;
     const ms_material *mt = m == MS_NO_MATERIAL ? &def : &w->sc->materials[m];
     cJSON *j = cJSON_CreateObject();
-    char name[64];
-    if (m == MS_NO_MATERIAL) snprintf(name, sizeof name, "default%s", var & VAR_BAKED ? "" : " (not baked)");
-    else snprintf(name, sizeof name, "material %u%s", m, var & VAR_BAKED ? "" : " (not baked)");
+    char name[96], tail[64] = "";
+    if (!(var & VAR_BAKED)) snprintf(tail, sizeof tail, " (not baked: %s)", ms_unbaked_name(why));
+    if (m == MS_NO_MATERIAL) snprintf(name, sizeof name, "default%s", tail);
+    else snprintf(name, sizeof name, "material %u%s", m, tail);
     cJSON_AddStringToObject(j, "name", name);
     cJSON *pbr = cJSON_AddObjectToObject(j, "pbrMetallicRoughness");
     float bc[4];
@@ -300,7 +304,7 @@ static int add_maps(writer *w)
 
 /* A triangle's group: its object (ms_scene.tri_object, else its mesh), material and variant. */
 typedef struct tri_key {
-    uint32_t mesh, material, var, tri;
+    uint32_t mesh, material, var, why, tri;   /* why: ms_unbaked, for the triangles not baked */
 } tri_key;
 
 static int cmp_key(const void *pa, const void *pb)
@@ -309,6 +313,7 @@ static int cmp_key(const void *pa, const void *pb)
     if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
     if (a->material != b->material) return a->material < b->material ? -1 : 1;
     if (a->var != b->var) return a->var < b->var ? -1 : 1;
+    if (a->why != b->why) return a->why < b->why ? -1 : 1;
     return (a->tri > b->tri) - (a->tri < b->tri);
 }
 
@@ -387,7 +392,7 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     }
     memset(slot, 0xff, cap * sizeof *slot);
     /* The material first: a normal texture carried into the file needs TANGENT on the vertices. */
-    const int mat = material_for(w, keys[0].material, var);
+    const int mat = material_for(w, keys[0].material, var, (ms_unbaked)keys[0].why);
     if (mat < 0) { free(vs); free(idx); free(slot); return NULL; }
     const uint32_t sm = keys[0].material;
     const int tangents = cJSON_GetObjectItem(cJSON_GetArrayItem(w->materials, mat), "normalTexture") != NULL;
@@ -446,6 +451,13 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     free(idx);
     cJSON_AddNumberToObject(prim, "material", mat);
     cJSON_AddNumberToObject(prim, "mode", 4);
+    if (!(var & VAR_BAKED)) {   /* glTF primitives have no name: extras say why they carry no lightmap */
+        cJSON *ex = cJSON_AddObjectToObject(prim, "extras");
+        char why[64];
+        snprintf(why, sizeof why, "not baked: %s", ms_unbaked_name((ms_unbaked)keys[0].why));
+        cJSON_AddStringToObject(ex, "name", why);
+        cJSON_AddNumberToObject(ex, "triangles", (double)n);
+    }
     return prim;
 }
 
@@ -478,7 +490,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
     ms_status st = MS_OK;
     const size_t n = sc->n_tris;
     w.image_of = malloc((sc->n_textures ? sc->n_textures : 1) * sizeof *w.image_of);
-    w.material_of = malloc((sc->n_materials + 1) * 4 * sizeof *w.material_of);
+    w.material_of = malloc((sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS * sizeof *w.material_of);
     tri_key *keys = malloc((n ? n : 1) * sizeof *keys);
     w.root = cJSON_CreateObject();
     if (!w.image_of || !w.material_of || !keys || !w.root) {
@@ -487,7 +499,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
         goto done;
     }
     for (size_t i = 0; i < sc->n_textures; i++) w.image_of[i] = -1;
-    for (size_t i = 0; i < (sc->n_materials + 1) * 4; i++) w.material_of[i] = -1;
+    for (size_t i = 0; i < (sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS; i++) w.material_of[i] = -1;
 
     cJSON *asset = cJSON_AddObjectToObject(w.root, "asset");
     cJSON_AddStringToObject(asset, "version", "2.0");
@@ -519,6 +531,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
         keys[m].mesh = sc->tri_object ? sc->tri_object[t] : sc->tri_mesh ? sc->tri_mesh[t] : 0;
         keys[m].material = sc->tri_material && sc->tri_material[t] < sc->n_materials ? sc->tri_material[t] : MS_NO_MATERIAL;
         keys[m].var = (uint32_t)var;
+        keys[m].why = var & VAR_BAKED ? MS_BAKED : (uint32_t)ms_bake_tri_state(sc, lm->uv, lm->frame.width, t);
         keys[m++].tri = (uint32_t)t;
     }
     if (flat) ms_warn("%zu triangles without area (no normal) left out of the glTF", flat);
