@@ -496,6 +496,14 @@ typedef enum ms_stream_mode {
     MS_STREAM_OFF = 2     /* never: the whole frame in memory, then the outputs */
 } ms_stream_mode;
 
+/* What a frame shades (ms_render_options.shading; docs/shading.md). */
+typedef enum ms_shading {
+    MS_SHADING_STANDARD = 0,  /* the materials as they are: diffuse and GGX specular, emission */
+    MS_SHADING_DIFFUSE = 1    /* base colour * E_unshadowed * S / pi alone (no specular, no metallic darkening, no
+                               * emission): the picture a lightmap can give, to compare with the baked glb's
+                               * viewer (docs/baking.md) */
+} ms_shading;
+
 typedef struct ms_render_options {
     const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
     ms_pattern pattern;
@@ -550,6 +558,7 @@ typedef struct ms_render_options {
     int aa;
     int aa_split;           /* aa > 1: the pixel's N light samples split among its K hits (N/K each, which must be
                              * a valid sample count for the pattern) instead of all N for every hit */
+    ms_shading shading;     /* 0: standard; the automatic exposure is that of the picture shaded */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */

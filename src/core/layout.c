@@ -35,7 +35,7 @@ static const layout_row rows[] = {
     FIELD(ms_render_options, primary), FIELD(ms_render_options, consistent_primary),
     FIELD(ms_render_options, closed_cull), FIELD(ms_render_options, no_interior), FIELD(ms_render_options, no_merge),
     FIELD(ms_render_options, max_memory), FIELD(ms_render_options, stream), FIELD(ms_render_options, stream_rows),
-    FIELD(ms_render_options, aa), FIELD(ms_render_options, aa_split),
+    FIELD(ms_render_options, aa), FIELD(ms_render_options, aa_split), FIELD(ms_render_options, shading),
     STRUCT(ms_stats), FIELD(ms_stats, triangles), FIELD(ms_stats, load_s), FIELD(ms_stats, build_s),
     FIELD(ms_stats, setup_s), FIELD(ms_stats, primary_s), FIELD(ms_stats, shadow_s), FIELD(ms_stats, total_s),
     FIELD(ms_stats, samples), FIELD(ms_stats, threads), FIELD(ms_stats, width), FIELD(ms_stats, height),

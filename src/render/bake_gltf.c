@@ -8,6 +8,7 @@
 #include "scene/scene_internal.h"
 #include "shade.h"
 #include "bake_unbaked.h"
+#include "frame_shade.h"
 #include "light/light_shape.h"
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -461,6 +462,24 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     return prim;
 }
 
+/* The exposures microshadow's frame of the scene's camera picks by itself (frame_shade.h), standard and diffuse,
+ * in the scene's extras.microshadow, so that a viewer shows the bake as the frame shows the scene by default
+ * (viewer/index.html: three.js puts them in gltf.scene.userData). Left out, with a warning, if they cannot be
+ * computed: the glb is still whole. */
+static void add_exposures(const ms_scene *sc, cJSON *scene0)
+{
+    float e[2];
+    char why[256] = "";
+    for (int k = 0; k < 2; k++)
+        if (ms_frame_auto_exposure(sc, k ? MS_SHADING_DIFFUSE : MS_SHADING_STANDARD, 0, &e[k], why, sizeof why)) {
+            ms_warn("the glTF carries no exposure for its viewer: %s", why);
+            return;
+        }
+    cJSON *ms = cJSON_AddObjectToObject(cJSON_AddObjectToObject(scene0, "extras"), "microshadow");
+    cJSON_AddNumberToObject(ms, "exposure", e[0]);
+    cJSON_AddNumberToObject(ms, "exposure_diffuse", e[1]);
+}
+
 ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
                            unsigned char **glb, size_t *len, char *err, size_t errlen)
 {
@@ -576,6 +595,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
     if (w.used_emissive_strength) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_materials_emissive_strength"));
     cJSON *scene0 = cJSON_CreateObject();
     cJSON_AddItemToArray(cJSON_AddArrayToObject(scene0, "nodes"), cJSON_CreateNumber(0));
+    add_exposures(sc, scene0);
     cJSON_AddItemToArray(scenes, scene0);
     if (w.bin.oom) { snprintf(err, errlen, "out of memory for the glTF's binary chunk"); st = MS_ERR_NO_MEMORY; goto done; }
     bin_put(&w.bin, NULL, 0);   /* pad to 4 */

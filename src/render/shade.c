@@ -173,7 +173,8 @@ int ms_interpolated_normal(const ms_scene *s, size_t t, const float b[3], float 
     return 1;
 }
 
-void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out)
+void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_shading shading,
+                   ms_surface *out)
 {
     memset(out, 0, sizeof *out);
     memcpy(out->n, h->n, sizeof out->n);
@@ -213,6 +214,10 @@ void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const 
     }
     out->roughness = rough;
     out->specular = 1;
+    if (shading == MS_SHADING_DIFFUSE) {   /* what a lightmap gives an engine's unlit base colour */
+        for (int c = 0; c < 3; c++) { out->diffuse[c] = base[c]; out->emissive[c] = 0.0f; }
+        out->specular = 0;
+    }
 }
 
 float ms_resolve_spec(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, const uint64_t *front,

@@ -36,8 +36,10 @@ int ms_interpolated_normal(const ms_scene *s, size_t t, const float b[3], float 
  * read it (docs/shading.md). 1, or 0 for degenerate UVs. */
 int ms_uv_tangent(const ms_scene *s, size_t t, int32_t set, const float n[3], float T[3], float *w);
 
-/* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye. */
-void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out);
+/* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye; shading
+ * MS_SHADING_DIFFUSE keeps the base colour as c_diff and drops the specular lobe and the emission. */
+void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_shading shading,
+                   ms_surface *out);
 
 /* S_spec = sum_i w_i v_i / sum_i w_i over the front samples, w_i = f_GGX(v, l_i) max(n_s.l_i, 0)
  * max(cos theta_l,i, 0) / r_i^2: the specular lobe's share of the light that is unoccluded, from the same
