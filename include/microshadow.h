@@ -910,8 +910,12 @@ MS_API ms_status ms_exr_write_stream(const ms_frame *f, FILE *out, const char *n
  * vertices welded per primitive where position, normal and both UV sets agree bit for bit (a chart seam or a
  * crease keeps two vertices). Attributes: POSITION, NORMAL (the shading normals where the scene has them,
  * else the triangle's), TEXCOORD_0 (UV set 0 where the primitive has it, else a copy of TEXCOORD_1: glTF
- * numbers the sets densely) and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv); triangles without baked UVs (a mesh
- * left out of the bake) form their own primitive without TEXCOORD_1 and without the lightmap. Materials carry
+ * numbers the sets densely) and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv), and TANGENT where the
+ * material carries a normal texture (the scene's tangents, MikkTSpace's where the asset has none); triangles without
+ * baked UVs (a mesh left out of the bake, triangles xatlas left out) form their own primitive without TEXCOORD_1 and
+ * without the lightmap, its extras {"name": "not baked: REASON", "triangles": n} and its material's name saying
+ * why. The scene's extras.microshadow {exposure, exposure_diffuse}: the automatic exposures of microshadow's frame
+ * of the scene's camera (ms_render_options.shading standard, diffuse), for a viewer's default. Materials carry
  * the scene's base colour, metallic, roughness, emission and alpha mode, and their base-colour, normal,
  * emissive and metallic-roughness textures (the decoded texels re-encoded as PNG: no file is read) where
  * those use UV set 0. Every baked material references:
