@@ -8,6 +8,8 @@
  * takes the exposure the bake wrote into the glb (the frame's own automatic exposure of diffuse shading,
  * checked equal to ms_render's), and its screenshot against the PNG of `microshadow SCENE --shading diffuse`
  * (base colour x E x S / pi, no specular) correlates >= 0.95 in luminance with mean brightness within 20%.
+ * As a user would: a mouse drag orbits the view (another picture, the scene still in it) and the key M gives
+ * the standard mode's picture pixel for pixel.
  * Skipped with a message without node, Chromium or viewer/node_modules (scripts/install-deps.sh installs
  * them). */
 #include "testutil.h"
@@ -218,6 +220,34 @@ static void test_viewer_exposes_as_frame(void **st)
     assert_true(n > W * H / 3);
     assert_true(corr >= 0.95);
     assert_true(ratio >= 0.8 && ratio <= 1.2);
+    /* the orbit and the mode key */
+    char drag[1024], key[1024], std[1024];
+    tu_path(drag, sizeof drag, dir, "drag.png");
+    tu_path(key, sizeof key, dir, "key.png");
+    tu_path(std, sizeof std, dir, "standard.png");
+    char cmd3[16384];
+    snprintf(cmd3, sizeof cmd3, "node '%s/screenshot.mjs' '%s' '%s' '%s' --drag 40,0 && node '%s/screenshot.mjs' '%s' '%s' '%s' --key m"
+             " && node '%s/screenshot.mjs' '%s' '%s' '%s' --mode standard", MS_VIEWER_DIR, glb, json, drag, MS_VIEWER_DIR, glb,
+             json, key, MS_VIEWER_DIR, glb, json, std);
+    fflush(stdout);
+    assert_int_equal(system(cmd3), 0);
+    double *dr = png_luminance(drag, W, H), *ky = png_luminance(key, W, H), *sd = png_luminance(std, W, H);
+    long moved = 0, lit = 0, key_off = 0, mode_changed = 0;
+    for (int i = 0; i < W * H; i++) {
+        moved += fabs(dr[i] - a[i]) > 0.02;
+        lit += dr[i] > 0.05;
+        key_off += ky[i] != sd[i];
+        mode_changed += fabs(ky[i] - a[i]) > 0.02;
+    }
+    printf("orbit: %ld of %d pixels changed by a 40-pixel drag (%ld lit after it); key M: %ld pixels unlike mode=standard, "
+           "%ld unlike the diffuse mode\n", moved, W * H, lit, key_off, mode_changed);
+    assert_true(moved > W * H / 10);
+    assert_true(lit > W * H / 4);
+    assert_int_equal(key_off, 0);
+    assert_true(mode_changed > W * H / 20);
+    free(dr);
+    free(ky);
+    free(sd);
     free(a);
     free(b);
     ms_frame_free(&fs);

@@ -3,6 +3,8 @@
 // Usage: node viewer/screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode diffuse|standard]
 //        [--chromium PATH]   exit 0, 1 when the page fails (its error printed), 2 on bad arguments.
 // Without --exposure the page takes the exposure the bake wrote into the glb (microshadow's frame's own).
+// --drag DX,DY drags the mouse by (DX, DY) pixels from the canvas centre (an orbit) and --key K presses a key
+// (M: the other mode) before the screenshot, as a user would.
 import puppeteer from 'puppeteer-core';
 import { basename } from 'node:path';
 import { serve } from './serve.mjs';
@@ -37,6 +39,16 @@ try {
   const error = await page.evaluate('window.viewerError');
   if (error) { console.error(`viewer: ${error}`); rc = 1; }
   else {
+    if (opt.drag) {
+      const [dx, dy] = opt.drag.split(',').map(Number);
+      const cx = (scene.camera.width ?? 1024) / 2, cy = (scene.camera.height ?? 768) / 2;
+      await page.mouse.move(cx, cy);
+      await page.mouse.down();
+      for (let k = 1; k <= 8; k++) await page.mouse.move(cx + dx * k / 8, cy + dy * k / 8);
+      await page.mouse.up();
+    }
+    if (opt.key) await page.keyboard.press(opt.key);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
     await page.evaluate(() => document.querySelectorAll('.ui').forEach((e) => e.remove()));   // the canvas alone
     const canvas = await page.$('canvas');
     await canvas.screenshot({ path: out });
