@@ -496,6 +496,14 @@ typedef enum ms_stream_mode {
     MS_STREAM_OFF = 2     /* never: the whole frame in memory, then the outputs */
 } ms_stream_mode;
 
+/* What a frame shades (ms_render_options.shading; docs/shading.md). */
+typedef enum ms_shading {
+    MS_SHADING_STANDARD = 0,  /* the materials as they are: diffuse and GGX specular, emission */
+    MS_SHADING_DIFFUSE = 1    /* base colour * E_unshadowed * S / pi alone (no specular, no metallic darkening, no
+                               * emission): the picture a lightmap can give, to compare with the baked glb's
+                               * viewer (docs/baking.md) */
+} ms_shading;
+
 typedef struct ms_render_options {
     const char *method;     /* shadow method by name: see ms_method_names(); NULL: MS_DEFAULT_METHOD */
     ms_pattern pattern;
@@ -550,6 +558,7 @@ typedef struct ms_render_options {
     int aa;
     int aa_split;           /* aa > 1: the pixel's N light samples split among its K hits (N/K each, which must be
                              * a valid sample count for the pattern) instead of all N for every hit */
+    ms_shading shading;     /* 0: standard; the automatic exposure is that of the picture shaded */
 } ms_render_options;
 
 /* Zeroes o and names the default method: the same as a zeroed struct. */
@@ -807,9 +816,11 @@ static inline ms_status ms_visibility_points(const ms_accel *a, const ms_light *
  * touches (conservative rasterization) is carried to the triangle's surface: its centre's barycentric
  * coordinates, moved to the nearest point of the triangle when the centre lies outside (a texel several
  * triangles touch takes the one containing its centre, else the nearest), give the world position; the
- * normal is the triangle's, by its winding (cross(b - a, c - a)). V and S there come from
- * ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
- * E_unshadowed * S * emission (ms_light_irradiance). Texels no triangle touches are filled by dilation
+ * normal (ms_lightmap.normal) is the triangle's, by its winding (cross(b - a, c - a)). V and S there come
+ * from ms_visibility_points with the triangle as receiver and the texel as pattern key; the irradiance is
+ * E_unshadowed * S * emission (ms_light_irradiance), E_unshadowed's cosine taken with the shading normal as
+ * frames shade (the vertex normals interpolated, turned to the winding's side; the triangle's where the mesh
+ * has none), so that smooth surfaces bake smooth. Texels no triangle touches are filled by dilation
  * from their neighbours (across chart seams) so that bilinear lookups do not bleed black. Then the seams
  * are stitched (unless no_seam_stitch): along every UV seam of a smooth edge the texels that bilinear
  * lookups from its two sides read are moved, by least squares, until both sides' lookups agree (the
@@ -860,6 +871,11 @@ typedef struct ms_lightmap {
     double seam_p99;
     size_t stitched_texels;    /* texels the seam stitching changed (0 with no_seam_stitch) */
     double stitch_s;           /* seconds stitching */
+    /* Triangles left out of the lightmap (ms_bake_layout): excluded_tris of meshes with "lightmap": false (as
+     * asked: reported, not warned about); unbaked_tris for any other reason - no area, no UVs (xatlas leaves out
+     * triangles of area at most FLT_EPSILON), UVs without area or outside the lightmap - each reason a warning
+     * with its count (ms_set_warning_handler). The glb names their primitives and materials after the reason. */
+    size_t excluded_tris, unbaked_tris;
 } ms_lightmap;
 
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
@@ -903,8 +919,12 @@ MS_API ms_status ms_exr_write_stream(const ms_frame *f, FILE *out, const char *n
  * vertices welded per primitive where position, normal and both UV sets agree bit for bit (a chart seam or a
  * crease keeps two vertices). Attributes: POSITION, NORMAL (the shading normals where the scene has them,
  * else the triangle's), TEXCOORD_0 (UV set 0 where the primitive has it, else a copy of TEXCOORD_1: glTF
- * numbers the sets densely) and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv); triangles without baked UVs (a mesh
- * left out of the bake) form their own primitive without TEXCOORD_1 and without the lightmap. Materials carry
+ * numbers the sets densely) and TEXCOORD_1 = the UVs the lightmap was baked into (ms_lightmap.uv), and TANGENT where the
+ * material carries a normal texture (the scene's tangents, MikkTSpace's where the asset has none); triangles without
+ * baked UVs (a mesh left out of the bake, triangles xatlas left out) form their own primitive without TEXCOORD_1 and
+ * without the lightmap, its extras {"name": "not baked: REASON", "triangles": n} and its material's name saying
+ * why. The scene's extras.microshadow {exposure, exposure_diffuse}: the automatic exposures of microshadow's frame
+ * of the scene's camera (ms_render_options.shading standard, diffuse), for a viewer's default. Materials carry
  * the scene's base colour, metallic, roughness, emission and alpha mode, and their base-colour, normal,
  * emissive and metallic-roughness textures (the decoded texels re-encoded as PNG: no file is read) where
  * those use UV set 0. Every baked material references:

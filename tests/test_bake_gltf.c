@@ -8,8 +8,9 @@
  *     of the intensity (I/510): the quantisation is the only difference allowed; at the points themselves the
  *     difference (interpolation and sampling) is reported;
  *   - the shadowmask holds each light's S in its channel (I/510 likewise), the extras name them;
- *   - the Khronos glTF Validator (npm gltf-validator, viewer/validate.mjs) reports 0 errors (skipped with a
- *     message without node or the validator);
+ *   - the ground's material has a normal texture: its primitive carries TANGENT (unit, orthogonal to NORMAL,
+ *     w = +-1), the others none; the Khronos glTF Validator (npm gltf-validator, viewer/validate.mjs) reports
+ *     0 errors and 0 warnings (skipped with a message without node or the validator);
  *   - the CLI writes the glb with the EXR, and refuses a --gltf not ending in .glb with exit 2, writing nothing. */
 #include "testutil.h"
 #include "glb_read.h"
@@ -56,7 +57,7 @@ static void write_scene(const char *dir, char *json_path, size_t n)
         "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1,\"TEXCOORD_1\":2},\"material\":0}]}],"
         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.8,0.7,1],\"baseColorTexture\":{\"index\":0},"
-        "\"metallicFactor\":0,\"roughnessFactor\":0.75}}],"
+        "\"metallicFactor\":0,\"roughnessFactor\":0.75},\"normalTexture\":{\"index\":0,\"scale\":0.5}}],"
         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
         "\"buffers\":[{\"byteLength\":168,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
         "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":72},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":48},"
@@ -352,10 +353,39 @@ static void test_validator(void **st)
     tu_path(path, sizeof path, dir, "valid.glb");
     assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, path, err, sizeof err), MS_OK);
     char cmd[2600];
-    snprintf(cmd, sizeof cmd, "node '%s/validate.mjs' '%s'", MS_VIEWER_DIR, path);
+    /* the normal-mapped ground carries TANGENT: unit, orthogonal to its NORMAL, w = +-1 */
+    tu_glb g;
+    assert_int_equal(tu_glb_read(path, &g), 0);
+    int tangents = 0;
+    for (int m = 0; tu_glb_item(&g, "meshes", m); m++) {
+        const cJSON *prims = cJSON_GetObjectItem(tu_glb_item(&g, "meshes", m), "primitives");
+        for (int p = 0; p < cJSON_GetArraySize(prims); p++) {
+            const cJSON *pr = cJSON_GetArrayItem(prims, p), *at = cJSON_GetObjectItem(pr, "attributes");
+            const cJSON *mat = tu_glb_item(&g, "materials", geti(pr, "material"));
+            const int has_nt = cJSON_GetObjectItem(mat, "normalTexture") != NULL;
+            assert_int_equal(has_nt, geti(at, "TANGENT") >= 0);
+            if (!has_nt) continue;
+            size_t nt, nn;
+            int ct, cn;
+            float *t = tu_glb_floats(&g, geti(at, "TANGENT"), &nt, &ct), *n = tu_glb_floats(&g, geti(at, "NORMAL"), &nn, &cn);
+            assert_true(t && n && ct == 4 && cn == 3 && nt == nn);
+            for (size_t i = 0; i < nt; i++) {
+                const float *a = t + 4 * i, *b = n + 3 * i;
+                assert_true(fabs(sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) - 1.0) < 1e-5);
+                assert_true(fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) < 1e-5);
+                assert_true(a[3] == 1.0f || a[3] == -1.0f);
+            }
+            tangents += (int)nt;
+            free(t);
+            free(n);
+        }
+    }
+    assert_true(tangents >= 3);
+    tu_glb_free(&g);
+    snprintf(cmd, sizeof cmd, "node '%s/validate.mjs' '%s' --max-warnings 0", MS_VIEWER_DIR, path);
     fflush(stdout);
     const int rc = system(cmd);
-    assert_int_equal(rc, 0);   /* 0 errors (the script prints the counts and every error and warning) */
+    assert_int_equal(rc, 0);   /* 0 errors, 0 warnings (the script prints the counts and every error and warning) */
     /* and the built-in scene, whose zero-area triangles are left out */
     ms_scene_free(&sc);
     ms_lightmap_free(&lm);
@@ -369,7 +399,7 @@ static void test_validator(void **st)
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
     tu_path(path, sizeof path, dir, "builtin.glb");
     assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, path, err, sizeof err), MS_OK);
-    snprintf(cmd, sizeof cmd, "node '%s/validate.mjs' '%s'", MS_VIEWER_DIR, path);
+    snprintf(cmd, sizeof cmd, "node '%s/validate.mjs' '%s' --max-warnings 0", MS_VIEWER_DIR, path);
     fflush(stdout);
     assert_int_equal(system(cmd), 0);
     ms_lightmap_free(&lm);
@@ -400,10 +430,100 @@ static void test_cli(void **st)
     assert_false(tu_file_exists(exr));
 }
 
+/* The warnings of one bake, kept for the test to read. */
+static char g_warnings[8192];
+
+static void keep_warning(void *user, const char *msg)
+{
+    (void)user;
+    const size_t n = strlen(g_warnings);
+    snprintf(g_warnings + n, sizeof g_warnings - n, "%s\n", msg);
+}
+
+/* The primitive whose extras.name is `name`: its extras.triangles and its material's name, or -1. */
+static int unbaked_primitive(const tu_glb *g, const char *name, char *material, size_t n)
+{
+    for (int m = 0; tu_glb_item(g, "meshes", m); m++) {
+        const cJSON *prims = cJSON_GetObjectItem(tu_glb_item(g, "meshes", m), "primitives");
+        for (int p = 0; p < cJSON_GetArraySize(prims); p++) {
+            const cJSON *pr = cJSON_GetArrayItem(prims, p), *ex = cJSON_GetObjectItem(pr, "extras");
+            const cJSON *nm = cJSON_GetObjectItem(ex, "name");
+            if (!cJSON_IsString(nm) || strcmp(nm->valuestring, name) != 0) continue;
+            const cJSON *mn = cJSON_GetObjectItem(tu_glb_item(g, "materials", geti(pr, "material")), "name");
+            snprintf(material, n, "%s", cJSON_IsString(mn) ? mn->valuestring : "");
+            assert_int_equal(geti(pr, "TEXCOORD_1"), -1);
+            return geti(ex, "triangles");
+        }
+    }
+    return -1;
+}
+
+/* Every triangle baked or named: a ground, a crumb of area 1e-8 (below xatlas's FLT_EPSILON: it charts it
+ * not), a triangle without area, a box with "lightmap": false. The bake warns once per reason with its
+ * count (not for "lightmap": false, which it counts), the glb names the primitives and materials, and the
+ * CLI says the same on stderr. */
+static void test_unbaked_named(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_gltf_unbaked");
+    char p[1024], json[1024], glb[1024], exr[1024], err[512] = "";
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "ground.obj"), "v -2 0 -2\nv -2 0 2\nv 2 0 2\nv 2 0 -2\nf 1 2 3 4\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "bits.obj"),
+        "v 0 0.5 0\nv 0.0001 0.5 0\nv 0 0.5 0.0002\nv 1 1 1\nv 1.5 1 1\nv 2 1 1\nf 1 2 3\nf 4 5 6\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "box.obj"),
+        "v 0.5 0 -0.5\nv 1.5 0 -0.5\nv 1.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 -0.5\nv 1.5 1 -0.5\nv 1.5 1 0.5\nv 0.5 1 0.5\n"
+        "f 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(json, sizeof json, dir, "scene.json"),
+        "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"bits.obj\"},{\"file\":\"box.obj\",\"lightmap\":false}],"
+        "\"camera\":{\"eye\":[0,5,5],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":32,\"height\":32},"
+        "\"light\":{\"corner\":[-0.5,4,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1],\"emission\":[1,1,1]}}"), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = 64;
+    bo.uv_set = -1;
+    bo.points.samples = 256;
+    bo.points.isa = tu_isa_cap();
+    ms_lightmap lm;
+    g_warnings[0] = 0;
+    ms_set_warning_handler(keep_warning, NULL);
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    tu_path(glb, sizeof glb, dir, "unbaked.glb");
+    assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, glb, err, sizeof err), MS_OK);
+    ms_set_warning_handler(NULL, NULL);
+    printf("%s", g_warnings);
+    assert_non_null(strstr(g_warnings, "1 triangle not baked: no UVs (xatlas leaves out triangles of area at most"));
+    assert_non_null(strstr(g_warnings, "1 triangle not baked: no area"));
+    assert_null(strstr(g_warnings, "lightmap false"));   /* asked for: counted, not warned about */
+    assert_int_equal(lm.excluded_tris, 12);
+    assert_int_equal(lm.unbaked_tris, 2);
+    tu_glb g;
+    assert_int_equal(tu_glb_read(glb, &g), 0);
+    char mat[128];
+    assert_int_equal(unbaked_primitive(&g, "not baked: no UVs", mat, sizeof mat), 1);
+    assert_non_null(strstr(mat, "(not baked: no UVs)"));
+    assert_int_equal(unbaked_primitive(&g, "not baked: lightmap false", mat, sizeof mat), 12);
+    assert_non_null(strstr(mat, "(not baked: lightmap false)"));
+    assert_int_equal(unbaked_primitive(&g, "not baked: no area", mat, sizeof mat), -1);   /* left out of the file */
+    tu_glb_free(&g);
+    /* the CLI: the same warnings and the count of "lightmap": false on the terminal */
+    tu_path(exr, sizeof exr, dir, "cli.exr");
+    const char *args[] = { "bake", json, "--uv", "xatlas", "--size", "64", "--samples", "256", "-o", exr, NULL };
+    char all[8192];
+    assert_int_equal(tu_run_cli_ex(args, NULL, all, sizeof all, NULL), 0);
+    assert_non_null(strstr(all, "warning: 1 triangle not baked: no UVs"));
+    assert_non_null(strstr(all, "warning: 1 triangle not baked: no area"));
+    assert_non_null(strstr(all, "bake: 14 triangles not baked: 12 of meshes with \"lightmap\": false, 2 for the reasons warned about"));
+    ms_lightmap_free(&lm);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_glb_reads_back),
+        cmocka_unit_test(test_unbaked_named),
         cmocka_unit_test(test_validator),
         cmocka_unit_test(test_cli),
     };

@@ -3,9 +3,17 @@
  * camera. Both show the diffuse radiance albedo / pi * E (the viewer: MeshBasicMaterial, whose light map three.js
  * shades as base colour * lightmap * intensity / pi; the frame: no materials, so no specular term), exposed by
  * the frame's exposure, clipped and sRGB-encoded. Over the pixels the frame hits, the luminance of the two
- * (linearised) correlates >= 0.95; the mean relative error is reported. Skipped with a message without node,
- * Chromium or viewer/node_modules (scripts/install-deps.sh installs them). */
+ * (linearised) correlates >= 0.95; the mean relative error is reported.
+ * Without an exposure given, on coloured, partly metallic and glossy materials: the viewer's diffuse mode
+ * takes the exposure the bake wrote into the glb (the frame's own automatic exposure of diffuse shading,
+ * checked equal to ms_render's), and its screenshot against the PNG of `microshadow SCENE --shading diffuse`
+ * (base colour x E x S / pi, no specular) correlates >= 0.95 in luminance with mean brightness within 20%.
+ * As a user would: a mouse drag orbits the view (another picture, the scene still in it) and the key M gives
+ * the standard mode's picture pixel for pixel.
+ * Skipped with a message without node, Chromium or viewer/node_modules (scripts/install-deps.sh installs
+ * them). */
 #include "testutil.h"
+#include "glb_read.h"
 #include <math.h>
 #include <png.h>
 #include <stdio.h>
@@ -99,8 +107,9 @@ static void test_viewer_matches_frame(void **st)
     }
     const double cov = sab / n - (sa / n) * (sb / n), va = saa / n - (sa / n) * (sa / n), vb = sbb / n - (sb / n) * (sb / n);
     const double corr = cov / sqrt(va * vb);
-    printf("viewer vs frame: %ld hit pixels, luminance correlation %.4f, mean relative error %.4f over the %ld pixels above "
-           "0.05, mean luminance %.4f vs %.4f\n", n, corr, rel / (double)nrel, nrel, sa / n, sb / n);
+    printf("viewer vs frame (exposure %.6g given): %ld hit pixels, luminance correlation %.4f, mean relative error %.4f over "
+           "the %ld pixels above 0.05, mean luminance %.4f vs %.4f\n", (double)fr.exposure, n, corr, rel / (double)nrel, nrel,
+           sa / n, sb / n);
     assert_true(n > W * H / 3);
     assert_true(corr >= 0.95);
     free(px);
@@ -109,10 +118,149 @@ static void test_viewer_matches_frame(void **st)
     ms_scene_free(&sc);
 }
 
+/* An sRGB PNG's linear luminance per pixel (W x H), or fails the test. */
+static double *png_luminance(const char *path, int W, int H)
+{
+    png_image img;
+    memset(&img, 0, sizeof img);
+    img.version = PNG_IMAGE_VERSION;
+    assert_true(png_image_begin_read_from_file(&img, path));
+    img.format = PNG_FORMAT_RGB;
+    assert_int_equal((int)img.width, W);
+    assert_int_equal((int)img.height, H);
+    uint8_t *px = malloc((size_t)W * H * 3);
+    double *y = malloc((size_t)W * H * sizeof *y);
+    assert_true(px && y);
+    assert_true(png_image_finish_read(&img, NULL, px, 0, NULL));
+    static const double wy[3] = { 0.2126, 0.7152, 0.0722 };
+    for (int i = 0; i < W * H; i++) {
+        y[i] = 0.0;
+        for (int c = 0; c < 3; c++) y[i] += wy[c] * srgb_to_linear(px[3 * i + c] / 255.0);
+    }
+    free(px);
+    return y;
+}
+
+static void test_viewer_exposes_as_frame(void **st)
+{
+    (void)st;
+    if (!have_browser()) skip();
+    const char *dir = tu_tmpdir("bake_viewer_exposure");
+    char p[1024], json[1024], glb[1024], shot[1024], frame_png[1024], err[512] = "";
+    /* the scene of the first test with materials: a grey glossy floor, a red half-metallic box, a blue plate */
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "m.mtl"),
+        "newmtl floor\nKd 0.7 0.7 0.65\nPr 0.3\nPm 0\nnewmtl box\nKd 0.8 0.25 0.15\nPr 0.4\nPm 0.5\n"
+        "newmtl plate\nKd 0.2 0.35 0.8\nPr 0.6\nPm 0\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "floor.obj"),
+        "mtllib m.mtl\nusemtl floor\nv -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "box.obj"),
+        "mtllib m.mtl\nusemtl box\nv 0.5 0 -0.5\nv 1.5 0 -0.5\nv 1.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 -0.5\nv 1.5 1 -0.5\n"
+        "v 1.5 1 0.5\nv 0.5 1 0.5\nf 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "plate.obj"),
+        "mtllib m.mtl\nusemtl plate\nv -1.6 1.2 -0.6\nv -1.6 1.2 0.6\nv -0.4 1.2 0.6\nv -0.4 1.2 -0.6\nf 1 2 3 4\nf 4 3 2 1\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(json, sizeof json, dir, "scene.json"),
+        "{\"meshes\":[{\"file\":\"floor.obj\"},{\"file\":\"box.obj\"},{\"file\":\"plate.obj\"}],"
+        "\"camera\":{\"eye\":[0,4.5,5.5],\"target\":[0,0.3,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":160,\"height\":120},"
+        "\"light\":{\"corner\":[-0.6,4,-0.6],\"edge_s\":[1.2,0,0],\"edge_t\":[0,0,1.2],\"emission\":[1,1,1]}}"), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    assert_non_null(sc.tri_material);
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = 512;
+    bo.uv_set = -1;
+    bo.points.samples = 256;
+    bo.points.isa = tu_isa_cap();
+    ms_lightmap lm;
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    tu_path(glb, sizeof glb, dir, "scene.glb");
+    assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, glb, err, sizeof err), MS_OK);
+    /* the glb's exposures are the frame's own, standard and diffuse */
+    ms_render_options ro;
+    tu_render_options_default(&ro);
+    ro.samples = 256;
+    ms_frame fs, fd;
+    assert_int_equal(ms_render(&sc, &ro, &fs, err, sizeof err), 0);
+    ro.shading = MS_SHADING_DIFFUSE;
+    assert_int_equal(ms_render(&sc, &ro, &fd, err, sizeof err), 0);
+    tu_glb g;
+    assert_int_equal(tu_glb_read(glb, &g), 0);
+    const cJSON *ex = cJSON_GetObjectItem(cJSON_GetObjectItem(tu_glb_item(&g, "scenes", 0), "extras"), "microshadow");
+    const cJSON *es = cJSON_GetObjectItem(ex, "exposure"), *ed = cJSON_GetObjectItem(ex, "exposure_diffuse");
+    assert_true(cJSON_IsNumber(es) && cJSON_IsNumber(ed));
+    printf("exposure: the glb's %.6g (standard), %.6g (diffuse); ms_render's %.6g, %.6g\n", es->valuedouble, ed->valuedouble,
+           (double)fs.exposure, (double)fd.exposure);
+    assert_true(es->valuedouble == (double)fs.exposure);
+    assert_true(ed->valuedouble == (double)fd.exposure);
+    assert_true(fd.exposure != fs.exposure);   /* the specular and the metallic box change what is exposed */
+    tu_glb_free(&g);
+    /* the frame as the CLI makes it, and the viewer with no exposure given */
+    tu_path(frame_png, sizeof frame_png, dir, "frame.png");
+    const char *args[] = { json, "--shading", "diffuse", "--samples", "256", "-o", frame_png, "--quiet", NULL };
+    char line[512];
+    assert_int_equal(tu_run_cli(args, line, sizeof line), 0);
+    tu_path(shot, sizeof shot, dir, "shot.png");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "node '%s/screenshot.mjs' '%s' '%s' '%s'", MS_VIEWER_DIR, glb, json, shot);
+    fflush(stdout);
+    assert_int_equal(system(cmd), 0);
+    const int W = fd.width, H = fd.height;
+    double *a = png_luminance(shot, W, H), *b = png_luminance(frame_png, W, H);
+    double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+    long n = 0;
+    for (int i = 0; i < W * H; i++) {
+        if (fd.vis[i] < 0.0f) continue;
+        sa += a[i]; sb += b[i]; saa += a[i] * a[i]; sbb += b[i] * b[i]; sab += a[i] * b[i];
+        n++;
+    }
+    const double cov = sab / n - (sa / n) * (sb / n), va = saa / n - (sa / n) * (sa / n), vb = sbb / n - (sb / n) * (sb / n);
+    const double corr = cov / sqrt(va * vb), ratio = sa / sb;
+    printf("viewer (diffuse mode, no exposure given) vs `microshadow --shading diffuse`: %ld hit pixels, luminance "
+           "correlation %.4f, mean brightness %.4f vs %.4f (ratio %.4f)\n", n, corr, sa / n, sb / n, ratio);
+    assert_true(n > W * H / 3);
+    assert_true(corr >= 0.95);
+    assert_true(ratio >= 0.8 && ratio <= 1.2);
+    /* the orbit and the mode key */
+    char drag[1024], key[1024], std[1024];
+    tu_path(drag, sizeof drag, dir, "drag.png");
+    tu_path(key, sizeof key, dir, "key.png");
+    tu_path(std, sizeof std, dir, "standard.png");
+    char cmd3[16384];
+    snprintf(cmd3, sizeof cmd3, "node '%s/screenshot.mjs' '%s' '%s' '%s' --drag 40,0 && node '%s/screenshot.mjs' '%s' '%s' '%s' --key m"
+             " && node '%s/screenshot.mjs' '%s' '%s' '%s' --mode standard", MS_VIEWER_DIR, glb, json, drag, MS_VIEWER_DIR, glb,
+             json, key, MS_VIEWER_DIR, glb, json, std);
+    fflush(stdout);
+    assert_int_equal(system(cmd3), 0);
+    double *dr = png_luminance(drag, W, H), *ky = png_luminance(key, W, H), *sd = png_luminance(std, W, H);
+    long moved = 0, lit = 0, key_off = 0, mode_changed = 0;
+    for (int i = 0; i < W * H; i++) {
+        moved += fabs(dr[i] - a[i]) > 0.02;
+        lit += dr[i] > 0.05;
+        key_off += ky[i] != sd[i];
+        mode_changed += fabs(ky[i] - a[i]) > 0.02;
+    }
+    printf("orbit: %ld of %d pixels changed by a 40-pixel drag (%ld lit after it); key M: %ld pixels unlike mode=standard, "
+           "%ld unlike the diffuse mode\n", moved, W * H, lit, key_off, mode_changed);
+    assert_true(moved > W * H / 10);
+    assert_true(lit > W * H / 4);
+    assert_int_equal(key_off, 0);
+    assert_true(mode_changed > W * H / 20);
+    free(dr);
+    free(ky);
+    free(sd);
+    free(a);
+    free(b);
+    ms_frame_free(&fs);
+    ms_frame_free(&fd);
+    ms_lightmap_free(&lm);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_viewer_matches_frame),
+        cmocka_unit_test(test_viewer_exposes_as_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

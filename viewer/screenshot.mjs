@@ -2,12 +2,15 @@
 // saves the canvas as a PNG of the scene camera's size.
 // Usage: node viewer/screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode diffuse|standard]
 //        [--chromium PATH]   exit 0, 1 when the page fails (its error printed), 2 on bad arguments.
+// Without --exposure the page takes the exposure the bake wrote into the glb (microshadow's frame's own).
+// --drag DX,DY drags the mouse by (DX, DY) pixels from the canvas centre (an orbit) and --key K presses a key
+// (M: the other mode) before the screenshot, as a user would.
 import puppeteer from 'puppeteer-core';
 import { basename } from 'node:path';
 import { serve } from './serve.mjs';
 
 const args = process.argv.slice(2);
-const opt = { exposure: '1', mode: 'diffuse', chromium: '/usr/bin/chromium' };
+const opt = { mode: 'diffuse', chromium: '/usr/bin/chromium' };
 const pos = [];
 for (let i = 0; i < args.length; i++) {
   if (args[i].startsWith('--')) opt[args[i].slice(2)] = args[++i];
@@ -29,12 +32,24 @@ try {
   const scene = JSON.parse(await (await import('node:fs/promises')).readFile(sceneFile, 'utf8'));
   await page.setViewport({ width: scene.camera.width ?? 1024, height: scene.camera.height ?? 768, deviceScaleFactor: 1 });
   const url = `http://127.0.0.1:${port}/index.html?glb=/data/${encodeURIComponent(basename(glb))}` +
-              `&scene=/data/${encodeURIComponent(basename(sceneFile))}&exposure=${opt.exposure}&mode=${opt.mode}`;
+              `&scene=/data/${encodeURIComponent(basename(sceneFile))}&mode=${encodeURIComponent(opt.mode)}` +
+              (opt.exposure !== undefined ? `&exposure=${encodeURIComponent(opt.exposure)}` : '');
   await page.goto(url);
   await page.waitForFunction('window.viewerReady || window.viewerError', { timeout: 60000 });
   const error = await page.evaluate('window.viewerError');
   if (error) { console.error(`viewer: ${error}`); rc = 1; }
   else {
+    if (opt.drag) {
+      const [dx, dy] = opt.drag.split(',').map(Number);
+      const cx = (scene.camera.width ?? 1024) / 2, cy = (scene.camera.height ?? 768) / 2;
+      await page.mouse.move(cx, cy);
+      await page.mouse.down();
+      for (let k = 1; k <= 8; k++) await page.mouse.move(cx + dx * k / 8, cy + dy * k / 8);
+      await page.mouse.up();
+    }
+    if (opt.key) await page.keyboard.press(opt.key);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
+    await page.evaluate(() => document.querySelectorAll('.ui').forEach((e) => e.remove()));   // the canvas alone
     const canvas = await page.$('canvas');
     await canvas.screenshot({ path: out });
     console.log(`${out}: ${scene.camera.width}x${scene.camera.height} screenshot of ${glb}`);

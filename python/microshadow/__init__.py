@@ -140,7 +140,8 @@ _RenderOptions = _mirror("ms_render_options", [
     ("height", ctypes.c_int), ("threads", ctypes.c_int), ("seed", ctypes.c_uint32), ("progress", _PROGRESS_CANCEL),
     ("progress_user", _p), ("isa", ctypes.c_int), ("embree_mode", ctypes.c_int), ("embree_filter", ctypes.c_int),
     ("traversal", ctypes.c_int), ("no_filter", ctypes.c_int), ("primary", ctypes.c_char_p),
-    ("consistent_primary", ctypes.c_int), ("max_memory", ctypes.c_uint64), ("aa", ctypes.c_int), ("aa_split", ctypes.c_int)])
+    ("consistent_primary", ctypes.c_int), ("max_memory", ctypes.c_uint64), ("aa", ctypes.c_int), ("aa_split", ctypes.c_int),
+    ("shading", ctypes.c_int)])
 _Points = _mirror("ms_points", [("n", _size), ("position", _p), ("normal", _p), ("triangle", _p), ("key", _p)])
 _PointsOptions = _mirror("ms_points_options", [
     ("method", ctypes.c_char_p), ("pattern", ctypes.c_int), ("samples", ctypes.c_int), ("threads", ctypes.c_int),
@@ -208,6 +209,7 @@ __version__ = _version(None, None, None).decode()
 
 _PATTERNS = {"grid": 0, "stratified": 1, "interleaved": 2}
 _ISAS = {"auto": 0, "scalar": 1, "avx2": 2, "avx512": 3}
+_SHADINGS = {"standard": 0, "diffuse": 1}
 _SHAPES = {"rect": 0, "disk": 1, "sphere": 2, "triangle": 3, "sun": 4}
 _SHAPE_NAMES = {v: k for k, v in _SHAPES.items()}
 # A light dict's keys per shape: required, then optional.
@@ -517,7 +519,7 @@ def _planes(ptr, n_lights, h, w, shape=None):
 
 
 def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", seed=0, threads=0, isa="auto",
-           primary=None, consistent_primary=False, progress=None, max_memory=0, aa=1, aa_split=False):
+           primary=None, consistent_primary=False, progress=None, max_memory=0, aa=1, aa_split=False, shading="standard"):
     """A frame (ms_render): dict of vis, shadow (H, W) float32 (-1 where the primary ray missed), front
     (H, W) uint16 (all of light 0), rgb (H, W, 3) linear radiance summed over the lights, exposure, stats
     (a dict), and lights: one dict per light of the scene with its vis, shadow, shadow_spec and front
@@ -525,7 +527,8 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
     progress: fn(fraction) -> truthy to cancel (Error with status 3). max_memory: the memory budget in bytes
     (0: the library's default); a frame over it is refused before allocating (Error with status 6). aa: primary
     samples per pixel (1, 4, 9 or 16; docs/antialiasing.md), the planes then their box-filtered average per
-    pixel; aa_split: the pixel's light samples split among them instead of all for each."""
+    pixel; aa_split: the pixel's light samples split among them instead of all for each. shading: "standard" or
+    "diffuse" (base colour x E x S / pi alone: what a baked lightmap can show; docs/shading.md)."""
     if not isinstance(scene, Scene):
         raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
     opt = _RenderOptions()
@@ -539,6 +542,7 @@ def render(scene, method=None, samples=0, width=0, height=0, pattern="grid", see
     if isinstance(aa, bool) or not isinstance(aa, int) or aa not in (1, 4, 9, 16):
         raise ValueError("aa: expected 1, 4, 9 or 16 primary samples per pixel, got %r" % (aa,))
     opt.aa, opt.aa_split = aa, 1 if aa_split else 0
+    opt.shading = _choice("shading", shading, _SHADINGS)
     cb = _progress_cancel(progress)
     opt.progress = cb
     fr, err = _Frame(), _errbuf()

@@ -255,6 +255,9 @@ int ms_cli_bake(int argc, char **argv)
         char stitched[96];
         if (bo.no_seam_stitch) snprintf(stitched, sizeof stitched, "not stitched");
         else snprintf(stitched, sizeof stitched, "stitched: %zu texels in %.3fs", lm.stitched_texels, lm.stitch_s);
+        if (lm.excluded_tris || lm.unbaked_tris)   /* each reason other than "lightmap": false was a warning */
+            fprintf(stderr, "bake: %zu triangles not baked: %zu of meshes with \"lightmap\": false, %zu for the reasons "
+                    "warned about\n", lm.excluded_tris + lm.unbaked_tris, lm.excluded_tris, lm.unbaked_tris);
         fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
                 "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
                 "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, p99 %.4f, max %.4f of the largest irradiance (%s) -> "

@@ -43,6 +43,9 @@ static void usage(FILE *f)
         "  --seed S            seed of the per-pixel sample patterns (default 0)\n"
         "  -o OUT.png|.exr     shaded image (default microshadow.png): PNG tone-mapped sRGB, EXR linear HDR\n"
         "                      radiance (channels R, G, B, V, S; several lights: V0, V1, ..., S0, S1, ...)\n"
+        "  --shading S         standard (default: the materials, diffuse and specular) or diffuse (base colour\n"
+        "                      x irradiance x S / pi alone: what a baked lightmap can show, to compare with\n"
+        "                      the viewer of `microshadow bake --gltf`)\n"
         "  --exposure EV       PNG: stops added to the automatic exposure (which maps the 99th percentile of\n"
         "                      unshadowed radiance to 1): the PNG shows radiance * 2^EV * auto (default 0)\n"
         "  --vis OUT.pfm|.exr  float visibility V, -1 where the primary ray missed\n"
@@ -100,7 +103,7 @@ static int cli_main(int argc, char **argv)
     enum { O_METHOD = 256, O_PATTERN, O_SAMPLES, O_WIDTH, O_HEIGHT, O_THREADS, O_SEED, O_VIS, O_SHADOW,
            O_STATS, O_ISA, O_TRAVERSAL, O_FRUSTUM_SHRINK, O_QUIET, O_HELP, O_VERSION, O_NO_FILTER,
            O_EXPOSURE, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_PRIMARY, O_CONSISTENT, O_CLOSED_CULL, O_NO_INTERIOR, O_NO_MERGE, O_MAX_MEMORY,
-           O_EMBREE_MODE, O_EMBREE_FILTER, O_STREAM, O_NO_STREAM, O_AA, O_AA_SPLIT };
+           O_EMBREE_MODE, O_EMBREE_FILTER, O_STREAM, O_NO_STREAM, O_AA, O_AA_SPLIT, O_SHADING };
     static const struct option longopts[] = {
         { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
         { "samples", required_argument, 0, O_SAMPLES }, { "width", required_argument, 0, O_WIDTH },
@@ -120,6 +123,7 @@ static int cli_main(int argc, char **argv)
         { "embree-mode", required_argument, 0, O_EMBREE_MODE }, { "embree-filter", required_argument, 0, O_EMBREE_FILTER },
         { "stream", no_argument, 0, O_STREAM }, { "no-stream", no_argument, 0, O_NO_STREAM },
         { "aa", required_argument, 0, O_AA }, { "aa-split", no_argument, 0, O_AA_SPLIT },
+        { "shading", required_argument, 0, O_SHADING },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -219,6 +223,11 @@ static int cli_main(int argc, char **argv)
             opt.aa = (int)v;
             break;
         case O_AA_SPLIT: opt.aa_split = 1; break;
+        case O_SHADING:
+            if (!strcmp(optarg, "standard")) opt.shading = MS_SHADING_STANDARD;
+            else if (!strcmp(optarg, "diffuse")) opt.shading = MS_SHADING_DIFFUSE;
+            else { fprintf(stderr, "microshadow: --shading: '%s' is not standard or diffuse\n", optarg); return EXIT_BAD_INPUT; }
+            break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &opt.max_memory)) return EXIT_BAD_INPUT; break;
         case O_EXPOSURE: {
             char *end;

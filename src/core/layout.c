@@ -35,7 +35,7 @@ static const layout_row rows[] = {
     FIELD(ms_render_options, primary), FIELD(ms_render_options, consistent_primary),
     FIELD(ms_render_options, closed_cull), FIELD(ms_render_options, no_interior), FIELD(ms_render_options, no_merge),
     FIELD(ms_render_options, max_memory), FIELD(ms_render_options, stream), FIELD(ms_render_options, stream_rows),
-    FIELD(ms_render_options, aa), FIELD(ms_render_options, aa_split),
+    FIELD(ms_render_options, aa), FIELD(ms_render_options, aa_split), FIELD(ms_render_options, shading),
     STRUCT(ms_stats), FIELD(ms_stats, triangles), FIELD(ms_stats, load_s), FIELD(ms_stats, build_s),
     FIELD(ms_stats, setup_s), FIELD(ms_stats, primary_s), FIELD(ms_stats, shadow_s), FIELD(ms_stats, total_s),
     FIELD(ms_stats, samples), FIELD(ms_stats, threads), FIELD(ms_stats, width), FIELD(ms_stats, height),
@@ -63,7 +63,7 @@ static const layout_row rows[] = {
     FIELD(ms_lightmap, triangle), FIELD(ms_lightmap, uv), FIELD(ms_lightmap, n_tris), FIELD(ms_lightmap, texels),
     FIELD(ms_lightmap, unwrapped_tris), FIELD(ms_lightmap, unwrap_s), FIELD(ms_lightmap, raster_s),
     FIELD(ms_lightmap, texels_moved), FIELD(ms_lightmap, leak_s), FIELD(ms_lightmap, seam_mean), FIELD(ms_lightmap, seam_max),
-    FIELD(ms_lightmap, seam_points),
+    FIELD(ms_lightmap, seam_points), FIELD(ms_lightmap, excluded_tris), FIELD(ms_lightmap, unbaked_tris),
     STRUCT(ms_bake_gltf_options), FIELD(ms_bake_gltf_options, no_textures), FIELD(ms_bake_gltf_options, no_shadowmask),
 };
 

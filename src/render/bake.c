@@ -10,6 +10,8 @@
 #include "bake_leaks.h"
 #include "bake_seams.h"
 #include "bake_stitch.h"
+#include "shade.h"
+#include "bake_unbaked.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -67,6 +69,28 @@ static void closest_on_triangle(const double p[2], const double a[2], const doub
     w[1] = vb * den;
     w[2] = vc * den;
     w[0] = 1.0 - w[1] - w[2];
+}
+
+/* The normal the irradiance's cosine takes at texel point p of scene triangle t (unit geometric normal ng):
+ * the vertex normals interpolated as frames shade (shade.c), so that a smooth surface bakes smooth and the
+ * two faces of a smooth edge agree there; ng where the mesh has none. Visibility keeps ng (lightmaps are
+ * one-sided): the result is turned to ng's side. A texel point moved off its triangle (an edge texel, the
+ * leak fix) takes its barycentrics clamped into the triangle rather than extrapolated normals. */
+static void shading_normal(const ms_scene *sc, uint32_t t, const float p[3], const float ng[3], float ns[3])
+{
+    memcpy(ns, ng, 3 * sizeof(float));
+    if (!sc->tri_normal || t >= sc->n_tris) return;
+    float b[3];
+    ms_barycentric(sc->tri + 9 * (size_t)t, p, b);
+    if (b[0] < 0.0f || b[1] < 0.0f || b[2] < 0.0f) {
+        float sum = 0.0f;
+        for (int k = 0; k < 3; k++) sum += b[k] = b[k] > 0.0f ? b[k] : 0.0f;
+        if (!(sum > 0.0f)) return;
+        for (int k = 0; k < 3; k++) b[k] /= sum;
+    }
+    if (!ms_interpolated_normal(sc, t, b, ns)) return;
+    if (ns[0] * ng[0] + ns[1] * ng[1] + ns[2] * ng[2] < 0.0f)
+        for (int k = 0; k < 3; k++) ns[k] = -ns[k];
 }
 
 /* The UVs baked into (bake_uvs.c): the scene's set, per-object regions, xatlas for the rest. */
@@ -263,6 +287,12 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
     const double t_raster = omp_get_wtime();
     if (!st) st = rasterize(scene, size, out, err, errlen);
     out->raster_s = omp_get_wtime() - t_raster;
+    if (!st) {   /* every triangle baked or named */
+        size_t count[MS_UNBAKED_REASONS];
+        ms_bake_report_unbaked(scene, out, size, count);
+        out->excluded_tris = count[MS_UNBAKED_EXCLUDED];
+        for (int r = MS_UNBAKED_NO_AREA; r < MS_UNBAKED_REASONS; r++) out->unbaked_tris += count[r];
+    }
     if (!st && o->pass) o->pass(o->pass_user, "texels", out->raster_s);
     const double t_leak = omp_get_wtime();
     if (!st && !o->no_leak_fix &&
@@ -486,6 +516,8 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     for (size_t i = 0; i < nt; i++) {
         if (lm->triangle[i] == MS_NO_TRIANGLE) continue;
         const float *p = lm->position + 3 * i, *n = lm->normal + 3 * i;
+        float ns[3];
+        shading_normal(scene, lm->triangle[i], p, n, ns);
         float c[3] = { 0, 0, 0 }, y = 0.0f;
         for (size_t l = 0; l < nl; l++) {
             ms_light L = lights[l];
@@ -505,7 +537,7 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
                 L.emission.y *= t[1];
                 L.emission.z *= t[2];
             }
-            const float e = ms_light_irradiance(&L, p, n), sh = f->shadow[l * nt + i];
+            const float e = ms_light_irradiance(&L, p, ns), sh = f->shadow[l * nt + i];
             c[0] += e * L.emission.x * sh;
             c[1] += e * L.emission.y * sh;
             c[2] += e * L.emission.z * sh;

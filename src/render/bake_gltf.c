@@ -6,6 +6,9 @@
 #include "core/abi.h"
 #include "image/png_encode.h"
 #include "scene/scene_internal.h"
+#include "shade.h"
+#include "bake_unbaked.h"
+#include "frame_shade.h"
 #include "light/light_shape.h"
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -51,7 +54,8 @@ typedef struct writer {
     int *image_of;          /* scene texture -> glTF image, -1 until made */
     int lightmap_tex, shadowmask_tex;
     double intensity;       /* the lightmap's scale I */
-    int *material_of;       /* (scene material + 1) * 4 + variant -> glTF material, -1 until made */
+    int *material_of;       /* ((scene material + 1) * 4 + variant) * MS_UNBAKED_REASONS + reason -> glTF material,
+                             * -1 until made */
     int used_emissive_strength, dropped_transform, dropped_uv_set;
     char *err;
     size_t errlen;
@@ -179,10 +183,11 @@ static const char *shape_name(ms_light_shape s)
 /* Variants of a material: baked (TEXCOORD_1 and the lightmap), with TEXCOORD_0 (its textures). */
 enum { VAR_BAKED = 1, VAR_UV0 = 2 };
 
-/* The glTF material of scene material m (MS_NO_MATERIAL: the default grey) in variant var; -1 on error. */
-static int material_for(writer *w, uint32_t m, int var)
+/* The glTF material of scene material m (MS_NO_MATERIAL: the default grey) in variant var, named after the
+ * reason its triangles were not baked when they were not; -1 on error. */
+static int material_for(writer *w, uint32_t m, int var, ms_unbaked why)
 {
-    const size_t slot = (m == MS_NO_MATERIAL ? 0 : (size_t)m + 1) * 4 + (size_t)var;
+    const size_t slot = ((m == MS_NO_MATERIAL ? 0 : (size_t)m + 1) * 4 + (size_t)var) * MS_UNBAKED_REASONS + (size_t)why;
     if (w->material_of[slot] >= 0) return w->material_of[slot];
     ms_material def;
     memset(&def, 0, sizeof def);
@@ -192,9 +197,10 @@ static int material_for(writer *w, uint32_t m, int var)
     def.base_color_texture = def.alpha_texture = def.normal_texture = def.emissive_texture = def.mr_texture = -1;
     const ms_material *mt = m == MS_NO_MATERIAL ? &def : &w->sc->materials[m];
     cJSON *j = cJSON_CreateObject();
-    char name[64];
-    if (m == MS_NO_MATERIAL) snprintf(name, sizeof name, "default%s", var & VAR_BAKED ? "" : " (not baked)");
-    else snprintf(name, sizeof name, "material %u%s", m, var & VAR_BAKED ? "" : " (not baked)");
+    char name[96], tail[64] = "";
+    if (!(var & VAR_BAKED)) snprintf(tail, sizeof tail, " (not baked: %s)", ms_unbaked_name(why));
+    if (m == MS_NO_MATERIAL) snprintf(name, sizeof name, "default%s", tail);
+    else snprintf(name, sizeof name, "material %u%s", m, tail);
     cJSON_AddStringToObject(j, "name", name);
     cJSON *pbr = cJSON_AddObjectToObject(j, "pbrMetallicRoughness");
     float bc[4];
@@ -299,7 +305,7 @@ static int add_maps(writer *w)
 
 /* A triangle's group: its object (ms_scene.tri_object, else its mesh), material and variant. */
 typedef struct tri_key {
-    uint32_t mesh, material, var, tri;
+    uint32_t mesh, material, var, why, tri;   /* why: ms_unbaked, for the triangles not baked */
 } tri_key;
 
 static int cmp_key(const void *pa, const void *pb)
@@ -308,11 +314,12 @@ static int cmp_key(const void *pa, const void *pb)
     if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
     if (a->material != b->material) return a->material < b->material ? -1 : 1;
     if (a->var != b->var) return a->var < b->var ? -1 : 1;
+    if (a->why != b->why) return a->why < b->why ? -1 : 1;
     return (a->tri > b->tri) - (a->tri < b->tri);
 }
 
-/* One vertex: position, normal, UV 0, UV 1. */
-typedef struct vert { float p[3], n[3], uv0[2], uv1[2]; } vert;
+/* One vertex: position, normal, UV 0, UV 1, tangent (zero where the primitive has none). */
+typedef struct vert { float p[3], n[3], uv0[2], uv1[2], t[4]; } vert;
 
 static uint64_t hash_vert(const vert *v)
 {
@@ -340,6 +347,35 @@ static int face_normal(const float *t, float n[3])
     return 1;
 }
 
+/* The TANGENT of corner c of triangle t (unit normal n as written): the scene's (the asset's, or MikkTSpace's
+ * made at load, as the renderer reads them), else the triangle's UV frame the renderer falls back on
+ * (ms_uv_tangent); made orthogonal to n and unit, w = +-1 (the validator's rules). */
+static void vertex_tangent(const ms_scene *sc, size_t t, int c, int32_t set, const float n[3], float out[4])
+{
+    const float *tg = sc->tri_tangent ? sc->tri_tangent + 12 * t : NULL;
+    for (int k = 0; tg && k < 12; k++)
+        if (!isfinite(tg[k])) tg = NULL;
+    float T[3] = { 0, 0, 0 }, w = 1.0f;
+    if (tg) {
+        memcpy(T, tg + 4 * c, sizeof T);
+        w = tg[4 * c + 3] < 0.0f ? -1.0f : 1.0f;
+    } else if (set < 0 || set >= MS_MAX_UV_SETS || !sc->tri_uv[set] || !ms_uv_tangent(sc, t, set, n, T, &w))
+        memset(T, 0, sizeof T);
+    double d = (double)T[0] * n[0] + (double)T[1] * n[1] + (double)T[2] * n[2], o[3], len = 0.0;
+    for (int k = 0; k < 3; k++) { o[k] = T[k] - d * n[k]; len += o[k] * o[k]; }
+    len = sqrt(len);
+    if (!(len > 1e-12) || !isfinite(len)) {   /* no frame: any unit vector orthogonal to n */
+        const int a = fabsf(n[0]) < 0.9f ? 0 : 1;
+        const double e[3] = { a == 0, a == 1, 0 };
+        d = e[0] * n[0] + e[1] * n[1];
+        len = 0.0;
+        for (int k = 0; k < 3; k++) { o[k] = e[k] - d * n[k]; len += o[k] * o[k]; }
+        len = sqrt(len);
+    }
+    for (int k = 0; k < 3; k++) out[k] = (float)(o[k] / len);
+    out[3] = w;
+}
+
 /* One primitive of the triangles keys[0..n) (one group), welded; its JSON, or NULL on error. */
 static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
 {
@@ -356,6 +392,12 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
         return NULL;
     }
     memset(slot, 0xff, cap * sizeof *slot);
+    /* The material first: a normal texture carried into the file needs TANGENT on the vertices. */
+    const int mat = material_for(w, keys[0].material, var, (ms_unbaked)keys[0].why);
+    if (mat < 0) { free(vs); free(idx); free(slot); return NULL; }
+    const uint32_t sm = keys[0].material;
+    const int tangents = cJSON_GetObjectItem(cJSON_GetArrayItem(w->materials, mat), "normalTexture") != NULL;
+    const int32_t tset = sm < sc->n_materials ? sc->materials[sm].normal_uv : 0;
     size_t nv = 0;
     for (size_t k = 0; k < n; k++) {
         const size_t t = keys[k].tri;
@@ -371,6 +413,7 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
             for (int d = 0; d < 3; d++) v.n[d] = sl > 0.0 ? (float)(sn[d] / sl) : fn[d];
             if (var & VAR_UV0) memcpy(v.uv0, sc->tri_uv[0] + 6 * t + 2 * c, sizeof v.uv0);
             if (var & VAR_BAKED) memcpy(v.uv1, w->lm->uv + 6 * t + 2 * c, sizeof v.uv1);
+            if (tangents) vertex_tangent(sc, t, c, tset, v.n, v.t);
             size_t h = (size_t)(hash_vert(&v) & (cap - 1));
             while (slot[h] != UINT32_MAX && memcmp(&vs[slot[h]], &v, sizeof v)) h = (h + 1) & (cap - 1);
             if (slot[h] == UINT32_MAX) { slot[h] = (uint32_t)nv; vs[nv++] = v; }
@@ -379,13 +422,17 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     }
     free(slot);
     /* attribute arrays out of the interleaved vertices */
-    float *a = malloc(nv * 3 * sizeof *a);
+    float *a = malloc(nv * 4 * sizeof *a);
     if (!a) { free(vs); free(idx); snprintf(w->err, w->errlen, "out of memory for a primitive"); return NULL; }
     cJSON *prim = cJSON_CreateObject(), *attr = cJSON_AddObjectToObject(prim, "attributes");
     for (size_t i = 0; i < nv; i++) memcpy(a + 3 * i, vs[i].p, 3 * sizeof(float));
     cJSON_AddNumberToObject(attr, "POSITION", add_accessor(w, a, nv, 3, 1));
     for (size_t i = 0; i < nv; i++) memcpy(a + 3 * i, vs[i].n, 3 * sizeof(float));
     cJSON_AddNumberToObject(attr, "NORMAL", add_accessor(w, a, nv, 3, 0));
+    if (tangents) {
+        for (size_t i = 0; i < nv; i++) memcpy(a + 4 * i, vs[i].t, 4 * sizeof(float));
+        cJSON_AddNumberToObject(attr, "TANGENT", add_accessor(w, a, nv, 4, 0));
+    }
     if (var & VAR_UV0) {
         for (size_t i = 0; i < nv; i++) memcpy(a + 2 * i, vs[i].uv0, 2 * sizeof(float));
         cJSON_AddNumberToObject(attr, "TEXCOORD_0", add_accessor(w, a, nv, 2, 0));
@@ -403,11 +450,34 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     free(a);
     free(vs);
     free(idx);
-    const int mat = material_for(w, keys[0].material, var);
-    if (mat < 0) { cJSON_Delete(prim); return NULL; }
     cJSON_AddNumberToObject(prim, "material", mat);
     cJSON_AddNumberToObject(prim, "mode", 4);
+    if (!(var & VAR_BAKED)) {   /* glTF primitives have no name: extras say why they carry no lightmap */
+        cJSON *ex = cJSON_AddObjectToObject(prim, "extras");
+        char why[64];
+        snprintf(why, sizeof why, "not baked: %s", ms_unbaked_name((ms_unbaked)keys[0].why));
+        cJSON_AddStringToObject(ex, "name", why);
+        cJSON_AddNumberToObject(ex, "triangles", (double)n);
+    }
     return prim;
+}
+
+/* The exposures microshadow's frame of the scene's camera picks by itself (frame_shade.h), standard and diffuse,
+ * in the scene's extras.microshadow, so that a viewer shows the bake as the frame shows the scene by default
+ * (viewer/index.html: three.js puts them in gltf.scene.userData). Left out, with a warning, if they cannot be
+ * computed: the glb is still whole. */
+static void add_exposures(const ms_scene *sc, cJSON *scene0)
+{
+    float e[2];
+    char why[256] = "";
+    for (int k = 0; k < 2; k++)
+        if (ms_frame_auto_exposure(sc, k ? MS_SHADING_DIFFUSE : MS_SHADING_STANDARD, 0, &e[k], why, sizeof why)) {
+            ms_warn("the glTF carries no exposure for its viewer: %s", why);
+            return;
+        }
+    cJSON *ms = cJSON_AddObjectToObject(cJSON_AddObjectToObject(scene0, "extras"), "microshadow");
+    cJSON_AddNumberToObject(ms, "exposure", e[0]);
+    cJSON_AddNumberToObject(ms, "exposure_diffuse", e[1]);
 }
 
 ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
@@ -439,7 +509,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
     ms_status st = MS_OK;
     const size_t n = sc->n_tris;
     w.image_of = malloc((sc->n_textures ? sc->n_textures : 1) * sizeof *w.image_of);
-    w.material_of = malloc((sc->n_materials + 1) * 4 * sizeof *w.material_of);
+    w.material_of = malloc((sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS * sizeof *w.material_of);
     tri_key *keys = malloc((n ? n : 1) * sizeof *keys);
     w.root = cJSON_CreateObject();
     if (!w.image_of || !w.material_of || !keys || !w.root) {
@@ -448,7 +518,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
         goto done;
     }
     for (size_t i = 0; i < sc->n_textures; i++) w.image_of[i] = -1;
-    for (size_t i = 0; i < (sc->n_materials + 1) * 4; i++) w.material_of[i] = -1;
+    for (size_t i = 0; i < (sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS; i++) w.material_of[i] = -1;
 
     cJSON *asset = cJSON_AddObjectToObject(w.root, "asset");
     cJSON_AddStringToObject(asset, "version", "2.0");
@@ -480,6 +550,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
         keys[m].mesh = sc->tri_object ? sc->tri_object[t] : sc->tri_mesh ? sc->tri_mesh[t] : 0;
         keys[m].material = sc->tri_material && sc->tri_material[t] < sc->n_materials ? sc->tri_material[t] : MS_NO_MATERIAL;
         keys[m].var = (uint32_t)var;
+        keys[m].why = var & VAR_BAKED ? MS_BAKED : (uint32_t)ms_bake_tri_state(sc, lm->uv, lm->frame.width, t);
         keys[m++].tri = (uint32_t)t;
     }
     if (flat) ms_warn("%zu triangles without area (no normal) left out of the glTF", flat);
@@ -524,6 +595,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
     if (w.used_emissive_strength) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_materials_emissive_strength"));
     cJSON *scene0 = cJSON_CreateObject();
     cJSON_AddItemToArray(cJSON_AddArrayToObject(scene0, "nodes"), cJSON_CreateNumber(0));
+    add_exposures(sc, scene0);
     cJSON_AddItemToArray(scenes, scene0);
     if (w.bin.oom) { snprintf(err, errlen, "out of memory for the glTF's binary chunk"); st = MS_ERR_NO_MEMORY; goto done; }
     bin_put(&w.bin, NULL, 0);   /* pad to 4 */

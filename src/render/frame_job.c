@@ -268,6 +268,10 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
         else snprintf(err, errlen, "unknown method '%s'", method);
         return MS_ERR_METHOD;
     }
+    if (opt->shading != MS_SHADING_STANDARD && opt->shading != MS_SHADING_DIFFUSE) {
+        snprintf(err, errlen, "shading %d is not MS_SHADING_STANDARD (0) or MS_SHADING_DIFFUSE (1)", (int)opt->shading);
+        return MS_ERR_INVALID;
+    }
     ms_frame_job *j = calloc(1, sizeof *j);
     if (!j) { snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
     j->t_start = t_start;
@@ -467,9 +471,9 @@ static ms_status job_create(const ms_scene *scene, const ms_render_options *opt,
     j->axis_sstate = calloc(3 * nl, sizeof *j->axis_sstate);
     j->interior_sstate = calloc(nl, sizeof *j->interior_sstate);
     ms_frame *f = &j->frame;
-    f->vis = malloc(nl * npix * sizeof(float));
-    f->shadow = malloc(nl * npix * sizeof(float));
-    f->shadow_spec = malloc(nl * npix * sizeof(float));
+    f->vis = calloc(nl * npix, sizeof(float));   /* zero until rendered: a finish without tiles reads them */
+    f->shadow = calloc(nl * npix, sizeof(float));
+    f->shadow_spec = calloc(nl * npix, sizeof(float));
     f->front = calloc(nl * npix, sizeof *f->front);
     f->rgb = malloc(npix * 3 * sizeof(float));
     f->n_lights = (int)nl;
@@ -610,7 +614,7 @@ static void surface_tiles(ms_frame_job *j, const int *tiles, int n)
                 const size_t p = (size_t)(y - j->y_base) * j->W + x;
                 float viewer[3];   /* the eye, or up the pixel's own ray for an orthographic camera */
                 ms_camera_viewer(&j->ctx.cam, j->hits[p].p, viewer);
-                ms_surface_at(j->scene, &j->bvh, &j->hits[p], viewer, &j->surf[p]);
+                ms_surface_at(j->scene, &j->bvh, &j->hits[p], viewer, j->opt.shading, &j->surf[p]);
             }
     }
 }

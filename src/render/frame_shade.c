@@ -66,7 +66,7 @@ int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_lig
         if (!surf) {
             float viewer[3];   /* the eye, or up the pixel's own ray for an orthographic camera */
             ms_camera_viewer(&ctx->cam, hits[i].p, viewer);
-            ms_surface_at(scene, NULL, &hits[i], viewer, &grey);
+            ms_surface_at(scene, NULL, &hits[i], viewer, MS_SHADING_STANDARD, &grey);   /* grey: the same in both */
         }
         float y = 0.0f;
         for (size_t l = 0; l < nlights; l++) {

@@ -15,4 +15,10 @@
 int ms_frame_shade(const ms_scene *scene, const ms_render_ctx *ctx, const ms_light *lights, size_t nlights,
                    const ms_hit *hits, const ms_surface *surf, int threads, int y0, ms_frame *f, float *lum);
 
+/* The exposure ms_render of the scene's camera picks by itself under `shading` (its automatic exposure:
+ * 1 / the 99th percentile of the unshadowed radiance over the hit pixels, computed by ms_frame_shade), without
+ * a shadow pass (render.c). */
+ms_status ms_frame_auto_exposure(const ms_scene *scene, ms_shading shading, int threads, float *exposure, char *err,
+                                 size_t errlen);
+
 #endif

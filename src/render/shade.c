@@ -94,6 +94,25 @@ static int lookup(const ms_scene *s, size_t t, const float b[3], int32_t tex, in
     return texture_rgba(tx, sm, u, v, srgb, out);
 }
 
+int ms_uv_tangent(const ms_scene *s, size_t t, int32_t set, const float n[3], float T[3], float *w)
+{
+    float B[3], nb[3];
+    const float *p = s->tri + 9 * t, *uv = s->tri_uv[set] + 6 * t;
+    float e1[3], e2[3];
+    v3_sub(e1, p + 3, p);
+    v3_sub(e2, p + 6, p);
+    const float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
+    const float r = du1 * dv2 - du2 * dv1;
+    if (!(fabsf(r) > 0.0f)) return 0;
+    for (int c = 0; c < 3; c++) {
+        T[c] = (e1[c] * dv2 - e2[c] * dv1) / r;   /* dP/du */
+        B[c] = (e1[c] * du2 - e2[c] * du1) / r;   /* -dP/dv: up the image */
+    }
+    v3_cross(nb, n, T);
+    *w = v3_dot(nb, B) < 0.0f ? -1.0f : 1.0f;
+    return 1;
+}
+
 /* The normal map's perturbation of the unit shading normal n (before it is turned to the eye): texel t ->
  * (x, y, z) = 2 t - 1 (linear), x and y times the scale; n' = normalize(x T + y B + z n) with T the tangent
  * made orthogonal to n and B = w n x T (glTF). The tangent: the scene's (the asset's TANGENT, or MikkTSpace
@@ -104,7 +123,7 @@ static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_m
 {
     float tex[4];
     if (!lookup(s, t, b, m->normal_texture, m->normal_uv, &m->normal_sampling, 0, tex)) return;
-    float T[3] = { 0, 0, 0 }, B[3], nb[3], tn[3], out[3];
+    float T[3] = { 0, 0, 0 }, nb[3], tn[3], out[3];
     const float *tg = s->tri_tangent ? s->tri_tangent + 12 * t : NULL;
     for (int k = 0; tg && k < 12; k++)
         if (!isfinite(tg[k])) tg = NULL;
@@ -112,21 +131,8 @@ static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_m
     if (tg) {
         for (int k = 0; k < 3; k++) v3_madd(T, T, tg + 4 * k, b[k]);
         w = tg[3] < 0.0f ? -1.0f : 1.0f;
-    } else {
-        const float *p = s->tri + 9 * t, *uv = s->tri_uv[m->normal_uv] + 6 * t;
-        float e1[3], e2[3];
-        v3_sub(e1, p + 3, p);
-        v3_sub(e2, p + 6, p);
-        const float du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
-        const float r = du1 * dv2 - du2 * dv1;
-        if (!(fabsf(r) > 0.0f)) return;   /* degenerate UVs: no tangent frame */
-        for (int c = 0; c < 3; c++) {
-            T[c] = (e1[c] * dv2 - e2[c] * dv1) / r;   /* dP/du */
-            B[c] = (e1[c] * du2 - e2[c] * du1) / r;   /* -dP/dv: up the image */
-        }
-        v3_cross(nb, n, T);
-        if (v3_dot(nb, B) < 0.0f) w = -1.0f;
-    }
+    } else if (!ms_uv_tangent(s, t, m->normal_uv, n, T, &w))
+        return;   /* degenerate UVs: no tangent frame */
     v3_madd(T, T, n, -v3_dot(n, T));
     if (!v3_finite(T) || !(v3_len(T) > 1e-20f)) return;
     v3_normalize(T, T);
@@ -140,8 +146,7 @@ static void normal_map(const ms_scene *s, size_t t, const float b[3], const ms_m
     v3_normalize(n, out);
 }
 
-/* Barycentric coordinates of p (on the triangle's plane) in tri. */
-static void barycentric(const float *tri, const float p[3], float b[3])
+void ms_barycentric(const float *tri, const float p[3], float b[3])
 {
     float e1[3], e2[3], d[3], n[3], c1[3], c2[3];
     v3_sub(e1, tri + 3, tri);
@@ -157,7 +162,19 @@ static void barycentric(const float *tri, const float p[3], float b[3])
     b[0] = 1.0f - b[1] - b[2];
 }
 
-void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out)
+int ms_interpolated_normal(const ms_scene *s, size_t t, const float b[3], float n[3])
+{
+    if (!s->tri_normal) return 0;
+    const float *vn = s->tri_normal + 9 * t;
+    float ni[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; k++) v3_madd(ni, ni, vn + 3 * k, b[k]);
+    if (!(v3_finite(ni) && v3_len(ni) > 1e-12f)) return 0;
+    v3_normalize(n, ni);
+    return 1;
+}
+
+void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_shading shading,
+                   ms_surface *out)
 {
     memset(out, 0, sizeof *out);
     memcpy(out->n, h->n, sizeof out->n);
@@ -170,15 +187,10 @@ void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const 
     const uint32_t mi = s->tri_material ? s->tri_material[t] : MS_NO_MATERIAL;
     const ms_material *m = mi < s->n_materials ? &s->materials[mi] : NULL;
     float b[3];
-    barycentric(s->tri + 9 * t, h->p, b);
+    ms_barycentric(s->tri + 9 * t, h->p, b);
     float ns[3];
     memcpy(ns, h->n, sizeof ns);
-    if (s->tri_normal) {
-        const float *vn = s->tri_normal + 9 * t;
-        float ni[3] = { 0, 0, 0 };
-        for (int k = 0; k < 3; k++) v3_madd(ni, ni, vn + 3 * k, b[k]);
-        if (v3_finite(ni) && v3_len(ni) > 1e-12f) v3_normalize(ns, ni);
-    }
+    ms_interpolated_normal(s, t, b, ns);
     /* The normal map perturbs the interpolated normal on its own side of the surface; then the result is
      * turned to the eye's side of the surface like h->n. */
     if (m && m->normal_map) normal_map(s, t, b, m, ns);
@@ -202,6 +214,10 @@ void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const 
     }
     out->roughness = rough;
     out->specular = 1;
+    if (shading == MS_SHADING_DIFFUSE) {   /* what a lightmap gives an engine's unlit base colour */
+        for (int c = 0; c < 3; c++) { out->diffuse[c] = base[c]; out->emissive[c] = 0.0f; }
+        out->specular = 0;
+    }
 }
 
 float ms_resolve_spec(const ms_render_ctx *ctx, const ms_shadow_query *q, const float *pts, const uint64_t *front,

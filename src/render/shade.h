@@ -23,8 +23,23 @@ typedef struct ms_surface {
     float emissive[3];   /* emitted radiance (material emission x strength x texture), added once per pixel */
 } ms_surface;
 
-/* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye. */
-void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_surface *out);
+/* Barycentric coordinates b of p (on the triangle's plane) in tri (9 floats). */
+void ms_barycentric(const float *tri, const float p[3], float b[3]);
+
+/* The shading normal of scene triangle t at barycentrics b: its vertex normals (ms_scene.tri_normal)
+ * interpolated and normalised into n, as frames shade (before any normal map; on the side the file gave it).
+ * 1, or 0 with n untouched where the triangle has no usable vertex normals. */
+int ms_interpolated_normal(const ms_scene *s, size_t t, const float b[3], float n[3]);
+
+/* The tangent frame of scene triangle t where its mesh has no tangents: T = dP/du over UV set `set` (not
+ * normalised) and w (+-1) such that w n x T runs up the image (towards decreasing glTF v), as normal maps
+ * read it (docs/shading.md). 1, or 0 for degenerate UVs. */
+int ms_uv_tangent(const ms_scene *s, size_t t, int32_t set, const float n[3], float T[3], float *w);
+
+/* The surface at a primary hit h of the frame (h->prim: leaf-order id of bvh), seen from eye; shading
+ * MS_SHADING_DIFFUSE keeps the base colour as c_diff and drops the specular lobe and the emission. */
+void ms_surface_at(const ms_scene *s, const ms_bvh *bvh, const ms_hit *h, const float eye[3], ms_shading shading,
+                   ms_surface *out);
 
 /* S_spec = sum_i w_i v_i / sum_i w_i over the front samples, w_i = f_GGX(v, l_i) max(n_s.l_i, 0)
  * max(cos theta_l,i, 0) / r_i^2: the specular lobe's share of the light that is unoccluded, from the same

@@ -180,6 +180,11 @@ class QuadTest(unittest.TestCase):
         np.testing.assert_array_equal(hit, c["vis"] >= 0)
         self.assertEqual(b["stats"]["samples_per_pixel"], 256)
         self.assertEqual(b["stats"]["filter_s"], 0.0)
+        # shading (the struct's last field): without materials the grey Lambertian is the same picture both ways
+        d = ms.render(self.scene, method="raytrace", samples=256, shading="diffuse")
+        np.testing.assert_array_equal(d["rgb"], b["rgb"])
+        with self.assertRaises(ValueError):
+            ms.render(self.scene, shading="glossy")
 
     def test_camera_types(self):
         # the mirrored ms_camera: a fisheye of 180 degrees (MS_CAMERA_FISHEYE = 2) on the same eye: no ray
