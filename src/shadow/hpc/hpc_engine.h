@@ -97,7 +97,7 @@
  *
  * The engine's files (docs/hpc.md, "Files", maps them): what does not depend on the ISA is compiled once and
  * declared in this header (hpc_tree.c, hpc_chunks.c, hpc_slots.c, hpc_triangle.c, hpc_footprint.c, hpc_tsure.c,
- * hpc_exact.c); the 16-lane parts are one source per ISA, hpc_impl.h and the *_impl.h files it
+ * hpc_exact.c, hpc_frame.c); the 16-lane parts are one source per ISA, hpc_impl.h and the *_impl.h files it
  * includes, compiled as hpc_scalar.c, hpc_avx2.c and hpc_avx512.c, each defining ms_hpc_cast_<isa>; hpc.c picks
  * one under the context's cap. hpc_impl.h says what the ISA changes: nothing in the masks and counters.
  * Measuring switches (ms_hpc_switches, hpc.h) turn off each optimisation of sec. 3.3 and each SIMD form.
@@ -318,5 +318,36 @@ static inline int tsure_on(const shared *sh) { return !(sh->sw & (MS_HPC_OFF_SUR
 /* 1 when every segment from a receiver in the box pc +- h to the light meets t's plane well inside the exact
  * test's range (hpc_tsure.c has the proof). */
 int hpc_t_sure(const shared *sh, const float pc[3], const float h[3], const tri_job *t);
+
+/* ---- the frame (hpc_frame.c): what one ms_hpc_cast_<isa> holds ---- */
+
+typedef struct hpc_frame {
+    shared sh;
+    int threads, cap, nchunks;       /* nchunks -1 when the split ran out of memory */
+    chunk *ch;
+    uint32_t *idx, nlive;            /* the live receivers (not in full umbra from the start), by chunk */
+    uint64_t *gumbra0;               /* by the caller's numbers (sh's arrays are by hierarchy order after */
+    uint8_t *full0;                  /* the renumbering) */
+    int32_t *slot0;
+    uint32_t *orig;
+    ms_shadow_query *q2;
+    uint64_t *gumbra2;
+    uint8_t *full2;
+    int32_t *slot2;
+    tri_job *jobs;                   /* a batch: its jobs, triangles, ids and pairing */
+    float *tri;
+    uint32_t *ids;
+    int8_t *pairs;
+} hpc_frame;
+
+/* Everything before the triangles: the shared state, the light's polygons, the groups, the receivers' horizon,
+ * the chunks and their hierarchies, the renumbering and the grid origins. 0, or -1 out of memory (F is then
+ * still to be ended). */
+int hpc_frame_begin(hpc_frame *F, const ms_render_ctx *ctx, int scanline, ms_raster_fn raster,
+                    const ms_shadow_query *q, size_t n, const uint64_t *front, uint64_t *counters);
+/* The visible masks, by the caller's numbers. */
+void hpc_frame_vis(const hpc_frame *F, uint64_t *vis);
+/* The chunks' counters and memory into counters; frees everything. */
+void hpc_frame_end(hpc_frame *F, uint64_t *counters);
 
 #endif
