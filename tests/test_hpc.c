@@ -357,14 +357,14 @@ static long hpc_pixels_off(const ms_scene *sc, int switches, const ms_frame *ref
  * in segments, crossing over a ground under a square light, seen from above. Every receiver on the ground
  * is in the penumbra of many bars whose shadows, from one receiver, are strips narrower than a sample
  * cell: the samples lie within ulps of the triangles' edges far more often than on the shared scenes, so
- * hpc's footprint test (hpc_impl.h) must keep every sample raytrace's rounding may call blocked (with its
+ * hpc's footprint test (hpc_footprint.c) must keep every sample raytrace's rounding may call blocked (with its
  * slack set to 0, pixels differ here), and half the bars' triangles face away from the light (the
- * closed-component cull, which must leave V and S as they are). The leaf footprint (hpc_impl.h) rules out
+ * closed-component cull, which must leave V and S as they are). The leaf footprint (hpc_leaf_bound_impl.h) rules out
  * samples for a whole leaf of receivers at once; its bound over the leaf's grid origins (which differ per
  * pixel) matters here: without it (MS_HPC_BREAK_LEAF_BOUND, wrong on purpose) pixels differ, so the scene
  * shows a bound that misses what raytrace blocks. Every face of a bar is an axis-aligned rectangle cut into two
- * triangles, so the pairs' leaf footprint is their rectangle's (hpc_impl.h, "rectangle pairs"): it runs here,
- * and bounded by its first triangle alone (MS_HPC_BREAK_RECT, wrong on purpose) pixels differ. Most samples a
+ * triangles, so the pairs' leaf footprint is their rectangle's (hpc_leaf_bound_impl.h, "rectangle pairs"): it
+ * runs here, and bounded by its first triangle alone (MS_HPC_BREAK_RECT, wrong on purpose) pixels differ. Most samples a
  * bar blocks lie well inside its footprint, where only the t range is tested (footprint_sure_lanes): that
  * runs here, and with the sure lanes' margin on the wrong side of the edges (MS_HPC_BREAK_SURE, wrong on
  * purpose) pixels differ. (With that margin at 0 none does: the samples on a bar's edge are blocked either way.)
@@ -486,7 +486,7 @@ static void test_bars(void **st)
     ms_scene_free(&sc);
 }
 
-/* Pairs (hpc_impl.h pair_batch: two triangles sharing an edge and a plane cast as one job): long thin quads at
+/* Pairs (hpc_triangle.c hpc_pair_batch: two triangles sharing an edge and a plane cast as one job): long thin quads at
  * random yaw, tilt and height over a ground, each two triangles split along the long diagonal, so that the
  * two triangles' hard shadows from one sample are slivers meeting along it and many samples fall within ulps
  * of the shared edge. hpc with its pairs equals raytrace bit for bit, as with every triangle cast alone

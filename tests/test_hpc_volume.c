@@ -122,7 +122,7 @@ static void test_active_planes(void **st)
     assert_true(hpc_volume_box(&v, HPC_ALL_PLANES, lo2, hi2, &out, &tests));
 }
 
-/* A blocker of four points (hpc casts two triangles sharing an edge as one job, hpc_impl.h pair_batch): for
+/* A blocker of four points (hpc casts two triangles sharing an edge as one job, hpc_triangle.c hpc_pair_batch): for
  * random pairs, flat (a quad, convex or not) and folded along the shared edge, every point either triangle
  * shadows lies inside the volume of the four points, with margin 0 up to rounding; and the volume still
  * culls (a point beside the light is outside; the flat pair's volume keeps its cap). The points are given

@@ -1,6 +1,6 @@
 /* Hierarchical penumbra casting (Laine & Aila 2005), the engine shared by methods "hpc" and
- * "hpc-scanline" (hpc_impl.h, compiled per ISA: hpc_scalar.c, hpc_avx2.c, hpc_avx512.c; the choice in
- * hpc.c; the methods in hpc_method.c). */
+ * "hpc-scanline" (hpc_engine.h: the method, its departures and its files; the per-ISA part hpc_impl.h, compiled
+ * as hpc_scalar.c, hpc_avx2.c, hpc_avx512.c; the choice in hpc.c; the methods in hpc_method.c). */
 #ifndef MS_HPC_H
 #define MS_HPC_H
 #include <stddef.h>
@@ -54,11 +54,13 @@ enum {
     MS_HPC_OFF_SORT = 16,        /* coarse blocker sorting: the scene's order (hpc_method.c) */
     MS_HPC_OFF_SIMD_SAMPLES = 32,/* the 16-lane sample test: one sample at a time (the scalar form) */
     MS_HPC_OFF_SIMD_PLANES = 64, /* the 16-lane volume tests: one plane at a time */
-    MS_HPC_OFF_FOOTPRINT = 128,  /* hpc's footprint test (hpc_impl.h): the group volumes V_Gk, as the paper */
-    MS_HPC_OFF_PAIRS = 256,      /* hpc's pairs (pair_batch, hpc_impl.h): every triangle cast alone */
-    MS_HPC_OFF_LEAF_FOOTPRINT = 512, /* hpc's leaf footprint (hpc_impl.h): every receiver's own footprint only */
+    MS_HPC_OFF_FOOTPRINT = 128,  /* hpc's footprint test (hpc_footprint.c): the group volumes V_Gk, as the paper */
+    MS_HPC_OFF_PAIRS = 256,      /* hpc's pairs (hpc_pair_batch, hpc_triangle.c): every triangle cast alone */
+    MS_HPC_OFF_LEAF_FOOTPRINT = 512, /* hpc's leaf footprint (hpc_leaf_bound_impl.h): every receiver's own
+                                      * footprint only */
     MS_HPC_ALL_LEAF_FOOTPRINT = 1024, /* the leaf footprint rule off: on every leaf, not only where it pays (leaf_fp_pays) */
-    MS_HPC_OFF_RECT = 2048,      /* hpc's rectangle pairs (hpc_impl.h): each triangle of such a pair bounded alone */
+    MS_HPC_OFF_RECT = 2048,      /* hpc's rectangle pairs (hpc_leaf_bound_impl.h): each triangle of such a pair
+                                  * bounded alone */
     MS_HPC_OFF_SURE = 4096,      /* hpc's sure lanes (footprint_sure_lanes): every candidate sample to the exact test */
     MS_HPC_BREAK_LEAF_BOUND = 8192,  /* not a measurement: the leaf footprint without its bound over the leaf's
                                       * grid origins (wrong on purpose), so that test_hpc can show its scene
@@ -68,9 +70,9 @@ enum {
     MS_HPC_BREAK_SURE = 32768,   /* not a measurement: the sure lanes (footprint_sure_lanes) with their margin on
                                   * the wrong side of the edges, -s (wrong on purpose), so that test_hpc can show
                                   * its scene depends on it */
-    MS_HPC_OFF_LEAF_LANES = 65536, /* hpc's leaf lanes (hpc_impl.h): a leaf's samples handed to each receiver in turn
-                                    * instead of tested for its 16 receivers at once */
-    MS_HPC_OFF_TSURE = 131072,   /* hpc's t_sure (hpc_impl.h): the sure lanes' t range tested, never proven */
+    MS_HPC_OFF_LEAF_LANES = 65536, /* hpc's leaf lanes (hpc_leaf_lanes_impl.h): a leaf's samples handed to each
+                                    * receiver in turn instead of tested for its 16 receivers at once */
+    MS_HPC_OFF_TSURE = 131072,   /* hpc's t_sure (hpc_tsure.c): the sure lanes' t range tested, never proven */
     MS_HPC_BREAK_TSURE = 262144  /* not a measurement: t_sure true for every receiver and triangle (wrong on
                                   * purpose), so that test_hpc can show its scene depends on it */
 };

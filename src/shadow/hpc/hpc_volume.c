@@ -62,7 +62,7 @@ int hpc_volume_build(hpc_volume *v, const double *poly, int np, const float tri[
 }
 
 /* Departure: the paper's blocker is a triangle; here it may be nt <= 4 points (hpc casts two triangles that
- * share an edge as one job, hpc_impl.h), and the candidates span every pair of its points, so that the planes
+ * share an edge as one job, hpc_triangle.c), and the candidates span every pair of its points, so that the planes
  * separate the polygon from the points' convex hull whatever their order or shape. For a triangle the pairs
  * are its three edges, as before. */
 int hpc_volume_build_points(hpc_volume *v, const double *poly, int np, const float *pts, int nt, float eps)

@@ -17,7 +17,7 @@ typedef struct hpc_volume {
     float eps;                      /* culling margin: a point is outside only below -eps */
     float pl[HPC_MAX_PLANES][4];    /* unit normal, offset: inside is n . x + d >= -eps */
     /* The same planes by component (unused ones 0), for the engine's 16-lane tests over all planes at
-     * once (hpc_impl.h): HPC_MAX_PLANES is one l16. */
+     * once (vol_box, vol_point: hpc_traverse_impl.h): HPC_MAX_PLANES is one l16. */
     float soa[4][HPC_MAX_PLANES];
 } hpc_volume;
 
