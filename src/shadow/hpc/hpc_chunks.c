@@ -53,10 +53,9 @@ static void bounds_parallel(const shared *sh, const uint32_t *idx, uint32_t n, f
 
 /* Splits the receivers into at most cap chunks by middle splits, always the one with the most points next,
  * until every chunk holds at most `target` points; returns the count. Splitting the largest first keeps the
- * chunks' sizes even when the cap runs out: depth first, empty regions used up the cap and left a GRIDS-like
- * frame's densest region as one chunk of 28% of the points, which one thread cast alone while the other
- * waited at the batch's end (at 1024² the last batch took 4.9 s of wall time for 5.0 s of CPU). Each split's
- * bounds and partition run over the threads (serial, they took 0.23 s of a 2048² frame's wall time). */
+ * chunks' sizes even when the cap runs out: depth first, empty regions used up the cap and left a frame's
+ * densest region as one chunk, which one thread cast alone while the others waited at the batch's end. Each
+ * split's bounds and partition run over the threads (serial, they were a visible share of a big frame). */
 int hpc_make_chunks(const shared *sh, uint32_t *idx, uint32_t n, uint32_t target, chunk *out, int cap, int threads)
 {
     typedef struct { uint32_t b, n; } range;

@@ -77,9 +77,9 @@
  *    slacks with one sign passes the exact test's edge functions (footprint_sure_lanes), so a block whose
  *    candidates are all such samples is decided by the exact test's t range alone (t_range16, its own
  *    operations). The paper has no such step: every open relation of an active group is tested against its
- *    hard shadow volume (L22); here the functions the footprint already evaluated decide most of them. On the
- *    merged bars (1,322 large rectangles) 70M of 90M sample tests take it and the cast is 10% faster; only
- *    footprints over several groups take it (cast_blocks; docs/hpc.md, session 15). Where the triangle lies
+ *    hard shadow volume (L22); here the functions the footprint already evaluated decide most of them (on
+ *    merged bars most sample tests take it); only footprints over several groups take it (cast_blocks). Where
+ *    the triangle lies
  *    well between every receiver of a leaf (or the one receiver) and the light, even the t range is proven
  *    (hpc_t_sure), and such samples are blocked without any test.
  *  - with the leaf footprint, the samples it leaves are tested for the leaf's receivers in the lanes, one

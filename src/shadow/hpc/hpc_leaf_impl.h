@@ -5,12 +5,10 @@
  * grow, so that they follow the triangles of the moment): only while it has left at most LEAF_FP_CANDS samples
  * per receiver to test in the lanes and, where its samples go to each receiver in turn (not lanes: the leaf lanes
  * off, or alpha), at most LEAF_FP_KEEP of the receivers to that per-receiver work; one leaf in LEAF_FP_PROBE uses
- * it regardless, to keep the counts current. Per chunk, so the same on every ISA and run. Measured (1024^2, the
- * leaf footprint on every leaf, before the leaf lanes): on a GRIDS-like scene's bars 58% of the receivers kept,
- * 2.1 samples per receiver, and it pays; Dabrovic Sponza's large triangles leave 12.5 samples per receiver (76%
- * kept), a scanned bunny's small ones keep 72% of the receivers (1.9 samples each): there it cost 20-25%. With
- * the leaf lanes a kept receiver costs no work of its own, and the keep rule off took the bars' cast 2.54 ->
- * 2.32 s (two threads), Sibenik, Dabrovic Sponza and the bunny within noise (docs/hpc.md, session 16). */
+ * it regardless, to keep the counts current. Per chunk, so the same on every ISA and run. It pays on thin bars
+ * (few receivers kept, two samples each) and costs where large triangles leave many samples per receiver or
+ * small ones keep most receivers; with the leaf lanes a kept receiver costs no work of its own, so the keep
+ * rule applies only without them. */
 #define LEAF_FP_PROBE 64u
 #define LEAF_FP_KEEP 0.75f
 #define LEAF_FP_CANDS 6.0f
@@ -95,8 +93,8 @@ static void leaf_choose(const shared *sh, chunk *c, const tri_job *t, leaf_cast 
 {
     const int nt = lc->nt;
     const unsigned act = lc->act, *on = lc->on;
-    /* pairs only: a lone triangle's set-up is shared by half as much work (measured on a scanned bunny, whose
-     * triangles are 91% alone: it cost 5% there even with leaf_fp_pays) */
+    /* pairs only: a lone triangle's set-up is shared by half as much work, and on a scanned mesh, whose
+     * triangles are mostly alone, it cost more than it saved even with leaf_fp_pays */
     /* the leaf's receivers in the lanes (leaf_lanes, above): not for alpha-tested triangles (their opacity is
      * looked up per hit, hpc_alpha_opaque) nor with the 16-lane sample test off */
     int lanes_ok = !(sh->sw & (MS_HPC_OFF_LEAF_LANES | MS_HPC_OFF_SIMD_SAMPLES));
@@ -105,11 +103,10 @@ static void leaf_choose(const shared *sh, chunk *c, const tri_job *t, leaf_cast 
                         ((sh->sw & MS_HPC_ALL_LEAF_FOOTPRINT) ||
                          (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c, lanes_ok)));
     /* The shapes whose footprints are formed: each triangle, or for a rectangle pair under the leaf footprint
-     * its rectangle, standing for both ("rectangle pairs" above; measured on grids, one thread, 1024^2: the
-     * cast 9.42 -> 8.71 s, 7%; the other scenes within noise: docs/hpc.md). */
+     * its rectangle, standing for both ("rectangle pairs" above: one footprint for two triangles). */
     /* Not where a receiver lies on one of the two (its own is not cast against it): the other, coplanar with it,
-     * rules out every sample by mixed signs, while the rectangle around the receiver rules out none (on the
-     * Quad's ground, with the leaf footprint on every leaf, the cast went 0.26 -> 0.85 s). */
+     * rules out every sample by mixed signs, while the rectangle around the receiver rules out none (on a
+     * ground plane that made the cast several times slower). */
     const int rect = leaf_fp && nt == 2 && t->rect && !(sh->sw & MS_HPC_OFF_RECT) && (act & on[0] & on[1]) == act,
               ns = rect ? 1 : nt;
     for (int u = 0; u < ns; u++) lc->shape[u] = rect ? (fp_shape){ t->rc, 4 } : (fp_shape){ t[u].v, 3 };
@@ -160,8 +157,7 @@ static unsigned leaf_bound(const shared *sh, chunk *c, leaf_cast *lc)
     if (!act) return lc->act = 0;
     /* A sample blocked already for every receiver of the leaf needs no test for any (the paper's L21, for a
      * whole leaf): the candidates masked by the union of the receivers' open samples, and below each
-     * receiver's by its own. Measured (session 14, one thread, 1024²): grids -13%, Sibenik -3 to -9%,
-     * Dabrovic Sponza -3%, the bunny -1 to -6%; on grids 32% fewer pairs reach per-receiver work. */
+     * receiver's by its own: a third fewer pairs reach per-receiver work on thin bars. */
     uint64_t any_open[64] = { 0 };
     for (unsigned m = act; m; m &= m - 1) {
         const int l = __builtin_ctz(m);

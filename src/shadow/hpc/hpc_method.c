@@ -5,12 +5,11 @@
  * (MS_OCC_CULL, on by default: visibility/occluders.h, docs/culling.md) ctx->bvh holds the scene's
  * triangles less those of closed components that face away from the whole light, which provably decide no
  * segment (same V and S); the driver names a receiver's own triangle in that set (ms_ctx_skip_prim). The
- * paper has no such cull; on a GRIDS-like scene (closed bars) it removes 32,640 of 74,880 triangles and
- * 37% of the time (docs/hpc.md). hpc also takes the occluders' merge of coplanar rectangles (MS_OCC_MERGE,
+ * paper has no such cull; on closed bars it removes nearly half the triangles and a third of the time. hpc also takes the occluders' merge of coplanar rectangles (MS_OCC_MERGE,
  * accel/coplanar.h: the same points; with MS_OCC_MERGE_EXACT each sample on a set that decides it as the pieces
  * do, render/exact_split.c), as the micro-raster methods
- * and mft do: the bars' faces, 32 segments each, become one rectangle (42,242 -> 1,322 triangles), and the
- * cost per pair, which bounds hpc (docs/hpc.md, session 14), is paid 30 times less often. The receivers on
+ * and mft do: the bars' faces, 32 segments each, become one rectangle, and the cost per pair, which bounds
+ * hpc, is paid 30 times less often. The receivers on
  * merged faces that the merge could answer otherwise are answered over the scene's own triangles by a second
  * call (shadow_frame.c); hpc-scanline keeps the triangles as they are. A procedural scene is streamed:
  * generated batch by batch, its primary hits from the depth pass (primary_depth.c), no BVH at all, no cull.

@@ -8,7 +8,7 @@ static void slot_setup(const shared *sh, chunk *c, int32_t s, const ms_shadow_qu
     const ms_render_ctx *ctx = sh->ctx;
     const int k = sh->k;
     int8_t *kz = slot_kz(sh, c, s);
-    /* ms_wt_packet_axis in the lanes (it was 9% of the cast on the merged bars in scalar form): a packet is
+    /* ms_wt_packet_axis in the lanes (in scalar form it was a visible share of the cast): a packet is
      * 16 consecutive samples of one row (k >= 16), its directions formed as group_block16 forms them, the
      * axis the light's (sh->shear_axis) or else lane 0's largest, kept when every lane's |d| on it is at
      * least half its largest. */

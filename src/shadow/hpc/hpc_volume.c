@@ -15,8 +15,8 @@
 #include <math.h>
 #include <string.h>
 
-/* fmin and fmax are library calls without -ffast-math (5% of a cast on a GRIDS-like scene); the values here
- * are finite. */
+/* fmin and fmax are library calls without -ffast-math (a visible share of a cast); the values here are
+ * finite. */
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
