@@ -2,7 +2,7 @@
  * (light_rect.c, light_disk.c, light_sphere.c), over the light's precomputed frame (light_frame.h). A new
  * shape is one file with its row plus its entry in light_shape.c's table (CONTRIBUTING.md). The row names
  * its scene-file keys and builds the light from their values (keys, build): the scene layer reads the JSON
- * generically (scene_json.c) and checks a light with the row's validate (scene_validate.c); this layer
+ * generically (scene_json_lights.c) and checks a light with the row's validate (scene_validate.c); this layer
  * knows no JSON.
  *
  * Every shape is a mask over the parameters (s,t) of a parallelogram, so every pattern, every method and
