@@ -686,7 +686,7 @@ typedef struct ms_output {
     ms_output_write_fn write;     /* one of the writers below, or the caller's own */
     const char *const *suffixes;  /* NULL-terminated accepted endings (case-insensitive), or NULL: any */
 } ms_output;
-#define MS_MAX_OUTPUTS 8
+#define MS_MAX_OUTPUTS 64   /* a paged lightmap writes each output once per page */
 MS_API ms_status ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
 /* Before writing anything it checks the frame (ms_frame_check_finite): a NaN or infinite value is an error
  * naming the first output's path and the pixel, and no file is written. */
@@ -830,6 +830,13 @@ typedef struct ms_bake_options {
     ms_bake_pass_fn pass;      /* may be NULL */
     void *pass_user;
     int no_seam_stitch;        /* 1: the seams keep the baked texels; 0: stitched (docs/baking.md, "Seams") */
+    float texel_density;       /* texels per world unit (times each mesh's "lightmap" scale) on as many size x size
+                                * pages as it takes (ms_lightmap.pages); 0: everything on one page, at the
+                                * largest density that fits */
+    const char *uv_cache;      /* a UV cache file (ms_bake_write_uv_cache) to take the UVs from when it was
+                                * made for this scene's geometry and these UV options (no unwrap); one that
+                                * was not is not used, with a warning; a missing file is not an error. NULL:
+                                * none (docs/baking.md, "The unwrap cache") */
 } ms_bake_options;
 
 typedef struct ms_lightmap {
@@ -860,6 +867,20 @@ typedef struct ms_lightmap {
     double seam_p99;
     size_t stitched_texels;    /* texels the seam stitching changed (0 with no_seam_stitch) */
     double stitch_s;           /* seconds stitching */
+    /* Pages (docs/baking.md, "Texel density and pages"): the frame holds them stacked, width size, height
+     * size * pages, page p in rows [p * size, (p + 1) * size); uv is in [0,1]^2 of the triangle's page. */
+    int pages;
+    uint32_t *page;            /* per scene triangle: its page */
+    double *page_fill;         /* per page: the fraction of its texels whose centre lies on a triangle */
+    /* Per object (ms_scene.tri_object; else per mesh): the UV set its layout was kept from (-1: xatlas
+     * charted it, -2: not baked) and, for a kept layout, its scale and offset (uv = file uv * (su, sv) +
+     * (ou, ov), 4 floats: su, sv, ou, ov; 0 for xatlas's). */
+    size_t n_objects;
+    int *object_uv_set;
+    float *object_scale_offset;
+    size_t charts;             /* charts xatlas made (0: none, or the UVs came from the cache) */
+    int uv_cached;             /* 1: the UVs came from ms_bake_options.uv_cache, nothing was unwrapped */
+    uint64_t uv_key;           /* the hash of what the UVs depend on (geometry, UV sets, scales, UV options) */
 } ms_lightmap;
 
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
@@ -887,6 +908,12 @@ MS_API ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt,
 /* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
  * image fields; total_s: the sum of the parts' seconds. */
 MS_API ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
+
+/* The UV cache of a bake (docs/baking.md, "The unwrap cache"): lm's key, UVs, pages and per-object sets and
+ * scale-offsets, which a later bake of the same geometry with the same UV options (lights, samples and
+ * methods may differ) reads through ms_bake_options.uv_cache instead of unwrapping. An ms_output-style
+ * writer; name is for messages. */
+static inline ms_status ms_bake_write_uv_cache(const ms_lightmap *lm, FILE *out, const char *name, char *err, size_t errlen);
 
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
  * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
@@ -984,6 +1011,8 @@ MS_API ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_
                              ms_lightmap *out, char *err, size_t errlen);
 MS_API ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_bake_options *opt,
                                     ms_lightmap *out, char *err, size_t errlen);
+MS_API ms_status ms_bake_write_uv_cache_abi(const ms_abi *abi, const ms_lightmap *lm, FILE *out, const char *name, char *err,
+                                            size_t errlen);
 MS_API ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *scene, const ms_lightmap *lm,
                                   const ms_bake_gltf_options *opt, unsigned char **glb, size_t *len, char *err,
                                   size_t errlen);
@@ -1018,6 +1047,8 @@ static inline ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, co
 static inline ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err,
                                        size_t errlen)
 { return ms_bake_layout_abi(ms_abi_compiled(), scene, opt, out, err, errlen); }
+static inline ms_status ms_bake_write_uv_cache(const ms_lightmap *lm, FILE *out, const char *name, char *err, size_t errlen)
+{ return ms_bake_write_uv_cache_abi(ms_abi_compiled(), lm, out, name, err, errlen); }
 static inline ms_status ms_bake_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
                                      unsigned char **glb, size_t *len, char *err, size_t errlen)
 { return ms_bake_gltf_abi(ms_abi_compiled(), scene, lm, opt, glb, len, err, errlen); }
