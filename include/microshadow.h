@@ -821,9 +821,11 @@ typedef void (*ms_bake_pass_fn)(void *user, const char *pass, double seconds);
 typedef struct ms_bake_options {
     ms_points_options points;  /* method, pattern, samples, threads, seed, isa, progress; zero: defaults */
     int size;                  /* texels per side; 0: 1024 (at most MS_MAX_IMAGE_SIZE) */
-    int uv_set;                /* the scene's UV set baked into (0 .. MS_MAX_UV_SETS-1); triangles whose mesh
-                                * lacks it are unwrapped by xatlas into the free space of one atlas with
-                                * them (all of them if no mesh has the set); -1: xatlas for every triangle */
+    int uv_set;                /* the UV set tried first (0 .. MS_MAX_UV_SETS-1): per object, the first of
+                                * this set and then the others in order that is a valid layout (on every
+                                * triangle, with area, no overlap) is kept in a region of its own; objects
+                                * without one are charted by xatlas (docs/baking.md, "Charts"); -1: xatlas
+                                * for every triangle */
     int dilate;                /* texels of dilation; 0: 4; -1: none */
     int padding;               /* texels between charts (xatlas's and the lightmap's regions); 0: 4 */
     int no_leak_fix;           /* 1: texels inside geometry keep their points (docs/baking.md, "Quality"); 0: moved */
@@ -959,7 +961,7 @@ static inline ms_status ms_bake_write_gltf(const ms_scene *scene, const ms_light
  *
  * Each checked entry point above (ms_scene_load, ms_scene_load_ex, ms_scene_default, ms_scene_showcase,
  * ms_render, ms_render_outputs, ms_frame_job_create, ms_accel_build, ms_visibility_points, ms_bake,
- * ms_bake_layout, ms_bake_gltf, ms_bake_write_gltf) is an inline function that hands the library the size of
+ * ms_bake_layout, ms_bake_gltf, ms_bake_write_gltf, ms_bake_write_uv_cache) is an inline function that hands the library the size of
  * every public struct as the program was compiled (ms_abi_compiled), and the library compares them with its own
  * before it reads or writes any: a program built against another microshadow header - a static library or a
  * shared one from another version, a binding's mirror gone stale - gets MS_ERR_INVALID and one line naming the

@@ -12,9 +12,9 @@ typedef struct ms_pack_rect {
 } ms_pack_rect;
 
 /* Packs the rectangles at scale k (w = k w0, h = k h0, texels) onto pages of size x size, `pad` texels
- * between them and around them, at most max_pages pages (0: no limit): tallest first, each into the first
- * shelf of the first page where it fits, a new shelf or page when none does. Returns the pages used, or -1
- * when a rectangle is larger than a page or max_pages do not suffice. */
+ * between them and around them, at most max_pages pages (0: no limit): largest first, each where it fits
+ * best on any open page (MaxRects, best short side), a new page when none has room. Returns the pages
+ * used, or -1 when a rectangle is larger than a page or max_pages do not suffice. */
 int ms_pack_pages(ms_pack_rect *r, size_t n, double k, int size, int pad, int max_pages);
 
 /* The largest scale at which every rectangle fits one page (bisection), packed there; -1 when none does. */

@@ -16,6 +16,7 @@
  * change: a warning says when and why the file's UVs were moved or not used. */
 #include "bake_uvs.h"
 #include "atlas_pack.h"
+#include "atlas_xpack.h"
 #include "uv_validity.h"
 #include "scene/scene_internal.h"
 #include <math.h>
@@ -165,7 +166,11 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     object_uv *ob = malloc(nobj * sizeof *ob);
     float *src = malloc((n ? n : 1) * 6 * sizeof *src), *scaled = NULL, *xuv = NULL;
     ms_pack_rect *rs = NULL;
-    int rc = -1;
+    double *rdim = NULL;
+    int *rpage = NULL, rc = -1;
+    float *xin = NULL, *xout = NULL;
+    uint32_t *xkey = NULL;
+    size_t *xtri_of = NULL;
     if (!use || !want || !bad || !start || !tris || !ob || !src) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); goto out; }
     out->pages = 1;
     for (size_t o = 0; o < nobj; o++) {
@@ -283,7 +288,6 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
         all.world_area += ob[o].world_area;
     }
     size_t nr = 0;
-    int x_first = -1, x_count = 0;
     for (int attempt = 0; attempt < 2; attempt++) {
         nr = 0;
         for (size_t o = 0; o < nobj; o++) ob[o].region = -1;
@@ -307,43 +311,90 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
                     T, shrunk, size, size);
         break;
     }
-    if (n_want) {
-        x_first = (int)nr;
-        if (!(T > 0.0)) { rs[nr].w0 = rs[nr].h0 = sqrt(want_weight > 0.0 ? want_weight : 1e-12); nr++; x_count = 1; }
-        else {   /* xatlas's pages at the density, each a fixed rectangle of what it used */
-            if (ms_lightmap_unwrap(xtri, n, want, group, size - 2 * pad, pad, (float)T, p->tuning, xuv, xpage, &info, err, errlen))
+    /* Placement. Regions alone are rectangles (atlas_pack.c): at the density, or at the largest common scale
+     * that fits one page. With xatlas charts, xatlas's packer places the regions and the charts together
+     * (atlas_xpack.c): at the density over as many pages as it takes, or on one page at the largest scale
+     * found by stepping it. */
+    if (!n_want) {
+        if (!(T > 0.0)) {
+            double wmax = 0.0;
+            for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].w0 * rs[r].h0);
+            for (size_t r = 0; r < nr; r++) {   /* relative sizes, so that tiny objects do not underflow */
+                rs[r].w0 = fmax(rs[r].w0 / sqrt(wmax), 1e-5);
+                rs[r].h0 = fmax(rs[r].h0 / sqrt(wmax), 1e-5);
+            }
+            if (ms_pack_one_page(rs, nr, size, pad)) {
+                snprintf(err, errlen, "the lightmap's %zu regions do not fit a %dx%d lightmap with %d texels of padding", nr, size, size, pad);
                 goto out;
-            rep->charts = info.charts;
-            x_count = (int)(info.atlases ? info.atlases : 1);
-            for (int a = 0; a < x_count; a++) { rs[nr + a].fixed = 1; rs[nr + a].w0 = rs[nr + a].h0 = 1.0; }
-            for (size_t t = 0; t < n; t++)
-                if (want[t] && isfinite(xuv[6 * t]))
-                    for (int k = 0; k < 3; k++) {
-                        ms_pack_rect *r = &rs[nr + xpage[t]];
-                        r->w0 = fmax(r->w0, ceil(xuv[6 * t + 2 * k] * (size - 2.0 * pad)));
-                        r->h0 = fmax(r->h0, ceil(xuv[6 * t + 2 * k + 1] * (size - 2.0 * pad)));
-                    }
-            nr += (size_t)x_count;
+            }
+        } else {
+            const int pages = ms_pack_pages(rs, nr, 1.0, size, pad, 0);
+            if (pages < 0) { snprintf(err, errlen, "the lightmap's %zu regions do not fit %dx%d pages", nr, size, size); goto out; }
+            out->pages = pages ? pages : 1;
         }
-    }
-    /* relative weights, so that tiny objects do not underflow (one page); a density packs at scale 1 */
-    if (!(T > 0.0)) {
-        double wmax = 0.0;
-        for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].w0 * rs[r].h0);
-        for (size_t r = 0; r < nr; r++) {
-            const double f = 1.0 / sqrt(wmax);
-            rs[r].w0 = fmax(rs[r].w0 * f, 1e-5);
-            rs[r].h0 = fmax(rs[r].h0 * f, 1e-5);
-        }
-        if (ms_pack_one_page(rs, nr, size, pad)) {
-            snprintf(err, errlen, "the lightmap's %zu regions do not fit a %dx%d lightmap with %d texels of padding", nr, size, size, pad);
-            goto out;
-        }
-        out->pages = 1;
     } else {
-        const int pages = ms_pack_pages(rs, nr, 1.0, size, pad, 0);
-        if (pages < 0) { snprintf(err, errlen, "the lightmap's %zu regions do not fit %dx%d pages", nr, size, size); goto out; }
-        out->pages = pages ? pages : 1;
+        const int res = size - 2 * pad;
+        if (ms_lightmap_unwrap(xtri, n, want, group, res, pad, (float)T, p->tuning, xuv, xpage, &info, err, errlen)) goto out;
+        rep->charts = info.charts;
+        const double k0 = T > 0.0 ? 1.0 : info.texels_per_unit;   /* region texels per rs unit at the charts' density */
+        rdim = malloc((nr ? nr : 1) * 4 * sizeof *rdim);
+        rpage = malloc((nr ? nr : 1) * sizeof *rpage);
+        xin = malloc(n * 6 * sizeof *xin);
+        xout = malloc(n * 6 * sizeof *xout);
+        xkey = malloc(n * 2 * sizeof *xkey);   /* the charts' keys (stage-1 atlases), then their pages */
+        xtri_of = malloc(n * sizeof *xtri_of);
+        if (!rdim || !rpage || !xin || !xout || !xkey || !xtri_of) { snprintf(err, errlen, "out of memory packing the lightmap"); goto out; }
+        double area = 0.0;
+        for (size_t r = 0; r < nr; r++) {
+            rdim[r] = rs[r].w0 * k0;
+            rdim[nr + r] = rs[r].h0 * k0;
+            area += rdim[r] * rdim[nr + r];
+        }
+        size_t nx = 0;
+        for (size_t t = 0; t < n; t++) {
+            if (!want[t] || !isfinite(xuv[6 * t])) continue;
+            for (int k = 0; k < 6; k++) xin[6 * nx + k] = xuv[6 * t + k] * (float)res;
+            area += uv_area(xin + 6 * nx) / 0.7;   /* charts' boxes and padding */
+            xkey[nx] = xpage[t];
+            xtri_of[nx++] = t;
+        }
+        ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n };
+        double scale = 1.0;
+        if (T > 0.0) {
+            const int pages = ms_xpack_run(&xp, 1.0, err, errlen);
+            if (pages < 0) goto out;
+            out->pages = pages;
+        } else {   /* one page: step the scale up while it fits, down while it does not */
+            double best = 0.0, worst = INFINITY, sc_ = sqrt(0.8 * (double)res * res / fmax(area, 1e-30));
+            for (int it = 0; it < 20; it++) {   /* 8% steps until the scale is bracketed, then 3 bisections */
+                char e2[256];
+                const int fits = ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1;
+                if (fits) best = sc_;
+                else worst = fmin(worst, sc_);
+                if (best > 0.0 && isfinite(worst)) {
+                    if (worst / best < 1.01) break;
+                    sc_ = sqrt(best * worst);
+                } else
+                    sc_ *= fits ? 1.08 : 0.92;
+            }
+            if (!(best > 0.0) || ms_xpack_run(&xp, best, err, errlen) != 1) {
+                snprintf(err, errlen, "the lightmap's regions and charts do not fit a %dx%d lightmap with %d texels of padding", size, size, pad);
+                goto out;
+            }
+            scale = best;
+        }
+        for (size_t r = 0; r < nr; r++) {
+            rs[r].x = rdim[2 * nr + r];
+            rs[r].y = rdim[3 * nr + r];
+            rs[r].w = rdim[r] * scale;
+            rs[r].h = rdim[nr + r] * scale;
+            rs[r].page = rpage[r];
+        }
+        for (size_t i = 0; i < nx; i++) {
+            const size_t t = xtri_of[i];
+            for (int k = 0; k < 6; k++) out->uv[6 * t + k] = xout[6 * i + k] / (float)size;
+            out->page[t] = xkey[n + i];
+        }
     }
     rep->regions = nr;
     rep->relaid = n_use > 0;
@@ -366,30 +417,6 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
             }
         }
     }
-    if (n_want && !(T > 0.0)) {
-        const ms_pack_rect *r = &rs[x_first];
-        const int side = (int)floor(fmin(r->w, r->h));
-        if (side < 1) { snprintf(err, errlen, "no room left in a %dx%d lightmap for the xatlas charts", size, size); goto out; }
-        if (ms_lightmap_unwrap(xtri, n, want, group, side, pad, 0.0f, p->tuning, xuv, NULL, &info, err, errlen)) goto out;
-        rep->charts = info.charts;
-        for (size_t t = 0; t < n; t++)
-            if (want[t])
-                for (int c = 0; c < 3; c++) {
-                    out->uv[6 * t + 2 * c] = (float)((r->x + xuv[6 * t + 2 * c] * side) / size);
-                    out->uv[6 * t + 2 * c + 1] = (float)((r->y + xuv[6 * t + 2 * c + 1] * side) / size);
-                }
-    } else if (n_want) {
-        const double side = size - 2.0 * pad;
-        for (size_t t = 0; t < n; t++)
-            if (want[t]) {
-                const ms_pack_rect *r = &rs[x_first + (int)xpage[t]];
-                out->page[t] = (uint32_t)r->page;
-                for (int c = 0; c < 3; c++) {
-                    out->uv[6 * t + 2 * c] = (float)((r->x + xuv[6 * t + 2 * c] * side) / size);
-                    out->uv[6 * t + 2 * c + 1] = (float)((r->y + xuv[6 * t + 2 * c + 1] * side) / size);
-                }
-            }
-    }
     if (rep->overlap_texels)
         ms_warn("%zu objects' UVs overlap each other (%zu texel centres covered twice): each object gets its own region "
                 "of the lightmap, its UVs scaled and offset (the baked UVs: ms_lightmap.uv, the glTF's TEXCOORD_1)",
@@ -408,5 +435,11 @@ out:
     free(scaled);
     free(xuv);
     free(rs);
+    free(rdim);
+    free(rpage);
+    free(xin);
+    free(xout);
+    free(xkey);
+    free(xtri_of);
     return rc;
 }
