@@ -110,8 +110,8 @@ int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
     xatlasComputeCharts(atlas, &co);
     xatlasPackOptions po;
     xatlasPackOptionsInit(&po);
-    po.resolution = (uint32_t)x->size;
-    po.padding = (uint32_t)x->pad;
+    po.resolution = x->grow ? 0 : (uint32_t)x->size;
+    po.padding = (uint32_t)(x->pad + 1) / 2;   /* xatlas pads each chart by this: two charts are twice it apart */
     po.texelsPerUnit = 1.0f;   /* UVs are texels already */
     po.bilinear = true;
     po.rotateCharts = false;
@@ -144,6 +144,24 @@ int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
         }
     }
     rc = (int)(atlas->atlasCount ? atlas->atlasCount : 1);
+    if (x->grow) {   /* one atlas of the size it took: moved to (pad, pad); 2 when it exceeds the page */
+        double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+        for (size_t i = 0; i < nr; i++) {
+            lo[0] = fmin(lo[0], x->rx[i]);
+            lo[1] = fmin(lo[1], x->ry[i]);
+            hi[0] = fmax(hi[0], x->rx[i] + x->rw[i] * s);
+            hi[1] = fmax(hi[1], x->ry[i] + x->rh[i] * s);
+        }
+        for (size_t i = 0; i < 6 * nt; i++) {
+            lo[i & 1] = fmin(lo[i & 1], x->out_uv[i]);
+            hi[i & 1] = fmax(hi[i & 1], x->out_uv[i]);
+        }
+        for (size_t i = 0; i < nr; i++) { x->rx[i] += x->pad - lo[0]; x->ry[i] += x->pad - lo[1]; x->rpage[i] = 0; }
+        for (size_t i = 0; i < 6 * nt; i++) x->out_uv[i] = (float)(x->out_uv[i] + x->pad - lo[i & 1]);
+        for (size_t t = 0; t < nt; t++) x->tpage[t] = 0;
+        x->extent = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+        rc = hi[0] - lo[0] + 2 * x->pad <= x->size && hi[1] - lo[1] + 2 * x->pad <= x->size ? 1 : 2;
+    }
 out:
     if (atlas) xatlasDestroy(atlas);
     free(ord);

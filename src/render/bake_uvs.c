@@ -268,12 +268,6 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     const float *xtri = weighted ? scaled : sc->tri;
     ms_unwrap_info info;
     memset(&info, 0, sizeof info);
-    if (!n_use && !(T > 0.0)) {   /* xatlas alone, over the whole lightmap */
-        if (ms_lightmap_unwrap(xtri, n, want, group, size, pad, 0.0f, p->tuning, out->uv, NULL, &info, err, errlen)) goto out;
-        rep->charts = info.charts;
-        rc = 0;
-        goto out;
-    }
     /* Regions: the file's layout as a whole when objects share one set and do not overlap, else one per
      * object with a layout; xatlas's square (one page) or its pages (a density). */
     int whole = !rep->overlap_texels && !weighted && !mixed;
@@ -354,19 +348,23 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
         for (size_t t = 0; t < n; t++) {
             if (!want[t] || !isfinite(xuv[6 * t])) continue;
             for (int k = 0; k < 6; k++) xin[6 * nx + k] = xuv[6 * t + k] * (float)res;
-            area += uv_area(xin + 6 * nx) / 0.7;   /* charts' boxes and padding */
+            area += uv_area(xin + 6 * nx) / 0.7;   /* charts' boxes */
             xkey[nx] = xpage[t];
             xtri_of[nx++] = t;
         }
-        ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n };
+        area += (double)info.charts * (2.0 * pad + 2.0) * (2.0 * pad + 2.0);   /* and their padding */
+        ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, !(T > 0.0), rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n, 0.0 };
         double scale = 1.0;
         if (T > 0.0) {
             const int pages = ms_xpack_run(&xp, 1.0, err, errlen);
             if (pages < 0) goto out;
             out->pages = pages;
         } else {   /* one page: step the scale up while it fits, down while it does not */
-            double best = 0.0, worst = INFINITY, sc_ = sqrt(0.8 * (double)res * res / fmax(area, 1e-30));
-            for (int it = 0; it < 20; it++) {   /* 8% steps until the scale is bracketed, then 3 bisections */
+            /* steps by the ratio of the page to the atlas's extent until the scale is bracketed, then bisection
+             * to 1% (the extent is not proportional to the scale: every chart brings its padding) */
+            const double target = size - 2.0 * pad;
+            double best = 0.0, worst = INFINITY, sc_ = sqrt(0.7 * target * target / fmax(area, 1e-30));
+            for (int it = 0; it < 30; it++) {
                 char e2[256];
                 const int fits = ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1;
                 if (fits) best = sc_;
@@ -374,8 +372,10 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
                 if (best > 0.0 && isfinite(worst)) {
                     if (worst / best < 1.01) break;
                     sc_ = sqrt(best * worst);
-                } else
-                    sc_ *= fits ? 1.08 : 0.92;
+                } else {
+                    const double r = xp.extent > 0.0 ? target / xp.extent : 0.5;
+                    sc_ *= fits ? fmin(1.5, fmax(1.02, r)) : fmax(0.5, fmin(0.98, r));
+                }
             }
             if (!(best > 0.0) || ms_xpack_run(&xp, best, err, errlen) != 1) {
                 snprintf(err, errlen, "the lightmap's regions and charts do not fit a %dx%d lightmap with %d texels of padding", size, size, pad);

@@ -141,7 +141,7 @@ int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const ui
         xatlasPackOptions po;
         xatlasPackOptionsInit(&po);
         po.resolution = (uint32_t)size;
-        po.padding = (uint32_t)padding;
+        po.padding = (uint32_t)(padding + 1) / 2;   /* xatlas pads each chart by this: two charts are twice it apart */
         po.texelsPerUnit = tpu;
         po.bilinear = true;
         xatlasPackCharts(atlas, &po);
