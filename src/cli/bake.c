@@ -23,8 +23,9 @@ static void usage(FILE *f)
         "SCENE): V and S per light and the irradiance summed over the lights, per texel of a UV set;\n"
         "triangles without that set get UVs from xatlas.\n"
         "\n"
-        "  --uv N              UV set to bake into: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1),\n"
-        "                      or 'xatlas' to unwrap every mesh\n"
+        "  --uv N              UV set tried first: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1); each\n"
+        "                      object keeps the first of its sets that is a valid layout (no overlap), xatlas\n"
+        "                      charts objects without one; or 'xatlas' to unwrap every mesh\n"
         "  --size N            lightmap width and height in texels (default 1024)\n"
         "  -o OUT.exr          channels R, G, B (irradiance), S and V (default lightmap.exr);\n"
         "                      several lights: S0, S1, ..., V0, V1, ... (one per light)\n"
@@ -301,8 +302,8 @@ int ms_cli_bake(int argc, char **argv)
         if (bo.no_seam_stitch) snprintf(stitched, sizeof stitched, "not stitched");
         else snprintf(stitched, sizeof stitched, "stitched: %zu texels in %.3fs", lm.stitched_texels, lm.stitch_s);
         char uvs[160], pages[200];
-        size_t kept = 0, charted = 0;
-        for (size_t o = 0; o < lm.n_objects; o++) { kept += lm.object_uv_set[o] >= 0; charted += lm.object_uv_set[o] == -1; }
+        size_t kept = 0;
+        for (size_t o = 0; o < lm.n_objects; o++) kept += lm.object_uv_set[o] >= 0;
         if (lm.uv_cached) snprintf(uvs, sizeof uvs, "UVs from %s in %.3fs", bo.uv_cache, lm.unwrap_s);
         else snprintf(uvs, sizeof uvs, "%zu objects in their own UVs, %zu triangles unwrapped by xatlas into %zu charts in %.3fs",
                       kept, lm.unwrapped_tris, lm.charts, lm.unwrap_s);
@@ -310,7 +311,6 @@ int ms_cli_bake(int argc, char **argv)
         for (int p = 0; p < lm.pages && lm.page_fill && at < (int)sizeof pages - 16; p++)
             at += snprintf(pages + at, sizeof pages - (size_t)at, "%s %.1f%%", p ? "," : "", 100.0 * lm.page_fill[p]);
         if (lm.pages > 12) snprintf(pages + at, sizeof pages - (size_t)at, " ...");
-        (void)charted;
         fprintf(stderr, "%s: %zu triangles (%s), %dx%d lightmap (%s), %zu texels on triangles "
                 "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
                 "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, p99 %.4f, max %.4f of the largest irradiance (%s) -> "
