@@ -2,9 +2,8 @@
  * charts keep their shape and their relative placement, as the file laid them out), so the packing is of
  * rectangles, unrotated. MaxRects with the best-short-side-fit rule (Jylänki, "A Thousand Ways to Pack the
  * Bin", 2010): every page keeps the maximal free rectangles, a region goes where it leaves the least slack
- * on its shorter side, over every open page, largest first. Shelves, which this replaced, left the width
- * beside a tall region empty: on the FlightHelmet a ground plane's square left a third of the page unused
- * (docs/notebook/2026-11-29-lightmap-charts.md). */
+ * on its shorter side, over every open page, largest first; shelves leave the width beside a tall region
+ * empty (docs/notebook/2026-11-29-lightmap-charts.md). */
 #include "atlas_pack.h"
 #include <math.h>
 #include <stdint.h>
@@ -83,8 +82,8 @@ int ms_pack_pages(ms_pack_rect *r, size_t n, double k, int size, int pad, int ma
     if (!order) goto out;
     for (size_t i = 0; i < n; i++) {
         order[i] = &r[i];
-        r[i].w = r[i].fixed ? r[i].w0 : k * r[i].w0;
-        r[i].h = r[i].fixed ? r[i].h0 : k * r[i].h0;
+        r[i].w = k * r[i].w0;
+        r[i].h = k * r[i].h0;
         if (r[i].w + 2 * pad > size || r[i].h + 2 * pad > size || !(r[i].w >= 0.0) || !(r[i].h >= 0.0)) goto out;
     }
     qsort(order, n, sizeof *order, cmp_area);
@@ -128,8 +127,7 @@ out:
 int ms_pack_one_page(ms_pack_rect *r, size_t n, int size, int pad)
 {
     double lo = 0.0, hi = 0.0;
-    for (size_t i = 0; i < n; i++)
-        if (!r[i].fixed) hi = fmax(hi, fmax(r[i].w0, r[i].h0));
+    for (size_t i = 0; i < n; i++) hi = fmax(hi, fmax(r[i].w0, r[i].h0));
     if (!(hi > 0.0)) return ms_pack_pages(r, n, 1.0, size, pad, 1) == 1 || n == 0 ? 0 : -1;
     hi = size / hi;
     for (int it = 0; it < 50; it++) {

@@ -1,11 +1,10 @@
-/* Rectangles (an object's UV layout, a page of xatlas charts) packed onto lightmap pages (atlas_pack.c). */
+/* Rectangles (the objects' UV layouts) packed onto lightmap pages (atlas_pack.c). */
 #ifndef MS_ATLAS_PACK_H
 #define MS_ATLAS_PACK_H
 #include <stddef.h>
 
 typedef struct ms_pack_rect {
     double w0, h0;   /* size at scale 1 (texels when the scale is 1) */
-    int fixed;       /* 1: not scaled (w0 x h0 texels whatever the scale) */
     /* out: where it went, in texels of its page */
     double x, y, w, h;
     int page;

@@ -7,13 +7,13 @@
  * The file's UVs are kept exactly when every object uses the same set, no two objects cover the same texel
  * centre, all lie in [0,1]^2, every mesh's texel-density weight is 1 and no density is asked for. Otherwise
  * every object with a layout (or the file's layout as a whole, when objects do not overlap) gets a
- * rectangle of its own, and xatlas charts the rest. Without a texel density everything shares one page:
- * a rectangle's area is proportional to the world area it carries times the square of its mesh's
- * "lightmap": {"scale": s}, divided by the fraction of its UV rectangle the charts cover, and the
- * rectangles are packed at the largest common scale that fits (bisection). With a density T each object
- * gets T texels per world unit (times s), xatlas packs its charts at T into pages of its own, and the
- * rectangles (objects, xatlas's pages) go onto as many pages as they need (atlas_pack.c). Never a silent
- * change: a warning says when and why the file's UVs were moved or not used. */
+ * rectangle of its own, and xatlas charts the rest. A rectangle's area is proportional to the world area it
+ * carries times the square of its mesh's "lightmap": {"scale": s}, divided by the fraction of its UV
+ * rectangle the charts cover, so that every object gets the same texels per world unit (times s); with a
+ * density T that is T texels per world unit. Rectangles alone are packed by atlas_pack.c; with xatlas
+ * charts, xatlas's packer places rectangles and charts together (atlas_xpack.c). Without a density
+ * everything shares one page at the largest scale that fits; with one, as many pages as it takes. Never a
+ * silent change: a warning says when and why the file's UVs were moved or not used. */
 #include "bake_uvs.h"
 #include "atlas_pack.h"
 #include "atlas_xpack.h"

@@ -1,6 +1,8 @@
 /* A UV set as one object's lightmap layout (uv_validity.h). A layout whose triangles overlap would bake two
- * surfaces into the same texels (tiling texture UVs, mirrored halves sharing one island), so such an
- * object is charted by xatlas instead. The overlap test bins the triangles' UV boxes into a uniform grid
+ * surfaces into the same texels (tiling texture UVs, mirrored halves sharing one island). A few overlapping
+ * triangles (a mirrored rivet on its twin's island) are charted apart and the rest of the layout kept; past
+ * 2% of the object's area the layout is dropped whole, as cutting islands apart adds seams (and at some
+ * point the charts are xatlas's anyway). The overlap test bins the triangles' UV boxes into a uniform grid
  * over the layout (about one triangle per cell) and tests the pairs that share a cell with the separating
  * axis theorem; triangles that only touch (a shared edge or vertex, or closer than the tolerance) are
  * apart. */
