@@ -803,7 +803,8 @@ static inline ms_status ms_visibility_points(const ms_accel *a, const ms_light *
 /* ---- Lightmap baking (docs/baking.md) ----
  *
  * Texel (x, y) of a size x size lightmap covers u in [x, x+1)/size and v in [y, y+1)/size of the UV set
- * baked into (row 0 at v = 0, the top of the image as glTF has it). Every texel a triangle's UV image
+ * baked into (row 0 at v = 0, the top of the image as glTF has it); page p of a paged lightmap is rows
+ * [p size, (p+1) size) of the frame, its texel (x, y) at row p size + y. Every texel a triangle's UV image
  * touches (conservative rasterization) is carried to the triangle's surface: its centre's barycentric
  * coordinates, moved to the nearest point of the triangle when the centre lies outside (a texel several
  * triangles touch takes the one containing its centre, else the nearest), give the world position; the
@@ -842,7 +843,8 @@ typedef struct ms_bake_options {
 } ms_bake_options;
 
 typedef struct ms_lightmap {
-    /* width = height = size; rgb: irradiance E (not radiance, summed over the lights), vis and shadow V
+    /* width = size, height = size * pages (one page: a square; "Pages" below); rgb: irradiance E (not
+     * radiance, summed over the lights), vis and shadow V
      * and S per light (-1 where neither a triangle nor dilation reached), front: the texel's front samples
      * per light (0 off the triangles);
      * exposure and stats as for frames (visible_pixels: texels on triangles). The ms_output writers and

@@ -200,12 +200,13 @@ static int dilate(ms_frame *f, int passes)
 
 /* The memory budget of a bake (budget.h) with its size and lights, building the accel here or not; the
  * estimate into *need when not NULL. */
-static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, int size, int build_accel, uint64_t *need,
-                             char *err, size_t errlen)
+static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, int size, int pages, int build_accel,
+                             uint64_t *need, char *err, size_t errlen)
 {
     ms_bake_shape bs;
     memset(&bs, 0, sizeof bs);
     bs.size = size;
+    bs.pages = pages;
     ms_scene_lights(scene, &bs.nl);
     bs.n_tris = scene->n_tris;
     bs.build_accel = build_accel;
@@ -243,11 +244,12 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
         snprintf(err, errlen, "UV set must be in [0, %d], or -1 for xatlas", MS_MAX_UV_SETS - 1);
         return MS_ERR_INVALID;
     }
-    ms_status bst = bake_budget(scene, o, size, 0, NULL, err, errlen);
+    ms_status bst = bake_budget(scene, o, size, 1, 0, NULL, err, errlen);
     if (bst) return bst;
     const int padding = o->padding > 0 ? o->padding : 4;
     ms_status st = ms_bake_choose_uvs(scene, o, size, padding, out, err, errlen);
     if (!st && o->pass) o->pass(o->pass_user, out->uv_cached ? "UVs (from the cache)" : "UVs", out->unwrap_s);
+    if (!st && out->pages > 1) st = bake_budget(scene, o, size, out->pages, 0, NULL, err, errlen);   /* known now */
     const int height = st ? size : size * out->pages;
     float *frame_uv = st ? NULL : ms_bake_frame_uv(out);
     if (!st && !frame_uv) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", scene->n_tris); st = MS_ERR_NO_MEMORY; }
@@ -537,7 +539,7 @@ ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_accel *
     uint64_t need = 0;
     if (scene && (scene->tri || !scene->n_tris) && size >= 1 && size <= MS_MAX_IMAGE_SIZE && o->uv_set >= -1 &&
         o->uv_set < MS_MAX_UV_SETS) {   /* with the accel built here; ms_bake_layout checks the rest */
-        ms_status bst = bake_budget(scene, o, size, !accel, &need, err, errlen);
+        ms_status bst = bake_budget(scene, o, size, 1, !accel, &need, err, errlen);
         if (bst) return bst;
     }
     ms_status st = ms_bake_layout(scene, opt_in, out, err, errlen);
