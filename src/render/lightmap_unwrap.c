@@ -102,6 +102,13 @@ int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const ui
     seg[ng] = nw;
     vbase[ng] = nv;
     free(slot);
+    /* xatlas drops triangles of area <= FLT_EPSILON in its units: on a small asset (the FlightHelmet is 0.6 m
+     * tall) that is every triangle under half a millimetre. Positions are scaled by a power of two (exact:
+     * welded vertices stay equal) so that the wanted triangles span about 1024 units; densities follow. */
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t v = 0; v < 3 * nv; v++) { lo = fmin(lo, pos[v]); hi = fmax(hi, pos[v]); }
+    const double g = hi > lo ? ldexp(1.0, (int)floor(log2(1024.0 / (hi - lo)))) : 1.0;
+    for (size_t v = 0; v < 3 * nv; v++) pos[v] = (float)(pos[v] * g);
 
     int rc = -1, told = 0;
     xatlasAtlas *atlas = xatlasCreate();
@@ -136,7 +143,7 @@ int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const ui
     co.maxCost = tu.max_cost;
     co.maxIterations = tu.max_iterations;
     xatlasComputeCharts(atlas, &co);
-    float tpu = density;   /* 0: xatlas estimates it from the resolution */
+    float tpu = (float)(density / g);   /* in xatlas's units; 0: xatlas estimates it from the resolution */
     for (int attempt = 0; attempt < 12; attempt++) {
         xatlasPackOptions po;
         xatlasPackOptionsInit(&po);
@@ -171,7 +178,7 @@ int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const ui
         }
         info->charts = atlas->chartCount;
         info->atlases = atlas->atlasCount;
-        info->texels_per_unit = atlas->texelsPerUnit;
+        info->texels_per_unit = (float)(atlas->texelsPerUnit * g);
         rc = 0;
         break;
     }
