@@ -364,10 +364,20 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
              * to 1% (the extent is not proportional to the scale: every chart brings its padding) */
             const double target = size - 2.0 * pad;
             double best = 0.0, worst = INFINITY, sc_ = sqrt(0.7 * target * target / fmax(area, 1e-30));
+            int best_grow = 1;
             for (int it = 0; it < 30; it++) {
+                /* the growing atlas stays square-ish, which may stack two wide regions and leave a strip; a
+                 * page of its own size, placed by random probes, may put them side by side: either will do */
                 char e2[256];
-                const int fits = ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1;
-                if (fits) best = sc_;
+                xp.grow = 1;
+                const double extent = (ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1) ? 0.0 : xp.extent;
+                int fits = extent == 0.0;
+                if (!fits) {
+                    xp.grow = 0;
+                    fits = ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1;
+                    xp.extent = extent;
+                }
+                if (fits) { best = sc_; best_grow = xp.grow; }
                 else worst = fmin(worst, sc_);
                 if (best > 0.0 && isfinite(worst)) {
                     if (worst / best < 1.01) break;
@@ -377,6 +387,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
                     sc_ *= fits ? fmin(1.5, fmax(1.02, r)) : fmax(0.5, fmin(0.98, r));
                 }
             }
+            xp.grow = best_grow;
             if (!(best > 0.0) || ms_xpack_run(&xp, best, err, errlen) != 1) {
                 snprintf(err, errlen, "the lightmap's regions and charts do not fit a %dx%d lightmap with %d texels of padding", size, size, pad);
                 goto out;
