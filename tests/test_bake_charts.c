@@ -11,7 +11,8 @@
  *     lm.1.exr;
  *   - the unwrap cache: a re-bake with another light takes the same UVs byte for byte, nothing unwrapped;
  *   - a cache of other geometry, a truncated one and one that is no cache are not used, each with one
- *     warning naming the file and the reason. */
+ *     warning naming the file and the reason;
+ *   - a 2 mm plate of triangles far under xatlas's area epsilon gets UVs for every triangle. */
 #include "testutil.h"
 #include "glb_read.h"
 #include <math.h>
@@ -451,10 +452,50 @@ static void test_uv_cache(void **st)
     ms_scene_free(&sc);
 }
 
+/* ---- tiny triangles: xatlas drops faces of area <= FLT_EPSILON in its units ---- */
+
+static void test_tiny_triangles(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_charts_tiny");
+    char path[512], json[512], text[1024], err[512] = "";
+    /* a 2 mm plate of 16 x 16 quads (triangle areas 3.9e-9, far under FLT_EPSILON) without UVs */
+    enum { Q = 16 };
+    static float p[Q * Q][4][3];
+    for (int i = 0; i < Q; i++)
+        for (int j = 0; j < Q; j++) {
+            const float h = 0.002f / Q;
+            flat(p[i * Q + j], i * h, (i + 1) * h, j * h, (j + 1) * h, 0.0f);
+        }
+    write_quads(tu_path(path, sizeof path, dir, "tiny.obj"), Q * Q, (const float (*)[4][3])p, NULL);
+    snprintf(text, sizeof text,
+             "{\"meshes\":[{\"file\":\"tiny.obj\"}],"
+             "\"camera\":{\"eye\":[0.001,0.01,0.001],\"target\":[0.001,0,0.001],\"up\":[0,0,-1],\"fov_y\":60,\"width\":32,\"height\":32},"
+             "\"light\":{\"corner\":[0,0.01,0],\"edge_s\":[0.002,0,0],\"edge_t\":[0,0,0.002]}}");
+    tu_path(json, sizeof json, dir, "tiny.json");
+    assert_int_equal(tu_write_file(json, text), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    assert_int_equal(sc.n_tris, 2 * Q * Q);
+    ms_bake_options bo;
+    bake_opts(&bo, 128);
+    bo.uv_set = -1;
+    ms_lightmap lm;
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    size_t with = 0;
+    for (size_t t = 0; t < sc.n_tris; t++) with += isfinite(lm.uv[6 * t]) && isfinite(lm.uv[6 * t + 5]);
+    printf("tiny plate: %zu of %zu triangles with UVs, %zu texels\n", with, sc.n_tris, lm.texels);
+    assert_int_equal(with, sc.n_tris);
+    assert_true(lm.texels > 1000);
+    ms_lightmap_free(&lm);
+    ms_scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_keep_and_chart),
+        cmocka_unit_test(test_tiny_triangles),
         cmocka_unit_test(test_pages),
         cmocka_unit_test(test_uv_cache),
     };
