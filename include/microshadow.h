@@ -695,7 +695,7 @@ typedef struct ms_output {
     ms_output_write_fn write;     /* one of the writers below, or the caller's own */
     const char *const *suffixes;  /* NULL-terminated accepted endings (case-insensitive), or NULL: any */
 } ms_output;
-#define MS_MAX_OUTPUTS 8
+#define MS_MAX_OUTPUTS 64   /* a paged lightmap writes each output once per page */
 MS_API ms_status ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
 /* Before writing anything it checks the frame (ms_frame_check_finite): a NaN or infinite value is an error
  * naming the first output's path and the pixel, and no file is written. */
@@ -812,7 +812,8 @@ static inline ms_status ms_visibility_points(const ms_accel *a, const ms_light *
 /* ---- Lightmap baking (docs/baking.md) ----
  *
  * Texel (x, y) of a size x size lightmap covers u in [x, x+1)/size and v in [y, y+1)/size of the UV set
- * baked into (row 0 at v = 0, the top of the image as glTF has it). Every texel a triangle's UV image
+ * baked into (row 0 at v = 0, the top of the image as glTF has it); page p of a paged lightmap is rows
+ * [p size, (p+1) size) of the frame, its texel (x, y) at row p size + y. Every texel a triangle's UV image
  * touches (conservative rasterization) is carried to the triangle's surface: its centre's barycentric
  * coordinates, moved to the nearest point of the triangle when the centre lies outside (a texel several
  * triangles touch takes the one containing its centre, else the nearest), give the world position; the
@@ -832,19 +833,29 @@ typedef void (*ms_bake_pass_fn)(void *user, const char *pass, double seconds);
 typedef struct ms_bake_options {
     ms_points_options points;  /* method, pattern, samples, threads, seed, isa, progress; zero: defaults */
     int size;                  /* texels per side; 0: 1024 (at most MS_MAX_IMAGE_SIZE) */
-    int uv_set;                /* the scene's UV set baked into (0 .. MS_MAX_UV_SETS-1); triangles whose mesh
-                                * lacks it are unwrapped by xatlas into the free space of one atlas with
-                                * them (all of them if no mesh has the set); -1: xatlas for every triangle */
+    int uv_set;                /* the UV set tried first (0 .. MS_MAX_UV_SETS-1): per object, the first of
+                                * this set and then the others in order that is a valid layout (on every
+                                * triangle, with area, no overlap) is kept in a region of its own; objects
+                                * without one are charted by xatlas (docs/baking.md, "Charts"); -1: xatlas
+                                * for every triangle */
     int dilate;                /* texels of dilation; 0: 4; -1: none */
     int padding;               /* texels between charts (xatlas's and the lightmap's regions); 0: 4 */
     int no_leak_fix;           /* 1: texels inside geometry keep their points (docs/baking.md, "Quality"); 0: moved */
     ms_bake_pass_fn pass;      /* may be NULL */
     void *pass_user;
     int no_seam_stitch;        /* 1: the seams keep the baked texels; 0: stitched (docs/baking.md, "Seams") */
+    float texel_density;       /* texels per world unit (times each mesh's "lightmap" scale) on as many size x size
+                                * pages as it takes (ms_lightmap.pages); 0: everything on one page, at the
+                                * largest density that fits */
+    const char *uv_cache;      /* a UV cache file (ms_bake_write_uv_cache) to take the UVs from when it was
+                                * made for this scene's geometry and these UV options (no unwrap); one that
+                                * was not is not used, with a warning; a missing file is not an error. NULL:
+                                * none (docs/baking.md, "The unwrap cache") */
 } ms_bake_options;
 
 typedef struct ms_lightmap {
-    /* width = height = size; rgb: irradiance E (not radiance, summed over the lights), vis and shadow V
+    /* width = size, height = size * pages (one page: a square; "Pages" below); rgb: irradiance E (not
+     * radiance, summed over the lights), vis and shadow V
      * and S per light (-1 where neither a triangle nor dilation reached), front: the texel's front samples
      * per light (0 off the triangles);
      * exposure and stats as for frames (visible_pixels: texels on triangles). The ms_output writers and
@@ -873,9 +884,23 @@ typedef struct ms_lightmap {
     double stitch_s;           /* seconds stitching */
     /* Triangles left out of the lightmap (ms_bake_layout): excluded_tris of meshes with "lightmap": false (as
      * asked: reported, not warned about); unbaked_tris for any other reason - no area, no UVs (xatlas leaves out
-     * triangles of area at most FLT_EPSILON), UVs without area or outside the lightmap - each reason a warning
+     * triangles of area at most FLT_EPSILON once the scene's extent is scaled to about 1024 units), UVs without area or outside the lightmap - each reason a warning
      * with its count (ms_set_warning_handler). The glb names their primitives and materials after the reason. */
     size_t excluded_tris, unbaked_tris;
+    /* Pages (docs/baking.md, "Texel density and pages"): the frame holds them stacked, width size, height
+     * size * pages, page p in rows [p * size, (p + 1) * size); uv is in [0,1]^2 of the triangle's page. */
+    int pages;
+    uint32_t *page;            /* per scene triangle: its page */
+    double *page_fill;         /* per page: the fraction of its texels whose centre lies on a triangle */
+    /* Per object (ms_scene.tri_object; else per mesh): the UV set its layout was kept from (-1: xatlas
+     * charted it, -2: not baked) and, for a kept layout, its scale and offset (uv = file uv * (su, sv) +
+     * (ou, ov), 4 floats: su, sv, ou, ov; 0 for xatlas's). */
+    size_t n_objects;
+    int *object_uv_set;
+    float *object_scale_offset;
+    size_t charts;             /* charts xatlas made (0: none, or the UVs came from the cache) */
+    int uv_cached;             /* 1: the UVs came from ms_bake_options.uv_cache, nothing was unwrapped */
+    uint64_t uv_key;           /* the hash of what the UVs depend on (geometry, UV sets, scales, UV options) */
 } ms_lightmap;
 
 /* Bakes the scene's lights into a lightmap: V, S and front per light (frame.n_lights planes, light l at
@@ -903,6 +928,12 @@ MS_API ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt,
 /* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
  * image fields; total_s: the sum of the parts' seconds. */
 MS_API ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
+
+/* The UV cache of a bake (docs/baking.md, "The unwrap cache"): lm's key, UVs, pages and per-object sets and
+ * scale-offsets, which a later bake of the same geometry with the same UV options (lights, samples and
+ * methods may differ) reads through ms_bake_options.uv_cache instead of unwrapping. An ms_output-style
+ * writer; name is for messages. */
+static inline ms_status ms_bake_write_uv_cache(const ms_lightmap *lm, FILE *out, const char *name, char *err, size_t errlen);
 
 /* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
  * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
@@ -952,7 +983,7 @@ static inline ms_status ms_bake_write_gltf(const ms_scene *scene, const ms_light
  *
  * Each checked entry point above (ms_scene_load, ms_scene_load_ex, ms_scene_default, ms_scene_showcase,
  * ms_render, ms_render_outputs, ms_frame_job_create, ms_accel_build, ms_visibility_points, ms_bake,
- * ms_bake_layout, ms_bake_gltf, ms_bake_write_gltf) is an inline function that hands the library the size of
+ * ms_bake_layout, ms_bake_gltf, ms_bake_write_gltf, ms_bake_write_uv_cache) is an inline function that hands the library the size of
  * every public struct as the program was compiled (ms_abi_compiled), and the library compares them with its own
  * before it reads or writes any: a program built against another microshadow header - a static library or a
  * shared one from another version, a binding's mirror gone stale - gets MS_ERR_INVALID and one line naming the
@@ -1004,6 +1035,8 @@ MS_API ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_
                              ms_lightmap *out, char *err, size_t errlen);
 MS_API ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_bake_options *opt,
                                     ms_lightmap *out, char *err, size_t errlen);
+MS_API ms_status ms_bake_write_uv_cache_abi(const ms_abi *abi, const ms_lightmap *lm, FILE *out, const char *name, char *err,
+                                            size_t errlen);
 MS_API ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *scene, const ms_lightmap *lm,
                                   const ms_bake_gltf_options *opt, unsigned char **glb, size_t *len, char *err,
                                   size_t errlen);
@@ -1038,6 +1071,8 @@ static inline ms_status ms_bake(const ms_scene *scene, const ms_accel *accel, co
 static inline ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *out, char *err,
                                        size_t errlen)
 { return ms_bake_layout_abi(ms_abi_compiled(), scene, opt, out, err, errlen); }
+static inline ms_status ms_bake_write_uv_cache(const ms_lightmap *lm, FILE *out, const char *name, char *err, size_t errlen)
+{ return ms_bake_write_uv_cache_abi(ms_abi_compiled(), lm, out, name, err, errlen); }
 static inline ms_status ms_bake_gltf(const ms_scene *scene, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
                                      unsigned char **glb, size_t *len, char *err, size_t errlen)
 { return ms_bake_gltf_abi(ms_abi_compiled(), scene, lm, opt, glb, len, err, errlen); }

@@ -458,8 +458,8 @@ static int unbaked_primitive(const tu_glb *g, const char *name, char *material, 
     return -1;
 }
 
-/* Every triangle baked or named: a ground, a crumb of area 1e-8 (below xatlas's FLT_EPSILON: it charts it
- * not), a triangle without area, a box with "lightmap": false. The bake warns once per reason with its
+/* Every triangle baked or named: a ground, a crumb of area 2e-14 (below xatlas's FLT_EPSILON even after the
+ * unwrap scales the scene's extent to about 1024 units: it charts it not), a triangle without area, a box with "lightmap": false. The bake warns once per reason with its
  * count (not for "lightmap": false, which it counts), the glb names the primitives and materials, and the
  * CLI says the same on stderr. */
 static void test_unbaked_named(void **st)
@@ -469,7 +469,7 @@ static void test_unbaked_named(void **st)
     char p[1024], json[1024], glb[1024], exr[1024], err[512] = "";
     assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "ground.obj"), "v -2 0 -2\nv -2 0 2\nv 2 0 2\nv 2 0 -2\nf 1 2 3 4\n"), 0);
     assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "bits.obj"),
-        "v 0 0.5 0\nv 0.0001 0.5 0\nv 0 0.5 0.0002\nv 1 1 1\nv 1.5 1 1\nv 2 1 1\nf 1 2 3\nf 4 5 6\n"), 0);
+        "v 0 0.5 0\nv 0.0000002 0.5 0\nv 0 0.5 0.0000002\nv 1 1 1\nv 1.5 1 1\nv 2 1 1\nf 1 2 3\nf 4 5 6\n"), 0);
     assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "box.obj"),
         "v 0.5 0 -0.5\nv 1.5 0 -0.5\nv 1.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 -0.5\nv 1.5 1 -0.5\nv 1.5 1 0.5\nv 0.5 1 0.5\n"
         "f 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"), 0);

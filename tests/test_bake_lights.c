@@ -136,7 +136,7 @@ static void sphere_every_method(ms_light sph, int want_inside)
 {
     ms_scene sc;
     quad_with(&sc, &sph, 1);
-    const int size = 40;
+    const int size = 56;   /* enough occluder texels inside the cutting sphere (more than 10) in xatlas's layout */
     const size_t nt = (size_t)size * size;
     char err[512];
     ms_bake_options bo;

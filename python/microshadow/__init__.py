@@ -150,9 +150,13 @@ _PointsOptions = _mirror("ms_points_options", [
 _Lightmap = _mirror("ms_lightmap", [
     ("frame", _Frame), ("position", ctypes.POINTER(_f)), ("normal", ctypes.POINTER(_f)),
     ("triangle", ctypes.POINTER(ctypes.c_uint32)), ("uv", ctypes.POINTER(_f)), ("n_tris", _size), ("texels", _size),
-    ("unwrapped_tris", _size), ("unwrap_s", ctypes.c_double), ("raster_s", ctypes.c_double)])
+    ("unwrapped_tris", _size), ("unwrap_s", ctypes.c_double), ("raster_s", ctypes.c_double),
+    ("pages", ctypes.c_int), ("page", ctypes.POINTER(ctypes.c_uint32)), ("page_fill", ctypes.POINTER(ctypes.c_double)),
+    ("n_objects", _size), ("object_uv_set", ctypes.POINTER(ctypes.c_int)), ("object_scale_offset", ctypes.POINTER(_f)),
+    ("charts", _size), ("uv_cached", ctypes.c_int)])
 _BakeOptions = _mirror("ms_bake_options", [("points", _PointsOptions), ("size", ctypes.c_int), ("uv_set", ctypes.c_int),
-                                           ("dilate", ctypes.c_int), ("padding", ctypes.c_int)])
+                                           ("dilate", ctypes.c_int), ("padding", ctypes.c_int), ("texel_density", _f),
+                                           ("uv_cache", ctypes.c_char_p)])
 
 _ERR = ctypes.c_char_p
 
@@ -587,13 +591,16 @@ def light_irradiance(light, point, normal):
 
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
-         dilate=4, padding=4, accel=None, progress=None, max_memory=0):
+         dilate=4, padding=4, accel=None, progress=None, max_memory=0, texel_density=0.0, uv_cache=None):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
     (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off
     the triangles; position in the scene's frame: add scene.origin for world coordinates), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked
     into, lights: one dict per light with its vis, shadow and front, and counts and timings. uv: the UV
     set (0..3) or None for xatlas everywhere; dilate 0: none; progress: fn(fraction) -> truthy to cancel
-    (Error with status 3)."""
+    (Error with status 3). texel_density: texels per world unit on as many pages as it takes (the images
+    then hold the pages stacked: (size * pages, size), page p in rows p*size..; "page" the page of each
+    triangle, "page_fill" each page's fraction of texel centres on triangles); uv_cache: a UV cache file
+    to take the UVs from when it matches (docs/baking.md)."""
     if not isinstance(scene, Scene):
         raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
     if accel is not None and not isinstance(accel, Accel):
@@ -611,22 +618,31 @@ def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed
     o.uv_set = -1 if uv is None else int(uv)
     o.dilate = -1 if dilate == 0 else int(dilate)
     o.padding = int(padding)
+    o.texel_density = float(texel_density)
+    cache = os.fsencode(uv_cache) if uv_cache is not None else None
+    o.uv_cache = cache
     lm, err = _Lightmap(), _errbuf()
     st = _bake(ctypes.byref(scene._s), accel._h if accel is not None else None, ctypes.byref(o), ctypes.byref(lm),
                err, len(err))
     if st != 0:
         raise Error(st, err.value.decode(errors="replace"))
     try:
-        n, nl = lm.frame.width, max(1, lm.frame.n_lights)
+        n, h, nl = lm.frame.width, lm.frame.height, max(1, lm.frame.n_lights)
         a = np.ctypeslib.as_array
-        vis, shadow, front = (_planes(p, nl, n, n) for p in (lm.frame.vis, lm.frame.shadow, lm.frame.front))
+        vis, shadow, front = (_planes(p, nl, h, n) for p in (lm.frame.vis, lm.frame.shadow, lm.frame.front))
         out = {
-            "irradiance": a(lm.frame.rgb, shape=(n, n, 3)).copy(),
+            "irradiance": a(lm.frame.rgb, shape=(h, n, 3)).copy(),
             "vis": vis[0], "shadow": shadow[0], "front": front[0],
             "lights": [{"vis": vis[l], "shadow": shadow[l], "front": front[l]} for l in range(nl)],
-            "position": a(lm.position, shape=(n, n, 3)).copy(),
-            "normal": a(lm.normal, shape=(n, n, 3)).copy(),
-            "triangle": a(lm.triangle, shape=(n, n)).copy(),
+            "position": a(lm.position, shape=(h, n, 3)).copy(),
+            "normal": a(lm.normal, shape=(h, n, 3)).copy(),
+            "triangle": a(lm.triangle, shape=(h, n)).copy(),
+            "pages": int(lm.pages),
+            "page": a(lm.page, shape=(lm.n_tris,)).copy() if lm.n_tris else np.zeros(0, np.uint32),
+            "page_fill": [float(lm.page_fill[p]) for p in range(lm.pages)] if lm.page_fill else [],
+            "object_uv_set": [int(lm.object_uv_set[o]) for o in range(lm.n_objects)],
+            "charts": int(lm.charts),
+            "uv_cached": bool(lm.uv_cached),
             "uv": a(lm.uv, shape=(lm.n_tris, 3, 2)).copy() if lm.n_tris else np.zeros((0, 3, 2), np.float32),
             "texels": int(lm.texels),
             "unwrapped_triangles": int(lm.unwrapped_tris),

@@ -3,6 +3,7 @@
  * (ms_outputs_*). */
 #include "microshadow.h"
 #include "bake.h"
+#include "bake_pages_out.h"
 #include "options.h"
 #ifdef MS_HAVE_MPI
 #include "mpi_run.h"
@@ -22,8 +23,9 @@ static void usage(FILE *f)
         "SCENE): V and S per light and the irradiance summed over the lights, per texel of a UV set;\n"
         "triangles without that set get UVs from xatlas.\n"
         "\n"
-        "  --uv N              UV set to bake into: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1),\n"
-        "                      or 'xatlas' to unwrap every mesh\n"
+        "  --uv N              UV set tried first: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1); each\n"
+        "                      object keeps the first of its sets that is a valid layout (no overlap), xatlas\n"
+        "                      charts objects without one; or 'xatlas' to unwrap every mesh\n"
         "  --size N            lightmap width and height in texels (default 1024)\n"
         "  -o OUT.exr          channels R, G, B (irradiance), S and V (default lightmap.exr);\n"
         "                      several lights: S0, S1, ..., V0, V1, ... (one per light)\n"
@@ -37,6 +39,13 @@ static void usage(FILE *f)
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
         "  --padding N         texels between charts and regions (default 4)\n"
         "  --no-leak-fix       keep the points of texels whose centre lies inside geometry\n"
+        "  --texel-density T   texels per world unit (times each mesh's \"lightmap\" scale), on as many\n"
+        "                      --size pages as it takes: page p > 0 of each image output is written with .p\n"
+        "                      before its ending (lightmap.exr, lightmap.1.exr, ...); default: one page\n"
+        "  --uv-cache FILE     the unwrap cache: its UVs are used when it was made for this geometry and these\n"
+        "                      UV options (no unwrap; other lights and samples are fine), and it is written\n"
+        "                      with the outputs (default: the -o path with .uvcache for .exr)\n"
+        "  --no-uv-cache       neither read nor write an unwrap cache\n"
         "  --no-seam-stitch    keep the baked texels along UV seams (default: stitched by least squares so that\n"
         "                      bilinear lookups from both sides of a seam on a smooth surface agree)\n"
         "  --method M, --pattern P, --samples N, --seed S, --threads T, --isa I, --max-memory SIZE   as for frames\n"
@@ -93,7 +102,7 @@ int ms_cli_bake(int argc, char **argv)
 {
     enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
            O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX,
-           O_NO_SEAM_STITCH };
+           O_NO_SEAM_STITCH, O_TEXEL_DENSITY, O_UV_CACHE, O_NO_UV_CACHE };
     static const struct option longopts[] = {
         { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
         { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -106,6 +115,8 @@ int ms_cli_bake(int argc, char **argv)
         { "verbose", no_argument, 0, O_VERBOSE }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
         { "gltf", required_argument, 0, O_GLTF }, { "no-leak-fix", no_argument, 0, O_NO_LEAK_FIX },
         { "no-seam-stitch", no_argument, 0, O_NO_SEAM_STITCH },
+        { "texel-density", required_argument, 0, O_TEXEL_DENSITY }, { "uv-cache", required_argument, 0, O_UV_CACHE },
+        { "no-uv-cache", no_argument, 0, O_NO_UV_CACHE },
 #ifdef MS_HAVE_MPI
         { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -125,8 +136,12 @@ int ms_cli_bake(int argc, char **argv)
         { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
         { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
         { "--gltf", NULL, write_glb, glb_suffix },   /* g_glb: made by ms_bake_gltf after the bake */
+        { "--uv-cache", NULL, ms_bake_uv_cache_write, NULL },
+        [7] = { NULL, NULL, NULL, NULL }, [MS_MAX_OUTPUTS - 1] = { NULL, NULL, NULL, NULL },   /* room for pages */
     };
-    enum { N_OUTS = sizeof outs / sizeof outs[0] };
+    enum { N_OUTS = 7 };
+    int n_outs = N_OUTS, no_uv_cache = 0;
+    char *uv_cache_default = NULL;
     ms_bake_options bo;
     memset(&bo, 0, sizeof bo);
     bo.uv_set = 1;
@@ -175,6 +190,19 @@ int ms_cli_bake(int argc, char **argv)
         case O_GLTF: outs[5].path = optarg; break;
         case O_NO_LEAK_FIX: bo.no_leak_fix = 1; break;
         case O_NO_SEAM_STITCH: bo.no_seam_stitch = 1; break;
+        case O_TEXEL_DENSITY: {
+            char *end;
+            errno = 0;
+            const double d = strtod(optarg, &end);
+            if (errno || end == optarg || *end || !(d > 0.0) || d > 1e9) {
+                fprintf(stderr, "microshadow bake: --texel-density: '%s' is not a number of texels per world unit in (0, 1e9]\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
+            bo.texel_density = (float)d;
+            break;
+        }
+        case O_UV_CACHE: outs[6].path = optarg; break;
+        case O_NO_UV_CACHE: no_uv_cache = 1; break;
         case O_QUIET: quiet = 1; break;
         case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &bo.points.max_memory)) return EXIT_BAD_INPUT; break;
         case O_VERBOSE: ms_set_warning_verbose(1); break;
@@ -197,11 +225,21 @@ int ms_cli_bake(int argc, char **argv)
     if (ms_cli_check_method(&cli, method)) return EXIT_BAD_INPUT;
     char err[1024];
     ms_outputs_cleanup_on_signals();
-    if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) { fprintf(stderr, "microshadow bake: %s\n", err); return EXIT_BAD_INPUT; }
+    if (no_uv_cache) outs[6].path = NULL;
+    else if (!outs[6].path) {   /* the cache beside the lightmap, where a re-bake of the same command finds it */
+        if (!(uv_cache_default = ms_bake_uv_cache_default(outs[0].path))) { fprintf(stderr, "microshadow bake: out of memory\n"); return EXIT_NO_MEMORY; }
+        outs[6].path = uv_cache_default;
+    }
+    bo.uv_cache = outs[6].path;
+    if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) {
+        fprintf(stderr, "microshadow bake: %s\n", err);
+        free(uv_cache_default);
+        return EXIT_BAD_INPUT;
+    }
     ms_scene scene;
     if (scene_path) {
         const ms_status lst = ms_scene_load(scene_path, &scene, err, sizeof err);
-        if (lst) { fprintf(stderr, "microshadow bake: %s\n", err); return ms_cli_exit_code(lst); }
+        if (lst) { fprintf(stderr, "microshadow bake: %s\n", err); free(uv_cache_default); return ms_cli_exit_code(lst); }
     } else if (ms_scene_default(&scene)) {
         fprintf(stderr, "microshadow bake: out of memory building the built-in scene\n");
         return EXIT_NO_MEMORY;
@@ -216,6 +254,7 @@ int ms_cli_bake(int argc, char **argv)
         const int mrc = ms_mpi_bake(&scene, scene_path ? scene_path : "built-in scene", &bo, schedule, chunk, &lm, err, sizeof err);
         if (mrc || ms_mpi_rank() != 0) {
             ms_scene_free(&scene);
+    free(uv_cache_default);
             return mrc ? EXIT_BAD_INPUT : 0;
         }
     } else
@@ -232,6 +271,7 @@ int ms_cli_bake(int argc, char **argv)
     if (st) {
         fprintf(stderr, "microshadow bake: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
         ms_scene_free(&scene);
+    free(uv_cache_default);
         return ms_cli_exit_code(st);
     }
     unsigned char *glb = NULL;
@@ -244,10 +284,16 @@ int ms_cli_bake(int argc, char **argv)
         }
         g_glb = glb;
     }
+    ms_bake_uv_cache_source(&lm);
+    if (!rc && (ms_bake_pages_out(&lm, outs, &n_outs, err, sizeof err) || ms_outputs_check(outs, n_outs, err, sizeof err))) {
+        fprintf(stderr, "microshadow bake: %s\n", err);
+        rc = EXIT_BAD_INPUT;
+    }
     if (!rc) {
-        rc = ms_cli_exit_code(ms_outputs_write(&lm.frame, outs, N_OUTS, err, sizeof err));
+        rc = ms_cli_exit_code(ms_outputs_write(&lm.frame, outs, n_outs, err, sizeof err));
         if (rc) fprintf(stderr, "microshadow bake: %s\n", err);
     }
+    ms_bake_pages_out_free();
     free(glb);
     if (!quiet && !rc) {
         const ms_stats *s = &lm.frame.stats;
@@ -258,16 +304,26 @@ int ms_cli_bake(int argc, char **argv)
         if (lm.excluded_tris || lm.unbaked_tris)   /* each reason other than "lightmap": false was a warning */
             fprintf(stderr, "bake: %zu triangles not baked: %zu of meshes with \"lightmap\": false, %zu for the reasons "
                     "warned about\n", lm.excluded_tris + lm.unbaked_tris, lm.excluded_tris, lm.unbaked_tris);
-        fprintf(stderr, "%s: %zu triangles (%zu unwrapped by xatlas in %.3fs), %dx%d lightmap, %zu texels on triangles "
+        char uvs[160], pages[200];
+        size_t kept = 0;
+        for (size_t o = 0; o < lm.n_objects; o++) kept += lm.object_uv_set[o] >= 0;
+        if (lm.uv_cached) snprintf(uvs, sizeof uvs, "UVs from %s in %.3fs", bo.uv_cache, lm.unwrap_s);
+        else snprintf(uvs, sizeof uvs, "%zu objects in their own UVs, %zu triangles unwrapped by xatlas into %zu charts in %.3fs",
+                      kept, lm.unwrapped_tris, lm.charts, lm.unwrap_s);
+        int at = snprintf(pages, sizeof pages, "%d page%s, texel centres on triangles", lm.pages, lm.pages > 1 ? "s" : "");
+        for (int p = 0; p < lm.pages && lm.page_fill && at < (int)sizeof pages - 16; p++)
+            at += snprintf(pages + at, sizeof pages - (size_t)at, "%s %.1f%%", p ? "," : "", 100.0 * lm.page_fill[p]);
+        if (lm.pages > 12) snprintf(pages + at, sizeof pages - (size_t)at, " ...");
+        fprintf(stderr, "%s: %zu triangles (%s), %dx%d lightmap (%s), %zu texels on triangles "
                 "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
                 "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, p99 %.4f, max %.4f of the largest irradiance (%s) -> "
                 "%s%s%s\n",
-                scene_path ? scene_path : "built-in scene", s->triangles, lm.unwrapped_tris, lm.unwrap_s, lm.frame.width,
-                lm.frame.height, lm.texels, lm.raster_s, lm.texels_moved, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads,
+                scene_path ? scene_path : "built-in scene", s->triangles, uvs, lm.frame.width, lm.frame.width, pages, lm.texels, lm.raster_s, lm.texels_moved, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads,
                 s->shadow_s, s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, lm.seam_points, lm.seam_mean,
                 lm.seam_p99, lm.seam_max, stitched, outs[0].path, outs[5].path ? ", " : "", outs[5].path ? outs[5].path : "");
     }
     ms_lightmap_free(&lm);
     ms_scene_free(&scene);
+    free(uv_cache_default);
     return rc;
 }

@@ -58,12 +58,16 @@ static const layout_row rows[] = {
     FIELD(ms_points_options, max_memory),
     STRUCT(ms_bake_options), FIELD(ms_bake_options, points), FIELD(ms_bake_options, size), FIELD(ms_bake_options, uv_set),
     FIELD(ms_bake_options, dilate), FIELD(ms_bake_options, padding), FIELD(ms_bake_options, no_leak_fix),
-    FIELD(ms_bake_options, pass), FIELD(ms_bake_options, pass_user),
+    FIELD(ms_bake_options, pass), FIELD(ms_bake_options, pass_user), FIELD(ms_bake_options, texel_density),
+    FIELD(ms_bake_options, uv_cache),
     STRUCT(ms_lightmap), FIELD(ms_lightmap, frame), FIELD(ms_lightmap, position), FIELD(ms_lightmap, normal),
     FIELD(ms_lightmap, triangle), FIELD(ms_lightmap, uv), FIELD(ms_lightmap, n_tris), FIELD(ms_lightmap, texels),
     FIELD(ms_lightmap, unwrapped_tris), FIELD(ms_lightmap, unwrap_s), FIELD(ms_lightmap, raster_s),
     FIELD(ms_lightmap, texels_moved), FIELD(ms_lightmap, leak_s), FIELD(ms_lightmap, seam_mean), FIELD(ms_lightmap, seam_max),
     FIELD(ms_lightmap, seam_points), FIELD(ms_lightmap, excluded_tris), FIELD(ms_lightmap, unbaked_tris),
+    FIELD(ms_lightmap, pages), FIELD(ms_lightmap, page), FIELD(ms_lightmap, page_fill),
+    FIELD(ms_lightmap, n_objects), FIELD(ms_lightmap, object_uv_set), FIELD(ms_lightmap, object_scale_offset),
+    FIELD(ms_lightmap, charts), FIELD(ms_lightmap, uv_cached),
     STRUCT(ms_bake_gltf_options), FIELD(ms_bake_gltf_options, no_textures), FIELD(ms_bake_gltf_options, no_shadowmask),
 };
 

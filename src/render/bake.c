@@ -12,6 +12,7 @@
 #include "bake_stitch.h"
 #include "shade.h"
 #include "bake_unbaked.h"
+#include "bake_pages.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -32,6 +33,7 @@ void ms_lightmap_free(ms_lightmap *lm)
     free(lm->normal);
     free(lm->triangle);
     free(lm->uv);
+    ms_bake_pages_free(lm);
     memset(lm, 0, sizeof *lm);
 }
 
@@ -93,27 +95,13 @@ static void shading_normal(const ms_scene *sc, uint32_t t, const float p[3], con
         for (int k = 0; k < 3; k++) ns[k] = -ns[k];
 }
 
-/* The UVs baked into (bake_uvs.c): the scene's set, per-object regions, xatlas for the rest. */
-static ms_status choose_uvs(const ms_scene *sc, const ms_bake_options *o, int size, int padding, ms_lightmap *lm,
-                            char *err, size_t errlen)
-{
-    const size_t n = sc->n_tris;
-    lm->uv = malloc((n ? n : 1) * 6 * sizeof(float));
-    if (!lm->uv) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); return MS_ERR_NO_MEMORY; }
-    const double t0 = omp_get_wtime();
-    ms_bake_uv_report rep;
-    const int rc = ms_bake_uvs(sc, o->uv_set, size, padding, lm->uv, &rep, err, errlen);
-    lm->unwrap_s = omp_get_wtime() - t0;
-    lm->unwrapped_tris = rep.unwrapped;
-    return rc ? MS_ERR_INVALID : MS_OK;
-}
-
 /* Texels of every triangle's UV image (conservative: every texel square the triangle overlaps, tested
  * with each edge function pushed out by half a texel in L1), each texel kept by the triangle nearest its
  * centre in UV space (0 inside; ties to the lower index, so the result does not depend on order). */
-static ms_status rasterize(const ms_scene *sc, int size, ms_lightmap *lm, char *err, size_t errlen)
+static ms_status rasterize(const ms_scene *sc, int size, int height, const float *frame_uv, ms_lightmap *lm, char *err,
+                           size_t errlen)
 {
-    const size_t nt = (size_t)size * size;
+    const size_t nt = (size_t)size * height;
     float *dist = malloc(nt * sizeof *dist);
     lm->triangle = malloc(nt * sizeof *lm->triangle);
     lm->position = malloc(nt * 3 * sizeof(float));
@@ -126,9 +114,9 @@ static ms_status rasterize(const ms_scene *sc, int size, ms_lightmap *lm, char *
     for (size_t i = 0; i < nt; i++) { dist[i] = INFINITY; lm->triangle[i] = MS_NO_TRIANGLE; }
     for (size_t i = 0; i < 3 * nt; i++) lm->position[i] = lm->normal[i] = NAN;
     for (size_t t = 0; t < sc->n_tris; t++) {
-        const float *uv = lm->uv + 6 * t;
-        double a[2] = { uv[0] * (double)size, uv[1] * (double)size }, b[2] = { uv[2] * (double)size, uv[3] * (double)size },
-               c[2] = { uv[4] * (double)size, uv[5] * (double)size };
+        const float *uv = frame_uv + 6 * t;
+        double a[2] = { uv[0] * (double)size, uv[1] * (double)height }, b[2] = { uv[2] * (double)size, uv[3] * (double)height },
+               c[2] = { uv[4] * (double)size, uv[5] * (double)height };
         if (!(isfinite(a[0]) && isfinite(a[1]) && isfinite(b[0]) && isfinite(b[1]) && isfinite(c[0]) && isfinite(c[1]))) continue;
         double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
         if (area == 0.0) continue;
@@ -138,7 +126,7 @@ static ms_status rasterize(const ms_scene *sc, int size, ms_lightmap *lm, char *
         for (int k = 0; k < 3; k++)
             for (int d = 0; d < 2; d++) { lo[d] = fmin(lo[d], v[k][d]); hi[d] = fmax(hi[d], v[k][d]); }
         const int x0 = (int)fmax(floor(lo[0]), 0.0), x1 = (int)fmin(floor(hi[0]), size - 1.0);
-        const int y0 = (int)fmax(floor(lo[1]), 0.0), y1 = (int)fmin(floor(hi[1]), size - 1.0);
+        const int y0 = (int)fmax(floor(lo[1]), 0.0), y1 = (int)fmin(floor(hi[1]), height - 1.0);
         const float *w = sc->tri + 9 * t;
         float e1[3], e2[3], nn[3];
         for (int d = 0; d < 3; d++) { e1[d] = w[3 + d] - w[d]; e2[d] = w[6 + d] - w[d]; }
@@ -183,6 +171,7 @@ static ms_status rasterize(const ms_scene *sc, int size, ms_lightmap *lm, char *
                 }
             }
     }
+    ms_bake_page_fill(lm, dist, size);
     free(dist);
     return MS_OK;
 }
@@ -236,12 +225,13 @@ static int dilate(ms_frame *f, int passes)
 
 /* The memory budget of a bake (budget.h) with its size and lights, building the accel here or not; the
  * estimate into *need when not NULL. */
-static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, int size, int build_accel, uint64_t *need,
-                             char *err, size_t errlen)
+static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, int size, int pages, int build_accel,
+                             uint64_t *need, char *err, size_t errlen)
 {
     ms_bake_shape bs;
     memset(&bs, 0, sizeof bs);
     bs.size = size;
+    bs.pages = pages;
     ms_scene_lights(scene, &bs.nl);
     bs.n_tris = scene->n_tris;
     bs.build_accel = build_accel;
@@ -279,13 +269,17 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
         snprintf(err, errlen, "UV set must be in [0, %d], or -1 for xatlas", MS_MAX_UV_SETS - 1);
         return MS_ERR_INVALID;
     }
-    ms_status bst = bake_budget(scene, o, size, 0, NULL, err, errlen);
+    ms_status bst = bake_budget(scene, o, size, 1, 0, NULL, err, errlen);
     if (bst) return bst;
     const int padding = o->padding > 0 ? o->padding : 4;
-    ms_status st = choose_uvs(scene, o, size, padding, out, err, errlen);
-    if (!st && o->pass) o->pass(o->pass_user, "UVs", out->unwrap_s);
+    ms_status st = ms_bake_choose_uvs(scene, o, size, padding, out, err, errlen);
+    if (!st && o->pass) o->pass(o->pass_user, out->uv_cached ? "UVs (from the cache)" : "UVs", out->unwrap_s);
+    if (!st && out->pages > 1) st = bake_budget(scene, o, size, out->pages, 0, NULL, err, errlen);   /* known now */
+    const int height = st ? size : size * out->pages;
+    float *frame_uv = st ? NULL : ms_bake_frame_uv(out);
+    if (!st && !frame_uv) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", scene->n_tris); st = MS_ERR_NO_MEMORY; }
     const double t_raster = omp_get_wtime();
-    if (!st) st = rasterize(scene, size, out, err, errlen);
+    if (!st) st = rasterize(scene, size, height, frame_uv, out, err, errlen);
     out->raster_s = omp_get_wtime() - t_raster;
     if (!st) {   /* every triangle baked or named */
         size_t count[MS_UNBAKED_REASONS];
@@ -296,19 +290,21 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
     if (!st && o->pass) o->pass(o->pass_user, "texels", out->raster_s);
     const double t_leak = omp_get_wtime();
     if (!st && !o->no_leak_fix &&
-        ms_bake_fix_leaks(scene, size, out->uv, out->triangle, out->position, out->normal, o->points.threads, &out->texels_moved,
-                          err, errlen))
+        ms_bake_fix_leaks(scene, size, height, frame_uv, out->triangle, out->position, out->normal, o->points.threads,
+                          &out->texels_moved, err, errlen))
         st = MS_ERR_NO_MEMORY;
+    if (frame_uv != out->uv) free(frame_uv);
     out->leak_s = omp_get_wtime() - t_leak;
     if (!st && o->pass && !o->no_leak_fix) o->pass(o->pass_user, "leak test", out->leak_s);
     out->n_tris = scene->n_tris;
-    const size_t nt = (size_t)size * size;
+    const size_t nt = (size_t)size * height;
     size_t nl;
     ms_scene_lights(scene, &nl);
     ms_frame *f = &out->frame;
     if (!st) {
         /* One plane of V, S and front per light, as frames have them (ms_frame.n_lights). */
-        f->width = f->height = size;
+        f->width = size;
+        f->height = height;
         f->n_lights = (int)nl;
         f->vis = malloc(nl * nt * sizeof(float));
         f->shadow = malloc(nl * nt * sizeof(float));
@@ -364,8 +360,8 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
     const ms_bake_options *o = opt_in ? opt_in : &zero;
     ms_frame *f = &lm->frame;
     const int size = f->width;
-    if (!accel || !f->vis || y0 < 0 || y1 > size || y0 > y1) {
-        snprintf(err, errlen, "ms_bake_rows: no accel or layout, or rows [%d, %d) not within [0, %d)", y0, y1, size);
+    if (!accel || !f->vis || y0 < 0 || y1 > f->height || y0 > y1) {
+        snprintf(err, errlen, "ms_bake_rows: no accel or layout, or rows [%d, %d) not within [0, %d)", y0, y1, f->height);
         return MS_ERR_INVALID;
     }
     const size_t first = (size_t)y0 * size, last = (size_t)y1 * size;
@@ -396,7 +392,7 @@ ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_
         }
         /* Each light in turn (its own ms_visibility_points call, as frames run a shadow pass per light),
          * the results kept aside until every light succeeded: lm is left as it was on an error. */
-        const size_t nt = (size_t)size * size;
+        const size_t nt = (size_t)size * f->height;
         float *vl = st ? NULL : malloc((m ? m : 1) * nl * sizeof *vl), *sl = st ? NULL : malloc((m ? m : 1) * nl * sizeof *sl);
         uint16_t *fl = st ? NULL : malloc((m ? m : 1) * nl * sizeof *fl);
         ms_stats sum;
@@ -444,7 +440,9 @@ static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_light
 {
     ms_seam *list = NULL;
     size_t n = 0;
-    if (ms_bake_seam_list(scene, lm->uv, &list, &n)) {
+    float *frame_uv = ms_bake_frame_uv(lm);   /* the UVs in the frame's rows: pages stacked */
+    if (!frame_uv || ms_bake_seam_list(scene, frame_uv, &list, &n)) {
+        if (frame_uv != lm->uv) free(frame_uv);
         snprintf(err, errlen, "out of memory finding the lightmap's seams");
         return MS_ERR_NO_MEMORY;
     }
@@ -454,7 +452,7 @@ static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_light
     if (stitch) {
         uint64_t bake_need = 0;
         char ignored[8];
-        bake_budget(scene, o, lm->frame.width, 1, &bake_need, ignored, sizeof ignored);
+        bake_budget(scene, o, lm->frame.width, lm->pages > 1 ? lm->pages : 1, 1, &bake_need, ignored, sizeof ignored);
         const uint64_t need = ms_bake_stitch_need(&lm->frame, list, n), budget = ms_memory_budget(o->points.max_memory);
         if (bake_need + need > budget) {
             ms_warn("seam stitching skipped: it needs %.1f MiB beside the bake's %.1f MiB, over the memory budget of "
@@ -465,15 +463,17 @@ static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_light
     }
     if (stitch) {
         const double t0 = omp_get_wtime();
-        const int rc = ms_bake_stitch(&lm->frame, lm->uv, lm->triangle, list, n, threads, &lm->stitched_texels);
+        const int rc = ms_bake_stitch(&lm->frame, frame_uv, lm->triangle, list, n, threads, &lm->stitched_texels);
         lm->stitch_s = omp_get_wtime() - t0;
         if (rc) {
             free(list);
+            if (frame_uv != lm->uv) free(frame_uv);
             snprintf(err, errlen, "out of memory stitching the lightmap's seams");
             return MS_ERR_NO_MEMORY;
         }
         if (o->pass) o->pass(o->pass_user, "seam stitching", lm->stitch_s);
     }
+    if (frame_uv != lm->uv) free(frame_uv);
     const double t0 = omp_get_wtime();
     ms_seam_error se;
     const int rc = ms_bake_seams(&lm->frame, list, n, &se);
@@ -496,7 +496,7 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     const double t_finish = omp_get_wtime();
     ms_frame *f = &lm->frame;
     const int size = f->width;
-    const size_t nt = (size_t)size * size, m = lm->texels;
+    const size_t nt = (size_t)size * f->height, m = lm->texels;
     /* Irradiance summed over the lights and the exposure (99th percentile), texels in row order: per light
      * E_unshadowed * S * emission, a textured light's emission times the weighted mean texel the texel's
      * front samples see (as frames shade, render.c). */
@@ -563,7 +563,8 @@ ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, m
     if (o->pass) o->pass(o->pass_user, "irradiance and dilation", omp_get_wtime() - t_finish);
     ms_status st = seams(scene, o, lm, threads, err, errlen);
     if (st) return st;
-    f->stats.width = f->stats.height = size;
+    f->stats.width = size;
+    f->stats.height = f->height;
     f->stats.triangles = scene->n_tris;
     f->stats.load_s = scene->load_s;
     f->stats.total_s = scene->load_s + lm->unwrap_s + lm->raster_s + lm->leak_s + f->stats.build_s + f->stats.setup_s + f->stats.shadow_s +
@@ -586,7 +587,7 @@ ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_accel *
     uint64_t need = 0;
     if (scene && (scene->tri || !scene->n_tris) && size >= 1 && size <= MS_MAX_IMAGE_SIZE && o->uv_set >= -1 &&
         o->uv_set < MS_MAX_UV_SETS) {   /* with the accel built here; ms_bake_layout checks the rest */
-        ms_status bst = bake_budget(scene, o, size, !accel, &need, err, errlen);
+        ms_status bst = bake_budget(scene, o, size, 1, !accel, &need, err, errlen);
         if (bst) return bst;
     }
     ms_status st = ms_bake_layout(scene, opt_in, out, err, errlen);

@@ -10,6 +10,7 @@
 #include "bake_unbaked.h"
 #include "frame_shade.h"
 #include "light/light_shape.h"
+#include "bake_gltf_pages.h"
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
@@ -52,10 +53,11 @@ typedef struct writer {
     cJSON *root, *views, *accessors, *images, *textures, *samplers, *materials, *meshes, *nodes;
     bin bin;
     int *image_of;          /* scene texture -> glTF image, -1 until made */
-    int lightmap_tex, shadowmask_tex;
+    int *lightmap_tex, *shadowmask_tex;   /* per lightmap page */
+    int pages;
     double intensity;       /* the lightmap's scale I */
-    int *material_of;       /* ((scene material + 1) * 4 + variant) * MS_UNBAKED_REASONS + reason -> glTF material,
-                             * -1 until made */
+    int *material_of;       /* (((scene material + 1) * 4 + variant) * MS_UNBAKED_REASONS + reason) * pages + page ->
+                             * glTF material, -1 until made */
     int used_emissive_strength, dropped_transform, dropped_uv_set;
     char *err;
     size_t errlen;
@@ -183,11 +185,12 @@ static const char *shape_name(ms_light_shape s)
 /* Variants of a material: baked (TEXCOORD_1 and the lightmap), with TEXCOORD_0 (its textures). */
 enum { VAR_BAKED = 1, VAR_UV0 = 2 };
 
-/* The glTF material of scene material m (MS_NO_MATERIAL: the default grey) in variant var, named after the
- * reason its triangles were not baked when they were not; -1 on error. */
-static int material_for(writer *w, uint32_t m, int var, ms_unbaked why)
+/* The glTF material of scene material m (MS_NO_MATERIAL: the default grey) in variant var on lightmap page `page`,
+ * named after the reason its triangles were not baked when they were not; -1 on error. */
+static int material_for(writer *w, uint32_t m, int var, ms_unbaked why, uint32_t page)
 {
-    const size_t slot = ((m == MS_NO_MATERIAL ? 0 : (size_t)m + 1) * 4 + (size_t)var) * MS_UNBAKED_REASONS + (size_t)why;
+    const size_t slot = (((m == MS_NO_MATERIAL ? 0 : (size_t)m + 1) * 4 + (size_t)var) * MS_UNBAKED_REASONS + (size_t)why) *
+                            (size_t)w->pages + page;
     if (w->material_of[slot] >= 0) return w->material_of[slot];
     ms_material def;
     memset(&def, 0, sizeof def);
@@ -197,10 +200,11 @@ static int material_for(writer *w, uint32_t m, int var, ms_unbaked why)
     def.base_color_texture = def.alpha_texture = def.normal_texture = def.emissive_texture = def.mr_texture = -1;
     const ms_material *mt = m == MS_NO_MATERIAL ? &def : &w->sc->materials[m];
     cJSON *j = cJSON_CreateObject();
-    char name[96], tail[64] = "";
+    char name[128], tail[64] = "", pg[24] = "";
     if (!(var & VAR_BAKED)) snprintf(tail, sizeof tail, " (not baked: %s)", ms_unbaked_name(why));
-    if (m == MS_NO_MATERIAL) snprintf(name, sizeof name, "default%s", tail);
-    else snprintf(name, sizeof name, "material %u%s", m, tail);
+    if (w->pages > 1 && (var & VAR_BAKED)) snprintf(pg, sizeof pg, " (page %u)", page);   /* a copy per page */
+    if (m == MS_NO_MATERIAL) snprintf(name, sizeof name, "default%s%s", tail, pg);
+    else snprintf(name, sizeof name, "material %u%s%s", m, tail, pg);
     cJSON_AddStringToObject(j, "name", name);
     cJSON *pbr = cJSON_AddObjectToObject(j, "pbrMetallicRoughness");
     float bc[4];
@@ -242,12 +246,12 @@ static int material_for(writer *w, uint32_t m, int var, ms_unbaked why)
         cJSON *ext = cJSON_GetObjectItem(j, "extensions");
         if (!ext) ext = cJSON_AddObjectToObject(j, "extensions");
         cJSON *lm = cJSON_AddObjectToObject(ext, "MOZ_lightmap");
-        cJSON_AddNumberToObject(lm, "index", w->lightmap_tex);
+        cJSON_AddNumberToObject(lm, "index", w->lightmap_tex[page]);
         cJSON_AddNumberToObject(lm, "texCoord", 1);
         cJSON_AddNumberToObject(lm, "intensity", w->intensity);
-        if (w->shadowmask_tex >= 0) {
+        if (w->shadowmask_tex[page] >= 0) {
             cJSON *sm = cJSON_AddObjectToObject(cJSON_AddObjectToObject(j, "extras"), "shadowmask");
-            cJSON_AddNumberToObject(sm, "index", w->shadowmask_tex);
+            cJSON_AddNumberToObject(sm, "index", w->shadowmask_tex[page]);
             cJSON_AddNumberToObject(sm, "texCoord", 1);
             cJSON *ch = cJSON_AddArrayToObject(sm, "channels");
             size_t nl;
@@ -278,34 +282,38 @@ static int add_maps(writer *w)
             for (int c = 0; c < 3; c++) imax = fmax(imax, f->rgb[3 * i + c]);
     w->intensity = imax > 0.0 ? imax : 1.0;
     const size_t nmask = w->opt.no_shadowmask ? 0 : nl;
-    uint8_t *px = malloc(4 * np);
+    /* one lightmap and one shadowmask image per page (the frame's rows [p size, (p+1) size)) */
+    const size_t pp = (size_t)f->width * f->width;
+    uint8_t *px = malloc(4 * pp);
     if (!px) { snprintf(w->err, w->errlen, "out of memory for the lightmap's image"); return -1; }
-    for (size_t i = 0; i < np; i++)
-        for (int c = 0; c < 3; c++)   /* linear; the nearest of the 256 steps */
-            px[3 * i + c] = f->vis[i] >= 0.0f ? (uint8_t)lrint(clamp01((float)(f->rgb[3 * i + c] / w->intensity)) * 255.0) : 0;
-    int im = add_png(w, px, f->width, f->height, 3, "lightmap");
-    if (im < 0) { free(px); return -1; }
-    /* no mipmaps: a minified lightmap would average across chart borders into the padding */
-    w->lightmap_tex = add_texture(w, im, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE, GL_LINEAR, GL_LINEAR);
-    w->shadowmask_tex = -1;
-    if (nmask) {
-        for (size_t i = 0; i < np; i++)
+    for (int p = 0; p < w->pages; p++) {
+        const size_t o = (size_t)p * pp;
+        for (size_t i = 0; i < pp; i++)
+            for (int c = 0; c < 3; c++)   /* linear; the nearest of the 256 steps */
+                px[3 * i + c] = f->vis[o + i] >= 0.0f ? (uint8_t)lrint(clamp01((float)(f->rgb[3 * (o + i) + c] / w->intensity)) * 255.0) : 0;
+        int im = add_png(w, px, f->width, f->width, 3, "lightmap");
+        if (im < 0) { free(px); return -1; }
+        /* no mipmaps: a minified lightmap would average across chart borders into the padding */
+        w->lightmap_tex[p] = add_texture(w, im, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE, GL_LINEAR, GL_LINEAR);
+        w->shadowmask_tex[p] = -1;
+        if (!nmask) continue;
+        for (size_t i = 0; i < pp; i++)
             for (size_t c = 0; c < 4; c++) {
-                const float s = c < nl ? f->shadow[c * np + i] : -1.0f;
+                const float s = c < nl ? f->shadow[c * np + o + i] : -1.0f;
                 px[4 * i + c] = c < nl ? (s >= 0.0f ? (uint8_t)lrint(clamp01(s) * 255.0f) : 0) : (c == 3 ? 255 : 0);
             }
-        im = add_png(w, px, f->width, f->height, 4, "shadowmask");
+        im = add_png(w, px, f->width, f->width, 4, "shadowmask");
         if (im < 0) { free(px); return -1; }
-        w->shadowmask_tex = add_texture(w, im, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE, GL_LINEAR, GL_LINEAR);
-        if (nl > 4) ms_warn("the glTF's shadowmask holds lights 0-3 only: lights 4-%zu are in the EXR (-o) alone", nl - 1);
+        w->shadowmask_tex[p] = add_texture(w, im, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE, GL_LINEAR, GL_LINEAR);
     }
+    if (nmask && nl > 4) ms_warn("the glTF's shadowmask holds lights 0-3 only: lights 4-%zu are in the EXR (-o) alone", nl - 1);
     free(px);
     return 0;
 }
 
 /* A triangle's group: its object (ms_scene.tri_object, else its mesh), material and variant. */
 typedef struct tri_key {
-    uint32_t mesh, material, var, why, tri;   /* why: ms_unbaked, for the triangles not baked */
+    uint32_t mesh, material, var, why, tri, page;   /* why: ms_unbaked, for the triangles not baked */
 } tri_key;
 
 static int cmp_key(const void *pa, const void *pb)
@@ -315,6 +323,7 @@ static int cmp_key(const void *pa, const void *pb)
     if (a->material != b->material) return a->material < b->material ? -1 : 1;
     if (a->var != b->var) return a->var < b->var ? -1 : 1;
     if (a->why != b->why) return a->why < b->why ? -1 : 1;
+    if (a->page != b->page) return a->page < b->page ? -1 : 1;
     return (a->tri > b->tri) - (a->tri < b->tri);
 }
 
@@ -393,7 +402,7 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     }
     memset(slot, 0xff, cap * sizeof *slot);
     /* The material first: a normal texture carried into the file needs TANGENT on the vertices. */
-    const int mat = material_for(w, keys[0].material, var, (ms_unbaked)keys[0].why);
+    const int mat = material_for(w, keys[0].material, var, (ms_unbaked)keys[0].why, keys[0].page);
     if (mat < 0) { free(vs); free(idx); free(slot); return NULL; }
     const uint32_t sm = keys[0].material;
     const int tangents = cJSON_GetObjectItem(cJSON_GetArrayItem(w->materials, mat), "normalTexture") != NULL;
@@ -451,6 +460,7 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     free(vs);
     free(idx);
     cJSON_AddNumberToObject(prim, "material", mat);
+    if (var & VAR_BAKED) ms_bake_gltf_lightmap_extras(prim, w->lm, keys[0].mesh, keys[0].page);
     cJSON_AddNumberToObject(prim, "mode", 4);
     if (!(var & VAR_BAKED)) {   /* glTF primitives have no name: extras say why they carry no lightmap */
         cJSON *ex = cJSON_AddObjectToObject(prim, "extras");
@@ -509,16 +519,19 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
     ms_status st = MS_OK;
     const size_t n = sc->n_tris;
     w.image_of = malloc((sc->n_textures ? sc->n_textures : 1) * sizeof *w.image_of);
-    w.material_of = malloc((sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS * sizeof *w.material_of);
+    w.pages = lm->pages > 1 ? lm->pages : 1;
+    w.material_of = malloc((sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS * (size_t)w.pages * sizeof *w.material_of);
+    w.lightmap_tex = malloc((size_t)w.pages * sizeof *w.lightmap_tex);
+    w.shadowmask_tex = malloc((size_t)w.pages * sizeof *w.shadowmask_tex);
     tri_key *keys = malloc((n ? n : 1) * sizeof *keys);
     w.root = cJSON_CreateObject();
-    if (!w.image_of || !w.material_of || !keys || !w.root) {
+    if (!w.image_of || !w.material_of || !w.lightmap_tex || !w.shadowmask_tex || !keys || !w.root) {
         snprintf(err, errlen, "out of memory for the glTF of %zu triangles", n);
         st = MS_ERR_NO_MEMORY;
         goto done;
     }
     for (size_t i = 0; i < sc->n_textures; i++) w.image_of[i] = -1;
-    for (size_t i = 0; i < (sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS; i++) w.material_of[i] = -1;
+    for (size_t i = 0; i < (sc->n_materials + 1) * 4 * MS_UNBAKED_REASONS * (size_t)w.pages; i++) w.material_of[i] = -1;
 
     cJSON *asset = cJSON_AddObjectToObject(w.root, "asset");
     cJSON_AddStringToObject(asset, "version", "2.0");
@@ -551,6 +564,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
         keys[m].material = sc->tri_material && sc->tri_material[t] < sc->n_materials ? sc->tri_material[t] : MS_NO_MATERIAL;
         keys[m].var = (uint32_t)var;
         keys[m].why = var & VAR_BAKED ? MS_BAKED : (uint32_t)ms_bake_tri_state(sc, lm->uv, lm->frame.width, t);
+        keys[m].page = (var & VAR_BAKED) && lm->page && lm->pages > 1 ? lm->page[t] : 0;
         keys[m++].tri = (uint32_t)t;
     }
     if (flat) ms_warn("%zu triangles without area (no normal) left out of the glTF", flat);
@@ -576,7 +590,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
         cJSON_AddItemToArray(w.meshes, mesh);
         for (size_t p = a; p < b && !st;) {
             size_t q = p;
-            while (q < b && keys[q].material == keys[p].material && keys[q].var == keys[p].var) q++;
+            while (q < b && keys[q].material == keys[p].material && keys[q].var == keys[p].var && keys[q].page == keys[p].page) q++;
             cJSON *prim = add_primitive(&w, keys + p, q - p);
             if (!prim) st = w.bin.oom ? MS_ERR_NO_MEMORY : MS_ERR_INVALID;
             else cJSON_AddItemToArray(prims, prim);
@@ -629,6 +643,8 @@ done:
     free(w.bin.p);
     free(w.image_of);
     free(w.material_of);
+    free(w.lightmap_tex);
+    free(w.shadowmask_tex);
     free(keys);
     return st;
 }

@@ -24,16 +24,16 @@
 #include <string.h>
 
 /* World length of one texel on each triangle (isotropic: the square root of the area ratio). */
-static float texel_world_size(const float *t, const float *u, int size)
+static float texel_world_size(const float *t, const float *u, int width, int height)
 {
     const double e1[3] = { t[3] - t[0], t[4] - t[1], t[5] - t[2] }, e2[3] = { t[6] - t[0], t[7] - t[1], t[8] - t[2] };
     const double c[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0] };
     const double wa = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    const double ua = fabs(((double)u[2] - u[0]) * ((double)u[5] - u[1]) - ((double)u[3] - u[1]) * ((double)u[4] - u[0])) * size * size;
+    const double ua = fabs(((double)u[2] - u[0]) * ((double)u[5] - u[1]) - ((double)u[3] - u[1]) * ((double)u[4] - u[0])) * width * height;
     return ua > 0.0 ? (float)sqrt(wa / ua) : 0.0f;
 }
 
-int ms_bake_fix_leaks(const ms_scene *sc, int size, const float *uv, const uint32_t *texel_tri, float *position,
+int ms_bake_fix_leaks(const ms_scene *sc, int size, int height, const float *uv, const uint32_t *texel_tri, float *position,
                       const float *normal, int threads, size_t *moved, char *err, size_t errlen)
 {
     *moved = 0;
@@ -48,7 +48,7 @@ int ms_bake_fix_leaks(const ms_scene *sc, int size, const float *uv, const uint3
         snprintf(err, errlen, "out of memory for the texels' leak test");
         return -1;
     }
-    const size_t np = (size_t)size * size;
+    const size_t np = (size_t)size * height;
     size_t count = 0;
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads > 0 ? threads : omp_get_num_procs()) reduction(+ : count)
     for (size_t i = 0; i < np; i++) {
@@ -56,7 +56,7 @@ int ms_bake_fix_leaks(const ms_scene *sc, int size, const float *uv, const uint3
         if (t == MS_NO_TRIANGLE) continue;
         /* a receiver wound into its own solid faces the inside: nothing there to move it out to */
         if (closed.component[t] != MS_OPEN_COMPONENT && closed.outward[closed.component[t]] < 0) continue;
-        const float r = 0.75f * texel_world_size(sc->tri + 9 * t, uv + 6 * t, size);
+        const float r = 0.75f * texel_world_size(sc->tri + 9 * t, uv + 6 * t, size, height);
         if (!(r > 0.0f) || !isfinite(r)) continue;
         const float *p = position + 3 * i, *n = normal + 3 * i;
         /* a tangent frame of the receiver */

@@ -118,11 +118,11 @@ int ms_bake_seam_list(const ms_scene *sc, const float *uv, ms_seam **seams, size
     return rc;
 }
 
-double ms_seam_len_texels(const ms_seam *s, int size)
+double ms_seam_len_texels(const ms_seam *s, int width, int height)
 {
-    const double la = hypot((double)s->a1[0] - s->a0[0], (double)s->a1[1] - s->a0[1]);
-    const double lb = hypot((double)s->b1[0] - s->b0[0], (double)s->b1[1] - s->b0[1]);
-    return fmax(la, lb) * size;
+    const double la = hypot(((double)s->a1[0] - s->a0[0]) * width, ((double)s->a1[1] - s->a0[1]) * height);
+    const double lb = hypot(((double)s->b1[0] - s->b0[0]) * width, ((double)s->b1[1] - s->b0[1]) * height);
+    return fmax(la, lb);
 }
 
 int ms_seam_samples(double len_texels, int per_texel)
@@ -158,7 +158,7 @@ int ms_bake_seams(const ms_frame *f, const ms_seam *seams, size_t n, ms_seam_err
 {
     memset(out, 0, sizeof *out);
     size_t total = 0;
-    for (size_t i = 0; i < n; i++) total += (size_t)ms_seam_samples(ms_seam_len_texels(&seams[i], f->width), 2);
+    for (size_t i = 0; i < n; i++) total += (size_t)ms_seam_samples(ms_seam_len_texels(&seams[i], f->width, f->height), 2);
     if (!total) return 0;
     double *d = malloc(total * sizeof *d);
     if (!d) return -1;
@@ -169,7 +169,7 @@ int ms_bake_seams(const ms_frame *f, const ms_seam *seams, size_t n, ms_seam_err
     double sum = 0.0;
     for (size_t i = 0; i < n; i++) {
         const ms_seam *s = &seams[i];
-        const int ns = ms_seam_samples(ms_seam_len_texels(s, f->width), 2);
+        const int ns = ms_seam_samples(ms_seam_len_texels(s, f->width, f->height), 2);
         for (int j = 0; j < ns; j++) {
             const double t = (j + 0.5) / ns;
             const double a = sample(f, s->a0[0] + t * (s->a1[0] - s->a0[0]), s->a0[1] + t * (s->a1[1] - s->a0[1]));

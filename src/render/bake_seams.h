@@ -20,7 +20,7 @@ int ms_bake_seam_list(const ms_scene *sc, const float *uv, ms_seam **seams, size
 /* Points along a seam of UV length len_texels on the longer side: spaced at most 1/per_texel texel, at
  * least one. The measure takes 2 per texel, the stitch 3 (at other places along the edge). */
 int ms_seam_samples(double len_texels, int per_texel);
-double ms_seam_len_texels(const ms_seam *s, int size);
+double ms_seam_len_texels(const ms_seam *s, int width, int height);   /* texels across a width x height frame */
 
 /* The seam error as an engine sees it: at 2 points per texel along every seam, the irradiance's largest
  * channel sampled bilinearly (clamped, texel centres at (x + 0.5) / size) on either side, the absolute

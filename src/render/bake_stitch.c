@@ -181,11 +181,11 @@ done:
 }
 
 /* Whether texel i's centre lies on its triangle's UV image (its value is the surface's there). */
-static int centre_on_triangle(const float *uv, const uint32_t *triangle, int W, size_t i)
+static int centre_on_triangle(const float *uv, const uint32_t *triangle, int W, int H, size_t i)
 {
     const uint32_t t = triangle[i];
     if (t == MS_NO_TRIANGLE) return 0;
-    const double px = ((double)(i % (size_t)W) + 0.5) / W, py = ((double)(i / (size_t)W) + 0.5) / W;
+    const double px = ((double)(i % (size_t)W) + 0.5) / W, py = ((double)(i / (size_t)W) + 0.5) / H;
     const float *u = uv + 6 * (size_t)t;
     double e[3];
     for (int k = 0; k < 3; k++) {
@@ -200,14 +200,14 @@ static int build_rows(const ms_frame *f, const ms_seam *seams, size_t n, int32_t
 {
     const int W = f->width, H = f->height;
     size_t cap = 0;
-    for (size_t i = 0; i < n; i++) cap += (size_t)ms_seam_samples(ms_seam_len_texels(&seams[i], W), PER_TEXEL);
+    for (size_t i = 0; i < n; i++) cap += (size_t)ms_seam_samples(ms_seam_len_texels(&seams[i], W, H), PER_TEXEL);
     s->rows = malloc((cap ? cap : 1) * sizeof *s->rows);
     const size_t np = (size_t)W * H;
     *texel_of = malloc((8 * cap < np ? 8 * cap + 1 : np) * sizeof **texel_of);
     if (!s->rows || !*texel_of) return -1;
     for (size_t i = 0; i < n; i++) {
         const ms_seam *sm = &seams[i];
-        const double len = ms_seam_len_texels(sm, W);
+        const double len = ms_seam_len_texels(sm, W, H);
         const int ns = ms_seam_samples(len, PER_TEXEL);
         const float sw = (float)sqrt(len / ns);
         for (int j = 0; j < ns; j++) {
@@ -268,7 +268,7 @@ uint64_t ms_bake_stitch_need(const ms_frame *f, const ms_seam *seams, size_t n)
     const uint64_t np = (uint64_t)f->width * (uint64_t)f->height;
     const uint64_t nch = 3u + (f->n_lights > 1 ? (uint64_t)f->n_lights : 1u);
     uint64_t nr = 0;   /* the rows: build_rows's capacity */
-    for (size_t i = 0; i < n; i++) nr += (uint64_t)ms_seam_samples(ms_seam_len_texels(&seams[i], f->width), PER_TEXEL);
+    for (size_t i = 0; i < n; i++) nr += (uint64_t)ms_seam_samples(ms_seam_len_texels(&seams[i], f->width, f->height), PER_TEXEL);
     const uint64_t nv = 8u * nr < np ? 8u * nr + 1u : np;   /* variables: texels read by some row */
     const uint64_t base = np * sizeof(int32_t) + nr * sizeof(row) + nv * sizeof(size_t);   /* var_of, rows, texel_of */
     /* split's copies (its union-find, renumbering and a second row array; the component starts at most one
@@ -298,7 +298,7 @@ int ms_bake_stitch(ms_frame *f, const float *uv, const uint32_t *triangle, const
     s.lam = malloc((s.nv ? s.nv : 1) * sizeof *s.lam);
     if (!s.lam) goto done;
     for (size_t k = 0; k < s.nv; k++)
-        s.lam[k] = centre_on_triangle(uv, triangle, f->width, texel_of[k]) ? LAMBDA : LAMBDA * LAMBDA_OFF_SCALE;
+        s.lam[k] = centre_on_triangle(uv, triangle, f->width, f->height, texel_of[k]) ? LAMBDA : LAMBDA * LAMBDA_OFF_SCALE;
     if (build_transpose(&s)) goto done;
     const size_t nv = s.nv, nch = 3 + nl;
     /* x0, d, r, z, p, q per variable; the new values of every channel; C p per row */

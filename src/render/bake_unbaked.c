@@ -51,8 +51,8 @@ void ms_bake_report_unbaked(const ms_scene *sc, const ms_lightmap *lm, int size,
     static const char *const why[MS_UNBAKED_REASONS] = {
         NULL, NULL,
         "no area (zero-area triangles have no plane to receive light)",
-        "no UVs (xatlas leaves out triangles of area at most 1.19e-7 square scene units, FLT_EPSILON, weighted by "
-        "their mesh's lightmap scale)",
+        "no UVs (xatlas leaves out triangles of area at most FLT_EPSILON, 1.19e-7, once the unwrap has scaled the "
+        "scene's extent to about 1024 units, weighted by their mesh's lightmap scale)",
         "UVs without area at this lightmap size",
         "UVs wholly outside the lightmap",
     };

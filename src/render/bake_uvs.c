@@ -1,19 +1,23 @@
-/* The UVs a bake bakes into (microshadow.h, "Lightmap baking"; docs/baking.md, "UVs that respect the asset").
+/* The UVs a bake bakes into (microshadow.h, "Lightmap baking"; docs/baking.md, "Charts").
  *
- * Per object (ms_scene.tri_object: a glTF node's mesh, a file of another format), the triangles that have the
- * chosen UV set keep the asset's charts; the rest get xatlas charts. The file's UVs are kept exactly when they
- * can be: every baked triangle has the set, no two objects cover the same texel centre, all lie in [0,1]^2
- * and every mesh's texel-density weight is 1. Otherwise each object with the set (when objects overlap, as
- * the Unity/Bevy convention of a 0-1 lightmap UV set per object makes them) or the file's layout as a whole
- * (when they do not) is fitted into a rectangle of its own - one scale and one offset, like Unity's
- * lightmapScaleOffset, so every chart keeps its shape - and xatlas charts the triangles without the set
- * into one more rectangle. A rectangle's area is proportional to the world area it carries times the square
- * of its mesh's "lightmap": {"scale": s}, divided by the fraction of its UV rectangle the charts cover, so
- * texel density per world unit is the same everywhere (times s); rectangles are packed on shelves, `padding`
- * texels apart, at the largest common scale that fits (bisection). Never a silent change: a warning says
- * when and why the file's UVs were moved. */
+ * Per object (ms_scene.tri_object: a glTF node's mesh, a file of another format), the first of its UV sets
+ * (the one asked for, then 0, 1, ...) that is a valid layout of the object (uv_validity.c: present on every
+ * triangle, with area, no two triangles overlapping) is kept: its charts keep their shape and placement, one
+ * scale and one offset for the object (Unity's lightmapScaleOffset). Objects with none get xatlas charts.
+ * The file's UVs are kept exactly when every object uses the same set, no two objects cover the same texel
+ * centre, all lie in [0,1]^2, every mesh's texel-density weight is 1 and no density is asked for. Otherwise
+ * every object with a layout (or the file's layout as a whole, when objects do not overlap) gets a
+ * rectangle of its own, and xatlas charts the rest. A rectangle's area is proportional to the world area it
+ * carries times the square of its mesh's "lightmap": {"scale": s}, divided by the fraction of its UV
+ * rectangle the charts cover, so that every object gets the same texels per world unit (times s); with a
+ * density T that is T texels per world unit. Rectangles alone are packed by atlas_pack.c; with xatlas
+ * charts, xatlas's packer places rectangles and charts together (atlas_xpack.c). Without a density
+ * everything shares one page at the largest scale that fits; with one, as many pages as it takes. Never a
+ * silent change: a warning says when and why the file's UVs were moved or not used. */
 #include "bake_uvs.h"
-#include "lightmap_unwrap.h"
+#include "atlas_pack.h"
+#include "atlas_xpack.h"
+#include "uv_validity.h"
 #include "scene/scene_internal.h"
 #include <math.h>
 #include <stdio.h>
@@ -49,66 +53,6 @@ static double uv_area(const float *u)
 {
     return 0.5 * fabs(((double)u[2] - u[0]) * ((double)u[5] - u[1]) - ((double)u[3] - u[1]) * ((double)u[4] - u[0]));
 }
-
-/* A rectangle to place: its aspect (width / height) and weight (area share); where it went, in texels. */
-typedef struct rect {
-    double aspect, weight;
-    double x, y, w, h;
-} rect;
-
-static int cmp_height(const void *a, const void *b)
-{
-    const rect *const *p = a, *const *q = b;
-    const double x = (*p)->weight / (*p)->aspect, y = (*q)->weight / (*q)->aspect;   /* h^2 up to the scale */
-    return (x < y) - (x > y);
-}
-
-/* Shelf packing of the rectangles (order: tallest first) at scale k (w = k sqrt(weight aspect), h = k
- * sqrt(weight / aspect), texels) into size x size with `pad` texels between and around them; 1 if they fit. */
-static int shelf_pack(rect *const *order, size_t n, double k, int size, int pad)
-{
-    double x = pad, y = pad, shelf = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        rect *r = order[i];
-        r->w = k * sqrt(r->weight * r->aspect);
-        r->h = k * sqrt(r->weight / r->aspect);
-        if (r->w + 2 * pad > size || r->h + 2 * pad > size) return 0;
-        if (x + r->w + pad > size) { x = pad; y += ceil(shelf) + pad; shelf = 0.0; }
-        r->x = x;
-        r->y = y;
-        x += ceil(r->w) + pad;
-        shelf = fmax(shelf, r->h);
-        if (y + r->h + pad > size) return 0;
-    }
-    return 1;
-}
-
-/* Places the rectangles at the largest scale that fits; -1 when none does (size too small for the padding). */
-static int pack(rect *rs, size_t n, int size, int pad)
-{
-    rect **order = malloc((n ? n : 1) * sizeof *order);
-    if (!order) return -1;
-    for (size_t i = 0; i < n; i++) order[i] = &rs[i];
-    qsort(order, n, sizeof *order, cmp_height);
-    double lo = 0.0, hi = 0.0;
-    for (size_t i = 0; i < n; i++) hi = fmax(hi, fmax(sqrt(rs[i].weight * rs[i].aspect), sqrt(rs[i].weight / rs[i].aspect)));
-    hi = size / hi;
-    for (int it = 0; it < 50; it++) {
-        const double mid = 0.5 * (lo + hi);
-        if (shelf_pack(order, n, mid, size, pad)) lo = mid;
-        else hi = mid;
-    }
-    const int ok = lo > 0.0 && shelf_pack(order, n, lo, size, pad);
-    free(order);
-    return ok ? 0 : -1;
-}
-
-/* Per object: the UV rectangle of its triangles with the set, the UV area they cover, the world area. */
-typedef struct object_uv {
-    double lo[2], hi[2], uv_area, world_area, weight;
-    size_t tris;
-    int region;
-} object_uv;
 
 /* Texel centres that triangles of two different objects both cover, rasterized at size x size. */
 static size_t count_overlap(const ms_scene *sc, const float *set, const uint8_t *use, int size, char *err, size_t errlen,
@@ -150,163 +94,363 @@ static size_t count_overlap(const ms_scene *sc, const float *set, const uint8_t 
     return overlap;
 }
 
-int ms_bake_uvs(const ms_scene *sc, int uv_set, int size, int padding, float *uv, ms_bake_uv_report *rep, char *err,
+
+size_t ms_bake_uv_objects(const ms_scene *sc) { return object_count(sc); }
+
+/* Per object: the UV rectangle of its triangles in its set, the UV area they cover, the world area. */
+typedef struct object_uv {
+    double lo[2], hi[2], uv_area, world_area;
+    size_t tris;
+    int region;
+} object_uv;
+
+static void box_init(object_uv *q)
+{
+    memset(q, 0, sizeof *q);
+    q->lo[0] = q->lo[1] = INFINITY;
+    q->hi[0] = q->hi[1] = -INFINITY;
+    q->region = -1;
+}
+
+/* A rectangle for q: at scale 1 its area is (world area per covered UV area) x (its UV rectangle's area),
+ * so that every region gets the same texels per world unit. */
+static void region_of(const object_uv *q, ms_pack_rect *r)
+{
+    const double ew = q->hi[0] - q->lo[0], eh = q->hi[1] - q->lo[1];
+    double k = sqrt(q->world_area / q->uv_area);   /* scale-1 texels per UV unit */
+    if (!(k > 0.0) || !isfinite(k) || !(ew > 0.0) || !(eh > 0.0)) k = 1e-6;
+    memset(r, 0, sizeof *r);
+    r->w0 = k * fmax(ew, 1e-9);
+    r->h0 = k * fmax(eh, 1e-9);
+}
+
+/* Picks each object's UV set (the asked one first, then the others in order): bad[i] (in tris' order) marks
+ * the triangles of a usable layout that overlap others or have no area (xatlas charts those); *invalid
+ * counts objects that have sets but no usable one, *partial the overlapping triangles of usable ones.
+ * Returns -1 when out of memory. */
+static int choose_sets(const ms_scene *sc, int first, const uint32_t *start, const uint32_t *tris, size_t nobj, int *set,
+                       uint8_t *bad, ms_uv_validity *why, size_t *fallback, size_t *invalid, size_t *partial)
+{
+    for (size_t o = 0; o < nobj; o++) {
+        if (start[o] == start[o + 1]) continue;
+        set[o] = -1;
+        if (first < 0) continue;
+        int tried = 0;
+        for (int c = 0; c < MS_MAX_UV_SETS; c++) {
+            const int s = c == 0 ? first : c - 1 < first ? c - 1 : c;
+            if (!sc->tri_uv[s]) continue;
+            ms_uv_validity v;
+            const int ok = ms_uv_layout_valid(sc->tri, sc->tri_uv[s], tris + start[o], start[o + 1] - start[o], bad + start[o], &v);
+            if (ok < 0) return -1;
+            if (ok) { set[o] = s; *fallback += s != first; *partial += v.overlapping; break; }
+            if (!v.missing && !tried++) {   /* the first set the object has, for the warning */
+                why->overlapping += v.overlapping;
+                why->degenerate += v.degenerate;
+            }
+        }
+        *invalid += set[o] < 0 && tried;
+    }
+    return 0;
+}
+
+int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layout *out, ms_bake_uv_report *rep, char *err,
                 size_t errlen)
 {
     memset(rep, 0, sizeof *rep);
     const size_t n = sc->n_tris, nobj = object_count(sc);
-    const float *set = uv_set >= 0 ? sc->tri_uv[uv_set] : NULL;
-    uint8_t *use = calloc(n ? n : 1, 1), *want = calloc(n ? n : 1, 1);
-    object_uv *ob = calloc(nobj, sizeof *ob);
-    float *scaled = NULL, *xuv = NULL;
-    rect *rs = NULL;
-    int rc = -1;
-    if (!use || !want || !ob) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); goto out; }
+    const int size = p->size, pad = p->padding;
+    const double T = p->density;
+    uint8_t *use = calloc(n ? n : 1, 1), *want = calloc(n ? n : 1, 1), *bad = calloc(n ? n : 1, 1);
+    uint32_t *start = calloc(nobj + 1, sizeof *start), *tris = malloc((n ? n : 1) * sizeof *tris), *group = NULL;
+    uint32_t *xpage = NULL;
+    object_uv *ob = malloc(nobj * sizeof *ob);
+    float *src = malloc((n ? n : 1) * 6 * sizeof *src), *scaled = NULL, *xuv = NULL;
+    ms_pack_rect *rs = NULL;
+    double *rdim = NULL;
+    int *rpage = NULL, rc = -1;
+    float *xin = NULL, *xout = NULL;
+    uint32_t *xkey = NULL;
+    size_t *xtri_of = NULL;
+    if (!use || !want || !bad || !start || !tris || !ob || !src) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); goto out; }
+    out->pages = 1;
     for (size_t o = 0; o < nobj; o++) {
-        ob[o].lo[0] = ob[o].lo[1] = INFINITY;
-        ob[o].hi[0] = ob[o].hi[1] = -INFINITY;
-        ob[o].region = -1;
+        box_init(&ob[o]);
+        out->object_set[o] = -2;
+        for (int k = 0; k < 4; k++) out->object_scale_offset[4 * o + k] = 0.0f;
     }
-    /* which triangles keep the file's UVs (use), which xatlas charts (want), which are not baked */
-    size_t n_use = 0, n_want = 0;
-    int inside = 1, weighted = 0;
-    double want_weight = 0.0;
+    /* the baked triangles by object (counting sort) */
+    int weighted = 0;
     for (size_t t = 0; t < n; t++) {
-        for (int k = 0; k < 6; k++) uv[6 * t + k] = NAN;
+        for (int k = 0; k < 6; k++) out->uv[6 * t + k] = src[6 * t + k] = NAN;
+        out->page[t] = 0;
         const float s = scale_of(sc, t);
         if (!(s > 0.0f)) { rep->excluded++; continue; }
         weighted |= s != 1.0f;
-        int ok = set != NULL;
-        for (int k = 0; k < 6 && ok; k++) ok = isfinite(set[6 * t + k]);
-        if (ok && uv_area(set + 6 * t) == 0.0) ok = 0;   /* a chart without area bakes nothing: chart it anew */
-        const double wa = world_area(sc->tri + 9 * t) * (double)s * s;
-        if (!ok) { want[t] = 1; n_want++; want_weight += wa; continue; }
-        use[t] = 1;
-        n_use++;
-        object_uv *o = &ob[object_of(sc, t)];
-        for (int k = 0; k < 3; k++)
-            for (int d = 0; d < 2; d++) {
-                const double v = set[6 * t + 2 * k + d];
-                o->lo[d] = fmin(o->lo[d], v);
-                o->hi[d] = fmax(o->hi[d], v);
-                inside &= v >= 0.0 && v <= 1.0;
-            }
-        o->uv_area += uv_area(set + 6 * t);
-        o->world_area += wa;
-        o->tris++;
+        start[object_of(sc, t) + 1]++;
     }
+    for (size_t o = 0; o < nobj; o++) start[o + 1] += start[o];
+    for (size_t t = 0; t < n; t++)
+        if (scale_of(sc, t) > 0.0f) tris[start[object_of(sc, t)]++] = (uint32_t)t;
+    for (size_t o = nobj; o > 0; o--) start[o] = start[o - 1];
+    start[0] = 0;
+    ms_uv_validity why;
+    memset(&why, 0, sizeof why);
+    size_t fallback = 0, invalid = 0, partial = 0;
+    if (choose_sets(sc, p->uv_set, start, tris, nobj, out->object_set, bad, &why, &fallback, &invalid, &partial)) {
+        snprintf(err, errlen, "out of memory checking the UV sets for overlaps");
+        goto out;
+    }
+    /* which triangles keep the file's UVs (use), which xatlas charts (want) */
+    size_t n_use = 0, n_want = 0;
+    int inside = 1, one_set = -1, mixed = 0;
+    double want_weight = 0.0;
+    for (size_t o = 0; o < nobj; o++) {
+        const int s = out->object_set[o];
+        if (s < -1) continue;
+        if (s >= 0) { rep->objects_kept++; mixed |= one_set >= 0 && one_set != s; one_set = s; }
+        else rep->objects_unwrapped++;
+        for (uint32_t i = start[o]; i < start[o + 1]; i++) {
+            const size_t t = tris[i];
+            const float sc_ = scale_of(sc, t);
+            const double wa = world_area(sc->tri + 9 * t) * (double)sc_ * sc_;
+            if (s < 0 || bad[i] || uv_area(sc->tri_uv[s] + 6 * t) == 0.0) {   /* no area, or overlapping: xatlas */
+                want[t] = 1;
+                n_want++;
+                want_weight += wa;
+                continue;
+            }
+            use[t] = 1;
+            n_use++;
+            memcpy(src + 6 * t, sc->tri_uv[s] + 6 * t, 6 * sizeof(float));
+            for (int k = 0; k < 3; k++)
+                for (int d = 0; d < 2; d++) {
+                    const double v = src[6 * t + 2 * k + d];
+                    ob[o].lo[d] = fmin(ob[o].lo[d], v);
+                    ob[o].hi[d] = fmax(ob[o].hi[d], v);
+                    inside &= v >= 0.0 && v <= 1.0;
+                }
+            ob[o].uv_area += uv_area(src + 6 * t);
+            ob[o].world_area += wa;
+            ob[o].tris++;
+        }
+    }
+    rep->unwrapped = n_want;
     int fail = 0;
-    if (n_use) rep->overlap_texels = count_overlap(sc, set, use, size, err, errlen, &fail);
+    if (n_use) rep->overlap_texels = count_overlap(sc, src, use, size, err, errlen, &fail);
     if (fail) goto out;
-    if (!n_want && !rep->overlap_texels && inside && !weighted) {   /* the file's UVs as they are */
+    if (invalid)
+        ms_warn("%zu objects have no UV set that is a valid lightmap layout (in the first set each has: %zu or more triangles overlap others, "
+                "%zu have no area): xatlas charts them", invalid, why.overlapping, why.degenerate);
+    if (partial)
+        ms_warn("%zu triangles overlap others in their object's UV layout: xatlas charts them, the rest keeps the layout", partial);
+    if (fallback) ms_warn("%zu objects have no valid UV set %d and are baked in another set of theirs", fallback, p->uv_set);
+    if (!n_want && !rep->overlap_texels && inside && !weighted && !mixed && !(T > 0.0)) {   /* the file's UVs as they are */
         for (size_t t = 0; t < n; t++)
-            if (use[t]) memcpy(uv + 6 * t, set + 6 * t, 6 * sizeof(float));
+            if (use[t]) memcpy(out->uv + 6 * t, src + 6 * t, 6 * sizeof(float));
+        for (size_t o = 0; o < nobj; o++)
+            if (out->object_set[o] >= 0) out->object_scale_offset[4 * o] = out->object_scale_offset[4 * o + 1] = 1.0f;
         rc = 0;
         goto out;
     }
-    if (!n_use) {   /* xatlas alone, over the whole lightmap */
-        rc = 0;
-        if (n_want) {
-            scaled = malloc(n * 9 * sizeof *scaled);
-            if (!scaled) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); rc = -1; goto out; }
-            /* texel density by mesh: xatlas sizes charts by world area, so scale each mesh's positions by its s */
+    /* xatlas's input: positions scaled by each mesh's weight (xatlas sizes charts by world area), one mesh
+     * per object */
+    if (n_want) {
+        xuv = malloc(n * 6 * sizeof *xuv);
+        xpage = calloc(n, sizeof *xpage);
+        group = malloc(n * sizeof *group);
+        scaled = weighted ? malloc(n * 9 * sizeof *scaled) : NULL;
+        if (!xuv || !xpage || !group || (weighted && !scaled)) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); goto out; }
+        for (size_t t = 0; t < n; t++) group[t] = object_of(sc, t);
+        if (weighted)
             for (size_t t = 0; t < n; t++)
                 for (int k = 0; k < 9; k++) scaled[9 * t + k] = sc->tri[9 * t + k] * (want[t] ? scale_of(sc, t) : 1.0f);
-            rc = ms_lightmap_unwrap(weighted ? scaled : sc->tri, n, want, size, padding, uv, err, errlen);
-            rep->unwrapped = n_want;
-        }
-        goto out;
     }
-    /* Regions: one per object with the set when objects overlap, else one for the file's layout as a whole;
-     * one more for xatlas. */
-    const int per_object = rep->overlap_texels > 0 || weighted;   /* each mesh's scale needs its own region */
-    size_t nr = 0;
-    rs = calloc(nobj + 2, sizeof *rs);
+    const float *xtri = weighted ? scaled : sc->tri;
+    ms_unwrap_info info;
+    memset(&info, 0, sizeof info);
+    /* Regions: the file's layout as a whole when objects share one set and do not overlap, else one per
+     * object with a layout; xatlas's square (one page) or its pages (a density). */
+    int whole = !rep->overlap_texels && !weighted && !mixed;
+    rs = calloc(nobj + n + 2, sizeof *rs);
     if (!rs) { snprintf(err, errlen, "out of memory for the lightmap's regions"); goto out; }
     object_uv all;
-    memset(&all, 0, sizeof all);
-    all.lo[0] = all.lo[1] = INFINITY;
-    all.hi[0] = all.hi[1] = -INFINITY;
+    box_init(&all);
     for (size_t o = 0; o < nobj; o++) {
         if (!ob[o].tris) continue;
         for (int d = 0; d < 2; d++) { all.lo[d] = fmin(all.lo[d], ob[o].lo[d]); all.hi[d] = fmax(all.hi[d], ob[o].hi[d]); }
         all.uv_area += ob[o].uv_area;
         all.world_area += ob[o].world_area;
     }
-    for (size_t o = 0; o < nobj + 1; o++) {
-        object_uv *q = per_object ? (o < nobj ? &ob[o] : NULL) : (o == nobj ? &all : NULL);
-        if (!q || (per_object && !q->tris)) continue;
-        const double ew = q->hi[0] - q->lo[0], eh = q->hi[1] - q->lo[1];
-        rs[nr].aspect = ew / eh;
-        /* world area per covered UV area, times the rectangle's UV area: the same texels per world unit */
-        rs[nr].weight = q->world_area / q->uv_area * ew * eh;
-        if (!(rs[nr].weight > 0.0) || !isfinite(rs[nr].weight) || !(rs[nr].aspect > 0.0) || !isfinite(rs[nr].aspect)) {
-            rs[nr].weight = 1e-12;
-            rs[nr].aspect = 1.0;
+    size_t nr = 0;
+    for (int attempt = 0; attempt < 2; attempt++) {
+        nr = 0;
+        for (size_t o = 0; o < nobj; o++) ob[o].region = -1;
+        all.region = -1;
+        if (whole && all.uv_area > 0.0) { region_of(&all, &rs[nr]); all.region = (int)nr++; }
+        else
+            for (size_t o = 0; o < nobj; o++)
+                if (ob[o].tris) { region_of(&ob[o], &rs[nr]); ob[o].region = (int)nr++; }
+        if (!(T > 0.0)) break;
+        /* a density: T texels per (scaled) world unit; a region larger than a page is shrunk to fit */
+        int shrunk = 0;
+        for (size_t r = 0; r < nr; r++) {
+            rs[r].w0 *= T;
+            rs[r].h0 *= T;
+            const double f = fmin(1.0, (size - 2.0 * pad) / fmax(rs[r].w0, rs[r].h0));
+            if (f < 1.0) { shrunk++; rs[r].w0 *= f; rs[r].h0 *= f; }
         }
-        q->region = (int)nr++;
+        if (shrunk && whole) { whole = 0; continue; }   /* the whole layout does not fit: per object */
+        if (shrunk)
+            ms_warn("texel density %g: %d objects are larger than a %dx%d page at that density and were scaled down to fit one",
+                    T, shrunk, size, size);
+        break;
     }
-    const int xatlas_region = n_want ? (int)nr : -1;
-    if (n_want) { rs[nr].aspect = 1.0; rs[nr].weight = want_weight > 0.0 ? want_weight : 1e-12; nr++; }
-    /* weights relative to the largest, so that tiny objects do not underflow */
-    double wmax = 0.0;
-    for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].weight);
-    for (size_t r = 0; r < nr; r++) rs[r].weight = fmax(rs[r].weight / wmax, 1e-9);
-    if (pack(rs, nr, size, padding)) {
-        snprintf(err, errlen, "the lightmap's %zu regions do not fit a %dx%d lightmap with %d texels of padding", nr, size, size, padding);
-        goto out;
+    /* Placement. Regions alone are rectangles (atlas_pack.c): at the density, or at the largest common scale
+     * that fits one page. With xatlas charts, xatlas's packer places the regions and the charts together
+     * (atlas_xpack.c): at the density over as many pages as it takes, or on one page at the largest scale
+     * found by stepping it. */
+    if (!n_want) {
+        if (!(T > 0.0)) {
+            double wmax = 0.0;
+            for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].w0 * rs[r].h0);
+            for (size_t r = 0; r < nr; r++) {   /* relative sizes, so that tiny objects do not underflow */
+                rs[r].w0 = fmax(rs[r].w0 / sqrt(wmax), 1e-5);
+                rs[r].h0 = fmax(rs[r].h0 / sqrt(wmax), 1e-5);
+            }
+            if (ms_pack_one_page(rs, nr, size, pad)) {
+                snprintf(err, errlen, "the lightmap's %zu regions do not fit a %dx%d lightmap with %d texels of padding", nr, size, size, pad);
+                goto out;
+            }
+        } else {
+            const int pages = ms_pack_pages(rs, nr, 1.0, size, pad, 0);
+            if (pages < 0) { snprintf(err, errlen, "the lightmap's %zu regions do not fit %dx%d pages", nr, size, size); goto out; }
+            out->pages = pages ? pages : 1;
+        }
+    } else {
+        const int res = size - 2 * pad;
+        if (ms_lightmap_unwrap(xtri, n, want, group, res, pad, (float)T, p->tuning, xuv, xpage, &info, err, errlen)) goto out;
+        rep->charts = info.charts;
+        const double k0 = T > 0.0 ? 1.0 : info.texels_per_unit;   /* region texels per rs unit at the charts' density */
+        rdim = malloc((nr ? nr : 1) * 4 * sizeof *rdim);
+        rpage = malloc((nr ? nr : 1) * sizeof *rpage);
+        xin = malloc(n * 6 * sizeof *xin);
+        xout = malloc(n * 6 * sizeof *xout);
+        xkey = malloc(n * 2 * sizeof *xkey);   /* the charts' keys (stage-1 atlases), then their pages */
+        xtri_of = malloc(n * sizeof *xtri_of);
+        if (!rdim || !rpage || !xin || !xout || !xkey || !xtri_of) { snprintf(err, errlen, "out of memory packing the lightmap"); goto out; }
+        double area = 0.0;
+        for (size_t r = 0; r < nr; r++) {
+            rdim[r] = rs[r].w0 * k0;
+            rdim[nr + r] = rs[r].h0 * k0;
+            area += rdim[r] * rdim[nr + r];
+        }
+        size_t nx = 0;
+        for (size_t t = 0; t < n; t++) {
+            if (!want[t] || !isfinite(xuv[6 * t])) continue;
+            for (int k = 0; k < 6; k++) xin[6 * nx + k] = xuv[6 * t + k] * (float)res;
+            area += uv_area(xin + 6 * nx) / 0.7;   /* charts' boxes */
+            xkey[nx] = xpage[t];
+            xtri_of[nx++] = t;
+        }
+        area += (double)info.charts * (2.0 * pad + 2.0) * (2.0 * pad + 2.0);   /* and their padding */
+        ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, !(T > 0.0), rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n, 0.0 };
+        double scale = 1.0;
+        if (T > 0.0) {
+            const int pages = ms_xpack_run(&xp, 1.0, err, errlen);
+            if (pages < 0) goto out;
+            out->pages = pages;
+        } else {   /* one page: step the scale up while it fits, down while it does not */
+            /* steps by the ratio of the page to the atlas's extent until the scale is bracketed, then bisection
+             * to 1% (the extent is not proportional to the scale: every chart brings its padding) */
+            const double target = size - 2.0 * pad;
+            double best = 0.0, worst = INFINITY, sc_ = sqrt(0.7 * target * target / fmax(area, 1e-30));
+            int best_grow = 1;
+            for (int it = 0; it < 30; it++) {
+                /* the growing atlas stays square-ish, which may stack two wide regions and leave a strip; a
+                 * page of its own size, placed by random probes, may put them side by side: either will do */
+                char e2[256];
+                xp.grow = 1;
+                const double extent = (ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1) ? 0.0 : xp.extent;
+                int fits = extent == 0.0;
+                if (!fits) {
+                    xp.grow = 0;
+                    fits = ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1;
+                    xp.extent = extent;
+                }
+                if (fits) { best = sc_; best_grow = xp.grow; }
+                else worst = fmin(worst, sc_);
+                if (best > 0.0 && isfinite(worst)) {
+                    if (worst / best < 1.01) break;
+                    sc_ = sqrt(best * worst);
+                } else {
+                    const double r = xp.extent > 0.0 ? target / xp.extent : 0.5;
+                    sc_ *= fits ? fmin(1.5, fmax(1.02, r)) : fmax(0.5, fmin(0.98, r));
+                }
+            }
+            xp.grow = best_grow;
+            if (!(best > 0.0) || ms_xpack_run(&xp, best, err, errlen) != 1) {
+                snprintf(err, errlen, "the lightmap's regions and charts do not fit a %dx%d lightmap with %d texels of padding", size, size, pad);
+                goto out;
+            }
+            scale = best;
+        }
+        for (size_t r = 0; r < nr; r++) {
+            rs[r].x = rdim[2 * nr + r];
+            rs[r].y = rdim[3 * nr + r];
+            rs[r].w = rdim[r] * scale;
+            rs[r].h = rdim[nr + r] * scale;
+            rs[r].page = rpage[r];
+        }
+        for (size_t i = 0; i < nx; i++) {
+            const size_t t = xtri_of[i];
+            for (int k = 0; k < 6; k++) out->uv[6 * t + k] = xout[6 * i + k] / (float)size;
+            out->page[t] = xkey[n + i];
+        }
     }
     rep->regions = nr;
-    rep->relaid = 1;
-    for (size_t t = 0; t < n; t++) {
-        if (!use[t]) continue;
-        const object_uv *q = per_object ? &ob[object_of(sc, t)] : &all;
-        const rect *r = &rs[q->region];
-        const double k = r->w / (q->hi[0] - q->lo[0]);   /* = h / (hi[1] - lo[1]): one scale, charts keep their shape */
-        for (int c = 0; c < 3; c++) {
-            uv[6 * t + 2 * c] = (float)((r->x + (set[6 * t + 2 * c] - q->lo[0]) * k) / size);
-            uv[6 * t + 2 * c + 1] = (float)((r->y + (set[6 * t + 2 * c + 1] - q->lo[1]) * k) / size);
+    rep->relaid = n_use > 0;
+    for (size_t o = 0; o < nobj; o++) {
+        const object_uv *q = all.region >= 0 ? &all : &ob[o];
+        if (out->object_set[o] < 0 || q->region < 0) continue;
+        const ms_pack_rect *r = &rs[q->region];
+        const double k = r->w / fmax(q->hi[0] - q->lo[0], 1e-30);   /* = h / (hi[1] - lo[1]): one scale */
+        float *so = out->object_scale_offset + 4 * o;
+        so[0] = so[1] = (float)(k / size);
+        so[2] = (float)((r->x - q->lo[0] * k) / size);
+        so[3] = (float)((r->y - q->lo[1] * k) / size);
+        for (uint32_t i = start[o]; i < start[o + 1]; i++) {
+            const size_t t = tris[i];
+            if (!use[t]) continue;
+            out->page[t] = (uint32_t)r->page;
+            for (int c = 0; c < 3; c++) {
+                out->uv[6 * t + 2 * c] = (float)((r->x + (src[6 * t + 2 * c] - q->lo[0]) * k) / size);
+                out->uv[6 * t + 2 * c + 1] = (float)((r->y + (src[6 * t + 2 * c + 1] - q->lo[1]) * k) / size);
+            }
         }
     }
-    if (n_want) {
-        const rect *r = &rs[xatlas_region];
-        const int side = (int)floor(fmin(r->w, r->h));
-        xuv = malloc(n * 6 * sizeof *xuv);
-        scaled = weighted ? malloc(n * 9 * sizeof *scaled) : NULL;
-        if (!xuv || (weighted && !scaled)) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); goto out; }
-        if (weighted)
-            for (size_t t = 0; t < n; t++)
-                for (int k = 0; k < 9; k++) scaled[9 * t + k] = sc->tri[9 * t + k] * (want[t] ? scale_of(sc, t) : 1.0f);
-        if (side < 1 || ms_lightmap_unwrap(weighted ? scaled : sc->tri, n, want, side, padding, xuv, err, errlen)) {
-            if (side < 1) snprintf(err, errlen, "no room left in a %dx%d lightmap for the xatlas charts", size, size);
-            goto out;
-        }
-        for (size_t t = 0; t < n; t++)
-            if (want[t])
-                for (int c = 0; c < 3; c++) {
-                    uv[6 * t + 2 * c] = (float)((r->x + xuv[6 * t + 2 * c] * side) / size);
-                    uv[6 * t + 2 * c + 1] = (float)((r->y + xuv[6 * t + 2 * c + 1] * side) / size);
-                }
-        rep->unwrapped = n_want;
-    }
-    if (per_object) {
-        size_t with = 0;
-        for (size_t o = 0; o < nobj; o++) with += ob[o].tris > 0;
-        ms_warn("UV set %d: %zu objects' UVs overlap (%zu texel centres covered twice): each object gets its own region "
+    if (rep->overlap_texels)
+        ms_warn("%zu objects' UVs overlap each other (%zu texel centres covered twice): each object gets its own region "
                 "of the lightmap, its UVs scaled and offset (the baked UVs: ms_lightmap.uv, the glTF's TEXCOORD_1)",
-                uv_set, with, rep->overlap_texels);
-    } else
-        ms_warn("UV set %d: the file's UVs are scaled and offset as a whole into a region of the lightmap (%s%s%s; the "
-                "baked UVs: ms_lightmap.uv, the glTF's TEXCOORD_1)", uv_set, n_want ? "room for xatlas charts of the triangles without the set" : "",
-                n_want && (weighted || !inside) ? ", " : "", weighted ? "per-mesh lightmap scales" : !inside ? "UVs outside [0,1]" : "");
+                rep->objects_kept, rep->overlap_texels);
     rc = 0;
 out:
-    if (rc == 0 && n_want && !rep->unwrapped) rep->unwrapped = n_want;
     free(use);
     free(want);
+    free(bad);
+    free(start);
+    free(tris);
+    free(group);
+    free(xpage);
     free(ob);
+    free(src);
     free(scaled);
     free(xuv);
     free(rs);
+    free(rdim);
+    free(rpage);
+    free(xin);
+    free(xout);
+    free(xkey);
+    free(xtri_of);
     return rc;
 }

@@ -280,7 +280,7 @@ uint64_t ms_bake_need(const ms_bake_shape *s, ms_need *need)
     ms_need local;
     if (!need) need = &local;
     memset(need, 0, sizeof *need);
-    const uint64_t P = (uint64_t)s->size * (uint64_t)s->size, n = s->n_tris, mw8 = (uint64_t)s->mask_words * 8u;
+    const uint64_t P = (uint64_t)s->size * (uint64_t)s->size * (uint64_t)(s->pages > 1 ? s->pages : 1), n = s->n_tris, mw8 = (uint64_t)s->mask_words * 8u;
     /* bake.c: per texel position and normal 24, triangle 4, the rasterization's distances 4, rgb 12; per light
      * V, S 8 and front 2; per triangle UVs 24 and a flag. xatlas's meshes and charts: about 400 bytes per
      * triangle unwrapped (its vertex and index copies, chart graphs). */
@@ -316,8 +316,10 @@ int ms_bake_budget_check(const ms_bake_shape *s, uint64_t budget, char *err, siz
     }
     if (lo >= 1) snprintf(hint, sizeof hint, "--size %d would fit", lo);
     else snprintf(hint, sizeof hint, "no lightmap size fits: the scene alone needs more");
-    snprintf(err, errlen, "a %dx%d lightmap with %zu light%s and %zu triangles needs about %s (%s) but the memory budget "
-             "is %s (--max-memory): %s", s->size, s->size, s->nl, s->nl == 1 ? "" : "s", s->n_tris, tb, parts, bb, hint);
+    char pg[32] = "";
+    if (s->pages > 1) snprintf(pg, sizeof pg, " (%d pages)", s->pages);
+    snprintf(err, errlen, "a %dx%d lightmap%s with %zu light%s and %zu triangles needs about %s (%s) but the memory budget "
+             "is %s (--max-memory): %s", s->size, s->size, pg, s->nl, s->nl == 1 ? "" : "s", s->n_tris, tb, parts, bb, hint);
     return MS_ERR_BUDGET;
 }
 

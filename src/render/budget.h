@@ -78,6 +78,7 @@ typedef struct ms_bake_shape {
     int mask_words;
     int threads;
     int whole_tri_copy;     /* the method reads the triangles in scene order (hpc): a copy per points call */
+    int pages;              /* lightmap pages of size x size (0: 1) */
 } ms_bake_shape;
 uint64_t ms_bake_need(const ms_bake_shape *s, ms_need *need);
 int ms_bake_budget_check(const ms_bake_shape *s, uint64_t budget, char *err, size_t errlen);

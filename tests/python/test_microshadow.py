@@ -222,6 +222,25 @@ class QuadTest(unittest.TestCase):
         self.assertTrue(np.all(E[dark] == 0.0))
         self.assertLess(np.abs(lm["vis"][ground] - truth).max(), 0.1)
 
+    def test_bake_pages(self):
+        # a texel density the Quad's 20 m ground and its occluder do not fit on one 64x64 page at: two pages,
+        # stacked in the arrays; the ground's irradiance is exact where the analytic visible fraction is 1 or 0
+        lm = ms.bake(self.scene, size=64, uv=None, samples=256, texel_density=10.0)
+        self.assertEqual(lm["pages"], 2)
+        self.assertEqual(lm["irradiance"].shape, (128, 64, 3))
+        self.assertEqual(len(lm["page_fill"]), 2)
+        self.assertTrue(all(0.0 < f <= 1.0 for f in lm["page_fill"]))
+        self.assertEqual(set(lm["page"].tolist()), {0, 1})
+        on = lm["triangle"] != ms.NO_TRIANGLE
+        rows = np.nonzero(on)[0]
+        self.assertTrue(np.all(lm["page"][lm["triangle"][on]] == rows // 64))   # each texel on its triangle's page
+        ground = on & (lm["position"][..., 1] == 0.0) & (lm["normal"][..., 1] > 0)
+        truth = visible_fraction(lm["position"][ground])
+        E = lm["irradiance"][ground][:, 1]
+        self.assertTrue(np.all(E[truth == 0.0] == 0.0))
+        self.assertGreater((truth == 1.0).sum(), 100)
+        self.assertEqual(lm["object_uv_set"], [-1])
+
 
 LIGHTS = {"rect": {"shape": "rect", "corner": [-1, 6, -1], "edge_s": [2, 0, 0], "edge_t": [0, 0, 2],
                    "emission": [1, 0.5, 0.25]},
