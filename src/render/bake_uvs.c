@@ -203,7 +203,6 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     /* which triangles keep the file's UVs (use), which xatlas charts (want) */
     size_t n_use = 0, n_want = 0;
     int inside = 1, one_set = -1, mixed = 0;
-    double want_weight = 0.0;
     for (size_t o = 0; o < nobj; o++) {
         const int s = out->object_set[o];
         if (s < -1) continue;
@@ -216,7 +215,6 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
             if (s < 0 || bad[i] || uv_area(sc->tri_uv[s] + 6 * t) == 0.0) {   /* no area, or overlapping: xatlas */
                 want[t] = 1;
                 n_want++;
-                want_weight += wa;
                 continue;
             }
             use[t] = 1;
