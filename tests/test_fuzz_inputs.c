@@ -127,14 +127,15 @@ static void run_batch(const char *target, char *const *files, int n, int *r)
         close(fd[1]);
         const int first = i;
         unsigned char c;
-        int leaked = 0;
+        int leaked = 0, ended = 0;
         while (read(fd[0], &c, 1) == 1) {
             if (i < n) r[i++] = c;
-            else leaked = c == 'L';
+            else { leaked = c == 'L'; ended = 1; }
         }
         close(fd[0]);
         const int died = wait_child(pid);
         if (died && i < n) r[i++] = died;   /* the file it was on */
+        else if (!ended) leaked = 1;        /* died in its leak check: its files one by one say which */
         if (leaked)
             for (int k = first; k < i; k++)
                 if (r[k] < 2) r[k] = run_one(target, files[k]);
