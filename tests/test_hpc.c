@@ -177,7 +177,7 @@ static void test_order_and_threads(void **st)
             }
         for (int threads = 1; threads <= 2; threads++) {
             perm_source ps2 = { &bvh, order, nt, 0 };
-            const hpc_source src = { &ps2, perm_rewind, perm_next };
+            const hpc_source src = { &ps2, perm_rewind, perm_next, 0 };
             ctx.threads = threads;
             uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
             for (int scan = 0; scan <= 1; scan++) {
@@ -255,7 +255,7 @@ static void test_isa_instances_and_switches(void **st)
                 const ms_hpc_cast_fn fn = ms_hpc_cast_isa((ms_isa)isa);
                 if (!fn || (ctx.isa_cap != MS_ISA_AUTO && isa > (int)ctx.isa_cap)) continue;
                 perm_source ps2 = { &bvh, area, nt, 0 };
-                const hpc_source src = { &ps2, perm_rewind, perm_next };
+                const hpc_source src = { &ps2, perm_rewind, perm_next, 0 };
                 uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
                 memset(vis, 0xA5, n * mw * sizeof *vis);
                 ms_hpc_switches = mode;
@@ -280,7 +280,7 @@ static void test_isa_instances_and_switches(void **st)
         for (size_t si = 0; si < sizeof switches / sizeof *switches; si++) {
             const int sw = switches[si];
             perm_source ps2 = { &bvh, area, nt, 0 };
-            const hpc_source src = { &ps2, perm_rewind, perm_next };
+            const hpc_source src = { &ps2, perm_rewind, perm_next, 0 };
             uint64_t cnt[MS_MAX_COUNTERS] = { 0 };
             ms_hpc_switches = sw;
             const int rc2 = ms_hpc_cast(&ctx, 0, NULL, q, n, front, vis, &src, cnt);
@@ -625,7 +625,7 @@ static void test_procedural_bad_input(void **st)
     assert_non_null(strstr(line, "procedural.type"));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_builtin),
@@ -640,5 +640,5 @@ int main(void)
         cmocka_unit_test(test_streamed_flowers),
         cmocka_unit_test(test_procedural_bad_input),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -12,11 +12,14 @@
 /* Where the blocker triangles come from: batches in any order, each triangle once. next writes up to max
  * triangles (9 floats each) and their ids (the prim id a receiver on that triangle carries, so that its own
  * triangle never blocks it) and returns how many, 0 at the end, (size_t)-1 on failure. rewind (may be
- * NULL) starts over. */
+ * NULL) starts over. total: how many triangles there are at most, 0 when not known (a streamed scene); a
+ * cast's batch buffers are no larger than that, which matters when one cast answers one point (a sphere's
+ * or sun's queries, one at a time) and the scene is small. */
 typedef struct hpc_source {
     void *user;
     int (*rewind)(void *user);
     size_t (*next)(void *user, float *tri, uint32_t *ids, size_t max);
+    size_t total;
 } hpc_source;
 
 #define HPC_N_COUNTERS 31

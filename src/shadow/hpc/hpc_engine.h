@@ -324,6 +324,7 @@ int hpc_t_sure(const shared *sh, const float pc[3], const float h[3], const tri_
 typedef struct hpc_frame {
     shared sh;
     int threads, cap, nchunks;       /* nchunks -1 when the split ran out of memory */
+    size_t batch;                    /* triangles per batch: BATCH, or fewer when the source has fewer */
     chunk *ch;
     uint32_t *idx, nlive;            /* the live receivers (not in full umbra from the start), by chunk */
     uint64_t *gumbra0;               /* by the caller's numbers (sh's arrays are by hierarchy order after */
@@ -344,7 +345,7 @@ typedef struct hpc_frame {
  * the chunks and their hierarchies, the renumbering and the grid origins. 0, or -1 out of memory (F is then
  * still to be ended). */
 int hpc_frame_begin(hpc_frame *F, const ms_render_ctx *ctx, int scanline, ms_raster_fn raster,
-                    const ms_shadow_query *q, size_t n, const uint64_t *front, uint64_t *counters);
+                    const ms_shadow_query *q, size_t n, const uint64_t *front, size_t batch, uint64_t *counters);
 /* The visible masks, by the caller's numbers. */
 void hpc_frame_vis(const hpc_frame *F, uint64_t *vis);
 /* The chunks' counters and memory into counters; frees everything. */

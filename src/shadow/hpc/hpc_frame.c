@@ -108,17 +108,19 @@ static int frame_alloc(hpc_frame *F)
 {
     shared *sh = &F->sh;
     const size_t n = sh->n;
-    F->cap = 16 * F->threads;   /* chunks: see hpc_make_chunks */
+    /* chunks (see hpc_make_chunks): never more than the receivers, each chunk holding one at least; a cast of
+     * one point (a sphere's or sun's query) needs one, not 16 per thread (each with its volumes) */
+    F->cap = n < (size_t)16 * F->threads ? (n ? (int)n : 1) : 16 * F->threads;
     sh->gmask = calloc((size_t)sh->G * sh->mw, sizeof *sh->gmask);
     sh->gumbra = F->gumbra0 = malloc(n * sizeof *sh->gumbra);
     sh->full = F->full0 = malloc(n);
     sh->slot = F->slot0 = malloc(n * sizeof *sh->slot);
     F->idx = malloc(n * sizeof *F->idx);
     F->ch = calloc((size_t)F->cap, sizeof *F->ch);
-    F->jobs = malloc(BATCH * sizeof *F->jobs);
-    F->tri = malloc(BATCH * 9 * sizeof *F->tri);
-    F->ids = malloc(BATCH * sizeof *F->ids);
-    F->pairs = malloc(BATCH);
+    F->jobs = malloc(F->batch * sizeof *F->jobs);
+    F->tri = malloc(F->batch * 9 * sizeof *F->tri);
+    F->ids = malloc(F->batch * sizeof *F->ids);
+    F->pairs = malloc(F->batch);
     return sh->gmask && sh->gumbra && sh->full && sh->slot && F->idx && F->ch && F->jobs && F->tri && F->ids &&
                    F->pairs
                ? 0
@@ -256,9 +258,10 @@ static void frame_origins(hpc_frame *F, uint64_t *counters)
 }
 
 int hpc_frame_begin(hpc_frame *F, const ms_render_ctx *ctx, int scanline, ms_raster_fn raster,
-                    const ms_shadow_query *q, size_t n, const uint64_t *front, uint64_t *counters)
+                    const ms_shadow_query *q, size_t n, const uint64_t *front, size_t batch, uint64_t *counters)
 {
     memset(F, 0, sizeof *F);
+    F->batch = batch;
     frame_shared(F, ctx, scanline, raster, q, n, front);
     if (frame_alloc(F)) return -1;
     frame_groups(F);

@@ -71,7 +71,7 @@ static int cast_batches(hpc_frame *F, const hpc_source *src, uint64_t *counters)
     const double t0 = omp_get_wtime();
     if (src->rewind && src->rewind(src->user)) return -1;
     for (;;) {
-        const size_t got = src->next(src->user, F->tri, F->ids, BATCH);
+        const size_t got = src->next(src->user, F->tri, F->ids, F->batch);
         if (got == (size_t)-1) return -1;
         if (!got) break;
         if (sh->pairs) hpc_pair_batch(F->tri, F->ids, F->pairs, got);
@@ -93,7 +93,9 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
                                         const hpc_source *src, uint64_t *counters)
 {
     hpc_frame F;
-    int rc = hpc_frame_begin(&F, ctx, scanline, raster, q, n, front, counters);
+    /* a batch holds every triangle of a small scene: the same single batch, without BATCH's buffers */
+    const size_t batch = src->total && src->total < BATCH ? src->total : BATCH;
+    int rc = hpc_frame_begin(&F, ctx, scanline, raster, q, n, front, batch, counters);
     if (!rc && (F.sh.sw & MS_HPC_OFF_ON_DEMAND)) rc = preload_slots(&F);
     if (!rc) rc = cast_batches(&F, src, counters);
     if (!rc) hpc_frame_vis(&F, vis);

@@ -117,7 +117,8 @@ static int hpc_cast_all(const hpc_state *s, const ms_render_ctx *ctx, const ms_s
                         const uint64_t *front, uint64_t *vis, uint64_t *counters, double *sort_s)
 {
     soup_source ss = { ctx, s, 0, 0.0 };
-    const hpc_source src = { &ss, soup_rewind, ctx->scene->procedural.type != MS_PROCEDURAL_NONE ? procedural_next : soup_next };
+    const int streamed = ctx->scene->procedural.type != MS_PROCEDURAL_NONE;
+    const hpc_source src = { &ss, soup_rewind, streamed ? procedural_next : soup_next, streamed ? 0 : ctx->bvh->n_tris };
     const int rc = ms_hpc_cast(ctx, s->scanline, s->raster, q, n, front, vis, &src, counters);
     *sort_s = ss.sort_s;
     return rc;
