@@ -911,7 +911,7 @@ static void test_loading_rules(void **state)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_method_gltf),
@@ -926,5 +926,5 @@ int main(void)
         cmocka_unit_test(test_loading_rules),
         cmocka_unit_test(test_bake_honours_alpha),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -327,7 +327,7 @@ static void test_cli(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_half_plane_edge), cmocka_unit_test(test_k1_unchanged),
@@ -335,5 +335,5 @@ int main(void)
         cmocka_unit_test(test_bad_values),      cmocka_unit_test(test_scene_file),
         cmocka_unit_test(test_cli),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -158,7 +158,7 @@ static void test_statuses(void **st)
     assert_string_equal(ms_status_name(MS_ERR_BUDGET), "over the memory budget");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_abi_matches),
@@ -166,5 +166,5 @@ int main(void)
         cmocka_unit_test(test_abi_version_and_table),
         cmocka_unit_test(test_statuses),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

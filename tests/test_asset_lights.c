@@ -406,7 +406,7 @@ static void test_punctual(void **st)
     assert_non_null(strstr(errbuf, "the cone is not modelled"));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell_emitter),
@@ -414,5 +414,5 @@ int main(void)
         cmocka_unit_test(test_too_many_emitters),
         cmocka_unit_test(test_punctual),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -243,7 +243,7 @@ static void test_cli_exit_2(void **st)
     assert_false(tu_file_exists(out));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gltf_buffer_uris),
@@ -252,5 +252,5 @@ int main(void)
         cmocka_unit_test(test_mtl_maps),
         cmocka_unit_test(test_cli_exit_2),
     };
-    return cmocka_run_group_tests(tests, setup, NULL);
+    return tu_run_group_tests(tests, setup, NULL, argc, argv);
 }

@@ -330,7 +330,7 @@ static void test_unwritable_outputs(void **st)
     expect_bad(s, FLAGS("-o", ""), NEEDLES("empty output path"));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_scene_renders),
@@ -342,5 +342,5 @@ int main(void)
         cmocka_unit_test(test_bake_flags),
         cmocka_unit_test(test_unwritable_outputs),
     };
-    return cmocka_run_group_tests(tests, setup, NULL);
+    return tu_run_group_tests(tests, setup, NULL, argc, argv);
 }

@@ -414,7 +414,7 @@ static void test_cli(void **st)
     assert_false(tu_file_exists(exr2));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_matches_frame_default),
@@ -425,5 +425,5 @@ int main(void)
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_cli),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -491,7 +491,7 @@ static void test_tiny_triangles(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_keep_and_chart),
@@ -499,5 +499,5 @@ int main(void)
         cmocka_unit_test(test_pages),
         cmocka_unit_test(test_uv_cache),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

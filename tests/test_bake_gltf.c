@@ -519,7 +519,7 @@ static void test_unbaked_named(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_glb_reads_back),
@@ -527,5 +527,5 @@ int main(void)
         cmocka_unit_test(test_validator),
         cmocka_unit_test(test_cli),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -292,7 +292,7 @@ static void test_cli_channels(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rect_and_sphere),
@@ -300,5 +300,5 @@ int main(void)
         cmocka_unit_test(test_sphere_every_method),
         cmocka_unit_test(test_cli_channels),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -335,11 +335,11 @@ static void test_scale_and_errors(void **st)
     assert_non_null(strstr(err, "meshes[1].lightmap"));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell),
         cmocka_unit_test(test_scale_and_errors),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

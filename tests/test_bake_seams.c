@@ -395,12 +395,12 @@ static void test_stitch_over_budget(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cylinder),
         cmocka_unit_test(test_hard_edges),
         cmocka_unit_test(test_stitch_over_budget),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -256,11 +256,11 @@ static void test_viewer_exposes_as_frame(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_viewer_matches_frame),
         cmocka_unit_test(test_viewer_exposes_as_frame),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -274,7 +274,7 @@ static void test_shallow_bvh(void **state)
     free(tri);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shallow_bvh),
@@ -284,5 +284,5 @@ int main(void)
         cmocka_unit_test(test_bunny),
         cmocka_unit_test(test_biglight),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -395,7 +395,7 @@ static void test_triangle_oracle(void **st)
     assert_true(hits > 1000 && misses > 1000);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_triangle_oracle),
@@ -404,5 +404,5 @@ int main(void)
         cmocka_unit_test(test_grid_edges_and_vertices),
         cmocka_unit_test(test_cluster_and_slivers),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

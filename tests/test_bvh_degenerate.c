@@ -102,10 +102,10 @@ static void test_degenerate_triangles(void **st)
     assert_int_equal(bad_depth, 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_degenerate_triangles),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

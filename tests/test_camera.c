@@ -162,7 +162,7 @@ static void test_cli_end_to_end(void **st)
     free(top);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hand_computed),
@@ -170,5 +170,5 @@ int main(void)
         cmocka_unit_test(test_degenerate),
         cmocka_unit_test(test_cli_end_to_end),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

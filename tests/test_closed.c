@@ -663,7 +663,7 @@ static void test_interior_points(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_topology),
@@ -673,5 +673,5 @@ int main(void)
         cmocka_unit_test(test_interior_frames),
         cmocka_unit_test(test_interior_points),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

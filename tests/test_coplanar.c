@@ -456,7 +456,7 @@ static void test_rect_pair(void **st)
     assert_int_equal(ms_coplanar_rect_pair(a, b, c), 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_merge),
@@ -466,5 +466,5 @@ int main(void)
         cmocka_unit_test(test_receiver_ok_samples),
         cmocka_unit_test(test_rect_pair),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

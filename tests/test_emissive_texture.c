@@ -117,12 +117,12 @@ static void test_no_uvs(void **st)
     check(&l, white);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_whole_texture),
         cmocka_unit_test(test_left_column),
         cmocka_unit_test(test_no_uvs),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

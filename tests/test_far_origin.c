@@ -502,7 +502,7 @@ static void test_localize(void **st)
     gen_free(&m);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_frame),
@@ -512,5 +512,5 @@ int main(void)
         cmocka_unit_test(test_cracks_far),
         cmocka_unit_test(test_localize),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -363,7 +363,7 @@ static void test_fuzz_corpora_render_finite(void **st)
     assert_true(rendered >= 30);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_texel_limit),
@@ -372,5 +372,5 @@ int main(void)
         cmocka_unit_test(test_guard_before_writing),
         cmocka_unit_test(test_fuzz_corpora_render_finite),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

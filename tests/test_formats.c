@@ -696,7 +696,7 @@ static int setup(void **st)
     return 0;
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_obj_variants),
@@ -711,5 +711,5 @@ int main(void)
         cmocka_unit_test(test_same_file_twice),
         cmocka_unit_test(test_bad_transforms),
     };
-    return cmocka_run_group_tests(tests, setup, NULL);
+    return tu_run_group_tests(tests, setup, NULL, argc, argv);
 }

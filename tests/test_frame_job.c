@@ -322,7 +322,7 @@ static void test_split_bake(void **state)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_split_frames),
@@ -331,5 +331,5 @@ int main(void)
         cmocka_unit_test(test_progress_cancel),
         cmocka_unit_test(test_split_bake),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

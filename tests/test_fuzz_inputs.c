@@ -244,11 +244,11 @@ static void test_crash_inputs_refused(void **st)
     assert_true(n >= 6);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_seeds_load),
         cmocka_unit_test(test_crash_inputs_refused),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

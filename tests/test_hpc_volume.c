@@ -186,12 +186,12 @@ static void test_pair_contains_both_shadows(void **st)
     assert_int_equal(capped, flat);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_contains_every_shadow),
         cmocka_unit_test(test_active_planes),
         cmocka_unit_test(test_pair_contains_both_shadows),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

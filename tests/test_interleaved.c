@@ -437,7 +437,7 @@ static void test_quality(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sets_are_nets),
@@ -448,5 +448,5 @@ int main(void)
         cmocka_unit_test(test_cli),
         cmocka_unit_test(test_quality),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -722,7 +722,7 @@ static void test_isa_cap(void **state)
     assert_int_equal(ms_isa_from_name(NULL, &dummy), MS_ERR_INVALID);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_kernel_table),
@@ -735,5 +735,5 @@ int main(void)
         cmocka_unit_test(test_random_32),
         cmocka_unit_test(test_random_64),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

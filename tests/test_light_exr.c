@@ -190,11 +190,11 @@ static void test_same_as_png(void **st)
     ms_scene_free(&sh);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_texels_read_back),
         cmocka_unit_test(test_same_as_png),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -1054,7 +1054,7 @@ static void test_triangle_irradiance(void **st)
     assert_true(worst < 2e-4);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_disk_mask_rows),
@@ -1075,5 +1075,5 @@ int main(void)
         cmocka_unit_test(test_triangle_frames_equal),
         cmocka_unit_test(test_triangle_irradiance),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

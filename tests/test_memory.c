@@ -403,7 +403,7 @@ static void test_cli(void **state)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refuse_big_frame),
@@ -413,5 +413,5 @@ int main(void)
         cmocka_unit_test(test_estimates_bound_peaks),
         cmocka_unit_test(test_cli),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -632,7 +632,7 @@ static void test_counters_account(void **state)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_equals_raytrace),
@@ -649,5 +649,5 @@ int main(void)
         cmocka_unit_test(test_switches_keep_masks),
         cmocka_unit_test(test_counters_account),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

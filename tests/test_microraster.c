@@ -370,7 +370,7 @@ static void test_pixel_class_counters(void **state)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_agrees_with_raytrace),
@@ -384,5 +384,5 @@ int main(void)
         cmocka_unit_test(test_bunny_agrees),
         cmocka_unit_test(test_pixel_class_counters),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -230,7 +230,7 @@ static void test_stats(void **st)
     ms_scene_free(&s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pfm),
@@ -238,5 +238,5 @@ int main(void)
         cmocka_unit_test(test_png_and_failures),
         cmocka_unit_test(test_stats),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

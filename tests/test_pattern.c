@@ -125,12 +125,12 @@ static void test_samples_to_k(void **st)
     assert_int_equal(ms_samples_to_k(-256), 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cells),
         cmocka_unit_test(test_determinism_and_variation),
         cmocka_unit_test(test_samples_to_k),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -574,7 +574,7 @@ static void test_primary_option(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exact_edges_and_vertices),
@@ -583,5 +583,5 @@ int main(void)
         cmocka_unit_test(test_against_watertight),
         cmocka_unit_test(test_variants_agree),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

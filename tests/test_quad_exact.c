@@ -146,11 +146,11 @@ static void check_pattern(ms_pattern pat, double mae_max, double max_max)
 static void test_quad_grid(void **st) { (void)st; check_pattern(MS_PATTERN_GRID, 0.002, 0.05); }
 static void test_quad_stratified(void **st) { (void)st; check_pattern(MS_PATTERN_STRATIFIED, 0.002, 0.05); }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_grid),
         cmocka_unit_test(test_quad_stratified),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -815,7 +815,7 @@ static void test_hostile_mtl(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ltc_against_brute_force),
@@ -828,5 +828,5 @@ int main(void)
         cmocka_unit_test(test_cli_exr_and_exposure),
         cmocka_unit_test(test_hostile_mtl),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

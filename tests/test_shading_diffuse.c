@@ -88,10 +88,10 @@ static void test_diffuse_against_oracle(void **st)
     assert_non_null(strstr(line, "--shading: 'glossy' is not standard or diffuse"));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_diffuse_against_oracle),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -292,7 +292,7 @@ static void test_cli(void **state)
     assert_int_equal(tu_count_entries(sub), 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_streamed_equals_whole),
@@ -300,5 +300,5 @@ int main(void)
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_cli),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -684,7 +684,7 @@ static void test_scene_file(void **st)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_method_wide),
@@ -698,5 +698,5 @@ int main(void)
         cmocka_unit_test(test_gltf_directional),
         cmocka_unit_test(test_scene_file),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

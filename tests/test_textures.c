@@ -559,12 +559,12 @@ static void test_extensions(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_texture_formats),
         cmocka_unit_test(test_normal_map_and_emission),
         cmocka_unit_test(test_extensions),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

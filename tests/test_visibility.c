@@ -509,7 +509,7 @@ static void test_quad_shaded(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_cuts_light),
@@ -517,5 +517,5 @@ int main(void)
         cmocka_unit_test(test_ceiling_from_below),
         cmocka_unit_test(test_quad_shaded),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

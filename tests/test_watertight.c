@@ -31,7 +31,7 @@
  * "Old code": this file built against commit 6956bd6 (Moller-Trumbore with sliver rejection, the
  * previous box test, Embree's default mode); each test prints its counts. The old code also fails
  * test_grazing_t (433 hits on the wrong side of near) and test_flat_grid_vertices (7.7% missed).
- * MS_TEST_FILTER=<test name> runs one test. */
+ * `test_watertight --only <test name>` runs one test (tu_run_tests). */
 #include "testutil.h"
 #include "accel/bvh.h"
 #include "shadow/method.h"
@@ -775,7 +775,7 @@ static void test_kernels_shared_edges(void **st)
     assert_int_equal(on_edges, 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_triangle_oracle),
@@ -787,7 +787,5 @@ int main(void)
         cmocka_unit_test(test_light_leak),
         cmocka_unit_test(test_primary_cracks),
     };
-    const char *filter = getenv("MS_TEST_FILTER");   /* e.g. MS_TEST_FILTER=test_light_leak */
-    if (filter && *filter) cmocka_set_test_filter(filter);
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

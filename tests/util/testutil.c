@@ -545,3 +545,50 @@ uint64_t tu_stat_counter(const ms_stats *st, const char *name)
     fail_msg("no counter %s", name);
     return 0;
 }
+
+/* 1 if name is one of the comma-separated names of list. */
+static int in_list(const char *list, const char *name)
+{
+    const size_t len = strlen(name);
+    for (const char *p = list; *p;) {
+        const size_t k = strcspn(p, ",");
+        if (k == len && !strncmp(p, name, len)) return 1;
+        p += k + (p[k] == ',');
+    }
+    return 0;
+}
+
+int tu_run_tests(const char *group, const struct CMUnitTest *tests, size_t n, CMFixtureFunction setup,
+                 CMFixtureFunction teardown, int argc, char **argv)
+{
+    if (argc == 1) return _cmocka_run_group_tests(group, tests, n, setup, teardown);
+    const int only = argc == 3 && !strcmp(argv[1], "--only"), except = argc == 3 && !strcmp(argv[1], "--except");
+    if (!only && !except) {
+        fprintf(stderr, "%s: usage: %s [--only|--except NAME[,NAME...]]\n", argv[0], argv[0]);
+        return 1;
+    }
+    /* every name given is a test here */
+    for (const char *p = argv[2]; *p;) {
+        const size_t k = strcspn(p, ",");
+        size_t i = 0;
+        while (i < n && !(strlen(tests[i].name) == k && !strncmp(tests[i].name, p, k))) i++;
+        if (i == n) {
+            fprintf(stderr, "%s: no test named \"%.*s\"\n", argv[0], (int)k, p);
+            return 1;
+        }
+        p += k + (p[k] == ',');
+    }
+    struct CMUnitTest *part = malloc((n ? n : 1) * sizeof *part);
+    if (!part) return 1;
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++)
+        if (in_list(argv[2], tests[i].name) == only) part[m++] = tests[i];
+    if (m == 0) {
+        fprintf(stderr, "%s: %s %s selects no test\n", argv[0], argv[1], argv[2]);
+        free(part);
+        return 1;
+    }
+    const int rc = _cmocka_run_group_tests(group, part, m, setup, teardown);
+    free(part);
+    return rc;
+}

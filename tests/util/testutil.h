@@ -8,6 +8,19 @@
 #include <cmocka.h>
 #include "microshadow.h"
 
+/* Runs the cmocka tests[0..n) of a program, all of them or the part its command line selects, so that one long
+ * program can be several ctest entries that `ctest -j` runs side by side (ms_test_parts in tests/CMakeLists.txt):
+ *   PROGRAM                          every test;
+ *   PROGRAM --only NAME[,NAME...]    the tests named;
+ *   PROGRAM --except NAME[,NAME...]  every test but those named (a program's last part, where a test added
+ *                                    later runs without anyone listing it).
+ * A name that is no test of the program, or any other argument, fails the run (exit 1), so that a renamed
+ * test cannot drop out of its part unnoticed. Returns what cmocka's run returns. */
+int tu_run_tests(const char *group, const struct CMUnitTest *tests, size_t n, CMFixtureFunction setup,
+                 CMFixtureFunction teardown, int argc, char **argv);
+#define tu_run_group_tests(tests, setup, teardown, argc, argv) \
+    tu_run_tests(#tests, tests, sizeof(tests) / sizeof((tests)[0]), setup, teardown, argc, argv)
+
 /* A fresh directory under the build tree for this test program; returns its path. */
 const char *tu_tmpdir(const char *test_name);
 /* Path buf = dir/name. */
