@@ -8,8 +8,8 @@
 #include <cmocka.h>
 #include "microshadow.h"
 
-/* Runs the cmocka tests[0..n) of a program, all of them or the part its command line selects, so that one long
- * program can be several ctest entries that `ctest -j` runs side by side (ms_test_parts in tests/CMakeLists.txt):
+/* Runs the cmocka tests[0..n) of a program, all of them or the part its command line selects (to run or time one
+ * test alone, or to make one long program several ctest entries that `ctest -j` runs side by side):
  *   PROGRAM                          every test;
  *   PROGRAM --only NAME[,NAME...]    the tests named;
  *   PROGRAM --except NAME[,NAME...]  every test but those named (a program's last part, where a test added
