@@ -95,8 +95,6 @@ typedef struct ms_render_options {
     void *progress_user;
     ms_isa isa;             /* cap on the instruction set of kernels and traversal; MS_ISA_AUTO: the CPU's best */
     /* Switches to measure what a part buys; leave them 0. */
-    int no_occlusion_cull;  /* micro-raster methods: no coverage cull of BVH nodes */
-    int no_child_order;     /* micro-raster methods: no near-first order of BVH children */
     ms_embree_mode embree_mode;
     ms_embree_filter embree_filter;
     ms_traversal traversal; /* micro-raster methods: block (default) or per-pixel traversal */

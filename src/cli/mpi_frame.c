@@ -58,8 +58,7 @@ static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
     const char *m = o->method ? o->method : MS_DEFAULT_METHOD;
     h = ms_mpi_hash(h, m, strlen(m));
     const int v[] = { (int)o->pattern, o->samples, o->width, o->height, (int)o->seed, (int)o->traversal,
-                      o->frustum_shrink, o->no_filter, o->no_occlusion_cull, o->no_child_order, o->aa, o->aa_split,
-                      s->aa };
+                      o->frustum_shrink, o->no_filter, o->aa, o->aa_split, s->aa };
     return ms_mpi_hash(h, v, sizeof v);
 }
 

@@ -68,9 +68,7 @@
 #define MFT_MAX_SKIP MS_BLOCK_LANES
 /* Cells of a footprint-cut rectangle above which the corner rays are still tried (measured against 64 and
  * "never"). */
-#ifndef MFT_CORNER_AREA
 #define MFT_CORNER_AREA 256.0f
-#endif
 
 typedef struct mft_state {
     ms_block_frusta *fr;
@@ -382,9 +380,7 @@ static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
  * cuts of at most MFT_GRID_ROWS rows, 16 lanes at once (taller cuts: the per-row work cost more than it
  * saved; docs/notebook/2026-11-26-mft-grid-setup-and-footprint.md). */
 #define MFT_GRID_EPS 1e-3f
-#ifndef MFT_GRID_ROWS
 #define MFT_GRID_ROWS 2
-#endif
 /* Per lane, the columns of the cut's first MFT_GRID_ROWS rows that hold a sample in the footprint's box:
  * first and last, by row. */
 typedef struct mft_grid_box {
@@ -490,7 +486,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         const l16 lamax = l16_max(la[0], l16_max(la[1], la[2]));
         const unsigned grazing = l16_le(an, l16_mul(lamax, l16_set1(nl1 * 1e-4f)));
         const unsigned foot_lanes = pass & s->has_m & ~grazing;
-        if (!(f->flags & MS_MFT_NO_FOOTPRINT) && foot_lanes) {
+        if (foot_lanes) {
             float box[4][MS_BLOCK_LANES];
             unsigned empty = 0;
             foot = mft_footprint16(s, a, la, foot_lanes, &empty, box);
