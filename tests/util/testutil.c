@@ -59,6 +59,30 @@ int tu_write_file(const char *path, const char *text)
     return fclose(f);
 }
 
+void tu_write_texture_png(const char *path, int w, int h, const float *rgb)
+{
+    ms_frame f;
+    memset(&f, 0, sizeof f);
+    f.width = w;
+    f.height = h;
+    float *vis = calloc((size_t)w * h, sizeof *vis);
+    assert_non_null(vis);
+    f.vis = vis;
+    f.rgb = (float *)rgb;
+    f.exposure = 1.0f;
+    char err[256];
+    assert_int_equal(ms_write_png(&f, path, err, sizeof err), 0);
+    free(vis);
+}
+
+void tu_unit3(double v[3])
+{
+    const double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    v[0] /= l;
+    v[1] /= l;
+    v[2] /= l;
+}
+
 int tu_file_exists(const char *path) { return access(path, F_OK) == 0; }
 
 int tu_count_entries(const char *dir)
@@ -227,6 +251,15 @@ ms_isa tu_isa_cap(void)
         abort();
     }
     return cap;
+}
+
+void tu_bake_options(ms_bake_options *bo, int size, int uv_set, int samples)
+{
+    memset(bo, 0, sizeof *bo);
+    bo->size = size;
+    bo->uv_set = uv_set;
+    bo->points.samples = samples;
+    bo->points.isa = tu_isa_cap();
 }
 
 void tu_render_options_default(ms_render_options *o)

@@ -13,6 +13,9 @@ const char *tu_tmpdir(const char *test_name);
 /* Path buf = dir/name. */
 const char *tu_path(char *buf, size_t n, const char *dir, const char *name);
 int tu_write_file(const char *path, const char *text);
+/* Writes a w x h PNG whose linear texels are rgb (ms_write_png, exposure 1): values 0 or 1 survive the 8-bit
+ * sRGB round trip exactly, for light and material textures. Fails the test when it cannot. */
+void tu_write_texture_png(const char *path, int w, int h, const float *rgb);
 /* Base64 of in[0..n) into out (4 ceil(n/3) characters and a NUL), for glTF data: URIs written by tests. */
 void tu_base64(const unsigned char *in, size_t n, char *out);
 /* An 8-bit RGB image of w x h texels (rows top first) as a PNG (libpng), base64-encoded into out[cap]: the payload
@@ -92,8 +95,13 @@ int tu_shadow_vs(const struct ms_shadow_method *m, void *state, const struct ms_
  * selection functions and run a forced SIMD variant only when tu_isa_allowed grants it, so that CI can run
  * the whole suite on the portable path (.ci/run). An unknown value aborts the test. */
 ms_isa tu_isa_cap(void);
+/* v scaled to unit length (v not zero). */
+void tu_unit3(double v[3]);
 /* ms_render_options_default with the run's ISA cap, for the tests that render whole frames. */
 void tu_render_options_default(ms_render_options *o);
+/* Zeroed bake options with the lightmap's size, UV set (-1: xatlas for every triangle), light samples and the
+ * run's ISA cap. */
+void tu_bake_options(ms_bake_options *bo, int size, int uv_set, int samples);
 int tu_isa_allowed(ms_isa isa);
 
 /* splitmix64: small, seedable, reproducible random numbers for the randomized tests. */
