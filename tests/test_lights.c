@@ -375,25 +375,6 @@ static void test_disk_irradiance(void **st)
     assert_true(worst_cross < 1e-3);
 }
 
-/* ---- textured lights ---- */
-
-/* Writes a w x h PNG whose linear texels are rgb (values 0 or 1 survive the 8-bit sRGB round trip exactly). */
-static void write_texture_png(const char *path, int w, int h, const float *rgb)
-{
-    ms_frame f;
-    memset(&f, 0, sizeof f);
-    f.width = w;
-    f.height = h;
-    float *vis = calloc((size_t)w * h, sizeof *vis);
-    assert_non_null(vis);
-    f.vis = vis;
-    f.rgb = (float *)rgb;
-    f.exposure = 1.0f;
-    char err[256];
-    assert_int_equal(ms_write_png(&f, path, err, sizeof err), 0);
-    free(vis);
-}
-
 /* ---- sphere lights ---- */
 
 /* The outline disk against the exact tangent cone: every rim point lies on the sphere and its tangent

@@ -276,7 +276,7 @@ void al_load_scene(const char *format, ms_scene *sc, char *dir_out, size_t dn)
     const int rc = ms_scene_load(tu_path(path, sizeof path, dir, "scene.json"), sc, err, sizeof err);
     if (rc) fprintf(stderr, "%s\n", err);
     assert_int_equal(rc, 0);
-    assert_int_equal((int)sc->al_n_tris, al_n_tris);
+    assert_int_equal((int)sc->n_tris, al_n_tris);
 }
 
 /* ---- the oracle ---- */
@@ -363,13 +363,13 @@ void al_setup_make(setup *s, const char *format, int size)
 {
     memset(s, 0, sizeof *s);
     al_load_scene(format, &s->sc, s->dir, sizeof s->dir);
-    assert_int_equal(ms_bvh_build(&s->bvh, s->sc.tri, s->sc.al_n_tris, 1), 0);
+    assert_int_equal(ms_bvh_build(&s->bvh, s->sc.tri, s->sc.n_tris, 1), 0);
     assert_int_equal(ms_alpha_build(&s->sc, &s->bvh, &s->alpha), 0);
     assert_non_null(s->alpha);
     assert_int_equal((int)s->alpha->n_alpha, al_n_tris - 2);
-    s->oracle_tri = malloc(s->bvh.al_n_tris * sizeof *s->oracle_tri);
+    s->oracle_tri = malloc(s->bvh.n_tris * sizeof *s->oracle_tri);
     assert_non_null(s->oracle_tri);
-    for (uint32_t i = 0; i < s->bvh.al_n_tris; i++) {
+    for (uint32_t i = 0; i < s->bvh.n_tris; i++) {
         s->oracle_tri[i] = al_oracle_index(s->bvh.tri + 9 * (size_t)i);
         assert_int_equal(s->alpha->flag[i], al_tris[s->oracle_tri[i]].alpha);
     }
