@@ -93,19 +93,9 @@ static void check_disk_methods(ms_scene *sc, const disk_geom *dg, int size, int 
     tu_ctx_init(&ctx, sc, &bvh, size, size, k);
     tu_ctx_set_pattern(&ctx, pat);
     ctx.seed = 7;
-    const ms_primary_method *pm = ms_find_primary_method("bvh");
     char err[256];
-    void *ps = NULL;
-    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
-    ms_hit *hits = malloc((size_t)size * size * sizeof *hits);
-    ms_shadow_query *q = malloc((size_t)size * size * sizeof *q);
-    assert_non_null(hits);
-    assert_non_null(q);
-    pm->trace(ps, &ctx, 0, 0, size, size, hits);
-    pm->destroy(ps);
-    int nq = 0;
-    for (int i = 0; i < size * size; i++)
-        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[nq++], &hits[i], i % size, i / size);
+    int nq;
+    ms_shadow_query *q = tu_frame_queries(&ctx, size, &nq);
     assert_true(nq > 0);
     const size_t mw = (size_t)ctx.mask_words;
     const int spp = ctx.samples;
@@ -169,7 +159,7 @@ static void check_disk_methods(ms_scene *sc, const disk_geom *dg, int size, int 
         }
     assert_true(have_ref);
     assert_true(sure > total * 99 / 100);   /* the brute force decides nearly every sample */
-    free(bc); free(bv); free(front); free(ref); free(vis); free(pts); free(hits); free(q);
+    free(bc); free(bv); free(front); free(ref); free(vis); free(pts); free(q);
     ms_bvh_free(&bvh);
 }
 

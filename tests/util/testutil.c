@@ -578,3 +578,32 @@ uint64_t tu_stat_counter(const ms_stats *st, const char *name)
     fail_msg("no counter %s", name);
     return 0;
 }
+
+struct ms_shadow_query *tu_frame_queries(const struct ms_render_ctx *ctx, int size, int *nq)
+{
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    assert_non_null(pm);
+    char err[256];
+    void *ps = NULL;
+    assert_int_equal(pm->create(ctx, &ps, err, sizeof err), 0);
+    ms_hit *hits = malloc((size_t)size * size * sizeof *hits);
+    ms_shadow_query *q = malloc((size_t)size * size * sizeof *q);
+    assert_non_null(hits);
+    assert_non_null(q);
+    pm->trace(ps, ctx, 0, 0, size, size, hits);
+    pm->destroy(ps);
+    int n = 0;
+    for (int i = 0; i < size * size; i++)
+        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[n++], &hits[i], i % size, i / size);
+    free(hits);
+    *nq = n;
+    return q;
+}
+
+void tu_shared_scene_load(const char *rel, ms_scene *sc)
+{
+    if (!tu_have_shared_scenes()) skip();
+    char path[4096], err[512] = "";
+    const int rc = ms_scene_load(tu_shared_scene(path, sizeof path, rel), sc, err, sizeof err);
+    if (rc) fail_msg("%s: %s", rel, err);
+}

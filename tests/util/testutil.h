@@ -47,6 +47,9 @@ int tu_run_cli_ex(const char *const *args, const tu_run_opts *opts, char *err_al
 void tu_make_quad(ms_scene *sc);
 /* 1 if ../shared/scenes is present; prints a skip message otherwise. */
 int tu_have_shared_scenes(void);
+/* Loads the shared scene at rel (under ../shared/scenes) into sc; skips the test when the folder is absent, fails it
+ * when the scene does not load. */
+void tu_shared_scene_load(const char *rel, ms_scene *sc);
 const char *tu_shared_scene(char *buf, size_t n, const char *rel);
 /* Reads a PFM written by ms_write_vis into a top-row-first array (caller frees). */
 float *tu_read_pfm(const char *path, int *w, int *h);
@@ -80,6 +83,10 @@ struct ms_bvh;
 struct ms_hit;
 /* The shadow query of a primary hit at pixel (x, y), as ms_render makes it. */
 void tu_query_from_hit(struct ms_shadow_query *q, const struct ms_hit *h, int x, int y);
+/* The queries of a size x size frame under ctx: camera rays through the bvh primary, one query per pixel that
+ * hits, in pixel order. A malloc'ed array (room for every pixel), their count in *nq; fails the test when out of
+ * memory. */
+struct ms_shadow_query *tu_frame_queries(const struct ms_render_ctx *ctx, int size, int *nq);
 /* A frame context as ms_render sets it up: grid pattern, k x k samples, the scene's camera at W x H. */
 void tu_ctx_init(struct ms_render_ctx *ctx, const ms_scene *sc, const struct ms_bvh *bvh, int W, int H, int k);
 /* Switches ctx to pattern p at its k (k*k samples in all): samples per pixel and mask words as ms_render
