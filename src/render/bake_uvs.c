@@ -327,7 +327,7 @@ static int fit_one_page(ms_xpack *xp, double area, int size, int pad, double *sc
  * density T over as many pages as it takes, or on one page at the largest scale that fits. Sets the regions'
  * places, the charted triangles' UVs and pages in out, out->pages and rep->charts. 0, or -1 with a message. */
 static int place_charts(const float *xtri, size_t n, const uint8_t *want, const uint32_t *group, int size, int pad, double T,
-                        const ms_unwrap_tuning *tuning, float *xuv, uint32_t *xpage, ms_pack_rect *rs, size_t nr,
+                        float *xuv, uint32_t *xpage, ms_pack_rect *rs, size_t nr,
                         ms_bake_uv_layout *out, ms_bake_uv_report *rep, char *err, size_t errlen)
 {
     ms_unwrap_info info;
@@ -338,7 +338,7 @@ static int place_charts(const float *xtri, size_t n, const uint8_t *want, const 
     uint32_t *xkey = NULL;
     size_t *xtri_of = NULL;
     const int res = size - 2 * pad;
-    if (ms_lightmap_unwrap(xtri, n, want, group, res, pad, (float)T, tuning, xuv, xpage, &info, err, errlen)) goto fail;
+    if (ms_lightmap_unwrap(xtri, n, want, group, res, pad, (float)T, xuv, xpage, &info, err, errlen)) goto fail;
     rep->charts = info.charts;
     const double k0 = T > 0.0 ? 1.0 : info.texels_per_unit;   /* region texels per rs unit at the charts' density */
     rdim = malloc((nr ? nr : 1) * 4 * sizeof *rdim);
@@ -487,7 +487,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
      * found by stepping it. */
     if (!n_want) {
         if (place_regions(rs, nr, size, pad, T, &out->pages, err, errlen)) goto out;
-    } else if (place_charts(xtri, n, want, group, size, pad, T, p->tuning, xuv, xpage, rs, nr, out, rep, err, errlen)) {
+    } else if (place_charts(xtri, n, want, group, size, pad, T, xuv, xpage, rs, nr, out, rep, err, errlen)) {
         goto out;
     }
     rep->regions = nr;

@@ -50,7 +50,7 @@ static int cmp_order(const void *a, const void *b)
 }
 
 int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const uint32_t *group, int size, int padding,
-                       float density, const ms_unwrap_tuning *tuning, float *uv, uint32_t *atlas_of, ms_unwrap_info *info,
+                       float density, float *uv, uint32_t *atlas_of, ms_unwrap_info *info,
                        char *err, size_t errlen)
 {
     ms_unwrap_info dummy;
@@ -121,8 +121,7 @@ int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const ui
     }
     xatlasAddMeshJoin(atlas);
     ms_unwrap_tuning tu;
-    if (tuning) tu = *tuning;
-    else ms_lightmap_unwrap_tuning_default(&tu);
+    ms_lightmap_unwrap_tuning_default(&tu);
     xatlasChartOptions co;
     xatlasChartOptionsInit(&co);
     co.normalDeviationWeight = tu.normal_deviation;
