@@ -41,7 +41,7 @@ static inline const ms_abi *ms_abi_compiled(void)
     return &abi;
 }
 
-/* The exported forms of the checked entry points: abi first, then the arguments documented above
+/* The exported forms of the checked entry points: abi first, then the arguments documented in the other parts
  * (ms_scene_load is ms_scene_load_abi with opt NULL). */
 MS_API ms_status ms_scene_load_abi(const ms_abi *abi, const char *json_path, const ms_scene_load_options *opt,
                                    ms_scene *out, char *err, size_t errlen);

@@ -1,7 +1,8 @@
 /* One frame over MPI ranks (mpi_run.h, docs/mpi.md): every rank sets up its own ms_frame_job (scene, BVH,
  * methods), the ranks take chunks of tiles under the chosen schedule, rank 0 gathers the other ranks' tiles
  * (every light's V, S, S_spec and front counts, unfiltered) and the sums of their stats into its job and
- * finishes the frame there, which makes it ms_render's frame bit for bit (microshadow.h, "A frame tile by tile"). */
+ * finishes the frame there, which makes it ms_render's frame bit for bit (microshadow/render.h, "A frame tile by
+ * tile"). */
 #include "mpi_run.h"
 #include <mpi.h>
 #include <limits.h>

@@ -1,4 +1,4 @@
-/* Lightmap baking (microshadow.h, "Lightmap baking"): UVs (the scene's set, xatlas for the rest), texels
+/* Lightmap baking (microshadow/bake.h, "Lightmap baking"): UVs (the scene's set, xatlas for the rest), texels
  * rasterized conservatively onto the triangles' UV images and carried to world points, V and S there
  * through ms_visibility_points (so every method bakes, on the frames' sample patterns keyed by texel),
  * irradiance from the exact unshadowed value times S, then dilation across chart seams and the seams

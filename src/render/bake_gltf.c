@@ -1,4 +1,4 @@
-/* The bake back onto the asset (microshadow.h, "The bake back onto the asset"): the scene's triangles, their
+/* The bake back onto the asset (microshadow/bake.h, "The bake back onto the asset"): the scene's triangles, their
  * materials and textures, TEXCOORD_1 = the baked UVs, the lightmap (MOZ_lightmap) and the shadowmask, as one
  * binary glTF 2.0. The JSON is built with cJSON; the binary chunk is ours: every accessor and image in one
  * buffer, each view aligned to 4 bytes. */

@@ -1,4 +1,4 @@
-/* The UVs a bake bakes into (microshadow.h, "Lightmap baking"; docs/baking.md, "Charts").
+/* The UVs a bake bakes into (microshadow/bake.h, "Lightmap baking"; docs/baking.md, "Charts").
  *
  * Per object (ms_scene.tri_object: a glTF node's mesh, a file of another format), the first of its UV sets
  * (the one asked for, then 0, 1, ...) that is a valid layout of the object (uv_validity.c: present on every

@@ -1,4 +1,4 @@
-/* Visibility at caller-given points (microshadow.h, "Visibility at any points"): the driver ms_render
+/* Visibility at caller-given points (microshadow/points.h, "Visibility at any points"): the driver ms_render
  * is for frames, without the camera. Points are grouped by proximity (30-bit Morton codes of their
  * positions in the points' bounding box) into batches of BATCH, and each batch goes through the shadow
  * method interface exactly as a frame tile does in frame_job.c: front masks (receiver.c), the method's
