@@ -1,10 +1,11 @@
-# `cmake --install`: the header, the static and shared libraries, the CLI, a relocatable CMake package
+# `cmake --install`: the header and its parts (include/microshadow/), the static and shared libraries, the CLI, a relocatable CMake package
 # (find_package(microshadow): microshadow::microshadow is the shared library, microshadow::microshadow_static
 # the static one with its dependencies, microshadow::cli the program) and pkg-config files
 # (microshadow: shared; microshadow-static: the archive and everything it needs).
 include(CMakePackageConfigHelpers)
 
 install(FILES include/microshadow.h ${PROJECT_BINARY_DIR}/include/microshadow_version.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY include/microshadow/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/microshadow FILES_MATCHING PATTERN "*.h")
 install(TARGETS microshadow microshadow_shared microshadow_cli EXPORT microshadowTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -81,11 +81,7 @@ static void write_scene(const char *dir, char *json_path, size_t n)
 static void bake(const ms_scene *sc, ms_lightmap *lm)
 {
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.uv_set = 1;
-    bo.points.samples = SAMPLES;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, SIZE, 1, SAMPLES);
     char err[512] = "";
     assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
 }
@@ -391,11 +387,7 @@ static void test_validator(void **st)
     ms_lightmap_free(&lm);
     assert_int_equal(ms_scene_default(&sc), 0);
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = 64;
-    bo.uv_set = -1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, 64, -1, 256);
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
     tu_path(path, sizeof path, dir, "builtin.glb");
     assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, path, err, sizeof err), MS_OK);
@@ -480,11 +472,7 @@ static void test_unbaked_named(void **st)
     ms_scene sc;
     assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = 64;
-    bo.uv_set = -1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, 64, -1, 256);
     ms_lightmap lm;
     g_warnings[0] = 0;
     ms_set_warning_handler(keep_warning, NULL);
