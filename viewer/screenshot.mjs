@@ -16,7 +16,7 @@ for (let i = 0; i < args.length; i++) {
   if (args[i].startsWith('--')) opt[args[i].slice(2)] = args[++i];
   else pos.push(args[i]);
 }
-if (pos.length !== 3) { console.error('usage: node screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode M]'); process.exit(2); }
+if (pos.length !== 3) { console.error('usage: node screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode M] [--shadowmask off]'); process.exit(2); }
 const [glb, sceneFile, out] = pos;
 const server = await serve([glb, sceneFile]);
 const { port } = server.address();
