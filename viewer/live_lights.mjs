@@ -7,8 +7,8 @@
 // Units, per light of radiance L (microshadow: every shape emits as a one-sided Lambertian surface, and a
 // Lambertian receiver of albedo a shows a E S / pi, E the unshadowed irradiance; docs/design.md, "Units"):
 // - rect: RectAreaLight of intensity L. three.js shades it with LTC: diffuse = colour x diffuseColor x F, F the
-//   rectangle's (horizon-clipped) form factor, i.e. E / (pi L); so its diffuse radiance is a L E / (pi L) x L =
-//   a E / pi, microshadow's. (three.js calls the intensity luminance in nits: power = intensity x pi x area, as
+//   rectangle's form factor clipped to the receiver's horizon (exactly, with exactLtcPars below), i.e. E / (pi L);
+//   so its diffuse radiance is a x L x E / (pi L) = a E / pi, microshadow's. (three.js calls the intensity luminance in nits: power = intensity x pi x area, as
 //   microshadow's flux = pi A L.) A parallelogram is kept: the light's matrix carries the two edge directions,
 //   which three.js turns into its half-width and half-height vectors without making them orthogonal.
 // - disk: no disk light in three.js; a RectAreaLight square of the disk's area (side r sqrt(pi)), centre and
@@ -121,6 +121,33 @@ function maskedLightsChunk() {
   return chunk;
 }
 
+// LTC_Evaluate with the polygon clipped to the receiver's horizon exactly (Heitz et al. 2016, as microshadow's
+// irradiance and its LTC specular clip it) in place of three.js's approximation of a clipped polygon by a sphere
+// of the same vector form factor, which departs wherever a large, near light straddles the horizon (curved
+// receivers under it). The clipped polygon has at most 5 vertices.
+const exactClip = `
+	vec3 clipped[ 5 ];
+	int nc = 0;
+	for ( int k = 0; k < 4; k ++ ) {
+		vec3 a = coords[ k ], b = coords[ ( k + 1 ) % 4 ];
+		if ( a.z > 0.0 ) { clipped[ nc ] = a; nc ++; }
+		if ( ( a.z > 0.0 ) != ( b.z > 0.0 ) ) { clipped[ nc ] = mix( a, b, a.z / ( a.z - b.z ) ); nc ++; }
+	}
+	vec3 vectorFormFactor = vec3( 0.0 );
+	for ( int k = 0; k < 5; k ++ ) {
+		if ( k >= nc ) break;
+		vectorFormFactor += LTC_EdgeVectorFormFactor( normalize( clipped[ k ] ), normalize( clipped[ ( k + 1 ) % nc ] ) );
+	}
+	float result = max( vectorFormFactor.z, 0.0 );`;
+
+function exactLtcPars() {
+  const chunk = THREE.ShaderChunk.lights_physical_pars_fragment;
+  const from = 'coords[ 0 ] = normalize( coords[ 0 ] );', to = 'float result = LTC_ClippedSphereFormFactor( vectorFormFactor );';
+  const a = chunk.indexOf(from), b = chunk.indexOf(to);
+  if (a < 0 || b < a) throw new Error("three.js's LTC_Evaluate has changed: the horizon clipping patch needs updating");
+  return chunk.slice(0, a) + exactClip.trim() + chunk.slice(b + to.length);
+}
+
 let white = null;
 
 // Patches material m (a MeshStandardMaterial of the glb) to shadow the live lights by its shadowmask texture `mask`
@@ -151,6 +178,7 @@ export function shadowmaskMaterial(m, mask, channels, live) {
       .replace('#include <uv_vertex>', '#include <uv_vertex>\nvMsUv1 = uv1;');
     shader.fragmentShader = shader.fragmentShader
       .replace('#include <common>', `#include <common>\n${fragmentDecl}`)
+      .replace('#include <lights_physical_pars_fragment>', exactLtcPars())
       .replace('#include <lights_fragment_begin>', maskedLightsChunk());
   };
   m.customProgramCacheKey = () => 'microshadow-shadowmask';
