@@ -147,8 +147,10 @@ static inline ms_status ms_bake_write_uv_cache(const ms_lightmap *lm, FILE *out,
  * material carries a normal texture (the scene's tangents, MikkTSpace's where the asset has none); triangles without
  * baked UVs (a mesh left out of the bake, triangles xatlas left out) form their own primitive without TEXCOORD_1 and
  * without the lightmap, its extras {"name": "not baked: REASON", "triangles": n} and its material's name saying
- * why. The scene's extras.microshadow {exposure, exposure_diffuse}: the automatic exposures of microshadow's frame
- * of the scene's camera (ms_render_options.shading standard, diffuse), for a viewer's default. Materials carry
+ * why. The scene's extras.microshadow {lights, exposure, exposure_diffuse}: the scene's lights as ms_scene_lights
+ * lists them (the shadowmask channels' "light" indices), in the glb's world coordinates, with their shape, geometry
+ * and radiance (docs/baking.md), for a viewer's live lights; the automatic exposures of microshadow's frame of the
+ * scene's camera (ms_render_options.shading standard, diffuse), for a viewer's default. Materials carry
  * the scene's base colour, metallic, roughness, emission and alpha mode, and their base-colour, normal,
  * emissive and metallic-roughness textures (the decoded texels re-encoded as PNG: no file is read) where
  * those use UV set 0. Every baked material references:

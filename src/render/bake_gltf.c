@@ -11,6 +11,7 @@
 #include "frame_shade.h"
 #include "light/light_shape.h"
 #include "bake_gltf_pages.h"
+#include "bake_gltf_lights.h"
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
@@ -472,12 +473,14 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     return prim;
 }
 
-/* The exposures microshadow's frame of the scene's camera picks by itself (frame_shade.h), standard and diffuse,
- * in the scene's extras.microshadow, so that a viewer shows the bake as the frame shows the scene by default
- * (viewer/index.html: three.js puts them in gltf.scene.userData). Left out, with a warning, if they cannot be
- * computed: the glb is still whole. */
-static void add_exposures(const ms_scene *sc, cJSON *scene0)
+/* The scene's extras.microshadow (viewer/index.html: three.js puts them in gltf.scene.userData): the scene's
+ * lights (bake_gltf_lights.h), and the exposures microshadow's frame of the scene's camera picks by itself
+ * (frame_shade.h), standard and diffuse, so that a viewer shows the bake as the frame shows the scene by default.
+ * The exposures are left out, with a warning, if they cannot be computed: the glb is still whole. */
+static void add_scene_extras(const ms_scene *sc, cJSON *scene0)
 {
+    cJSON *ms = cJSON_AddObjectToObject(cJSON_AddObjectToObject(scene0, "extras"), "microshadow");
+    ms_bake_gltf_lights(ms, sc);
     float e[2];
     char why[256] = "";
     for (int k = 0; k < 2; k++)
@@ -485,7 +488,6 @@ static void add_exposures(const ms_scene *sc, cJSON *scene0)
             ms_warn("the glTF carries no exposure for its viewer: %s", why);
             return;
         }
-    cJSON *ms = cJSON_AddObjectToObject(cJSON_AddObjectToObject(scene0, "extras"), "microshadow");
     cJSON_AddNumberToObject(ms, "exposure", e[0]);
     cJSON_AddNumberToObject(ms, "exposure_diffuse", e[1]);
 }
@@ -654,7 +656,7 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
     if (w.used_emissive_strength) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_materials_emissive_strength"));
     cJSON *scene0 = cJSON_CreateObject();
     cJSON_AddItemToArray(cJSON_AddArrayToObject(scene0, "nodes"), cJSON_CreateNumber(0));
-    add_exposures(sc, scene0);
+    add_scene_extras(sc, scene0);
     cJSON_AddItemToArray(scenes, scene0);
     if (w.bin.oom) { snprintf(err, errlen, "out of memory for the glTF's binary chunk"); st = MS_ERR_NO_MEMORY; goto done; }
     bin_put(&w.bin, NULL, 0);   /* pad to 4 */
