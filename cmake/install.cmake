@@ -1,10 +1,11 @@
-# `cmake --install`: the header, the static and shared libraries, the CLI, a relocatable CMake package
+# `cmake --install`: the header and its parts (include/microshadow/), the static and shared libraries, the CLI, a relocatable CMake package
 # (find_package(microshadow): microshadow::microshadow is the shared library, microshadow::microshadow_static
 # the static one with its dependencies, microshadow::cli the program) and pkg-config files
 # (microshadow: shared; microshadow-static: the archive and everything it needs).
 include(CMakePackageConfigHelpers)
 
 install(FILES include/microshadow.h ${PROJECT_BINARY_DIR}/include/microshadow_version.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY include/microshadow/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/microshadow FILES_MATCHING PATTERN "*.h")
 install(TARGETS microshadow microshadow_shared microshadow_cli EXPORT microshadowTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
@@ -21,7 +22,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/microshadowConfig.cmake
 # pkg-config: prefix relative to the .pc file's own folder, so an install under any --prefix works.
 file(RELATIVE_PATH MS_PC_TO_PREFIX "/p/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/p")
 string(REGEX REPLACE "/$" "" MS_PC_TO_PREFIX "${MS_PC_TO_PREFIX}")
-set(MS_PC_REQUIRES "libcjson libpng libturbojpeg OpenEXR")
+set(MS_PC_REQUIRES "libcjson libpng libturbojpeg libzstd OpenEXR")
 get_filename_component(MS_EXRCORE_NAME ${OPENEXRCORE_LIB} NAME_WE)
 string(REGEX REPLACE "^lib" "-l" MS_PC_LIBS_PRIVATE "${MS_EXRCORE_NAME}")
 if(MS_HAVE_EMBREE)

@@ -2,8 +2,10 @@
 # The images of docs/baking.md, into docs/images/: the Quad's and the built-in scene's lightmaps, a frame of the
 # built-in scene, and the Stanford bunny (../shared/scenes) baked into a glTF, shown by the three.js viewer in
 # headless chromium beside microshadow's own frame of the same camera. Prints the bunny bake's summary line
-# (bake time, texels/s, seams) and the validator's verdict on its glb.
-# Usage: scripts/make_bake_images.sh [BUILD_DIR]   (a Release build: default build/; needs node, chromium and
+# (bake time, texels/s, seams) and the validator's verdict on its glb. With HELMET_DIR set to a folder holding
+# Khronos' FlightHelmet sample (FlightHelmet.gltf; fetched by hand, it is not in ../shared), the same three
+# pictures of it on a ground with two rect lights, baked with the default options.
+# Usage: [HELMET_DIR=DIR] scripts/make_bake_images.sh [BUILD_DIR]   (a Release build: default build/; needs node, chromium and
 # viewer/node_modules for the viewer's image: scripts/install-deps.sh)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -42,3 +44,21 @@ print(ms.render(ms.load('$bunny'), width=512, height=512, samples=1024)['exposur
 import json; s = json.load(open('$bunny')); s['camera']['width'] = s['camera']['height'] = 512
 json.dump({'camera': s['camera']}, open('$tmp/camera.json', 'w'))"
 node "$root/viewer/screenshot.mjs" "$tmp/bunny.glb" "$tmp/camera.json" "$out/bake_bunny_viewer.png" --exposure "$exposure"
+
+# The FlightHelmet on a 2 x 2 ground, two rect lights (20 W above, 10 W from the side), default bake options at
+# 1024²; the viewer takes the exposure the bake wrote into the glb, the frame is --shading diffuse (what a
+# lightmap can show).
+if [ -n "${HELMET_DIR:-}" ]; then
+  printf 'v -1 -0.4404 -1\nv 1 -0.4404 -1\nv 1 -0.4404 1\nv -1 -0.4404 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 1 0\nf 1/1/1 3/3/1 2/2/1\nf 1/1/1 4/4/1 3/3/1\n' >"$tmp/ground.obj"
+  cat >"$tmp/helmet.json" <<EOF
+{ "meshes": [ { "file": "$(cd "$HELMET_DIR" && pwd)/FlightHelmet.gltf" }, { "file": "ground.obj" } ],
+  "camera": { "eye": [0.6, 0.2, 0.9], "target": [0, -0.15, 0], "up": [0, 1, 0], "fov_y": 45, "width": 512, "height": 512 },
+  "lights": [ { "corner": [-0.3, 0.8, 0.1], "edge_s": [0.4, 0, 0], "edge_t": [0, 0, 0.4], "power": 20 },
+              { "corner": [0.8, -0.3, -0.2], "edge_s": [0, 0, 0.4], "edge_t": [0, 0.4, 0], "power": 10 } ] }
+EOF
+  "$ms" bake "$tmp/helmet.json" --size 1024 -o "$tmp/helmet.exr" --png "$out/bake_helmet_lightmap.png" --gltf "$tmp/helmet.glb" \
+      2>&1 | grep -v '^bake: '
+  node "$root/viewer/validate.mjs" "$tmp/helmet.glb"
+  node "$root/viewer/screenshot.mjs" "$tmp/helmet.glb" "$tmp/helmet.json" "$out/bake_helmet_viewer.png"
+  "$ms" "$tmp/helmet.json" --shading diffuse -o "$out/bake_helmet_frame.png"
+fi

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # The shared library exports exactly the API: every dynamic symbol it defines is an ms_ function declared
 # MS_API in the header, and every MS_API declaration is defined (a declared function that is missing would
-# fail only in a consumer's link). Usage: check_exports.sh LIBRARY.so include/microshadow.h
+# fail only in a consumer's link). The header is read with its parts, the microshadow/*.h beside it.
+# Usage: check_exports.sh LIBRARY.so include/microshadow.h
 set -euo pipefail
 lib=${1:?usage: check_exports.sh LIBRARY.so HEADER}
 header=${2:?usage: check_exports.sh LIBRARY.so HEADER}
-# The names the header declares MS_API (one declaration starts per line).
-declared=$(sed -n 's/^MS_API .*\b\(ms_[a-z0-9_]*\)(.*/\1/p' "$header" | sort -u)
+parts=("$(dirname "$header")"/microshadow/*.h)
+[ -e "${parts[0]}" ] || { echo "check_exports: no parts beside $header (microshadow/*.h)"; exit 1; }
+# The names the header and its parts declare MS_API (one declaration starts per line).
+declared=$(sed -n 's/^MS_API .*\b\(ms_[a-z0-9_]*\)(.*/\1/p' "$header" "${parts[@]}" | sort -u)
 [ -n "$declared" ] || { echo "check_exports: no MS_API declaration found in $header"; exit 1; }
 # Every defined dynamic symbol, of any kind (functions, data, weak, unique, absolute).
 exported=$(nm -D --defined-only "$lib" | awk '{print $NF}' | sed 's/@.*//' | sort -u)

@@ -11,7 +11,8 @@
  *   - the ground's material has a normal texture: its primitive carries TANGENT (unit, orthogonal to NORMAL,
  *     w = +-1), the others none; the Khronos glTF Validator (npm gltf-validator, viewer/validate.mjs) reports
  *     0 errors and 0 warnings (skipped with a message without node or the validator);
- *   - the CLI writes the glb with the EXR, and refuses a --gltf not ending in .glb with exit 2, writing nothing. */
+ *   - the CLI writes the glb with the EXR, and refuses a --gltf not ending in .glb with exit 2, writing nothing;
+ *   - the scene's extras list the scene's lights, every shape, in world coordinates, with their radiance. */
 #include "testutil.h"
 #include "glb_read.h"
 #include <math.h>
@@ -81,11 +82,7 @@ static void write_scene(const char *dir, char *json_path, size_t n)
 static void bake(const ms_scene *sc, ms_lightmap *lm)
 {
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.uv_set = 1;
-    bo.points.samples = SAMPLES;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, SIZE, 1, SAMPLES);
     char err[512] = "";
     assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
 }
@@ -391,11 +388,7 @@ static void test_validator(void **st)
     ms_lightmap_free(&lm);
     assert_int_equal(ms_scene_default(&sc), 0);
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = 64;
-    bo.uv_set = -1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, 64, -1, 256);
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
     tu_path(path, sizeof path, dir, "builtin.glb");
     assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, path, err, sizeof err), MS_OK);
@@ -480,11 +473,7 @@ static void test_unbaked_named(void **st)
     ms_scene sc;
     assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = 64;
-    bo.uv_set = -1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, 64, -1, 256);
     ms_lightmap lm;
     g_warnings[0] = 0;
     ms_set_warning_handler(keep_warning, NULL);
@@ -519,6 +508,71 @@ static void test_unbaked_named(void **st)
     ms_scene_free(&sc);
 }
 
+static double num(const cJSON *o, const char *key, int i)
+{
+    const cJSON *v = cJSON_GetObjectItem(o, key);
+    if (i >= 0) v = cJSON_GetArrayItem(v, i);
+    assert_true(cJSON_IsNumber(v));
+    return v->valuedouble;
+}
+
+/* The scene's lights in the glb (extras.microshadow.lights), for a viewer's live lights: every shape, in the scene's
+ * order, in world coordinates although the scene lies 1e5 from the origin (so that it is loaded into a frame of its
+ * own and the root node carries the origin), with their radiance ("power" converted: 40 W / (pi 4 m^2)). */
+static void test_lights_listed(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_gltf_lights");
+    char p[1024], json[1024], glb[1024], exr[1024], line[512];
+    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "ground.obj"),
+        "v 99998 0 -2\nv 99998 0 2\nv 100002 0 2\nv 100002 0 -2\nf 1 2 3 4\n"), 0);
+    assert_int_equal(tu_write_file(tu_path(json, sizeof json, dir, "scene.json"),
+        "{\"meshes\":[{\"file\":\"ground.obj\"}],"
+        "\"camera\":{\"eye\":[100000,6,6],\"target\":[100000,0,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":32,\"height\":32},\"lights\":["
+        "{\"corner\":[99999,3,-1],\"edge_s\":[2,0,0],\"edge_t\":[0,0,2],\"power\":40},"
+        "{\"shape\":\"disk\",\"center\":[100001,3,1],\"normal\":[0,-1,0],\"radius\":0.5,\"emission\":2},"
+        "{\"shape\":\"sphere\",\"center\":[100000,2,0],\"radius\":0.25,\"emission\":[3,2,1]},"
+        "{\"shape\":\"triangle\",\"vertices\":[[99999,2.5,1],[100000,2.5,1],[99999,2.5,2]],\"emission\":4},"
+        "{\"shape\":\"sun\",\"direction\":[0,1,1],\"angular_diameter_deg\":2,\"emission\":100}]}"), 0);
+    tu_path(glb, sizeof glb, dir, "lights.glb");
+    tu_path(exr, sizeof exr, dir, "lights.exr");
+    const char *args[] = { "bake", json, "--size", "32", "--samples", "256", "-o", exr, "--gltf", glb, "--quiet", NULL };
+    assert_int_equal(tu_run_cli(args, line, sizeof line), 0);
+    tu_glb g;
+    assert_int_equal(tu_glb_read(glb, &g), 0);
+    assert_true(fabs(num(tu_glb_item(&g, "nodes", 0), "translation", 0)) > 1e4);   /* the root carries the origin */
+    const cJSON *L = cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(tu_glb_item(&g, "scenes", 0), "extras"),
+                                                              "microshadow"), "lights");
+    assert_int_equal(cJSON_GetArraySize(L), 5);
+    static const char *const shape[5] = { "rect", "disk", "sphere", "triangle", "sun" };
+    static const double radiance[5] = { 40.0 / (M_PI * 4.0), 2, 3, 4, 100 };
+    for (int i = 0; i < 5; i++) {
+        const cJSON *l = cJSON_GetArrayItem(L, i);
+        assert_string_equal(cJSON_GetObjectItem(l, "shape")->valuestring, shape[i]);
+        assert_true(fabs(num(l, "radiance", 0) - radiance[i]) < 1e-5 * radiance[i]);
+    }
+    const double tol = 1e-4;
+    const cJSON *r = cJSON_GetArrayItem(L, 0), *d = cJSON_GetArrayItem(L, 1), *sp = cJSON_GetArrayItem(L, 2);
+    const cJSON *tr = cJSON_GetArrayItem(L, 3), *sun = cJSON_GetArrayItem(L, 4);
+    const double rc[3] = { 99999, 3, -1 }, re[3] = { 2, 0, 0 }, dc[3] = { 100001, 3, 1 }, sc[3] = { 100000, 2, 0 };
+    const double ta[3] = { 99999, 2.5, 1 }, tb[3] = { 1, 0, 0 }, tc[3] = { 0, 0, 1 };
+    for (int c = 0; c < 3; c++) {
+        assert_true(fabs(num(r, "corner", c) - rc[c]) < tol);
+        assert_true(fabs(num(r, "edge_s", c) - re[c]) < tol);
+        /* the disk as its bounding square: its centre the disk's, its edges 2 r */
+        assert_true(fabs(num(d, "corner", c) + 0.5 * (num(d, "edge_s", c) + num(d, "edge_t", c)) - dc[c]) < tol);
+        assert_true(fabs(num(sp, "center", c) - sc[c]) < tol);
+        assert_true(fabs(num(tr, "corner", c) - ta[c]) < tol);
+        assert_true(fabs(num(tr, "edge_s", c) - tb[c]) < tol);
+        assert_true(fabs(num(tr, "edge_t", c) - tc[c]) < tol);
+        assert_true(fabs(num(sun, "direction", c) - (c ? M_SQRT1_2 : 0.0)) < 1e-6);
+    }
+    assert_true(fabs(hypot(hypot(num(d, "edge_s", 0), num(d, "edge_s", 1)), num(d, "edge_s", 2)) - 1.0) < tol);
+    assert_true(fabs(num(sp, "radius", -1) - 0.25) < 1e-7);
+    assert_true(fabs(num(sun, "angular_diameter_deg", -1) - 2.0) < 1e-4);
+    tu_glb_free(&g);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -526,6 +580,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_unbaked_named),
         cmocka_unit_test(test_validator),
         cmocka_unit_test(test_cli),
+        cmocka_unit_test(test_lights_listed),
     };
     return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

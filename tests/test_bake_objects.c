@@ -130,11 +130,7 @@ static void keep_warning(void *user, const char *msg)
 static void bake(const ms_scene *sc, ms_lightmap *lm)
 {
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.uv_set = 1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, SIZE, 1, 256);
     char err[512] = "";
     assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
 }

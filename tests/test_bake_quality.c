@@ -44,11 +44,7 @@ static void note_pass(void *user, const char *pass, double s)
 static void bake(const ms_scene *sc, int no_fix, ms_lightmap *lm)
 {
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.uv_set = 0;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, SIZE, 0, 256);
     bo.no_leak_fix = no_fix;
     bo.pass = note_pass;
     char err[512] = "";
@@ -234,11 +230,7 @@ static void test_padding_and_seams(void **st)
     ms_scene sc;
     assert_int_equal(ms_scene_default(&sc), 0);
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = 256;
-    bo.uv_set = -1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, 256, -1, 256);
     char err[512] = "";
     ms_lightmap lm;
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);

@@ -54,11 +54,7 @@ static void write_sphere(const char *dir, const char *name, int normals, char *j
 static void bake(const ms_scene *sc, ms_lightmap *lm)
 {
     ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.uv_set = -1;
-    bo.points.samples = SAMPLES;
-    bo.points.isa = tu_isa_cap();
+    tu_bake_options(&bo, SIZE, -1, SAMPLES);
     /* the baked texels themselves: the seam stitch moves those its lookups read (test_bake_seams checks it) */
     bo.no_seam_stitch = 1;
     char err[512] = "";

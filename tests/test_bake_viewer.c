@@ -14,71 +14,71 @@
  * them). */
 #include "testutil.h"
 #include "glb_read.h"
+#include "viewer.h"
 #include <math.h>
 #include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-static int have_browser(void)
+/* The scene of both tests in dir, its path into json: a floor, a box standing on it, a plate above it casting a
+ * soft shadow, a rect light. With materials: a grey glossy floor, a red half-metallic box, a blue plate. */
+static void write_scene(const char *dir, int materials, char *json, size_t n)
 {
-    if (system("node --version > /dev/null 2>&1") != 0) { printf("skipped: node not found (scripts/install-deps.sh installs nodejs)\n"); return 0; }
-    if (access("/usr/bin/chromium", X_OK) != 0) { printf("skipped: /usr/bin/chromium not found (scripts/install-deps.sh installs chromium)\n"); return 0; }
-    if (access(MS_VIEWER_DIR "/node_modules/puppeteer-core/package.json", R_OK) != 0 ||
-        access(MS_VIEWER_DIR "/node_modules/three/build/three.module.js", R_OK) != 0) {
-        printf("skipped: " MS_VIEWER_DIR "/node_modules lacks three or puppeteer-core (scripts/install-deps.sh runs npm ci there)\n");
-        return 0;
+    static const char *const mesh[3][2] = {
+        { "floor", "v -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n" },
+        { "box", "v 0.5 0 -0.5\nv 1.5 0 -0.5\nv 1.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 -0.5\nv 1.5 1 -0.5\nv 1.5 1 0.5\nv 0.5 1 0.5\n"
+                 "f 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n" },
+        { "plate", "v -1.6 1.2 -0.6\nv -1.6 1.2 0.6\nv -0.4 1.2 0.6\nv -0.4 1.2 -0.6\nf 1 2 3 4\nf 4 3 2 1\n" },
+    };
+    char p[1024], name[64], text[1024];
+    if (materials)
+        assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "m.mtl"),
+            "newmtl floor\nKd 0.7 0.7 0.65\nPr 0.3\nPm 0\nnewmtl box\nKd 0.8 0.25 0.15\nPr 0.4\nPm 0.5\n"
+            "newmtl plate\nKd 0.2 0.35 0.8\nPr 0.6\nPm 0\n"), 0);
+    for (int m = 0; m < 3; m++) {
+        snprintf(name, sizeof name, "%s.obj", mesh[m][0]);
+        if (materials) snprintf(text, sizeof text, "mtllib m.mtl\nusemtl %s\n%s", mesh[m][0], mesh[m][1]);
+        else snprintf(text, sizeof text, "%s", mesh[m][1]);
+        assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, name), text), 0);
     }
-    return 1;
+    assert_int_equal(tu_write_file(tu_path(json, n, dir, "scene.json"),
+        "{\"meshes\":[{\"file\":\"floor.obj\"},{\"file\":\"box.obj\"},{\"file\":\"plate.obj\"}],"
+        "\"camera\":{\"eye\":[0,4.5,5.5],\"target\":[0,0.3,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":160,\"height\":120},"
+        "\"light\":{\"corner\":[-0.6,4,-0.6],\"edge_s\":[1.2,0,0],\"edge_t\":[0,0,1.2],\"emission\":[1,1,1]}}"), 0);
 }
 
-static double srgb_to_linear(double c)
+/* The scene baked (512^2, xatlas UVs, 256 samples) into lm and written as dir/scene.glb (its path into glb). */
+static void bake_glb(const ms_scene *sc, const char *dir, ms_lightmap *lm, char *glb, size_t n)
 {
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+    char err[512] = "";
+    ms_bake_options bo;
+    tu_bake_options(&bo, 512, -1, 256);
+    assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
+    tu_path(glb, n, dir, "scene.glb");
+    assert_int_equal(ms_bake_write_gltf(sc, lm, NULL, glb, err, sizeof err), MS_OK);
 }
 
 static void test_viewer_matches_frame(void **st)
 {
     (void)st;
-    if (!have_browser()) skip();
+    if (!tu_have_browser()) skip();
     const char *dir = tu_tmpdir("bake_viewer");
-    char p[1024], json[1024], glb[1024], shot[1024], err[512] = "";
-    /* a floor, a box standing on it, a plate above it casting a soft shadow, a rect light */
-    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "floor.obj"),
-        "v -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n"), 0);
-    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "box.obj"),
-        "v 0.5 0 -0.5\nv 1.5 0 -0.5\nv 1.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 -0.5\nv 1.5 1 -0.5\nv 1.5 1 0.5\nv 0.5 1 0.5\n"
-        "f 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"), 0);
-    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "plate.obj"),
-        "v -1.6 1.2 -0.6\nv -1.6 1.2 0.6\nv -0.4 1.2 0.6\nv -0.4 1.2 -0.6\nf 1 2 3 4\nf 4 3 2 1\n"), 0);
-    assert_int_equal(tu_write_file(tu_path(json, sizeof json, dir, "scene.json"),
-        "{\"meshes\":[{\"file\":\"floor.obj\"},{\"file\":\"box.obj\"},{\"file\":\"plate.obj\"}],"
-        "\"camera\":{\"eye\":[0,4.5,5.5],\"target\":[0,0.3,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":160,\"height\":120},"
-        "\"light\":{\"corner\":[-0.6,4,-0.6],\"edge_s\":[1.2,0,0],\"edge_t\":[0,0,1.2],\"emission\":[1,1,1]}}"), 0);
+    char json[1024], glb[1024], shot[1024], err[512] = "";
+    write_scene(dir, 0, json, sizeof json);
     ms_scene sc;
     assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
-    ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = 512;
-    bo.uv_set = -1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
     ms_lightmap lm;
-    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
-    tu_path(glb, sizeof glb, dir, "scene.glb");
-    assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, glb, err, sizeof err), MS_OK);
+    bake_glb(&sc, dir, &lm, glb, sizeof glb);
     ms_render_options ro;
     tu_render_options_default(&ro);
     ro.samples = 256;
     ms_frame fr;
     assert_int_equal(ms_render(&sc, &ro, &fr, err, sizeof err), 0);
     tu_path(shot, sizeof shot, dir, "shot.png");
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "node '%s/screenshot.mjs' '%s' '%s' '%s' --exposure %.9g", MS_VIEWER_DIR, glb, json, shot,
-             (double)fr.exposure);
-    fflush(stdout);
-    assert_int_equal(system(cmd), 0);
+    char exposure[64];
+    snprintf(exposure, sizeof exposure, "--exposure %.9g", (double)fr.exposure);
+    tu_screenshot(glb, json, shot, exposure);
     png_image img;
     memset(&img, 0, sizeof img);
     img.version = PNG_IMAGE_VERSION;
@@ -98,7 +98,7 @@ static void test_viewer_matches_frame(void **st)
         double a = 0, b = 0;
         static const double wy[3] = { 0.2126, 0.7152, 0.0722 };
         for (int c = 0; c < 3; c++) {
-            a += wy[c] * srgb_to_linear(px[3 * i + c] / 255.0);
+            a += wy[c] * tu_srgb_to_linear(px[3 * i + c] / 255.0);
             b += wy[c] * fmin(fmax(fr.rgb[3 * i + c] * fr.exposure, 0.0), 1.0);
         }
         sa += a; sb += b; saa += a * a; sbb += b * b; sab += a * b;
@@ -118,63 +118,18 @@ static void test_viewer_matches_frame(void **st)
     ms_scene_free(&sc);
 }
 
-/* An sRGB PNG's linear luminance per pixel (W x H), or fails the test. */
-static double *png_luminance(const char *path, int W, int H)
-{
-    png_image img;
-    memset(&img, 0, sizeof img);
-    img.version = PNG_IMAGE_VERSION;
-    assert_true(png_image_begin_read_from_file(&img, path));
-    img.format = PNG_FORMAT_RGB;
-    assert_int_equal((int)img.width, W);
-    assert_int_equal((int)img.height, H);
-    uint8_t *px = malloc((size_t)W * H * 3);
-    double *y = malloc((size_t)W * H * sizeof *y);
-    assert_true(px && y);
-    assert_true(png_image_finish_read(&img, NULL, px, 0, NULL));
-    static const double wy[3] = { 0.2126, 0.7152, 0.0722 };
-    for (int i = 0; i < W * H; i++) {
-        y[i] = 0.0;
-        for (int c = 0; c < 3; c++) y[i] += wy[c] * srgb_to_linear(px[3 * i + c] / 255.0);
-    }
-    free(px);
-    return y;
-}
-
 static void test_viewer_exposes_as_frame(void **st)
 {
     (void)st;
-    if (!have_browser()) skip();
+    if (!tu_have_browser()) skip();
     const char *dir = tu_tmpdir("bake_viewer_exposure");
-    char p[1024], json[1024], glb[1024], shot[1024], frame_png[1024], err[512] = "";
-    /* the scene of the first test with materials: a grey glossy floor, a red half-metallic box, a blue plate */
-    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "m.mtl"),
-        "newmtl floor\nKd 0.7 0.7 0.65\nPr 0.3\nPm 0\nnewmtl box\nKd 0.8 0.25 0.15\nPr 0.4\nPm 0.5\n"
-        "newmtl plate\nKd 0.2 0.35 0.8\nPr 0.6\nPm 0\n"), 0);
-    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "floor.obj"),
-        "mtllib m.mtl\nusemtl floor\nv -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n"), 0);
-    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "box.obj"),
-        "mtllib m.mtl\nusemtl box\nv 0.5 0 -0.5\nv 1.5 0 -0.5\nv 1.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 -0.5\nv 1.5 1 -0.5\n"
-        "v 1.5 1 0.5\nv 0.5 1 0.5\nf 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"), 0);
-    assert_int_equal(tu_write_file(tu_path(p, sizeof p, dir, "plate.obj"),
-        "mtllib m.mtl\nusemtl plate\nv -1.6 1.2 -0.6\nv -1.6 1.2 0.6\nv -0.4 1.2 0.6\nv -0.4 1.2 -0.6\nf 1 2 3 4\nf 4 3 2 1\n"), 0);
-    assert_int_equal(tu_write_file(tu_path(json, sizeof json, dir, "scene.json"),
-        "{\"meshes\":[{\"file\":\"floor.obj\"},{\"file\":\"box.obj\"},{\"file\":\"plate.obj\"}],"
-        "\"camera\":{\"eye\":[0,4.5,5.5],\"target\":[0,0.3,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":160,\"height\":120},"
-        "\"light\":{\"corner\":[-0.6,4,-0.6],\"edge_s\":[1.2,0,0],\"edge_t\":[0,0,1.2],\"emission\":[1,1,1]}}"), 0);
+    char json[1024], glb[1024], shot[1024], frame_png[1024], err[512] = "";
+    write_scene(dir, 1, json, sizeof json);   /* the scene of the first test with materials */
     ms_scene sc;
     assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
     assert_non_null(sc.tri_material);
-    ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = 512;
-    bo.uv_set = -1;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
     ms_lightmap lm;
-    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
-    tu_path(glb, sizeof glb, dir, "scene.glb");
-    assert_int_equal(ms_bake_write_gltf(&sc, &lm, NULL, glb, err, sizeof err), MS_OK);
+    bake_glb(&sc, dir, &lm, glb, sizeof glb);
     /* the glb's exposures are the frame's own, standard and diffuse */
     ms_render_options ro;
     tu_render_options_default(&ro);
@@ -200,38 +155,24 @@ static void test_viewer_exposes_as_frame(void **st)
     char line[512];
     assert_int_equal(tu_run_cli(args, line, sizeof line), 0);
     tu_path(shot, sizeof shot, dir, "shot.png");
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "node '%s/screenshot.mjs' '%s' '%s' '%s'", MS_VIEWER_DIR, glb, json, shot);
-    fflush(stdout);
-    assert_int_equal(system(cmd), 0);
+    tu_screenshot(glb, json, shot, "");
     const int W = fd.width, H = fd.height;
-    double *a = png_luminance(shot, W, H), *b = png_luminance(frame_png, W, H);
-    double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
-    long n = 0;
-    for (int i = 0; i < W * H; i++) {
-        if (fd.vis[i] < 0.0f) continue;
-        sa += a[i]; sb += b[i]; saa += a[i] * a[i]; sbb += b[i] * b[i]; sab += a[i] * b[i];
-        n++;
-    }
-    const double cov = sab / n - (sa / n) * (sb / n), va = saa / n - (sa / n) * (sa / n), vb = sbb / n - (sb / n) * (sb / n);
-    const double corr = cov / sqrt(va * vb), ratio = sa / sb;
+    double *a = tu_png_luminance(shot, W, H), *b = tu_png_luminance(frame_png, W, H);
+    const tu_lum_agreement ag = tu_lum_compare(a, b, fd.vis, (size_t)W * H);
     printf("viewer (diffuse mode, no exposure given) vs `microshadow --shading diffuse`: %ld hit pixels, luminance "
-           "correlation %.4f, mean brightness %.4f vs %.4f (ratio %.4f)\n", n, corr, sa / n, sb / n, ratio);
-    assert_true(n > W * H / 3);
-    assert_true(corr >= 0.95);
-    assert_true(ratio >= 0.8 && ratio <= 1.2);
+           "correlation %.4f, mean brightness %.4f vs %.4f (ratio %.4f)\n", ag.n, ag.corr, ag.mean_a, ag.mean_b, ag.ratio);
+    assert_true(ag.n > W * H / 3);
+    assert_true(ag.corr >= 0.95);
+    assert_true(ag.ratio >= 0.8 && ag.ratio <= 1.2);
     /* the orbit and the mode key */
     char drag[1024], key[1024], std[1024];
     tu_path(drag, sizeof drag, dir, "drag.png");
     tu_path(key, sizeof key, dir, "key.png");
     tu_path(std, sizeof std, dir, "standard.png");
-    char cmd3[16384];
-    snprintf(cmd3, sizeof cmd3, "node '%s/screenshot.mjs' '%s' '%s' '%s' --drag 40,0 && node '%s/screenshot.mjs' '%s' '%s' '%s' --key m"
-             " && node '%s/screenshot.mjs' '%s' '%s' '%s' --mode standard", MS_VIEWER_DIR, glb, json, drag, MS_VIEWER_DIR, glb,
-             json, key, MS_VIEWER_DIR, glb, json, std);
-    fflush(stdout);
-    assert_int_equal(system(cmd3), 0);
-    double *dr = png_luminance(drag, W, H), *ky = png_luminance(key, W, H), *sd = png_luminance(std, W, H);
+    tu_screenshot(glb, json, drag, "--drag 40,0");
+    tu_screenshot(glb, json, key, "--key m");
+    tu_screenshot(glb, json, std, "--mode standard");
+    double *dr = tu_png_luminance(drag, W, H), *ky = tu_png_luminance(key, W, H), *sd = tu_png_luminance(std, W, H);
     long moved = 0, lit = 0, key_off = 0, mode_changed = 0;
     for (int i = 0; i < W * H; i++) {
         moved += fabs(dr[i] - a[i]) > 0.02;

@@ -36,22 +36,12 @@ static masks method_masks(const ms_scene *sc, const char *method, int k, int siz
     tu_ctx_init(&ctx, sc, &bvh, size, size, k);
     ctx.isa_cap = cap;
     ctx.traversal = trav;
-    const ms_primary_method *pm = ms_find_primary_method("bvh");
     const ms_shadow_method *sm = ms_find_shadow_method(method);
-    assert_non_null(pm);
     assert_non_null(sm);
     char err[256];
-    void *ps = NULL, *ss = NULL;
-    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
-    ms_hit *hits = malloc((size_t)size * size * sizeof *hits);
-    ms_shadow_query *q = malloc((size_t)size * size * sizeof *q);
-    assert_non_null(hits);
-    assert_non_null(q);
-    pm->trace(ps, &ctx, 0, 0, size, size, hits);
-    pm->destroy(ps);
-    int nq = 0;
-    for (int i = 0; i < size * size; i++)
-        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[nq++], &hits[i], i % size, i / size);
+    void *ss = NULL;
+    int nq;
+    ms_shadow_query *q = tu_frame_queries(&ctx, size, &nq);
     const size_t mw = (size_t)ctx.mask_words;
     uint64_t *front = calloc((size_t)nq * mw + 1, sizeof *front);
     r.vis = calloc((size_t)nq * mw + 1, sizeof *r.vis);
@@ -70,7 +60,6 @@ static masks method_masks(const ms_scene *sc, const char *method, int k, int siz
     assert_int_equal(sm->visibility(ss, &ctx, q, nq, front, r.vis, r.cnt), 0);
     sm->destroy(ss);
     free(front);
-    free(hits);
     free(q);
     ms_bvh_free(&bvh);
     r.n = nq;

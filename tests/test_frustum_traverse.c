@@ -184,7 +184,7 @@ static void test_sponza(void **state) { (void)state; shared_scene("dabrovic-spon
 static void test_bunny(void **state) { (void)state; shared_scene("stanford-bunny/stanford-bunny.json", 32, 200); }
 static void test_sibenik(void **state) { (void)state; shared_scene("sibenik/sibenik.json", 32, 200); }
 
-int main(void)
+int main(int argc, char **argv)
 {
     isa_fns isa = available();
     const struct CMUnitTest cap_tests[] = { cmocka_unit_test(test_isa_cap) };
@@ -203,5 +203,5 @@ int main(void)
         cmocka_unit_test(test_bunny),
         cmocka_unit_test(test_sibenik),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL) || rc;
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv) || rc;
 }

@@ -671,7 +671,7 @@ static void test_light_texture_exr(void **st)
     expect_bad(exr_light_scene("exr-z.json", "z.exr"), NULL, NEEDLES("z.exr", "no R, G and B (or Y) channels"));
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ply_binary_header_without_body),
@@ -700,5 +700,5 @@ int main(void)
      * the others are single-threaded, and under RLIMIT_FSIZE TSan's own runtime dies of SIGBUS. */
     const char *filter = getenv("MS_TEST_FILTER");
     if (filter && *filter) cmocka_set_test_filter(filter);
-    return cmocka_run_group_tests(tests, setup, NULL);
+    return tu_run_group_tests(tests, setup, NULL, argc, argv);
 }

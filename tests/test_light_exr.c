@@ -46,22 +46,6 @@ static void planes_of(const float *rgb, int n, float *r, float *g, float *b)
     for (int i = 0; i < n; i++) { r[i] = rgb[3 * i]; g[i] = rgb[3 * i + 1]; b[i] = rgb[3 * i + 2]; }
 }
 
-static void write_png(const char *path, int w, int h, const float *rgb)
-{
-    ms_frame f;
-    memset(&f, 0, sizeof f);
-    f.width = w;
-    f.height = h;
-    float *vis = calloc((size_t)w * h, sizeof *vis);
-    assert_non_null(vis);
-    f.vis = vis;
-    f.rgb = (float *)rgb;
-    f.exposure = 1.0f;
-    char err[256];
-    assert_int_equal(ms_write_png(&f, path, err, sizeof err), 0);
-    free(vis);
-}
-
 static void render(const ms_scene *sc, const char *method, ms_frame *f)
 {
     ms_render_options o;
@@ -119,7 +103,7 @@ static void test_same_as_png(void **st)
                                1, 0, 0, 0, 0, 0, 1, 1, 1, 0, 1, 0 };
     float r[N], g[N], b[N], hdr[N];
     planes_of(tex, N, r, g, b);
-    write_png(in_dir("t.png"), W, H, tex);
+    tu_write_texture_png(in_dir("t.png"), W, H, tex);
     const char *names[] = { "R", "G", "B" };
     const float *const p[] = { r, g, b };
     assert_int_equal(tu_write_exr(in_dir("t.exr"), W, H, 3, names, p, 1, EXR_COMPRESSION_ZIP), 0);
@@ -130,7 +114,7 @@ static void test_same_as_png(void **st)
         grey[3 * i] = grey[3 * i + 1] = grey[3 * i + 2] = v;
         hdr[i] = 3.5f * v;
     }
-    write_png(in_dir("grey.png"), W, H, grey);
+    tu_write_texture_png(in_dir("grey.png"), W, H, grey);
     const float *const ph[] = { hdr, hdr, hdr };
     assert_int_equal(tu_write_exr(in_dir("hdr.exr"), W, H, 3, names, ph, 1, EXR_COMPRESSION_RLE), 0);
 

@@ -150,13 +150,8 @@ static void test_tiny_occluders_grid_cut(void **state)
 
 static void real_scene(const char *rel, int size)
 {
-    if (!tu_have_shared_scenes()) skip();
-    char path[4096];
     ms_scene sc;
-    char err[512];
-    int rc = ms_scene_load(tu_shared_scene(path, sizeof path, rel), &sc, err, sizeof err);
-    if (rc) fprintf(stderr, "%s\n", err);
-    assert_int_equal(rc, 0);
+    tu_shared_scene_load(rel, &sc);
     const int samples[] = { 1024 };
     equal_on_scene(&sc, rel, samples, 1, size);
     ms_scene_free(&sc);
@@ -238,23 +233,13 @@ static uint64_t *mft_masks_ex(const ms_scene *sc, ms_pattern pat, int k, int siz
     ctx.queries_in_order = in_order;
     ctx.frustum_shrink = fs;
     ctx.no_child_order = no_order;
-    const ms_primary_method *pm = ms_find_primary_method("bvh");
     const ms_shadow_method *sm = ms_find_shadow_method("mft");
-    assert_non_null(pm);
     assert_non_null(sm);
     assert_int_equal(sm->needs_grid, 0);
     char err[256];
-    void *ps = NULL, *ss = NULL;
-    assert_int_equal(pm->create(&ctx, &ps, err, sizeof err), 0);
-    ms_hit *hits = malloc((size_t)size * size * sizeof *hits);
-    ms_shadow_query *q = malloc((size_t)size * size * sizeof *q);
-    assert_non_null(hits);
-    assert_non_null(q);
-    pm->trace(ps, &ctx, 0, 0, size, size, hits);
-    pm->destroy(ps);
-    int nq = 0;
-    for (int i = 0; i < size * size; i++)
-        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[nq++], &hits[i], i % size, i / size);
+    void *ss = NULL;
+    int nq;
+    ms_shadow_query *q = tu_frame_queries(&ctx, size, &nq);
     const size_t mw = (size_t)ctx.mask_words;
     uint64_t *front = calloc((size_t)nq * mw + 1, sizeof *front), *vis = calloc((size_t)nq * mw + 1, sizeof *vis);
     assert_non_null(front);
@@ -284,7 +269,6 @@ static uint64_t *mft_masks_ex(const ms_scene *sc, ms_pattern pat, int k, int siz
     }
     if (mw_out) *mw_out = (int)mw;
     free(front);
-    free(hits);
     free(q);
     ms_bvh_free(&bvh);
     *n_out = nq;

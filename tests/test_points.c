@@ -509,7 +509,7 @@ static void test_bad_input(void **st)
     ms_scene_free(&sc);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_frame_agreement),
@@ -521,5 +521,5 @@ int main(void)
         cmocka_unit_test(test_progress_cancel),
         cmocka_unit_test(test_bad_input),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

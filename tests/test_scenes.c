@@ -98,12 +98,12 @@ static void test_quad_file_matches(void **st)
     ms_scene_free(&s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     if (!tu_have_shared_scenes()) return 77;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_file_matches),
         cmocka_unit_test(test_all_scenes),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -1,7 +1,7 @@
 // Renders OUT.glb in viewer/index.html with headless Chromium (puppeteer-core driving Debian's chromium) and
 // saves the canvas as a PNG of the scene camera's size.
 // Usage: node viewer/screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode diffuse|standard]
-//        [--chromium PATH]   exit 0, 1 when the page fails (its error printed), 2 on bad arguments.
+//        [--shadowmask off] [--chromium PATH]   exit 0, 1 when the page fails (its error printed), 2 on bad arguments.
 // Without --exposure the page takes the exposure the bake wrote into the glb (microshadow's frame's own).
 // --drag DX,DY drags the mouse by (DX, DY) pixels from the canvas centre (an orbit) and --key K presses a key
 // (M: the other mode) before the screenshot, as a user would.
@@ -16,7 +16,7 @@ for (let i = 0; i < args.length; i++) {
   if (args[i].startsWith('--')) opt[args[i].slice(2)] = args[++i];
   else pos.push(args[i]);
 }
-if (pos.length !== 3) { console.error('usage: node screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode M]'); process.exit(2); }
+if (pos.length !== 3) { console.error('usage: node screenshot.mjs OUT.glb SCENE.json SHOT.png [--exposure E] [--mode M] [--shadowmask off]'); process.exit(2); }
 const [glb, sceneFile, out] = pos;
 const server = await serve([glb, sceneFile]);
 const { port } = server.address();
@@ -28,12 +28,14 @@ const browser = await puppeteer.launch({
 let rc = 0;
 try {
   const page = await browser.newPage();
-  page.on('console', (m) => { if (m.type() === 'error') console.error('page:', m.text()); });
+  // the page's errors, and its warnings (what the standard mode's live lights depart in)
+  page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warn') console.error('page:', m.text()); });
   const scene = JSON.parse(await (await import('node:fs/promises')).readFile(sceneFile, 'utf8'));
   await page.setViewport({ width: scene.camera.width ?? 1024, height: scene.camera.height ?? 768, deviceScaleFactor: 1 });
   const url = `http://127.0.0.1:${port}/index.html?glb=/data/${encodeURIComponent(basename(glb))}` +
               `&scene=/data/${encodeURIComponent(basename(sceneFile))}&mode=${encodeURIComponent(opt.mode)}` +
-              (opt.exposure !== undefined ? `&exposure=${encodeURIComponent(opt.exposure)}` : '');
+              (opt.exposure !== undefined ? `&exposure=${encodeURIComponent(opt.exposure)}` : '') +
+              (opt.shadowmask !== undefined ? `&shadowmask=${encodeURIComponent(opt.shadowmask)}` : '');
   await page.goto(url);
   await page.waitForFunction('window.viewerReady || window.viewerError', { timeout: 60000 });
   const error = await page.evaluate('window.viewerError');

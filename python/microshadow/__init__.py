@@ -162,7 +162,7 @@ _ERR = ctypes.c_char_p
 
 
 class _Abi(ctypes.Structure):
-    """ms_abi (microshadow.h, "The ABI check"): the size of each struct as this module mirrors it, handed to the
+    """ms_abi (microshadow/abi.h, "The ABI check"): the size of each struct as this module mirrors it, handed to the
     library's checked entry points (the *_abi functions) with every call; 0 for a struct the module does not
     mirror (not compared), and no version (the mirrors were checked against the library with ms_layout)."""
     _fields_ = [(n, ctypes.c_uint32) for n in (
@@ -464,7 +464,7 @@ def _progress_cancel(fn):
 def visibility_points(scene, positions, normals, triangles=None, keys=None, method=None, samples=1024,
                       pattern="grid", seed=0, threads=0, light=None, isa="auto", progress=None,
                       return_front=False, max_memory=0):
-    """V and S at n points (microshadow.h, "Visibility at any points").
+    """V and S at n points (microshadow/points.h, "Visibility at any points").
 
     scene: a Scene or an Accel (reused); positions, normals: (n, 3); triangles: (n,) scene triangle
     each point lies on (never occludes it; NO_TRIANGLE for none); keys: (n, 2) pixel whose sample

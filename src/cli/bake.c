@@ -98,38 +98,49 @@ static void pass_line_plain(void *user, const char *pass, double seconds)
     fprintf(stderr, "bake: %s: %.3f s\n", pass, seconds);
 }
 
-int ms_cli_bake(int argc, char **argv)
+enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
+       O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX,
+       O_NO_SEAM_STITCH, O_TEXEL_DENSITY, O_UV_CACHE, O_NO_UV_CACHE };
+static const struct option longopts[] = {
+    { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
+    { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
+    { "vis", required_argument, 0, O_VIS }, { "shadow", required_argument, 0, O_SHADOW },
+    { "dilate", required_argument, 0, O_DILATE }, { "padding", required_argument, 0, O_PADDING },
+    { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
+    { "samples", required_argument, 0, O_SAMPLES }, { "seed", required_argument, 0, O_SEED },
+    { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
+    { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
+    { "verbose", no_argument, 0, O_VERBOSE }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
+    { "gltf", required_argument, 0, O_GLTF }, { "no-leak-fix", no_argument, 0, O_NO_LEAK_FIX },
+    { "no-seam-stitch", no_argument, 0, O_NO_SEAM_STITCH },
+    { "texel-density", required_argument, 0, O_TEXEL_DENSITY }, { "uv-cache", required_argument, 0, O_UV_CACHE },
+    { "no-uv-cache", no_argument, 0, O_NO_UV_CACHE },
+#ifdef MS_HAVE_MPI
+    { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
+#endif
+    { 0, 0, 0, 0 } };
+
+/* What `microshadow bake`'s command line asks for. */
+typedef struct bake_request {
+    ms_bake_options bo;
+    ms_output outs[MS_MAX_OUTPUTS];   /* the N_OUTS outputs, then room for the pages' (bake_pages_out.c) */
+    int quiet, no_uv_cache;
+#ifdef MS_HAVE_MPI
+    ms_mpi_schedule schedule;
+    int chunk;
+#endif
+} bake_request;
+enum { OUT_EXR, OUT_PNG, OUT_STATS, OUT_VIS, OUT_SHADOW, OUT_GLTF, OUT_UV_CACHE, N_OUTS };
+
+static const char *const exr_suffix[] = { ".exr", NULL };
+static const char *const png_suffix[] = { ".png", NULL };
+static const char *const json_suffix[] = { ".json", NULL };
+static const char *const glb_suffix[] = { ".glb", NULL };
+
+static void request_init(bake_request *r)
 {
-    enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
-           O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX,
-           O_NO_SEAM_STITCH, O_TEXEL_DENSITY, O_UV_CACHE, O_NO_UV_CACHE };
-    static const struct option longopts[] = {
-        { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
-        { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
-        { "vis", required_argument, 0, O_VIS }, { "shadow", required_argument, 0, O_SHADOW },
-        { "dilate", required_argument, 0, O_DILATE }, { "padding", required_argument, 0, O_PADDING },
-        { "method", required_argument, 0, O_METHOD }, { "pattern", required_argument, 0, O_PATTERN },
-        { "samples", required_argument, 0, O_SAMPLES }, { "seed", required_argument, 0, O_SEED },
-        { "threads", required_argument, 0, O_THREADS }, { "isa", required_argument, 0, O_ISA },
-        { "quiet", no_argument, 0, O_QUIET }, { "help", no_argument, 0, O_HELP },
-        { "verbose", no_argument, 0, O_VERBOSE }, { "max-memory", required_argument, 0, O_MAX_MEMORY },
-        { "gltf", required_argument, 0, O_GLTF }, { "no-leak-fix", no_argument, 0, O_NO_LEAK_FIX },
-        { "no-seam-stitch", no_argument, 0, O_NO_SEAM_STITCH },
-        { "texel-density", required_argument, 0, O_TEXEL_DENSITY }, { "uv-cache", required_argument, 0, O_UV_CACHE },
-        { "no-uv-cache", no_argument, 0, O_NO_UV_CACHE },
-#ifdef MS_HAVE_MPI
-        { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
-#endif
-        { 0, 0, 0, 0 } };
-#ifdef MS_HAVE_MPI
-    ms_mpi_schedule schedule = MS_MPI_COUNTER;   /* balanced best (docs/mpi.md) */
-    int chunk = 8;
-#endif
-    static const char *const exr_suffix[] = { ".exr", NULL };
-    static const char *const png_suffix[] = { ".png", NULL };
-    static const char *const json_suffix[] = { ".json", NULL };
-    static const char *const glb_suffix[] = { ".glb", NULL };
-    ms_output outs[] = {
+    memset(r, 0, sizeof *r);
+    const ms_output outs[N_OUTS] = {
         { "-o", "lightmap.exr", ms_exr_write_stream, exr_suffix },
         { "--png", NULL, ms_png_write_stream, png_suffix },
         { "--stats", NULL, ms_stats_write_stream, json_suffix },
@@ -137,101 +148,146 @@ int ms_cli_bake(int argc, char **argv)
         { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
         { "--gltf", NULL, write_glb, glb_suffix },   /* g_glb: made by ms_bake_gltf after the bake */
         { "--uv-cache", NULL, ms_bake_uv_cache_write, NULL },
-        [7] = { NULL, NULL, NULL, NULL }, [MS_MAX_OUTPUTS - 1] = { NULL, NULL, NULL, NULL },   /* room for pages */
     };
-    enum { N_OUTS = 7 };
-    int n_outs = N_OUTS, no_uv_cache = 0;
-    char *uv_cache_default = NULL;
-    ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.uv_set = 1;
-    bo.size = 1024;
-    int quiet = 0, c;
+    memcpy(r->outs, outs, sizeof outs);
+    r->bo.uv_set = 1;
+    r->bo.size = 1024;
+#ifdef MS_HAVE_MPI
+    r->schedule = MS_MPI_COUNTER;   /* balanced best (docs/mpi.md) */
+    r->chunk = 8;
+#endif
+}
+
+/* Option c of `microshadow bake` (its argument in optarg) into r: -1 to go on, else the exit code (0 once --help
+ * is done). */
+static int take_option(bake_request *r, ms_cli_parser *cli, int c)
+{
     long v;
+    switch (c) {
+    case O_UV:
+        if (!strcmp(optarg, "xatlas")) r->bo.uv_set = -1;
+        else if (ms_cli_parse_long(cli, "--uv", optarg, 0, MS_MAX_UV_SETS - 1, &v)) return EXIT_BAD_INPUT;
+        else r->bo.uv_set = (int)v;
+        break;
+    case O_SIZE: if (ms_cli_parse_long(cli, "--size", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; r->bo.size = (int)v; break;
+    case O_DILATE: if (ms_cli_parse_long(cli, "--dilate", optarg, 0, 1 << 16, &v)) return EXIT_BAD_INPUT; r->bo.dilate = v ? (int)v : -1; break;
+    case O_PADDING: if (ms_cli_parse_long(cli, "--padding", optarg, 1, 256, &v)) return EXIT_BAD_INPUT; r->bo.padding = (int)v; break;
+    case O_METHOD: r->bo.points.method = optarg; break;
+    case O_PATTERN:
+        if (!strcmp(optarg, "grid")) r->bo.points.pattern = MS_PATTERN_GRID;
+        else if (!strcmp(optarg, "stratified")) r->bo.points.pattern = MS_PATTERN_STRATIFIED;
+        else { fprintf(stderr, "microshadow bake: --pattern: '%s' is not grid or stratified\n", optarg); return EXIT_BAD_INPUT; }
+        break;
+    case O_SAMPLES:
+        if (ms_cli_parse_long(cli, "--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
+        if (v != 256 && v != 1024 && v != 4096) {
+            fprintf(stderr, "microshadow bake: --samples: %ld is not one of 256, 1024, 4096\n", v);
+            return EXIT_BAD_INPUT;
+        }
+        r->bo.points.samples = (int)v;
+        break;
+    case O_SEED: if (ms_cli_parse_long(cli, "--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; r->bo.points.seed = (uint32_t)v; break;
+    case O_THREADS: if (ms_cli_parse_long(cli, "--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; r->bo.points.threads = (int)v; break;
+    case O_ISA:
+        if (ms_isa_from_name(optarg, &r->bo.points.isa)) {
+            fprintf(stderr, "microshadow bake: --isa: '%s' is not auto, avx512, avx2 or scalar\n", optarg);
+            return EXIT_BAD_INPUT;
+        }
+        break;
+    case 'o': r->outs[OUT_EXR].path = optarg; break;
+    case O_PNG: r->outs[OUT_PNG].path = optarg; break;
+    case O_STATS: r->outs[OUT_STATS].path = optarg; break;
+    case O_VIS: r->outs[OUT_VIS].path = optarg; break;
+    case O_SHADOW: r->outs[OUT_SHADOW].path = optarg; break;
+    case O_GLTF: r->outs[OUT_GLTF].path = optarg; break;
+    case O_NO_LEAK_FIX: r->bo.no_leak_fix = 1; break;
+    case O_NO_SEAM_STITCH: r->bo.no_seam_stitch = 1; break;
+    case O_TEXEL_DENSITY: {
+        char *end;
+        errno = 0;
+        const double d = strtod(optarg, &end);
+        if (errno || end == optarg || *end || !(d > 0.0) || d > 1e9) {
+            fprintf(stderr, "microshadow bake: --texel-density: '%s' is not a number of texels per world unit in (0, 1e9]\n", optarg);
+            return EXIT_BAD_INPUT;
+        }
+        r->bo.texel_density = (float)d;
+        break;
+    }
+    case O_UV_CACHE: r->outs[OUT_UV_CACHE].path = optarg; break;
+    case O_NO_UV_CACHE: r->no_uv_cache = 1; break;
+    case O_QUIET: r->quiet = 1; break;
+    case O_MAX_MEMORY: if (ms_cli_parse_size(cli, "--max-memory", optarg, &r->bo.points.max_memory)) return EXIT_BAD_INPUT; break;
+    case O_VERBOSE: ms_set_warning_verbose(1); break;
+#ifdef MS_HAVE_MPI
+    case O_MPI_SCHEDULE:
+        if (ms_mpi_schedule_from_name(optarg, &r->schedule)) {
+            fprintf(stderr, "microshadow bake: --mpi-r->schedule: '%s' is not queue, counter or static\n", optarg);
+            return EXIT_BAD_INPUT;
+        }
+        break;
+    case O_MPI_CHUNK: if (ms_cli_parse_long(cli, "--mpi-r->chunk", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; r->chunk = (int)v; break;
+#endif
+    case 'h': case O_HELP: usage(stdout); return 0;
+    default: return EXIT_BAD_INPUT;   /* ms_cli_next said why */
+    }
+    return -1;
+}
+
+/* The bake's summary on stderr: what was not baked, the UVs, the pages, the texels, the shadow pass, the seams. */
+static void report(const ms_bake_options *bo, const ms_output *outs, const ms_lightmap *lm, const char *what)
+{
+    const ms_stats *s = &lm->frame.stats;
+    const int nl = lm->frame.n_lights > 1 ? lm->frame.n_lights : 1;
+    char stitched[96];
+    if (bo->no_seam_stitch) snprintf(stitched, sizeof stitched, "not stitched");
+    else snprintf(stitched, sizeof stitched, "stitched: %zu texels in %.3fs", lm->stitched_texels, lm->stitch_s);
+    if (lm->excluded_tris || lm->unbaked_tris)   /* each reason other than "lightmap": false was a warning */
+        fprintf(stderr, "bake: %zu triangles not baked: %zu of meshes with \"lightmap\": false, %zu for the reasons "
+                "warned about\n", lm->excluded_tris + lm->unbaked_tris, lm->excluded_tris, lm->unbaked_tris);
+    char uvs[160], pages[200];
+    size_t kept = 0;
+    for (size_t o = 0; o < lm->n_objects; o++) kept += lm->object_uv_set[o] >= 0;
+    if (lm->uv_cached) snprintf(uvs, sizeof uvs, "UVs from %s in %.3fs", bo->uv_cache, lm->unwrap_s);
+    else snprintf(uvs, sizeof uvs, "%zu objects in their own UVs, %zu triangles unwrapped by xatlas into %zu charts in %.3fs",
+                  kept, lm->unwrapped_tris, lm->charts, lm->unwrap_s);
+    int at = snprintf(pages, sizeof pages, "%d page%s, texel centres on triangles", lm->pages, lm->pages > 1 ? "s" : "");
+    for (int p = 0; p < lm->pages && lm->page_fill && at < (int)sizeof pages - 16; p++)
+        at += snprintf(pages + at, sizeof pages - (size_t)at, "%s %.1f%%", p ? "," : "", 100.0 * lm->page_fill[p]);
+    if (lm->pages > 12) snprintf(pages + at, sizeof pages - (size_t)at, " ...");
+    fprintf(stderr, "%s: %zu triangles (%s), %dx%d lightmap (%s), %zu texels on triangles "
+            "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
+            "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, p99 %.4f, max %.4f of the largest irradiance (%s) -> "
+            "%s%s%s\n",
+            what, s->triangles, uvs, lm->frame.width, lm->frame.width, pages, lm->texels, lm->raster_s, lm->texels_moved, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads,
+            s->shadow_s, s->shadow_s > 0 ? (double)lm->texels / s->shadow_s : 0.0, s->total_s, lm->seam_points, lm->seam_mean,
+            lm->seam_p99, lm->seam_max, stitched, outs[OUT_EXR].path, outs[OUT_GLTF].path ? ", " : "", outs[OUT_GLTF].path ? outs[OUT_GLTF].path : "");
+}
+
+int ms_cli_bake(int argc, char **argv)
+{
+    bake_request r;
+    request_init(&r);
+    int n_outs = N_OUTS, c;
+    char *uv_cache_default = NULL;
     ms_cli_parser cli;
     ms_cli_parser_init(&cli, "microshadow bake", longopts);
     while ((c = ms_cli_next(&cli, argc, argv)) != -1) {
-        switch (c) {
-        case O_UV:
-            if (!strcmp(optarg, "xatlas")) bo.uv_set = -1;
-            else if (ms_cli_parse_long(&cli, "--uv", optarg, 0, MS_MAX_UV_SETS - 1, &v)) return EXIT_BAD_INPUT;
-            else bo.uv_set = (int)v;
-            break;
-        case O_SIZE: if (ms_cli_parse_long(&cli, "--size", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; bo.size = (int)v; break;
-        case O_DILATE: if (ms_cli_parse_long(&cli, "--dilate", optarg, 0, 1 << 16, &v)) return EXIT_BAD_INPUT; bo.dilate = v ? (int)v : -1; break;
-        case O_PADDING: if (ms_cli_parse_long(&cli, "--padding", optarg, 1, 256, &v)) return EXIT_BAD_INPUT; bo.padding = (int)v; break;
-        case O_METHOD: bo.points.method = optarg; break;
-        case O_PATTERN:
-            if (!strcmp(optarg, "grid")) bo.points.pattern = MS_PATTERN_GRID;
-            else if (!strcmp(optarg, "stratified")) bo.points.pattern = MS_PATTERN_STRATIFIED;
-            else { fprintf(stderr, "microshadow bake: --pattern: '%s' is not grid or stratified\n", optarg); return EXIT_BAD_INPUT; }
-            break;
-        case O_SAMPLES:
-            if (ms_cli_parse_long(&cli, "--samples", optarg, 1, 1 << 20, &v)) return EXIT_BAD_INPUT;
-            if (v != 256 && v != 1024 && v != 4096) {
-                fprintf(stderr, "microshadow bake: --samples: %ld is not one of 256, 1024, 4096\n", v);
-                return EXIT_BAD_INPUT;
-            }
-            bo.points.samples = (int)v;
-            break;
-        case O_SEED: if (ms_cli_parse_long(&cli, "--seed", optarg, 0, UINT32_MAX, &v)) return EXIT_BAD_INPUT; bo.points.seed = (uint32_t)v; break;
-        case O_THREADS: if (ms_cli_parse_long(&cli, "--threads", optarg, 1, 4096, &v)) return EXIT_BAD_INPUT; bo.points.threads = (int)v; break;
-        case O_ISA:
-            if (ms_isa_from_name(optarg, &bo.points.isa)) {
-                fprintf(stderr, "microshadow bake: --isa: '%s' is not auto, avx512, avx2 or scalar\n", optarg);
-                return EXIT_BAD_INPUT;
-            }
-            break;
-        case 'o': outs[0].path = optarg; break;
-        case O_PNG: outs[1].path = optarg; break;
-        case O_STATS: outs[2].path = optarg; break;
-        case O_VIS: outs[3].path = optarg; break;
-        case O_SHADOW: outs[4].path = optarg; break;
-        case O_GLTF: outs[5].path = optarg; break;
-        case O_NO_LEAK_FIX: bo.no_leak_fix = 1; break;
-        case O_NO_SEAM_STITCH: bo.no_seam_stitch = 1; break;
-        case O_TEXEL_DENSITY: {
-            char *end;
-            errno = 0;
-            const double d = strtod(optarg, &end);
-            if (errno || end == optarg || *end || !(d > 0.0) || d > 1e9) {
-                fprintf(stderr, "microshadow bake: --texel-density: '%s' is not a number of texels per world unit in (0, 1e9]\n", optarg);
-                return EXIT_BAD_INPUT;
-            }
-            bo.texel_density = (float)d;
-            break;
-        }
-        case O_UV_CACHE: outs[6].path = optarg; break;
-        case O_NO_UV_CACHE: no_uv_cache = 1; break;
-        case O_QUIET: quiet = 1; break;
-        case O_MAX_MEMORY: if (ms_cli_parse_size(&cli, "--max-memory", optarg, &bo.points.max_memory)) return EXIT_BAD_INPUT; break;
-        case O_VERBOSE: ms_set_warning_verbose(1); break;
-#ifdef MS_HAVE_MPI
-        case O_MPI_SCHEDULE:
-            if (ms_mpi_schedule_from_name(optarg, &schedule)) {
-                fprintf(stderr, "microshadow bake: --mpi-schedule: '%s' is not queue, counter or static\n", optarg);
-                return EXIT_BAD_INPUT;
-            }
-            break;
-        case O_MPI_CHUNK: if (ms_cli_parse_long(&cli, "--mpi-chunk", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; chunk = (int)v; break;
-#endif
-        case 'h': case O_HELP: usage(stdout); return 0;
-        default: return EXIT_BAD_INPUT;   /* ms_cli_next said why */
-        }
+        const int rc = take_option(&r, &cli, c);
+        if (rc >= 0) return rc;
     }
     if (argc - optind > 1) { fprintf(stderr, "microshadow bake: more than one scene file given\n"); return EXIT_BAD_INPUT; }
     const char *scene_path = optind < argc ? argv[optind] : NULL;
-    const char *method = bo.points.method ? bo.points.method : MS_DEFAULT_METHOD;
+    const char *method = r.bo.points.method ? r.bo.points.method : MS_DEFAULT_METHOD;
     if (ms_cli_check_method(&cli, method)) return EXIT_BAD_INPUT;
     char err[1024];
     ms_outputs_cleanup_on_signals();
-    if (no_uv_cache) outs[6].path = NULL;
-    else if (!outs[6].path) {   /* the cache beside the lightmap, where a re-bake of the same command finds it */
-        if (!(uv_cache_default = ms_bake_uv_cache_default(outs[0].path))) { fprintf(stderr, "microshadow bake: out of memory\n"); return EXIT_NO_MEMORY; }
-        outs[6].path = uv_cache_default;
+    if (r.no_uv_cache) r.outs[OUT_UV_CACHE].path = NULL;
+    else if (!r.outs[OUT_UV_CACHE].path) {   /* the cache beside the lightmap, where a re-bake of the same command finds it */
+        if (!(uv_cache_default = ms_bake_uv_cache_default(r.outs[OUT_EXR].path))) { fprintf(stderr, "microshadow bake: out of memory\n"); return EXIT_NO_MEMORY; }
+        r.outs[OUT_UV_CACHE].path = uv_cache_default;
     }
-    bo.uv_cache = outs[6].path;
-    if (ms_outputs_check(outs, N_OUTS, err, sizeof err)) {
+    r.bo.uv_cache = r.outs[OUT_UV_CACHE].path;
+    if (ms_outputs_check(r.outs, N_OUTS, err, sizeof err)) {
         fprintf(stderr, "microshadow bake: %s\n", err);
         free(uv_cache_default);
         return EXIT_BAD_INPUT;
@@ -250,78 +306,52 @@ int ms_cli_bake(int argc, char **argv)
 #ifdef MS_HAVE_MPI
     if (ms_mpi_active()) {
         /* Every rank bakes its rows; rank 0 alone writes (mpi_bake.c). */
-        outs[2].write = ms_mpi_stats_write_stream;
-        const int mrc = ms_mpi_bake(&scene, scene_path ? scene_path : "built-in scene", &bo, schedule, chunk, &lm, err, sizeof err);
+        r.outs[OUT_STATS].write = ms_mpi_stats_write_stream;
+        const int mrc = ms_mpi_bake(&scene, scene_path ? scene_path : "built-in scene", &r.bo, r.schedule, r.chunk, &lm, err, sizeof err);
         if (mrc || ms_mpi_rank() != 0) {
             ms_scene_free(&scene);
-    free(uv_cache_default);
+            free(uv_cache_default);
             return mrc ? EXIT_BAD_INPUT : 0;
         }
     } else
 #endif
     {
-        if (!quiet && isatty(STDERR_FILENO)) {
-            bo.points.progress = progress_bar;
-            bo.points.progress_user = &last;
-            bo.pass = pass_line;
-        } else if (!quiet)
-            bo.pass = pass_line_plain;
-        st = ms_bake(&scene, NULL, &bo, &lm, err, sizeof err);
+        if (!r.quiet && isatty(STDERR_FILENO)) {
+            r.bo.points.progress = progress_bar;
+            r.bo.points.progress_user = &last;
+            r.bo.pass = pass_line;
+        } else if (!r.quiet)
+            r.bo.pass = pass_line_plain;
+        st = ms_bake(&scene, NULL, &r.bo, &lm, err, sizeof err);
     }
     if (st) {
         fprintf(stderr, "microshadow bake: %s: %s\n", scene_path ? scene_path : "built-in scene", err);
         ms_scene_free(&scene);
-    free(uv_cache_default);
+        free(uv_cache_default);
         return ms_cli_exit_code(st);
     }
     unsigned char *glb = NULL;
     int rc = 0;
-    if (outs[5].path) {
+    if (r.outs[OUT_GLTF].path) {
         st = ms_bake_gltf(&scene, &lm, NULL, &glb, &g_glb_len, err, sizeof err);
         if (st) {
-            fprintf(stderr, "microshadow bake: %s: %s\n", outs[5].path, err);
+            fprintf(stderr, "microshadow bake: %s: %s\n", r.outs[OUT_GLTF].path, err);
             rc = ms_cli_exit_code(st);
         }
         g_glb = glb;
     }
     ms_bake_uv_cache_source(&lm);
-    if (!rc && (ms_bake_pages_out(&lm, outs, &n_outs, err, sizeof err) || ms_outputs_check(outs, n_outs, err, sizeof err))) {
+    if (!rc && (ms_bake_pages_out(&lm, r.outs, &n_outs, err, sizeof err) || ms_outputs_check(r.outs, n_outs, err, sizeof err))) {
         fprintf(stderr, "microshadow bake: %s\n", err);
         rc = EXIT_BAD_INPUT;
     }
     if (!rc) {
-        rc = ms_cli_exit_code(ms_outputs_write(&lm.frame, outs, n_outs, err, sizeof err));
+        rc = ms_cli_exit_code(ms_outputs_write(&lm.frame, r.outs, n_outs, err, sizeof err));
         if (rc) fprintf(stderr, "microshadow bake: %s\n", err);
     }
     ms_bake_pages_out_free();
     free(glb);
-    if (!quiet && !rc) {
-        const ms_stats *s = &lm.frame.stats;
-        const int nl = lm.frame.n_lights > 1 ? lm.frame.n_lights : 1;
-        char stitched[96];
-        if (bo.no_seam_stitch) snprintf(stitched, sizeof stitched, "not stitched");
-        else snprintf(stitched, sizeof stitched, "stitched: %zu texels in %.3fs", lm.stitched_texels, lm.stitch_s);
-        if (lm.excluded_tris || lm.unbaked_tris)   /* each reason other than "lightmap": false was a warning */
-            fprintf(stderr, "bake: %zu triangles not baked: %zu of meshes with \"lightmap\": false, %zu for the reasons "
-                    "warned about\n", lm.excluded_tris + lm.unbaked_tris, lm.excluded_tris, lm.unbaked_tris);
-        char uvs[160], pages[200];
-        size_t kept = 0;
-        for (size_t o = 0; o < lm.n_objects; o++) kept += lm.object_uv_set[o] >= 0;
-        if (lm.uv_cached) snprintf(uvs, sizeof uvs, "UVs from %s in %.3fs", bo.uv_cache, lm.unwrap_s);
-        else snprintf(uvs, sizeof uvs, "%zu objects in their own UVs, %zu triangles unwrapped by xatlas into %zu charts in %.3fs",
-                      kept, lm.unwrapped_tris, lm.charts, lm.unwrap_s);
-        int at = snprintf(pages, sizeof pages, "%d page%s, texel centres on triangles", lm.pages, lm.pages > 1 ? "s" : "");
-        for (int p = 0; p < lm.pages && lm.page_fill && at < (int)sizeof pages - 16; p++)
-            at += snprintf(pages + at, sizeof pages - (size_t)at, "%s %.1f%%", p ? "," : "", 100.0 * lm.page_fill[p]);
-        if (lm.pages > 12) snprintf(pages + at, sizeof pages - (size_t)at, " ...");
-        fprintf(stderr, "%s: %zu triangles (%s), %dx%d lightmap (%s), %zu texels on triangles "
-                "(rasterized in %.3fs; %zu inside geometry moved out), %d light%s, %d samples, method %s, %d threads: shadow %.3fs "
-                "(%.0f texels/s), total %.3fs; seams: %zu points, mean %.4f, p99 %.4f, max %.4f of the largest irradiance (%s) -> "
-                "%s%s%s\n",
-                scene_path ? scene_path : "built-in scene", s->triangles, uvs, lm.frame.width, lm.frame.width, pages, lm.texels, lm.raster_s, lm.texels_moved, nl, nl > 1 ? "s" : "", s->samples, s->method, s->threads,
-                s->shadow_s, s->shadow_s > 0 ? (double)lm.texels / s->shadow_s : 0.0, s->total_s, lm.seam_points, lm.seam_mean,
-                lm.seam_p99, lm.seam_max, stitched, outs[0].path, outs[5].path ? ", " : "", outs[5].path ? outs[5].path : "");
-    }
+    if (!r.quiet && !rc) report(&r.bo, r.outs, &lm, scene_path ? scene_path : "built-in scene");
     ms_lightmap_free(&lm);
     ms_scene_free(&scene);
     free(uv_cache_default);

@@ -1,7 +1,8 @@
 /* One frame over MPI ranks (mpi_run.h, docs/mpi.md): every rank sets up its own ms_frame_job (scene, BVH,
  * methods), the ranks take chunks of tiles under the chosen schedule, rank 0 gathers the other ranks' tiles
  * (every light's V, S, S_spec and front counts, unfiltered) and the sums of their stats into its job and
- * finishes the frame there, which makes it ms_render's frame bit for bit (microshadow.h, "A frame tile by tile"). */
+ * finishes the frame there, which makes it ms_render's frame bit for bit (microshadow/render.h, "A frame tile by
+ * tile"). */
 #include "mpi_run.h"
 #include <mpi.h>
 #include <limits.h>
@@ -58,35 +59,27 @@ static uint64_t fingerprint(const ms_scene *s, const ms_render_options *o)
     const char *m = o->method ? o->method : MS_DEFAULT_METHOD;
     h = ms_mpi_hash(h, m, strlen(m));
     const int v[] = { (int)o->pattern, o->samples, o->width, o->height, (int)o->seed, (int)o->traversal,
-                      o->frustum_shrink, o->no_filter, o->no_occlusion_cull, o->no_child_order, o->aa, o->aa_split,
-                      s->aa };
+                      o->frustum_shrink, o->no_filter, o->aa, o->aa_split, s->aa };
     return ms_mpi_hash(h, v, sizeof v);
 }
 
-int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_options *opt, ms_mpi_schedule sched,
-                 int chunk, ms_frame *out, char *err, size_t errlen)
+/* The checks every rank makes together before the frame is distributed: the same scene and options on every rank,
+ * a method whose frame can be split, a gather whose counts fit MPI's ints. 0, or -1 (agreed by all ranks). */
+static int frame_checks(const ms_scene *scene, const char *what, const ms_render_options *opt, ms_frame_job *job)
 {
-    memset(out, 0, sizeof *out);
     const int rank = ms_mpi_rank(), size = ms_mpi_size();
-    ms_frame_job *job = NULL;
-    const int failed = ms_frame_job_create(scene, opt, &job, err, errlen) != 0;
-    if (failed) fprintf(stderr, "microshadow: %s: %s\n", what, err);
-    if (ms_mpi_agree(failed)) return -1;
     /* Every rank must render the same frame: a rank given another scene or other options fails the run. */
     if (!ms_mpi_same(fingerprint(scene, opt))) {
         if (rank == 0) fprintf(stderr, "microshadow: the MPI ranks were given different scenes or options\n");
         ms_mpi_agree(rank == 0);
-        ms_frame_job_free(job);
         return -1;
     }
-    int tiles_x, tiles_y;
-    const int ntiles = ms_frame_job_tiles(job, &tiles_x, &tiles_y);
+    const int ntiles = ms_frame_job_tiles(job, NULL, NULL);
     if (size > 1 && !ms_frame_job_splittable(job)) {
         if (rank == 0)
             fprintf(stderr, "microshadow: method '%s' cannot be split over MPI ranks: its answer at a pixel depends on the "
                     "frame's other pixels (run it with one rank)\n", opt->method ? opt->method : MS_DEFAULT_METHOD);
         ms_mpi_agree(rank == 0);
-        ms_frame_job_free(job);
         return -1;
     }
     /* MPI counts are ints: the gather's floats (3 per pixel and light, whole tiles) must fit one. */
@@ -98,10 +91,89 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
                 fprintf(stderr, "microshadow: %s: a %d-tile frame with %zu lights is too large to gather over MPI ranks "
                         "(run it with one rank)\n", what, ntiles, nl);
             ms_mpi_agree(rank == 0);
-            ms_frame_job_free(job);
             return -1;
         }
     }
+    return 0;
+}
+
+/* Rank 0 gathers the other ranks' tiles into its frame f: each rank's tile ids (ids: mine of them), then per tile
+ * and light V, S and S_spec (vs: FT floats a tile) and front counts (fr: UT a tile). Collective. */
+static void gather_tiles(ms_frame *f, int tiles_x, size_t nl, size_t FT, size_t UT, int mine, const int *ids, const float *vs,
+                         const uint16_t *fr)
+{
+    const int rank = ms_mpi_rank(), size = ms_mpi_size();
+    const int W = f->width, H = f->height;
+    const size_t npix = (size_t)W * H;
+    int *counts = rank == 0 ? calloc((size_t)size, sizeof *counts) : NULL;
+    int *displ = rank == 0 ? calloc((size_t)size, sizeof *displ) : NULL;
+    int *c2 = rank == 0 ? calloc((size_t)size, sizeof *c2) : NULL;
+    int *d2 = rank == 0 ? calloc((size_t)size, sizeof *d2) : NULL;
+    int *c1 = rank == 0 ? calloc((size_t)size, sizeof *c1) : NULL;
+    int *d1 = rank == 0 ? calloc((size_t)size, sizeof *d1) : NULL;
+    MPI_Gather(&mine, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    int total = 0;
+    if (rank == 0) {
+        if (!counts || !displ || !c2 || !d2 || !c1 || !d1) ms_mpi_fatal("out of memory gathering the ranks' results");
+        for (int r = 0; r < size; r++) {
+            displ[r] = total;
+            c2[r] = (int)((size_t)counts[r] * FT);   /* < INT_MAX: checked before the distribution */
+            d2[r] = (int)((size_t)total * FT);
+            c1[r] = (int)((size_t)counts[r] * UT);
+            d1[r] = (int)((size_t)total * UT);
+            total += counts[r];
+        }
+    }
+    int *all_ids = rank == 0 ? malloc(((size_t)total + 1) * sizeof *all_ids) : NULL;
+    float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * FT * sizeof *all_vs) : NULL;
+    uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * UT * sizeof *all_fr) : NULL;
+    if (rank == 0 && (!all_ids || !all_vs || !all_fr)) ms_mpi_fatal("out of memory gathering the ranks' results");
+    MPI_Gatherv(ids, mine, MPI_INT, all_ids, counts, displ, MPI_INT, 0, MPI_COMM_WORLD);
+    MPI_Gatherv(vs, (int)((size_t)mine * FT), MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
+    MPI_Gatherv(fr, (int)((size_t)mine * UT), MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);
+    for (int k = 0; rank == 0 && k < total; k++) {
+        const int t = all_ids[k];
+        const int x0 = (t % tiles_x) * MS_TILE_SIZE, y0 = (t / tiles_x) * MS_TILE_SIZE;
+        for (size_t l = 0; l < nl; l++) {
+            const float *v = all_vs + (size_t)k * FT + 3 * l * TP;
+            const uint16_t *u = all_fr + (size_t)k * UT + l * TP;
+            for (int p = 0; p < TP; p++) {
+                const int x = x0 + p % MS_TILE_SIZE, y = y0 + p / MS_TILE_SIZE;
+                if (x >= W || y >= H) continue;
+                const size_t i = l * npix + (size_t)y * W + x;
+                f->vis[i] = v[p];
+                f->shadow[i] = v[TP + p];
+                f->shadow_spec[i] = v[2 * TP + p];
+                f->front[i] = u[p];
+            }
+        }
+    }
+    free(all_ids);
+    free(all_vs);
+    free(all_fr);
+    free(counts);
+    free(displ);
+    free(c2);
+    free(d2);
+    free(c1);
+    free(d1);
+}
+
+int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_options *opt, ms_mpi_schedule sched,
+                 int chunk, ms_frame *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    const int rank = ms_mpi_rank(), size = ms_mpi_size();
+    ms_frame_job *job = NULL;
+    const int failed = ms_frame_job_create(scene, opt, &job, err, errlen) != 0;
+    if (failed) fprintf(stderr, "microshadow: %s: %s\n", what, err);
+    if (ms_mpi_agree(failed)) return -1;
+    if (frame_checks(scene, what, opt, job)) {
+        ms_frame_job_free(job);
+        return -1;
+    }
+    int tiles_x, tiles_y;
+    const int ntiles = ms_frame_job_tiles(job, &tiles_x, &tiles_y);
     const double t0 = MPI_Wtime();
     unsigned char *done = malloc((size_t)ntiles);
     frame_work w = { job, malloc((size_t)chunk * sizeof(int)) };
@@ -157,60 +229,7 @@ int ms_mpi_frame(const ms_scene *scene, const char *what, const ms_render_option
         }
         k++;
     }
-    if (size > 1) {
-        int *counts = rank == 0 ? calloc((size_t)size, sizeof *counts) : NULL;
-        int *displ = rank == 0 ? calloc((size_t)size, sizeof *displ) : NULL;
-        int *c2 = rank == 0 ? calloc((size_t)size, sizeof *c2) : NULL;
-        int *d2 = rank == 0 ? calloc((size_t)size, sizeof *d2) : NULL;
-        int *c1 = rank == 0 ? calloc((size_t)size, sizeof *c1) : NULL;
-        int *d1 = rank == 0 ? calloc((size_t)size, sizeof *d1) : NULL;
-        MPI_Gather(&mine, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
-        int total = 0;
-        if (rank == 0) {
-            if (!counts || !displ || !c2 || !d2 || !c1 || !d1) ms_mpi_fatal("out of memory gathering the ranks' results");
-            for (int r = 0; r < size; r++) {
-                displ[r] = total;
-                c2[r] = (int)((size_t)counts[r] * FT);   /* < INT_MAX: checked before the distribution */
-                d2[r] = (int)((size_t)total * FT);
-                c1[r] = (int)((size_t)counts[r] * UT);
-                d1[r] = (int)((size_t)total * UT);
-                total += counts[r];
-            }
-        }
-        int *all_ids = rank == 0 ? malloc(((size_t)total + 1) * sizeof *all_ids) : NULL;
-        float *all_vs = rank == 0 ? malloc(((size_t)total + 1) * FT * sizeof *all_vs) : NULL;
-        uint16_t *all_fr = rank == 0 ? malloc(((size_t)total + 1) * UT * sizeof *all_fr) : NULL;
-        if (rank == 0 && (!all_ids || !all_vs || !all_fr)) ms_mpi_fatal("out of memory gathering the ranks' results");
-        MPI_Gatherv(ids, mine, MPI_INT, all_ids, counts, displ, MPI_INT, 0, MPI_COMM_WORLD);
-        MPI_Gatherv(vs, (int)((size_t)mine * FT), MPI_FLOAT, all_vs, c2, d2, MPI_FLOAT, 0, MPI_COMM_WORLD);
-        MPI_Gatherv(fr, (int)((size_t)mine * UT), MPI_UINT16_T, all_fr, c1, d1, MPI_UINT16_T, 0, MPI_COMM_WORLD);
-        for (int k = 0; rank == 0 && k < total; k++) {
-            const int t = all_ids[k];
-            const int x0 = (t % tiles_x) * MS_TILE_SIZE, y0 = (t / tiles_x) * MS_TILE_SIZE;
-            for (size_t l = 0; l < nl; l++) {
-                const float *v = all_vs + (size_t)k * FT + 3 * l * TP;
-                const uint16_t *u = all_fr + (size_t)k * UT + l * TP;
-                for (int p = 0; p < TP; p++) {
-                    const int x = x0 + p % MS_TILE_SIZE, y = y0 + p / MS_TILE_SIZE;
-                    if (x >= W || y >= H) continue;
-                    const size_t i = l * npix + (size_t)y * W + x;
-                    f->vis[i] = v[p];
-                    f->shadow[i] = v[TP + p];
-                    f->shadow_spec[i] = v[2 * TP + p];
-                    f->front[i] = u[p];
-                }
-            }
-        }
-        free(all_ids);
-        free(all_vs);
-        free(all_fr);
-        free(counts);
-        free(displ);
-        free(c2);
-        free(d2);
-        free(c1);
-        free(d1);
-    }
+    if (size > 1) gather_tiles(f, tiles_x, nl, FT, UT, mine, ids, vs, fr);
     free(ids);
     free(vs);
     free(fr);

@@ -1,4 +1,4 @@
-/* ms_abi_check: a program's struct sizes against this library's (microshadow.h, "The ABI check"). */
+/* ms_abi_check: a program's struct sizes against this library's (microshadow/abi.h, "The ABI check"). */
 #include "abi.h"
 #include <stdio.h>
 

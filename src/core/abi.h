@@ -1,4 +1,4 @@
-/* The check behind the API's checked entry points (microshadow.h, "The ABI check"). */
+/* The check behind the API's checked entry points (microshadow/abi.h, "The ABI check"). */
 #ifndef MS_CORE_ABI_H
 #define MS_CORE_ABI_H
 #include "microshadow.h"

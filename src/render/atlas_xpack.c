@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <xatlas_c.h>
+#include "xatlas_meshes.h"
 
 typedef struct tkey_rec { uint32_t key; uint32_t tri; } tkey_rec;
 
@@ -94,16 +94,9 @@ int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
         vuv[2 * v] = (float)(vuv[2 * v] * s);
         vuv[2 * v + 1] = (float)(vuv[2 * v + 1] * s);
     }
-    for (size_t g = 0; g < ng; g++) {
-        xatlasUvMeshDecl d;
-        xatlasUvMeshDeclInit(&d);
-        d.vertexUvData = vuv + 2 * vseg[g];
-        d.vertexCount = (uint32_t)(vseg[g + 1] - vseg[g]);
-        d.vertexStride = 2 * sizeof(float);
-        d.indexData = idx + 3 * seg[g];
-        d.indexCount = (uint32_t)(3 * (seg[g + 1] - seg[g]));
-        d.indexFormat = XATLAS_INDEX_FORMAT_UINT32;
-        if (xatlasAddUvMesh(atlas, &d) != XATLAS_ADD_MESH_ERROR_SUCCESS) { snprintf(err, errlen, "xatlas: charts were refused"); goto out; }
+    if (ms_xatlas_add_meshes(atlas, 2, vuv, vseg, idx, seg, ng) != XATLAS_ADD_MESH_ERROR_SUCCESS) {
+        snprintf(err, errlen, "xatlas: charts were refused");
+        goto out;
     }
     xatlasChartOptions co;
     xatlasChartOptionsInit(&co);

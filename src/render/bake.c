@@ -1,4 +1,4 @@
-/* Lightmap baking (microshadow.h, "Lightmap baking"): UVs (the scene's set, xatlas for the rest), texels
+/* Lightmap baking (microshadow/bake.h, "Lightmap baking"): UVs (the scene's set, xatlas for the rest), texels
  * rasterized conservatively onto the triangles' UV images and carried to world points, V and S there
  * through ms_visibility_points (so every method bakes, on the frames' sample patterns keyed by texel),
  * irradiance from the exact unshadowed value times S, then dilation across chart seams and the seams
@@ -128,14 +128,8 @@ static ms_status rasterize(const ms_scene *sc, int size, int height, const float
         const int x0 = (int)fmax(floor(lo[0]), 0.0), x1 = (int)fmin(floor(hi[0]), size - 1.0);
         const int y0 = (int)fmax(floor(lo[1]), 0.0), y1 = (int)fmin(floor(hi[1]), height - 1.0);
         const float *w = sc->tri + 9 * t;
-        float e1[3], e2[3], nn[3];
-        for (int d = 0; d < 3; d++) { e1[d] = w[3 + d] - w[d]; e2[d] = w[6 + d] - w[d]; }
-        nn[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        nn[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        nn[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        const float len = sqrtf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-        if (!(len > 0.0f) || !isfinite(len)) continue;   /* no plane, no receiver */
-        for (int d = 0; d < 3; d++) nn[d] /= len;
+        float nn[3];
+        if (ms_bake_tri_normal(w, nn)) continue;   /* no plane, no receiver */
         for (int y = y0; y <= y1; y++)
             for (int x = x0; x <= x1; x++) {
                 const double p[2] = { x + 0.5, y + 0.5 };

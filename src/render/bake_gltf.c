@@ -1,4 +1,4 @@
-/* The bake back onto the asset (microshadow.h, "The bake back onto the asset"): the scene's triangles, their
+/* The bake back onto the asset (microshadow/bake.h, "The bake back onto the asset"): the scene's triangles, their
  * materials and textures, TEXCOORD_1 = the baked UVs, the lightmap (MOZ_lightmap) and the shadowmask, as one
  * binary glTF 2.0. The JSON is built with cJSON; the binary chunk is ours: every accessor and image in one
  * buffer, each view aligned to 4 bytes. */
@@ -11,6 +11,7 @@
 #include "frame_shade.h"
 #include "light/light_shape.h"
 #include "bake_gltf_pages.h"
+#include "bake_gltf_lights.h"
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
@@ -472,12 +473,14 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
     return prim;
 }
 
-/* The exposures microshadow's frame of the scene's camera picks by itself (frame_shade.h), standard and diffuse,
- * in the scene's extras.microshadow, so that a viewer shows the bake as the frame shows the scene by default
- * (viewer/index.html: three.js puts them in gltf.scene.userData). Left out, with a warning, if they cannot be
- * computed: the glb is still whole. */
-static void add_exposures(const ms_scene *sc, cJSON *scene0)
+/* The scene's extras.microshadow (viewer/index.html: three.js puts them in gltf.scene.userData): the scene's
+ * lights (bake_gltf_lights.h), and the exposures microshadow's frame of the scene's camera picks by itself
+ * (frame_shade.h), standard and diffuse, so that a viewer shows the bake as the frame shows the scene by default.
+ * The exposures are left out, with a warning, if they cannot be computed: the glb is still whole. */
+static void add_scene_extras(const ms_scene *sc, cJSON *scene0)
 {
+    cJSON *ms = cJSON_AddObjectToObject(cJSON_AddObjectToObject(scene0, "extras"), "microshadow");
+    ms_bake_gltf_lights(ms, sc);
     float e[2];
     char why[256] = "";
     for (int k = 0; k < 2; k++)
@@ -485,9 +488,101 @@ static void add_exposures(const ms_scene *sc, cJSON *scene0)
             ms_warn("the glTF carries no exposure for its viewer: %s", why);
             return;
         }
-    cJSON *ms = cJSON_AddObjectToObject(cJSON_AddObjectToObject(scene0, "extras"), "microshadow");
     cJSON_AddNumberToObject(ms, "exposure", e[0]);
     cJSON_AddNumberToObject(ms, "exposure_diffuse", e[1]);
+}
+
+/* The triangles to write as keys, sorted by mesh, material, variant and page; zero-area ones left out (with a
+ * warning). Returns how many. */
+static size_t sorted_keys(const ms_scene *sc, const ms_lightmap *lm, tri_key *keys)
+{
+    const size_t n = sc->n_tris;
+    size_t m = 0, flat = 0;
+    for (size_t t = 0; t < n; t++) {
+        float fn[3];
+        if (!face_normal(sc->tri + 9 * t, fn)) { flat++; continue; }
+        int var = all_finite(lm->uv + 6 * t, 6) ? VAR_BAKED : 0;
+        if (sc->tri_uv[0] && all_finite(sc->tri_uv[0] + 6 * t, 6)) var |= VAR_UV0;
+        keys[m].mesh = sc->tri_object ? sc->tri_object[t] : sc->tri_mesh ? sc->tri_mesh[t] : 0;
+        keys[m].material = sc->tri_material && sc->tri_material[t] < sc->n_materials ? sc->tri_material[t] : MS_NO_MATERIAL;
+        keys[m].var = (uint32_t)var;
+        keys[m].why = var & VAR_BAKED ? MS_BAKED : (uint32_t)ms_bake_tri_state(sc, lm->uv, lm->frame.width, t);
+        keys[m].page = (var & VAR_BAKED) && lm->page && lm->pages > 1 ? lm->page[t] : 0;
+        keys[m++].tri = (uint32_t)t;
+    }
+    if (flat) ms_warn("%zu triangles without area (no normal) left out of the glTF", flat);
+    qsort(keys, m, sizeof *keys, cmp_key);
+    return m;
+}
+
+/* The node tree: a root carrying the scene's origin, one node and mesh per object, one primitive per run of keys
+ * sharing material, variant and page. MS_OK, or the failure of a primitive (its message in w->err). */
+static ms_status add_meshes(writer *w, const tri_key *keys, size_t m)
+{
+    const ms_scene *sc = w->sc;
+    ms_status st = MS_OK;
+    cJSON *root_node = cJSON_CreateObject();
+    cJSON_AddStringToObject(root_node, "name", "microshadow bake");
+    if (sc->origin[0] != 0.0 || sc->origin[1] != 0.0 || sc->origin[2] != 0.0) {
+        cJSON *tr = cJSON_AddArrayToObject(root_node, "translation");
+        for (int d = 0; d < 3; d++) cJSON_AddItemToArray(tr, cJSON_CreateNumber(sc->origin[d]));
+    }
+    cJSON *children = cJSON_AddArrayToObject(root_node, "children");
+    cJSON_AddItemToArray(w->nodes, root_node);
+    for (size_t a = 0; a < m && !st;) {
+        size_t b = a;
+        while (b < m && keys[b].mesh == keys[a].mesh) b++;
+        cJSON *mesh = cJSON_CreateObject();
+        char name[64];
+        if (sc->tri_object && sc->tri_mesh)
+            snprintf(name, sizeof name, "object %u (scene mesh %u)", keys[a].mesh, sc->tri_mesh[keys[a].tri]);
+        else snprintf(name, sizeof name, "mesh %u", keys[a].mesh);
+        cJSON_AddStringToObject(mesh, "name", name);
+        cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
+        cJSON_AddItemToArray(w->meshes, mesh);
+        for (size_t p = a; p < b && !st;) {
+            size_t q = p;
+            while (q < b && keys[q].material == keys[p].material && keys[q].var == keys[p].var && keys[q].page == keys[p].page) q++;
+            cJSON *prim = add_primitive(w, keys + p, q - p);
+            if (!prim) st = w->bin.oom ? MS_ERR_NO_MEMORY : MS_ERR_INVALID;
+            else cJSON_AddItemToArray(prims, prim);
+            p = q;
+        }
+        cJSON *node = cJSON_CreateObject();
+        cJSON_AddStringToObject(node, "name", name);
+        cJSON_AddNumberToObject(node, "mesh", cJSON_GetArraySize(w->meshes) - 1);
+        cJSON_AddItemToArray(w->nodes, node);
+        cJSON_AddItemToArray(children, cJSON_CreateNumber(cJSON_GetArraySize(w->nodes) - 1));
+        a = b;
+    }
+    return st;
+}
+
+/* The glb of w's JSON and binary chunk: a malloc'ed buffer *glb of *len bytes. MS_OK, or a status with a message. */
+static ms_status glb_bytes(const writer *w, unsigned char **glb, size_t *len, char *err, size_t errlen)
+{
+    char *json = cJSON_PrintUnformatted(w->root);
+    if (!json) { snprintf(err, errlen, "out of memory printing the glTF's JSON"); return MS_ERR_NO_MEMORY; }
+    const size_t jn = strlen(json), jpad = (jn + 3) & ~(size_t)3;
+    const size_t total = 12 + 8 + jpad + 8 + w->bin.n;
+    if (total > UINT32_MAX) {
+        snprintf(err, errlen, "the glTF would be %zu bytes, more than a .glb holds (4 GiB)", total);
+        free(json);
+        return MS_ERR_INVALID;
+    }
+    unsigned char *out = malloc(total);
+    if (!out) { free(json); snprintf(err, errlen, "out of memory for a %zu-byte glTF", total); return MS_ERR_NO_MEMORY; }
+    const uint32_t head[5] = { 0x46546C67u /* glTF */, 2, (uint32_t)total, (uint32_t)jpad, 0x4E4F534Au /* JSON */ };
+    memcpy(out, head, sizeof head);   /* little-endian, as x86 and the glb are */
+    memcpy(out + 20, json, jn);
+    memset(out + 20 + jn, ' ', jpad - jn);
+    const uint32_t bhead[2] = { (uint32_t)w->bin.n, 0x004E4942u /* BIN */ };
+    memcpy(out + 20 + jpad, bhead, sizeof bhead);
+    memcpy(out + 28 + jpad, w->bin.p, w->bin.n);
+    free(json);
+    *glb = out;
+    *len = total;
+    return MS_OK;
 }
 
 ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_lightmap *lm, const ms_bake_gltf_options *opt,
@@ -553,91 +648,22 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
     cJSON *buffers = cJSON_AddArrayToObject(w.root, "buffers");
     if (add_maps(&w)) { st = w.bin.oom ? MS_ERR_NO_MEMORY : MS_ERR_INVALID; goto done; }
 
-    /* the triangles by mesh, material and variant; zero-area ones left out */
-    size_t m = 0, flat = 0;
-    for (size_t t = 0; t < n; t++) {
-        float fn[3];
-        if (!face_normal(sc->tri + 9 * t, fn)) { flat++; continue; }
-        int var = all_finite(lm->uv + 6 * t, 6) ? VAR_BAKED : 0;
-        if (sc->tri_uv[0] && all_finite(sc->tri_uv[0] + 6 * t, 6)) var |= VAR_UV0;
-        keys[m].mesh = sc->tri_object ? sc->tri_object[t] : sc->tri_mesh ? sc->tri_mesh[t] : 0;
-        keys[m].material = sc->tri_material && sc->tri_material[t] < sc->n_materials ? sc->tri_material[t] : MS_NO_MATERIAL;
-        keys[m].var = (uint32_t)var;
-        keys[m].why = var & VAR_BAKED ? MS_BAKED : (uint32_t)ms_bake_tri_state(sc, lm->uv, lm->frame.width, t);
-        keys[m].page = (var & VAR_BAKED) && lm->page && lm->pages > 1 ? lm->page[t] : 0;
-        keys[m++].tri = (uint32_t)t;
-    }
-    if (flat) ms_warn("%zu triangles without area (no normal) left out of the glTF", flat);
-    qsort(keys, m, sizeof *keys, cmp_key);
-    cJSON *root_node = cJSON_CreateObject();
-    cJSON_AddStringToObject(root_node, "name", "microshadow bake");
-    if (sc->origin[0] != 0.0 || sc->origin[1] != 0.0 || sc->origin[2] != 0.0) {
-        cJSON *tr = cJSON_AddArrayToObject(root_node, "translation");
-        for (int d = 0; d < 3; d++) cJSON_AddItemToArray(tr, cJSON_CreateNumber(sc->origin[d]));
-    }
-    cJSON *children = cJSON_AddArrayToObject(root_node, "children");
-    cJSON_AddItemToArray(w.nodes, root_node);
-    for (size_t a = 0; a < m && !st;) {
-        size_t b = a;
-        while (b < m && keys[b].mesh == keys[a].mesh) b++;
-        cJSON *mesh = cJSON_CreateObject();
-        char name[64];
-        if (sc->tri_object && sc->tri_mesh)
-            snprintf(name, sizeof name, "object %u (scene mesh %u)", keys[a].mesh, sc->tri_mesh[keys[a].tri]);
-        else snprintf(name, sizeof name, "mesh %u", keys[a].mesh);
-        cJSON_AddStringToObject(mesh, "name", name);
-        cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
-        cJSON_AddItemToArray(w.meshes, mesh);
-        for (size_t p = a; p < b && !st;) {
-            size_t q = p;
-            while (q < b && keys[q].material == keys[p].material && keys[q].var == keys[p].var && keys[q].page == keys[p].page) q++;
-            cJSON *prim = add_primitive(&w, keys + p, q - p);
-            if (!prim) st = w.bin.oom ? MS_ERR_NO_MEMORY : MS_ERR_INVALID;
-            else cJSON_AddItemToArray(prims, prim);
-            p = q;
-        }
-        cJSON *node = cJSON_CreateObject();
-        cJSON_AddStringToObject(node, "name", name);
-        cJSON_AddNumberToObject(node, "mesh", cJSON_GetArraySize(w.meshes) - 1);
-        cJSON_AddItemToArray(w.nodes, node);
-        cJSON_AddItemToArray(children, cJSON_CreateNumber(cJSON_GetArraySize(w.nodes) - 1));
-        a = b;
-    }
+    const size_t m = sorted_keys(sc, lm, keys);
+    st = add_meshes(&w, keys, m);
     if (st) goto done;
     if (w.dropped_uv_set) ms_warn("%d material textures on a UV set other than 0 left out of the glTF", w.dropped_uv_set);
     if (w.dropped_transform) ms_warn("%d material textures carried into the glTF without their KHR_texture_transform", w.dropped_transform);
     if (w.used_emissive_strength) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_materials_emissive_strength"));
     cJSON *scene0 = cJSON_CreateObject();
     cJSON_AddItemToArray(cJSON_AddArrayToObject(scene0, "nodes"), cJSON_CreateNumber(0));
-    add_exposures(sc, scene0);
+    add_scene_extras(sc, scene0);
     cJSON_AddItemToArray(scenes, scene0);
     if (w.bin.oom) { snprintf(err, errlen, "out of memory for the glTF's binary chunk"); st = MS_ERR_NO_MEMORY; goto done; }
     bin_put(&w.bin, NULL, 0);   /* pad to 4 */
     cJSON *buf0 = cJSON_CreateObject();
     cJSON_AddNumberToObject(buf0, "byteLength", (double)w.bin.n);
     cJSON_AddItemToArray(buffers, buf0);
-    char *json = cJSON_PrintUnformatted(w.root);
-    if (!json) { snprintf(err, errlen, "out of memory printing the glTF's JSON"); st = MS_ERR_NO_MEMORY; goto done; }
-    const size_t jn = strlen(json), jpad = (jn + 3) & ~(size_t)3;
-    const size_t total = 12 + 8 + jpad + 8 + w.bin.n;
-    if (total > UINT32_MAX) {
-        snprintf(err, errlen, "the glTF would be %zu bytes, more than a .glb holds (4 GiB)", total);
-        free(json);
-        st = MS_ERR_INVALID;
-        goto done;
-    }
-    unsigned char *out = malloc(total);
-    if (!out) { free(json); snprintf(err, errlen, "out of memory for a %zu-byte glTF", total); st = MS_ERR_NO_MEMORY; goto done; }
-    const uint32_t head[5] = { 0x46546C67u /* glTF */, 2, (uint32_t)total, (uint32_t)jpad, 0x4E4F534Au /* JSON */ };
-    memcpy(out, head, sizeof head);   /* little-endian, as x86 and the glb are */
-    memcpy(out + 20, json, jn);
-    memset(out + 20 + jn, ' ', jpad - jn);
-    const uint32_t bhead[2] = { (uint32_t)w.bin.n, 0x004E4942u /* BIN */ };
-    memcpy(out + 20 + jpad, bhead, sizeof bhead);
-    memcpy(out + 28 + jpad, w.bin.p, w.bin.n);
-    free(json);
-    *glb = out;
-    *len = total;
+    st = glb_bytes(&w, glb, len, err, errlen);
 done:
     cJSON_Delete(w.root);
     free(w.bin.p);

@@ -1,4 +1,4 @@
-/* Texels inside geometry (microshadow.h, "Lightmap baking"; docs/baking.md, "Quality").
+/* Texels inside geometry (microshadow/bake.h, "Lightmap baking"; docs/baking.md, "Quality").
  *
  * A texel's centre may land where another object stands on or cuts through the receiver (the floor under a
  * box's side, a wall running into another): evaluated there it is in full shadow, and bilinear filtering

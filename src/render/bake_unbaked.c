@@ -7,19 +7,26 @@
 #include <math.h>
 #include <string.h>
 
-ms_unbaked ms_bake_tri_state(const ms_scene *sc, const float *uv, int size, size_t t)
+int ms_bake_tri_normal(const float *w, float nn[3])
 {
-    if (sc->mesh_lightmap_scale && sc->tri_mesh && sc->tri_mesh[t] < sc->n_meshes &&
-        !(sc->mesh_lightmap_scale[sc->tri_mesh[t]] > 0.0f))
-        return MS_UNBAKED_EXCLUDED;
-    const float *w = sc->tri + 9 * t;
-    float e1[3], e2[3], nn[3];
+    float e1[3], e2[3];
     for (int d = 0; d < 3; d++) { e1[d] = w[3 + d] - w[d]; e2[d] = w[6 + d] - w[d]; }
     nn[0] = e1[1] * e2[2] - e1[2] * e2[1];
     nn[1] = e1[2] * e2[0] - e1[0] * e2[2];
     nn[2] = e1[0] * e2[1] - e1[1] * e2[0];
     const float len = sqrtf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-    if (!(len > 0.0f) || !isfinite(len)) return MS_UNBAKED_NO_AREA;
+    if (!(len > 0.0f) || !isfinite(len)) return -1;
+    for (int d = 0; d < 3; d++) nn[d] /= len;
+    return 0;
+}
+
+ms_unbaked ms_bake_tri_state(const ms_scene *sc, const float *uv, int size, size_t t)
+{
+    if (sc->mesh_lightmap_scale && sc->tri_mesh && sc->tri_mesh[t] < sc->n_meshes &&
+        !(sc->mesh_lightmap_scale[sc->tri_mesh[t]] > 0.0f))
+        return MS_UNBAKED_EXCLUDED;
+    float nn[3];
+    if (ms_bake_tri_normal(sc->tri + 9 * t, nn)) return MS_UNBAKED_NO_AREA;
     const float *u = uv + 6 * t;
     for (int k = 0; k < 6; k++)
         if (!isfinite(u[k])) return MS_UNBAKED_NO_UVS;

@@ -18,6 +18,11 @@ typedef enum ms_unbaked {
  * triangle, ms_lightmap.uv), as the texel rasterization (bake.c) decides; MS_BAKED when it has UVs to bake. */
 ms_unbaked ms_bake_tri_state(const ms_scene *sc, const float *uv, int size, size_t t);
 
+/* The unit normal nn of the triangle with world vertices w (9 floats), as the texels' rasterization takes it
+ * (bake.c) and ms_bake_tri_state mirrors it: 0, or -1 when the triangle has no plane (no finite, non-zero
+ * normal: no receiver). */
+int ms_bake_tri_normal(const float *w, float nn[3]);
+
 /* A short name of the reason ("no UVs"), for names in the glb. */
 const char *ms_unbaked_name(ms_unbaked r);
 

@@ -1,4 +1,4 @@
-/* The UVs a bake bakes into (microshadow.h, "Lightmap baking"; docs/baking.md, "Charts").
+/* The UVs a bake bakes into (microshadow/bake.h, "Lightmap baking"; docs/baking.md, "Charts").
  *
  * Per object (ms_scene.tri_object: a glTF node's mesh, a file of another format), the first of its UV sets
  * (the one asked for, then 0, 1, ...) that is a valid layout of the object (uv_validity.c: present on every
@@ -153,6 +153,248 @@ static int choose_sets(const ms_scene *sc, int first, const uint32_t *start, con
     return 0;
 }
 
+/* Which triangles keep their object's file UVs (use, their UVs copied into src and counted in ob) and which
+ * xatlas charts (want): those of objects without a usable set, and those with no area or overlapping others
+ * (bad) in it. Counts both, and says whether the kept UVs lie in [0,1]^2 and whether objects use different
+ * sets. */
+static void keep_or_chart(const ms_scene *sc, size_t nobj, const uint32_t *start, const uint32_t *tris, const uint8_t *bad,
+                          const int *set, uint8_t *use, uint8_t *want, float *src, object_uv *ob, ms_bake_uv_report *rep,
+                          size_t *n_use, size_t *n_want, int *inside, int *mixed)
+{
+    int one_set = -1;
+    for (size_t o = 0; o < nobj; o++) {
+        const int s = set[o];
+        if (s < -1) continue;
+        if (s >= 0) { rep->objects_kept++; *mixed |= one_set >= 0 && one_set != s; one_set = s; }
+        else rep->objects_unwrapped++;
+        for (uint32_t i = start[o]; i < start[o + 1]; i++) {
+            const size_t t = tris[i];
+            const float sc_ = scale_of(sc, t);
+            const double wa = world_area(sc->tri + 9 * t) * (double)sc_ * sc_;
+            if (s < 0 || bad[i] || uv_area(sc->tri_uv[s] + 6 * t) == 0.0) {   /* no area, or overlapping: xatlas */
+                want[t] = 1;
+                (*n_want)++;
+                continue;
+            }
+            use[t] = 1;
+            (*n_use)++;
+            memcpy(src + 6 * t, sc->tri_uv[s] + 6 * t, 6 * sizeof(float));
+            for (int k = 0; k < 3; k++)
+                for (int d = 0; d < 2; d++) {
+                    const double v = src[6 * t + 2 * k + d];
+                    ob[o].lo[d] = fmin(ob[o].lo[d], v);
+                    ob[o].hi[d] = fmax(ob[o].hi[d], v);
+                    *inside &= v >= 0.0 && v <= 1.0;
+                }
+            ob[o].uv_area += uv_area(src + 6 * t);
+            ob[o].world_area += wa;
+            ob[o].tris++;
+        }
+    }
+}
+
+/* The regions to pack into rs: the file's layout as a whole (all, the objects' union) when whole and it has
+ * area, else one per object with a layout (ob[o].region, all->region say which); with a density T, sized at
+ * T texels per world unit, a region larger than a page shrunk to fit one (and the whole layout given up for
+ * per-object regions when it does not fit). Returns their count. */
+static size_t make_regions(object_uv *ob, size_t nobj, object_uv *all, int whole, double T, int size, int pad, ms_pack_rect *rs)
+{
+    box_init(all);
+    for (size_t o = 0; o < nobj; o++) {
+        if (!ob[o].tris) continue;
+        for (int d = 0; d < 2; d++) { all->lo[d] = fmin(all->lo[d], ob[o].lo[d]); all->hi[d] = fmax(all->hi[d], ob[o].hi[d]); }
+        all->uv_area += ob[o].uv_area;
+        all->world_area += ob[o].world_area;
+    }
+    size_t nr = 0;
+    for (int attempt = 0; attempt < 2; attempt++) {
+        nr = 0;
+        for (size_t o = 0; o < nobj; o++) ob[o].region = -1;
+        all->region = -1;
+        if (whole && all->uv_area > 0.0) { region_of(all, &rs[nr]); all->region = (int)nr++; }
+        else
+            for (size_t o = 0; o < nobj; o++)
+                if (ob[o].tris) { region_of(&ob[o], &rs[nr]); ob[o].region = (int)nr++; }
+        if (!(T > 0.0)) break;
+        /* a density: T texels per (scaled) world unit; a region larger than a page is shrunk to fit */
+        int shrunk = 0;
+        for (size_t r = 0; r < nr; r++) {
+            rs[r].w0 *= T;
+            rs[r].h0 *= T;
+            const double f = fmin(1.0, (size - 2.0 * pad) / fmax(rs[r].w0, rs[r].h0));
+            if (f < 1.0) { shrunk++; rs[r].w0 *= f; rs[r].h0 *= f; }
+        }
+        if (shrunk && whole) { whole = 0; continue; }   /* the whole layout does not fit: per object */
+        if (shrunk)
+            ms_warn("texel density %g: %d objects are larger than a %dx%d page at that density and were scaled down to fit one",
+                    T, shrunk, size, size);
+        break;
+    }
+    return nr;
+}
+
+/* Regions alone placed as rectangles (atlas_pack.c): at the density T over as many pages as it takes
+ * (*pages_used), or at the largest common scale that fits one page. 0, or -1 with a message. */
+static int place_regions(ms_pack_rect *rs, size_t nr, int size, int pad, double T, int *pages_used, char *err, size_t errlen)
+{
+    if (!(T > 0.0)) {
+        double wmax = 0.0;
+        for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].w0 * rs[r].h0);
+        for (size_t r = 0; r < nr; r++) {   /* relative sizes, so that tiny objects do not underflow */
+            rs[r].w0 = fmax(rs[r].w0 / sqrt(wmax), 1e-5);
+            rs[r].h0 = fmax(rs[r].h0 / sqrt(wmax), 1e-5);
+        }
+        if (ms_pack_one_page(rs, nr, size, pad)) {
+            snprintf(err, errlen, "the lightmap's %zu regions do not fit a %dx%d lightmap with %d texels of padding", nr, size, size, pad);
+            return -1;
+        }
+    } else {
+        const int pages = ms_pack_pages(rs, nr, 1.0, size, pad, 0);
+        if (pages < 0) { snprintf(err, errlen, "the lightmap's %zu regions do not fit %dx%d pages", nr, size, size); return -1; }
+        *pages_used = pages ? pages : 1;
+    }
+    return 0;
+}
+
+/* The kept triangles' UVs moved into their region (the object's, or the whole layout's), one scale and offset
+ * per object (out->object_scale_offset), and their pages. */
+static void place_kept(size_t nobj, const uint32_t *start, const uint32_t *tris, const uint8_t *use, const float *src,
+                       const object_uv *ob, const object_uv *all, const ms_pack_rect *rs, int size, ms_bake_uv_layout *out)
+{
+    for (size_t o = 0; o < nobj; o++) {
+        const object_uv *q = all->region >= 0 ? all : &ob[o];
+        if (out->object_set[o] < 0 || q->region < 0) continue;
+        const ms_pack_rect *r = &rs[q->region];
+        const double k = r->w / fmax(q->hi[0] - q->lo[0], 1e-30);   /* = h / (hi[1] - lo[1]): one scale */
+        float *so = out->object_scale_offset + 4 * o;
+        so[0] = so[1] = (float)(k / size);
+        so[2] = (float)((r->x - q->lo[0] * k) / size);
+        so[3] = (float)((r->y - q->lo[1] * k) / size);
+        for (uint32_t i = start[o]; i < start[o + 1]; i++) {
+            const size_t t = tris[i];
+            if (!use[t]) continue;
+            out->page[t] = (uint32_t)r->page;
+            for (int c = 0; c < 3; c++) {
+                out->uv[6 * t + 2 * c] = (float)((r->x + (src[6 * t + 2 * c] - q->lo[0]) * k) / size);
+                out->uv[6 * t + 2 * c + 1] = (float)((r->y + (src[6 * t + 2 * c + 1] - q->lo[1]) * k) / size);
+            }
+        }
+    }
+}
+
+/* One page: the largest scale at which xatlas packs the regions and charts of xp on a size x size page. It
+ * steps by the ratio of the page to the atlas's extent until the scale is bracketed, then bisects to 1% (the
+ * extent is not proportional to the scale: every chart brings its padding). area: the regions' and charts'
+ * area at scale 1, for the first guess. 0 with *scale and xp->grow set for it, or -1 with a message. */
+static int fit_one_page(ms_xpack *xp, double area, int size, int pad, double *scale, char *err, size_t errlen)
+{
+    const double target = size - 2.0 * pad;
+    double best = 0.0, worst = INFINITY, sc_ = sqrt(0.7 * target * target / fmax(area, 1e-30));
+    int best_grow = 1;
+    for (int it = 0; it < 30; it++) {
+        /* the growing atlas stays square-ish, which may stack two wide regions and leave a strip; a
+         * page of its own size, placed by random probes, may put them side by side: either will do */
+        char e2[256];
+        xp->grow = 1;
+        const double extent = (ms_xpack_run(xp, sc_, e2, sizeof e2) == 1) ? 0.0 : xp->extent;
+        int fits = extent == 0.0;
+        if (!fits) {
+            xp->grow = 0;
+            fits = ms_xpack_run(xp, sc_, e2, sizeof e2) == 1;
+            xp->extent = extent;
+        }
+        if (fits) { best = sc_; best_grow = xp->grow; }
+        else worst = fmin(worst, sc_);
+        if (best > 0.0 && isfinite(worst)) {
+            if (worst / best < 1.01) break;
+            sc_ = sqrt(best * worst);
+        } else {
+            const double r = xp->extent > 0.0 ? target / xp->extent : 0.5;
+            sc_ *= fits ? fmin(1.5, fmax(1.02, r)) : fmax(0.5, fmin(0.98, r));
+        }
+    }
+    xp->grow = best_grow;
+    if (!(best > 0.0) || ms_xpack_run(xp, best, err, errlen) != 1) {
+        snprintf(err, errlen, "the lightmap's regions and charts do not fit a %dx%d lightmap with %d texels of padding", size, size, pad);
+        return -1;
+    }
+    *scale = best;
+    return 0;
+}
+
+/* Regions and xatlas charts placed together (atlas_xpack.c): the wanted triangles of xtri charted by xatlas
+ * (xuv, xpage: its UVs and atlases, the caller's arrays of n), then regions rs[0..nr) and charts packed at the
+ * density T over as many pages as it takes, or on one page at the largest scale that fits. Sets the regions'
+ * places, the charted triangles' UVs and pages in out, out->pages and rep->charts. 0, or -1 with a message. */
+static int place_charts(const float *xtri, size_t n, const uint8_t *want, const uint32_t *group, int size, int pad, double T,
+                        float *xuv, uint32_t *xpage, ms_pack_rect *rs, size_t nr,
+                        ms_bake_uv_layout *out, ms_bake_uv_report *rep, char *err, size_t errlen)
+{
+    ms_unwrap_info info;
+    memset(&info, 0, sizeof info);
+    double *rdim = NULL;
+    int *rpage = NULL, rc = -1;
+    float *xin = NULL, *xout = NULL;
+    uint32_t *xkey = NULL;
+    size_t *xtri_of = NULL;
+    const int res = size - 2 * pad;
+    if (ms_lightmap_unwrap(xtri, n, want, group, res, pad, (float)T, xuv, xpage, &info, err, errlen)) goto fail;
+    rep->charts = info.charts;
+    const double k0 = T > 0.0 ? 1.0 : info.texels_per_unit;   /* region texels per rs unit at the charts' density */
+    rdim = malloc((nr ? nr : 1) * 4 * sizeof *rdim);
+    rpage = malloc((nr ? nr : 1) * sizeof *rpage);
+    xin = malloc(n * 6 * sizeof *xin);
+    xout = malloc(n * 6 * sizeof *xout);
+    xkey = malloc(n * 2 * sizeof *xkey);   /* the charts' keys (stage-1 atlases), then their pages */
+    xtri_of = malloc(n * sizeof *xtri_of);
+    if (!rdim || !rpage || !xin || !xout || !xkey || !xtri_of) { snprintf(err, errlen, "out of memory packing the lightmap"); goto fail; }
+    double area = 0.0;
+    for (size_t r = 0; r < nr; r++) {
+        rdim[r] = rs[r].w0 * k0;
+        rdim[nr + r] = rs[r].h0 * k0;
+        area += rdim[r] * rdim[nr + r];
+    }
+    size_t nx = 0;
+    for (size_t t = 0; t < n; t++) {
+        if (!want[t] || !isfinite(xuv[6 * t])) continue;
+        for (int k = 0; k < 6; k++) xin[6 * nx + k] = xuv[6 * t + k] * (float)res;
+        area += uv_area(xin + 6 * nx) / 0.7;   /* charts' boxes */
+        xkey[nx] = xpage[t];
+        xtri_of[nx++] = t;
+    }
+    area += (double)info.charts * (2.0 * pad + 2.0) * (2.0 * pad + 2.0);   /* and their padding */
+    ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, !(T > 0.0), rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n, 0.0 };
+    double scale = 1.0;
+    if (T > 0.0) {
+        const int pages = ms_xpack_run(&xp, 1.0, err, errlen);
+        if (pages < 0) goto fail;
+        out->pages = pages;
+    } else if (fit_one_page(&xp, area, size, pad, &scale, err, errlen)) {   /* one page */
+        goto fail;
+    }
+    for (size_t r = 0; r < nr; r++) {
+        rs[r].x = rdim[2 * nr + r];
+        rs[r].y = rdim[3 * nr + r];
+        rs[r].w = rdim[r] * scale;
+        rs[r].h = rdim[nr + r] * scale;
+        rs[r].page = rpage[r];
+    }
+    for (size_t i = 0; i < nx; i++) {
+        const size_t t = xtri_of[i];
+        for (int k = 0; k < 6; k++) out->uv[6 * t + k] = xout[6 * i + k] / (float)size;
+        out->page[t] = xkey[n + i];
+    }
+    rc = 0;
+fail:
+    free(rdim);
+    free(rpage);
+    free(xin);
+    free(xout);
+    free(xkey);
+    free(xtri_of);
+    return rc;
+}
+
 int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layout *out, ms_bake_uv_report *rep, char *err,
                 size_t errlen)
 {
@@ -166,11 +408,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     object_uv *ob = malloc(nobj * sizeof *ob);
     float *src = malloc((n ? n : 1) * 6 * sizeof *src), *scaled = NULL, *xuv = NULL;
     ms_pack_rect *rs = NULL;
-    double *rdim = NULL;
-    int *rpage = NULL, rc = -1;
-    float *xin = NULL, *xout = NULL;
-    uint32_t *xkey = NULL;
-    size_t *xtri_of = NULL;
+    int rc = -1;
     if (!use || !want || !bad || !start || !tris || !ob || !src) { snprintf(err, errlen, "out of memory for the UVs of %zu triangles", n); goto out; }
     out->pages = 1;
     for (size_t o = 0; o < nobj; o++) {
@@ -202,36 +440,8 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     }
     /* which triangles keep the file's UVs (use), which xatlas charts (want) */
     size_t n_use = 0, n_want = 0;
-    int inside = 1, one_set = -1, mixed = 0;
-    for (size_t o = 0; o < nobj; o++) {
-        const int s = out->object_set[o];
-        if (s < -1) continue;
-        if (s >= 0) { rep->objects_kept++; mixed |= one_set >= 0 && one_set != s; one_set = s; }
-        else rep->objects_unwrapped++;
-        for (uint32_t i = start[o]; i < start[o + 1]; i++) {
-            const size_t t = tris[i];
-            const float sc_ = scale_of(sc, t);
-            const double wa = world_area(sc->tri + 9 * t) * (double)sc_ * sc_;
-            if (s < 0 || bad[i] || uv_area(sc->tri_uv[s] + 6 * t) == 0.0) {   /* no area, or overlapping: xatlas */
-                want[t] = 1;
-                n_want++;
-                continue;
-            }
-            use[t] = 1;
-            n_use++;
-            memcpy(src + 6 * t, sc->tri_uv[s] + 6 * t, 6 * sizeof(float));
-            for (int k = 0; k < 3; k++)
-                for (int d = 0; d < 2; d++) {
-                    const double v = src[6 * t + 2 * k + d];
-                    ob[o].lo[d] = fmin(ob[o].lo[d], v);
-                    ob[o].hi[d] = fmax(ob[o].hi[d], v);
-                    inside &= v >= 0.0 && v <= 1.0;
-                }
-            ob[o].uv_area += uv_area(src + 6 * t);
-            ob[o].world_area += wa;
-            ob[o].tris++;
-        }
-    }
+    int inside = 1, mixed = 0;
+    keep_or_chart(sc, nobj, start, tris, bad, out->object_set, use, want, src, ob, rep, &n_use, &n_want, &inside, &mixed);
     rep->unwrapped = n_want;
     int fail = 0;
     if (n_use) rep->overlap_texels = count_overlap(sc, src, use, size, err, errlen, &fail);
@@ -264,168 +474,25 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
                 for (int k = 0; k < 9; k++) scaled[9 * t + k] = sc->tri[9 * t + k] * (want[t] ? scale_of(sc, t) : 1.0f);
     }
     const float *xtri = weighted ? scaled : sc->tri;
-    ms_unwrap_info info;
-    memset(&info, 0, sizeof info);
     /* Regions: the file's layout as a whole when objects share one set and do not overlap, else one per
      * object with a layout; xatlas's square (one page) or its pages (a density). */
     int whole = !rep->overlap_texels && !weighted && !mixed;
     rs = calloc(nobj + n + 2, sizeof *rs);
     if (!rs) { snprintf(err, errlen, "out of memory for the lightmap's regions"); goto out; }
     object_uv all;
-    box_init(&all);
-    for (size_t o = 0; o < nobj; o++) {
-        if (!ob[o].tris) continue;
-        for (int d = 0; d < 2; d++) { all.lo[d] = fmin(all.lo[d], ob[o].lo[d]); all.hi[d] = fmax(all.hi[d], ob[o].hi[d]); }
-        all.uv_area += ob[o].uv_area;
-        all.world_area += ob[o].world_area;
-    }
-    size_t nr = 0;
-    for (int attempt = 0; attempt < 2; attempt++) {
-        nr = 0;
-        for (size_t o = 0; o < nobj; o++) ob[o].region = -1;
-        all.region = -1;
-        if (whole && all.uv_area > 0.0) { region_of(&all, &rs[nr]); all.region = (int)nr++; }
-        else
-            for (size_t o = 0; o < nobj; o++)
-                if (ob[o].tris) { region_of(&ob[o], &rs[nr]); ob[o].region = (int)nr++; }
-        if (!(T > 0.0)) break;
-        /* a density: T texels per (scaled) world unit; a region larger than a page is shrunk to fit */
-        int shrunk = 0;
-        for (size_t r = 0; r < nr; r++) {
-            rs[r].w0 *= T;
-            rs[r].h0 *= T;
-            const double f = fmin(1.0, (size - 2.0 * pad) / fmax(rs[r].w0, rs[r].h0));
-            if (f < 1.0) { shrunk++; rs[r].w0 *= f; rs[r].h0 *= f; }
-        }
-        if (shrunk && whole) { whole = 0; continue; }   /* the whole layout does not fit: per object */
-        if (shrunk)
-            ms_warn("texel density %g: %d objects are larger than a %dx%d page at that density and were scaled down to fit one",
-                    T, shrunk, size, size);
-        break;
-    }
+    const size_t nr = make_regions(ob, nobj, &all, whole, T, size, pad, rs);
     /* Placement. Regions alone are rectangles (atlas_pack.c): at the density, or at the largest common scale
      * that fits one page. With xatlas charts, xatlas's packer places the regions and the charts together
      * (atlas_xpack.c): at the density over as many pages as it takes, or on one page at the largest scale
      * found by stepping it. */
     if (!n_want) {
-        if (!(T > 0.0)) {
-            double wmax = 0.0;
-            for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].w0 * rs[r].h0);
-            for (size_t r = 0; r < nr; r++) {   /* relative sizes, so that tiny objects do not underflow */
-                rs[r].w0 = fmax(rs[r].w0 / sqrt(wmax), 1e-5);
-                rs[r].h0 = fmax(rs[r].h0 / sqrt(wmax), 1e-5);
-            }
-            if (ms_pack_one_page(rs, nr, size, pad)) {
-                snprintf(err, errlen, "the lightmap's %zu regions do not fit a %dx%d lightmap with %d texels of padding", nr, size, size, pad);
-                goto out;
-            }
-        } else {
-            const int pages = ms_pack_pages(rs, nr, 1.0, size, pad, 0);
-            if (pages < 0) { snprintf(err, errlen, "the lightmap's %zu regions do not fit %dx%d pages", nr, size, size); goto out; }
-            out->pages = pages ? pages : 1;
-        }
-    } else {
-        const int res = size - 2 * pad;
-        if (ms_lightmap_unwrap(xtri, n, want, group, res, pad, (float)T, p->tuning, xuv, xpage, &info, err, errlen)) goto out;
-        rep->charts = info.charts;
-        const double k0 = T > 0.0 ? 1.0 : info.texels_per_unit;   /* region texels per rs unit at the charts' density */
-        rdim = malloc((nr ? nr : 1) * 4 * sizeof *rdim);
-        rpage = malloc((nr ? nr : 1) * sizeof *rpage);
-        xin = malloc(n * 6 * sizeof *xin);
-        xout = malloc(n * 6 * sizeof *xout);
-        xkey = malloc(n * 2 * sizeof *xkey);   /* the charts' keys (stage-1 atlases), then their pages */
-        xtri_of = malloc(n * sizeof *xtri_of);
-        if (!rdim || !rpage || !xin || !xout || !xkey || !xtri_of) { snprintf(err, errlen, "out of memory packing the lightmap"); goto out; }
-        double area = 0.0;
-        for (size_t r = 0; r < nr; r++) {
-            rdim[r] = rs[r].w0 * k0;
-            rdim[nr + r] = rs[r].h0 * k0;
-            area += rdim[r] * rdim[nr + r];
-        }
-        size_t nx = 0;
-        for (size_t t = 0; t < n; t++) {
-            if (!want[t] || !isfinite(xuv[6 * t])) continue;
-            for (int k = 0; k < 6; k++) xin[6 * nx + k] = xuv[6 * t + k] * (float)res;
-            area += uv_area(xin + 6 * nx) / 0.7;   /* charts' boxes */
-            xkey[nx] = xpage[t];
-            xtri_of[nx++] = t;
-        }
-        area += (double)info.charts * (2.0 * pad + 2.0) * (2.0 * pad + 2.0);   /* and their padding */
-        ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, !(T > 0.0), rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n, 0.0 };
-        double scale = 1.0;
-        if (T > 0.0) {
-            const int pages = ms_xpack_run(&xp, 1.0, err, errlen);
-            if (pages < 0) goto out;
-            out->pages = pages;
-        } else {   /* one page: step the scale up while it fits, down while it does not */
-            /* steps by the ratio of the page to the atlas's extent until the scale is bracketed, then bisection
-             * to 1% (the extent is not proportional to the scale: every chart brings its padding) */
-            const double target = size - 2.0 * pad;
-            double best = 0.0, worst = INFINITY, sc_ = sqrt(0.7 * target * target / fmax(area, 1e-30));
-            int best_grow = 1;
-            for (int it = 0; it < 30; it++) {
-                /* the growing atlas stays square-ish, which may stack two wide regions and leave a strip; a
-                 * page of its own size, placed by random probes, may put them side by side: either will do */
-                char e2[256];
-                xp.grow = 1;
-                const double extent = (ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1) ? 0.0 : xp.extent;
-                int fits = extent == 0.0;
-                if (!fits) {
-                    xp.grow = 0;
-                    fits = ms_xpack_run(&xp, sc_, e2, sizeof e2) == 1;
-                    xp.extent = extent;
-                }
-                if (fits) { best = sc_; best_grow = xp.grow; }
-                else worst = fmin(worst, sc_);
-                if (best > 0.0 && isfinite(worst)) {
-                    if (worst / best < 1.01) break;
-                    sc_ = sqrt(best * worst);
-                } else {
-                    const double r = xp.extent > 0.0 ? target / xp.extent : 0.5;
-                    sc_ *= fits ? fmin(1.5, fmax(1.02, r)) : fmax(0.5, fmin(0.98, r));
-                }
-            }
-            xp.grow = best_grow;
-            if (!(best > 0.0) || ms_xpack_run(&xp, best, err, errlen) != 1) {
-                snprintf(err, errlen, "the lightmap's regions and charts do not fit a %dx%d lightmap with %d texels of padding", size, size, pad);
-                goto out;
-            }
-            scale = best;
-        }
-        for (size_t r = 0; r < nr; r++) {
-            rs[r].x = rdim[2 * nr + r];
-            rs[r].y = rdim[3 * nr + r];
-            rs[r].w = rdim[r] * scale;
-            rs[r].h = rdim[nr + r] * scale;
-            rs[r].page = rpage[r];
-        }
-        for (size_t i = 0; i < nx; i++) {
-            const size_t t = xtri_of[i];
-            for (int k = 0; k < 6; k++) out->uv[6 * t + k] = xout[6 * i + k] / (float)size;
-            out->page[t] = xkey[n + i];
-        }
+        if (place_regions(rs, nr, size, pad, T, &out->pages, err, errlen)) goto out;
+    } else if (place_charts(xtri, n, want, group, size, pad, T, xuv, xpage, rs, nr, out, rep, err, errlen)) {
+        goto out;
     }
     rep->regions = nr;
     rep->relaid = n_use > 0;
-    for (size_t o = 0; o < nobj; o++) {
-        const object_uv *q = all.region >= 0 ? &all : &ob[o];
-        if (out->object_set[o] < 0 || q->region < 0) continue;
-        const ms_pack_rect *r = &rs[q->region];
-        const double k = r->w / fmax(q->hi[0] - q->lo[0], 1e-30);   /* = h / (hi[1] - lo[1]): one scale */
-        float *so = out->object_scale_offset + 4 * o;
-        so[0] = so[1] = (float)(k / size);
-        so[2] = (float)((r->x - q->lo[0] * k) / size);
-        so[3] = (float)((r->y - q->lo[1] * k) / size);
-        for (uint32_t i = start[o]; i < start[o + 1]; i++) {
-            const size_t t = tris[i];
-            if (!use[t]) continue;
-            out->page[t] = (uint32_t)r->page;
-            for (int c = 0; c < 3; c++) {
-                out->uv[6 * t + 2 * c] = (float)((r->x + (src[6 * t + 2 * c] - q->lo[0]) * k) / size);
-                out->uv[6 * t + 2 * c + 1] = (float)((r->y + (src[6 * t + 2 * c + 1] - q->lo[1]) * k) / size);
-            }
-        }
-    }
+    place_kept(nobj, start, tris, use, src, ob, &all, rs, size, out);
     if (rep->overlap_texels)
         ms_warn("%zu objects' UVs overlap each other (%zu texel centres covered twice): each object gets its own region "
                 "of the lightmap, its UVs scaled and offset (the baked UVs: ms_lightmap.uv, the glTF's TEXCOORD_1)",
@@ -444,11 +511,5 @@ out:
     free(scaled);
     free(xuv);
     free(rs);
-    free(rdim);
-    free(rpage);
-    free(xin);
-    free(xout);
-    free(xkey);
-    free(xtri_of);
     return rc;
 }

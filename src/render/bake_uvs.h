@@ -10,7 +10,6 @@ typedef struct ms_bake_uv_params {
     int uv_set;              /* the set tried first for every object; -1: xatlas for all */
     int size, padding;
     float density;           /* texels per world unit (times each mesh's scale); 0: everything on one page */
-    const ms_unwrap_tuning *tuning;   /* NULL: the default */
 } ms_bake_uv_params;
 
 /* What ms_bake_uvs did, for the caller's report. */

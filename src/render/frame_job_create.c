@@ -290,8 +290,6 @@ static ms_status job_scene(ms_frame_job *j, const ms_render_options *opt, const 
     if (!streamed && ms_alpha_build(scene, &j->bvh, &j->alpha)) { snprintf(err, errlen, "out of memory for the alpha-tested triangles"); return MS_ERR_NO_MEMORY; }
     ctx->alpha = j->alpha;
     ctx->isa_cap = opt->isa;
-    ctx->no_occlusion_cull = opt->no_occlusion_cull;
-    ctx->no_child_order = opt->no_child_order;
     ctx->traversal = opt->traversal;
     ctx->frustum_shrink = opt->frustum_shrink;
     ctx->embree_mode = opt->embree_mode;

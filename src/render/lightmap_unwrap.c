@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <xatlas_c.h>
+#include "xatlas_meshes.h"
 
 /* xatlas's defaults (normal deviation 2, roundness 0.01, straightness 6, normal seam 4, texture seam 0.5,
  * max cost 2, 1 iteration) cut scanned and finely tessellated surfaces into thousands of charts a few
@@ -50,7 +50,7 @@ static int cmp_order(const void *a, const void *b)
 }
 
 int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const uint32_t *group, int size, int padding,
-                       float density, const ms_unwrap_tuning *tuning, float *uv, uint32_t *atlas_of, ms_unwrap_info *info,
+                       float density, float *uv, uint32_t *atlas_of, ms_unwrap_info *info,
                        char *err, size_t errlen)
 {
     ms_unwrap_info dummy;
@@ -113,26 +113,15 @@ int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const ui
     int rc = -1, told = 0;
     xatlasAtlas *atlas = xatlasCreate();
     if (!atlas) { snprintf(err, errlen, "xatlas: out of memory"); told = 1; goto out; }
-    for (size_t g = 0; g < ng; g++) {
-        xatlasMeshDecl decl;
-        xatlasMeshDeclInit(&decl);
-        decl.vertexPositionData = pos + 3 * vbase[g];
-        decl.vertexCount = (uint32_t)(vbase[g + 1] - vbase[g]);
-        decl.vertexPositionStride = 3 * sizeof(float);
-        decl.indexData = index + 3 * seg[g];
-        decl.indexCount = (uint32_t)(3 * (seg[g + 1] - seg[g]));
-        decl.indexFormat = XATLAS_INDEX_FORMAT_UINT32;
-        const xatlasAddMeshError e = xatlasAddMesh(atlas, &decl, (uint32_t)ng);
-        if (e != XATLAS_ADD_MESH_ERROR_SUCCESS) {
-            snprintf(err, errlen, "xatlas: %s", xatlasAddMeshErrorString(e));
-            told = 1;
-            goto out;
-        }
+    const xatlasAddMeshError e = ms_xatlas_add_meshes(atlas, 3, pos, vbase, index, seg, ng);
+    if (e != XATLAS_ADD_MESH_ERROR_SUCCESS) {
+        snprintf(err, errlen, "xatlas: %s", xatlasAddMeshErrorString(e));
+        told = 1;
+        goto out;
     }
     xatlasAddMeshJoin(atlas);
     ms_unwrap_tuning tu;
-    if (tuning) tu = *tuning;
-    else ms_lightmap_unwrap_tuning_default(&tu);
+    ms_lightmap_unwrap_tuning_default(&tu);
     xatlasChartOptions co;
     xatlasChartOptionsInit(&co);
     co.normalDeviationWeight = tu.normal_deviation;

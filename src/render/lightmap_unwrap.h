@@ -4,8 +4,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* xatlas's chart-growing weights (xatlas.h, ChartOptions); ms_lightmap_unwrap_tuning_default gives the ones
- * the bake uses. */
+/* xatlas's chart-growing weights (xatlas.h, ChartOptions): ms_lightmap_unwrap_tuning_default gives the ones the
+ * unwrap uses (and the UV cache's key hashes). */
 typedef struct ms_unwrap_tuning {
     float normal_deviation, roundness, straightness, normal_seam, texture_seam, max_cost;
     unsigned max_iterations;
@@ -24,9 +24,9 @@ typedef struct ms_unwrap_info {
  * are welded within it so that charts span connected surfaces (and cross the file's normal seams).
  * density 0: one atlas of about size x size, the UVs in [0,1]^2 of it (the density lowered until one
  * suffices; atlas may be NULL). density > 0: that many texels per unit of tri, in as many size x size
- * atlases as it takes, atlas[i] the one of triangle i and uv in [0,1]^2 of it. tuning NULL: the default.
+ * atlases as it takes, atlas[i] the one of triangle i and uv in [0,1]^2 of it.
  * 0, or -1 with a message. */
 int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const uint32_t *group, int size, int padding,
-                       float density, const ms_unwrap_tuning *tuning, float *uv, uint32_t *atlas, ms_unwrap_info *info,
+                       float density, float *uv, uint32_t *atlas, ms_unwrap_info *info,
                        char *err, size_t errlen);
 #endif

@@ -1,4 +1,4 @@
-/* Visibility at caller-given points (microshadow.h, "Visibility at any points"): the driver ms_render
+/* Visibility at caller-given points (microshadow/points.h, "Visibility at any points"): the driver ms_render
  * is for frames, without the camera. Points are grouped by proximity (30-bit Morton codes of their
  * positions in the points' bounding box) into batches of BATCH, and each batch goes through the shadow
  * method interface exactly as a frame tile does in frame_job.c: front masks (receiver.c), the method's
@@ -230,27 +230,11 @@ ms_status ms_visibility_points_abi(const ms_abi *abi, const ms_accel *a, const m
     return st;
 }
 
-ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, const ms_points *pts,
-                                     const ms_points_options *opt_in, float *vis, float *shadow, uint16_t *front_out,
-                                     ms_stats *stats, char *err, size_t errlen)
+/* The method of the options (MS_AUTO_METHOD resolved), and the buffer side k of their samples, checked against
+ * the pattern (points take the grid and stratified patterns at 256, 1024 or 4096 samples). */
+static ms_status points_method(const ms_points_options *opt, const ms_shadow_method **sm_out, int *k_out, char *err,
+                               size_t errlen)
 {
-    const double t_start = omp_get_wtime();
-    ms_points_options zero;
-    memset(&zero, 0, sizeof zero);
-    const ms_points_options *opt = opt_in ? opt_in : &zero;
-    if (stats) memset(stats, 0, sizeof *stats);
-    if (!a) { snprintf(err, errlen, "ms_visibility_points: no accel"); return MS_ERR_INVALID; }
-    if (!light) light = &a->view.light;
-    if (!ms_light_shape_of(light->shape)) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
-    if (!ms_light_finite(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area (a sphere: radius not > 0)"); return MS_ERR_INVALID; }
-    /* A sun: placed for the accel's scene as frames place it (sun_place.h), whatever distance the caller's holds. */
-    ms_light placed = *light;
-    float sbox[6];
-    ms_scene_tri_box(&a->view, &a->bvh, sbox);
-    ms_light_sun_place(&placed, sbox);
-    light = &placed;
-    ms_status st = check_points(a, pts, err, errlen);
-    if (st) return st;
     const char *method = opt->method ? opt->method : MS_DEFAULT_METHOD;
     if (strcmp(method, MS_AUTO_METHOD) == 0) method = ms_auto_method(opt->pattern);
     const ms_shadow_method *sm = ms_find_shadow_method(method);
@@ -275,39 +259,18 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
         snprintf(err, errlen, "method '%s' needs the grid pattern", sm->name);
         return MS_ERR_INVALID;
     }
-    const int threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
-    const uint64_t budget = ms_memory_budget(opt->max_memory);
-    if (ms_points_budget_check(pts->n, a->view.n_tris, sm->visibility_all != NULL, (k * k + 63) / 64, threads, budget, err,
-                               errlen))
-        return MS_ERR_BUDGET;
+    *sm_out = sm;
+    *k_out = k;
+    return MS_OK;
+}
 
-    /* The hpc methods (those with a frame-level entry) read the scene's triangles in scene order
-     * (hpc_method.c), which the accel keeps only in the BVH's leaf order: a scene-order copy for this call. */
-    ms_scene view = a->view;
-    float *scene_tri = NULL;
-    if (sm->visibility_all && a->view.n_tris) {
-        scene_tri = calloc(a->view.n_tris * 9, sizeof *scene_tri);
-        if (!scene_tri) { snprintf(err, errlen, "out of memory for the triangles of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
-        for (uint32_t i = 0; i < a->bvh.n_tris; i++)
-            memcpy(scene_tri + 9 * (size_t)a->bvh.tri_source[i], a->bvh.tri + 9 * (size_t)i, 9 * sizeof *scene_tri);
-        view.tri = scene_tri;
-    }
-    ms_render_ctx ctx;   /* the frames' context (ms_render_ctx_init), so points answer as frames do */
-    ms_render_ctx_init(&ctx, &view, &a->bvh, light, opt->pattern, k, opt->seed, threads);
-    ctx.alpha = a->alpha;
-    ctx.isa_cap = opt->isa;
-    ctx.embree_mode = opt->embree_mode;
-    ctx.embree_filter = opt->embree_filter;
-    ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
-    const ms_light_shape_ops *shape = ms_light_shape_of(light->shape);
-    const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
-    const int batched = outlined && sm->outlines;    /* ... which the method takes a batch at a time (frame_job.c) */
-    ms_render_ctx bctx;   /* the batch's context then: each query's light its outline (ms_ctx_for_query) */
-
+/* The points in proximity order: Morton codes in their bounding box, ties by index (a total order). A malloc'ed
+ * array of pts->n, NULL when out of memory. */
+static morton_item *proximity_order(const ms_points *pts)
+{
     const size_t n = pts->n;
-    /* Proximity order: Morton codes in the points' bounding box, ties by index (a total order). */
     morton_item *order = malloc((n ? n : 1) * sizeof *order);
-    if (!order) { free(scene_tri); snprintf(err, errlen, "out of memory for %zu points", n); return MS_ERR_NO_MEMORY; }
+    if (!order) return NULL;
     float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {
@@ -326,19 +289,221 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
         order[i].index = i;
     }
     qsort(order, n, sizeof *order, cmp_morton);
+    return order;
+}
+
+/* What every batch of one call shares, read-only while the batches run. */
+typedef struct points_run {
+    const ms_accel *a;
+    const ms_points *pts;
+    const morton_item *order;
+    const ms_shadow_method *sm;
+    void *sstate;
+    const ms_render_ctx *ctx, *bctx;   /* the call's context; the batch's when each query has its own outline */
+    const ms_light_shape_ops *shape;
+    int outlined, batched;             /* a per-receiver light (the shape's outline); the method takes it by batch */
+    size_t mw;
+    float *vis, *shadow;
+    uint16_t *front_out;
+} points_run;
+
+/* The points [i0, i1) of the proximity order, as a frame tile (frame_job.c): their queries and front masks, the
+ * method's visible masks, V and S. A sphere or a sun: each point has its own light, the shape's outline seen
+ * from it, and the method takes the batch with each point's outline (.outlines) or is called one point at a
+ * time with it, exactly as frames do; a point inside a sphere has no sample in front (V = S = 0). Scratch: fm,
+ * vm (BATCH masks each), spts (a pixel's samples, stratified patterns only), q (BATCH queries). Adds to the
+ * thread's counters, segments, penumbra points and resolve seconds. 0, or -1 when the method failed. */
+static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm, uint64_t *vm, float *spts,
+                        ms_shadow_query *q, uint64_t *counters, uint64_t *segments, uint64_t *penumbra, double *resolve_s)
+{
+    const int m = (int)(i1 - i0);
+    ms_render_ctx qc = *r->ctx;
+    int nq = 0;
+    size_t where[BATCH];
+    for (int j = 0; j < m; j++) {
+        const size_t i = r->order[i0 + j].index;
+        make_query(r->a, r->pts, i, &q[nq]);
+        if (r->outlined && r->shape->outline(&r->ctx->light, q[nq].p, &qc.light)) {
+            if (r->front_out) r->front_out[i] = 0;
+            if (r->vis) r->vis[i] = 0.0f;
+            if (r->shadow) r->shadow[i] = 0.0f;
+            continue;
+        }
+        if (spts) ms_pattern_points(r->ctx->pattern, &qc.light, r->ctx->k, q[nq].px, q[nq].py, r->ctx->seed, spts);
+        const int nf = ms_front_mask(&qc, &q[nq], spts, fm + (size_t)nq * r->mw);
+        if (r->front_out) r->front_out[i] = (uint16_t)nf;
+        *segments += (uint64_t)nf;
+        where[nq++] = i;
+    }
+    int vfail = 0;
+    if (!r->outlined || r->batched) vfail = nq && r->sm->visibility(r->sstate, r->batched ? r->bctx : r->ctx, q, nq, fm, vm, counters);
+    else
+        for (int j = 0; j < nq && !vfail; j++) {
+            r->shape->outline(&r->ctx->light, q[j].p, &qc.light);
+            vfail = r->sm->visibility(r->sstate, &qc, &q[j], 1, fm + (size_t)j * r->mw, vm + (size_t)j * r->mw, counters);
+        }
+    if (vfail) return -1;
+    const double tr = omp_get_wtime();
+    for (int j = 0; j < nq; j++) {
+        const size_t i = where[j];
+        float v, s;
+        if (r->outlined) r->shape->outline(&r->ctx->light, q[j].p, &qc.light);
+        if (spts) ms_pattern_points(r->ctx->pattern, &qc.light, r->ctx->k, q[j].px, q[j].py, r->ctx->seed, spts);
+        *penumbra += (uint64_t)ms_resolve_vs(&qc, &q[j], spts, fm + (size_t)j * r->mw, vm + (size_t)j * r->mw, &v, &s);
+        if (r->vis) r->vis[i] = v;
+        if (r->shadow) r->shadow[i] = s;
+    }
+    *resolve_s += omp_get_wtime() - tr;
+    return 0;
+}
+
+/* What a call measured: the timings and the counters summed over the threads. */
+typedef struct points_tally {
+    double setup_s, shadow_s, resolve_thread_s, t_start;
+    uint64_t interior_boxes, penumbra, segments;
+    const uint64_t *counters;
+    ms_isa kisa, tisa;
+} points_tally;
+
+/* The stats of a call: the accel's, the method's, and what it measured. */
+static void points_stats(const ms_accel *a, const ms_shadow_method *sm, const ms_render_ctx *ctx, size_t n, int threads,
+                         uint64_t budget, const points_tally *t, ms_stats *stats)
+{
+    const int stratified = ctx->pattern != MS_PATTERN_GRID;
+    const size_t mw = (size_t)ctx->mask_words;
+    stats->triangles = a->view.n_tris;
+    stats->build_s = a->bvh.build_s;
+    stats->setup_s = t->setup_s;
+    stats->shadow_s = t->shadow_s;
+    stats->interior_boxes = t->interior_boxes;
+    stats->samples = ctx->samples;
+    stats->samples_per_pixel = ctx->samples;   /* every point gets all N (no interleaving here) */
+    stats->threads = threads;
+    stats->method = sm->name;
+    stats->pattern = stratified ? "stratified" : "grid";
+    stats->kernel_isa = t->kisa == MS_ISA_AUTO ? "none" : ms_isa_name(t->kisa);
+    stats->traversal_isa = t->tisa == MS_ISA_AUTO ? "none" : ms_isa_name(t->tisa);
+    stats->visible_pixels = n;
+    stats->penumbra_pixels = t->penumbra;
+    stats->shadow_rays = t->segments;
+    stats->shadow_factor_s = t->resolve_thread_s / threads;
+    stats->n_counters = sm->n_counters;
+    for (int c = 0; c < sm->n_counters; c++) { stats->counter_name[c] = sm->counter_names[c]; stats->counter[c] = t->counters[c]; }
+    stats->memory_need = ms_points_need(n, a->view.n_tris, sm->visibility_all != NULL, (int)mw, threads, NULL);
+    stats->memory_budget = budget;
+    stats->total_s = omp_get_wtime() - t->t_start;
+}
+
+/* A NaN or infinite V or S (geometry the form-factor weights overflow on) is an error naming the point. */
+static ms_status points_finite(size_t n, const float *vis, const float *shadow, char *err, size_t errlen)
+{
+    for (size_t i = 0; i < n; i++)
+        if ((vis && !isfinite(vis[i])) || (shadow && !isfinite(shadow[i]))) {
+            snprintf(err, errlen, "point %zu: %s is %s (a NaN or infinite result is an error)", i,
+                     vis && !isfinite(vis[i]) ? "V" : "S", isnan(vis && !isfinite(vis[i]) ? vis[i] : shadow[i]) ? "NaN" : "infinite");
+            return MS_ERR_INVALID;
+        }
+    return MS_OK;
+}
+
+/* The light a call answers for: light, or the accel's scene's first (NULL), checked; a sun placed for the
+ * accel's scene as frames place it (sun_place.h), whatever distance the caller's holds. */
+static ms_status points_light(const ms_accel *a, const ms_light *light, ms_light *placed, char *err, size_t errlen)
+{
+    if (!light) light = &a->view.light;
+    if (!ms_light_shape_of(light->shape)) { snprintf(err, errlen, "unknown light shape %d", (int)light->shape); return MS_ERR_INVALID; }
+    if (!ms_light_finite(light)) { snprintf(err, errlen, "light has a NaN or infinite value, or zero area (a sphere: radius not > 0)"); return MS_ERR_INVALID; }
+    *placed = *light;
+    float sbox[6];
+    ms_scene_tri_box(&a->view, &a->bvh, sbox);
+    ms_light_sun_place(placed, sbox);
+    return MS_OK;
+}
+
+/* The interior boxes of the accel's closed surfaces that the light allows (occluders.h) into occ, and ctx->interior
+ * pointing at them where there are any. 0, or -1 when out of memory. */
+static int points_interior(const ms_accel *a, const ms_scene *view, const ms_light *light, int threads, ms_occluders *occ,
+                           ms_render_ctx *ctx)
+{
+    if (ms_occluders_build(occ, view, &a->bvh, &a->closed, &a->interior, a->interior_eps, a->alpha, light, MS_OCC_INTERIOR,
+                           threads))
+        return -1;
+    if (occ->interior.n_tris) ctx->interior = &occ->interior;
+    return 0;
+}
+
+/* The accel's triangles in scene order (it keeps them in the BVH's leaf order): a malloc'ed copy, NULL when out
+ * of memory. */
+static float *scene_order_tris(const ms_accel *a)
+{
+    float *tri = calloc(a->view.n_tris * 9, sizeof *tri);
+    if (!tri) return NULL;
+    for (uint32_t i = 0; i < a->bvh.n_tris; i++)
+        memcpy(tri + 9 * (size_t)a->bvh.tri_source[i], a->bvh.tri + 9 * (size_t)i, 9 * sizeof *tri);
+    return tri;
+}
+
+ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, const ms_points *pts,
+                                     const ms_points_options *opt_in, float *vis, float *shadow, uint16_t *front_out,
+                                     ms_stats *stats, char *err, size_t errlen)
+{
+    const double t_start = omp_get_wtime();
+    ms_points_options zero;
+    memset(&zero, 0, sizeof zero);
+    const ms_points_options *opt = opt_in ? opt_in : &zero;
+    if (stats) memset(stats, 0, sizeof *stats);
+    if (!a) { snprintf(err, errlen, "ms_visibility_points: no accel"); return MS_ERR_INVALID; }
+    ms_light placed;
+    ms_status st = points_light(a, light, &placed, err, errlen);
+    if (st) return st;
+    light = &placed;
+    st = check_points(a, pts, err, errlen);
+    if (st) return st;
+    const ms_shadow_method *sm;
+    int k;
+    st = points_method(opt, &sm, &k, err, errlen);
+    if (st) return st;
+    const int threads = opt->threads > 0 ? opt->threads : omp_get_num_procs();
+    const uint64_t budget = ms_memory_budget(opt->max_memory);
+    if (ms_points_budget_check(pts->n, a->view.n_tris, sm->visibility_all != NULL, (k * k + 63) / 64, threads, budget, err,
+                               errlen))
+        return MS_ERR_BUDGET;
+
+    /* The hpc methods (those with a frame-level entry) read the scene's triangles in scene order
+     * (hpc_method.c), which the accel keeps only in the BVH's leaf order: a scene-order copy for this call. */
+    ms_scene view = a->view;
+    float *scene_tri = NULL;
+    if (sm->visibility_all && a->view.n_tris) {
+        if (!(scene_tri = scene_order_tris(a))) {
+            snprintf(err, errlen, "out of memory for the triangles of method '%s'", sm->name);
+            return MS_ERR_NO_MEMORY;
+        }
+        view.tri = scene_tri;
+    }
+    ms_render_ctx ctx;   /* the frames' context (ms_render_ctx_init), so points answer as frames do */
+    ms_render_ctx_init(&ctx, &view, &a->bvh, light, opt->pattern, k, opt->seed, threads);
+    ctx.alpha = a->alpha;
+    ctx.isa_cap = opt->isa;
+    ctx.embree_mode = opt->embree_mode;
+    ctx.embree_filter = opt->embree_filter;
+    ctx.queries_in_order = 1;   /* Morton order: block methods group consecutive points */
+    const ms_light_shape_ops *shape = ms_light_shape_of(light->shape);
+    const int outlined = shape && shape->outline;   /* a per-receiver light: the shape's outline (light_shape.h) */
+    const int batched = outlined && sm->outlines;    /* ... which the method takes a batch at a time (frame_job.c) */
+    ms_render_ctx bctx;   /* the batch's context then: each query's light its outline (ms_ctx_for_query) */
+
+    const size_t n = pts->n;
+    morton_item *order = proximity_order(pts);
+    if (!order) { free(scene_tri); snprintf(err, errlen, "out of memory for %zu points", n); return MS_ERR_NO_MEMORY; }
 
     void *sstate = NULL;
     const double t_setup = omp_get_wtime();
     ms_occluders occ = { 0 };
-    if ((sm->occluders & MS_OCC_INTERIOR) && a->interior.n_boxes) {
-        if (ms_occluders_build(&occ, &view, &a->bvh, &a->closed, &a->interior, a->interior_eps, a->alpha, light,
-                               MS_OCC_INTERIOR, threads)) {
-            free(order);
-            free(scene_tri);
-            snprintf(err, errlen, "out of memory for the interior boxes");
-            return MS_ERR_NO_MEMORY;
-        }
-        if (occ.interior.n_tris) ctx.interior = &occ.interior;
+    if ((sm->occluders & MS_OCC_INTERIOR) && a->interior.n_boxes && points_interior(a, &view, light, threads, &occ, &ctx)) {
+        free(order);
+        free(scene_tri);
+        snprintf(err, errlen, "out of memory for the interior boxes");
+        return MS_ERR_NO_MEMORY;
     }
     const uint64_t occ_boxes = occ.interior_boxes;
     if (sm->create(&ctx, &sstate, err, errlen)) { ms_occluders_free(&occ); free(order); free(scene_tri); return MS_ERR_METHOD; }
@@ -354,6 +519,7 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     double resolve_thread_s = 0.0;
     long done = 0;
     int failed = 0, cancelled = 0;
+    const points_run run = { a, pts, order, sm, sstate, &ctx, &bctx, shape, outlined, batched, mw, vis, shadow, front_out };
     const double t0 = omp_get_wtime();
 #pragma omp parallel num_threads(threads)
     {
@@ -376,53 +542,12 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
             stop = cancelled;
             if (!ok || stop) continue;
             const size_t i0 = (size_t)b * BATCH, i1 = i0 + BATCH < n ? i0 + BATCH : n;
-            const int m = (int)(i1 - i0);
-            /* A sphere or a sun: each point has its own light, the shape's outline seen from it, and the
-             * method takes the batch with each point's outline (.outlines) or is called one point at a time
-             * with it, exactly as frames do (frame_job.c); a point inside a sphere has no sample in front
-             * (V = S = 0). */
-            ms_render_ctx qc = ctx;
-            int nq = 0;
-            size_t where[BATCH];
-            for (int j = 0; j < m; j++) {
-                const size_t i = order[i0 + j].index;
-                make_query(a, pts, i, &q[nq]);
-                if (outlined && shape->outline(&ctx.light, q[nq].p, &qc.light)) {
-                    if (front_out) front_out[i] = 0;
-                    if (vis) vis[i] = 0.0f;
-                    if (shadow) shadow[i] = 0.0f;
-                    continue;
-                }
-                if (spts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[nq].px, q[nq].py, ctx.seed, spts);
-                const int nf = ms_front_mask(&qc, &q[nq], spts, fm + (size_t)nq * mw);
-                if (front_out) front_out[i] = (uint16_t)nf;
-                local_segments += (uint64_t)nf;
-                where[nq++] = i;
-            }
-            int vfail = 0;
-            if (!outlined || batched) vfail = nq && sm->visibility(sstate, batched ? &bctx : &ctx, q, nq, fm, vm, local);
-            else
-                for (int j = 0; j < nq && !vfail; j++) {
-                    shape->outline(&ctx.light, q[j].p, &qc.light);
-                    vfail = sm->visibility(sstate, &qc, &q[j], 1, fm + (size_t)j * mw, vm + (size_t)j * mw, local);
-                }
-            if (vfail) {
+            if (points_batch(&run, i0, i1, fm, vm, spts, q, local, &local_segments, &local_penumbra, &local_resolve)) {
                 ok = 0;
 #pragma omp atomic write
                 failed = 1;
                 continue;
             }
-            const double tr = omp_get_wtime();
-            for (int j = 0; j < nq; j++) {
-                const size_t i = where[j];
-                float v, s;
-                if (outlined) shape->outline(&ctx.light, q[j].p, &qc.light);
-                if (spts) ms_pattern_points(ctx.pattern, &qc.light, ctx.k, q[j].px, q[j].py, ctx.seed, spts);
-                local_penumbra += (uint64_t)ms_resolve_vs(&qc, &q[j], spts, fm + (size_t)j * mw, vm + (size_t)j * mw, &v, &s);
-                if (vis) vis[i] = v;
-                if (shadow) shadow[i] = s;
-            }
-            local_resolve += omp_get_wtime() - tr;
             if (opt->progress) {
                 /* One caller at a time; its answer stops the remaining batches. */
 #pragma omp critical(ms_points_progress)
@@ -456,35 +581,11 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     free(scene_tri);
     if (failed) { snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
     if (cancelled) { snprintf(err, errlen, "cancelled by the progress callback"); return MS_ERR_CANCELLED; }
-    /* A NaN or infinite V or S (geometry the form-factor weights overflow on) is an error naming the point. */
-    for (size_t i = 0; i < n; i++)
-        if ((vis && !isfinite(vis[i])) || (shadow && !isfinite(shadow[i]))) {
-            snprintf(err, errlen, "point %zu: %s is %s (a NaN or infinite result is an error)", i,
-                     vis && !isfinite(vis[i]) ? "V" : "S", isnan(vis && !isfinite(vis[i]) ? vis[i] : shadow[i]) ? "NaN" : "infinite");
-            return MS_ERR_INVALID;
-        }
+    st = points_finite(n, vis, shadow, err, errlen);
+    if (st) return st;
     if (stats) {
-        stats->triangles = a->view.n_tris;
-        stats->build_s = a->bvh.build_s;
-        stats->setup_s = setup_s;
-        stats->shadow_s = t1 - t0;
-        stats->interior_boxes = occ_boxes;
-        stats->samples = ctx.samples;
-        stats->samples_per_pixel = ctx.samples;   /* every point gets all N (no interleaving here) */
-        stats->threads = threads;
-        stats->method = sm->name;
-        stats->pattern = stratified ? "stratified" : "grid";
-        stats->kernel_isa = kisa == MS_ISA_AUTO ? "none" : ms_isa_name(kisa);
-        stats->traversal_isa = tisa == MS_ISA_AUTO ? "none" : ms_isa_name(tisa);
-        stats->visible_pixels = n;
-        stats->penumbra_pixels = penumbra;
-        stats->shadow_rays = segments;
-        stats->shadow_factor_s = resolve_thread_s / threads;
-        stats->n_counters = sm->n_counters;
-        for (int c = 0; c < sm->n_counters; c++) { stats->counter_name[c] = sm->counter_names[c]; stats->counter[c] = counters[c]; }
-        stats->memory_need = ms_points_need(n, a->view.n_tris, sm->visibility_all != NULL, (int)mw, threads, NULL);
-        stats->memory_budget = budget;
-        stats->total_s = omp_get_wtime() - t_start;
+        const points_tally t = { setup_s, t1 - t0, resolve_thread_s, t_start, occ_boxes, penumbra, segments, counters, kisa, tisa };
+        points_stats(a, sm, &ctx, n, threads, budget, &t, stats);
     }
     return MS_OK;
 }

@@ -55,12 +55,9 @@ uint64_t ms_uv_cache_key(const ms_scene *sc, const ms_bake_uv_params *p)
     const int ints[3] = { p->uv_set, p->size, p->padding };
     hash_bytes(&s, ints, sizeof ints);
     hash_bytes(&s, &p->density, sizeof p->density);
-    ms_unwrap_tuning tu;
-    if (p->tuning) tu = *p->tuning;
-    else {
-        memset(&tu, 0, sizeof tu);
-        ms_lightmap_unwrap_tuning_default(&tu);
-    }
+    ms_unwrap_tuning tu;   /* the chart weights: a cache charted with other weights is not used */
+    memset(&tu, 0, sizeof tu);
+    ms_lightmap_unwrap_tuning_default(&tu);
     hash_bytes(&s, &tu, sizeof tu);
     return s.h;
 }

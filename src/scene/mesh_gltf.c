@@ -342,8 +342,10 @@ static long texture_of(const cgltf_data *d, const cgltf_options *opt, const cglt
 {
     const cgltf_texture *tx = tv->texture;
     if (!tx) return -1;
-    /* KHR_texture_basisu's KTX2 image only where there is no PNG/JPEG fallback (texture.c decodes
-     * uncompressed KTX2 and names what it cannot decode). */
+    /* KHR_texture_basisu's KTX2 image only where the texture has no fallback `source`: the extension's
+     * payloads are Basis Universal (ETC1S, UASTC), which microshadow does not transcode (docs/shading.md),
+     * so a PNG/JPEG fallback is the image that can be shown. Without one the KTX2 is tried: 8-bit levels,
+     * plain or Zstandard, decode (texture_ktx2.c); a Basis payload is one warning naming the file. */
     const cgltf_image *img = tx->image ? tx->image : tx->has_basisu ? tx->basisu_image : NULL;
     if (!img) {
         ms_warn_material("%s: material %zu: %s: texture %zu has no PNG, JPEG or KTX2 image%s: texture ignored", path, mi, slot,
@@ -381,9 +383,9 @@ static long texture_of(const cgltf_data *d, const cgltf_options *opt, const cglt
     return tex_of[im];
 }
 
-/* Extensions microshadow implements (KHR_texture_basisu: its KTX2 images, uncompressed ones decoded, the
- * others named in a warning); any other in extensionsRequired is an error, in extensionsUsed one warning
- * each saying what is left out. */
+/* Extensions microshadow implements (KHR_texture_basisu: the fallback source, else its KTX2 image, 8-bit
+ * plain or Zstandard levels decoded, Basis payloads named in a warning); any other in extensionsRequired is
+ * an error, in extensionsUsed one warning each saying what is left out. */
 static const char *const known_ext[] = { "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_texture_basisu",
                                          "KHR_mesh_quantization", "KHR_lights_punctual" };
 static const struct { const char *name, *left_out; } ext_left_out[] = {

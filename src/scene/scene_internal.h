@@ -138,6 +138,13 @@ int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, in
 /* The same decode appended to the soup as a texture; its index, or -1 with one line in err naming `what`. flip_rows: store the rows bottom-up (OBJ's v = 0 is
  * the image's last row; textures follow glTF, v = 0 the first). Loaders treat a texture that fails as a
  * warning, the material keeping its factors: a scene whose textures are missing or undecodable still loads. */
+/* The size check every decoder makes before allocating: at most MS_MAX_TEXTURE_SIDE a side and w x h RGBA8
+ * within `budget`; 1, or 0 with one line in err naming `what`. */
+int ms_texture_size_ok(unsigned w, unsigned h, size_t budget, const char *what, char *err, size_t errlen);
+/* A KTX2 file (texture_ktx2.c): level 0 of an 8-bit uncompressed format, stored plain or Zstandard-
+ * supercompressed; anything else refused with one line naming what it is. As ms_texture_decode. */
+int ms_texture_decode_ktx2(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                           struct ms_texture *out, char *err, size_t errlen);
 long ms_soup_add_texture_memory(ms_tri_soup *soup, const unsigned char *buf, size_t len, const char *what,
                                 int flip_rows, char *err, size_t errlen);
 /* The same from a file (a regular file of at most MS_MAX_MESH_BYTES). */

@@ -1,7 +1,7 @@
 /* Material textures into RGBA8, told apart by content: PNG (libpng's simplified API: 8- and 16-bit,
  * paletted, grey), JPEG (libjpeg-turbo's TurboJPEG API, which reports errors and never exits) and KTX2
- * (the container parsed here; its uncompressed 8-bit formats). The size is checked against the limits
- * from the header before any pixel memory is allocated. */
+ * (texture_ktx2.c). The size is checked against the limits from the header before any pixel memory is
+ * allocated. */
 #include "scene_internal.h"
 #include "microshadow.h"
 #include <png.h>
@@ -10,9 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The size check every decoder makes before allocating: at most MS_MAX_TEXTURE_SIDE a side, and the
- * decoded RGBA8 within the budget left. */
-static int size_ok(unsigned w, unsigned h, size_t budget, const char *what, char *err, size_t errlen)
+int ms_texture_size_ok(unsigned w, unsigned h, size_t budget, const char *what, char *err, size_t errlen)
 {
     if (w == 0 || h == 0 || w > MS_MAX_TEXTURE_SIDE || h > MS_MAX_TEXTURE_SIDE) {
         snprintf(err, errlen, "%s: a %ux%u texture (at most %d a side)", what, w, h, MS_MAX_TEXTURE_SIDE);
@@ -35,7 +33,7 @@ static int decode_png(const unsigned char *buf, size_t len, const char *what, in
         snprintf(err, errlen, "%s: bad PNG: %s", what, img.message);
         return -1;
     }
-    if (!size_ok(img.width, img.height, budget, what, err, errlen)) { png_image_free(&img); return -1; }
+    if (!ms_texture_size_ok(img.width, img.height, budget, what, err, errlen)) { png_image_free(&img); return -1; }
     /* Colour stays sRGB-encoded (shade.c converts at lookup). A 16-bit file without gAMA/sRGB chunks is
      * sRGB-encoded too (glTF's textures are), not the linear data libpng assumes by default; it is
      * reduced to 8 bits. Palettes and grey are expanded by libpng. */
@@ -75,7 +73,7 @@ static int decode_jpeg(const unsigned char *buf, size_t len, const char *what, i
         goto out;
     }
     if (w < 1 || h < 1) { snprintf(err, errlen, "%s: bad JPEG: no frame header (a file cut short?)", what); goto out; }
-    if (!size_ok((unsigned)w, (unsigned)h, budget, what, err, errlen)) goto out;
+    if (!ms_texture_size_ok((unsigned)w, (unsigned)h, budget, what, err, errlen)) goto out;
     if (!(px = malloc((size_t)w * (size_t)h * 4))) {
         snprintf(err, errlen, "%s: out of memory for a %dx%d texture", what, w, h);
         goto out;
@@ -100,70 +98,7 @@ out:
     return rc;
 }
 
-static uint32_t rd32(const unsigned char *p) { return p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
-static uint64_t rd64(const unsigned char *p) { return rd32(p) | (uint64_t)rd32(p + 4) << 32; }
-
 static const unsigned char ktx2_id[12] = { 0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n' };
-
-/* KTX2 (Khronos KTX 2.0): the header, the level index, level 0 of an uncompressed 8-bit format (rows
- * tightly packed, top row first as glTF expects); supercompressed (BasisLZ, Zstandard, ZLIB) and
- * block-compressed payloads are refused naming what they are (no decoder here). */
-static int decode_ktx2(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
-                       ms_texture *out, char *err, size_t errlen)
-{
-    if (len < 80 + 24) { snprintf(err, errlen, "%s: bad KTX2: %zu bytes, shorter than its header", what, len); return -1; }
-    const uint32_t vk = rd32(buf + 12), w = rd32(buf + 20), h = rd32(buf + 24), depth = rd32(buf + 28),
-                   layers = rd32(buf + 32), faces = rd32(buf + 36), levels = rd32(buf + 40), scheme = rd32(buf + 44);
-    static const char *const schemes[] = { "none", "BasisLZ", "Zstandard", "ZLIB" };
-    if (scheme != 0) {
-        snprintf(err, errlen, "%s: KTX2 with %s supercompression%s is not decoded (no decoder)", what,
-                 scheme < 4 ? schemes[scheme] : "unknown", scheme == 1 ? " (KHR_texture_basisu)" : "");
-        return -1;
-    }
-    /* bytes per texel and where R, G, B, A are (-1: absent) */
-    int bpp = 0, ch[4] = { -1, -1, -1, -1 };
-    switch (vk) {
-    case 9: case 15: bpp = 1; ch[0] = 0; break;                                   /* R8_UNORM, R8_SRGB */
-    case 16: case 22: bpp = 2; ch[0] = 0; ch[1] = 1; break;                       /* R8G8_UNORM, _SRGB */
-    case 23: case 29: bpp = 3; ch[0] = 0; ch[1] = 1; ch[2] = 2; break;            /* R8G8B8_UNORM, _SRGB */
-    case 30: case 36: bpp = 3; ch[0] = 2; ch[1] = 1; ch[2] = 0; break;            /* B8G8R8_UNORM, _SRGB */
-    case 37: case 43: bpp = 4; ch[0] = 0; ch[1] = 1; ch[2] = 2; ch[3] = 3; break; /* R8G8B8A8_UNORM, _SRGB */
-    case 44: case 50: bpp = 4; ch[0] = 2; ch[1] = 1; ch[2] = 0; ch[3] = 3; break; /* B8G8R8A8_UNORM, _SRGB */
-    default:
-        snprintf(err, errlen, "%s: KTX2 vkFormat %u is not decoded (%s; 8-bit R, RG, RGB, BGR, RGBA, BGRA are)", what, vk,
-                 vk == 0 ? "UASTC or another format described only by its DFD" : "a block-compressed, packed or wider format");
-        return -1;
-    }
-    if (depth > 1 || layers > 1 || faces != 1) {
-        snprintf(err, errlen, "%s: a KTX2 %s is not a 2D texture", what, depth > 1 ? "3D texture" : layers > 1 ? "array" : "cube map");
-        return -1;
-    }
-    if (!size_ok(w, h, budget, what, err, errlen)) return -1;
-    if (levels > 64 || 80 + 24 * (size_t)(levels ? levels : 1) > len) {
-        snprintf(err, errlen, "%s: bad KTX2: a level index of %u levels past the end of the file", what, levels);
-        return -1;
-    }
-    const uint64_t off = rd64(buf + 80), n = rd64(buf + 88);
-    const size_t need = (size_t)w * h * (size_t)bpp;
-    if (n < need || off > len || need > len - off) {
-        snprintf(err, errlen, "%s: bad KTX2: level 0 (%llu bytes at %llu) does not hold %ux%u texels within the %zu-byte file",
-                 what, (unsigned long long)n, (unsigned long long)off, w, h, len);
-        return -1;
-    }
-    uint8_t *px = malloc((size_t)w * h * 4);
-    if (!px) { snprintf(err, errlen, "%s: out of memory for a %ux%u texture", what, w, h); return -1; }
-    for (size_t y = 0; y < h; y++) {
-        const unsigned char *src = buf + off + y * w * (size_t)bpp;
-        uint8_t *dst = px + (flip_rows ? h - 1 - y : y) * w * 4;
-        for (size_t x = 0; x < w; x++)
-            for (int c = 0; c < 4; c++)
-                dst[4 * x + c] = ch[c] >= 0 ? src[x * (size_t)bpp + (size_t)ch[c]] : c == 3 ? 255 : 0;
-    }
-    out->width = (int)w;
-    out->height = (int)h;
-    out->rgba = px;
-    return 0;
-}
 
 int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
                       ms_texture *out, char *err, size_t errlen)
@@ -171,7 +106,7 @@ int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, in
     memset(out, 0, sizeof *out);
     if (len >= 3 && buf[0] == 0xFF && buf[1] == 0xD8 && buf[2] == 0xFF)
         return decode_jpeg(buf, len, what, flip_rows, budget, out, err, errlen);
-    if (len >= 12 && !memcmp(buf, ktx2_id, 12)) return decode_ktx2(buf, len, what, flip_rows, budget, out, err, errlen);
+    if (len >= 12 && !memcmp(buf, ktx2_id, 12)) return ms_texture_decode_ktx2(buf, len, what, flip_rows, budget, out, err, errlen);
     if (len >= 8 && !png_sig_cmp(buf, 0, 8)) return decode_png(buf, len, what, flip_rows, budget, out, err, errlen);
     snprintf(err, errlen, "%s: not a PNG, JPEG or KTX2 image", what);
     return -1;

@@ -25,7 +25,8 @@ typedef struct ms_render_ctx {
     /* Switches of the micro-rasterization methods (zero: the defaults). isa_cap caps the instruction set
      * of the kernels and the traversal (MS_ISA_AUTO: the CPU's best); no_occlusion_cull and
      * no_child_order switch off the traversal's coverage test and near-first child order, to measure
-     * what each buys. */
+     * what each buys: no driver sets them (they are not among the render options), only tests that build
+     * a context themselves. */
     ms_isa isa_cap;
     int no_occlusion_cull, no_child_order;
     ms_traversal traversal;            /* micro-raster methods: block or per-pixel traversal */

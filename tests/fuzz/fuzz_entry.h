@@ -88,6 +88,37 @@ static inline int ms_fuzz_jpeg(const uint8_t *data, size_t size)
     return rc;
 }
 
+/* A KTX2 texture (src/scene/texture_ktx2.c: the container, uncompressed and Zstandard levels), from bytes;
+ * 0 if it decoded. Decoded twice, rows top-down and bottom-up: success means both decode, each within the
+ * size limit and the 16 MiB budget of ms_fuzz_jpeg, the same image with its rows reversed. */
+static inline int ms_fuzz_ktx2(const uint8_t *data, size_t size)
+{
+    const char *path = MS_FUZZ_MESH_PATH "ktx2";
+    const size_t budget = (size_t)16 << 20;
+    ms_texture t[2];
+    char err[1024] = "";
+    int rc = 0;
+    for (int flip = 0; flip < 2; flip++) {
+        err[0] = 0;
+        const int r = ms_texture_decode(data, size, path, flip, budget, &t[flip], err, sizeof err);
+        if (r) ms_fuzz_check_message(err, path);
+        else if (!t[flip].rgba || t[flip].width < 1 || t[flip].height < 1 ||
+                 (size_t)t[flip].width * (size_t)t[flip].height * 4 > budget)
+            abort();
+        if (flip && r != rc) abort();   /* the rows' order cannot decide whether a file decodes */
+        rc = r;
+    }
+    if (!rc) {
+        const size_t row = (size_t)t[0].width * 4, h = (size_t)t[0].height;
+        if (t[1].width != t[0].width || t[1].height != t[0].height) abort();
+        for (size_t y = 0; y < h; y++)
+            if (memcmp(t[0].rgba + y * row, t[1].rgba + (h - 1 - y) * row, row)) abort();
+    }
+    free(t[0].rgba);
+    free(t[1].rgba);
+    return rc;
+}
+
 static inline void ms_fuzz_ignore_warning(void *user, const char *msg) { (void)user; (void)msg; }
 
 /* A PNG texture, from bytes, through both decoders: a light's emission texture (src/image/png_read.c, linear

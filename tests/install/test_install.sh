@@ -15,7 +15,7 @@ mkdir -p "$work"
 prefix=$work/prefix
 cmake --install "$build" --prefix "$prefix" >"$work/install.log"
 libdir=$(dirname "$(find "$prefix" -name libmicroshadow.a | head -1)")
-for f in "$prefix/include/microshadow.h" "$prefix/include/microshadow_version.h" "$prefix/share/doc/microshadow/LICENSE" "$libdir/libmicroshadow.a" "$libdir/libmicroshadow.so" \
+for f in "$prefix/include/microshadow.h" "$prefix/include/microshadow/render.h" "$prefix/include/microshadow_version.h" "$prefix/share/doc/microshadow/LICENSE" "$libdir/libmicroshadow.a" "$libdir/libmicroshadow.so" \
          "$prefix/bin/microshadow" "$libdir/cmake/microshadow/microshadowConfig.cmake" \
          "$libdir/pkgconfig/microshadow.pc" "$libdir/pkgconfig/microshadow-static.pc"; do
     [ -e "$f" ] || { echo "test_install: not installed: ${f#"$prefix"/}"; exit 1; }

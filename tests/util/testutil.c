@@ -59,6 +59,30 @@ int tu_write_file(const char *path, const char *text)
     return fclose(f);
 }
 
+void tu_write_texture_png(const char *path, int w, int h, const float *rgb)
+{
+    ms_frame f;
+    memset(&f, 0, sizeof f);
+    f.width = w;
+    f.height = h;
+    float *vis = calloc((size_t)w * h, sizeof *vis);
+    assert_non_null(vis);
+    f.vis = vis;
+    f.rgb = (float *)rgb;
+    f.exposure = 1.0f;
+    char err[256];
+    assert_int_equal(ms_write_png(&f, path, err, sizeof err), 0);
+    free(vis);
+}
+
+void tu_unit3(double v[3])
+{
+    const double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    v[0] /= l;
+    v[1] /= l;
+    v[2] /= l;
+}
+
 int tu_file_exists(const char *path) { return access(path, F_OK) == 0; }
 
 int tu_count_entries(const char *dir)
@@ -227,6 +251,15 @@ ms_isa tu_isa_cap(void)
         abort();
     }
     return cap;
+}
+
+void tu_bake_options(ms_bake_options *bo, int size, int uv_set, int samples)
+{
+    memset(bo, 0, sizeof *bo);
+    bo->size = size;
+    bo->uv_set = uv_set;
+    bo->points.samples = samples;
+    bo->points.isa = tu_isa_cap();
 }
 
 void tu_render_options_default(ms_render_options *o)
@@ -544,6 +577,35 @@ uint64_t tu_stat_counter(const ms_stats *st, const char *name)
         if (!strcmp(st->counter_name[i], name)) return st->counter[i];
     fail_msg("no counter %s", name);
     return 0;
+}
+
+struct ms_shadow_query *tu_frame_queries(const struct ms_render_ctx *ctx, int size, int *nq)
+{
+    const ms_primary_method *pm = ms_find_primary_method("bvh");
+    assert_non_null(pm);
+    char err[256];
+    void *ps = NULL;
+    assert_int_equal(pm->create(ctx, &ps, err, sizeof err), 0);
+    ms_hit *hits = malloc((size_t)size * size * sizeof *hits);
+    ms_shadow_query *q = malloc((size_t)size * size * sizeof *q);
+    assert_non_null(hits);
+    assert_non_null(q);
+    pm->trace(ps, ctx, 0, 0, size, size, hits);
+    pm->destroy(ps);
+    int n = 0;
+    for (int i = 0; i < size * size; i++)
+        if (hits[i].prim != UINT32_MAX) tu_query_from_hit(&q[n++], &hits[i], i % size, i / size);
+    free(hits);
+    *nq = n;
+    return q;
+}
+
+void tu_shared_scene_load(const char *rel, ms_scene *sc)
+{
+    if (!tu_have_shared_scenes()) skip();
+    char path[4096], err[512] = "";
+    const int rc = ms_scene_load(tu_shared_scene(path, sizeof path, rel), sc, err, sizeof err);
+    if (rc) fail_msg("%s: %s", rel, err);
 }
 
 /* 1 if name is one of the comma-separated names of list. */

@@ -26,6 +26,9 @@ const char *tu_tmpdir(const char *test_name);
 /* Path buf = dir/name. */
 const char *tu_path(char *buf, size_t n, const char *dir, const char *name);
 int tu_write_file(const char *path, const char *text);
+/* Writes a w x h PNG whose linear texels are rgb (ms_write_png, exposure 1): values 0 or 1 survive the 8-bit
+ * sRGB round trip exactly, for light and material textures. Fails the test when it cannot. */
+void tu_write_texture_png(const char *path, int w, int h, const float *rgb);
 /* Base64 of in[0..n) into out (4 ceil(n/3) characters and a NUL), for glTF data: URIs written by tests. */
 void tu_base64(const unsigned char *in, size_t n, char *out);
 /* An 8-bit RGB image of w x h texels (rows top first) as a PNG (libpng), base64-encoded into out[cap]: the payload
@@ -57,6 +60,9 @@ int tu_run_cli_ex(const char *const *args, const tu_run_opts *opts, char *err_al
 void tu_make_quad(ms_scene *sc);
 /* 1 if ../shared/scenes is present; prints a skip message otherwise. */
 int tu_have_shared_scenes(void);
+/* Loads the shared scene at rel (under ../shared/scenes) into sc; skips the test when the folder is absent, fails it
+ * when the scene does not load. */
+void tu_shared_scene_load(const char *rel, ms_scene *sc);
 const char *tu_shared_scene(char *buf, size_t n, const char *rel);
 /* Reads a PFM written by ms_write_vis into a top-row-first array (caller frees). */
 float *tu_read_pfm(const char *path, int *w, int *h);
@@ -90,6 +96,10 @@ struct ms_bvh;
 struct ms_hit;
 /* The shadow query of a primary hit at pixel (x, y), as ms_render makes it. */
 void tu_query_from_hit(struct ms_shadow_query *q, const struct ms_hit *h, int x, int y);
+/* The queries of a size x size frame under ctx: camera rays through the bvh primary, one query per pixel that
+ * hits, in pixel order. A malloc'ed array (room for every pixel), their count in *nq; fails the test when out of
+ * memory. */
+struct ms_shadow_query *tu_frame_queries(const struct ms_render_ctx *ctx, int size, int *nq);
 /* A frame context as ms_render sets it up: grid pattern, k x k samples, the scene's camera at W x H. */
 void tu_ctx_init(struct ms_render_ctx *ctx, const ms_scene *sc, const struct ms_bvh *bvh, int W, int H, int k);
 /* Switches ctx to pattern p at its k (k*k samples in all): samples per pixel and mask words as ms_render
@@ -105,8 +115,13 @@ int tu_shadow_vs(const struct ms_shadow_method *m, void *state, const struct ms_
  * selection functions and run a forced SIMD variant only when tu_isa_allowed grants it, so that CI can run
  * the whole suite on the portable path (.ci/run). An unknown value aborts the test. */
 ms_isa tu_isa_cap(void);
+/* v scaled to unit length (v not zero). */
+void tu_unit3(double v[3]);
 /* ms_render_options_default with the run's ISA cap, for the tests that render whole frames. */
 void tu_render_options_default(ms_render_options *o);
+/* Zeroed bake options with the lightmap's size, UV set (-1: xatlas for every triangle), light samples and the
+ * run's ISA cap. */
+void tu_bake_options(ms_bake_options *bo, int size, int uv_set, int samples);
 int tu_isa_allowed(ms_isa isa);
 
 /* splitmix64: small, seedable, reproducible random numbers for the randomized tests. */

@@ -1,7 +1,9 @@
 /* The choice of the penumbra casting engine's instance (hpc_impl.h) under the context's ISA cap. */
 #include "hpc.h"
 
+#ifdef MS_TEST_HOOKS
 int ms_hpc_switches;
+#endif
 
 ms_hpc_cast_fn ms_hpc_cast_isa(ms_isa isa)
 {

@@ -8,6 +8,7 @@
 #include "shadow/method.h"
 #include "raster/raster.h"
 #include "core/cpu.h"
+#include "core/test_hooks.h"
 
 /* Where the blocker triangles come from: batches in any order, each triangle once. next writes up to max
  * triangles (9 floats each) and their ids (the prim id a receiver on that triangle carries, so that its own
@@ -46,9 +47,12 @@ int ms_hpc_cast_avx512(const ms_render_ctx *, int, ms_raster_fn, const ms_shadow
 ms_hpc_cast_fn ms_hpc_cast_isa(ms_isa isa);
 ms_hpc_cast_fn ms_hpc_cast_select(ms_isa cap, ms_isa *chosen);
 
-/* Measuring switches (bench_hpc --off), each turning one part of the engine off; 0, the default, is the
- * engine as designed. Process-wide and read when a cast starts: set it before rendering, never during.
- * Answers do not change, only the work. The letters are the paper's (sec. 3.3, Fig. 3). */
+#ifdef MS_TEST_HOOKS
+/* Measuring switches (bench_hpc --off), each turning one part of the engine off, and the faults test_hpc
+ * injects; test hooks (core/test_hooks.h), so only in the tests' and benchmarks' copy of the library. 0, the
+ * default, is the engine as designed. Process-wide and read when a cast starts: set it before rendering, never
+ * during. A switch changes the work, not the answers; a fault (BREAK) the answers. The letters are the paper's
+ * (sec. 3.3, Fig. 3). */
 enum {
     MS_HPC_OFF_UMBRA = 1,        /* A: umbra bits (and the rebuild) */
     MS_HPC_OFF_PLANE_SETS = 2,   /* B: active plane sets: every plane of a volume tested at every node */
@@ -80,6 +84,7 @@ enum {
                                   * purpose), so that test_hpc can show its scene depends on it */
 };
 extern int ms_hpc_switches;
+#endif
 
 /* Coarse blocker sorting (sec. 3.3): the order of n triangles (9 floats each) bucketed by area, largest
  * bucket first, stable within a bucket, in two linear passes (a histogram of log2 areas, then placement).

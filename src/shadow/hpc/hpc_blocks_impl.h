@@ -37,10 +37,10 @@ static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q,
     const int k = sh->k, gs = sh->gs;
     unsigned hit;
     int shared_axis = 1;
-    const int all_sure = !(live & ~sure) && !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES));
+    const int all_sure = !(live & ~sure) && !hpc_sw(sh, MS_HPC_OFF_SURE | MS_HPC_OFF_SIMD_SAMPLES);
     if (all_sure && *tsure < 0) {   /* hpc_t_sure for this receiver, once a block could use it (-1: not yet known) */
         static const float zero3[3] = { 0.0f, 0.0f, 0.0f };
-        *tsure = tsure_on(sh) && ((sh->sw & MS_HPC_BREAK_TSURE) || hpc_t_sure(sh, q->p, zero3, t));
+        *tsure = tsure_on(sh) && (hpc_sw(sh, MS_HPC_BREAK_TSURE) || hpc_t_sure(sh, q->p, zero3, t));
     }
     if (all_sure && !*tsure)
         for (int r = 0; r < LANES / gs; r++) shared_axis &= kz[((jb + r) * k + i0) / LANES] >= 0;
@@ -53,7 +53,7 @@ static unsigned block_hits(const shared *sh, chunk *c, const ms_shadow_query *q,
         l16 d[3];
         block_dirs(q, g, i0, jb, gs, d);
         hit = t_range16(sh, t, d, l16_set1(num), live);
-    } else if (sh->sw & MS_HPC_OFF_SIMD_SAMPLES) {   /* one lane at a time, the scalar form */
+    } else if (hpc_sw(sh, MS_HPC_OFF_SIMD_SAMPLES)) {   /* one lane at a time, the scalar form */
         hit = 0;
         for (unsigned b = live; b; b &= b - 1) {
             const int l = __builtin_ctz(b), i = i0 + l % gs, j = jb + l / gs;
@@ -92,7 +92,7 @@ static inline __attribute__((always_inline)) void cast_blocks(const shared *sh, 
     l16 ssl[2][3];
     unsigned sok[2] = { 0u, 0u };
     for (int u = 0; u < nt && !v->direct && with_sure; u++) {
-        for (int e = 0; e < 3; e++) ssl[u][e] = l16_set1((sh->sw & MS_HPC_BREAK_SURE) ? -v->fp[u].s[e] : v->fp[u].s[e]);
+        for (int e = 0; e < 3; e++) ssl[u][e] = l16_set1(hpc_sw(sh, MS_HPC_BREAK_SURE) ? -v->fp[u].s[e] : v->fp[u].s[e]);
         sok[u] = v->fp[u].s[0] > 1e-30f && v->fp[u].s[1] > 1e-30f && v->fp[u].s[2] > 1e-30f ? 0xffffu : 0u;
     }
     l16 foff[2][4];

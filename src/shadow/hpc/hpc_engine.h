@@ -100,7 +100,8 @@
  * hpc_exact.c, hpc_frame.c); the 16-lane parts are one source per ISA, hpc_impl.h and the *_impl.h files it
  * includes, compiled as hpc_scalar.c, hpc_avx2.c and hpc_avx512.c, each defining ms_hpc_cast_<isa>; hpc.c picks
  * one under the context's cap. hpc_impl.h says what the ISA changes: nothing in the masks and counters.
- * Measuring switches (ms_hpc_switches, hpc.h) turn off each optimisation of sec. 3.3 and each SIMD form.
+ * Measuring switches (ms_hpc_switches, hpc.h; the tests' copy of the library only) turn off each optimisation of
+ * sec. 3.3 and each SIMD form.
  *
  * Threads: the receiver points are split into spatially coherent chunks (the top of a middle-split
  * hierarchy, up to 16 per thread, the largest split first: hpc_make_chunks), each with its own hierarchy, masks
@@ -128,13 +129,9 @@
 #define MEDIAN_BELOW_DEPTH 40     /* median splits from here: depth at most 40 + log2(points) */
 #define BATCH 16384               /* triangles read and prepared together */
 #define EDGE_ON 1e-3f             /* as microraster.c */
-#ifndef LEAF_FP_MIN
 #define LEAF_FP_MIN 6
-#endif
 #define LANES 16                  /* the reference tracer's packet width (raytrace_impl.h) */
-#ifndef SURE_MIN_GROUPS
 #define SURE_MIN_GROUPS 4         /* the sure lanes only for footprints over this many groups (cast_footprint) */
-#endif
 
 enum {
     C_TRIANGLES, C_TRI_CHUNK_PASSES, C_NODE_VISITS, C_NODES_OUTSIDE_VL, C_UMBRA_NODE_SKIPS, C_PLANE_TESTS,
@@ -178,7 +175,9 @@ typedef struct act_group { uint32_t k, planes; } act_group;
 /* Per frame, read-only while the triangles are cast. */
 typedef struct shared {
     const ms_render_ctx *ctx;
-    int sw;                          /* ms_hpc_switches when the cast started */
+#ifdef MS_TEST_HOOKS
+    int sw;                          /* ms_hpc_switches when the cast started (hpc_sw) */
+#endif
     int scanline;
     ms_raster_fn raster;
     int k, mw, gs, G, npk;
@@ -206,6 +205,11 @@ typedef struct shared {
     int32_t *slot;
     size_t slot_bytes, frame_off, kz_off;
 } shared;
+
+/* Whether one of the measuring switches or faults in bits (hpc.h) is set for this cast: in the tests' copy of the
+ * library only (core/test_hooks.h); 0 in the library users get, where each branch on it folds away (sh is
+ * still named there, so that a function that reads it for nothing else has no unused parameter). */
+#define hpc_sw(sh, bits) ((void)(sh), MS_HOOK((sh)->sw & (bits)))
 
 /* One chunk of receivers with its own hierarchy and mask pool (one thread at a time). */
 typedef struct chunk {
@@ -314,7 +318,7 @@ void hpc_footprint_setup(hpc_footprint *f, const float A[3], const float B[3], c
 
 /* ---- the sure lanes' t range (hpc_tsure.c) ---- */
 
-static inline int tsure_on(const shared *sh) { return !(sh->sw & (MS_HPC_OFF_SURE | MS_HPC_OFF_TSURE)); }
+static inline int tsure_on(const shared *sh) { return !hpc_sw(sh, MS_HPC_OFF_SURE | MS_HPC_OFF_TSURE); }
 /* 1 when every segment from a receiver in the box pc +- h to the light meets t's plane well inside the exact
  * test's range (hpc_tsure.c has the proof). */
 int hpc_t_sure(const shared *sh, const float pc[3], const float h[3], const tri_job *t);

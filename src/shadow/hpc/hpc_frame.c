@@ -50,7 +50,9 @@ static void frame_shared(hpc_frame *F, const ms_render_ctx *ctx, int scanline, m
     shared *sh = &F->sh;
     const int k = ctx->k, mw = ctx->mask_words;
     sh->ctx = ctx;
+#ifdef MS_TEST_HOOKS
     sh->sw = ms_hpc_switches;
+#endif
     sh->scanline = scanline;
     sh->raster = raster;
     sh->k = k;
@@ -63,7 +65,7 @@ static void frame_shared(hpc_frame *F, const ms_render_ctx *ctx, int scanline, m
         sh->group_j0[g] = (float)(g / (k / sh->gs) * sh->gs);
     }
     for (int b = 0; b < 64; b++) { sh->bit_i[b] = (float)(b % k); sh->bit_j[b] = (float)(b / k); }
-    sh->footprint = !scanline && !(sh->sw & MS_HPC_OFF_FOOTPRINT);
+    sh->footprint = !scanline && !hpc_sw(sh, MS_HPC_OFF_FOOTPRINT);
     sh->all_groups = sh->G == 64 ? UINT64_MAX : (UINT64_C(1) << sh->G) - 1u;
     sh->npk = k * k / LANES;
     sh->n = n;
@@ -254,7 +256,7 @@ static void frame_origins(hpc_frame *F, uint64_t *counters)
     }
     if (!same) { free(sh->p0); sh->p0 = NULL; }
     else counters[C_SAMPLE_BYTES] += (uint64_t)nlive * 4u * sizeof *sh->p0;
-    sh->pairs = sh->p0 && !(sh->sw & MS_HPC_OFF_PAIRS);
+    sh->pairs = sh->p0 && !hpc_sw(sh, MS_HPC_OFF_PAIRS);
 }
 
 int hpc_frame_begin(hpc_frame *F, const ms_render_ctx *ctx, int scanline, ms_raster_fn raster,

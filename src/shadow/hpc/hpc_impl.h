@@ -15,7 +15,8 @@
  *  - the box- and point-in-volume tests (INTERSECTS, POINT-IN-VOLUME) evaluate all the planes of a volume
  *    in one 16-lane operation (hpc_volume.h keeps them by component) and then keep the active ones: the
  *    scalar form's arithmetic per plane, without its early exit (the counter counts every active plane).
- * Measuring switches (ms_hpc_switches, hpc.h) turn off each optimisation of sec. 3.3 and each SIMD form. */
+ * Measuring switches (ms_hpc_switches, hpc.h; the tests' copy of the library only) turn off each optimisation of
+ * sec. 3.3 and each SIMD form. */
 
 #include "hpc_engine.h"
 #include "visibility/receiver.h"
@@ -96,7 +97,7 @@ int MS_CAT(ms_hpc_cast_, MS_ISA_SUFFIX)(const ms_render_ctx *ctx, int scanline, 
     /* a batch holds every triangle of a small scene: the same single batch, without BATCH's buffers */
     const size_t batch = src->total && src->total < BATCH ? src->total : BATCH;
     int rc = hpc_frame_begin(&F, ctx, scanline, raster, q, n, front, batch, counters);
-    if (!rc && (F.sh.sw & MS_HPC_OFF_ON_DEMAND)) rc = preload_slots(&F);
+    if (!rc && hpc_sw(&F.sh, MS_HPC_OFF_ON_DEMAND)) rc = preload_slots(&F);
     if (!rc) rc = cast_batches(&F, src, counters);
     if (!rc) hpc_frame_vis(&F, vis);
     hpc_frame_end(&F, counters);

@@ -97,20 +97,20 @@ static void leaf_choose(const shared *sh, chunk *c, const tri_job *t, leaf_cast 
      * triangles are mostly alone, it cost more than it saved even with leaf_fp_pays */
     /* the leaf's receivers in the lanes (leaf_lanes, above): not for alpha-tested triangles (their opacity is
      * looked up per hit, hpc_alpha_opaque) nor with the 16-lane sample test off */
-    int lanes_ok = !(sh->sw & (MS_HPC_OFF_LEAF_LANES | MS_HPC_OFF_SIMD_SAMPLES));
+    int lanes_ok = !hpc_sw(sh, MS_HPC_OFF_LEAF_LANES | MS_HPC_OFF_SIMD_SAMPLES);
     for (int u = 0; u < nt && lanes_ok; u++) lanes_ok = !ms_alpha_tested(sh->ctx->alpha, t[u].self);
-    const int leaf_fp = !(sh->sw & MS_HPC_OFF_LEAF_FOOTPRINT) &&
-                        ((sh->sw & MS_HPC_ALL_LEAF_FOOTPRINT) ||
+    const int leaf_fp = !hpc_sw(sh, MS_HPC_OFF_LEAF_FOOTPRINT) &&
+                        (hpc_sw(sh, MS_HPC_ALL_LEAF_FOOTPRINT) ||
                          (nt == 2 && __builtin_popcount(act) >= LEAF_FP_MIN && leaf_fp_pays(c, lanes_ok)));
     /* The shapes whose footprints are formed: each triangle, or for a rectangle pair under the leaf footprint
      * its rectangle, standing for both ("rectangle pairs" above: one footprint for two triangles). */
     /* Not where a receiver lies on one of the two (its own is not cast against it): the other, coplanar with it,
      * rules out every sample by mixed signs, while the rectangle around the receiver rules out none (on a
      * ground plane that made the cast several times slower). */
-    const int rect = leaf_fp && nt == 2 && t->rect && !(sh->sw & MS_HPC_OFF_RECT) && (act & on[0] & on[1]) == act,
+    const int rect = leaf_fp && nt == 2 && t->rect && !hpc_sw(sh, MS_HPC_OFF_RECT) && (act & on[0] & on[1]) == act,
               ns = rect ? 1 : nt;
     for (int u = 0; u < ns; u++) lc->shape[u] = rect ? (fp_shape){ t->rc, 4 } : (fp_shape){ t[u].v, 3 };
-    if (rect && (sh->sw & MS_HPC_BREAK_RECT)) lc->shape[0].nv = 3;   /* wrong on purpose: the first triangle for both */
+    if (rect && hpc_sw(sh, MS_HPC_BREAK_RECT)) lc->shape[0].nv = 3;   /* wrong on purpose: the first triangle for both */
     lc->lanes_ok = lanes_ok;
     lc->leaf_fp = leaf_fp;
     lc->rect = rect;
@@ -140,7 +140,7 @@ static unsigned leaf_bound(const shared *sh, chunk *c, leaf_cast *lc)
         bx->h[a] = ms_maxf(phi - bx->pc[a], bx->pc[a] - plo) * 1.000001f;
         bx->p0c[a] = 0.5f * (olo + ohi);
         bx->J[a] = ms_maxf(ohi - bx->p0c[a], bx->p0c[a] - olo) * 1.000001f;
-        if (sh->sw & MS_HPC_BREAK_LEAF_BOUND) bx->J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
+        if (hpc_sw(sh, MS_HPC_BREAK_LEAF_BOUND)) bx->J[a] = 0.0f;   /* wrong on purpose (test_hpc) */
     }
     leaf_fn fn[2];
     leaf_setup(sh, bx, lc->shape, ns, fn);
@@ -271,7 +271,7 @@ static int leaf_shape_samples(const shared *sh, chunk *c, const tri_job *t, leaf
     for (int x = 0; x < 1 + rect; x++) {
         for (int e = 0; e < 3; e++) {
             sl[x][e] = l16_load(lc->fs[u][rect ? rect_tri[x][e] : e]);
-            slsure[x][e] = (sh->sw & MS_HPC_BREAK_SURE) ? l16_sub(zero, sl[x][e]) : sl[x][e];
+            slsure[x][e] = hpc_sw(sh, MS_HPC_BREAK_SURE) ? l16_sub(zero, sl[x][e]) : sl[x][e];
         }
         slok[x] = footprint_slack_ok(sl[x]);
     }

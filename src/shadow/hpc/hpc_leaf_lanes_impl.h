@@ -96,7 +96,7 @@ static int leaf_lanes_sample(const shared *sh, chunk *c, const tri_job *t, leaf_
                 for (int a = 0; a < 3; a++) L->V[u][v][a] = l16_sub(l16_set1(tr->v[3 * v + a]), L->p[a]);
             L->num[u] = ms_wt_offset16((const l16 (*)[3])L->V[u], tr->N);
             L->have |= 1u << u;
-            if (tsure_on(sh) && ((sh->sw & MS_HPC_BREAK_TSURE) || hpc_t_sure(sh, L->pc, L->h, tr))) L->tsure |= 1u << u;
+            if (tsure_on(sh) && (hpc_sw(sh, MS_HPC_BREAK_TSURE) || hpc_t_sure(sh, L->pc, L->h, tr))) L->tsure |= 1u << u;
         }
         L->has[u] |= live;
         c->cnt[C_SAMPLE_TESTS] += (uint64_t)__builtin_popcount(live);
@@ -121,7 +121,7 @@ static int leaf_lanes_sample(const shared *sh, chunk *c, const tri_job *t, leaf_
             m1 |= (unsigned)(z == 1) << l;
             mneg |= (unsigned)(z < 0) << l;
         }
-        if (!(live & ~sure[x]) && !mneg && !(sh->sw & MS_HPC_OFF_SURE)) {
+        if (!(live & ~sure[x]) && !mneg && !hpc_sw(sh, MS_HPC_OFF_SURE)) {
             c->cnt[C_SAMPLES_SURE] += (uint64_t)__builtin_popcount(live);
             hit |= t_range16(sh, tr, d, L->num[u], live);
         } else {

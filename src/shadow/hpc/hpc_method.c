@@ -56,7 +56,7 @@ static size_t procedural_next(void *user, float *tri, uint32_t *ids, size_t max)
     for (size_t c = 0; c < n; c += 1024) ms_procedural_triangles(sc, src->pos + c, n - c < 1024 ? n - c : 1024, raw + 9 * c);
     const double t0 = omp_get_wtime();
     uint32_t *order = ms_hpc_area_order(raw, n);
-    if (order && (ms_hpc_switches & MS_HPC_OFF_SORT))
+    if (order && MS_HOOK(ms_hpc_switches & MS_HPC_OFF_SORT))
         for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
     src->sort_s += omp_get_wtime() - t0;
     if (!order) { free(raw); return (size_t)-1; }
@@ -98,7 +98,7 @@ static int hpc_create_common(const ms_render_ctx *ctx, void **state, char *err, 
     const size_t n = ctx->bvh->n_tris;
     const double t0 = omp_get_wtime();
     s->order = ms_hpc_area_order(ctx->bvh->tri, n);
-    if (s->order && (ms_hpc_switches & MS_HPC_OFF_SORT))   /* measuring: the scene's own order */
+    if (s->order && MS_HOOK(ms_hpc_switches & MS_HPC_OFF_SORT))   /* measuring: the scene's own order */
         for (size_t i = 0; i < n; i++) s->order[i] = (uint32_t)i;
     s->sort_s = omp_get_wtime() - t0;
     if (!s->order) {

@@ -35,11 +35,11 @@ void hpc_slot_put(chunk *c, int32_t s)
 /* Receiver r's open groups after a triangle (L72-L75): its umbra bits, and at full umbra its mask back. */
 void hpc_record_umbra(const shared *sh, chunk *c, uint32_t r, int32_t s, uint64_t gu)
 {
-    if (sh->sw & MS_HPC_OFF_UMBRA) return;   /* A off: umbra found by casting is not recorded */
+    if (hpc_sw(sh, MS_HPC_OFF_UMBRA)) return;   /* A off: umbra found by casting is not recorded */
     sh->gumbra[r] = gu;
     if (gu == sh->all_groups) {
         sh->full[r] = 1;
-        if (!(sh->sw & MS_HPC_OFF_ON_DEMAND)) {   /* D: the mask goes back (L75) */
+        if (!hpc_sw(sh, MS_HPC_OFF_ON_DEMAND)) {   /* D: the mask goes back (L75) */
             hpc_slot_put(c, s);
             sh->slot[r] = -1;
         }

@@ -6,7 +6,7 @@
 static int vol_box(const shared *sh, const hpc_volume *v, uint32_t act, const float lo[3], const float hi[3],
                    uint32_t *out, uint64_t *tests)
 {
-    if (sh->sw & MS_HPC_OFF_SIMD_PLANES) return hpc_volume_box(v, act, lo, hi, out, tests);
+    if (hpc_sw(sh, MS_HPC_OFF_SIMD_PLANES)) return hpc_volume_box(v, act, lo, hi, out, tests);
     act &= v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u;
     if (!act) { *out = 0; return 1; }
     l16 mx = l16_load(v->soa[3]), mn = mx;
@@ -24,7 +24,7 @@ static int vol_box(const shared *sh, const hpc_volume *v, uint32_t act, const fl
 /* POINT-IN-VOLUME (hpc_volume_point) over all planes at once. */
 static int vol_point(const shared *sh, const hpc_volume *v, uint32_t act, const float p[3], uint64_t *tests)
 {
-    if (sh->sw & MS_HPC_OFF_SIMD_PLANES) return hpc_volume_point(v, act, p, tests);
+    if (hpc_sw(sh, MS_HPC_OFF_SIMD_PLANES)) return hpc_volume_point(v, act, p, tests);
     act &= v->n >= 32 ? UINT32_MAX : (UINT32_C(1) << v->n) - 1u;
     if (!act) return 1;
     const l16 s = l16_add(l16_add(l16_add(l16_mul(l16_load(v->soa[0]), l16_set1(p[0])), l16_mul(l16_load(v->soa[1]), l16_set1(p[1]))),
@@ -86,7 +86,7 @@ static void cast_point(const shared *sh, chunk *c, uint32_t r, const tri_job *t,
             c->cnt[C_GROUP_POINT_TESTS]++;
             if (!vol_point(sh, &c->gvol[gk], ag[i].planes, q->p, &c->cnt[C_PLANE_TESTS])) continue;
             HPC_GRID();
-            const int done = sh->sw & MS_HPC_OFF_SIMD_SAMPLES ? hpc_cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
+            const int done = hpc_sw(sh, MS_HPC_OFF_SIMD_SAMPLES) ? hpc_cast_group(sh, c, open, kz, gk, q, &g, t, A, B, C, num)
                                                               : cast_group16(sh, c, open, kz, gk, q, &g, t, A, B, C, num);
             if (done) gu |= UINT64_C(1) << gk;
         }
@@ -103,7 +103,7 @@ static void cast_node(const shared *sh, chunk *c, uint32_t ni, const tri_job *t,
     if (N->full) { c->cnt[C_UMBRA_NODE_SKIPS]++; return; }
     uint32_t pl2;
     if (!vol_box(sh, &t->vl, pl, N->lo, N->hi, &pl2, &c->cnt[C_PLANE_TESTS])) { c->cnt[C_NODES_OUTSIDE_VL]++; return; }
-    const int sets = !(sh->sw & MS_HPC_OFF_PLANE_SETS);
+    const int sets = !hpc_sw(sh, MS_HPC_OFF_PLANE_SETS);
     if (!sets) pl2 = HPC_ALL_PLANES;
     act_group ag2[64];
     int n2 = 0;
@@ -147,7 +147,7 @@ static void cast_triangle(const shared *sh, chunk *c, const tri_job *t)
     c->gvol_built = 0;
     /* C off: before the traversal (not for a pair: the group volumes are one triangle's, and they would cull
      * nodes for the other; with the footprint test they serve only that node culling) */
-    if ((sh->sw & MS_HPC_OFF_LAZY) && t->pair <= 0) hpc_group_volumes(sh, c, t);
+    if (hpc_sw(sh, MS_HPC_OFF_LAZY) && t->pair <= 0) hpc_group_volumes(sh, c, t);
     act_group ag[64];
     for (int g = 0; g < sh->G; g++) ag[g] = (act_group){ (uint32_t)g, HPC_ALL_PLANES };
     cast_node(sh, c, 0, t, HPC_ALL_PLANES, ag, sh->G);

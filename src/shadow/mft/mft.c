@@ -27,12 +27,8 @@
 /* Largest leaf of the shallow BVH (accel/bvh.h: subtrees of at most this many triangles collapsed into
  * one leaf). 8 measured fastest for the grid and stratified tracer (faster on the statues, no slower
  * elsewhere), 4 for the interleaved one (figures: docs/notebook/2026-11-29-source-comment-figures.md). */
-#ifndef MFT_SHALLOW_LEAF
 #define MFT_SHALLOW_LEAF 8
-#endif
-#ifndef MFT_SHALLOW_LEAF_INTERLEAVED
 #define MFT_SHALLOW_LEAF_INTERLEAVED 4
-#endif
 
 /* The interleaved mode's tables of the 16 sample sets (each set the same in every block, pattern.c): per set
  * its n = N/16 points and each point's cell of the g x g grid over the light; per cell the points of the
@@ -178,9 +174,6 @@ static int mft_create(const ms_render_ctx *ctx, void **state, char *err, size_t 
     /* The paper's own mode: each pixel of a 4x4 block its own set of N/16 points (pattern.c), traced by
      * cell of the light across the block (mft_visibility_groups). */
     f->cells = ctx->pattern != MS_PATTERN_INTERLEAVED;
-#ifdef MFT_NO_FOOTPRINT
-    f->flags |= MS_MFT_NO_FOOTPRINT;   /* measurement builds only */
-#endif
     /* The 16 sets' tables once for the frame's light (they were formed per call, i.e. per tile). */
     if (!f->cells) {
         if (mft_sets_alloc(&s->sets, ms_pattern_spp(f->pattern, f->k))) {
@@ -480,13 +473,6 @@ static int mft_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow
 {
     const mft_method *s = state;
     const size_t mw = (size_t)ctx->mask_words, ns = (size_t)ctx->samples;
-#ifdef MFT_NULL_MEASURE
-    /* Measurement builds only: no ray traced (every front sample visible), to measure what the frame
-     * costs around the method (front masks, V and S, the filter). */
-    memcpy(vis, front, (size_t)nq * mw * sizeof *vis);
-    (void)s; (void)ns; (void)cnt; (void)q;
-    return 0;
-#endif
     int *order = malloc((size_t)nq * sizeof *order);
     float *rayf = malloc(MS_BLOCK_LANES * 5 * ns * sizeof *rayf);
     signed char *kzs = malloc(MS_BLOCK_LANES * (ns / 16));

@@ -34,9 +34,8 @@ typedef struct ms_mft_frame {
 } ms_mft_frame;
 
 /* Flags: near-first child order; frustum shrinking of the traversal's bounds too (the paper's FS; CR,
- * the corner rays' recomputation, is always on); no footprint restriction of the tested packets (to
- * measure what it buys). */
-enum { MS_MFT_ORDER = 1, MS_MFT_FS = 2, MS_MFT_NO_FOOTPRINT = 4 };
+ * the corner rays' recomputation, is always on). */
+enum { MS_MFT_ORDER = 1, MS_MFT_FS = 2 };
 
 typedef struct ms_mft_lane {
     float c[3], n[3];             /* receiver point and its normal facing the camera */

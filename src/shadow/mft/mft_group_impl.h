@@ -19,9 +19,10 @@
  *   3. per surviving group, its 16 rays in one SIMD operation: method raytrace's watertight test
  *      (raytrace_impl.h, packet_triangle) with each ray's own shear axis (its pixel's packet's) and
  *      shear, operation for operation, so every ray gets raytrace's answer; one bit per ray, a hit clears
- *      it (in the group and in its pixel's mask); a group with no live ray leaves the traversal;
- *   4. (off by default, MFTG_CR) after a leaf in which a group lost rays, its boxes recomputed from its
- *      live rays (the paper's CR, frustum shrinking, for the culling and the traversal).
+ *      it (in the group and in its pixel's mask); a group with no live ray leaves the traversal.
+ * A group's boxes are not recomputed after a leaf in which it lost rays (the paper's CR, frustum shrinking:
+ * with the groups starting from their cell's box, the recomputation per group and leaf cost more than the
+ * tighter boxes saved), a departure from the paper.
  *
  * Departures from the paper, and why:
  *  - the paper traces one frustum per pixel, its 16 rays (one interleaved set) spread over the whole light,
@@ -48,27 +49,15 @@
 #include "visibility/alpha.h"
 
 #define MFTG_REL 1e-5f
-/* Measurement switches (builds with -D...; their figures: docs/notebook/2026-11-29-source-comment-figures.md):
- * the groups at a triangle from which it is culled for all at once (with one or two groups the cull costs
- * more than it saves; 8 measured a little faster than 4, and never culling slower);
- * CR on or off (off: with the groups starting from their cell's box, a recomputation per group and leaf
- * that lost rays costs more than the tighter boxes save). Departure from the paper, which shrinks. */
-#ifndef MFTG_TRI_CULL
+/* The groups at a triangle from which it is culled for all at once: with one or two groups the cull costs
+ * more than it saves; 8 measured a little faster than 4, and never culling slower (figures:
+ * docs/notebook/2026-11-29-source-comment-figures.md). */
 #define MFTG_TRI_CULL 8
-#endif
-#ifndef MFTG_CR
-#define MFTG_CR 0
-#endif
 /* The frusta's node test for 16 lanes at once only where MFTG_FRUSTUM_MIN or more lanes reach the parent;
- * with fewer, their per-ray tests alone are cheaper (measured against always and never). Without the
- * frusta's entry distances, the children are ordered along the block's direction to the light
- * (MFTG_DIR_ORDER: always so; within noise of the frusta's majority vote). */
-#ifndef MFTG_FRUSTUM_MIN
+ * with fewer, their per-ray tests alone are cheaper (measured against always and never). Where the frusta
+ * were not tested, the children are ordered along the block's direction to the light; where they were, by
+ * the frusta's majority vote on the entry distances. */
 #define MFTG_FRUSTUM_MIN 4
-#endif
-#ifndef MFTG_DIR_ORDER
-#define MFTG_DIR_ORDER 0
-#endif
 #define MFTG_TINY 1e-30f   /* block_traverse.c's stand-in for a zero direction bound (1/TINY finite) */
 
 typedef struct mftg_state {
@@ -266,7 +255,6 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
         cq[a] = l16_load(s->c[a]);
     }
     const l16 lmag = l16_load(s->mag), near = l16_set1(f->near);
-    unsigned lost = 0;
     uint64_t pairs = 0, c_box = 0, c_plane = 0, tested = 0, isec = 0, early = 0;
     for (uint32_t t = n->first; t < n->first + n->count; t++) {
         unsigned lanes = mask & fr->live;
@@ -358,7 +346,6 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
                 const int q = __builtin_ctz(m), i = g->sample[q];
                 rb->mask[q][i >> 6] &= ~(UINT64_C(1) << (i & 63));
             }
-            lost |= 1u << l;
             if (!g->live) { fr->live &= ~(1u << l); early++; }
         }
     }
@@ -368,11 +355,6 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
     cnt[MS_MFT_PAIRS_TESTED] += tested;
     cnt[MS_MFT_ISEC16] += isec;
     cnt[MS_MFT_FRUSTA_EARLY_OUT] += early;
-    /* 4. The groups that lost rays: their boxes from the live rays (CR). */
-    for (unsigned m = MFTG_CR ? lost & fr->live : 0u; m; m &= m - 1) {
-        mftg_lane_bounds(s, __builtin_ctz(m));
-        cnt[MS_MFT_RECT_SHRINKS]++;
-    }
 }
 
 /* Of the lanes m whose frustum reaches child n, those with rays entering it (out[l]: the rays; rays[l]:
@@ -437,7 +419,7 @@ static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
             mr = mftg_child_rays(s, &sh->nodes[c0 + 1], mr, rays, rr, &ray_tests, &lanes_culled);
             if (ml && mr) {
                 int right_first = 0;
-                if (order && (MFTG_DIR_ORDER || !fr_test)) {
+                if (order && !fr_test) {
                     const ms_bvh_node *a = &sh->nodes[c0], *b = &sh->nodes[c0 + 1];
                     float dot = 0.0f;
                     for (int x = 0; x < 3; x++) dot += (b->bmin[x] + b->bmax[x] - a->bmin[x] - a->bmax[x]) * s->dir[x];

@@ -68,9 +68,7 @@
 #define MFT_MAX_SKIP MS_BLOCK_LANES
 /* Cells of a footprint-cut rectangle above which the corner rays are still tried (measured against 64 and
  * "never"). */
-#ifndef MFT_CORNER_AREA
 #define MFT_CORNER_AREA 256.0f
-#endif
 
 typedef struct mft_state {
     ms_block_frusta *fr;
@@ -382,14 +380,142 @@ static inline void mft_pair_packet(mft_pair *pr, int ch, unsigned bits)
  * cuts of at most MFT_GRID_ROWS rows, 16 lanes at once (taller cuts: the per-row work cost more than it
  * saved; docs/notebook/2026-11-26-mft-grid-setup-and-footprint.md). */
 #define MFT_GRID_EPS 1e-3f
-#ifndef MFT_GRID_ROWS
 #define MFT_GRID_ROWS 2
-#endif
 /* Per lane, the columns of the cut's first MFT_GRID_ROWS rows that hold a sample in the footprint's box:
  * first and last, by row. */
 typedef struct mft_grid_box {
     int32_t rows[2 * MFT_GRID_ROWS][MS_BLOCK_LANES];
 } mft_grid_box;
+
+/* The plane: num = (v - C) . N from the vertex nearest C (ms_wt_offset, bit for bit; a: the vertices relative to
+ * the 16 origins C, lv their squared lengths); the segments' d . N over the frustum lies between the corner rays'
+ * (cd, of lengths cl: the samples are convex combinations of the corners), widened; a hit needs num / (d . N) in
+ * [near, far]. The lanes whose segments cannot meet the plane there; num and |num| into *num_out, *an_out. */
+static inline unsigned mft_plane_out(const ms_mft_frame *f, const l16 a[3][3], const l16 lv[3], const float *N, float nl1,
+                                     const l16 cd[4][3], const l16 cl[4], l16 *num_out, l16 *an_out)
+{
+    const l16 zero = l16_set1(0.0f), near = l16_set1(f->near), far = l16_set1(f->far);
+    const l16 one_lo = l16_set1(1.0f - MFT_REL), one_hi = l16_set1(1.0f + MFT_REL);
+    const l16 inf = l16_set1(INFINITY), ninf = l16_set1(-INFINITY);
+    const unsigned p0 = l16_le(lv[0], lv[1]) & l16_le(lv[0], lv[2]);
+    const unsigned p1 = ~l16_le(lv[0], lv[1]) & l16_le(lv[1], lv[2]);
+    l16 vn[3];
+    for (int x = 0; x < 3; x++) vn[x] = l16_select(p0, a[0][x], l16_select(p1, a[1][x], a[2][x]));
+    const l16 num = l16_add(l16_add(l16_mul(vn[0], l16_set1(N[0])), l16_mul(vn[1], l16_set1(N[1]))), l16_mul(vn[2], l16_set1(N[2])));
+    l16 dlo = inf, dhi = ninf, clmax = zero;
+    for (int q = 0; q < 4; q++) {
+        const l16 den = l16_add(l16_add(l16_mul(cd[q][0], l16_set1(N[0])), l16_mul(cd[q][1], l16_set1(N[1]))),
+                                l16_mul(cd[q][2], l16_set1(N[2])));
+        dlo = l16_min(dlo, den);
+        dhi = l16_max(dhi, den);
+        clmax = l16_max(clmax, cl[q]);
+    }
+    const l16 dtol = l16_mul(clmax, l16_set1(nl1 * MFT_REL));
+    dlo = l16_sub(dlo, dtol);
+    dhi = l16_add(dhi, dtol);
+    const unsigned pos = l16_gt(num, zero);
+    const l16 an = l16_abs(num);
+    *num_out = num;
+    *an_out = an;
+    const l16 slo = l16_select(pos, dlo, l16_sub(zero, dhi)), shi = l16_select(pos, dhi, l16_sub(zero, dlo));
+    const unsigned plane_out = l16_le(an, zero) | l16_le(shi, zero) | l16_lt(l16_mul(far, shi), l16_mul(an, one_lo)) |
+                               l16_gt(l16_mul(near, slo), l16_mul(an, one_hi));
+    return plane_out;
+}
+
+/* Corner rays against the edge planes through C (a: the vertices relative to the 16 origins, la their L1 lengths;
+ * cd, cl: the corner rays and their lengths): a ray hits (t > 0) only inside the cone of the vertices, where every
+ * edge function (a_i x a_j) . d has the sign of det = (a0 x a1) . a2. Trusted only where |det| clears its own
+ * rounding. The lanes of corner_lanes whose four corner rays all miss. */
+static inline unsigned mft_corner_out(const l16 a[3][3], const l16 la[3], const l16 cd[4][3], const l16 cl[4],
+                                      unsigned corner_lanes)
+{
+    const l16 zero = l16_set1(0.0f), rel = l16_set1(MFT_REL);
+    l16 e[3][3];
+    for (int q = 0; q < 3; q++) {
+        const l16 *x = a[q], *y = a[q == 2 ? 0 : q + 1];
+        e[q][0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1]));
+        e[q][1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2]));
+        e[q][2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0]));
+    }
+    const l16 det = l16_add(l16_add(l16_mul(e[0][0], a[2][0]), l16_mul(e[0][1], a[2][1])), l16_mul(e[0][2], a[2][2]));
+    const unsigned det_ok = l16_gt(l16_abs(det), l16_mul(l16_mul(l16_mul(la[0], la[1]), la[2]), rel));
+    const unsigned det_pos = l16_gt(det, zero);
+    unsigned corner_out = 0;
+    for (int q = 0; q < 3; q++) {
+        const l16 lq = l16_mul(l16_mul(la[q], la[q == 2 ? 0 : q + 1]), rel);
+        unsigned all = 0xFFFF;
+        for (int c4 = 0; c4 < 4; c4++) {
+            const l16 ev = l16_add(l16_add(l16_mul(e[q][0], cd[c4][0]), l16_mul(e[q][1], cd[c4][1])),
+                                   l16_mul(e[q][2], cd[c4][2]));
+            const l16 tol = l16_mul(lq, cl[c4]);
+            all &= (det_pos & l16_lt(l16_add(ev, tol), zero)) | (~det_pos & l16_gt(l16_sub(ev, tol), zero));
+        }
+        corner_out |= all;
+    }
+    return corner_out & det_ok & corner_lanes;
+}
+
+/* The pair's live rays in cells [x0, x1] x [y0, y1] of its lane l, one 16-ray test per packet that holds any; fine:
+ * each row narrowed to the grid's columns in the footprint's box (gbox). */
+static inline void mft_pair_cells(mft_pair *pr, const ms_mft_lane *L, int l, int k, int x0, int x1, int y0, int y1, int fine,
+                                  const mft_grid_box *gbox)
+{
+    const int cpr = k / 16;
+    if (k >= 16) {
+        /* Row by row, the live rays of columns x0..x1, one test per 16-sample packet that holds any. */
+        const uint64_t cols = ((UINT64_C(2) << x1) - 1) & ~((UINT64_C(1) << x0) - 1);
+                for (int y = y0; y <= y1 && !pr->done; y++) {
+            uint64_t row = mft_row(L->mask, k, y) & cols;
+            if (row && fine) {
+                const int q = y - y0, i0 = gbox->rows[2 * q][l], i1 = gbox->rows[2 * q + 1][l];
+                row = i0 > i1 ? 0 : row & ((UINT64_C(2) << i1) - 1) & ~((UINT64_C(1) << i0) - 1);
+            }
+            while (row) {
+                const int p = __builtin_ctzll(row) >> 4;
+                const unsigned bits = (unsigned)(row >> 16 * p) & 0xFFFFu;
+                row &= ~(UINT64_C(0xFFFF) << 16 * p);
+                mft_pair_packet(pr, y * cpr + p, bits);
+            }
+        }
+    } else {
+        /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (An earlier loop took k / 16 =
+         * 0 packets per row and tested no ray at all: mft answered the front mask; the known bug of
+         * test_visibility.) */
+        const int rpp = 16 / k;
+        const unsigned rowcols = ((1u << (x1 - x0 + 1)) - 1u) << x0;
+        for (int ch = y0 / rpp; ch <= y1 / rpp; ch++) {
+            unsigned cols = 0;
+            for (int r = 0; r < rpp; r++)
+                if (ch * rpp + r >= y0 && ch * rpp + r <= y1) cols |= rowcols << (r * k);
+            const unsigned bits = (unsigned)(L->mask[ch >> 2] >> (ch & 3) * 16) & cols;
+            if (bits) mft_pair_packet(pr, ch, bits);
+        }
+    }
+}
+
+/* The grid's samples in the footprint's box (above MFT_GRID_EPS): the columns of each of the first MFT_GRID_ROWS rows
+ * of the cuts r into gbox, for the 16 lanes at once. The lanes whose cut holds no sample. */
+static inline unsigned mft_grid_cut(const mft_state *s, int k, float box[4][MS_BLOCK_LANES], const l16 r[4],
+                                    mft_grid_box *gbox)
+{
+    const l16 kf = l16_set1((float)k), keps = l16_set1((float)k * MFT_GRID_EPS), eps = l16_set1(MFT_GRID_EPS);
+    const l16 oa = l16_load(s->goa), v = l16_load(s->gv);
+    const l16 ga0 = l16_sub(l16_sub(l16_load(box[0]), oa), eps), ga1 = l16_add(l16_sub(l16_load(box[1]), oa), eps);
+    const l16 gb0 = l16_ceil(l16_sub(l16_sub(l16_mul(kf, l16_load(box[2])), keps), v));
+    const l16 gb1 = l16_floor(l16_add(l16_sub(l16_mul(kf, l16_load(box[3])), v), keps));
+    const l16 invk = l16_set1(1.0f / (float)k);
+    unsigned none = 0xFFFF;
+    for (int q = 0; q < MFT_GRID_ROWS; q++) {
+        const l16 j = l16_add(r[2], l16_set1((float)q)), jk = l16_mul(j, invk), kj = l16_mul(j, kf);
+        const l16 ia = l16_max(l16_max(l16_ceil(l16_add(ga0, jk)), l16_sub(gb0, kj)), r[0]);
+        const l16 ib = l16_min(l16_min(l16_floor(l16_add(ga1, jk)), l16_sub(gb1, kj)), r[1]);
+        l16_store_int(gbox->rows[2 * q], ia);
+        l16_store_int(gbox->rows[2 * q + 1], ib);
+        none &= l16_gt(ia, ib) | (q ? l16_gt(j, r[3]) : 0u);
+    }
+    return none;
+}
 
 static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
 {
@@ -397,7 +523,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
     const ms_mft_frame *f = s->f;
     ms_mft_block *blk = s->blk;
     uint64_t *cnt = s->bt_cnt;
-    const int k = f->k, cpr = k / 16;
+    const int k = f->k;
     /* The pixels whose own triangle is in this leaf. */
     uint32_t skip_tri[MFT_MAX_SKIP];
     unsigned skip_lane[MFT_MAX_SKIP];
@@ -416,9 +542,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         cl[q] = l16_load(s->cl[q]);
         for (int a = 0; a < 3; a++) cd[q][a] = l16_load(s->cd[q][a]);
     }
-    const l16 zero = l16_set1(0.0f), rel = l16_set1(MFT_REL), near = l16_set1(f->near), far = l16_set1(f->far);
-    const l16 one_lo = l16_set1(1.0f - MFT_REL), one_hi = l16_set1(1.0f + MFT_REL);
-    const l16 inf = l16_set1(INFINITY), ninf = l16_set1(-INFINITY);
+    const l16 zero = l16_set1(0.0f), rel = l16_set1(MFT_REL);
     unsigned terminated = 0;
     uint64_t pairs = 0, c_hor = 0, c_plane = 0, c_corner = 0, c_foot = 0, tested = 0, isec = 0, early = 0;
     for (uint32_t t = n->first; t < n->first + n->count; t++) {
@@ -438,34 +562,9 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             const l16 h = l16_add(l16_add(l16_mul(hn[0], a[v][0]), l16_mul(hn[1], a[v][1])), l16_mul(hn[2], a[v][2]));
             behind &= l16_lt(h, l16_sub(zero, l16_mul(la[v], rel)));
         }
-        /* The plane: num = (v - C) . N from the vertex nearest C (ms_wt_offset, bit for bit); the
-         * segments' d . N over the frustum lies between the corner rays' (the samples are convex
-         * combinations of the corners), widened; a hit needs num / (d . N) in [near, far]. */
-        const unsigned p0 = l16_le(lv[0], lv[1]) & l16_le(lv[0], lv[2]);
-        const unsigned p1 = ~l16_le(lv[0], lv[1]) & l16_le(lv[1], lv[2]);
-        l16 num = zero;
-        {
-            l16 vn[3];
-            for (int x = 0; x < 3; x++) vn[x] = l16_select(p0, a[0][x], l16_select(p1, a[1][x], a[2][x]));
-            num = l16_add(l16_add(l16_mul(vn[0], l16_set1(N[0])), l16_mul(vn[1], l16_set1(N[1]))), l16_mul(vn[2], l16_set1(N[2])));
-        }
         const float nl1 = fabsf(N[0]) + fabsf(N[1]) + fabsf(N[2]);
-        l16 dlo = inf, dhi = ninf, clmax = zero;
-        for (int q = 0; q < 4; q++) {
-            const l16 den = l16_add(l16_add(l16_mul(cd[q][0], l16_set1(N[0])), l16_mul(cd[q][1], l16_set1(N[1]))),
-                                    l16_mul(cd[q][2], l16_set1(N[2])));
-            dlo = l16_min(dlo, den);
-            dhi = l16_max(dhi, den);
-            clmax = l16_max(clmax, cl[q]);
-        }
-        const l16 dtol = l16_mul(clmax, l16_set1(nl1 * MFT_REL));
-        dlo = l16_sub(dlo, dtol);
-        dhi = l16_add(dhi, dtol);
-        const unsigned pos = l16_gt(num, zero);
-        const l16 an = l16_abs(num);
-        const l16 slo = l16_select(pos, dlo, l16_sub(zero, dhi)), shi = l16_select(pos, dhi, l16_sub(zero, dlo));
-        const unsigned plane_out = l16_le(an, zero) | l16_le(shi, zero) | l16_lt(l16_mul(far, shi), l16_mul(an, one_lo)) |
-                                   l16_gt(l16_mul(near, slo), l16_mul(an, one_hi));
+        l16 num, an;
+        const unsigned plane_out = mft_plane_out(f, a, lv, N, nl1, cd, cl, &num, &an);
         unsigned pass = lanes & ~behind;
         c_hor += (uint64_t)ms_bt_popcount16(lanes & behind);
         c_plane += (uint64_t)ms_bt_popcount16(pass & plane_out);
@@ -490,7 +589,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
         const l16 lamax = l16_max(la[0], l16_max(la[1], la[2]));
         const unsigned grazing = l16_le(an, l16_mul(lamax, l16_set1(nl1 * 1e-4f)));
         const unsigned foot_lanes = pass & s->has_m & ~grazing;
-        if (!(f->flags & MS_MFT_NO_FOOTPRINT) && foot_lanes) {
+        if (foot_lanes) {
             float box[4][MS_BLOCK_LANES];
             unsigned empty = 0;
             foot = mft_footprint16(s, a, la, foot_lanes, &empty, box);
@@ -501,62 +600,21 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             }
             unsigned out = empty | (foot & (l16_gt(r[0], r[1]) | l16_gt(r[2], r[3])));
             const unsigned short_cut = foot & ~out & l16_le(r[3], l16_add(r[2], l16_set1((float)(MFT_GRID_ROWS - 1))));
-            if (s->grid_rows && short_cut) {
-                /* The grid's samples in the box (above MFT_GRID_EPS): the columns of each row of the short
-                 * cuts, for the 16 lanes at once; a cut with none drops the pair. */
+            if (s->grid_rows && short_cut) {   /* a short cut with no sample of the grid drops the pair */
                 grid_rows = short_cut;
-                const l16 kf = l16_set1((float)k), keps = l16_set1((float)k * MFT_GRID_EPS), eps = l16_set1(MFT_GRID_EPS);
-                const l16 oa = l16_load(s->goa), v = l16_load(s->gv);
-                const l16 ga0 = l16_sub(l16_sub(l16_load(box[0]), oa), eps), ga1 = l16_add(l16_sub(l16_load(box[1]), oa), eps);
-                const l16 gb0 = l16_ceil(l16_sub(l16_sub(l16_mul(kf, l16_load(box[2])), keps), v));
-                const l16 gb1 = l16_floor(l16_add(l16_sub(l16_mul(kf, l16_load(box[3])), v), keps));
-                const l16 invk = l16_set1(1.0f / (float)k);
-                unsigned none = 0xFFFF;
-                for (int q = 0; q < MFT_GRID_ROWS; q++) {
-                    const l16 j = l16_add(r[2], l16_set1((float)q)), jk = l16_mul(j, invk), kj = l16_mul(j, kf);
-                    const l16 ia = l16_max(l16_max(l16_ceil(l16_add(ga0, jk)), l16_sub(gb0, kj)), r[0]);
-                    const l16 ib = l16_min(l16_min(l16_floor(l16_add(ga1, jk)), l16_sub(gb1, kj)), r[1]);
-                    l16_store_int(gbox.rows[2 * q], ia);
-                    l16_store_int(gbox.rows[2 * q + 1], ib);
-                    none &= l16_gt(ia, ib) | (q ? l16_gt(j, r[3]) : 0u);
-                }
-                out |= grid_rows & none;
+                out |= grid_rows & mft_grid_cut(s, k, box, r, &gbox);
             }
             c_foot += (uint64_t)ms_bt_popcount16(pass & out);
             pass &= ~out;
         }
-        /* Corner rays against the edge planes through C, for the lanes without a footprint only (with
-         * one, the cut above culls nearly every pair this test would: measured): a ray hits (t > 0)
-         * only inside the cone of the vertices, where every edge function (a_i x a_j) . d has the sign of
-         * det = (a0 x a1) . a2. Trusted only where |det| clears its own
-         * rounding. */
+        /* Corner rays (mft_corner_out) for the lanes without a footprint, or whose cut still spans more than
+         * MFT_CORNER_AREA cells (with a small cut, the cut above culls nearly every pair this test would:
+         * measured). */
         const l16 one_f = l16_set1(1.0f);
         const l16 area = l16_mul(l16_add(l16_sub(r[1], r[0]), one_f), l16_add(l16_sub(r[3], r[2]), one_f));
         const unsigned corner_lanes = pass & (~foot | l16_gt(area, l16_set1(MFT_CORNER_AREA)));
         if (corner_lanes) {
-            l16 e[3][3];
-            for (int q = 0; q < 3; q++) {
-                const l16 *x = a[q], *y = a[q == 2 ? 0 : q + 1];
-                e[q][0] = l16_sub(l16_mul(x[1], y[2]), l16_mul(x[2], y[1]));
-                e[q][1] = l16_sub(l16_mul(x[2], y[0]), l16_mul(x[0], y[2]));
-                e[q][2] = l16_sub(l16_mul(x[0], y[1]), l16_mul(x[1], y[0]));
-            }
-            const l16 det = l16_add(l16_add(l16_mul(e[0][0], a[2][0]), l16_mul(e[0][1], a[2][1])), l16_mul(e[0][2], a[2][2]));
-            const unsigned det_ok = l16_gt(l16_abs(det), l16_mul(l16_mul(l16_mul(la[0], la[1]), la[2]), rel));
-            const unsigned det_pos = l16_gt(det, zero);
-            unsigned corner_out = 0;
-            for (int q = 0; q < 3; q++) {
-                const l16 lq = l16_mul(l16_mul(la[q], la[q == 2 ? 0 : q + 1]), rel);
-                unsigned all = 0xFFFF;
-                for (int c4 = 0; c4 < 4; c4++) {
-                    const l16 ev = l16_add(l16_add(l16_mul(e[q][0], cd[c4][0]), l16_mul(e[q][1], cd[c4][1])),
-                                           l16_mul(e[q][2], cd[c4][2]));
-                    const l16 tol = l16_mul(lq, cl[c4]);
-                    all &= (det_pos & l16_lt(l16_add(ev, tol), zero)) | (~det_pos & l16_gt(l16_sub(ev, tol), zero));
-                }
-                corner_out |= all;
-            }
-            corner_out &= det_ok & corner_lanes;
+            const unsigned corner_out = mft_corner_out(a, la, cd, cl, corner_lanes);
             c_corner += (uint64_t)ms_bt_popcount16(pass & corner_out);
             pass &= ~corner_out;
         }
@@ -571,37 +629,7 @@ static void mft_leaf(mft_state *s, const ms_bvh_node *n, unsigned mask)
             ms_mft_lane *L = &blk->lane[l];
             const int x0 = rc[0][l], x1 = rc[1][l], y0 = rc[2][l], y1 = rc[3][l];
             mft_pair pr = { .s = s, .L = L, .l = l, .t = t, .tri = tri, .N = N, .num = numv[l] };
-            if (k >= 16) {
-                /* Row by row, the live rays of columns x0..x1, one test per 16-sample packet that holds any. */
-                const uint64_t cols = ((UINT64_C(2) << x1) - 1) & ~((UINT64_C(1) << x0) - 1);
-                const int fine = grid_rows >> l & 1;
-                for (int y = y0; y <= y1 && !pr.done; y++) {
-                    uint64_t row = mft_row(L->mask, k, y) & cols;
-                    if (row && fine) {
-                        const int q = y - y0, i0 = gbox.rows[2 * q][l], i1 = gbox.rows[2 * q + 1][l];
-                        row = i0 > i1 ? 0 : row & ((UINT64_C(2) << i1) - 1) & ~((UINT64_C(1) << i0) - 1);
-                    }
-                    while (row) {
-                        const int p = __builtin_ctzll(row) >> 4;
-                        const unsigned bits = (unsigned)(row >> 16 * p) & 0xFFFFu;
-                        row &= ~(UINT64_C(0xFFFF) << 16 * p);
-                        mft_pair_packet(&pr, y * cpr + p, bits);
-                    }
-                }
-            } else {
-                /* k = 4, 8 (stratified 16, 64): a packet is 16 / k whole rows. (An earlier loop took k / 16 =
-                 * 0 packets per row and tested no ray at all: mft answered the front mask; the known bug of
-                 * test_visibility.) */
-                const int rpp = 16 / k;
-                const unsigned rowcols = ((1u << (x1 - x0 + 1)) - 1u) << x0;
-                for (int ch = y0 / rpp; ch <= y1 / rpp; ch++) {
-                    unsigned cols = 0;
-                    for (int r = 0; r < rpp; r++)
-                        if (ch * rpp + r >= y0 && ch * rpp + r <= y1) cols |= rowcols << (r * k);
-                    const unsigned bits = (unsigned)(L->mask[ch >> 2] >> (ch & 3) * 16) & cols;
-                    if (bits) mft_pair_packet(&pr, ch, bits);
-                }
-            }
+            mft_pair_cells(&pr, L, l, k, x0, x1, y0, y1, grid_rows >> l & 1, &gbox);
             isec += (uint64_t)pr.isec;
             if (!pr.cleared) continue;
             terminated |= 1u << l;
