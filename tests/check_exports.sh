@@ -8,8 +8,10 @@ lib=${1:?usage: check_exports.sh LIBRARY.so HEADER}
 header=${2:?usage: check_exports.sh LIBRARY.so HEADER}
 parts=("$(dirname "$header")"/microshadow/*.h)
 [ -e "${parts[0]}" ] || { echo "check_exports: no parts beside $header (microshadow/*.h)"; exit 1; }
-# The names the header and its parts declare MS_API (one declaration starts per line).
-declared=$(sed -n 's/^MS_API .*\b\(ms_[a-z0-9_]*\)(.*/\1/p' "$header" "${parts[@]}" | sort -u)
+# The names the header and its parts declare MS_API (one declaration starts per line): functions, and
+# data (an array, `name[]`).
+declared=$(sed -n -e 's/^MS_API .*\b\(ms_[a-z0-9_]*\)(.*/\1/p' -e 's/^MS_API extern .*\b\(ms_[a-z0-9_]*\)\[\];.*/\1/p' \
+    "$header" "${parts[@]}" | sort -u)
 [ -n "$declared" ] || { echo "check_exports: no MS_API declaration found in $header"; exit 1; }
 # Every defined dynamic symbol, of any kind (functions, data, weak, unique, absolute).
 exported=$(nm -D --defined-only "$lib" | awk '{print $NF}' | sed 's/@.*//' | sort -u)

@@ -144,13 +144,35 @@ static void test_statuses(void **st)
 
     /* Outputs: a wrong ending is the caller's mistake, an unwritable place an i/o failure. */
     static const char *const png_only[] = { ".png", NULL };
-    ms_output out = { "-o", tu_path(path, sizeof path, dir, "x.jpg"), ms_png_write_stream, png_only };
+    ms_output out = { "-o", tu_path(path, sizeof path, dir, "x.jpg"), ms_png_write_stream, png_only, NULL, 0 };
     assert_int_equal(ms_outputs_check(&out, 1, err, sizeof err), MS_ERR_INVALID);
     out.path = "/nonexistent-dir/x.png";
     assert_int_equal(ms_outputs_check(&out, 1, err, sizeof err), MS_ERR_IO);
     assert_int_equal(ms_write_png(&f, "/nonexistent-dir/x.png", err, sizeof err), MS_ERR_IO);
     assert_int_equal(ms_write_png(&f, tu_path(path, sizeof path, dir, "ok.png"), err, sizeof err), MS_OK);
     assert_true(tu_file_exists(path));
+    /* An output without a writer is its bytes (a glb made after the render), written with the others, all or
+     * nothing: read back equal; bytes promised but missing are refused and nothing is left behind. */
+    static const char glb_bytes[] = "glTF\x02\0\0\0 any bytes, \0 zeros included";
+    ms_output raw[2] = { { "-o", tu_path(path, sizeof path, dir, "ok2.png"), ms_png_write_stream, NULL, NULL, 0 },
+                         { "--gltf", NULL, NULL, NULL, glb_bytes, sizeof glb_bytes } };
+    char raw_path[4096];
+    raw[1].path = tu_path(raw_path, sizeof raw_path, dir, "raw.glb");
+    assert_int_equal(ms_outputs_check(raw, 2, err, sizeof err), MS_OK);
+    assert_int_equal(ms_outputs_write(&f, raw, 2, err, sizeof err), MS_OK);
+    FILE *rf = fopen(raw_path, "rb");
+    assert_non_null(rf);
+    char back[sizeof glb_bytes + 8];
+    assert_int_equal(fread(back, 1, sizeof back, rf), sizeof glb_bytes);
+    fclose(rf);
+    assert_memory_equal(back, glb_bytes, sizeof glb_bytes);
+    assert_int_equal(remove(raw_path), 0);
+    assert_int_equal(remove(path), 0);
+    raw[1].bytes = NULL;
+    assert_int_equal(ms_outputs_write(&f, raw, 2, err, sizeof err), MS_ERR_IO);
+    printf("bytes missing: %s\n", err);
+    assert_false(tu_file_exists(raw_path));
+    assert_false(tu_file_exists(path));
     f.vis[5] = NAN;
     assert_int_equal(ms_frame_check_finite(&f, "frame", err, sizeof err), MS_ERR_INVALID);
     ms_frame_free(&f);

@@ -230,7 +230,8 @@ static void test_guard_before_writing(void **st)
         const float keep = cases[c].p[cases[c].at];
         cases[c].p[cases[c].at] = cases[c].v;
         const char *target = in_dir("bad.exr");
-        ms_output outs[2] = { { "-o", target, ms_exr_write_stream, NULL }, { "--vis", in_dir("bad.pfm"), ms_vis_write_stream, NULL } };
+        ms_output outs[2] = { { "-o", target, ms_exr_write_stream, NULL, NULL, 0 },
+                                { "--vis", in_dir("bad.pfm"), ms_vis_write_stream, NULL, NULL, 0 } };
         assert_int_equal(ms_outputs_check(outs, 2, err, sizeof err), 0);
         assert_int_not_equal(ms_outputs_write(&f, outs, 2, err, sizeof err), 0);
         printf("%s\n", err);

@@ -475,7 +475,7 @@ static void test_outputs_signal_removes_staging(void **st)
         if (pid == 0) {
             g_sig = sigs[k];
             ms_outputs_cleanup_on_signals();
-            ms_output outs[2] = { { "-a", a, writer_ok, NULL }, { "-b", b, writer_signal, NULL } };
+            ms_output outs[2] = { { "-a", a, writer_ok, NULL, NULL, 0 }, { "-b", b, writer_signal, NULL, NULL, 0 } };
             char err[256];
             ms_frame fr;
             memset(&fr, 0, sizeof fr);
@@ -527,7 +527,8 @@ static void test_outputs_signal_on_other_thread(void **st)
                 snprintf(n, sizeof n, "a%05d.txt", i); tu_path(a, sizeof a, dir, n);
                 snprintf(n, sizeof n, "b%05d.txt", i); tu_path(b, sizeof b, dir, n);
                 snprintf(n, sizeof n, "c%05d.txt", i); tu_path(c, sizeof c, dir, n);
-                ms_output outs[3] = { { "-a", a, writer_ok, NULL }, { "-b", b, writer_ok, NULL }, { "-c", c, writer_ok, NULL } };
+                ms_output outs[3] = { { "-a", a, writer_ok, NULL, NULL, 0 }, { "-b", b, writer_ok, NULL, NULL, 0 },
+                                      { "-c", c, writer_ok, NULL, NULL, 0 } };
                 char err[256];
                 ms_frame fr;
                 memset(&fr, 0, sizeof fr);

@@ -80,9 +80,9 @@ static int render_to(const ms_scene *sc, const ms_render_options *o, const char 
     tu_path(p[2], sizeof p[2], dir, name);
     static const char *const img[] = { ".png", ".exr", NULL };
     const ms_output outs[3] = {
-        { "-o", p[0], exr_rgb ? ms_exr_write_stream : ms_png_write_stream, img },
-        { "--vis", p[1], ms_vis_write_stream, ms_float_image_suffixes },
-        { "--shadow", p[2], ms_shadow_write_stream, ms_float_image_suffixes },
+        { "-o", p[0], exr_rgb ? ms_exr_write_stream : ms_png_write_stream, img, NULL, 0 },
+        { "--vis", p[1], ms_vis_write_stream, ms_float_image_suffixes, NULL, 0 },
+        { "--shadow", p[2], ms_shadow_write_stream, ms_float_image_suffixes, NULL, 0 },
     };
     if (ms_outputs_check(outs, 3, err, errlen)) return -1;
     return ms_render_outputs(sc, o, 0.5, outs, 3, st, err, errlen);

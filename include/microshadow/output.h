@@ -18,8 +18,12 @@ typedef ms_status (*ms_output_write_fn)(const ms_frame *f, FILE *out, const char
 typedef struct ms_output {
     const char *flag;             /* how the caller named it, for messages ("-o", "--vis") */
     const char *path;             /* NULL: not requested */
-    ms_output_write_fn write;     /* one of the writers below, or the caller's own */
+    ms_output_write_fn write;     /* one of the writers below, or the caller's own; NULL: the file is `bytes` */
     const char *const *suffixes;  /* NULL-terminated accepted endings (case-insensitive), or NULL: any */
+    /* With write NULL, the file's bytes as the caller made them (a file that needs more than the frame, e.g. a
+     * glb of the scene and its lightmap): set by the time of ms_outputs_write, checked like any output before. */
+    const void *bytes;
+    size_t n_bytes;
 } ms_output;
 #define MS_MAX_OUTPUTS 64   /* a paged lightmap writes each output once per page */
 MS_API ms_status ms_outputs_check(const ms_output *outs, int n, char *err, size_t errlen);
@@ -36,7 +40,7 @@ MS_API ms_status ms_png_write_stream(const ms_frame *f, FILE *out, const char *n
 MS_API ms_status ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 MS_API ms_status ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 MS_API ms_status ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
-extern const char *const ms_float_image_suffixes[];   /* ".pfm", ".exr" */
+MS_API extern const char *const ms_float_image_suffixes[];   /* ".pfm", ".exr": the endings of --vis and --shadow */
 
 /* A frame rendered and written to outs[0..n) (ms_outputs_check them first), all or nothing: the whole frame in
  * memory, then ms_outputs_write; or, streamed (opt->stream, docs/memory.md), band by band of MS_TILE_SIZE-row

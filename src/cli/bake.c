@@ -58,19 +58,6 @@ static void usage(FILE *f)
         "  --help\n", MS_MAX_UV_SETS - 1);
 }
 
-/* --gltf: the glb is made whole before the outputs are written (it needs the scene and the lightmap, which an
- * ms_output_write_fn is not given), then written as they are, all or nothing with the others. */
-static const unsigned char *g_glb;
-static size_t g_glb_len;
-
-static ms_status write_glb(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
-{
-    (void)f;
-    if (fwrite(g_glb, 1, g_glb_len, out) == g_glb_len) return MS_OK;
-    snprintf(err, errlen, "%s: write failed", name);
-    return MS_ERR_IO;
-}
-
 /* Within the lights' pass: a percentage on the terminal, overwritten by the pass's own line at its end. */
 static int progress_bar(void *user, double frac)
 {
@@ -141,13 +128,15 @@ static void request_init(bake_request *r)
 {
     memset(r, 0, sizeof *r);
     const ms_output outs[N_OUTS] = {
-        { "-o", "lightmap.exr", ms_exr_write_stream, exr_suffix },
-        { "--png", NULL, ms_png_write_stream, png_suffix },
-        { "--stats", NULL, ms_stats_write_stream, json_suffix },
-        { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
-        { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
-        { "--gltf", NULL, write_glb, glb_suffix },   /* g_glb: made by ms_bake_gltf after the bake */
-        { "--uv-cache", NULL, ms_bake_uv_cache_write, NULL },
+        { "-o", "lightmap.exr", ms_exr_write_stream, exr_suffix, NULL, 0 },
+        { "--png", NULL, ms_png_write_stream, png_suffix, NULL, 0 },
+        { "--stats", NULL, ms_stats_write_stream, json_suffix, NULL, 0 },
+        { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes, NULL, 0 },
+        { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes, NULL, 0 },
+        /* the glb is made whole after the bake (it needs the scene and the lightmap, which a writer is not
+         * given), then written with the others, all or nothing */
+        { "--gltf", NULL, NULL, glb_suffix, NULL, 0 },
+        { "--uv-cache", NULL, ms_bake_uv_cache_write, NULL, NULL, 0 },
     };
     memcpy(r->outs, outs, sizeof outs);
     r->bo.uv_set = 1;
@@ -333,12 +322,14 @@ int ms_cli_bake(int argc, char **argv)
     unsigned char *glb = NULL;
     int rc = 0;
     if (r.outs[OUT_GLTF].path) {
-        st = ms_bake_gltf(&scene, &lm, NULL, &glb, &g_glb_len, err, sizeof err);
+        size_t len = 0;
+        st = ms_bake_gltf(&scene, &lm, NULL, &glb, &len, err, sizeof err);
         if (st) {
             fprintf(stderr, "microshadow bake: %s: %s\n", r.outs[OUT_GLTF].path, err);
             rc = ms_cli_exit_code(st);
         }
-        g_glb = glb;
+        r.outs[OUT_GLTF].bytes = glb;
+        r.outs[OUT_GLTF].n_bytes = len;
     }
     ms_bake_uv_cache_source(&lm);
     if (!rc && (ms_bake_pages_out(&lm, r.outs, &n_outs, err, sizeof err) || ms_outputs_check(r.outs, n_outs, err, sizeof err))) {

@@ -151,10 +151,10 @@ static void request_init(cli_request *r)
     memset(r, 0, sizeof *r);
     ms_render_options_default(&r->opt);
     const ms_output outs[N_OUTS] = {
-        { "-o", "microshadow.png", ms_png_write_stream, image_suffixes },
-        { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes },
-        { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes },
-        { "--stats", NULL, ms_stats_write_stream, json_suffix },
+        { "-o", "microshadow.png", ms_png_write_stream, image_suffixes, NULL, 0 },
+        { "--vis", NULL, ms_vis_write_stream, ms_float_image_suffixes, NULL, 0 },
+        { "--shadow", NULL, ms_shadow_write_stream, ms_float_image_suffixes, NULL, 0 },
+        { "--stats", NULL, ms_stats_write_stream, json_suffix, NULL, 0 },
     };
     memcpy(r->outs, outs, sizeof outs);
 #ifdef MS_HAVE_MPI

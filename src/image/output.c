@@ -333,6 +333,17 @@ static FILE *open_staged(const ms_output *o, int *slot, char *err, size_t errlen
     return fp;
 }
 
+/* An output without a writer: its bytes as they are. */
+static ms_status write_bytes(const ms_output *o, FILE *out, char *err, size_t errlen)
+{
+    if (!o->bytes && o->n_bytes) { snprintf(err, errlen, "%s: %s has neither a writer nor its bytes", o->path, o->flag); return MS_ERR_INVALID; }
+    if (o->n_bytes && fwrite(o->bytes, 1, o->n_bytes, out) != o->n_bytes) {
+        snprintf(err, errlen, "%s: write failed", o->path);
+        return MS_ERR_IO;
+    }
+    return MS_OK;
+}
+
 ms_status ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char *err, size_t errlen)
 {
     int slot[MS_MAX_OUTPUTS];
@@ -349,7 +360,8 @@ ms_status ms_outputs_write(const ms_frame *f, const ms_output *outs, int n, char
         if (!outs[k].path) continue;
         FILE *fp = open_staged(&outs[k], &slot[k], err, errlen);
         if (!fp) { rc = -1; break; }
-        rc = close_staged(fp, outs[k].path, outs[k].write(f, fp, outs[k].path, err, errlen), err, errlen);
+        const ms_status w = outs[k].write ? outs[k].write(f, fp, outs[k].path, err, errlen) : write_bytes(&outs[k], fp, err, errlen);
+        rc = close_staged(fp, outs[k].path, w, err, errlen);
     }
     return commit_all(outs, slot, n, rc, err, errlen) ? MS_ERR_IO : MS_OK;
 }
@@ -459,7 +471,7 @@ int ms_outputs_spill(const char *near, char *err, size_t errlen)
 static int write_one(const ms_frame *f, const char *path, const char *flag, ms_output_write_fn fn,
                      const char *const *suffixes, char *err, size_t errlen)
 {
-    ms_output o = { flag, path ? path : "", fn, suffixes };
+    ms_output o = { flag, path ? path : "", fn, suffixes, NULL, 0 };
     if (ms_outputs_check(&o, 1, err, errlen)) return -1;
     return ms_outputs_write(f, &o, 1, err, errlen);
 }

@@ -675,34 +675,21 @@ done:
     return st;
 }
 
-/* The bytes ms_bake_write_gltf hands to ms_outputs_write, per thread (the writer is called on the caller's). */
-static _Thread_local const unsigned char *t_glb;
-static _Thread_local size_t t_glb_len;
-
-static ms_status write_glb(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen)
-{
-    (void)f;
-    if (fwrite(t_glb, 1, t_glb_len, out) == t_glb_len) return MS_OK;
-    snprintf(err, errlen, "%s: write failed", name);
-    return MS_ERR_IO;
-}
-
 ms_status ms_bake_write_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_lightmap *lm,
                                  const ms_bake_gltf_options *opt, const char *path, char *err, size_t errlen)
 {
     const ms_status ast = ms_abi_check(abi, "ms_bake_write_gltf", err, errlen);
     if (ast) return ast;
     static const char *const glb_suffix[] = { ".glb", NULL };
-    ms_output o = { "glTF", path ? path : "", write_glb, glb_suffix };
+    ms_output o = { "glTF", path ? path : "", NULL, glb_suffix, NULL, 0 };
     if (ms_outputs_check(&o, 1, err, errlen)) return MS_ERR_IO;
     unsigned char *glb;
     size_t len;
     ms_status st = ms_bake_gltf(sc, lm, opt, &glb, &len, err, errlen);
     if (st) return st;
-    t_glb = glb;
-    t_glb_len = len;
+    o.bytes = glb;
+    o.n_bytes = len;
     st = ms_outputs_write(&lm->frame, &o, 1, err, errlen) ? MS_ERR_IO : MS_OK;
-    t_glb = NULL;
     free(glb);
     return st;
 }

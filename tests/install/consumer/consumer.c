@@ -1,7 +1,8 @@
 /* A program of someone else's: uses the installed microshadow through its public header only. The
  * built-in scene's light (y = 6, 2.5 x 2.5 around the y axis, emitting down) fully lights an open
  * point of the ground, a point inside the cube (x 1.5..3, y 0..1.5, z -1.5..0) sees none of it, and
- * a point under the floating plate lies in its penumbra; a small frame renders. Exit 0 when all hold. */
+ * a point under the floating plate lies in its penumbra; a small frame renders; the API's data links. Exit 0
+ * when all hold. */
 #include <microshadow.h>
 #include <stdio.h>
 
@@ -32,6 +33,9 @@ int main(void)
         printf("frame %dx%d, %llu visible pixels, version %s\n", f.width, f.height,
                (unsigned long long)f.stats.visible_pixels, MS_VERSION_STRING);
         ok = ok && f.stats.visible_pixels > 0;
+        /* the API's data too (a symbol the shared library must export, not only its functions) */
+        printf("float image endings: %s %s\n", ms_float_image_suffixes[0], ms_float_image_suffixes[1]);
+        ok = ok && ms_float_image_suffixes[0] && ms_float_image_suffixes[2] == NULL;
         ms_frame_free(&f);
     }
     ms_scene_free(&sc);
