@@ -110,6 +110,21 @@ static void test_exr(void **st)
     make_frame(&f);
     check_exr(&f, 0);
     check_exr(&f, 1);
+    /* The EXR of everything (ms_write_exr): R, G, B, V and S read back as written; only .exr is accepted. */
+    const char *dir = tu_tmpdir("outputs_exr_all");
+    char path[4096], err[512];
+    assert_int_not_equal(ms_write_exr(&f, tu_path(path, sizeof path, dir, "all.pfm"), err, sizeof err), 0);
+    assert_int_equal(ms_write_exr(&f, tu_path(path, sizeof path, dir, "all.exr"), err, sizeof err), 0);
+    assert_int_equal(tu_count_entries(dir), 1);
+    float *img = calloc(FW * FH, sizeof(float));
+    assert_non_null(img);
+    assert_int_equal(tu_read_exr_channel(path, "V", FW, FH, img), 0);
+    assert_memory_equal(img, f.vis, sizeof(float) * FW * FH);
+    assert_int_equal(tu_read_exr_channel(path, "S", FW, FH, img), 0);
+    assert_memory_equal(img, f.shadow, sizeof(float) * FW * FH);
+    assert_int_equal(tu_read_exr_channel(path, "G", FW, FH, img), 0);
+    for (int i = 0; i < FW * FH; i++) assert_true(img[i] == f.rgb[3 * i + 1]);
+    free(img);
     ms_frame_free(&f);
 }
 
@@ -139,7 +154,7 @@ static void test_png_and_failures(void **st)
     assert_non_null(strstr(err, bad[1]));
     assert_int_not_equal(ms_write_vis(&f, bad[2], err, sizeof err), 0);
     assert_non_null(strstr(err, bad[2]));
-    assert_int_not_equal(ms_write_stats_json(&f, bad[3], err, sizeof err), 0);
+    assert_int_not_equal(ms_write_stats(&f, bad[3], err, sizeof err), 0);
     assert_non_null(strstr(err, bad[3]));
     assert_int_not_equal(ms_write_vis(&f, tu_path(path, sizeof path, dir, "v.tiff"), err, sizeof err), 0);
     assert_int_equal(tu_count_entries(dir), 1);
@@ -200,7 +215,7 @@ static void test_stats(void **st)
     ms_frame fr;
     assert_int_equal(ms_render(&s, &opt, &fr, err, sizeof err), 0);
     assert_int_equal(fr.stats.threads, 2);
-    assert_int_equal(ms_write_stats_json(&fr, tu_path(path, sizeof path, dir, "s.json"), err, sizeof err), 0);
+    assert_int_equal(ms_write_stats(&fr, tu_path(path, sizeof path, dir, "s.json"), err, sizeof err), 0);
     check_stats(path, &fr, s.n_tris);
     /* Through the CLI (built-in scene), with all four outputs: exactly four files, no temporaries; the S
      * image is the frame's S (the same render through the library). */

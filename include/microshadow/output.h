@@ -34,9 +34,14 @@ MS_API ms_status ms_outputs_write(const ms_frame *f, const ms_output *outs, int 
  * skipped) and, with rgb, the exposure are finite; else MS_ERR_INVALID with one line "what: ... at pixel (x, y) is NaN". */
 MS_API ms_status ms_frame_check_finite(const ms_frame *f, const char *what, char *err, size_t errlen);
 MS_API void ms_outputs_cleanup_on_signals(void);
-/* The writers: tone-mapped sRGB PNG; V resp. S as .pfm or .exr (by name; with several lights the EXR has
- * one channel per light, V0, V1, ... resp. S0, S1, ..., and the PFM light 0); the stats as JSON. */
+/* The writers, ms_<what>_write_stream (an ms_output_write_fn each) and ms_write_<what> for one file alone
+ * (checked, staged and renamed): tone-mapped sRGB PNG; the EXR of everything; V resp. S as .pfm or .exr (by
+ * name; with several lights the EXR has one channel per light, V0, V1, ... resp. S0, S1, ..., and the PFM
+ * light 0); the stats as JSON. The EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance
+ * of frames, irradiance of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per
+ * light) instead of S and V; it ends in .exr. */
 MS_API ms_status ms_png_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API ms_status ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 MS_API ms_status ms_vis_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 MS_API ms_status ms_shadow_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
 MS_API ms_status ms_stats_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
@@ -56,13 +61,9 @@ static inline ms_status ms_render_outputs(const ms_scene *scene, const ms_render
 
 /* One output alone, all or nothing (checked, staged and renamed). */
 MS_API ms_status ms_write_png(const ms_frame *f, const char *path, char *err, size_t errlen);      /* tone-mapped sRGB */
+MS_API ms_status ms_write_exr(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .exr, all channels */
 MS_API ms_status ms_write_vis(const ms_frame *f, const char *path, char *err, size_t errlen);      /* .pfm or .exr, float V */
 MS_API ms_status ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t errlen);   /* .pfm or .exr, float S */
-MS_API ms_status ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen);
-
-/* One EXR of a frame or lightmap: 32-bit float channels R, G, B (rgb: radiance of frames, irradiance
- * of lightmaps), V and S; with several lights S0, S1, ... and V0, V1, ... (one per light) instead of S
- * and V. An ms_output_write_fn; ends in .exr. */
-MS_API ms_status ms_exr_write_stream(const ms_frame *f, FILE *out, const char *name, char *err, size_t errlen);
+MS_API ms_status ms_write_stats(const ms_frame *f, const char *path, char *err, size_t errlen);    /* JSON */
 
 #endif

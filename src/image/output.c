@@ -491,7 +491,13 @@ ms_status ms_write_shadow(const ms_frame *f, const char *path, char *err, size_t
     return write_one(f, path, "the shadow factor image", ms_shadow_write_stream, ms_float_image_suffixes, err, errlen) ? MS_ERR_IO : MS_OK;
 }
 
-ms_status ms_write_stats_json(const ms_frame *f, const char *path, char *err, size_t errlen)
+ms_status ms_write_exr(const ms_frame *f, const char *path, char *err, size_t errlen)
+{
+    static const char *const exr[] = { ".exr", NULL };
+    return write_one(f, path, "EXR", ms_exr_write_stream, exr, err, errlen) ? MS_ERR_IO : MS_OK;
+}
+
+ms_status ms_write_stats(const ms_frame *f, const char *path, char *err, size_t errlen)
 {
     return write_one(f, path, "stats", ms_stats_write_stream, NULL, err, errlen) ? MS_ERR_IO : MS_OK;
 }
