@@ -1,0 +1,118 @@
+/* How full one lightmap page gets when two objects keep their own layouts (src/render/bake_uvs.c,
+ * atlas_xpack.c), against answers made here. A 2 x 2 ground and a 1.2 x 1.2 plate, each with UV0 the
+ * whole unit square (so their layouts overlap and each gets a region of its own), and a few quads without
+ * UVs (xatlas charts, packed together with the regions):
+ *   - one texel density: the regions' sides in texels (measured from the baked UVs) are in the ratio of
+ *     the quads' world sides;
+ *   - the packing is not what limits the scale: two squares of sides g and b share a square page only if
+ *     g + b plus the space between and around them fits its side (otherwise their extents overlap in both
+ *     directions), and the scale found brings g + b within 3% of that bound, though the page keeps empty
+ *     texels beside the smaller square: at one density the two squares, not the packer, set the fill;
+ *   - no texel centre lies in two objects' baked UV images (rasterized here, edges included), every triangle
+ *     on the page, and the texel centres on triangles counted here are the reported page fill. */
+#include "testutil.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SIZE 256
+#define PAD 4
+
+/* An OBJ of one horizontal quad x0..x1, z0..z1 at height y, with UV0 the unit square when uv is set. */
+static void write_quad(const char *path, float x0, float x1, float z0, float z1, float y, int uv)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "v %g %g %g\nv %g %g %g\nv %g %g %g\nv %g %g %g\n", x0, y, z1, x1, y, z1, x1, y, z0, x0, y, z0);
+    if (uv) fprintf(f, "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+    else fprintf(f, "f 1 2 3\nf 1 3 4\n");
+    fclose(f);
+}
+
+static int centre_in(const float *u, double px, double py)
+{
+    double e[3];
+    for (int k = 0; k < 3; k++) {
+        const float *a = u + 2 * k, *b = u + 2 * ((k + 1) % 3);
+        e[k] = ((double)b[0] - a[0]) * (py - a[1]) - ((double)b[1] - a[1]) * (px - a[0]);
+    }
+    return (e[0] >= 0 && e[1] >= 0 && e[2] >= 0) || (e[0] <= 0 && e[1] <= 0 && e[2] <= 0);
+}
+
+static void test_two_regions_bound(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_fill");
+    char path[512], json[512], err[512] = "";
+    write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
+    write_quad(tu_path(path, sizeof path, dir, "plate.obj"), 1.5f, 2.7f, -0.6f, 0.6f, 0.0f, 1);
+    write_quad(tu_path(path, sizeof path, dir, "tile0.obj"), -0.8f, -0.6f, -0.8f, -0.6f, 0.3f, 0);
+    write_quad(tu_path(path, sizeof path, dir, "tile1.obj"), 0.4f, 0.7f, 0.2f, 0.35f, 0.3f, 0);
+    tu_path(json, sizeof json, dir, "scene.json");
+    assert_int_equal(tu_write_file(json,
+        "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"plate.obj\"},{\"file\":\"tile0.obj\"},{\"file\":\"tile1.obj\"}],"
+        "\"camera\":{\"eye\":[0.8,5,0.1],\"target\":[0.8,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
+        "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}"), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = SIZE;
+    bo.padding = PAD;
+    bo.uv_set = 0;
+    bo.points.samples = 256;
+    bo.points.isa = tu_isa_cap();
+    ms_lightmap lm;
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    assert_int_equal(lm.pages, 1);
+    assert_int_equal(lm.object_uv_set[0], 0);
+    assert_int_equal(lm.object_uv_set[1], 0);
+    /* each object's baked UV box, texels */
+    double lo[4][2], hi[4][2];
+    for (int m = 0; m < 4; m++)
+        for (int d = 0; d < 2; d++) { lo[m][d] = INFINITY; hi[m][d] = -INFINITY; }
+    for (size_t t = 0; t < sc.n_tris; t++) {
+        const int m = (int)sc.tri_mesh[t];
+        assert_int_equal(lm.page[t], 0);
+        for (int k = 0; k < 6; k++) {
+            const double v = lm.uv[6 * t + k] * SIZE;
+            assert_true(v >= 0.0 && v <= SIZE);
+            lo[m][k & 1] = fmin(lo[m][k & 1], v);
+            hi[m][k & 1] = fmax(hi[m][k & 1], v);
+        }
+    }
+    const double g = hi[0][0] - lo[0][0], b = hi[1][0] - lo[1][0];
+    assert_true(fabs((hi[0][1] - lo[0][1]) / g - 1.0) < 1e-4);   /* squares stay squares */
+    assert_true(fabs((hi[1][1] - lo[1][1]) / b - 1.0) < 1e-4);
+    assert_true(fabs((g / b) / (2.0 / 1.2) - 1.0) < 1e-3);   /* one texel density */
+    /* the bound: the page less the space between two regions (xatlas pads each by PAD / 2 texels beyond the
+     * texels bilinear lookups read, one each side) and at least half a texel to each page edge */
+    const double bound = SIZE - 1.0 - (PAD + 2.0);
+    printf("ground %.1f + plate %.1f = %.1f texels, bound %.1f; page fill %.1f%%\n", g, b, g + b, bound, 100.0 * lm.page_fill[0]);
+    assert_true(g + b > 0.97 * bound);
+    assert_true(g + b <= bound + 2.0);   /* a region's edge may lie anywhere in its first and last texel */
+    /* no texel centre in two objects */
+    int twice = 0, on = 0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            const double px = (x + 0.5) / SIZE, py = (y + 0.5) / SIZE;
+            int owner = -1, n = 0;   /* an object's triangles are consecutive */
+            for (size_t t = 0; t < sc.n_tris; t++)
+                if (centre_in(lm.uv + 6 * t, px, py) && (int)sc.tri_mesh[t] != owner) { owner = (int)sc.tri_mesh[t]; n++; }
+            twice += n > 1;
+            on += n > 0;
+        }
+    assert_int_equal(twice, 0);
+    assert_true(fabs(on / (double)(SIZE * SIZE) - lm.page_fill[0]) < 0.01);
+    ms_lightmap_free(&lm);
+    ms_scene_free(&sc);
+}
+
+int main(int argc, char **argv)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_two_regions_bound),
+    };
+    return tu_run_group_tests(tests, NULL, NULL, argc, argv);
+}
