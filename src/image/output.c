@@ -336,7 +336,7 @@ static FILE *open_staged(const ms_output *o, int *slot, char *err, size_t errlen
 /* An output without a writer: its bytes as they are. */
 static ms_status write_bytes(const ms_output *o, FILE *out, char *err, size_t errlen)
 {
-    if (!o->bytes && o->n_bytes) { snprintf(err, errlen, "%s: %s has neither a writer nor its bytes", o->path, o->flag); return MS_ERR_INVALID; }
+    if (!o->bytes) { snprintf(err, errlen, "%s: %s has neither a writer nor its bytes", o->path, o->flag); return MS_ERR_INVALID; }
     if (o->n_bytes && fwrite(o->bytes, 1, o->n_bytes, out) != o->n_bytes) {
         snprintf(err, errlen, "%s: write failed", o->path);
         return MS_ERR_IO;
