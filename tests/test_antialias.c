@@ -161,6 +161,10 @@ static void test_methods_agree(void **st)
                 fprintf(stderr, "%s: skipped (%s)\n", *m, err);
                 continue;
             }
+            /* the stats count the shading grid and say how it relates to the output */
+            assert_int_equal(f.stats.aa, 4);
+            assert_int_equal(f.stats.width, 2 * f.width);
+            assert_int_equal(f.stats.height, 2 * f.height);
             const tu_agreement a = tu_compare_frames(&f, &rt);
             fprintf(stderr, "aa 4%s: %s vs raytrace: %ld of %ld pixels differ, max |dV| %.2f samples\n",
                     split ? " split" : "", *m, a.differ, a.pixels, a.max_steps);

@@ -189,6 +189,8 @@ typedef struct ms_stats {
     uint64_t memory_need;          /* bytes the call estimated it would allocate, checked against its memory budget */
     uint64_t memory_budget;        /* that budget (max_memory, or the default: ms_memory_budget) */
     int stream_rows;               /* ms_render_outputs: the output rows of a band when the outputs were streamed, else 0 */
+    int aa;                        /* frames: primary samples per pixel (1, 4, 9, 16); width and height above count
+                                    * them (sqrt(aa) times the output's size); 0 from the points API and bakes */
 } ms_stats;
 
 typedef struct ms_frame {

@@ -364,7 +364,7 @@ static int cli_main(int argc, char **argv)
         size_t n_lights;
         ms_scene_lights(&scene, &n_lights);
         /* the frame's size as asked; the stats count the shading grid (aa per pixel) */
-        const int aa = r.opt.aa > 0 ? r.opt.aa : scene.aa > 0 ? scene.aa : 1, aa_s = (int)lround(sqrt((double)aa));
+        const int aa = s->aa > 0 ? s->aa : 1, aa_s = (int)lround(sqrt((double)aa));
         fprintf(stderr, "%s: %zu triangles, %zu light%s, %dx%d (aa %d), %d samples (%s), method %s, %d threads: build %.3fs, "
                 "setup %.3fs, primary %.3fs, shadow %.3fs (%.1f M shadow rays/s), total %.3fs -> %s\n",
                 what, s->triangles, n_lights, n_lights == 1 ? "" : "s", s->width / aa_s, s->height / aa_s, aa, s->samples,

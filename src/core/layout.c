@@ -45,7 +45,7 @@ static const layout_row rows[] = {
     FIELD(ms_stats, n_counters), FIELD(ms_stats, counter_name), FIELD(ms_stats, counter), FIELD(ms_stats, shadow_cpu_s),
     FIELD(ms_stats, primary), FIELD(ms_stats, primary_setups), FIELD(ms_stats, primary_edge_evals),
     FIELD(ms_stats, primary_nodes), FIELD(ms_stats, occluders_culled), FIELD(ms_stats, interior_boxes), FIELD(ms_stats, occluders_merged), FIELD(ms_stats, receivers_on_merged),
-    FIELD(ms_stats, memory_need), FIELD(ms_stats, memory_budget), FIELD(ms_stats, stream_rows),
+    FIELD(ms_stats, memory_need), FIELD(ms_stats, memory_budget), FIELD(ms_stats, stream_rows), FIELD(ms_stats, aa),
     STRUCT(ms_frame), FIELD(ms_frame, width), FIELD(ms_frame, height), FIELD(ms_frame, vis), FIELD(ms_frame, shadow),
     FIELD(ms_frame, front), FIELD(ms_frame, rgb), FIELD(ms_frame, exposure), FIELD(ms_frame, stats),
     FIELD(ms_frame, shadow_spec), FIELD(ms_frame, n_lights),

@@ -22,9 +22,9 @@
 #define PER_TEXEL 3
 /* The pull towards the baked values, per texel, against the seam term in texel-length units: small, so the
  * seams close almost fully, yet it alone fixes what the seams leave free (the paper's small regulariser
- * towards the input). At 1e-2 a long seam of an asset's own layout whose sides lie a few texels apart kept
- * a tenth of the largest irradiance across it; at 1e-4 the seams close to a fifth of that error and the
- * lightmap still equals the points API (docs/baking.md, "Quality"). */
+ * towards the input). Small enough that the texels beside a seam, which interior lookups also read, yield
+ * to it: where a kept layout puts a seam's two sides a few texels apart those texels decide the seam. The
+ * lightmap stays within the points API's answer (docs/baking.md, "Quality"; figures in the lab notebook). */
 #define LAMBDA 1e-4
 /* Texels whose centre lies off their triangle (the conservative rasterization's edge texels, evaluated at the
  * nearest point of the triangle, and dilation's) hold stand-ins rather than the surface at their centre: they

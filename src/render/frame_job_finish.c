@@ -37,6 +37,7 @@ static void job_stats(ms_frame_job *j, ms_stats *st)
     st->threads = j->threads;
     st->width = j->W;
     st->height = j->H;
+    st->aa = j->aa_s * j->aa_s;
     st->method = j->sm->name;
     st->primary = j->pm->name;
     if (j->pm->counters) {
