@@ -16,12 +16,14 @@ import os
 
 import numpy as np
 
-__all__ = ["Error", "Scene", "Accel", "load", "default_scene", "visibility_points", "render", "bake",
+__all__ = ["Error", "Scene", "Accel", "load", "default_scene", "scene_from_arrays", "visibility_points", "render", "bake",
            "method_names", "light_irradiance", "__version__"]
 
 MAX_UV_SETS = 4
 MAX_COUNTERS = 32
 NO_TRIANGLE = 0xFFFFFFFF
+NO_MATERIAL = 0xFFFFFFFF
+MAX_LIGHTS = 64
 
 
 class Error(RuntimeError):
@@ -112,11 +114,17 @@ _Camera = _mirror("ms_camera", [("eye", _Vec3), ("target", _Vec3), ("up", _Vec3)
 _Light = _mirror("ms_light", [("corner", _Vec3), ("edge_s", _Vec3), ("edge_t", _Vec3), ("emission", _Vec3),
                               ("shape", ctypes.c_int), ("texture", ctypes.POINTER(_f)), ("texture_width", ctypes.c_int),
                               ("texture_height", ctypes.c_int), ("center", _Vec3), ("radius", _f)])
+_Material = _mirror("ms_material", [("base_color", _f * 4), ("metallic", _f), ("roughness", _f),
+                                    ("base_color_texture", ctypes.c_int32), ("alpha_texture", ctypes.c_int32),
+                                    ("emissive", _f * 3)])
 _Scene = _mirror("ms_scene", [("tri", ctypes.POINTER(_f)), ("n_tris", _size), ("camera", _Camera), ("light", _Light),
                               ("samples", ctypes.c_int), ("load_s", ctypes.c_double),
                               ("tri_mesh", ctypes.POINTER(ctypes.c_uint32)), ("tri_uv", ctypes.POINTER(_f) * MAX_UV_SETS),
                               ("n_meshes", _size), ("lights", ctypes.POINTER(_Light)), ("n_lights", _size),
-                              ("origin", ctypes.c_double * 3)])
+                              ("origin", ctypes.c_double * 3), ("tri_object", ctypes.POINTER(ctypes.c_uint32)),
+                              ("n_objects", _size), ("mesh_lightmap_scale", ctypes.POINTER(_f)),
+                              ("materials", ctypes.POINTER(_Material)), ("n_materials", _size),
+                              ("tri_material", ctypes.POINTER(ctypes.c_uint32)), ("tri_normal", ctypes.POINTER(_f))])
 _Stats = _mirror("ms_stats", [("triangles", _size)] +
                  [(n, ctypes.c_double) for n in ("load_s", "build_s", "setup_s", "primary_s", "shadow_s", "total_s")] +
                  [(n, ctypes.c_int) for n in ("samples", "threads", "width", "height", "samples_per_pixel")] +
@@ -188,6 +196,7 @@ _scene_load = _checked("ms_scene_load", ctypes.c_int, ctypes.c_char_p, ctypes.PO
                        ctypes.POINTER(_Scene), _ERR, _size)
 _scene_default = _checked("ms_scene_default", ctypes.c_int, ctypes.POINTER(_Scene))
 _scene_free = _sig("ms_scene_free", None, ctypes.POINTER(_Scene))
+_scene_validate = _sig("ms_scene_validate", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.c_char_p, _ERR, _size)
 _accel_build = _checked("ms_accel_build", ctypes.c_int, ctypes.POINTER(_Scene), ctypes.c_int, ctypes.POINTER(_p), _ERR, _size)
 _accel_free = _sig("ms_accel_free", None, _p)
 _accel_lights = _sig("ms_accel_lights", ctypes.POINTER(_Light), _p, ctypes.POINTER(_size))
@@ -299,8 +308,11 @@ def _light_dict(L):
     elif shape == "disk":
         c, es, et = (np.array(v(x), np.float64) for x in (L.corner, L.edge_s, L.edge_t))
         m = np.cross(es, et)
-        d.update(center=tuple(c + (es + et) / 2), normal=tuple(m / np.linalg.norm(m)),
-                 radius=float(np.linalg.norm(es) / 2))
+        if abs(np.linalg.norm(es) - np.linalg.norm(et)) > 1e-6 * np.linalg.norm(es) or abs(es @ et) > 1e-6 * (es @ es):
+            d.update(corner=v(L.corner), edge_s=v(L.edge_s), edge_t=v(L.edge_t))  # an ellipse: its parallelogram
+        else:
+            d.update(center=tuple(c + (es + et) / 2), normal=tuple(m / np.linalg.norm(m)),
+                     radius=float(np.linalg.norm(es) / 2))
     elif shape == "triangle":
         c, es, et = (np.array(v(x), np.float64) for x in (L.corner, L.edge_s, L.edge_t))
         d.update(vertices=(tuple(c), tuple(c + es), tuple(c + et)))
@@ -322,6 +334,9 @@ def _light_struct(light, arg="light"):
     shape = light.get("shape", "rect")
     _choice(arg + "['shape']", shape, _SHAPES)
     required, optional = _LIGHT_KEYS[shape]
+    ellipse = shape == "disk" and "corner" in light
+    if ellipse:  # the ellipse inscribed in a parallelogram (microshadow/lights.h, MS_LIGHT_DISK)
+        required = _LIGHT_KEYS["rect"][0]
     for k in light:
         if k not in required and k not in optional:
             raise ValueError("%s: %r is not a key of a %s light (did you mean %r?)" % (arg, k, shape,
@@ -333,6 +348,9 @@ def _light_struct(light, arg="light"):
     L.emission = _vec3(arg + "['emission']", light.get("emission", (1.0, 1.0, 1.0)))
     if shape == "rect":
         L.corner, L.edge_s, L.edge_t = (_vec3(arg + "[%r]" % k, light[k]) for k in required)
+    elif ellipse:
+        L.corner, L.edge_s, L.edge_t = (_vec3(arg + "[%r]" % k, light[k]) for k in required)
+        L.shape = _SHAPES["disk"]
     elif shape == "disk":
         if _light_disk(ctypes.byref(L), _vec3(arg + "['center']", light["center"]),
                        _vec3(arg + "['normal']", light["normal"]), float(light["radius"])) != 0:
@@ -363,17 +381,20 @@ def _light_struct(light, arg="light"):
 
 
 class Scene:
-    """A loaded scene (ms_scene). .triangles is an (n, 3, 3) float32 copy; .lights a list of dicts (the
-    first is also .light). Both are in the scene's frame: world = local + .origin (docs/design.md, "The scene's
-    frame"; (0, 0, 0) unless the scene lies far from the origin). visibility_points takes world positions."""
+    """A scene (ms_scene), loaded (load, default_scene) or built (scene_from_arrays). .triangles is an (n, 3, 3)
+    float32 copy; .lights a list of dicts (the first is also .light). Both are in the scene's frame: world =
+    local + .origin (docs/design.md, "The scene's frame"; (0, 0, 0) unless the scene lies far from the origin).
+    visibility_points takes world positions."""
 
-    def __init__(self, _s):
+    def __init__(self, _s, keep=None):
         self._s = _s
+        # a built scene points into these arrays, which it keeps alive; the library frees only what it allocated
+        self._keep = keep
 
     def __del__(self):
-        if getattr(self, "_s", None) is not None:
+        if getattr(self, "_s", None) is not None and getattr(self, "_keep", None) is None:
             _scene_free(ctypes.byref(self._s))
-            self._s = None
+        self._s = None
 
     @property
     def n_triangles(self):
@@ -428,6 +449,120 @@ def default_scene():
     if _scene_default(ctypes.byref(s)) != 0:
         raise Error(2, "out of memory")
     return Scene(s)
+
+
+_CAMERA_TYPES = {"pinhole": 0, "orthographic": 1, "fisheye": 2, "latlong": 3, "parabolic": 4}
+
+
+def _camera_struct(camera):
+    if not isinstance(camera, dict):
+        raise ValueError("camera: expected a dict (eye, target, up, width, height, and fov_y or ortho_height), got %s"
+                         % type(camera).__name__)
+    keys = ("type", "eye", "target", "up", "fov_y", "width", "height", "fov", "ortho_height")
+    for k in camera:
+        if k not in keys:
+            raise ValueError("camera: %r is not a camera key (did you mean %r?)" % (k, _suggest(k, keys)))
+    c = _Camera()
+    c.type = _choice("camera['type']", camera.get("type", "pinhole"), _CAMERA_TYPES)
+    c.eye, c.target = _vec3("camera['eye']", camera["eye"]), _vec3("camera['target']", camera["target"])
+    c.up = _vec3("camera['up']", camera.get("up", (0.0, 0.0, 1.0)))
+    c.fov_y, c.fov = float(camera.get("fov_y", 45.0)), float(camera.get("fov", 180.0))
+    c.ortho_height = float(camera.get("ortho_height", 0.0))
+    c.width, c.height = int(camera.get("width", 640)), int(camera.get("height", 480))
+    return c
+
+
+def scene_from_arrays(triangles, lights, camera=None, normals=None, uvs=None, objects=None, materials=None,
+                      triangle_materials=None, lightmap_scale=None, samples=0):
+    """A Scene built from arrays, in world coordinates (what a host application such as Blender hands over
+    without writing files; ms_scene in microshadow/scene.h).
+
+    triangles: (n, 3, 3) vertex positions; lights: a list of light dicts (as Scene.lights; a "disk" given by
+    corner, edge_s and edge_t is the ellipse inscribed in that parallelogram), at least one; camera: a dict of
+    eye, target, up, width, height and fov_y (degrees; "type": "pinhole") or ortho_height ("type":
+    "orthographic"); normals: (n, 3, 3) shading normals of the vertices (NaN rows: the triangle's own);
+    uvs: a list of up to 4 UV sets, each (n, 3, 2) or None (NaN where a triangle has none); objects: (n,) the
+    object of each triangle, 0 .. m-1 (a bake gives each object its own region of the lightmap when UVs
+    overlap; default: one object); materials: a list of dicts with base_color (linear RGBA), metallic and
+    roughness (glTF metallic-roughness; missing keys: glTF's defaults), triangle_materials: (n,) an index into
+    it or NO_MATERIAL (the default grey); lightmap_scale: (m,) each object's texel density weight in bakes
+    (0: not baked, still an occluder); samples: the scene's light samples per pixel (0: the library's default).
+    The scene is checked (ms_scene_validate): a degenerate light or a non-finite vertex is an Error naming it."""
+    tri = _array("triangles", np.asarray(triangles, np.float32).reshape(-1, 9), 9, "float")
+    n = tri.shape[0]
+    if n == 0:
+        raise ValueError("triangles: expected at least one triangle")
+    keep = [tri]
+    s = _Scene()
+    s.tri, s.n_tris = tri.ctypes.data_as(ctypes.POINTER(_f)), n
+    if not isinstance(lights, (list, tuple)) or not lights:
+        raise ValueError("lights: expected a non-empty list of light dicts")
+    if len(lights) > MAX_LIGHTS:
+        raise ValueError("lights: at most %d lights, got %d" % (MAX_LIGHTS, len(lights)))
+    Ls = (_Light * len(lights))()
+    for i, d in enumerate(lights):
+        Ls[i], k = _light_struct(d, "lights[%d]" % i)
+        keep.append(k)
+    keep.append(Ls)
+    s.lights, s.n_lights, s.light = ctypes.cast(Ls, ctypes.POINTER(_Light)), len(lights), Ls[0]
+    if camera is not None:
+        s.camera = _camera_struct(camera)
+    else:  # no camera: one looking at the scene's box from above its corner (bakes need none)
+        v = tri.reshape(-1, 3)
+        v = v[np.isfinite(v).all(1)] if np.isfinite(v).any() else np.zeros((1, 3), np.float32)
+        lo, hi = v.min(0), v.max(0)
+        c, r = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) + 1e-3
+        s.camera = _camera_struct({"eye": tuple(c + r), "target": tuple(c), "up": (0.0, 0.0, 1.0)})
+    s.samples = int(samples)
+    if normals is not None:
+        nor = _array("normals", np.asarray(normals, np.float32).reshape(-1, 9), 9, "float", n)
+        keep.append(nor)
+        s.tri_normal = nor.ctypes.data_as(ctypes.POINTER(_f))
+    if uvs is not None:
+        if not isinstance(uvs, (list, tuple)) or len(uvs) > MAX_UV_SETS:
+            raise ValueError("uvs: expected a list of at most %d UV sets" % MAX_UV_SETS)
+        for k, u in enumerate(uvs):
+            if u is None:
+                continue
+            a = np.ascontiguousarray(np.asarray(u, np.float32).reshape(-1, 6))
+            if a.shape[0] != n:
+                raise ValueError("uvs[%d]: expected (%d, 3, 2), got %d triangles" % (k, n, a.shape[0]))
+            keep.append(a)
+            s.tri_uv[k] = a.ctypes.data_as(ctypes.POINTER(_f))
+    obj = np.zeros(n, np.uint32) if objects is None else np.ascontiguousarray(objects, dtype=np.uint32)
+    if obj.shape != (n,):
+        raise ValueError("objects: expected (%d,), got %s" % (n, obj.shape))
+    m = int(obj.max()) + 1
+    keep.append(obj)
+    s.tri_object = s.tri_mesh = obj.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
+    s.n_objects = s.n_meshes = m
+    if lightmap_scale is not None:
+        sc = np.ascontiguousarray(lightmap_scale, dtype=np.float32)
+        if sc.shape != (m,) or not np.all(np.isfinite(sc)) or sc.min() < 0:
+            raise ValueError("lightmap_scale: expected (%d,) finite weights >= 0, one per object" % m)
+        keep.append(sc)
+        s.mesh_lightmap_scale = sc.ctypes.data_as(ctypes.POINTER(_f))
+    if materials:
+        M = (_Material * len(materials))()
+        for i, d in enumerate(materials):
+            bc = d.get("base_color", (1.0, 1.0, 1.0, 1.0))
+            if len(bc) == 3:
+                bc = tuple(bc) + (1.0,)
+            M[i].base_color[:] = [float(x) for x in bc]
+            M[i].metallic, M[i].roughness = float(d.get("metallic", 1.0)), float(d.get("roughness", 1.0))
+            M[i].base_color_texture = M[i].alpha_texture = -1
+        keep.append(M)
+        s.materials, s.n_materials = ctypes.cast(M, ctypes.POINTER(_Material)), len(materials)
+        tm = np.full(n, NO_MATERIAL, np.uint32) if triangle_materials is None else \
+            np.ascontiguousarray(triangle_materials, dtype=np.uint32)
+        if tm.shape != (n,) or np.any((tm >= len(materials)) & (tm != NO_MATERIAL)):
+            raise ValueError("triangle_materials: expected (%d,) indices into materials or NO_MATERIAL" % n)
+        keep.append(tm)
+        s.tri_material = tm.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
+    err = _errbuf()
+    if _scene_validate(ctypes.byref(s), b"scene_from_arrays", err, len(err)) != 0:
+        raise Error(1, err.value.decode(errors="replace"))
+    return Scene(s, keep)
 
 
 class Accel:
