@@ -149,6 +149,21 @@ static void test_units(void **st)
     assert_float_equal(sc.light.edge_t.z, 2.0f, 0.0f);
     assert_float_equal(sc.light.edge_s.z * sc.light.edge_t.x - sc.light.edge_s.x * sc.light.edge_t.z, -4.0f, 0.0f);
     ms_scene_free(&sc);
+    /* An ellipse inscribed in a 3 x 1 rectangle (area 3 pi / 4) emitting 100 W: a disk over the parallelogram as
+     * given, L = 100 / (pi * 3 pi / 4) = 13.50949; its samples are the disk mask's */
+    path = scene_with("units_ellipse.json",
+        "\"light\": { \"shape\": \"ellipse\", \"corner\": [-1.5, 6, -0.5], \"edge_s\": [3, 0, 0], \"edge_t\": [0, 0, 1], "
+        "\"power\": 100 }");
+    assert_int_equal(ms_scene_load(path, &sc, err, sizeof err), 0);
+    assert_int_equal(sc.light.shape, MS_LIGHT_DISK);
+    assert_float_equal(sc.light.corner.x, -1.5f, 0.0f);
+    assert_float_equal(sc.light.edge_s.x, 3.0f, 0.0f);
+    assert_float_equal(sc.light.edge_t.z, 1.0f, 0.0f);
+    assert_float_equal(ms_light_area(&sc.light), 3.0f * (float)M_PI / 4.0f, 1e-6f);
+    assert_float_equal(sc.light.emission.x, 13.50949f, 1e-4f);
+    assert_true(ms_light_shape_contains(sc.light.shape, 0.5f, 0.5f));
+    assert_false(ms_light_shape_contains(sc.light.shape, 0.95f, 0.95f));
+    ms_scene_free(&sc);
 }
 
 /* The CLI on a bad light: exit 2, one line naming the file and the problem. */
@@ -176,7 +191,7 @@ static void test_bad_light_json(void **st)
     const char *rect = "\"corner\": [-1, 6, -1], \"edge_s\": [2, 0, 0], \"edge_t\": [0, 0, 2]";
     char buf[1024];
     snprintf(buf, sizeof buf, "\"light\": { \"shape\": \"hexagon\", %s }", rect);
-    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\", \"sphere\", \"triangle\" or \"sun\" (got \"hexagon\")");
+    expect_bad("b1.json", buf, "light.shape must be \"rect\", \"disk\", \"sphere\", \"triangle\", \"sun\" or \"ellipse\" (got \"hexagon\")");
     expect_bad("b19.json", "\"light\": { \"shape\": \"triangle\", \"vertices\": [[0, 6, 0], [1, 6, 0], [2, 6, 0]] }",
                "light.vertices must not be collinear");
     expect_bad("b20.json", "\"light\": { \"shape\": \"triangle\", \"vertices\": [[0, 6, 0], [1, 6, 0]] }",

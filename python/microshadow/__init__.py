@@ -16,8 +16,8 @@ import os
 
 import numpy as np
 
-__all__ = ["Error", "Scene", "Accel", "load", "default_scene", "scene_from_arrays", "visibility_points", "render", "bake",
-           "method_names", "light_irradiance", "__version__"]
+__all__ = ["Error", "Scene", "Accel", "load", "default_scene", "visibility_points", "render", "bake",
+           "method_names", "light_irradiance", "set_warning_handler", "scene_from_arrays", "__version__"]
 
 MAX_UV_SETS = 4
 MAX_COUNTERS = 32
@@ -228,6 +228,7 @@ _SHAPE_NAMES = {v: k for k, v in _SHAPES.items()}
 # A light dict's keys per shape: required, then optional.
 _LIGHT_KEYS = {"rect": (("corner", "edge_s", "edge_t"), ("shape", "emission", "texture")),
                "disk": (("center", "normal", "radius"), ("shape", "emission", "texture")),
+               "ellipse": (("corner", "edge_s", "edge_t"), ("shape", "emission", "texture")),
                "sphere": (("center", "radius"), ("shape", "emission")),
                "triangle": (("vertices",), ("shape", "emission")),
                "sun": (("direction",), ("shape", "emission", "angular_diameter_deg"))}
@@ -287,6 +288,25 @@ def _vec3(arg, v):
     return _Vec3(*[float(x) for x in a])
 
 
+_WARNING_FN = ctypes.CFUNCTYPE(None, _p, ctypes.c_char_p)
+_set_warning_handler = _sig("ms_set_warning_handler", None, _WARNING_FN, _p)
+_warning_cb = None
+
+
+def set_warning_handler(fn):
+    """Routes the library's warnings (one line each, without "microshadow: warning: ") to fn(message) instead
+    of stderr; None restores stderr. Process-wide, like ms_set_warning_handler; fn may be called from the
+    thread of any call into the library."""
+    global _warning_cb
+    if fn is None:
+        _warning_cb = None
+        _set_warning_handler(_WARNING_FN(), None)
+        return
+    cb = _WARNING_FN(lambda user, msg: fn(msg.decode(errors="replace")))
+    _set_warning_handler(cb, None)
+    _warning_cb = cb  # kept alive while the library holds it
+
+
 def method_names():
     names, i = [], 0
     arr = _method_names()
@@ -298,7 +318,7 @@ def method_names():
 
 def _light_dict(L):
     """A light as a dict: its shape's parameters (rect: corner, edge_s, edge_t; disk: center, normal,
-    radius; sphere: center, radius; triangle: vertices; sun: direction towards it, angular_diameter_deg),
+    radius; ellipse, a disk over a parallelogram that is not a square: corner, edge_s, edge_t; sphere: center, radius; triangle: vertices; sun: direction towards it, angular_diameter_deg),
     emission, and the texture (h, w, 3) when it has one."""
     v = lambda a: (a.x, a.y, a.z)  # noqa: E731
     shape = _SHAPE_NAMES.get(L.shape, "rect")
@@ -309,7 +329,7 @@ def _light_dict(L):
         c, es, et = (np.array(v(x), np.float64) for x in (L.corner, L.edge_s, L.edge_t))
         m = np.cross(es, et)
         if abs(np.linalg.norm(es) - np.linalg.norm(et)) > 1e-6 * np.linalg.norm(es) or abs(es @ et) > 1e-6 * (es @ es):
-            d.update(corner=v(L.corner), edge_s=v(L.edge_s), edge_t=v(L.edge_t))  # an ellipse: its parallelogram
+            d.update(shape="ellipse", corner=v(L.corner), edge_s=v(L.edge_s), edge_t=v(L.edge_t))
         else:
             d.update(center=tuple(c + (es + et) / 2), normal=tuple(m / np.linalg.norm(m)),
                      radius=float(np.linalg.norm(es) / 2))
@@ -332,11 +352,9 @@ def _light_struct(light, arg="light"):
     if not isinstance(light, dict):
         raise ValueError("%s: expected a dict (see Scene.lights), got %s" % (arg, type(light).__name__))
     shape = light.get("shape", "rect")
-    _choice(arg + "['shape']", shape, _SHAPES)
+    _choice(arg + "['shape']", shape, _LIGHT_KEYS)
     required, optional = _LIGHT_KEYS[shape]
-    ellipse = shape == "disk" and "corner" in light
-    if ellipse:  # the ellipse inscribed in a parallelogram (microshadow/lights.h, MS_LIGHT_DISK)
-        required = _LIGHT_KEYS["rect"][0]
+    ellipse = shape == "ellipse"  # the ellipse inscribed in a parallelogram: a disk (microshadow/lights.h)
     for k in light:
         if k not in required and k not in optional:
             raise ValueError("%s: %r is not a key of a %s light (did you mean %r?)" % (arg, k, shape,
@@ -477,8 +495,7 @@ def scene_from_arrays(triangles, lights, camera=None, normals=None, uvs=None, ob
     """A Scene built from arrays, in world coordinates (what a host application such as Blender hands over
     without writing files; ms_scene in microshadow/scene.h).
 
-    triangles: (n, 3, 3) vertex positions; lights: a list of light dicts (as Scene.lights; a "disk" given by
-    corner, edge_s and edge_t is the ellipse inscribed in that parallelogram), at least one; camera: a dict of
+    triangles: (n, 3, 3) vertex positions; lights: a list of light dicts (as Scene.lights), at least one; camera: a dict of
     eye, target, up, width, height and fov_y (degrees; "type": "pinhole") or ortho_height ("type":
     "orthographic"); normals: (n, 3, 3) shading normals of the vertices (NaN rows: the triangle's own);
     uvs: a list of up to 4 UV sets, each (n, 3, 2) or None (NaN where a triangle has none); objects: (n,) the

@@ -133,3 +133,28 @@ const ms_light_shape_ops ms_light_disk_shape = {
               { "radius", MS_LIGHT_KEY_NUMBER, 1, 0, 0 } },
     .build = disk_build,
 };
+
+/* The ellipse (shape "ellipse"): the ellipse inscribed in any parallelogram, as Blender's and Unity's ellipse
+ * area lights are; the same MS_LIGHT_DISK everywhere else, only its scene-file keys differ from the disk's. */
+static int ellipse_build(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n)
+{
+    (void)max_coord; (void)msg; (void)n;   /* the parallelogram is checked as every light is (scene_validate.c) */
+    l->corner = (ms_vec3){ (float)v->v[0][0], (float)v->v[0][1], (float)v->v[0][2] };
+    l->edge_s = (ms_vec3){ (float)v->v[1][0], (float)v->v[1][1], (float)v->v[1][2] };
+    l->edge_t = (ms_vec3){ (float)v->v[2][0], (float)v->v[2][1], (float)v->v[2][2] };
+    l->shape = MS_LIGHT_DISK;
+    return 0;
+}
+
+const ms_light_shape_ops ms_light_ellipse_shape = {
+    .shape = MS_LIGHT_DISK,
+    .name = "ellipse",
+    .textured = 1,
+    .contains = disk_contains,
+    .area = disk_area,
+    .irradiance = disk_irradiance,
+    .polygon = disk_polygon,
+    .keys = { { "corner", MS_LIGHT_KEY_POINT, 1, 0, 0 }, { "edge_s", MS_LIGHT_KEY_VECTOR, 1, 0, 0 },
+              { "edge_t", MS_LIGHT_KEY_VECTOR, 1, 0, 0 } },
+    .build = ellipse_build,
+};

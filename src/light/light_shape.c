@@ -5,7 +5,7 @@
 #include <string.h>
 
 extern const ms_light_shape_ops ms_light_rect, ms_light_disk_shape, ms_light_sphere_shape, ms_light_triangle_shape,
-    ms_light_sun_shape;
+    ms_light_sun_shape, ms_light_ellipse_shape;
 
 /* Indexed by ms_light_shape. */
 static const ms_light_shape_ops *const shapes[] = {
@@ -21,16 +21,22 @@ const ms_light_shape_ops *ms_light_shape_of(ms_light_shape shape)
     return (unsigned)shape < sizeof shapes / sizeof *shapes ? shapes[shape] : NULL;
 }
 
+/* The scene file's shapes: one row per enum value, and the ellipse, a disk given by its parallelogram. */
+static const ms_light_shape_ops *const named[] = {
+    &ms_light_rect, &ms_light_disk_shape, &ms_light_sphere_shape, &ms_light_triangle_shape, &ms_light_sun_shape,
+    &ms_light_ellipse_shape,
+};
+
 const ms_light_shape_ops *ms_light_shape_named(const char *name)
 {
-    for (size_t i = 0; i < sizeof shapes / sizeof *shapes; i++)
-        if (strcmp(shapes[i]->name, name) == 0) return shapes[i];
+    for (size_t i = 0; i < sizeof named / sizeof *named; i++)
+        if (strcmp(named[i]->name, name) == 0) return named[i];
     return NULL;
 }
 
 const ms_light_shape_ops *ms_light_shape_at(size_t i)
 {
-    return i < sizeof shapes / sizeof *shapes ? shapes[i] : NULL;
+    return i < sizeof named / sizeof *named ? named[i] : NULL;
 }
 
 int ms_light_finite(const ms_light *l)

@@ -561,7 +561,7 @@ class BuiltSceneTest(unittest.TestCase):
     def test_ellipse_light(self):
         # the ellipse inscribed in a 2 x 1 rectangle at height 3, emitting down: irradiance at a point on the
         # ground against the integral of cos cos / (pi r^2)-weighted radiance over a fine grid of the ellipse
-        L = {"shape": "disk", "corner": [-1, 3, -0.5], "edge_s": [2, 0, 0], "edge_t": [0, 0, 1]}
+        L = {"shape": "ellipse", "corner": [-1, 3, -0.5], "edge_s": [2, 0, 0], "edge_t": [0, 0, 1]}
         p, nrm = np.array([0.7, 0.0, 0.4]), np.array([0.0, 1.0, 0.0])
         g = (np.arange(2000) + 0.5) / 2000
         s, t = np.meshgrid(g, g, indexing="ij")

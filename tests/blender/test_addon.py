@@ -1,0 +1,310 @@
+"""The Blender add-on (blender/microshadow_blender) in Debian's Blender, headless:
+
+    blender -b --factory-startup --python-exit-code 1 --python test_addon.py -- CLI OUTDIR
+
+against independent answers: Cycles' render of a lit plane for the light units (each light type), the
+command line's bake and frame of the scene the add-on exports (texel for texel and pixel for pixel), and
+the checks a user meets (a cancelled bake writes nothing, a light of zero size is one clear report).
+The scene is built here: a ground, objects with and without a UV map, area lights of every shape, a sun.
+"""
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import bpy
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.normpath(os.path.join(HERE, "..", "..", "blender")))
+import microshadow_blender as addon  # noqa: E402
+from microshadow_blender import bake, export, scene_from_blender  # noqa: E402
+
+ARGS = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+CLI = ARGS[0] if ARGS else "microshadow"
+OUT = ARGS[1] if len(ARGS) > 1 else tempfile.mkdtemp(prefix="ms_blender_")
+
+
+def read_pfm(path):
+    """A PFM image (the CLI's --vis and --shadow) as float32 rows from the top."""
+    with open(path, "rb") as f:
+        kind = f.readline().strip()
+        w, h = (int(x) for x in f.readline().split())
+        scale = float(f.readline())
+        data = np.frombuffer(f.read(), "<f4" if scale < 0 else ">f4")
+    ch = 3 if kind == b"PF" else 1
+    return data.reshape(h, w, ch)[::-1].squeeze()  # PFM stores the bottom row first
+
+
+def files_in(folder):
+    out = {}
+    for name in os.listdir(folder):
+        with open(os.path.join(folder, name), "rb") as f:
+            out[name] = f.read()
+    return out
+
+
+def clear_scene():
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob)
+    for coll in (bpy.data.meshes, bpy.data.lights, bpy.data.cameras, bpy.data.materials, bpy.data.images):
+        for x in list(coll):
+            if x.users == 0 or coll is bpy.data.images:
+                coll.remove(x)
+
+
+def diffuse_material(name, color):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = tuple(color) + (1.0,)
+    o = nt.nodes.new("ShaderNodeOutputMaterial")
+    nt.links.new(d.outputs[0], o.inputs[0])
+    return mat
+
+
+def add_light(kind, name="L", location=(0.5, 0.3, 2.5), rotation=(0.3, 0.2, 0.0), **data):
+    ld = bpy.data.lights.new(name, kind)
+    for k, v in data.items():
+        setattr(ld, k, v)
+    ob = bpy.data.objects.new(name, ld)
+    bpy.context.scene.collection.objects.link(ob)
+    ob.location, ob.rotation_euler = location, rotation
+    return ob
+
+
+def add_camera(location, rotation, ortho_scale=None, lens=None):
+    cam = bpy.data.cameras.new("cam")
+    if ortho_scale:
+        cam.type, cam.ortho_scale = "ORTHO", ortho_scale
+    if lens:
+        cam.lens = lens
+    ob = bpy.data.objects.new("cam", cam)
+    bpy.context.scene.collection.objects.link(ob)
+    ob.location, ob.rotation_euler = location, rotation
+    bpy.context.scene.camera = ob
+    return ob
+
+
+def build_bake_scene():
+    """A ground (its own UV map), a cube (UV map), an ico sphere without a UV map on a plinth, a monkey turned
+    (UV map), each kind of area light and a sun."""
+    clear_scene()
+    sc = bpy.context.scene
+    bpy.ops.mesh.primitive_plane_add(size=8, location=(0, 0, 0))
+    bpy.context.active_object.name = "ground"
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(-1.2, 0.4, 0.5))
+    bpy.context.active_object.name = "cube"
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2, radius=0.6, location=(1.2, -0.3, 0.8))
+    ico = bpy.context.active_object
+    ico.name = "ico"
+    while ico.data.uv_layers:
+        ico.data.uv_layers.remove(ico.data.uv_layers[0])
+    bpy.ops.mesh.primitive_monkey_add(size=0.8, location=(0.2, 1.4, 0.6), rotation=(0.2, 0.0, 0.7))
+    bpy.context.active_object.name = "monkey"
+    bpy.ops.object.shade_smooth()
+    add_light("AREA", "square", (0.5, 0.3, 3.0), (0.2, 0.1, 0.0), shape="SQUARE", size=1.0, energy=150)
+    add_light("AREA", "rectangle", (-2.0, -1.0, 2.5), (0.4, -0.3, 0.2), shape="RECTANGLE", size=1.2, size_y=0.4,
+              energy=120)
+    add_light("AREA", "disk", (2.0, 1.5, 2.2), (-0.3, 0.5, 0.0), shape="DISK", size=0.8, energy=100)
+    add_light("AREA", "ellipse", (0.0, -2.0, 2.8), (0.5, 0.0, 0.3), shape="ELLIPSE", size=1.4, size_y=0.5, energy=100)
+    add_light("SUN", "sun", (0, 0, 5), (0.6, 0.3, 0.0), angle=math.radians(3.0), energy=2.0)
+    add_camera((5.0, -6.0, 4.5), (math.radians(60), 0, math.radians(40)))
+    sc.render.resolution_x, sc.render.resolution_y, sc.render.resolution_percentage = 96, 64, 100
+    st = sc.microshadow
+    st.samples, st.bake_size, st.threads = "256", 256, 2
+    for ob in sc.objects:
+        ob.select_set(ob.name in ("ground", "cube", "ico", "monkey"))
+    bpy.context.view_layer.objects.active = bpy.data.objects["cube"]
+
+
+class LightUnitsTest(unittest.TestCase):
+    """Blender's light units through the add-on against Cycles: a white diffuse plane seen from above by an
+    orthographic camera (below the light), each light alone; the mean of the frames within 2% and the pixels
+    correlated (Cycles at 1024 samples per pixel, direct light, no denoising)."""
+
+    CASES = [("square", "AREA", dict(shape="SQUARE", size=1.0, energy=100)),
+             ("rectangle", "AREA", dict(shape="RECTANGLE", size=1.5, size_y=0.5, energy=100)),
+             ("disk", "AREA", dict(shape="DISK", size=1.2, energy=100)),
+             ("ellipse", "AREA", dict(shape="ELLIPSE", size=1.5, size_y=0.6, energy=100)),
+             ("point", "POINT", dict(shadow_soft_size=0.1, energy=200)),
+             ("sun", "SUN", dict(angle=math.radians(10), energy=3.0))]
+
+    def render(self, engine):
+        sc = bpy.context.scene
+        sc.render.engine = engine
+        if engine == "CYCLES":
+            sc.cycles.samples, sc.cycles.use_denoising, sc.cycles.max_bounces = 1024, False, 0
+            sc.cycles.use_adaptive_sampling, sc.cycles.device = False, "CPU"
+            sc.cycles.filter_width = 0.01  # each pixel sampled at its centre, as microshadow's aa 1 is
+        else:
+            sc.microshadow.shading, sc.microshadow.aa = "diffuse", "1"
+        sc.render.filepath = os.path.join(OUT, "units_%s.exr" % engine)
+        sc.render.image_settings.file_format = "OPEN_EXR"
+        sc.render.image_settings.color_depth = "32"
+        bpy.ops.render.render(write_still=True)
+        img = bpy.data.images.load(sc.render.filepath, check_existing=False)
+        px = np.array(img.pixels[:], np.float64).reshape(img.size[1], img.size[0], 4)[..., :3]
+        bpy.data.images.remove(img)
+        return px
+
+    def test_units_match_cycles(self):
+        clear_scene()
+        sc = bpy.context.scene
+        white = diffuse_material("white", (1, 1, 1))
+        bpy.ops.mesh.primitive_plane_add(size=8, location=(0, 0, 0))
+        bpy.context.active_object.data.materials.append(white)
+        # a small block between the plane and the lights: a shadow for the pixels to correlate on
+        bpy.ops.mesh.primitive_cube_add(size=0.25, location=(0.45, -0.1, 0.3))
+        bpy.context.active_object.data.materials.append(white)
+        add_camera((0.3, -0.2, 1.0), (0, 0, 0), ortho_scale=2.0)
+        sc.render.resolution_x = sc.render.resolution_y = 32
+        sc.render.resolution_percentage = 100
+        sc.world = bpy.data.worlds.new("black")
+        sc.world.color = (0, 0, 0)
+        for name, kind, data in self.CASES:
+            with self.subTest(light=name):
+                for ob in [o for o in sc.objects if o.type == "LIGHT"]:
+                    bpy.data.objects.remove(ob)
+                add_light(kind, name, **data)
+                cyc, ms = self.render("CYCLES"), self.render("MICROSHADOW")
+                ratio = ms.mean() / cyc.mean()
+                corr = np.corrcoef(ms[..., 1].ravel(), cyc[..., 1].ravel())[0, 1]
+                print("light units %-9s: microshadow / Cycles %.4f, correlation %.4f" % (name, ratio, corr))
+                self.assertGreater(cyc.mean(), 0.05)
+                self.assertAlmostEqual(ratio, 1.0, delta=0.02)
+                self.assertGreater(corr, 0.95)
+
+
+class BakeTest(unittest.TestCase):
+    """The bake operator against the command line's bake of the scene the add-on exports (scene.json and OBJ
+    files, read by the CLI's own parsers): the irradiance and every light's S texel for texel."""
+
+    def test_bake_equals_cli(self):
+        build_bake_scene()
+        sc = bpy.context.scene
+        folder = os.path.join(OUT, "bake")
+        sc.microshadow.bake_output = folder
+        self.assertEqual(bpy.ops.microshadow.bake(), {"FINISHED"})
+        irr = np.array(bpy.data.images["microshadow_irradiance"].pixels[:], np.float32).reshape(256, 256, 4)[..., :3]
+        self.assertTrue(os.path.isfile(os.path.join(folder, "microshadow_irradiance.exr")))
+        names = ["square", "rectangle", "disk", "ellipse", "sun"]
+        for n in names:
+            self.assertTrue(os.path.isfile(os.path.join(folder, "microshadow_shadowmask_%s.exr" % n)), n)
+        # the lightmap UVs went back onto the meshes
+        self.assertIn(bake.LIGHTMAP_UV, bpy.data.objects["ico"].data.uv_layers)
+        exported = os.path.join(OUT, "exported")
+        self.assertEqual(bpy.ops.microshadow.export_scene(directory=exported), {"FINISHED"})
+        cli_exr, cli_s = os.path.join(OUT, "cli_bake.exr"), os.path.join(OUT, "cli_s.exr")
+        r = subprocess.run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
+                            "256", "--threads", "2", "--quiet", "-o", cli_exr], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        img = bpy.data.images.load(cli_exr, check_existing=False)
+        cli = np.array(img.pixels[:], np.float32).reshape(img.size[1], img.size[0], 4)[..., :3]
+        # the CLI's EXR has row 0 at the top of the file as v = 0 (microshadow/bake.h); Blender loads the file's
+        # first row as its last
+        cli = cli[::-1]
+        peak = float(irr.max())
+        self.assertGreater(peak, 0.1)
+        diff = np.abs(irr - cli)
+        print("bake: add-on against CLI: max |difference| %.3g of a peak %.3g, %d texels differ"
+              % (diff.max(), peak, int((diff > 0).any(-1).sum())))
+        self.assertLessEqual(float(diff.max()), 1e-6 * peak)
+        # light 0's S, bit for bit: the CLI's PFM against the add-on's shadowmask image
+        s0 = os.path.join(OUT, "cli_s0.pfm")
+        r = subprocess.run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
+                            "256", "--threads", "2", "--quiet", "-o", cli_exr, "--shadow", s0], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        mask = np.array(bpy.data.images["microshadow_shadowmask_square"].pixels[:], np.float32).reshape(256, 256, 4)[..., 0]
+        s = np.maximum(read_pfm(s0), 0.0)  # rows from v = 0 as the image's; -1 (nothing baked there) shown as 0
+        self.assertGreater(float((s > 0).mean()), 0.3)
+        np.testing.assert_allclose(mask, s, rtol=0, atol=1e-6)
+
+
+class OperatorsTest(unittest.TestCase):
+    """What a user meets around the bake and the frame: Esc, a bad light, F12's passes."""
+
+    def test_cancel_writes_nothing(self):
+        build_bake_scene()
+        sc = bpy.context.scene
+        folder = os.path.join(OUT, "cancelled")
+        sc.microshadow.bake_output = folder
+        sc.microshadow.bake_size, sc.microshadow.samples = 128, "256"
+        self.assertEqual(bpy.ops.microshadow.bake(), {"FINISHED"})
+        before = files_in(folder)
+        self.assertEqual(len(before), 6)
+        # a bigger re-bake cancelled at its first progress report (as Esc does in the modal operator)
+        sc.microshadow.bake_size, sc.microshadow.samples = 1024, "1024"
+        run, got, ms = bake.start(bpy.context)
+        run.cancel = True
+        run.wait()
+        with self.assertRaises(bake.Cancelled):
+            bake.finish(bpy.context, run, got, ms)
+        after = files_in(folder)
+        self.assertEqual(after, before)  # no new, half-written or temporary file; the old ones untouched
+
+    def test_zero_size_light(self):
+        build_bake_scene()
+        bpy.data.objects["rectangle"].data.size_y = 0.0
+        with self.assertRaisesRegex(scene_from_blender.SceneError, "'rectangle'.*zero size"):
+            bake.start(bpy.context)
+        with self.assertRaisesRegex(RuntimeError, "'rectangle'.*zero size"):  # the operator's report, one line
+            bpy.ops.microshadow.bake()
+        bpy.data.objects["rectangle"].data.size_y = 0.4
+        bpy.data.objects["disk"].data.type = "POINT"
+        bpy.data.objects["disk"].data.shadow_soft_size = 0.0
+        with self.assertRaisesRegex(scene_from_blender.SceneError, "'disk'.*radius 0"):
+            bake.start(bpy.context)
+        # the render engine reports it and returns: Blender goes on
+        sc = bpy.context.scene
+        sc.render.engine = "MICROSHADOW"
+        with self.assertRaisesRegex(RuntimeError, "'disk'.*radius 0"):
+            bpy.ops.render.render()
+
+    def test_render_passes(self):
+        """F12 with microshadow: each light's V and S passes (through the compositor's viewer) equal the CLI's
+        frame of the exported scene pixel for pixel, and the Combined pass is lit."""
+        build_bake_scene()
+        sc = bpy.context.scene
+        sc.render.engine = "MICROSHADOW"
+        sc.microshadow.aa = "1"
+        exported = os.path.join(OUT, "exported_frame")
+        self.assertEqual(bpy.ops.microshadow.export_scene(directory=exported), {"FINISHED"})
+        sc.use_nodes = True
+        tree = sc.node_tree
+        tree.nodes.clear()
+        rl, comp = tree.nodes.new("CompositorNodeRLayers"), tree.nodes.new("CompositorNodeComposite")
+        W, H = sc.render.resolution_x, sc.render.resolution_y
+        fmt = sc.render.image_settings
+        fmt.file_format, fmt.color_depth, fmt.exr_codec = "OPEN_EXR", "32", "ZIP"
+        sc.render.filepath = os.path.join(OUT, "f12.exr")
+        for light in ("square", "rectangle", "disk", "ellipse", "sun"):
+            for kind in "VS":
+                self.assertIn("%s %s" % (kind, light), rl.outputs, "the passes: %s" % [o.name for o in rl.outputs])
+        for light in ("square",):  # the CLI's PFM holds light 0
+            for kind, flag in (("V", "--vis"), ("S", "--shadow")):
+                name = "%s %s" % (kind, light)
+                tree.links.new(rl.outputs[name], comp.inputs["Image"])  # the pass is what F12 writes
+                bpy.ops.render.render(write_still=True)
+                img = bpy.data.images.load(sc.render.filepath, check_existing=False)
+                got = np.array(img.pixels[:], np.float32).reshape(H, W, 4)[::-1, :, 0]  # the file's rows from the top
+                bpy.data.images.remove(img)
+                out = os.path.join(OUT, "cli_%s_%s.exr" % (kind, light))
+                pfm = out[:-4] + ".pfm"
+                r = subprocess.run([CLI, os.path.join(exported, "scene.json"), "--aa", "1", "--samples", "256",
+                                    "--threads", "2", "--quiet", "-o", os.path.join(OUT, "cli_frame.png"), flag, pfm],
+                                   capture_output=True, text=True)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                want = np.maximum(read_pfm(pfm), 0.0)
+                self.assertGreater(float((want > 0).mean()), 0.2)
+                np.testing.assert_allclose(got, want, rtol=0, atol=1e-6, err_msg=name)
+
+
+if __name__ == "__main__":
+    addon.register()
+    res = unittest.main(argv=[sys.argv[0]], exit=False, verbosity=2).result
+    sys.exit(0 if res.wasSuccessful() else 1)
