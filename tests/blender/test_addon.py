@@ -178,6 +178,22 @@ class LightUnitsTest(unittest.TestCase):
                 self.assertGreater(cyc.mean(), 0.05)
                 self.assertAlmostEqual(ratio, 1.0, delta=0.02)
                 self.assertGreater(corr, 0.95)
+        # an emissive mesh (an Emission shader on a quad facing down): its triangles as lights, both sides
+        for ob in [o for o in sc.objects if o.type == "LIGHT"]:
+            bpy.data.objects.remove(ob)
+        bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.4, 0.2, 2.0), rotation=(math.pi, 0, 0))
+        em = bpy.data.materials.new("emit")
+        em.use_nodes = True
+        nt = em.node_tree
+        nt.nodes.clear()
+        e, o = nt.nodes.new("ShaderNodeEmission"), nt.nodes.new("ShaderNodeOutputMaterial")
+        e.inputs["Strength"].default_value, e.inputs["Color"].default_value = 5.0, (1.0, 0.8, 0.6, 1.0)
+        nt.links.new(e.outputs[0], o.inputs[0])
+        bpy.context.active_object.data.materials.append(em)
+        cyc, ms = self.render("CYCLES"), self.render("MICROSHADOW")
+        ratio = ms.mean((0, 1)) / cyc.mean((0, 1))
+        print("light units emissive : microshadow / Cycles %s" % np.round(ratio, 4))
+        np.testing.assert_allclose(ratio, 1.0, atol=0.02)
 
 
 class BakeTest(unittest.TestCase):
