@@ -28,17 +28,34 @@ def _receivers(context):
 
 
 def lightmap_pack(context, objects, uv_map):
-    """Blender's Lightmap Pack of the objects together into uv_map (made on meshes that lack it)."""
-    for ob in objects:
-        if ob.type == "MESH" and uv_map not in ob.data.uv_layers:
+    """Blender's Lightmap Pack of the objects' meshes together into uv_map (made on meshes that lack it), in
+    Edit Mode over all of them at once (the active object set to one of them and restored afterwards)."""
+    meshes = [ob for ob in objects if ob.type == "MESH"]
+    if not meshes:
+        return
+    for ob in meshes:
+        if uv_map not in ob.data.uv_layers:
             ob.data.uv_layers.new(name=uv_map)
-        if ob.type == "MESH":
-            ob.data.uv_layers.active = ob.data.uv_layers[uv_map]
-    with context.temp_override(selected_editable_objects=objects, active_object=objects[0], object=objects[0]):
+        ob.data.uv_layers.active = ob.data.uv_layers[uv_map]
+    layer = context.view_layer
+    active, selected = layer.objects.active, [ob for ob in layer.objects if ob.select_get()]
+    try:
+        for ob in selected:
+            ob.select_set(False)
+        for ob in meshes:
+            ob.select_set(True)
+        layer.objects.active = meshes[0]
         bpy.ops.object.mode_set(mode="EDIT")
         bpy.ops.mesh.select_all(action="SELECT")
         bpy.ops.uv.lightmap_pack(PREF_CONTEXT="ALL_FACES", PREF_PACK_IN_ONE=True, PREF_NEW_UVLAYER=False)
-        bpy.ops.object.mode_set(mode="OBJECT")
+    finally:
+        if context.mode != "OBJECT":
+            bpy.ops.object.mode_set(mode="OBJECT")
+        for ob in meshes:
+            ob.select_set(False)
+        for ob in selected:
+            ob.select_set(True)
+        layer.objects.active = active
 
 
 def start(context):
@@ -59,7 +76,7 @@ def start(context):
     sc = ms.scene_from_arrays(**got.arrays)
     run = job.Job(ms, ms.bake, scene=sc, size=st.bake_size, uv=None if st.bake_uv_source == "MICROSHADOW" else 0,
                   method=properties.method_value(st.method), samples=int(st.samples), threads=st.threads,
-                  padding=st.bake_padding)
+                  padding=st.bake_padding, texel_density=st.bake_texel_density)
     run.scene = sc
     return run, got, ms
 
@@ -88,22 +105,24 @@ def finish(context, run, got, ms):
         raise run.error
     st = context.scene.microshadow
     lm = run.result
-    if lm["pages"] != 1:
-        raise scene_from_blender.SceneError("the bake has %d pages; the add-on writes one" % lm["pages"])
-    size = st.bake_size
+    size, pages = st.bake_size, lm["pages"]
     images = [("microshadow_irradiance", lm["irradiance"])]
     for name, lt in zip(got.light_names, lm["lights"]):
         if name is not None:
             s = np.maximum(lt["shadow"], 0.0)
             images.append(("microshadow_shadowmask_" + name, np.repeat(s[..., None], 3, -1)))
-    made = [_image(n, p, size) for n, p in images]
-    skipped = _write_uvs(got, lm["uv"])
+    # page p is rows p * size .. of every plane (microshadow/bake.h), its images named with ".p" after the first
+    # as the CLI's files are (lightmap.exr, lightmap.1.exr, ...)
+    made = [_image(n + ("" if p == 0 else ".%d" % p), rows[p * size:(p + 1) * size], size)
+            for n, rows in images for p in range(pages)]
+    skipped = _write_uvs(got, lm["uv"], lm["page"])
     folder = bpy.path.abspath(st.bake_output)
     written = []
     if bpy.data.filepath or not st.bake_output.startswith("//"):
         written = _save_all(made, folder, context.scene)
-    summary = "microshadow: baked %d objects into %d x %d, %d texels on triangles, %.1f s" % (
-        sum(1 for o in got.objects if _is_receiver(got, o)), size, size, lm["texels"], time.time() - run.started)
+    summary = "microshadow: baked %d objects into %d x %d%s, %d texels on triangles, %.1f s" % (
+        sum(1 for o in got.objects if _is_receiver(got, o)), size, size, " x %d pages" % pages if pages > 1 else "",
+        lm["texels"], time.time() - run.started)
     if written:
         summary += "; wrote %s" % ", ".join(os.path.basename(p) for p in written)
     else:
@@ -111,7 +130,9 @@ def finish(context, run, got, ms):
     return summary, skipped
 
 
-def _write_uvs(got, uv):
+def _write_uvs(got, uv, page):
+    """The lightmap UVs onto each baked object's mesh, and the page its texels are on as the object's custom
+    property microshadow_lightmap_page (its images are those with ".<page>" after the name, none for page 0)."""
     skipped = []
     for o in got.objects:
         ob = o.original
@@ -127,6 +148,7 @@ def _write_uvs(got, uv):
         per_loop = np.zeros((len(me.loops), 2), np.float32)
         per_loop[o.loops.ravel()] = uv[o.first:o.first + o.count].reshape(-1, 2)
         layer.data.foreach_set("uv", per_loop.ravel())
+        ob["microshadow_lightmap_page"] = int(page[o.first]) if len(page) else 0
     return skipped
 
 
@@ -188,28 +210,29 @@ class MICROSHADOW_OT_bake(bpy.types.Operator):
     def execute(self, context):
         """Synchronous (scripts, background mode): the same steps as the modal bake without the event loop."""
         try:
-            run, got, ms = start(context)
-            self._run = run
-            for w in got.warnings:
-                self.report({"WARNING"}, w)
-            run.wait()
-            summary, skipped = finish(context, run, got, ms)
+            self._run, self._got, self._ms = start(context)
+        except Exception as e:
+            self._report_error(e)
+            return {"CANCELLED"}
+        self._run.wait()
+        return self._finish(context)
+
+    def _finish(self, context):
+        for w in self._got.warnings + self._run.warnings:
+            self.report({"WARNING"}, w if w.startswith("microshadow") else "microshadow: " + w)
+        try:
+            summary, skipped = finish(context, self._run, self._got, self._ms)
         except Cancelled:
             self.report({"WARNING"}, "microshadow: bake cancelled; nothing written")
             return {"CANCELLED"}
         except Exception as e:
             self._report_error(e)
             return {"CANCELLED"}
-        self._report_done(summary, skipped)
-        return {"FINISHED"}
-
-    def _report_done(self, summary, skipped):
-        for w in self._run.warnings:
-            self.report({"WARNING"}, "microshadow: " + w)
         if skipped:
             self.report({"WARNING"}, "microshadow: the lightmap UVs of %s were not written back (modifiers change "
                                      "the topology, or no room for a UV map)" % ", ".join(skipped))
         self.report({"INFO"}, summary)
+        return {"FINISHED"}
 
     def invoke(self, context, event):
         try:
@@ -217,8 +240,6 @@ class MICROSHADOW_OT_bake(bpy.types.Operator):
         except Exception as e:
             self._report_error(e)
             return {"CANCELLED"}
-        for w in self._got.warnings:
-            self.report({"WARNING"}, w)
         wm = context.window_manager
         wm.progress_begin(0, 100)
         self._timer = wm.event_timer_add(0.1, window=context.window)
@@ -240,13 +261,4 @@ class MICROSHADOW_OT_bake(bpy.types.Operator):
         wm.progress_end()
         if context.area:
             context.area.header_text_set(None)
-        try:
-            summary, skipped = finish(context, self._run, self._got, self._ms)
-        except Cancelled:
-            self.report({"WARNING"}, "microshadow: bake cancelled; nothing written")
-            return {"CANCELLED"}
-        except Exception as e:
-            self._report_error(e)
-            return {"CANCELLED"}
-        self._report_done(summary, skipped)
-        return {"FINISHED"}
+        return self._finish(context)

@@ -1,6 +1,6 @@
 """The add-on's settings: per scene (frames and bakes) and the add-on's preferences."""
 import bpy
-from bpy.props import EnumProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 METHODS = [("AUTO", "Automatic", "microshadow picks the method for the scene (docs/methods.md)"),
            ("scanline", "Scanline", "Bit-parallel scanline micro-rasterization (Woop)"),
@@ -30,6 +30,9 @@ class MicroshadowSettings(bpy.types.PropertyGroup):
                                                                         "lightmap can show")], default="standard")
     threads: IntProperty(name="Threads", default=0, min=0, description="0: every core")
     bake_size: IntProperty(name="Size", default=1024, min=16, max=8192, description="Lightmap texels per side")
+    bake_texel_density: FloatProperty(name="Texel Density", default=0.0, min=0.0, soft_max=1024.0,
+                                      description="Texels per world unit over as many pages as it takes (each "
+                                                  "page Size x Size); 0: one page at the largest density that fits")
     bake_padding: IntProperty(name="Padding", default=4, min=1, max=64, description="Texels between charts")
     bake_uv_map: StringProperty(name="UV Map", default="",
                                 description="The UV map baked into; empty: each object's active render UV map. "

@@ -221,7 +221,8 @@ def collect(depsgraph, uv_map="", receivers=None, camera=None, width=0, height=0
         raise SceneError("the scene has %d lights; microshadow takes at most %d" % (len(lights), MAX_LIGHTS))
     scale = None
     if receivers is not None:
-        scale = np.array([1.0 if o.name in receivers else 0.0 for o in objects], np.float32)
+        # an instance (particles, collection instances) occludes but is never baked: it has no mesh of its own
+        scale = np.array([1.0 if o.original is not None and o.name in receivers else 0.0 for o in objects], np.float32)
     arrays = {"triangles": np.concatenate(tris), "normals": np.concatenate(nors), "uvs": [np.concatenate(uvs)],
               "objects": np.concatenate(objs), "lights": lights,
               "materials": [{k: m[k] for k in ("base_color", "metallic", "roughness")} for m in materials] or None,

@@ -45,6 +45,7 @@ class MICROSHADOW_PT_bake(bpy.types.Panel):
         if st.bake_uv_source != "MICROSHADOW":
             layout.prop(st, "bake_uv_map")
         layout.prop(st, "bake_size")
+        layout.prop(st, "bake_texel_density")
         layout.prop(st, "bake_padding")
         layout.prop(st, "bake_output")
         layout.operator("microshadow.bake", icon="RENDER_STILL")
@@ -60,13 +61,23 @@ class MICROSHADOW_PT_bake_sidebar(bpy.types.Panel):
 
 
 def _engine_panels():
-    """Blender's own panels that serve any engine (dimensions, output, colour management, lights' data)."""
+    """Blender's own panels that serve any engine (dimensions, output, colour management, the lights' and the
+    camera's data). Only those whose COMPAT_ENGINES set is their own: some families share one set object
+    (all of Cycles' panels do), and adding to it would show the whole family."""
     wanted = {"RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_output", "RENDER_PT_color_management",
-              "DATA_PT_context_light", "DATA_PT_light", "DATA_PT_area", "DATA_PT_spot", "DATA_PT_lens",
-              "DATA_PT_camera", "DATA_PT_camera_display", "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_surface",
-              "EEVEE_MATERIAL_PT_context_material", "CYCLES_LIGHT_PT_light", "CYCLES_LIGHT_PT_nodes"}
-    return [getattr(bpy.types, n) for n in wanted if hasattr(bpy.types, n) and hasattr(getattr(bpy.types, n),
-                                                                                    "COMPAT_ENGINES")]
+              "DATA_PT_context_light", "DATA_PT_EEVEE_light", "DATA_PT_spot", "DATA_PT_lens", "DATA_PT_camera",
+              "DATA_PT_camera_display", "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface"}
+    users = {}
+    for name in dir(bpy.types):
+        ce = getattr(getattr(bpy.types, name), "COMPAT_ENGINES", None)
+        if isinstance(ce, set):
+            users.setdefault(id(ce), set()).add(name)
+    out = []
+    for name in sorted(wanted):
+        ce = getattr(getattr(bpy.types, name, None), "COMPAT_ENGINES", None)
+        if isinstance(ce, set) and users[id(ce)] <= wanted:
+            out.append(getattr(bpy.types, name))
+    return out
 
 
 CLASSES = (MICROSHADOW_PT_render, MICROSHADOW_PT_bake, MICROSHADOW_PT_bake_sidebar)

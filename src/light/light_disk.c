@@ -139,9 +139,7 @@ const ms_light_shape_ops ms_light_disk_shape = {
 static int ellipse_build(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n)
 {
     (void)max_coord; (void)msg; (void)n;   /* the parallelogram is checked as every light is (scene_validate.c) */
-    l->corner = (ms_vec3){ (float)v->v[0][0], (float)v->v[0][1], (float)v->v[0][2] };
-    l->edge_s = (ms_vec3){ (float)v->v[1][0], (float)v->v[1][1], (float)v->v[1][2] };
-    l->edge_t = (ms_vec3){ (float)v->v[2][0], (float)v->v[2][1], (float)v->v[2][2] };
+    ms_light_parallelogram_from(l, v);
     l->shape = MS_LIGHT_DISK;
     return 0;
 }

@@ -38,12 +38,17 @@ static int rect_polygon(const ms_light_frame *F, const float p[3], int sides, fl
     return 4;
 }
 
-static int rect_build(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n)
+void ms_light_parallelogram_from(ms_light *l, const ms_light_params *v)
 {
-    (void)max_coord; (void)msg; (void)n;   /* the parallelogram is checked as every light is (scene_validate.c) */
     l->corner = (ms_vec3){ (float)v->v[0][0], (float)v->v[0][1], (float)v->v[0][2] };
     l->edge_s = (ms_vec3){ (float)v->v[1][0], (float)v->v[1][1], (float)v->v[1][2] };
     l->edge_t = (ms_vec3){ (float)v->v[2][0], (float)v->v[2][1], (float)v->v[2][2] };
+}
+
+static int rect_build(ms_light *l, const ms_light_params *v, float max_coord, char *msg, size_t n)
+{
+    (void)max_coord; (void)msg; (void)n;   /* the parallelogram is checked as every light is (scene_validate.c) */
+    ms_light_parallelogram_from(l, v);
     l->shape = MS_LIGHT_RECT;
     return 0;
 }

@@ -63,6 +63,9 @@ typedef struct ms_light_shape_ops {
     int (*finite)(const ms_light *l);
 } ms_light_shape_ops;
 
+/* corner, edge_s, edge_t from the first three keys' values (the rect's and the ellipse's build). */
+void ms_light_parallelogram_from(ms_light *l, const ms_light_params *v);
+
 /* The row of a shape; NULL for a value outside the enum (validation refuses those before they get here). */
 const ms_light_shape_ops *ms_light_shape_of(ms_light_shape shape);
 /* The row named `name` ("rect", "disk", "sphere"), NULL when there is none. */

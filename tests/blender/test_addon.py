@@ -116,6 +116,9 @@ def build_bake_scene():
     add_camera((5.0, -6.0, 4.5), (math.radians(60), 0, math.radians(40)))
     sc.render.resolution_x, sc.render.resolution_y, sc.render.resolution_percentage = 96, 64, 100
     st = sc.microshadow
+    for k in st.bl_rna.properties.keys():  # each test starts from the defaults
+        if k not in ("rna_type", "name"):
+            st.property_unset(k)
     st.samples, st.bake_size, st.threads = "256", 256, 2
     for ob in sc.objects:
         ob.select_set(ob.name in ("ground", "cube", "ico", "monkey"))
@@ -240,6 +243,50 @@ class BakeTest(unittest.TestCase):
         self.assertGreater(float((s > 0).mean()), 0.3)
         np.testing.assert_allclose(mask, s, rtol=0, atol=1e-6)
 
+    def test_pages(self):
+        """A texel density over several pages: each page's images against the CLI's page files of the exported
+        scene texel for texel, each object's page recorded on it."""
+        build_bake_scene()
+        sc = bpy.context.scene
+        sc.microshadow.bake_texel_density, sc.microshadow.bake_size = 28.0, 256
+        sc.microshadow.bake_output = os.path.join(OUT, "pages")
+        self.assertEqual(bpy.ops.microshadow.bake(), {"FINISHED"})
+        pages = 1 + max(bpy.data.objects[n]["microshadow_lightmap_page"] for n in ("ground", "cube", "ico", "monkey"))
+        self.assertGreaterEqual(pages, 2)
+        exported = os.path.join(OUT, "exported_pages")
+        self.assertEqual(bpy.ops.microshadow.export_scene(directory=exported), {"FINISHED"})
+        out = os.path.join(OUT, "cli_pages.exr")
+        r = subprocess.run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256",
+                            "--texel-density", "28", "--samples", "256", "--threads", "2", "--quiet", "-o", out],
+                           capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for p in range(pages):
+            mine = bpy.data.images["microshadow_irradiance" + ("" if p == 0 else ".%d" % p)]
+            img = bpy.data.images.load(out if p == 0 else out[:-4] + ".%d.exr" % p, check_existing=False)
+            cli = np.array(img.pixels[:], np.float32).reshape(256, 256, 4)[::-1, :, :3]
+            got = np.array(mine.pixels[:], np.float32).reshape(256, 256, 4)[..., :3]
+            self.assertGreater(float(got.max()), 0.1)
+            np.testing.assert_array_equal(got, cli, err_msg="page %d" % p)
+        self.assertFalse(os.path.exists(out[:-4] + ".%d.exr" % pages))
+
+    def test_lightmap_pack(self):
+        """Blender's Lightmap Pack of the selected objects into one UV map: a layout without overlaps, which
+        the bake keeps as it is (the baked UVs are that UV map, loop for loop), whatever object was active."""
+        build_bake_scene()
+        sc = bpy.context.scene
+        sc.microshadow.bake_uv_source, sc.microshadow.bake_uv_map = "LIGHTMAP_PACK", "lightmap"
+        sc.microshadow.bake_output = os.path.join(OUT, "packed")
+        bpy.context.view_layer.objects.active = bpy.data.objects["square"]  # a light: not a mesh
+        self.assertEqual(bpy.ops.microshadow.bake(), {"FINISHED"})
+        self.assertEqual(bpy.context.mode, "OBJECT")
+        self.assertEqual(bpy.context.view_layer.objects.active.name, "square")
+        for name in ("ground", "cube", "ico", "monkey"):
+            me = bpy.data.objects[name].data
+            a, b = (np.empty(2 * len(me.loops), np.float32) for _ in range(2))
+            me.uv_layers["lightmap"].data.foreach_get("uv", a)
+            me.uv_layers[bake.LIGHTMAP_UV].data.foreach_get("uv", b)
+            np.testing.assert_array_equal(a, b, err_msg=name)
+
 
 class OperatorsTest(unittest.TestCase):
     """What a user meets around the bake and the frame: Esc, a bad light, F12's passes."""
@@ -282,8 +329,8 @@ class OperatorsTest(unittest.TestCase):
             bpy.ops.render.render()
 
     def test_render_passes(self):
-        """F12 with microshadow: each light's V and S passes (through the compositor's viewer) equal the CLI's
-        frame of the exported scene pixel for pixel, and the Combined pass is lit."""
+        """F12 with microshadow: each light's V and S passes (what the compositor writes) equal the CLI's
+        frame of the exported scene pixel for pixel."""
         build_bake_scene()
         sc = bpy.context.scene
         sc.render.engine = "MICROSHADOW"

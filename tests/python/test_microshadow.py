@@ -576,6 +576,23 @@ class BuiltSceneTest(unittest.TestCase):
         self.assertEqual(set(ms.scene_from_arrays(self.loaded.triangles, [L]).light), {"shape", "emission", "corner",
                                                                                     "edge_s", "edge_t"})
 
+    def test_warning_handler(self):
+        # the library's warnings (here an unknown key of a scene file) reach the handler, one line each, and
+        # no longer once it is removed
+        got = []
+        path = os.path.join(self.dir.name, "unknown_key.json")
+        with open(path, "w") as f:
+            f.write(scene_json([LIGHTS["rect"]]).replace('"meshes"', '"colour": 1, "meshes"'))
+        ms.set_warning_handler(got.append)
+        try:
+            ms.load(path)
+        finally:
+            ms.set_warning_handler(None)
+        self.assertEqual(len(got), 1, got)
+        self.assertIn("colour", got[0])
+        ms.load(path)
+        self.assertEqual(len(got), 1)
+
     def test_refused(self):
         tri = self.loaded.triangles
         with self.assertRaisesRegex(ms.Error, "lights\\[1\\].*zero area"):
