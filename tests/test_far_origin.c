@@ -473,7 +473,7 @@ static void test_localize(void **st)
                            { 0, 0, 0 }, 0 };
     sc.samples = 256;
     ms_frame before, after;
-    render(&sc, "raytrace", 24, &before);   /* small: in world floats nothing is culled (slow under ASan) */
+    render(&sc, "raytrace", 8, &before);   /* small: in world floats nothing is culled (slow under ASan) */
     assert_int_equal(ms_scene_localize(&sc), 0);
     print_message("localized: origin (%.17g, %.17g, %.17g), eye (%g, %g, %g)\n", sc.origin[0], sc.origin[1], sc.origin[2],
                   (double)sc.camera.eye.x, (double)sc.camera.eye.y, (double)sc.camera.eye.z);
@@ -491,7 +491,7 @@ static void test_localize(void **st)
         }
         ms_frame_free(&f);
     }
-    render(&sc, "raytrace", 24, &after);
+    render(&sc, "raytrace", 8, &after);
     print_message("raytrace %s: %.0f in world floats, %.0f localized\n", after.stats.counter_name[1],
                   (double)before.stats.counter[1], (double)after.stats.counter[1]);
     assert_true(4.0 * (double)after.stats.counter[1] < (double)before.stats.counter[1]);
