@@ -82,8 +82,8 @@ def start(context):
 
 
 def _image(name, pixels_rgb, size):
-    """A float image (replacing one of that name) holding (size, size, 3) rows from v = 0: Blender's row 0 is
-    v = 0 too, as microshadow's lightmap rows are (microshadow/bake.h)."""
+    """A float image (replacing one of that name) holding the (size, size, 3) rows of a lightmap page: its row 0
+    is the top (glTF's v = 0, microshadow/bake.h), Blender's the bottom."""
     img = bpy.data.images.get(name)
     if img is not None and (img.size[0] != size or img.size[1] != size or not img.is_float):
         bpy.data.images.remove(img)
@@ -91,7 +91,7 @@ def _image(name, pixels_rgb, size):
     if img is None:
         img = bpy.data.images.new(name, size, size, alpha=False, float_buffer=True)
     rgba = np.ones((size, size, 4), np.float32)
-    rgba[..., :3] = np.nan_to_num(pixels_rgb, nan=0.0)
+    rgba[..., :3] = np.nan_to_num(pixels_rgb, nan=0.0)[::-1]
     img.pixels.foreach_set(rgba.ravel())
     img.update()
     return img
@@ -146,7 +146,7 @@ def _write_uvs(got, uv, page):
             skipped.append(o.name)
             continue
         per_loop = np.zeros((len(me.loops), 2), np.float32)
-        per_loop[o.loops.ravel()] = uv[o.first:o.first + o.count].reshape(-1, 2)
+        per_loop[o.loops.ravel()] = scene_from_blender.flip_v(uv[o.first:o.first + o.count]).reshape(-1, 2)
         layer.data.foreach_set("uv", per_loop.ravel())
         ob["microshadow_lightmap_page"] = int(page[o.first]) if len(page) else 0
     return skipped

@@ -29,13 +29,23 @@ class BlenderObject:
         self.same_topology = same_topology  # the evaluated mesh's loops are the original mesh's
 
 
+def flip_v(uv):
+    """Blender's UVs (v upwards) as glTF's (v downwards) and back: the add-on hands microshadow glTF's, so that
+    a bake equals the command line's bake of the exported glTF, and the lightmap's row 0 is the top of the
+    image (v = 1 in Blender)."""
+    out = np.array(uv, np.float32, copy=True)
+    out[..., 1] = 1.0 - out[..., 1]
+    return out
+
+
 class Collected:
     """What collect() found: arrays (scene_from_arrays' keyword arguments), objects (a BlenderObject per
     object, in the arrays' order), warnings (lines to report), light_names (the Blender light of each
-    microshadow light, None for an emissive mesh's triangles)."""
+    microshadow light, None for an emissive mesh's triangles), material_names (of arrays["materials"])."""
 
-    def __init__(self, arrays, objects, warnings, light_names):
+    def __init__(self, arrays, objects, warnings, light_names, material_names):
         self.arrays, self.objects, self.warnings, self.light_names = arrays, objects, warnings, light_names
+        self.material_names = material_names
 
 
 def _material_params(mat, warnings):
@@ -173,6 +183,7 @@ def collect(depsgraph, uv_map="", receivers=None, camera=None, width=0, height=0
                 uv = np.empty(len(mesh.loops) * 2, np.float32)
                 layer.data.foreach_get("uv", uv)
                 uv = uv.reshape(-1, 2)[lt_loops].reshape(n, 3, 2)
+                uv = flip_v(uv)
             else:
                 uv = np.full((n, 3, 2), np.nan, np.float32)
             slot_mat = []
@@ -190,6 +201,12 @@ def collect(depsgraph, uv_map="", receivers=None, camera=None, width=0, height=0
                 slot_mat.append(material_index[key])
             tmat = np.array([slot_mat[i] if i < len(slot_mat) else 0xFFFFFFFF for i in mi], np.uint32) \
                 if slot_mat else np.full(n, 0xFFFFFFFF, np.uint32)
+            # one material after another in the object (stable): the order of the glTF primitives the export
+            # writes, so that the command line reads the triangles in this order (and charts them alike)
+            order = np.argsort(tmat, kind="stable")
+            tmat, lt_loops, lt_verts = tmat[order], lt_loops.reshape(n, 3)[order].ravel(), \
+                lt_verts.reshape(n, 3)[order].ravel()
+            uv = uv[order]
             t = co[lt_verts].reshape(n, 3, 3)
             for k in np.unique(tmat):
                 if k != 0xFFFFFFFF and any(materials[k]["emission"]):
@@ -230,4 +247,10 @@ def collect(depsgraph, uv_map="", receivers=None, camera=None, width=0, height=0
               "lightmap_scale": scale}
     if camera is not None:
         arrays["camera"] = _camera(camera, width, height, warnings)
-    return Collected(arrays, objects, warnings, light_names)
+    else:  # bakes need none, the scene file one: looking at the scene's box from above a corner
+        v = arrays["triangles"].reshape(-1, 3).astype(np.float64)
+        lo, hi = v.min(0), v.max(0)
+        c, r = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) + 1e-3
+        arrays["camera"] = {"type": "pinhole", "eye": tuple(c + r), "target": tuple(c), "up": (0.0, 0.0, 1.0),
+                            "fov_y": 45.0, "width": 640, "height": 480}
+    return Collected(arrays, objects, warnings, light_names, [m["name"] for m in materials])
