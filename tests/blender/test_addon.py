@@ -9,6 +9,7 @@ The scene is built here: a ground, objects with and without a UV map, area light
 """
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -221,7 +222,7 @@ class BakeTest(unittest.TestCase):
         # each exported object is valid glTF (the Khronos validator, when scripts/install-deps.sh installed it)
         viewer = os.path.normpath(os.path.join(HERE, "..", "..", "viewer"))
         if os.path.isdir(os.path.join(viewer, "node_modules", "gltf-validator")):
-            for name in sorted(os.listdir(os.path.join(exported, "objects"))):
+            for name in sorted(f for f in os.listdir(os.path.join(exported, "objects")) if f.endswith(".glb")):
                 r = subprocess.run(["node", os.path.join(viewer, "validate.mjs"), os.path.join(exported, "objects", name),
                                     "--max-warnings", "0"], capture_output=True, text=True)
                 self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
@@ -376,6 +377,8 @@ class OperatorsTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
+    shutil.rmtree(OUT, ignore_errors=True)  # this run's files only (the cancel test compares folders)
+    os.makedirs(OUT)
     addon.register()
     res = unittest.main(argv=[sys.argv[0]], exit=False, verbosity=2).result
     sys.exit(0 if res.wasSuccessful() else 1)
