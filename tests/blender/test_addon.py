@@ -28,6 +28,13 @@ CLI = ARGS[0] if ARGS else "microshadow"
 OUT = ARGS[1] if len(ARGS) > 1 else tempfile.mkdtemp(prefix="ms_blender_")
 
 
+def run(args):
+    """A program of this build (the CLI) or node, without the sanitizer runtime a sanitized build preloads into
+    Blender: the CLI links its own, and two ASan runtimes in one process refuse to start."""
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    return subprocess.run(args, capture_output=True, text=True, env=env)
+
+
 def read_pfm(path):
     """A PFM image (the CLI's --vis and --shadow) as float32 rows from the top."""
     with open(path, "rb") as f:
@@ -223,14 +230,14 @@ class BakeTest(unittest.TestCase):
         viewer = os.path.normpath(os.path.join(HERE, "..", "..", "viewer"))
         if os.path.isdir(os.path.join(viewer, "node_modules", "gltf-validator")):
             for name in sorted(f for f in os.listdir(os.path.join(exported, "objects")) if f.endswith(".glb")):
-                r = subprocess.run(["node", os.path.join(viewer, "validate.mjs"), os.path.join(exported, "objects", name),
-                                    "--max-warnings", "0"], capture_output=True, text=True)
+                r = run(["node", os.path.join(viewer, "validate.mjs"), os.path.join(exported, "objects", name),
+                                    "--max-warnings", "0"])
                 self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
         else:
             print("bake: the glTF validator is not installed (viewer/node_modules): the exported files not validated")
         cli_exr, cli_s = os.path.join(OUT, "cli_bake.exr"), os.path.join(OUT, "cli_s.exr")
-        r = subprocess.run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
-                            "256", "--threads", "2", "--quiet", "-o", cli_exr], capture_output=True, text=True)
+        r = run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
+                            "256", "--threads", "2", "--quiet", "-o", cli_exr])
         self.assertEqual(r.returncode, 0, r.stderr)
         img = bpy.data.images.load(cli_exr, check_existing=False)
         # Blender loads the EXR's rows (the lightmap's, from its top) as it shows the add-on's images
@@ -243,8 +250,8 @@ class BakeTest(unittest.TestCase):
         self.assertLessEqual(float(diff.max()), 1e-6 * peak)
         # light 0's S, bit for bit: the CLI's PFM against the add-on's shadowmask image
         s0 = os.path.join(OUT, "cli_s0.pfm")
-        r = subprocess.run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
-                            "256", "--threads", "2", "--quiet", "-o", cli_exr, "--shadow", s0], capture_output=True, text=True)
+        r = run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
+                            "256", "--threads", "2", "--quiet", "-o", cli_exr, "--shadow", s0])
         self.assertEqual(r.returncode, 0, r.stderr)
         mask = np.array(bpy.data.images["microshadow_shadowmask_square"].pixels[:], np.float32).reshape(256, 256, 4)[..., 0]
         s = np.maximum(read_pfm(s0), 0.0)[::-1]  # rows from the bottom as Blender's; -1 (not baked) shown as 0
@@ -264,9 +271,8 @@ class BakeTest(unittest.TestCase):
         exported = os.path.join(OUT, "exported_pages")
         self.assertEqual(bpy.ops.microshadow.export_scene(directory=exported), {"FINISHED"})
         out = os.path.join(OUT, "cli_pages.exr")
-        r = subprocess.run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256",
-                            "--texel-density", "28", "--samples", "256", "--threads", "2", "--quiet", "-o", out],
-                           capture_output=True, text=True)
+        r = run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256",
+                            "--texel-density", "28", "--samples", "256", "--threads", "2", "--quiet", "-o", out])
         self.assertEqual(r.returncode, 0, r.stderr)
         for p in range(pages):
             mine = bpy.data.images["microshadow_irradiance" + ("" if p == 0 else ".%d" % p)]
@@ -367,9 +373,8 @@ class OperatorsTest(unittest.TestCase):
                 bpy.data.images.remove(img)
                 out = os.path.join(OUT, "cli_%s_%s.exr" % (kind, light))
                 pfm = out[:-4] + ".pfm"
-                r = subprocess.run([CLI, os.path.join(exported, "scene.json"), "--aa", "1", "--samples", "256",
-                                    "--threads", "2", "--quiet", "-o", os.path.join(OUT, "cli_frame.png"), flag, pfm],
-                                   capture_output=True, text=True)
+                r = run([CLI, os.path.join(exported, "scene.json"), "--aa", "1", "--samples", "256",
+                                    "--threads", "2", "--quiet", "-o", os.path.join(OUT, "cli_frame.png"), flag, pfm])
                 self.assertEqual(r.returncode, 0, r.stderr)
                 want = np.maximum(read_pfm(pfm), 0.0)
                 self.assertGreater(float((want > 0).mean()), 0.2)
