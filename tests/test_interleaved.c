@@ -395,24 +395,21 @@ static mae mae_of(const ms_frame *f, const ms_frame *ref)
 
 static void quality_on(const ms_scene *sc, const char *name, int size)
 {
-    ms_frame ref, il, raw, s16, s64, s256;
-    render(sc, "raytrace", MS_PATTERN_GRID, 4096, size, 0, &ref);
+    ms_frame ref, il, raw, s16;
+    /* the converged answer: the 4096-sample grid, by scanline (raytrace's V and S sample for sample, which
+     * test_visibility and test_scenes check; a fraction of raytrace's time under ASan) */
+    render(sc, "scanline", MS_PATTERN_GRID, 4096, size, 0, &ref);
     render(sc, "raytrace", MS_PATTERN_INTERLEAVED, 256, size, 0, &il);
     render(sc, "raytrace", MS_PATTERN_INTERLEAVED, 256, size, 1, &raw);
     render(sc, "raytrace", MS_PATTERN_STRATIFIED, 16, size, 0, &s16);
-    render(sc, "raytrace", MS_PATTERN_STRATIFIED, 64, size, 0, &s64);
-    render(sc, "raytrace", MS_PATTERN_STRATIFIED, 256, size, 0, &s256);
     assert_int_equal(s16.stats.samples_per_pixel, 16);
     assert_int_equal(il.stats.samples_per_pixel, 16);
     const mae e_il = mae_of(&il, &ref), e_raw = mae_of(&raw, &ref), e16 = mae_of(&s16, &ref);
-    const mae e64 = mae_of(&s64, &ref), e256 = mae_of(&s256, &ref);
-    fprintf(stderr, "%s %dx%d, MAE against raytrace grid 4096 over %ld pixels (V / S):\n"
+    fprintf(stderr, "%s %dx%d, MAE against the grid 4096 over %ld pixels (V / S):\n"
             "  interleaved N=256 filtered (16 rays/pixel) %.5f / %.5f\n"
             "  interleaved N=256 raw      (16 rays/pixel) %.5f / %.5f\n"
-            "  stratified 16                              %.5f / %.5f\n"
-            "  stratified 64                              %.5f / %.5f\n"
-            "  stratified 256                             %.5f / %.5f\n",
-            name, size, size, e_il.n, e_il.v, e_il.s, e_raw.v, e_raw.s, e16.v, e16.s, e64.v, e64.s, e256.v, e256.s);
+            "  stratified 16                              %.5f / %.5f\n",
+            name, size, size, e_il.n, e_il.v, e_il.s, e_raw.v, e_raw.s, e16.v, e16.s);
     assert_true(e_il.n > 0);
     assert_true(e_il.v < e16.v);
     assert_true(e_il.s < e16.s);
@@ -421,8 +418,6 @@ static void quality_on(const ms_scene *sc, const char *name, int size)
     ms_frame_free(&il);
     ms_frame_free(&raw);
     ms_frame_free(&s16);
-    ms_frame_free(&s64);
-    ms_frame_free(&s256);
 }
 
 static void test_quality(void **st)

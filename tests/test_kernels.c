@@ -456,7 +456,7 @@ static long scaled(long n)
     return s > 0 ? (long)(n * s) : n;
 }
 
-static void test_random_32(void **state) { (void)state; run_random(32, scaled(1000000), 1); }
+static void test_random_32(void **state) { (void)state; run_random(32, scaled(500000), 1); }
 static void test_random_16(void **state) { (void)state; run_random(16, scaled(300000), 2); }
 static void test_random_64(void **state) { (void)state; run_random(64, scaled(150000), 3); }
 
