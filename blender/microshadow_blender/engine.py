@@ -7,8 +7,6 @@ exposure: Blender's colour management (its view transform and Exposure) then sho
 render of the same lights, which is what an artist comparing the two expects. The frame's own exposure is
 reported in the render's stats line.
 """
-import time
-
 import bpy
 import numpy as np
 
@@ -16,8 +14,8 @@ from . import job, library, properties, scene_from_blender
 
 
 def light_pass_names(scene):
-    """The V and S pass names of each light the frame will have, in microshadow's light order (the lights as
-    the depsgraph lists them; an emissive mesh's triangles are one light each and get no pass)."""
+    """The Blender lights the frame gets V and S passes for, before rendering (the compositor asks for them):
+    every light object shown in renders. An emissive mesh's triangles are lights without passes."""
     names = []
     for ob in scene.objects:
         if ob.type == "LIGHT" and not ob.hide_render:

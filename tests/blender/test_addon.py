@@ -325,6 +325,25 @@ class OperatorsTest(unittest.TestCase):
         after = files_in(folder)
         self.assertEqual(after, before)  # no new, half-written or temporary file; the old ones untouched
 
+    def test_beside_the_blend(self):
+        """The default folder (//) is the saved .blend's; an unsaved file gets the images and a line saying why
+        no file was written."""
+        build_bake_scene()
+        sc = bpy.context.scene
+        sc.microshadow.bake_size = 64
+        self.assertEqual(sc.microshadow.bake_output, "//")
+        folder = os.path.join(OUT, "saved")
+        os.makedirs(folder)
+        bpy.ops.wm.save_as_mainfile(filepath=os.path.join(folder, "scene.blend"))
+        self.assertEqual(bpy.ops.microshadow.bake(), {"FINISHED"})
+        self.assertTrue(os.path.isfile(os.path.join(folder, "microshadow_irradiance.exr")))
+        bpy.ops.wm.read_homefile(use_empty=True)  # unsaved again
+        build_bake_scene()
+        bpy.context.scene.microshadow.bake_size = 64
+        self.assertEqual(bpy.ops.microshadow.bake(), {"FINISHED"})
+        self.assertIn("microshadow_irradiance", bpy.data.images)
+        self.assertEqual(bpy.data.images["microshadow_irradiance"].source, "GENERATED")
+
     def test_zero_size_light(self):
         build_bake_scene()
         bpy.data.objects["rectangle"].data.size_y = 0.0
