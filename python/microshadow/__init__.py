@@ -318,7 +318,8 @@ def method_names():
 
 def _light_dict(L):
     """A light as a dict: its shape's parameters (rect: corner, edge_s, edge_t; disk: center, normal,
-    radius; ellipse, a disk over a parallelogram that is not a square: corner, edge_s, edge_t; sphere: center, radius; triangle: vertices; sun: direction towards it, angular_diameter_deg),
+    radius; ellipse, a disk over a parallelogram that is not a square: corner, edge_s, edge_t; sphere:
+    center, radius; triangle: vertices; sun: direction towards it, angular_diameter_deg),
     emission, and the texture (h, w, 3) when it has one."""
     v = lambda a: (a.x, a.y, a.z)  # noqa: E731
     shape = _SHAPE_NAMES.get(L.shape, "rect")
