@@ -71,7 +71,7 @@ def start(context):
         uv_map = uv_map or "lightmap"
         lightmap_pack(context, receivers, uv_map)
     depsgraph = context.evaluated_depsgraph_get()
-    got = scene_from_blender.collect(depsgraph, uv_map=uv_map, receivers={o.name for o in receivers},
+    got = scene_from_blender.collect(depsgraph, ms, uv_map=uv_map, receivers={o.name for o in receivers},
                                      skip_hidden_render=True)
     sc = ms.scene_from_arrays(**got.arrays)
     run = job.Job(ms, ms.bake, scene=sc, size=st.bake_size, uv=None if st.bake_uv_source == "MICROSHADOW" else 0,

@@ -73,7 +73,7 @@ class MicroshadowRenderEngine(bpy.types.RenderEngine):
         st = scene.microshadow
         if scene.camera is None:
             raise scene_from_blender.SceneError("the scene has no active camera")
-        got = scene_from_blender.collect(depsgraph, camera=scene.camera, width=width, height=height)
+        got = scene_from_blender.collect(depsgraph, ms, camera=scene.camera, width=width, height=height)
         for w in got.warnings:
             self.report({"WARNING"}, w)
         arrays, names = got.arrays, got.light_names

@@ -17,7 +17,7 @@ import struct
 import bpy
 import numpy as np
 
-from . import scene_from_blender
+from . import library, properties, scene_from_blender
 
 # column-major, as glTF and the scene file's "matrix" take it: Blender's Z-up to glTF's Y-up, (x, y, z) ->
 # (x, z, -y), and back, (x, y, z) -> (x, -z, y); entries 0 and +-1 only, so both are exact in floats
@@ -134,8 +134,10 @@ class MICROSHADOW_OT_export_scene(bpy.types.Operator):
         try:
             r = scene.render
             recv = {o.name for o in context.selected_objects} if self.selected_receivers else None
+            prefs = properties.preferences(context)
+            ms = library.module(prefs.library if prefs else "")
             got = scene_from_blender.collect(
-                context.evaluated_depsgraph_get(), uv_map=scene.microshadow.bake_uv_map, receivers=recv,
+                context.evaluated_depsgraph_get(), ms, uv_map=scene.microshadow.bake_uv_map, receivers=recv,
                 camera=scene.camera, width=int(r.resolution_x * r.resolution_percentage / 100),
                 height=int(r.resolution_y * r.resolution_percentage / 100), skip_hidden_render=True)
             path = write(got, bpy.path.abspath(self.directory), int(scene.microshadow.samples))

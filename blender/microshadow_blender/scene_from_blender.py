@@ -124,10 +124,10 @@ def _light_params(light):
     return p
 
 
-def collect(depsgraph, uv_map="", receivers=None, camera=None, width=0, height=0, skip_hidden_render=False):
+def collect(depsgraph, ms, uv_map="", receivers=None, camera=None, width=0, height=0, skip_hidden_render=False):
     """The scene as a Collected.
 
-    uv_map: the UV map baked into (an object without it gets NaN UVs: microshadow charts it); "" takes each
+    ms: the microshadow module (library.module()). uv_map: the UV map baked into (an object without it gets NaN UVs: microshadow charts it); "" takes each
     object's active render UV map. receivers: names of the objects baked (the rest occlude only); None: all.
     camera: the camera object for frames (None for bakes)."""
     warnings, tris, nors, uvs, objs, mats_of_tri, lights, objects = [], [], [], [], [], [], [], []
@@ -247,10 +247,6 @@ def collect(depsgraph, uv_map="", receivers=None, camera=None, width=0, height=0
               "lightmap_scale": scale}
     if camera is not None:
         arrays["camera"] = _camera(camera, width, height, warnings)
-    else:  # bakes need none, the scene file one: looking at the scene's box from above a corner
-        v = arrays["triangles"].reshape(-1, 3).astype(np.float64)
-        lo, hi = v.min(0), v.max(0)
-        c, r = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) + 1e-3
-        arrays["camera"] = {"type": "pinhole", "eye": tuple(c + r), "target": tuple(c), "up": (0.0, 0.0, 1.0),
-                            "fov_y": 45.0, "width": 640, "height": 480}
+    else:  # bakes need none, the exported scene file one
+        arrays["camera"] = ms.default_camera(arrays["triangles"])
     return Collected(arrays, objects, warnings, light_names, [m["name"] for m in materials])

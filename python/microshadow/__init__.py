@@ -17,7 +17,7 @@ import os
 import numpy as np
 
 __all__ = ["Error", "Scene", "Accel", "load", "default_scene", "visibility_points", "render", "bake",
-           "method_names", "light_irradiance", "set_warning_handler", "scene_from_arrays", "__version__"]
+           "method_names", "light_irradiance", "set_warning_handler", "scene_from_arrays", "default_camera", "__version__"]
 
 MAX_UV_SETS = 4
 MAX_COUNTERS = 32
@@ -491,6 +491,17 @@ def _camera_struct(camera):
     return c
 
 
+def default_camera(triangles):
+    """A camera dict for a scene given without one (bakes need none; a scene file does): a pinhole looking at
+    the triangles' bounding box from above its corner, 640 x 480. Non-finite vertices are left out."""
+    v = np.asarray(triangles, np.float64).reshape(-1, 3)
+    v = v[np.isfinite(v).all(1)] if np.isfinite(v).any() else np.zeros((1, 3))
+    lo, hi = v.min(0), v.max(0)
+    c, r = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) + 1e-3
+    return {"type": "pinhole", "eye": tuple(c + r), "target": tuple(c), "up": (0.0, 0.0, 1.0), "fov_y": 45.0,
+            "width": 640, "height": 480}
+
+
 def scene_from_arrays(triangles, lights, camera=None, normals=None, uvs=None, objects=None, materials=None,
                       triangle_materials=None, lightmap_scale=None, samples=0):
     """A Scene built from arrays, in world coordinates (what a host application such as Blender hands over
@@ -525,12 +536,8 @@ def scene_from_arrays(triangles, lights, camera=None, normals=None, uvs=None, ob
     s.lights, s.n_lights, s.light = ctypes.cast(Ls, ctypes.POINTER(_Light)), len(lights), Ls[0]
     if camera is not None:
         s.camera = _camera_struct(camera)
-    else:  # no camera: one looking at the scene's box from above its corner (bakes need none)
-        v = tri.reshape(-1, 3)
-        v = v[np.isfinite(v).all(1)] if np.isfinite(v).any() else np.zeros((1, 3), np.float32)
-        lo, hi = v.min(0), v.max(0)
-        c, r = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) + 1e-3
-        s.camera = _camera_struct({"eye": tuple(c + r), "target": tuple(c), "up": (0.0, 0.0, 1.0)})
+    else:  # bakes need none
+        s.camera = _camera_struct(default_camera(tri))
     s.samples = int(samples)
     if normals is not None:
         nor = _array("normals", np.asarray(normals, np.float32).reshape(-1, 9), 9, "float", n)
