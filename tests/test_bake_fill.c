@@ -9,7 +9,10 @@
  *     directions), and the scale found brings g + b within 3% of that bound, though the page keeps empty
  *     texels beside the smaller square: at one density the two squares, not the packer, set the fill;
  *   - no texel centre lies in two objects' baked UV images (rasterized here, edges included), every triangle
- *     on the page, and the texel centres on triangles counted here are the reported page fill. */
+ *     on the page, and the texel centres on triangles counted here are the reported page fill.
+ * With uv_islands, an object whose layout holds four small islands in the corners of its UV square: each
+ * island moved as a whole (one scale for u and v, no rotation), one texel density for every island of both
+ * objects, no texel centre in two islands, and the page far fuller than with one region per object. */
 #include "testutil.h"
 #include <math.h>
 #include <stdio.h>
@@ -109,10 +112,115 @@ static void test_two_regions_bound(void **st)
     ms_scene_free(&sc);
 }
 
+/* Four 0.5 x 0.5 quads at height 0.3, each UV0 a 0.2 x 0.2 square in a corner of the unit square. */
+static void write_parts(const char *path)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    static const float at[4][2] = { { -0.9f, -0.9f }, { 0.3f, -0.9f }, { -0.9f, 0.3f }, { 0.3f, 0.3f } };
+    static const float uv[4][2] = { { 0.0f, 0.0f }, { 0.75f, 0.0f }, { 0.0f, 0.75f }, { 0.75f, 0.75f } };
+    for (int q = 0; q < 4; q++) {
+        const float x0 = at[q][0], z0 = at[q][1], x1 = x0 + 0.5f, z1 = z0 + 0.5f, u0 = uv[q][0], v0 = uv[q][1];
+        fprintf(f, "v %g 0.3 %g\nv %g 0.3 %g\nv %g 0.3 %g\nv %g 0.3 %g\n", x0, z1, x1, z1, x1, z0, x0, z0);
+        fprintf(f, "vt %g %g\nvt %g %g\nvt %g %g\nvt %g %g\n", u0, v0, u0 + 0.2f, v0, u0 + 0.2f, v0 + 0.2f, u0, v0 + 0.2f);
+    }
+    for (int q = 0; q < 4; q++) {
+        const int b = 4 * q;
+        fprintf(f, "f %d/%d %d/%d %d/%d\nf %d/%d %d/%d %d/%d\n", b + 1, b + 1, b + 2, b + 2, b + 3, b + 3, b + 1, b + 1, b + 3,
+                b + 3, b + 4, b + 4);
+    }
+    fclose(f);
+}
+
+static double bake_fill(const ms_scene *sc, int islands, ms_lightmap *lm)
+{
+    char err[512] = "";
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = SIZE;
+    bo.padding = PAD;
+    bo.uv_set = 0;
+    bo.uv_islands = islands;
+    bo.points.samples = 256;
+    bo.points.isa = tu_isa_cap();
+    assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
+    assert_int_equal(lm->pages, 1);
+    return lm->page_fill[0];
+}
+
+static void test_islands(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_fill_islands");
+    char path[512], json[512], err[512] = "";
+    write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
+    write_parts(tu_path(path, sizeof path, dir, "parts.obj"));
+    tu_path(json, sizeof json, dir, "scene.json");
+    assert_int_equal(tu_write_file(json,
+        "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"parts.obj\"}],"
+        "\"camera\":{\"eye\":[0,5,0.1],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
+        "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}"), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    assert_int_equal(sc.n_tris, 10);
+    ms_lightmap whole, lm;
+    const double f0 = bake_fill(&sc, 0, &whole), f1 = bake_fill(&sc, 1, &lm);
+    /* islands: the ground's one (triangles 0, 1) and the parts' four (triangles 2 + 2q, 3 + 2q) */
+    const double world_per_uv[2] = { 2.0, 2.5 };
+    double density[5], off[5][2];
+    for (size_t t = 0; t < sc.n_tris; t++) {
+        const int m = (int)sc.tri_mesh[t], isl = (int)t / 2;
+        assert_int_equal(lm.object_uv_set[m], 0);
+        assert_true(lm.object_scale_offset[4 * m] == 0.0f);   /* no one scale-offset */
+        const float *f = sc.tri_uv[0] + 6 * t, *b = lm.uv + 6 * t;
+        /* the scale along u and along v from the triangle's edges: equal (no rotation, no stretch) */
+        double au = 0.0, av = 0.0;
+        for (int e = 1; e < 3; e++) {
+            const double du = f[2 * e] - f[0], dv = f[2 * e + 1] - f[1];
+            if (fabs(du) > 0.1) au = (b[2 * e] - b[0]) * SIZE / du;
+            if (fabs(dv) > 0.1) av = (b[2 * e + 1] - b[1]) * SIZE / dv;
+            if (fabs(du) > 0.1 && fabs(dv) > 0.1) {   /* a diagonal edge: the same scale on both axes */
+                assert_true(fabs((b[2 * e] - b[0]) * SIZE / du - (b[2 * e + 1] - b[1]) * SIZE / dv) < 1e-3 * fabs(au));
+            }
+        }
+        assert_true(au > 0.0 && fabs(au / av - 1.0) < 1e-4);
+        const double o[2] = { b[0] * SIZE - au * f[0], b[1] * SIZE - av * f[1] };
+        if (t % 2 == 0) {
+            density[isl] = au / world_per_uv[m];   /* texels per world unit */
+            off[isl][0] = o[0];
+            off[isl][1] = o[1];
+        } else {   /* the island's second triangle moved with the first */
+            assert_true(fabs(au / world_per_uv[m] - density[isl]) < 1e-4 * density[isl]);
+            assert_true(fabs(o[0] - off[isl][0]) < 1e-2 && fabs(o[1] - off[isl][1]) < 1e-2);
+        }
+    }
+    for (int i = 1; i < 5; i++) assert_true(fabs(density[i] / density[0] - 1.0) < 1e-3);
+    /* no texel centre in two islands; the centres on triangles are the page fill */
+    int twice = 0, on = 0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            const double px = (x + 0.5) / SIZE, py = (y + 0.5) / SIZE;
+            int owner = -1, n = 0;
+            for (size_t t = 0; t < sc.n_tris; t++)
+                if (centre_in(lm.uv + 6 * t, px, py) && (int)t / 2 != owner) { owner = (int)t / 2; n++; }
+            twice += n > 1;
+            on += n > 0;
+        }
+    printf("islands: %.1f texels per world unit, page fill %.1f%% (one region per object: %.1f%%)\n", density[0],
+           100.0 * f1, 100.0 * f0);
+    assert_int_equal(twice, 0);
+    assert_true(fabs(on / (double)(SIZE * SIZE) - f1) < 0.01);
+    assert_true(f1 > 0.6 && f1 > 2.0 * f0);
+    ms_lightmap_free(&whole);
+    ms_lightmap_free(&lm);
+    ms_scene_free(&sc);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_two_regions_bound),
+        cmocka_unit_test(test_islands),
     };
     return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -49,6 +49,11 @@ typedef struct ms_bake_options {
                                 * made for this scene's geometry and these UV options (no unwrap); one that
                                 * was not is not used, with a warning; a missing file is not an error. NULL:
                                 * none (docs/baking.md, "The unwrap cache") */
+    int uv_islands;            /* 1: a kept layout's islands (its triangles joined by shared UVs) are packed one
+                                * by one, each keeping its shape at the object's texel density, beside xatlas's
+                                * charts: pages fill far better than with one region per object, but an object
+                                * has no single scale-offset (its object_scale_offset is 0; the baked UVs are
+                                * the glTF's TEXCOORD_1). 0: one region per object (docs/baking.md, "Charts") */
 } ms_bake_options;
 
 typedef struct ms_lightmap {
@@ -92,7 +97,7 @@ typedef struct ms_lightmap {
     double *page_fill;         /* per page: the fraction of its texels whose centre lies on a triangle */
     /* Per object (ms_scene.tri_object; else per mesh): the UV set its layout was kept from (-1: xatlas
      * charted it, -2: not baked) and, for a kept layout, its scale and offset (uv = file uv * (su, sv) +
-     * (ou, ov), 4 floats: su, sv, ou, ov; 0 for xatlas's). */
+     * (ou, ov), 4 floats: su, sv, ou, ov; 0 for xatlas's and for islands packed one by one, uv_islands). */
     size_t n_objects;
     int *object_uv_set;
     float *object_scale_offset;

@@ -26,6 +26,8 @@ static void usage(FILE *f)
         "  --uv N              UV set tried first: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1); each\n"
         "                      object keeps the first of its sets that is a valid layout (no overlap), xatlas\n"
         "                      charts objects without one; or 'xatlas' to unwrap every mesh\n"
+        "  --uv-islands        pack the kept layouts island by island beside xatlas's charts (pages fill far\n"
+        "                      better; an object then has no single scale-offset: use the glb's TEXCOORD_1)\n"
         "  --size N            lightmap width and height in texels (default 1024)\n"
         "  -o OUT.exr          channels R, G, B (irradiance), S and V (default lightmap.exr);\n"
         "                      several lights: S0, S1, ..., V0, V1, ... (one per light)\n"
@@ -87,7 +89,7 @@ static void pass_line_plain(void *user, const char *pass, double seconds)
 
 enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
        O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX,
-       O_NO_SEAM_STITCH, O_TEXEL_DENSITY, O_UV_CACHE, O_NO_UV_CACHE };
+       O_NO_SEAM_STITCH, O_TEXEL_DENSITY, O_UV_CACHE, O_NO_UV_CACHE, O_UV_ISLANDS };
 static const struct option longopts[] = {
     { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
     { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -101,7 +103,7 @@ static const struct option longopts[] = {
     { "gltf", required_argument, 0, O_GLTF }, { "no-leak-fix", no_argument, 0, O_NO_LEAK_FIX },
     { "no-seam-stitch", no_argument, 0, O_NO_SEAM_STITCH },
     { "texel-density", required_argument, 0, O_TEXEL_DENSITY }, { "uv-cache", required_argument, 0, O_UV_CACHE },
-    { "no-uv-cache", no_argument, 0, O_NO_UV_CACHE },
+    { "no-uv-cache", no_argument, 0, O_NO_UV_CACHE }, { "uv-islands", no_argument, 0, O_UV_ISLANDS },
 #ifdef MS_HAVE_MPI
     { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -204,6 +206,7 @@ static int take_option(bake_request *r, ms_cli_parser *cli, int c)
     }
     case O_UV_CACHE: r->outs[OUT_UV_CACHE].path = optarg; break;
     case O_NO_UV_CACHE: r->no_uv_cache = 1; break;
+    case O_UV_ISLANDS: r->bo.uv_islands = 1; break;
     case O_QUIET: r->quiet = 1; break;
     case O_MAX_MEMORY: if (ms_cli_parse_size(cli, "--max-memory", optarg, &r->bo.points.max_memory)) return EXIT_BAD_INPUT; break;
     case O_VERBOSE: ms_set_warning_verbose(1); break;

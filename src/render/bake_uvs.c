@@ -322,12 +322,22 @@ static int fit_one_page(ms_xpack *xp, double area, int size, int pad, double *sc
     return 0;
 }
 
+/* Kept layouts packed island by island (ms_bake_options.uv_islands): the triangles to place (use), their file
+ * UVs (src), and per object its texels per UV unit at scale 1 (k: world units per UV unit, as region_of). */
+typedef struct islands {
+    const uint8_t *use;
+    const float *src;
+    const double *k;
+    const ms_scene *sc;
+} islands;
+
 /* Regions and xatlas charts placed together (atlas_xpack.c): the wanted triangles of xtri charted by xatlas
- * (xuv, xpage: its UVs and atlases, the caller's arrays of n), then regions rs[0..nr) and charts packed at the
- * density T over as many pages as it takes, or on one page at the largest scale that fits. Sets the regions'
- * places, the charted triangles' UVs and pages in out, out->pages and rep->charts. 0, or -1 with a message. */
+ * (xuv, xpage: its UVs and atlases, the caller's arrays of n), then regions rs[0..nr), charts and the islands
+ * of is (may be NULL) packed at the density T over as many pages as it takes, or on one page at the largest
+ * scale that fits. Sets the regions' places, the charted and island triangles' UVs and pages in out,
+ * out->pages and rep->charts. 0, or -1 with a message. */
 static int place_charts(const float *xtri, size_t n, const uint8_t *want, const uint32_t *group, int size, int pad, double T,
-                        float *xuv, uint32_t *xpage, ms_pack_rect *rs, size_t nr,
+                        float *xuv, uint32_t *xpage, ms_pack_rect *rs, size_t nr, const islands *is,
                         ms_bake_uv_layout *out, ms_bake_uv_report *rep, char *err, size_t errlen)
 {
     ms_unwrap_info info;
@@ -340,7 +350,8 @@ static int place_charts(const float *xtri, size_t n, const uint8_t *want, const 
     const int res = size - 2 * pad;
     if (ms_lightmap_unwrap(xtri, n, want, group, res, pad, (float)T, xuv, xpage, &info, err, errlen)) goto fail;
     rep->charts = info.charts;
-    const double k0 = T > 0.0 ? 1.0 : info.texels_per_unit;   /* region texels per rs unit at the charts' density */
+    /* region texels per rs unit at the charts' density (without charts any: one page is scaled to fit) */
+    const double k0 = T > 0.0 ? 1.0 : info.charts ? info.texels_per_unit : 1.0;
     rdim = malloc((nr ? nr : 1) * 4 * sizeof *rdim);
     rpage = malloc((nr ? nr : 1) * sizeof *rpage);
     xin = malloc(n * 6 * sizeof *xin);
@@ -360,6 +371,16 @@ static int place_charts(const float *xtri, size_t n, const uint8_t *want, const 
         for (int k = 0; k < 6; k++) xin[6 * nx + k] = xuv[6 * t + k] * (float)res;
         area += uv_area(xin + 6 * nx) / 0.7;   /* charts' boxes */
         xkey[nx] = xpage[t];
+        xtri_of[nx++] = t;
+    }
+    /* The islands: each object's file UVs at its density, one UV mesh per object (key above xatlas's atlases),
+     * which xatlas's packer splits into charts at the UVs they do not share: the asset's own islands. */
+    for (size_t t = 0; is && t < n; t++) {
+        if (!is->use[t]) continue;
+        const uint32_t o = object_of(is->sc, t);
+        for (int k = 0; k < 6; k++) xin[6 * nx + k] = (float)(is->src[6 * t + k] * is->k[o] * k0);
+        area += uv_area(xin + 6 * nx) / 0.7;
+        xkey[nx] = 0x80000000u + o;
         xtri_of[nx++] = t;
     }
     area += (double)info.charts * (2.0 * pad + 2.0) * (2.0 * pad + 2.0);   /* and their padding */
@@ -392,6 +413,25 @@ fail:
     free(xout);
     free(xkey);
     free(xtri_of);
+    return rc;
+}
+
+/* The kept layouts island by island (ms_bake_options.uv_islands), packed with xatlas's charts of the rest: one
+ * texel density for all, but no object keeps one scale-offset (its object_scale_offset stays 0). 0, or -1. */
+static int place_islands(const ms_scene *sc, size_t n, size_t nobj, const object_uv *ob, const uint8_t *use, const float *src,
+                         const float *xtri, const uint8_t *want, const uint32_t *group, int size, int pad, double T, float *xuv,
+                         uint32_t *xpage, ms_bake_uv_layout *out, ms_bake_uv_report *rep, char *err, size_t errlen)
+{
+    double *k = malloc((nobj ? nobj : 1) * sizeof *k);
+    if (!k) { snprintf(err, errlen, "out of memory for the lightmap's islands"); return -1; }
+    for (size_t o = 0; o < nobj; o++) {   /* as region_of: scale-1 texels per UV unit (world units) */
+        k[o] = ob[o].uv_area > 0.0 ? sqrt(ob[o].world_area / ob[o].uv_area) : 0.0;
+        if (T > 0.0) k[o] *= T;
+    }
+    const islands is = { use, src, k, sc };
+    ms_pack_rect none;
+    const int rc = place_charts(xtri, n, want, group, size, pad, T, xuv, xpage, &none, 0, &is, out, rep, err, errlen);
+    free(k);
     return rc;
 }
 
@@ -452,7 +492,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     if (partial)
         ms_warn("%zu triangles overlap others in their object's UV layout: xatlas charts them, the rest keeps the layout", partial);
     if (fallback) ms_warn("%zu objects have no valid UV set %d and are baked in another set of theirs", fallback, p->uv_set);
-    if (!n_want && !rep->overlap_texels && inside && !weighted && !mixed && !(T > 0.0)) {   /* the file's UVs as they are */
+    if (!n_want && !rep->overlap_texels && inside && !weighted && !mixed && !(T > 0.0) && !p->islands) {   /* the file's UVs as they are */
         for (size_t t = 0; t < n; t++)
             if (use[t]) memcpy(out->uv + 6 * t, src + 6 * t, 6 * sizeof(float));
         for (size_t o = 0; o < nobj; o++)
@@ -462,7 +502,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     }
     /* xatlas's input: positions scaled by each mesh's weight (xatlas sizes charts by world area), one mesh
      * per object */
-    if (n_want) {
+    if (n_want || (p->islands && n_use)) {
         xuv = malloc(n * 6 * sizeof *xuv);
         xpage = calloc(n, sizeof *xpage);
         group = malloc(n * sizeof *group);
@@ -474,6 +514,11 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
                 for (int k = 0; k < 9; k++) scaled[9 * t + k] = sc->tri[9 * t + k] * (want[t] ? scale_of(sc, t) : 1.0f);
     }
     const float *xtri = weighted ? scaled : sc->tri;
+    if (p->islands && n_use) {   /* every kept layout island by island, with xatlas's charts */
+        if (place_islands(sc, n, nobj, ob, use, src, xtri, want, group, size, pad, T, xuv, xpage, out, rep, err, errlen)) goto out;
+        rc = 0;
+        goto out;
+    }
     /* Regions: the file's layout as a whole when objects share one set and do not overlap, else one per
      * object with a layout; xatlas's square (one page) or its pages (a density). */
     int whole = !rep->overlap_texels && !weighted && !mixed;
@@ -487,7 +532,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
      * found by stepping it. */
     if (!n_want) {
         if (place_regions(rs, nr, size, pad, T, &out->pages, err, errlen)) goto out;
-    } else if (place_charts(xtri, n, want, group, size, pad, T, xuv, xpage, rs, nr, out, rep, err, errlen)) {
+    } else if (place_charts(xtri, n, want, group, size, pad, T, xuv, xpage, rs, nr, NULL, out, rep, err, errlen)) {
         goto out;
     }
     rep->regions = nr;

@@ -10,6 +10,7 @@ typedef struct ms_bake_uv_params {
     int uv_set;              /* the set tried first for every object; -1: xatlas for all */
     int size, padding;
     float density;           /* texels per world unit (times each mesh's scale); 0: everything on one page */
+    int islands;             /* 1: kept layouts packed island by island (ms_bake_options.uv_islands) */
 } ms_bake_uv_params;
 
 /* What ms_bake_uvs did, for the caller's report. */
@@ -26,7 +27,7 @@ typedef struct ms_bake_uv_report {
 /* The layout: uv (6 floats per scene triangle, in [0,1]^2 of its page, NaN for triangles not baked), page
  * (per triangle), the pages used, and per object (ms_scene.n_objects, else one per mesh: ms_bake_uv_objects)
  * the set it was baked in (-1: xatlas, -2: not baked) and its scale and offset (uv = file uv * s + o:
- * su, sv, ou, ov; 0 0 0 0 for xatlas). All arrays are the caller's. */
+ * su, sv, ou, ov; 0 0 0 0 for xatlas and for islands packed one by one). All arrays are the caller's. */
 typedef struct ms_bake_uv_layout {
     float *uv;
     uint32_t *page;

@@ -52,7 +52,7 @@ uint64_t ms_uv_cache_key(const ms_scene *sc, const ms_bake_uv_params *p)
         hash_bytes(&s, &has, sizeof has);
         if (has) hash_bytes(&s, sc->tri_uv[u], (size_t)n * 6 * sizeof(float));
     }
-    const int ints[3] = { p->uv_set, p->size, p->padding };
+    const int ints[4] = { p->uv_set, p->size, p->padding, p->islands };
     hash_bytes(&s, ints, sizeof ints);
     hash_bytes(&s, &p->density, sizeof p->density);
     ms_unwrap_tuning tu;   /* the chart weights: a cache charted with other weights is not used */
