@@ -76,7 +76,8 @@ def start(context):
     sc = ms.scene_from_arrays(**got.arrays)
     run = job.Job(ms, ms.bake, scene=sc, size=st.bake_size, uv=None if st.bake_uv_source == "MICROSHADOW" else 0,
                   method=properties.method_value(st.method), samples=int(st.samples), threads=st.threads,
-                  padding=st.bake_padding, texel_density=st.bake_texel_density)
+                  padding=st.bake_padding, texel_density=st.bake_texel_density,
+                  uv_islands=st.bake_pack_islands and st.bake_uv_source != "MICROSHADOW")
     run.scene = sc
     return run, got, ms
 

@@ -1,6 +1,6 @@
 """The add-on's settings: per scene (frames and bakes) and the add-on's preferences."""
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 METHODS = [("AUTO", "Automatic", "microshadow picks the method for the scene (docs/methods.md)"),
            ("scanline", "Scanline", "Bit-parallel scanline micro-rasterization (Woop)"),
@@ -34,6 +34,10 @@ class MicroshadowSettings(bpy.types.PropertyGroup):
                                       description="Texels per world unit over as many pages as it takes (each "
                                                   "page Size x Size); 0: one page at the largest density that fits")
     bake_padding: IntProperty(name="Padding", default=4, min=1, max=64, description="Texels between charts")
+    bake_pack_islands: BoolProperty(name="Pack Islands", default=False,
+                                    description="Pack the UV map's islands one by one instead of each object's "
+                                                "layout as a whole: the lightmap fills far better, the islands "
+                                                "keep their shapes but not their places")
     bake_uv_map: StringProperty(name="UV Map", default="",
                                 description="The UV map baked into; empty: each object's active render UV map. "
                                             "Objects without it are charted by microshadow")
