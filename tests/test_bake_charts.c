@@ -396,6 +396,14 @@ static void test_uv_cache(void **st)
     assert_non_null(strstr(g_warn, "other geometry or UV options"));
     ms_lightmap_free(&b);
     bo.size = 128;
+    /* the islands packed one by one: another layout, so the cache is not used either */
+    g_warn[0] = 0;
+    bo.uv_islands = 1;
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &b, err, sizeof err), MS_OK);
+    assert_int_equal(b.uv_cached, 0);
+    assert_non_null(strstr(g_warn, "other geometry or UV options"));
+    ms_lightmap_free(&b);
+    bo.uv_islands = 0;
     ms_scene_free(&sc);
     /* other geometry (a plate moved) */
     {
