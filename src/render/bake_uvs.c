@@ -400,11 +400,16 @@ static int place_charts(const float *xtri, size_t n, const uint8_t *want, const 
         rs[r].h = rdim[nr + r] * scale;
         rs[r].page = rpage[r];
     }
+    size_t shrunk = 0;   /* island triangles xatlas scaled down (an island larger than a page at the density) */
     for (size_t i = 0; i < nx; i++) {
         const size_t t = xtri_of[i];
         for (int k = 0; k < 6; k++) out->uv[6 * t + k] = xout[6 * i + k] / (float)size;
         out->page[t] = xkey[n + i];
+        shrunk += is && is->use[t] && uv_area(xout + 6 * i) < 0.98 * uv_area(xin + 6 * i) * scale * scale;
     }
+    if (shrunk)
+        ms_warn("texel density %g: islands of %zu triangles are larger than a %dx%d page at that density and were scaled "
+                "down to fit one", T, shrunk, size, size);
     rc = 0;
 fail:
     free(rdim);
