@@ -132,6 +132,14 @@ static void write_parts(const char *path)
     fclose(f);
 }
 
+static char g_scaled[512];
+
+static void keep_scaled(void *user, const char *msg)
+{
+    (void)user;
+    if (strstr(msg, "scaled down")) snprintf(g_scaled, sizeof g_scaled, "%s", msg);
+}
+
 static double bake_fill(const ms_scene *sc, int islands, ms_lightmap *lm)
 {
     char err[512] = "";
@@ -212,6 +220,25 @@ static void test_islands(void **st)
     assert_true(fabs(on / (double)(SIZE * SIZE) - f1) < 0.01);
     assert_true(f1 > 0.6 && f1 > 2.0 * f0);
     ms_lightmap_free(&whole);
+    ms_lightmap_free(&lm);
+    /* a density at which the ground's island (2 x 2) is wider than a page: scaled down to fit, with a warning
+     * that counts its triangles; the parts' islands keep the density */
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = SIZE;
+    bo.padding = PAD;
+    bo.uv_islands = 1;
+    bo.texel_density = 200.0f;
+    bo.points.samples = 256;
+    bo.points.isa = tu_isa_cap();
+    g_scaled[0] = 0;
+    ms_set_warning_handler(keep_scaled, NULL);
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    ms_set_warning_handler(NULL, NULL);
+    printf("warning: %s\n", g_scaled);
+    assert_non_null(strstr(g_scaled, "islands of 2 triangles"));
+    const double side = fabs(lm.uv[6 * 2 + 2] - lm.uv[6 * 2]) * SIZE;   /* a part's first edge, 0.5 world units */
+    assert_true(fabs(side - 100.0) < 0.5);
     ms_lightmap_free(&lm);
     ms_scene_free(&sc);
 }
