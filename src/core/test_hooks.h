@@ -2,7 +2,8 @@
  * (a part made wrong, to show a test depends on it) exist only in microshadow_test, the copy of the library the
  * tests and benchmarks link, compiled with MS_TEST_HOOKS (CMakeLists.txt). The library users get has none: there,
  * every hook reads as 0 and its branch folds away. A source of the library that includes this header must be
- * listed in CMakeLists.txt's MS_HOOKED_SOURCES, which compiles it in both forms (and defines MS_HOOKABLE). */
+ * listed in CMakeLists.txt's MS_HOOKED_SOURCES, which compiles it in both forms (and defines MS_HOOKABLE; a
+ * sanitized build, the test suite's own, only the hooked one). */
 #ifndef MS_TEST_HOOKS_H
 #define MS_TEST_HOOKS_H
 
