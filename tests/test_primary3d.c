@@ -164,7 +164,7 @@ static void test_variants_agree(void **st)
     if (!tu_have_shared_scenes()) {
         print_message("shared scenes absent: skipped them\n");
     } else {
-        /* Crytek's Sponza is left out here (6.6 s of loading and 3D rasterization under ASan, an interior as
+        /* Crytek's Sponza is left out here (the longest to load and rasterize under ASan, an interior as
          * Dabrovic's and Sibenik's are); test_against_watertight below still renders it. */
         static const char *const scenes[] = { "stanford-bunny/stanford-bunny.json", "dabrovic-sponza/dabrovic-sponza.json",
                                               "sibenik/sibenik.json", "quad/quad.json" };

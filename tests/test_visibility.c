@@ -327,8 +327,9 @@ static void test_two_lifts(void **st)
     for (size_t m = 0; methods[m]; m++)
     for (int li = 0; li < 2; li++) {
         /* Penumbra casting is left out here: it answers these points through a receiver hierarchy built per
-         * call, 9 of this test's 23 s under ASan, and test_hpc holds both of its variants to raytrace's V and
-         * S sample for sample on every frame; raytrace, the definition, and the other methods run. */
+         * call, the slowest part of this test under ASan, and test_hpc holds both of its variants to
+         * raytrace's V and S sample for sample on every frame; raytrace, the definition, and the other
+         * methods run. */
         if (strncmp(methods[m], "hpc", 3) == 0) continue;
         const float lift = lifts[li];
         for (int i = 0; i < n; i++) {
