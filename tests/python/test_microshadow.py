@@ -529,6 +529,35 @@ class BuiltSceneTest(unittest.TestCase):
     def built(self, **kw):
         return ms.scene_from_arrays(self.loaded.triangles, self.loaded.lights, camera=self.CAMERA, **kw)
 
+    def test_bake_islands(self):
+        # a ground (UVs: the unit square) and an object of four 0.5 x 0.5 quads whose UVs are 0.2 x 0.2 squares in
+        # the corners of the unit square: with uv_islands each quad moves whole, at one texel density, and the
+        # page fills far more than with one region per object
+        tri, uv, obj = [], [], []
+        def quad(x0, z0, w, y, u0, v0, uw, o):
+            p = [[x0, y, z0 + w], [x0 + w, y, z0 + w], [x0 + w, y, z0], [x0, y, z0]]
+            t = [[u0, v0], [u0 + uw, v0], [u0 + uw, v0 + uw], [u0, v0 + uw]]
+            for a, b, c in ((0, 1, 2), (0, 2, 3)):
+                tri.append([p[a], p[b], p[c]])
+                uv.append([t[a], t[b], t[c]])
+                obj.append(o)
+        quad(-1, -1, 2, 0, 0, 0, 1, 0)
+        for (x, z), (u, v) in zip([(-0.9, -0.9), (0.3, -0.9), (-0.9, 0.3), (0.3, 0.3)], [(0, 0), (0.75, 0), (0, 0.75), (0.75, 0.75)]):
+            quad(x, z, 0.5, 0.3, u, v, 0.2, 1)
+        sc = ms.scene_from_arrays(np.array(tri), [LIGHTS["rect"]], camera=self.CAMERA, uvs=[np.array(uv)],
+                                  objects=np.array(obj))
+        whole = ms.bake(sc, size=256, uv=0, samples=256)
+        isl = ms.bake(sc, size=256, uv=0, samples=256, uv_islands=True)
+        self.assertGreater(isl["page_fill"][0], 2 * whole["page_fill"][0])
+        src, got = np.array(uv, np.float64), isl["uv"].astype(np.float64) * 256
+        density = []
+        for q in range(5):   # the ground's island, then the four quads: texels per world unit of each
+            a = (got[2 * q, 1] - got[2 * q, 0]) / (src[2 * q, 1] - src[2 * q, 0])[0]
+            off = got[2 * q: 2 * q + 2] - a[0] * src[2 * q: 2 * q + 2]
+            np.testing.assert_allclose(off - off[0, 0], 0, atol=1e-2)   # both triangles, every corner: one move
+            density.append(a[0] / (2.0 if q == 0 else 2.5))
+        np.testing.assert_allclose(density, density[0], rtol=1e-3)
+
     def test_same_as_loaded(self):
         a = ms.render(self.loaded, samples=256)
         b = ms.render(self.built(), samples=256)
