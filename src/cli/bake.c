@@ -240,8 +240,9 @@ static void report(const ms_bake_options *bo, const ms_output *outs, const ms_li
     size_t kept = 0;
     for (size_t o = 0; o < lm->n_objects; o++) kept += lm->object_uv_set[o] >= 0;
     if (lm->uv_cached) snprintf(uvs, sizeof uvs, "UVs from %s in %.3fs", bo->uv_cache, lm->unwrap_s);
-    else snprintf(uvs, sizeof uvs, "%zu objects in their own UVs, %zu triangles unwrapped by xatlas into %zu charts in %.3fs",
-                  kept, lm->unwrapped_tris, lm->charts, lm->unwrap_s);
+    else snprintf(uvs, sizeof uvs, "%zu objects in their own UVs%s, %zu triangles unwrapped by xatlas into %zu charts in %.3fs",
+                  kept, bo->uv_islands && kept ? " (islands packed one by one)" : "", lm->unwrapped_tris, lm->charts,
+                  lm->unwrap_s);
     int at = snprintf(pages, sizeof pages, "%d page%s, texel centres on triangles", lm->pages, lm->pages > 1 ? "s" : "");
     for (int p = 0; p < lm->pages && lm->page_fill && at < (int)sizeof pages - 16; p++)
         at += snprintf(pages + at, sizeof pages - (size_t)at, "%s %.1f%%", p ? "," : "", 100.0 * lm->page_fill[p]);
