@@ -43,6 +43,22 @@ static int centre_in(const float *u, double px, double py)
     return (e[0] >= 0 && e[1] >= 0 && e[2] >= 0) || (e[0] <= 0 && e[1] <= 0 && e[2] <= 0);
 }
 
+/* A bake of sc in UV set 0 on SIZE pages, islands packed one by one or not, at texel density T (0: one page). */
+static void bake_uv0(const ms_scene *sc, int islands, float T, ms_lightmap *lm)
+{
+    char err[512] = "";
+    ms_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.size = SIZE;
+    bo.padding = PAD;
+    bo.uv_set = 0;
+    bo.uv_islands = islands;
+    bo.texel_density = T;
+    bo.points.samples = 256;
+    bo.points.isa = tu_isa_cap();
+    assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
+}
+
 static void test_two_regions_bound(void **st)
 {
     (void)st;
@@ -59,15 +75,8 @@ static void test_two_regions_bound(void **st)
         "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}"), 0);
     ms_scene sc;
     assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
-    ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.padding = PAD;
-    bo.uv_set = 0;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
     ms_lightmap lm;
-    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    bake_uv0(&sc, 0, 0.0f, &lm);
     assert_int_equal(lm.pages, 1);
     assert_int_equal(lm.object_uv_set[0], 0);
     assert_int_equal(lm.object_uv_set[1], 0);
@@ -142,16 +151,7 @@ static void keep_scaled(void *user, const char *msg)
 
 static double bake_fill(const ms_scene *sc, int islands, ms_lightmap *lm)
 {
-    char err[512] = "";
-    ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.padding = PAD;
-    bo.uv_set = 0;
-    bo.uv_islands = islands;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
-    assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
+    bake_uv0(sc, islands, 0.0f, lm);
     assert_int_equal(lm->pages, 1);
     return lm->page_fill[0];
 }
@@ -223,17 +223,9 @@ static void test_islands(void **st)
     ms_lightmap_free(&lm);
     /* a density at which the ground's island (2 x 2) is wider than a page: scaled down to fit, with a warning
      * that counts its triangles; the parts' islands keep the density */
-    ms_bake_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.size = SIZE;
-    bo.padding = PAD;
-    bo.uv_islands = 1;
-    bo.texel_density = 200.0f;
-    bo.points.samples = 256;
-    bo.points.isa = tu_isa_cap();
     g_scaled[0] = 0;
     ms_set_warning_handler(keep_scaled, NULL);
-    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
+    bake_uv0(&sc, 1, 200.0f, &lm);
     ms_set_warning_handler(NULL, NULL);
     printf("warning: %s\n", g_scaled);
     assert_non_null(strstr(g_scaled, "islands of 2 triangles"));

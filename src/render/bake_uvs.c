@@ -400,12 +400,13 @@ static int place_charts(const float *xtri, size_t n, const uint8_t *want, const 
         rs[r].h = rdim[nr + r] * scale;
         rs[r].page = rpage[r];
     }
-    size_t shrunk = 0;   /* island triangles xatlas scaled down (an island larger than a page at the density) */
+    size_t shrunk = 0;   /* island triangles xatlas scaled down (an island larger than a page at a density; on one
+                          * page the scale found fits everything) */
     for (size_t i = 0; i < nx; i++) {
         const size_t t = xtri_of[i];
         for (int k = 0; k < 6; k++) out->uv[6 * t + k] = xout[6 * i + k] / (float)size;
         out->page[t] = xkey[n + i];
-        shrunk += is && is->use[t] && uv_area(xout + 6 * i) < 0.98 * uv_area(xin + 6 * i) * scale * scale;
+        shrunk += T > 0.0 && is && is->use[t] && uv_area(xout + 6 * i) < 0.98 * uv_area(xin + 6 * i);
     }
     if (shrunk)
         ms_warn("texel density %g: islands of %zu triangles are larger than a %dx%d page at that density and were scaled "
@@ -434,8 +435,7 @@ static int place_islands(const ms_scene *sc, size_t n, size_t nobj, const object
         if (T > 0.0) k[o] *= T;
     }
     const islands is = { use, src, k, sc };
-    ms_pack_rect none;
-    const int rc = place_charts(xtri, n, want, group, size, pad, T, xuv, xpage, &none, 0, &is, out, rep, err, errlen);
+    const int rc = place_charts(xtri, n, want, group, size, pad, T, xuv, xpage, NULL, 0, &is, out, rep, err, errlen);
     free(k);
     return rc;
 }
