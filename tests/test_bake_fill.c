@@ -12,7 +12,11 @@
  *     on the page, and the texel centres on triangles counted here are the reported page fill.
  * With uv_islands, an object whose layout holds four small islands in the corners of its UV square: each
  * island moved as a whole (one scale for u and v, no rotation), one texel density for every island of both
- * objects, no texel centre in two islands, and the page far fuller than with one region per object. */
+ * objects, no texel centre in two islands, and the page far fuller than with one region per object.
+ * Regions alone (no xatlas chart: the rectangle packer) at the default padding of 2 texels: the texels a
+ * bilinear lookup inside each region reads (centres within one texel of its UV square) leave at least 2
+ * texels between the two regions, which no lookup reads, so the dilation that fills a region's border texels
+ * never averages in the other's. */
 #include "testutil.h"
 #include <math.h>
 #include <stdio.h>
@@ -43,14 +47,15 @@ static int centre_in(const float *u, double px, double py)
     return (e[0] >= 0 && e[1] >= 0 && e[2] >= 0) || (e[0] <= 0 && e[1] <= 0 && e[2] <= 0);
 }
 
-/* A bake of sc in UV set 0 on SIZE pages, islands packed one by one or not, at texel density T (0: one page). */
-static void bake_uv0(const ms_scene *sc, int islands, float T, ms_lightmap *lm)
+/* A bake of sc in UV set 0 on SIZE pages, islands packed one by one or not, at texel density T (0: one page),
+ * with `padding` (0: the default). */
+static void bake_uv0(const ms_scene *sc, int islands, float T, int padding, ms_lightmap *lm)
 {
     char err[512] = "";
     ms_bake_options bo;
     memset(&bo, 0, sizeof bo);
     bo.size = SIZE;
-    bo.padding = PAD;
+    bo.padding = padding;
     bo.uv_set = 0;
     bo.uv_islands = islands;
     bo.texel_density = T;
@@ -76,7 +81,7 @@ static void test_two_regions_bound(void **st)
     ms_scene sc;
     assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
     ms_lightmap lm;
-    bake_uv0(&sc, 0, 0.0f, &lm);
+    bake_uv0(&sc, 0, 0.0f, PAD, &lm);
     assert_int_equal(lm.pages, 1);
     assert_int_equal(lm.object_uv_set[0], 0);
     assert_int_equal(lm.object_uv_set[1], 0);
@@ -151,7 +156,7 @@ static void keep_scaled(void *user, const char *msg)
 
 static double bake_fill(const ms_scene *sc, int islands, ms_lightmap *lm)
 {
-    bake_uv0(sc, islands, 0.0f, lm);
+    bake_uv0(sc, islands, 0.0f, PAD, lm);
     assert_int_equal(lm->pages, 1);
     return lm->page_fill[0];
 }
@@ -225,7 +230,7 @@ static void test_islands(void **st)
      * that counts its triangles; the parts' islands keep the density */
     g_scaled[0] = 0;
     ms_set_warning_handler(keep_scaled, NULL);
-    bake_uv0(&sc, 1, 200.0f, &lm);
+    bake_uv0(&sc, 1, 200.0f, PAD, &lm);
     ms_set_warning_handler(NULL, NULL);
     printf("warning: %s\n", g_scaled);
     assert_non_null(strstr(g_scaled, "islands of 2 triangles"));
@@ -235,11 +240,61 @@ static void test_islands(void **st)
     ms_scene_free(&sc);
 }
 
+/* The texel rows or columns [lo, hi] whose centres lie within one texel of the UV span [a, b] (texels). */
+static void footprint(double a, double b, int *lo, int *hi)
+{
+    *lo = (int)floor(a - 1.5) + 1;   /* i + 0.5 > a - 1 */
+    *hi = (int)ceil(b + 0.5) - 1;    /* i + 0.5 < b + 1 */
+}
+
+static void test_regions_apart(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("bake_fill_apart");
+    char path[512], json[512], err[512] = "";
+    write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
+    write_quad(tu_path(path, sizeof path, dir, "plate.obj"), 1.5f, 2.7f, -0.6f, 0.6f, 0.0f, 1);
+    tu_path(json, sizeof json, dir, "scene.json");
+    assert_int_equal(tu_write_file(json,
+        "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"plate.obj\"}],"
+        "\"camera\":{\"eye\":[0.8,5,0.1],\"target\":[0.8,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
+        "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}"), 0);
+    ms_scene sc;
+    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    ms_lightmap lm;
+    bake_uv0(&sc, 0, 0.0f, 0, &lm);
+    assert_int_equal(lm.pages, 1);
+    assert_int_equal(lm.charts, 0);   /* no xatlas: the regions' own packer */
+    int fp[2][2][2];   /* [object][axis][lo, hi] */
+    for (int m = 0; m < 2; m++) {
+        double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+        for (size_t t = 0; t < sc.n_tris; t++)
+            if ((int)sc.tri_mesh[t] == m)
+                for (int k = 0; k < 6; k++) {
+                    lo[k & 1] = fmin(lo[k & 1], lm.uv[6 * t + k] * SIZE);
+                    hi[k & 1] = fmax(hi[k & 1], lm.uv[6 * t + k] * SIZE);
+                }
+        for (int d = 0; d < 2; d++) footprint(lo[d], hi[d], &fp[m][d][0], &fp[m][d][1]);
+    }
+    int apart = -1;   /* texels between the two footprints along the axis that separates them */
+    for (int d = 0; d < 2; d++) {
+        const int gap = (fp[1][d][0] > fp[0][d][1] ? fp[1][d][0] - fp[0][d][1] : fp[0][d][0] - fp[1][d][1]) - 1;
+        if (gap > apart) apart = gap;
+    }
+    printf("regions: footprints x %d..%d and %d..%d, y %d..%d and %d..%d: %d texels apart; page fill %.1f%%\n",
+           fp[0][0][0], fp[0][0][1], fp[1][0][0], fp[1][0][1], fp[0][1][0], fp[0][1][1], fp[1][1][0], fp[1][1][1], apart,
+           100.0 * lm.page_fill[0]);
+    assert_true(apart >= 2);
+    ms_lightmap_free(&lm);
+    ms_scene_free(&sc);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_two_regions_bound),
         cmocka_unit_test(test_islands),
+        cmocka_unit_test(test_regions_apart),
     };
     return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

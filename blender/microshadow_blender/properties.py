@@ -33,7 +33,7 @@ class MicroshadowSettings(bpy.types.PropertyGroup):
     bake_texel_density: FloatProperty(name="Texel Density", default=0.0, min=0.0, soft_max=1024.0,
                                       description="Texels per world unit over as many pages as it takes (each "
                                                   "page Size x Size); 0: one page at the largest density that fits")
-    bake_padding: IntProperty(name="Padding", default=4, min=1, max=64, description="Texels between charts")
+    bake_padding: IntProperty(name="Padding", default=2, min=1, max=64, description="Texels between charts")
     bake_pack_islands: BoolProperty(name="Pack Islands", default=False,
                                     description="Pack the UV map's islands one by one instead of each object's "
                                                 "layout as a whole: the lightmap fills far better, the islands "

@@ -37,7 +37,7 @@ typedef struct ms_bake_options {
                                 * without one are charted by xatlas (docs/baking.md, "Charts"); -1: xatlas
                                 * for every triangle */
     int dilate;                /* texels of dilation; 0: 4; -1: none */
-    int padding;               /* texels between charts (xatlas's and the lightmap's regions); 0: 4 */
+    int padding;               /* texels between charts (xatlas's and the lightmap's regions); 0: 2 */
     int no_leak_fix;           /* 1: texels inside geometry keep their points (docs/baking.md, "Quality"); 0: moved */
     ms_bake_pass_fn pass;      /* may be NULL */
     void *pass_user;

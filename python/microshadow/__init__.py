@@ -751,7 +751,7 @@ def light_irradiance(light, point, normal):
 
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
-         dilate=4, padding=4, accel=None, progress=None, max_memory=0, texel_density=0.0, uv_cache=None,
+         dilate=4, padding=2, accel=None, progress=None, max_memory=0, texel_density=0.0, uv_cache=None,
          uv_islands=False):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
     (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off

@@ -39,7 +39,7 @@ static void usage(FILE *f)
         "                      lights 0-3 in R, G, B, A; the materials' extras name them), one binary glTF\n"
         "  --stats OUT.json    timings and counters\n"
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
-        "  --padding N         texels between charts and regions (default 4)\n"
+        "  --padding N         texels between charts and regions (default 2)\n"
         "  --no-leak-fix       keep the points of texels whose centre lies inside geometry\n"
         "  --texel-density T   texels per world unit (times each mesh's \"lightmap\" scale), on as many\n"
         "                      --size pages as it takes: page p > 0 of each image output is written with .p\n"

@@ -104,9 +104,8 @@ int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
     xatlasPackOptions po;
     xatlasPackOptionsInit(&po);
     po.resolution = x->grow ? 0 : (uint32_t)x->size;
-    po.padding = (uint32_t)(x->pad + 1) / 2;   /* xatlas pads each chart by this: two charts are twice it apart */
+    ms_xatlas_pack_padding(&po, x->pad);
     po.texelsPerUnit = 1.0f;   /* UVs are texels already */
-    po.bilinear = true;
     po.rotateCharts = false;
     po.rotateChartsToAxis = false;
     xatlasPackCharts(atlas, &po);

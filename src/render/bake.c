@@ -265,7 +265,7 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
     }
     ms_status bst = bake_budget(scene, o, size, 1, 0, NULL, err, errlen);
     if (bst) return bst;
-    const int padding = o->padding > 0 ? o->padding : 4;
+    const int padding = o->padding > 0 ? o->padding : 2;
     ms_status st = ms_bake_choose_uvs(scene, o, size, padding, out, err, errlen);
     if (!st && o->pass) o->pass(o->pass_user, out->uv_cached ? "UVs (from the cache)" : "UVs", out->unwrap_s);
     if (!st && out->pages > 1) st = bake_budget(scene, o, size, out->pages, 0, NULL, err, errlen);   /* known now */

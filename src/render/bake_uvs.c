@@ -18,6 +18,7 @@
 #include "atlas_pack.h"
 #include "atlas_xpack.h"
 #include "uv_validity.h"
+#include "xatlas_meshes.h"   /* ms_chart_padding */
 #include "scene/scene_internal.h"
 #include <math.h>
 #include <stdio.h>
@@ -237,6 +238,9 @@ static size_t make_regions(object_uv *ob, size_t nobj, object_uv *all, int whole
  * (*pages_used), or at the largest common scale that fits one page. 0, or -1 with a message. */
 static int place_regions(ms_pack_rect *rs, size_t nr, int size, int pad, double T, int *pages_used, char *err, size_t errlen)
 {
+    /* A lookup inside a region reads the texels whose centres lie within one texel of it: rectangles 2 + 2 c
+     * apart leave 2 c texels between two regions' footprints, as xatlas's packer leaves between charts' */
+    const int gap = 2 + 2 * ms_chart_padding(pad);
     if (!(T > 0.0)) {
         double wmax = 0.0;
         for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].w0 * rs[r].h0);
@@ -244,12 +248,12 @@ static int place_regions(ms_pack_rect *rs, size_t nr, int size, int pad, double 
             rs[r].w0 = fmax(rs[r].w0 / sqrt(wmax), 1e-5);
             rs[r].h0 = fmax(rs[r].h0 / sqrt(wmax), 1e-5);
         }
-        if (ms_pack_one_page(rs, nr, size, pad)) {
+        if (ms_pack_one_page(rs, nr, size, gap)) {
             snprintf(err, errlen, "the lightmap's %zu regions do not fit a %dx%d lightmap with %d texels of padding", nr, size, size, pad);
             return -1;
         }
     } else {
-        const int pages = ms_pack_pages(rs, nr, 1.0, size, pad, 0);
+        const int pages = ms_pack_pages(rs, nr, 1.0, size, gap, 0);
         if (pages < 0) { snprintf(err, errlen, "the lightmap's %zu regions do not fit %dx%d pages", nr, size, size); return -1; }
         *pages_used = pages ? pages : 1;
     }

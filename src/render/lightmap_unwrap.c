@@ -137,9 +137,8 @@ int ms_lightmap_unwrap(const float *tri, size_t n, const uint8_t *want, const ui
         xatlasPackOptions po;
         xatlasPackOptionsInit(&po);
         po.resolution = (uint32_t)size;
-        po.padding = (uint32_t)(padding + 1) / 2;   /* xatlas pads each chart by this: two charts are twice it apart */
+        ms_xatlas_pack_padding(&po, padding);
         po.texelsPerUnit = tpu;
-        po.bilinear = true;
         xatlasPackCharts(atlas, &po);
         if (atlas->meshCount != ng) break;
         if (density <= 0.0f && atlas->atlasCount > 1) {   /* one atlas wanted: lower the density, pack again */

@@ -34,3 +34,9 @@ xatlasAddMeshError ms_xatlas_add_meshes(xatlasAtlas *atlas, int dim, const float
     }
     return XATLAS_ADD_MESH_ERROR_SUCCESS;
 }
+
+void ms_xatlas_pack_padding(xatlasPackOptions *po, int padding)
+{
+    po->bilinear = true;
+    po->padding = (uint32_t)ms_chart_padding(padding);
+}
