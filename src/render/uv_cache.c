@@ -10,6 +10,7 @@
  * microshadow builds for). */
 #include "uv_cache.h"
 #include "core/abi.h"
+#include "xatlas_meshes.h"   /* ms_chart_padding */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,7 +53,8 @@ uint64_t ms_uv_cache_key(const ms_scene *sc, const ms_bake_uv_params *p)
         hash_bytes(&s, &has, sizeof has);
         if (has) hash_bytes(&s, sc->tri_uv[u], (size_t)n * 6 * sizeof(float));
     }
-    const int ints[4] = { p->uv_set, p->size, p->padding, p->islands };
+    /* the padding as the packers apply it (a cache laid out by an earlier rule for the same number is remade) */
+    const int ints[5] = { p->uv_set, p->size, p->padding, p->islands, ms_chart_padding(p->padding) };
     hash_bytes(&s, ints, sizeof ints);
     hash_bytes(&s, &p->density, sizeof p->density);
     ms_unwrap_tuning tu;   /* the chart weights: a cache charted with other weights is not used */
