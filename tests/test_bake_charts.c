@@ -1,8 +1,8 @@
 /* Charts, texel density, pages and the unwrap cache of a bake (src/render/bake_uvs.c, uv_validity.c,
  * atlas_pack.c, uv_cache.c, bake_pages.c), against answers made here:
- *   - an object whose UV0 is a valid layout keeps it: in the glb (read by the tests' own reader) its
- *     TEXCOORD_1 is its TEXCOORD_0 under one scale and one offset, fitted here from the vertices, and the
- *     primitive's extras name UV set 0 and that scale-offset; an object whose UV0 overlaps itself goes to
+ *   - an object whose UV0 is a valid layout keeps it (moved whole: MS_UV_PACK_REGIONS): in the glb (read by
+ *     the tests' own reader) its TEXCOORD_1 is its TEXCOORD_0 under one scale and one offset, fitted here
+ *     from the vertices, and the primitive's extras name UV set 0 and that scale-offset; an object whose UV0 overlaps itself goes to
  *     xatlas (its baked UV images are disjoint, which no single scale-offset of its UV0 could make);
  *   - a texel density that needs two pages gives two, each at least 70% covered by texel centres on
  *     triangles (counted here by rasterizing the baked UVs), every triangle on one page with its texels
@@ -91,6 +91,7 @@ static void test_keep_and_chart(void **st)
     assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
     ms_bake_options bo;
     bake_opts(&bo, 128);
+    bo.uv_packing = MS_UV_PACK_REGIONS;   /* the kept layout under one scale-offset, recorded in the glb */
     ms_lightmap lm;
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);
     assert_int_equal(lm.n_objects, 2);
@@ -398,12 +399,12 @@ static void test_uv_cache(void **st)
     bo.size = 128;
     /* the islands packed one by one: another layout, so the cache is not used either */
     g_warn[0] = 0;
-    bo.uv_islands = 1;
+    bo.uv_packing = MS_UV_PACK_ISLANDS;
     assert_int_equal(ms_bake(&sc, NULL, &bo, &b, err, sizeof err), MS_OK);
     assert_int_equal(b.uv_cached, 0);
     assert_non_null(strstr(g_warn, "other geometry or UV options"));
     ms_lightmap_free(&b);
-    bo.uv_islands = 0;
+    bo.uv_packing = MS_UV_PACK_DEFAULT;
     ms_scene_free(&sc);
     /* other geometry (a plate moved) */
     {

@@ -10,7 +10,7 @@
  *     texels beside the smaller square: at one density the two squares, not the packer, set the fill;
  *   - no texel centre lies in two objects' baked UV images (rasterized here, edges included), every triangle
  *     on the page, and the texel centres on triangles counted here are the reported page fill.
- * With uv_islands, an object whose layout holds four small islands in the corners of its UV square: each
+ * Island by island (MS_UV_PACK_ISLANDS, what the default does here), an object whose layout holds four small islands in the corners of its UV square: each
  * island moved as a whole (one scale for u and v, no rotation), one texel density for every island of both
  * objects, no texel centre in two islands, and the page far fuller than with one region per object.
  * Regions alone (no xatlas chart: the rectangle packer) at the default padding of 2 texels: the texels a
@@ -57,7 +57,7 @@ static void bake_uv0(const ms_scene *sc, int islands, float T, int padding, ms_l
     bo.size = SIZE;
     bo.padding = padding;
     bo.uv_set = 0;
-    bo.uv_islands = islands;
+    bo.uv_packing = islands ? MS_UV_PACK_ISLANDS : MS_UV_PACK_REGIONS;
     bo.texel_density = T;
     bo.points.samples = 256;
     bo.points.isa = tu_isa_cap();

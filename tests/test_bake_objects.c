@@ -2,7 +2,7 @@
  * objects (five walls, a short box: one glTF node and mesh each) all bring TEXCOORD_1 spanning 0-1, the
  * Unity/Bevy convention; beside it a floating cube without UVs (xatlas) and a tall block with
  * "lightmap": false. Against independent answers:
- *   - the overlap is said (a warning), and every object gets its own region: no texel centre lies in two
+ *   - with each layout moved whole (MS_UV_PACK_REGIONS), the overlap is said (a warning), and every object gets its own region: no texel centre lies in two
  *     objects' baked UV images (rasterized here), and each object's baked UVs are its file UVs under one
  *     scale and one offset (its charts keep their shape);
  *   - the tall block is not baked (no UVs, no texels) but still casts: the floor behind it is in shadow;
@@ -131,6 +131,7 @@ static void bake(const ms_scene *sc, ms_lightmap *lm)
 {
     ms_bake_options bo;
     tu_bake_options(&bo, SIZE, 1, 256);
+    bo.uv_packing = MS_UV_PACK_REGIONS;   /* what is checked: each layout moved whole under one scale-offset */
     char err[512] = "";
     assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
 }

@@ -77,7 +77,7 @@ def start(context):
     run = job.Job(ms, ms.bake, scene=sc, size=st.bake_size, uv=None if st.bake_uv_source == "MICROSHADOW" else 0,
                   method=properties.method_value(st.method), samples=int(st.samples), threads=st.threads,
                   padding=st.bake_padding, texel_density=st.bake_texel_density,
-                  uv_islands=st.bake_pack_islands and st.bake_uv_source != "MICROSHADOW")
+                  uv_packing="regions" if st.bake_whole_layouts and st.bake_uv_source != "MICROSHADOW" else "default")
     run.scene = sc
     return run, got, ms
 

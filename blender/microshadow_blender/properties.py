@@ -34,10 +34,11 @@ class MicroshadowSettings(bpy.types.PropertyGroup):
                                       description="Texels per world unit over as many pages as it takes (each "
                                                   "page Size x Size); 0: one page at the largest density that fits")
     bake_padding: IntProperty(name="Padding", default=2, min=1, max=64, description="Texels between charts")
-    bake_pack_islands: BoolProperty(name="Pack Islands", default=False,
-                                    description="Pack the UV map's islands one by one instead of each object's "
-                                                "layout as a whole: the lightmap fills far better, the islands "
-                                                "keep their shapes but not their places")
+    bake_whole_layouts: BoolProperty(name="Whole Layouts", default=False,
+                                     description="Move each object's UV layout into the lightmap as one rectangle "
+                                                 "(one scale and offset per object) instead of packing its islands "
+                                                 "one by one: the islands keep their places, the lightmap fills "
+                                                 "far less")
     bake_uv_map: StringProperty(name="UV Map", default="",
                                 description="The UV map baked into; empty: each object's active render UV map. "
                                             "Objects without it are charted by microshadow")

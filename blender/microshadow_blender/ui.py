@@ -44,7 +44,7 @@ class MICROSHADOW_PT_bake(bpy.types.Panel):
         layout.prop(st, "bake_uv_source")
         if st.bake_uv_source != "MICROSHADOW":
             layout.prop(st, "bake_uv_map")
-            layout.prop(st, "bake_pack_islands")
+            layout.prop(st, "bake_whole_layouts")
         layout.prop(st, "bake_size")
         layout.prop(st, "bake_texel_density")
         layout.prop(st, "bake_padding")

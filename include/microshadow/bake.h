@@ -28,6 +28,21 @@
  * test", "acceleration structure", "light 1/3", ..., "irradiance and dilation", "seam stitching", "seams") and its seconds: one
  * progress line per pass for a command line (the points' progress callback goes on within the lights). */
 typedef void (*ms_bake_pass_fn)(void *user, const char *pass, double seconds);
+/* How the objects' own UV layouts (the kept ones: docs/baking.md, "Charts") are placed on the lightmap's pages. */
+typedef enum ms_uv_packing {
+    /* The file's UVs as they are where they can be (every object in the same set, no overlap, all in [0, 1],
+     * no "lightmap" scale, no texel density); else MS_UV_PACK_ISLANDS. */
+    MS_UV_PACK_DEFAULT = 0,
+    /* Each kept layout's islands (its triangles joined by shared UVs) packed one by one beside xatlas's charts,
+     * each keeping its shape at the object's texel density: an object then has no single scale-offset
+     * (object_scale_offset 0; engines read the baked UVs, the glTF's TEXCOORD_1). */
+    MS_UV_PACK_ISLANDS = 1,
+    /* Each object's layout moved whole into a rectangle of its own under one scale and one offset (Unity's
+     * lightmapScaleOffset, object_scale_offset): the layouts' empty space travels with them, and two large
+     * objects cap the scale, so pages fill less. */
+    MS_UV_PACK_REGIONS = 2
+} ms_uv_packing;
+
 typedef struct ms_bake_options {
     ms_points_options points;  /* method, pattern, samples, threads, seed, isa, progress; zero: defaults */
     int size;                  /* texels per side; 0: 1024 (at most MS_MAX_IMAGE_SIZE) */
@@ -49,11 +64,7 @@ typedef struct ms_bake_options {
                                 * made for this scene's geometry and these UV options (no unwrap); one that
                                 * was not is not used, with a warning; a missing file is not an error. NULL:
                                 * none (docs/baking.md, "The unwrap cache") */
-    int uv_islands;            /* 1: a kept layout's islands (its triangles joined by shared UVs) are packed one
-                                * by one, each keeping its shape at the object's texel density, beside xatlas's
-                                * charts: pages fill far better than with one region per object, but an object
-                                * has no single scale-offset (its object_scale_offset is 0; the baked UVs are
-                                * the glTF's TEXCOORD_1). 0: one region per object (docs/baking.md, "Charts") */
+    ms_uv_packing uv_packing;  /* how the kept layouts are placed (above); 0: MS_UV_PACK_DEFAULT */
 } ms_bake_options;
 
 typedef struct ms_lightmap {
@@ -97,7 +108,7 @@ typedef struct ms_lightmap {
     double *page_fill;         /* per page: the fraction of its texels whose centre lies on a triangle */
     /* Per object (ms_scene.tri_object; else per mesh): the UV set its layout was kept from (-1: xatlas
      * charted it, -2: not baked) and, for a kept layout, its scale and offset (uv = file uv * (su, sv) +
-     * (ou, ov), 4 floats: su, sv, ou, ov; 0 for xatlas's and for islands packed one by one, uv_islands). */
+     * (ou, ov), 4 floats: su, sv, ou, ov; 0 for xatlas's and for islands packed one by one: MS_UV_PACK_ISLANDS). */
     size_t n_objects;
     int *object_uv_set;
     float *object_scale_offset;

@@ -164,7 +164,7 @@ _Lightmap = _mirror("ms_lightmap", [
     ("charts", _size), ("uv_cached", ctypes.c_int)])
 _BakeOptions = _mirror("ms_bake_options", [("points", _PointsOptions), ("size", ctypes.c_int), ("uv_set", ctypes.c_int),
                                            ("dilate", ctypes.c_int), ("padding", ctypes.c_int), ("texel_density", _f),
-                                           ("uv_cache", ctypes.c_char_p), ("uv_islands", ctypes.c_int)])
+                                           ("uv_cache", ctypes.c_char_p), ("uv_packing", ctypes.c_int)])
 
 _ERR = ctypes.c_char_p
 
@@ -223,6 +223,7 @@ __version__ = _version(None, None, None).decode()
 _PATTERNS = {"grid": 0, "stratified": 1, "interleaved": 2}
 _ISAS = {"auto": 0, "scalar": 1, "avx2": 2, "avx512": 3}
 _SHADINGS = {"standard": 0, "diffuse": 1}
+_UV_PACKINGS = {"default": 0, "islands": 1, "regions": 2}
 _SHAPES = {"rect": 0, "disk": 1, "sphere": 2, "triangle": 3, "sun": 4}
 _SHAPE_NAMES = {v: k for k, v in _SHAPES.items()}
 # A light dict's keys per shape: required, then optional.
@@ -752,7 +753,7 @@ def light_irradiance(light, point, normal):
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
          dilate=4, padding=2, accel=None, progress=None, max_memory=0, texel_density=0.0, uv_cache=None,
-         uv_islands=False):
+         uv_packing="default"):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
     (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off
     the triangles; position in the scene's frame: add scene.origin for world coordinates), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked
@@ -761,8 +762,9 @@ def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed
     (Error with status 3). texel_density: texels per world unit on as many pages as it takes (the images
     then hold the pages stacked: (size * pages, size), page p in rows p*size..; "page" the page of each
     triangle, "page_fill" each page's fraction of texel centres on triangles); uv_cache: a UV cache file
-    to take the UVs from when it matches (docs/baking.md); uv_islands: pack the kept layouts island by
-    island (ms_bake_options.uv_islands)."""
+    to take the UVs from when it matches (docs/baking.md); uv_packing (ms_bake_options.uv_packing): "default"
+    (the file's UVs as they are where they serve, else "islands"), "islands" (each kept layout's islands
+    packed one by one) or "regions" (each object's layout moved whole: one scale-offset per object)."""
     if not isinstance(scene, Scene):
         raise ValueError("scene: expected a Scene (load() or default_scene()), got %s" % type(scene).__name__)
     if accel is not None and not isinstance(accel, Accel):
@@ -781,7 +783,7 @@ def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed
     o.dilate = -1 if dilate == 0 else int(dilate)
     o.padding = int(padding)
     o.texel_density = float(texel_density)
-    o.uv_islands = 1 if uv_islands else 0
+    o.uv_packing = _choice("uv_packing", uv_packing, _UV_PACKINGS)
     cache = os.fsencode(uv_cache) if uv_cache is not None else None
     o.uv_cache = cache
     lm, err = _Lightmap(), _errbuf()

@@ -26,8 +26,11 @@ static void usage(FILE *f)
         "  --uv N              UV set tried first: 0..%d (glTF TEXCOORD_N, assimp channel N; default 1); each\n"
         "                      object keeps the first of its sets that is a valid layout (no overlap), xatlas\n"
         "                      charts objects without one; or 'xatlas' to unwrap every mesh\n"
-        "  --uv-islands        pack the kept layouts island by island beside xatlas's charts (pages fill far\n"
-        "                      better; an object then has no single scale-offset: use the glb's TEXCOORD_1)\n"
+        "                      Kept layouts are packed island by island beside xatlas's charts (engines read\n"
+        "                      the glb's TEXCOORD_1), unless the file's UVs serve as they are\n"
+        "  --uv-regions        move each kept layout whole into a rectangle of its own instead: one scale-offset\n"
+        "                      per object (Unity's lightmapScaleOffset), pages far less full\n"
+        "  --uv-islands        pack island by island even where the file's UVs would serve as they are\n"
         "  --size N            lightmap width and height in texels (default 1024)\n"
         "  -o OUT.exr          channels R, G, B (irradiance), S and V (default lightmap.exr);\n"
         "                      several lights: S0, S1, ..., V0, V1, ... (one per light)\n"
@@ -89,7 +92,7 @@ static void pass_line_plain(void *user, const char *pass, double seconds)
 
 enum { O_UV = 256, O_SIZE, O_PNG, O_STATS, O_VIS, O_SHADOW, O_DILATE, O_PADDING, O_METHOD, O_PATTERN, O_SAMPLES, O_SEED,
        O_THREADS, O_ISA, O_QUIET, O_HELP, O_MPI_SCHEDULE, O_MPI_CHUNK, O_VERBOSE, O_MAX_MEMORY, O_GLTF, O_NO_LEAK_FIX,
-       O_NO_SEAM_STITCH, O_TEXEL_DENSITY, O_UV_CACHE, O_NO_UV_CACHE, O_UV_ISLANDS };
+       O_NO_SEAM_STITCH, O_TEXEL_DENSITY, O_UV_CACHE, O_NO_UV_CACHE, O_UV_ISLANDS, O_UV_REGIONS };
 static const struct option longopts[] = {
     { "uv", required_argument, 0, O_UV }, { "size", required_argument, 0, O_SIZE },
     { "png", required_argument, 0, O_PNG }, { "stats", required_argument, 0, O_STATS },
@@ -104,6 +107,7 @@ static const struct option longopts[] = {
     { "no-seam-stitch", no_argument, 0, O_NO_SEAM_STITCH },
     { "texel-density", required_argument, 0, O_TEXEL_DENSITY }, { "uv-cache", required_argument, 0, O_UV_CACHE },
     { "no-uv-cache", no_argument, 0, O_NO_UV_CACHE }, { "uv-islands", no_argument, 0, O_UV_ISLANDS },
+    { "uv-regions", no_argument, 0, O_UV_REGIONS },
 #ifdef MS_HAVE_MPI
     { "mpi-schedule", required_argument, 0, O_MPI_SCHEDULE }, { "mpi-chunk", required_argument, 0, O_MPI_CHUNK },
 #endif
@@ -206,7 +210,8 @@ static int take_option(bake_request *r, ms_cli_parser *cli, int c)
     }
     case O_UV_CACHE: r->outs[OUT_UV_CACHE].path = optarg; break;
     case O_NO_UV_CACHE: r->no_uv_cache = 1; break;
-    case O_UV_ISLANDS: r->bo.uv_islands = 1; break;
+    case O_UV_ISLANDS: r->bo.uv_packing = MS_UV_PACK_ISLANDS; break;
+    case O_UV_REGIONS: r->bo.uv_packing = MS_UV_PACK_REGIONS; break;
     case O_QUIET: r->quiet = 1; break;
     case O_MAX_MEMORY: if (ms_cli_parse_size(cli, "--max-memory", optarg, &r->bo.points.max_memory)) return EXIT_BAD_INPUT; break;
     case O_VERBOSE: ms_set_warning_verbose(1); break;
@@ -237,11 +242,14 @@ static void report(const ms_bake_options *bo, const ms_output *outs, const ms_li
         fprintf(stderr, "bake: %zu triangles not baked: %zu of meshes with \"lightmap\": false, %zu for the reasons "
                 "warned about\n", lm->excluded_tris + lm->unbaked_tris, lm->excluded_tris, lm->unbaked_tris);
     char uvs[160], pages[200];
-    size_t kept = 0;
-    for (size_t o = 0; o < lm->n_objects; o++) kept += lm->object_uv_set[o] >= 0;
+    size_t kept = 0, whole = 0;   /* objects in their own UVs; of them, moved whole (a scale-offset) */
+    for (size_t o = 0; o < lm->n_objects; o++) {
+        kept += lm->object_uv_set[o] >= 0;
+        whole += lm->object_uv_set[o] >= 0 && lm->object_scale_offset && lm->object_scale_offset[4 * o] != 0.0f;
+    }
     if (lm->uv_cached) snprintf(uvs, sizeof uvs, "UVs from %s in %.3fs", bo->uv_cache, lm->unwrap_s);
     else snprintf(uvs, sizeof uvs, "%zu objects in their own UVs%s, %zu triangles unwrapped by xatlas into %zu charts in %.3fs",
-                  kept, bo->uv_islands && kept ? " (islands packed one by one)" : "", lm->unwrapped_tris, lm->charts,
+                  kept, whole < kept ? " (islands packed one by one)" : "", lm->unwrapped_tris, lm->charts,
                   lm->unwrap_s);
     int at = snprintf(pages, sizeof pages, "%d page%s, texel centres on triangles", lm->pages, lm->pages > 1 ? "s" : "");
     for (int p = 0; p < lm->pages && lm->page_fill && at < (int)sizeof pages - 16; p++)

@@ -61,7 +61,7 @@ static const layout_row rows[] = {
     FIELD(ms_points_options, max_memory),
     STRUCT(ms_bake_options), FIELD(ms_bake_options, points), FIELD(ms_bake_options, size), FIELD(ms_bake_options, uv_set),
     FIELD(ms_bake_options, dilate), FIELD(ms_bake_options, padding), FIELD(ms_bake_options, no_leak_fix),
-    FIELD(ms_bake_options, pass), FIELD(ms_bake_options, pass_user), FIELD(ms_bake_options, texel_density), FIELD(ms_bake_options, uv_islands),
+    FIELD(ms_bake_options, pass), FIELD(ms_bake_options, pass_user), FIELD(ms_bake_options, texel_density), FIELD(ms_bake_options, uv_packing),
     FIELD(ms_bake_options, uv_cache),
     STRUCT(ms_lightmap), FIELD(ms_lightmap, frame), FIELD(ms_lightmap, position), FIELD(ms_lightmap, normal),
     FIELD(ms_lightmap, triangle), FIELD(ms_lightmap, uv), FIELD(ms_lightmap, n_tris), FIELD(ms_lightmap, texels),

@@ -9,7 +9,7 @@ void ms_bake_gltf_lightmap_extras(cJSON *prim, const ms_lightmap *lm, uint32_t o
     cJSON *j = cJSON_AddObjectToObject(ex, "lightmap");
     cJSON_AddNumberToObject(j, "page", page);
     const int has = lm->object_uv_set && object < lm->n_objects;
-    /* a layout packed island by island (uv_islands) has no one scale-offset: TEXCOORD_1 alone, as xatlas's */
+    /* a layout packed island by island (MS_UV_PACK_ISLANDS) has no one scale-offset: TEXCOORD_1 alone, as xatlas's */
     const int set = has && lm->object_scale_offset[4 * (size_t)object] != 0.0f ? lm->object_uv_set[object] : -1;
     cJSON_AddNumberToObject(j, "uvSet", set);
     if (set >= 0) {

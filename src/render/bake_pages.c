@@ -43,7 +43,7 @@ ms_status ms_bake_choose_uvs(const ms_scene *sc, const ms_bake_options *o, int s
     lm->n_objects = nobj;
     lm->n_tris = n;
     const double t0 = omp_get_wtime();
-    ms_bake_uv_params p = { o->uv_set, size, padding, o->texel_density, o->uv_islands != 0 };
+    ms_bake_uv_params p = { o->uv_set, size, padding, o->texel_density, o->uv_packing };
     ms_bake_uv_layout L = { lm->uv, lm->page, 1, lm->object_uv_set, lm->object_scale_offset };
     lm->uv_key = ms_uv_cache_key(sc, &p);
     if (o->uv_cache) {

@@ -326,7 +326,7 @@ static int fit_one_page(ms_xpack *xp, double area, int size, int pad, double *sc
     return 0;
 }
 
-/* Kept layouts packed island by island (ms_bake_options.uv_islands): the triangles to place (use), their file
+/* Kept layouts packed island by island (MS_UV_PACK_ISLANDS): the triangles to place (use), their file
  * UVs (src), and per object its texels per UV unit at scale 1 (k: world units per UV unit, as region_of). */
 typedef struct islands {
     const uint8_t *use;
@@ -426,7 +426,7 @@ fail:
     return rc;
 }
 
-/* The kept layouts island by island (ms_bake_options.uv_islands), packed with xatlas's charts of the rest: one
+/* The kept layouts island by island (MS_UV_PACK_ISLANDS, the default), packed with xatlas's charts of the rest: one
  * texel density for all, but no object keeps one scale-offset (its object_scale_offset stays 0). 0, or -1. */
 static int place_islands(const ms_scene *sc, size_t n, size_t nobj, const object_uv *ob, const uint8_t *use, const float *src,
                          const float *xtri, const uint8_t *want, const uint32_t *group, int size, int pad, double T, float *xuv,
@@ -501,7 +501,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     if (partial)
         ms_warn("%zu triangles overlap others in their object's UV layout: xatlas charts them, the rest keeps the layout", partial);
     if (fallback) ms_warn("%zu objects have no valid UV set %d and are baked in another set of theirs", fallback, p->uv_set);
-    if (!n_want && !rep->overlap_texels && inside && !weighted && !mixed && !(T > 0.0) && !p->islands) {   /* the file's UVs as they are */
+    if (!n_want && !rep->overlap_texels && inside && !weighted && !mixed && !(T > 0.0) && p->packing != MS_UV_PACK_ISLANDS) {   /* the file's UVs as they are */
         for (size_t t = 0; t < n; t++)
             if (use[t]) memcpy(out->uv + 6 * t, src + 6 * t, 6 * sizeof(float));
         for (size_t o = 0; o < nobj; o++)
@@ -511,7 +511,8 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
     }
     /* xatlas's input: positions scaled by each mesh's weight (xatlas sizes charts by world area), one mesh
      * per object */
-    if (n_want || (p->islands && n_use)) {
+    const int islands = p->packing != MS_UV_PACK_REGIONS;
+    if (n_want || (islands && n_use)) {
         xuv = malloc(n * 6 * sizeof *xuv);
         xpage = calloc(n, sizeof *xpage);
         group = malloc(n * sizeof *group);
@@ -523,7 +524,7 @@ int ms_bake_uvs(const ms_scene *sc, const ms_bake_uv_params *p, ms_bake_uv_layou
                 for (int k = 0; k < 9; k++) scaled[9 * t + k] = sc->tri[9 * t + k] * (want[t] ? scale_of(sc, t) : 1.0f);
     }
     const float *xtri = weighted ? scaled : sc->tri;
-    if (p->islands && n_use) {   /* every kept layout island by island, with xatlas's charts */
+    if (islands && n_use) {   /* every kept layout island by island, with xatlas's charts */
         if (place_islands(sc, n, nobj, ob, use, src, xtri, want, group, size, pad, T, xuv, xpage, out, rep, err, errlen)) goto out;
         rc = 0;
         goto out;

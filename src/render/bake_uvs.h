@@ -10,7 +10,7 @@ typedef struct ms_bake_uv_params {
     int uv_set;              /* the set tried first for every object; -1: xatlas for all */
     int size, padding;
     float density;           /* texels per world unit (times each mesh's scale); 0: everything on one page */
-    int islands;             /* 1: kept layouts packed island by island (ms_bake_options.uv_islands) */
+    ms_uv_packing packing;   /* ms_bake_options.uv_packing */
 } ms_bake_uv_params;
 
 /* What ms_bake_uvs did, for the caller's report. */

@@ -54,7 +54,7 @@ uint64_t ms_uv_cache_key(const ms_scene *sc, const ms_bake_uv_params *p)
         if (has) hash_bytes(&s, sc->tri_uv[u], (size_t)n * 6 * sizeof(float));
     }
     /* the padding as the packers apply it (a cache laid out by an earlier rule for the same number is remade) */
-    const int ints[5] = { p->uv_set, p->size, p->padding, p->islands, ms_chart_padding(p->padding) };
+    const int ints[5] = { p->uv_set, p->size, p->padding, (int)p->packing, ms_chart_padding(p->padding) };
     hash_bytes(&s, ints, sizeof ints);
     hash_bytes(&s, &p->density, sizeof p->density);
     ms_unwrap_tuning tu;   /* the chart weights: a cache charted with other weights is not used */

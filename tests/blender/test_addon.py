@@ -259,14 +259,14 @@ class BakeTest(unittest.TestCase):
         np.testing.assert_allclose(mask, s, rtol=0, atol=1e-6)
 
     def test_pages(self):
-        """A texel density over several pages, the UV maps' islands packed one by one: each page's images against
-        the CLI's page files of the exported scene (`--uv-islands`) texel for texel, each object's page recorded
-        on it."""
+        """A texel density over several pages, each object's UV map moved whole (Whole Layouts): each page's
+        images against the CLI's page files of the exported scene (`--uv-regions`) texel for texel, each object's
+        page recorded on it."""
         build_bake_scene()
         sc = bpy.context.scene
         sc.microshadow.bake_texel_density, sc.microshadow.bake_size = 28.0, 256
-        sc.microshadow.bake_pack_islands = True
-        self.addCleanup(setattr, sc.microshadow, "bake_pack_islands", False)
+        sc.microshadow.bake_whole_layouts = True
+        self.addCleanup(setattr, sc.microshadow, "bake_whole_layouts", False)
         sc.microshadow.bake_output = os.path.join(OUT, "pages")
         self.assertEqual(bpy.ops.microshadow.bake(), {"FINISHED"})
         pages = 1 + max(bpy.data.objects[n]["microshadow_lightmap_page"] for n in ("ground", "cube", "ico", "monkey"))
@@ -275,7 +275,7 @@ class BakeTest(unittest.TestCase):
         self.assertEqual(bpy.ops.microshadow.export_scene(directory=exported), {"FINISHED"})
         out = os.path.join(OUT, "cli_pages.exr")
         r = run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256",
-                            "--texel-density", "28", "--uv-islands", "--samples", "256", "--threads", "2", "--quiet",
+                            "--texel-density", "28", "--uv-regions", "--samples", "256", "--threads", "2", "--quiet",
                             "-o", out])
         self.assertEqual(r.returncode, 0, r.stderr)
         for p in range(pages):

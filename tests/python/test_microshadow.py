@@ -531,8 +531,9 @@ class BuiltSceneTest(unittest.TestCase):
 
     def test_bake_islands(self):
         # a ground (UVs: the unit square) and an object of four 0.5 x 0.5 quads whose UVs are 0.2 x 0.2 squares in
-        # the corners of the unit square: with uv_islands each quad moves whole, at one texel density, and the
-        # page fills far more than with one region per object
+        # the corners of the unit square: by default (their layouts overlap, so they are not kept as they are) each
+        # quad moves whole as an island, at one texel density, and the page fills far more than with one region
+        # per object (uv_packing="regions")
         tri, uv, obj = [], [], []
         def quad(x0, z0, w, y, u0, v0, uw, o):
             p = [[x0, y, z0 + w], [x0 + w, y, z0 + w], [x0 + w, y, z0], [x0, y, z0]]
@@ -546,8 +547,12 @@ class BuiltSceneTest(unittest.TestCase):
             quad(x, z, 0.5, 0.3, u, v, 0.2, 1)
         sc = ms.scene_from_arrays(np.array(tri), [LIGHTS["rect"]], camera=self.CAMERA, uvs=[np.array(uv)],
                                   objects=np.array(obj))
-        whole = ms.bake(sc, size=256, uv=0, samples=256)
-        isl = ms.bake(sc, size=256, uv=0, samples=256, uv_islands=True)
+        whole = ms.bake(sc, size=256, uv=0, samples=256, uv_packing="regions")
+        isl = ms.bake(sc, size=256, uv=0, samples=256)
+        forced = ms.bake(sc, size=256, uv=0, samples=256, uv_packing="islands")
+        np.testing.assert_array_equal(isl["uv"], forced["uv"])
+        with self.assertRaises(ValueError):
+            ms.bake(sc, size=256, uv=0, samples=256, uv_packing="island")
         self.assertGreater(isl["page_fill"][0], 2 * whole["page_fill"][0])
         src, got = np.array(uv, np.float64), isl["uv"].astype(np.float64) * 256
         density = []
