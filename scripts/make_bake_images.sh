@@ -4,8 +4,9 @@
 # headless chromium beside microshadow's own frame of the same camera. Prints the bunny bake's summary line
 # (bake time, texels/s, seams) and the validator's verdict on its glb. With HELMET_DIR set to a folder holding
 # Khronos' FlightHelmet sample (FlightHelmet.gltf; fetched by hand, it is not in ../shared), the same three
-# pictures of it on a ground with two rect lights, baked with the default options.
-# Usage: [HELMET_DIR=DIR] scripts/make_bake_images.sh [BUILD_DIR]   (a Release build: default build/; needs node, chromium and
+# pictures of it on a ground with two rect lights, baked with the default options; with MIXED_DIR set to
+# Bevy's assets/models/MixedLightingExample folder (MixedLightingExample.gltf), the same of it.
+# Usage: [HELMET_DIR=DIR] [MIXED_DIR=DIR] scripts/make_bake_images.sh [BUILD_DIR]   (a Release build: default build/; needs node, chromium and
 # viewer/node_modules for the viewer's image: scripts/install-deps.sh)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -61,4 +62,21 @@ EOF
   node "$root/viewer/validate.mjs" "$tmp/helmet.glb"
   node "$root/viewer/screenshot.mjs" "$tmp/helmet.glb" "$tmp/helmet.json" "$out/bake_helmet_viewer.png"
   "$ms" "$tmp/helmet.json" --shading diffuse -o "$out/bake_helmet_frame.png"
+fi
+
+# Bevy's MixedLightingExample (a ground, a sphere and the four parts of the SheenChair, each with a TEXCOORD_1 of
+# its own), two rect lights (40 W above the chair, 15 W from the side; its punctual sun left out), default bake
+# options at 1024².
+if [ -n "${MIXED_DIR:-}" ]; then
+  cat >"$tmp/mixed.json" <<EOF
+{ "meshes": [ { "file": "$(cd "$MIXED_DIR" && pwd)/MixedLightingExample.gltf" } ],
+  "camera": { "eye": [1.4, 1.0, 1.5], "target": [0, 0.3, 0], "up": [0, 1, 0], "fov_y": 45, "width": 512, "height": 512 },
+  "lights": [ { "corner": [0.2, 1.6, 0.0], "edge_s": [0.5, 0, 0], "edge_t": [0, 0, 0.5], "power": 40 },
+              { "corner": [-1.2, 0.4, -0.6], "edge_s": [0, 0, 0.5], "edge_t": [0, 0.5, 0], "power": 15 } ] }
+EOF
+  "$ms" bake "$tmp/mixed.json" --size 1024 -o "$tmp/mixed.exr" --png "$out/bake_mixed_lightmap.png" --gltf "$tmp/mixed.glb" \
+      2>&1 | grep -v '^bake: '
+  node "$root/viewer/validate.mjs" "$tmp/mixed.glb"
+  node "$root/viewer/screenshot.mjs" "$tmp/mixed.glb" "$tmp/mixed.json" "$out/bake_mixed_viewer.png"
+  "$ms" "$tmp/mixed.json" --shading diffuse -o "$out/bake_mixed_frame.png"
 fi
