@@ -384,6 +384,10 @@ static void test_bad_options(void **st)
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_ERR_INVALID);
     bake_options(&bo, 16, 1, 100);
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_ERR_INVALID);
+    bake_options(&bo, 16, 1, 256);
+    bo.uv_packing = (ms_uv_packing)3;
+    assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_ERR_INVALID);
+    assert_non_null(strstr(err, "uv_packing 3"));
     assert_null(lm.frame.vis);
     ms_scene_free(&sc);
 }

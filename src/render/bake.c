@@ -263,6 +263,10 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
         snprintf(err, errlen, "UV set must be in [0, %d], or -1 for xatlas", MS_MAX_UV_SETS - 1);
         return MS_ERR_INVALID;
     }
+    if ((int)o->uv_packing < MS_UV_PACK_DEFAULT || (int)o->uv_packing > MS_UV_PACK_REGIONS) {
+        snprintf(err, errlen, "ms_bake: uv_packing %d is not one of 0 (default), 1 (islands), 2 (regions)", (int)o->uv_packing);
+        return MS_ERR_INVALID;
+    }
     ms_status bst = bake_budget(scene, o, size, 1, 0, NULL, err, errlen);
     if (bst) return bst;
     const int padding = o->padding > 0 ? o->padding : 2;
