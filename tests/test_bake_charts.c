@@ -214,23 +214,6 @@ static int centre_in(const float *u, double px, double py)
     return (e[0] >= 0 && e[1] >= 0 && e[2] >= 0) || (e[0] <= 0 && e[1] <= 0 && e[2] <= 0);
 }
 
-/* Irradiance (green) of page `page` at (u, v) of it, bilinear with the texel rows of that page only. */
-static double bilinear_page(const ms_frame *f, int page, double u, double v)
-{
-    const int S = f->width;
-    const double x = u * S - 0.5, y = v * S - 0.5;
-    const int x0 = (int)floor(x), y0 = (int)floor(y);
-    const double fx = x - x0, fy = y - y0;
-    double s = 0.0;
-    for (int j = 0; j < 2; j++)
-        for (int i = 0; i < 2; i++) {
-            const int xx = x0 + i < 0 ? 0 : x0 + i >= S ? S - 1 : x0 + i;
-            const int yy = y0 + j < 0 ? 0 : y0 + j >= S ? S - 1 : y0 + j;
-            s += (i ? fx : 1 - fx) * (j ? fy : 1 - fy) * f->rgb[3 * ((size_t)(page * S + yy) * S + xx) + 1];
-        }
-    return s;
-}
-
 static void test_pages(void **st)
 {
     (void)st;
@@ -306,23 +289,12 @@ static void test_pages(void **st)
         double a = (double)(tu_rng_next(&rng) % 100000) / 100000.0, b = (double)(tu_rng_next(&rng) % 100000) / 100000.0;
         if (a + b > 1.0) { a = 1.0 - a; b = 1.0 - b; }
         const double w[3] = { 1.0 - a - b, a, b };
-        float p[3] = { 0, 0, 0 };
-        double uv[2] = { 0, 0 };
-        for (int c = 0; c < 3; c++) {
-            for (int d = 0; d < 3; d++) p[d] += (float)(w[c] * sc.tri[9 * t + 3 * c + d]);
-            for (int d = 0; d < 2; d++) uv[d] += w[c] * lm.uv[6 * t + 2 * c + d];
-        }
+        float p[3];
+        double uv[2];
+        tu_tri_point(&sc, lm.uv, t, w, p, uv);
         const float nrm[3] = { 0, 1, 0 };
-        const uint32_t tri = (uint32_t)t, key[2] = { (uint32_t)(uv[0] * PSIZE), (uint32_t)(uv[1] * PSIZE) };
-        ms_points pts = { 1, p, nrm, &tri, key };
-        ms_points_options po;
-        memset(&po, 0, sizeof po);
-        po.samples = 256;
-        po.isa = tu_isa_cap();
-        float S;
-        assert_int_equal(ms_visibility_points(acc, NULL, &pts, &po, NULL, &S, NULL, NULL, err, sizeof err), MS_OK);
-        const double want = ms_light_irradiance(&sc.light, p, nrm) * S * sc.light.emission.y;
-        const double got = bilinear_page(&lm.frame, (int)lm.page[t], uv[0], uv[1]);
+        const double want = tu_point_irradiance(acc, &sc, p, nrm, (uint32_t)t, uv, PSIZE);
+        const double got = tu_lightmap_green(&lm.frame, (int)lm.page[t], uv[0], uv[1]);
         sum += fabs(got - want) / emax;
         worst = fmax(worst, fabs(got - want) / emax);
         seen[lm.page[t]]++;

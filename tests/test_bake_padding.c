@@ -45,23 +45,6 @@ static void write_grid(const char *path)
     fclose(f);
 }
 
-/* Irradiance (green) at (u, v), bilinear, edges clamped. */
-static double bilinear(const ms_frame *f, double u, double v)
-{
-    const int S = f->width;
-    const double x = u * S - 0.5, y = v * S - 0.5;
-    const int x0 = (int)floor(x), y0 = (int)floor(y);
-    const double fx = x - x0, fy = y - y0;
-    double s = 0.0;
-    for (int j = 0; j < 2; j++)
-        for (int i = 0; i < 2; i++) {
-            const int xx = x0 + i < 0 ? 0 : x0 + i >= S ? S - 1 : x0 + i;
-            const int yy = y0 + j < 0 ? 0 : y0 + j >= S ? S - 1 : y0 + j;
-            s += (i ? fx : 1 - fx) * (j ? fy : 1 - fy) * f->rgb[3 * ((size_t)yy * S + xx) + 1];
-        }
-    return s;
-}
-
 /* 1 if the open square of side 2 about (px, py) meets UV triangle u (texels): the boxes overlap and no edge
  * separates them (a texel whose square only touches the triangle gets no weight in a lookup there). */
 static int square_meets(const double u[3][2], double px, double py)
@@ -142,23 +125,12 @@ static void test_tight_charts_do_not_mix(void **st)
                     w[e] = j / 8.0;
                     w[(e + 1) % 3] = 1.0 - j / 8.0;
                     for (int c = 0; c < 3; c++) w[c] = 0.99 * w[c] + (c == (e + 2) % 3 ? 0.01 : 0.0);
-                    float p[3] = { 0, 0, 0 };
-                    double uv[2] = { 0, 0 };
-                    for (int c = 0; c < 3; c++) {
-                        for (int d = 0; d < 3; d++) p[d] += (float)(w[c] * sc.tri[9 * t + 3 * c + d]);
-                        for (int d = 0; d < 2; d++) uv[d] += w[c] * lm.uv[6 * t + 2 * c + d];
-                    }
+                    float p[3];
+                    double uv[2];
+                    tu_tri_point(&sc, lm.uv, t, w, p, uv);
                     const float nrm[3] = { 0, 1, 0 };
-                    const uint32_t tri = (uint32_t)t, key[2] = { (uint32_t)(uv[0] * SIZE), (uint32_t)(uv[1] * SIZE) };
-                    ms_points pts = { 1, p, nrm, &tri, key };
-                    ms_points_options po;
-                    memset(&po, 0, sizeof po);
-                    po.samples = 256;
-                    po.isa = tu_isa_cap();
-                    float S;
-                    assert_int_equal(ms_visibility_points(acc, NULL, &pts, &po, NULL, &S, NULL, NULL, err, sizeof err), MS_OK);
-                    const double want = ms_light_irradiance(&sc.light, p, nrm) * S * sc.light.emission.y;
-                    const double d = fabs(bilinear(&lm.frame, uv[0], uv[1]) - want) / emax;
+                    const double want = tu_point_irradiance(acc, &sc, p, nrm, (uint32_t)t, uv, SIZE);
+                    const double d = fabs(tu_lightmap_green(&lm.frame, 0, uv[0], uv[1]) - want) / emax;
                     worst = fmax(worst, d);
                     sum += d;
                     n++;

@@ -69,21 +69,6 @@ static int floor_uv(const ms_scene *sc, const ms_lightmap *lm, double x, double 
     return 0;
 }
 
-static double bilinear_g(const ms_frame *f, double u, double v)
-{
-    const double x = u * f->width - 0.5, y = v * f->height - 0.5;
-    const int x0 = (int)floor(x), y0 = (int)floor(y);
-    const double fx = x - x0, fy = y - y0;
-    double s = 0.0;
-    for (int j = 0; j < 2; j++)
-        for (int i = 0; i < 2; i++) {
-            const int xx = x0 + i < 0 ? 0 : x0 + i >= f->width ? f->width - 1 : x0 + i;
-            const int yy = y0 + j < 0 ? 0 : y0 + j >= f->height ? f->height - 1 : y0 + j;
-            s += (i ? fx : 1 - fx) * (j ? fy : 1 - fy) * f->rgb[3 * ((size_t)yy * f->width + xx) + 1];
-        }
-    return s;
-}
-
 /* At floor points 0.3 texel outside each side of the box: baked (bilinear) against the oracle; mean and worst
  * |dE| / Emax. */
 static void contact_error(const ms_scene *sc, const ms_lightmap *lm, double *mean, double *worst)
@@ -111,17 +96,9 @@ static void contact_error(const ms_scene *sc, const ms_lightmap *lm, double *mea
             double uv[2] = { 0, 0 };
             uint32_t tri = 0;
             assert_true(floor_uv(sc, lm, x, z, uv, &tri));
-            const double got = bilinear_g(&lm->frame, uv[0], uv[1]);
+            const double got = tu_lightmap_green(&lm->frame, 0, uv[0], uv[1]);
             const float p[3] = { (float)x, 0.0f, (float)z }, nrm[3] = { 0, 1, 0 };
-            const uint32_t key[2] = { (uint32_t)floor(uv[0] * SIZE), (uint32_t)floor(uv[1] * SIZE) };
-            ms_points pts = { 1, p, nrm, &tri, key };
-            ms_points_options po;
-            memset(&po, 0, sizeof po);
-            po.samples = 256;
-            po.isa = tu_isa_cap();
-            float S;
-            assert_int_equal(ms_visibility_points(acc, NULL, &pts, &po, NULL, &S, NULL, NULL, err, sizeof err), MS_OK);
-            const double want = ms_light_irradiance(&sc->light, p, nrm) * S * sc->light.emission.y;
+            const double want = tu_point_irradiance(acc, sc, p, nrm, tri, uv, SIZE);
             sum += fabs(got - want) / emax;
             *worst = fmax(*worst, fabs(got - want) / emax);
             n++;

@@ -262,6 +262,47 @@ void tu_bake_options(ms_bake_options *bo, int size, int uv_set, int samples)
     bo->points.isa = tu_isa_cap();
 }
 
+void tu_tri_point(const ms_scene *sc, const float *uvs, size_t t, const double w[3], float p[3], double uv[2])
+{
+    p[0] = p[1] = p[2] = 0.0f;
+    uv[0] = uv[1] = 0.0;
+    for (int c = 0; c < 3; c++) {
+        for (int d = 0; d < 3; d++) p[d] += (float)(w[c] * sc->tri[9 * t + 3 * (size_t)c + d]);
+        for (int d = 0; d < 2; d++) uv[d] += w[c] * uvs[6 * t + 2 * (size_t)c + d];
+    }
+}
+
+double tu_lightmap_green(const ms_frame *f, int page, double u, double v)
+{
+    const int S = f->width;
+    const double x = u * S - 0.5, y = v * S - 0.5;
+    const int x0 = (int)floor(x), y0 = (int)floor(y);
+    const double fx = x - x0, fy = y - y0;
+    double s = 0.0;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            const int xx = x0 + i < 0 ? 0 : x0 + i >= S ? S - 1 : x0 + i;
+            const int yy = y0 + j < 0 ? 0 : y0 + j >= S ? S - 1 : y0 + j;
+            s += (i ? fx : 1 - fx) * (j ? fy : 1 - fy) * f->rgb[3 * ((size_t)(page * S + yy) * S + xx) + 1];
+        }
+    return s;
+}
+
+double tu_point_irradiance(const ms_accel *acc, const ms_scene *sc, const float p[3], const float n[3], uint32_t tri,
+                           const double uv[2], int size)
+{
+    const uint32_t key[2] = { (uint32_t)(uv[0] * size), (uint32_t)(uv[1] * size) };
+    ms_points pts = { 1, p, n, &tri, key };
+    ms_points_options po;
+    memset(&po, 0, sizeof po);
+    po.samples = 256;
+    po.isa = tu_isa_cap();
+    float S;
+    char err[512] = "";
+    assert_int_equal(ms_visibility_points(acc, NULL, &pts, &po, NULL, &S, NULL, NULL, err, sizeof err), MS_OK);
+    return ms_light_irradiance(&sc->light, p, n) * S * sc->light.emission.y;
+}
+
 void tu_render_options_default(ms_render_options *o)
 {
     ms_render_options_default(o);

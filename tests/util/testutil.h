@@ -122,6 +122,17 @@ void tu_render_options_default(ms_render_options *o);
 /* Zeroed bake options with the lightmap's size, UV set (-1: xatlas for every triangle), light samples and the
  * run's ISA cap. */
 void tu_bake_options(ms_bake_options *bo, int size, int uv_set, int samples);
+/* The point of triangle t of sc with barycentric weights w (of its three vertices), in space (p) and in the
+ * triangle's lightmap UVs (uvs: 6 floats per triangle, as ms_lightmap.uv). */
+void tu_tri_point(const ms_scene *sc, const float *uvs, size_t t, const double w[3], float p[3], double uv[2]);
+/* A lightmap's irradiance (green) at (u, v) of page `page`, looked up bilinearly as an engine does, from that
+ * page's texel rows only (edges clamped). */
+double tu_lightmap_green(const ms_frame *f, int page, double u, double v);
+/* The oracle of a bake's lookups: the irradiance (green) of the scene's light at point p (normal n, on triangle
+ * tri, lightmap coordinates uv of a size x size page for the pattern's key), E_unshadowed x S with S from
+ * ms_visibility_points at 256 samples. */
+double tu_point_irradiance(const ms_accel *acc, const ms_scene *sc, const float p[3], const float n[3], uint32_t tri,
+                           const double uv[2], int size);
 int tu_isa_allowed(ms_isa isa);
 
 /* splitmix64: small, seedable, reproducible random numbers for the randomized tests. */
