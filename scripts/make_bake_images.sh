@@ -46,6 +46,16 @@ import json; s = json.load(open('$bunny')); s['camera']['width'] = s['camera']['
 json.dump({'camera': s['camera']}, open('$tmp/camera.json', 'w'))"
 node "$root/viewer/screenshot.mjs" "$tmp/bunny.glb" "$tmp/camera.json" "$out/bake_bunny_viewer.png" --exposure "$exposure"
 
+# An asset's three pictures from its scene file $tmp/NAME.json: the default bake at 1024² (its lightmap, and its glb
+# through the validator), the viewer's screenshot with the exposure the bake wrote, the --shading diffuse frame.
+asset_pictures() {
+  "$ms" bake "$tmp/$1.json" --size 1024 -o "$tmp/$1.exr" --png "$out/bake_$1_lightmap.png" --gltf "$tmp/$1.glb" \
+      2>&1 | grep -v '^bake: '
+  node "$root/viewer/validate.mjs" "$tmp/$1.glb"
+  node "$root/viewer/screenshot.mjs" "$tmp/$1.glb" "$tmp/$1.json" "$out/bake_$1_viewer.png"
+  "$ms" "$tmp/$1.json" --shading diffuse -o "$out/bake_$1_frame.png"
+}
+
 # The FlightHelmet on a 2 x 2 ground, two rect lights (20 W above, 10 W from the side), default bake options at
 # 1024²; the viewer takes the exposure the bake wrote into the glb, the frame is --shading diffuse (what a
 # lightmap can show).
@@ -57,11 +67,7 @@ if [ -n "${HELMET_DIR:-}" ]; then
   "lights": [ { "corner": [-0.3, 0.8, 0.1], "edge_s": [0.4, 0, 0], "edge_t": [0, 0, 0.4], "power": 20 },
               { "corner": [0.8, -0.3, -0.2], "edge_s": [0, 0, 0.4], "edge_t": [0, 0.4, 0], "power": 10 } ] }
 EOF
-  "$ms" bake "$tmp/helmet.json" --size 1024 -o "$tmp/helmet.exr" --png "$out/bake_helmet_lightmap.png" --gltf "$tmp/helmet.glb" \
-      2>&1 | grep -v '^bake: '
-  node "$root/viewer/validate.mjs" "$tmp/helmet.glb"
-  node "$root/viewer/screenshot.mjs" "$tmp/helmet.glb" "$tmp/helmet.json" "$out/bake_helmet_viewer.png"
-  "$ms" "$tmp/helmet.json" --shading diffuse -o "$out/bake_helmet_frame.png"
+  asset_pictures helmet
 fi
 
 # Bevy's MixedLightingExample (a ground, a sphere and the four parts of the SheenChair, each with a TEXCOORD_1 of
@@ -74,9 +80,5 @@ if [ -n "${MIXED_DIR:-}" ]; then
   "lights": [ { "corner": [0.2, 1.6, 0.0], "edge_s": [0.5, 0, 0], "edge_t": [0, 0, 0.5], "power": 40 },
               { "corner": [-1.2, 0.4, -0.6], "edge_s": [0, 0, 0.5], "edge_t": [0, 0.5, 0], "power": 15 } ] }
 EOF
-  "$ms" bake "$tmp/mixed.json" --size 1024 -o "$tmp/mixed.exr" --png "$out/bake_mixed_lightmap.png" --gltf "$tmp/mixed.glb" \
-      2>&1 | grep -v '^bake: '
-  node "$root/viewer/validate.mjs" "$tmp/mixed.glb"
-  node "$root/viewer/screenshot.mjs" "$tmp/mixed.glb" "$tmp/mixed.json" "$out/bake_mixed_viewer.png"
-  "$ms" "$tmp/mixed.json" --shading diffuse -o "$out/bake_mixed_frame.png"
+  asset_pictures mixed
 fi

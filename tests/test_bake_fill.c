@@ -64,22 +64,33 @@ static void bake_uv0(const ms_scene *sc, int islands, float T, int padding, ms_l
     assert_int_equal(ms_bake(sc, NULL, &bo, lm, err, sizeof err), MS_OK);
 }
 
+/* The 2 x 2 ground and the 1.2 x 1.2 plate (UV0 the unit square each), with the two quads for xatlas when
+ * `tiles`, written into a fresh folder `name` and loaded into sc. */
+static void ground_and_plate(const char *name, int tiles, ms_scene *sc)
+{
+    const char *dir = tu_tmpdir(name);
+    char path[512], json[512], text[1024], err[512] = "";
+    write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
+    write_quad(tu_path(path, sizeof path, dir, "plate.obj"), 1.5f, 2.7f, -0.6f, 0.6f, 0.0f, 1);
+    if (tiles) {
+        write_quad(tu_path(path, sizeof path, dir, "tile0.obj"), -0.8f, -0.6f, -0.8f, -0.6f, 0.3f, 0);
+        write_quad(tu_path(path, sizeof path, dir, "tile1.obj"), 0.4f, 0.7f, 0.2f, 0.35f, 0.3f, 0);
+    }
+    snprintf(text, sizeof text,
+             "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"plate.obj\"}%s],"
+             "\"camera\":{\"eye\":[0.8,5,0.1],\"target\":[0.8,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
+             "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}",
+             tiles ? ",{\"file\":\"tile0.obj\"},{\"file\":\"tile1.obj\"}" : "");
+    tu_path(json, sizeof json, dir, "scene.json");
+    assert_int_equal(tu_write_file(json, text), 0);
+    assert_int_equal(ms_scene_load(json, sc, err, sizeof err), 0);
+}
+
 static void test_two_regions_bound(void **st)
 {
     (void)st;
-    const char *dir = tu_tmpdir("bake_fill");
-    char path[512], json[512], err[512] = "";
-    write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
-    write_quad(tu_path(path, sizeof path, dir, "plate.obj"), 1.5f, 2.7f, -0.6f, 0.6f, 0.0f, 1);
-    write_quad(tu_path(path, sizeof path, dir, "tile0.obj"), -0.8f, -0.6f, -0.8f, -0.6f, 0.3f, 0);
-    write_quad(tu_path(path, sizeof path, dir, "tile1.obj"), 0.4f, 0.7f, 0.2f, 0.35f, 0.3f, 0);
-    tu_path(json, sizeof json, dir, "scene.json");
-    assert_int_equal(tu_write_file(json,
-        "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"plate.obj\"},{\"file\":\"tile0.obj\"},{\"file\":\"tile1.obj\"}],"
-        "\"camera\":{\"eye\":[0.8,5,0.1],\"target\":[0.8,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
-        "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}"), 0);
     ms_scene sc;
-    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    ground_and_plate("bake_fill", 1, &sc);
     ms_lightmap lm;
     bake_uv0(&sc, 0, 0.0f, PAD, &lm);
     assert_int_equal(lm.pages, 1);
@@ -250,17 +261,8 @@ static void footprint(double a, double b, int *lo, int *hi)
 static void test_regions_apart(void **st)
 {
     (void)st;
-    const char *dir = tu_tmpdir("bake_fill_apart");
-    char path[512], json[512], err[512] = "";
-    write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
-    write_quad(tu_path(path, sizeof path, dir, "plate.obj"), 1.5f, 2.7f, -0.6f, 0.6f, 0.0f, 1);
-    tu_path(json, sizeof json, dir, "scene.json");
-    assert_int_equal(tu_write_file(json,
-        "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"plate.obj\"}],"
-        "\"camera\":{\"eye\":[0.8,5,0.1],\"target\":[0.8,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
-        "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}"), 0);
     ms_scene sc;
-    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+    ground_and_plate("bake_fill_apart", 0, &sc);
     ms_lightmap lm;
     bake_uv0(&sc, 0, 0.0f, 0, &lm);
     assert_int_equal(lm.pages, 1);
