@@ -69,7 +69,7 @@ static void bake_uv0(const ms_scene *sc, int islands, float T, int padding, ms_l
 static void ground_and_plate(const char *name, int tiles, ms_scene *sc)
 {
     const char *dir = tu_tmpdir(name);
-    char path[512], json[512], text[1024], err[512] = "";
+    char path[512], text[1024];
     write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
     write_quad(tu_path(path, sizeof path, dir, "plate.obj"), 1.5f, 2.7f, -0.6f, 0.6f, 0.0f, 1);
     if (tiles) {
@@ -81,9 +81,7 @@ static void ground_and_plate(const char *name, int tiles, ms_scene *sc)
              "\"camera\":{\"eye\":[0.8,5,0.1],\"target\":[0.8,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
              "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}",
              tiles ? ",{\"file\":\"tile0.obj\"},{\"file\":\"tile1.obj\"}" : "");
-    tu_path(json, sizeof json, dir, "scene.json");
-    assert_int_equal(tu_write_file(json, text), 0);
-    assert_int_equal(ms_scene_load(json, sc, err, sizeof err), 0);
+    tu_load_scene_text(dir, text, sc);
 }
 
 static void test_two_regions_bound(void **st)
@@ -176,16 +174,14 @@ static void test_islands(void **st)
 {
     (void)st;
     const char *dir = tu_tmpdir("bake_fill_islands");
-    char path[512], json[512], err[512] = "";
+    char path[512];
     write_quad(tu_path(path, sizeof path, dir, "ground.obj"), -1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1);
     write_parts(tu_path(path, sizeof path, dir, "parts.obj"));
-    tu_path(json, sizeof json, dir, "scene.json");
-    assert_int_equal(tu_write_file(json,
+    ms_scene sc;
+    tu_load_scene_text(dir,
         "{\"meshes\":[{\"file\":\"ground.obj\"},{\"file\":\"parts.obj\"}],"
         "\"camera\":{\"eye\":[0,5,0.1],\"target\":[0,0,0],\"up\":[0,1,0],\"fov_y\":60,\"width\":32,\"height\":32},"
-        "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}"), 0);
-    ms_scene sc;
-    assert_int_equal(ms_scene_load(json, &sc, err, sizeof err), 0);
+        "\"light\":{\"corner\":[-0.5,3,-0.5],\"edge_s\":[1,0,0],\"edge_t\":[0,0,1]}}", &sc);
     assert_int_equal(sc.n_tris, 10);
     ms_lightmap whole, lm;
     const double f0 = bake_fill(&sc, 0, &whole), f1 = bake_fill(&sc, 1, &lm);

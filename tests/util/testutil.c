@@ -262,6 +262,13 @@ void tu_bake_options(ms_bake_options *bo, int size, int uv_set, int samples)
     bo->points.isa = tu_isa_cap();
 }
 
+void tu_load_scene_text(const char *dir, const char *text, ms_scene *sc)
+{
+    char json[4096], err[512] = "";
+    assert_int_equal(tu_write_file(tu_path(json, sizeof json, dir, "scene.json"), text), 0);
+    if (ms_scene_load(json, sc, err, sizeof err) != MS_OK) fail_msg("%s: %s", json, err);
+}
+
 void tu_tri_point(const ms_scene *sc, const float *uvs, size_t t, const double w[3], float p[3], double uv[2])
 {
     p[0] = p[1] = p[2] = 0.0f;

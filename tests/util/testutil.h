@@ -58,6 +58,9 @@ int tu_run_cli_ex(const char *const *args, const tu_run_opts *opts, char *err_al
 /* The Quad in code (as ../shared/scenes/quad): a 20x20 ground at y = 0 (two triangles), a 4x4 occluder
  * at y = 2, a 2x2 light at y = 6, a 96x96 camera, 1024 samples. ms_scene_free frees it. */
 void tu_make_quad(ms_scene *sc);
+/* Writes the scene file text as dir/scene.json and loads it into sc (paths in it are relative to dir); fails the
+ * test when it does not load. */
+void tu_load_scene_text(const char *dir, const char *text, ms_scene *sc);
 /* 1 if ../shared/scenes is present; prints a skip message otherwise. */
 int tu_have_shared_scenes(void);
 /* Loads the shared scene at rel (under ../shared/scenes) into sc; skips the test when the folder is absent, fails it
