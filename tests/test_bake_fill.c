@@ -16,7 +16,8 @@
  * Regions alone (no xatlas chart: the rectangle packer) at the default padding of 2 texels: the texels a
  * bilinear lookup inside each region reads (centres within one texel of its UV square) leave at least 2
  * texels between the two regions, which no lookup reads, so the dilation that fills a region's border texels
- * never averages in the other's. */
+ * never averages in the other's; at a texel density that makes both larger than a page, each is shrunk to fit
+ * one page with that space around it. */
 #include "testutil.h"
 #include <math.h>
 #include <stdio.h>
@@ -283,6 +284,12 @@ static void test_regions_apart(void **st)
            fp[0][0][0], fp[0][0][1], fp[1][0][0], fp[1][0][1], fp[0][1][0], fp[0][1][1], fp[1][1][0], fp[1][1][1], apart,
            100.0 * lm.page_fill[0]);
     assert_true(apart >= 2);
+    ms_lightmap_free(&lm);
+    /* at a density where both are larger than a page: each shrunk to fit one with that space around it */
+    bake_uv0(&sc, 0, 300.0f, 0, &lm);
+    assert_int_equal(lm.pages, 2);
+    for (size_t t = 0; t < sc.n_tris; t++)
+        for (int k = 0; k < 6; k++) assert_true(lm.uv[6 * t + k] * SIZE >= 2.0 && lm.uv[6 * t + k] * SIZE <= SIZE - 2.0);
     ms_lightmap_free(&lm);
     ms_scene_free(&sc);
 }

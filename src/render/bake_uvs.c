@@ -194,6 +194,11 @@ static void keep_or_chart(const ms_scene *sc, size_t nobj, const uint32_t *start
     }
 }
 
+/* The space the rectangle packer leaves between two regions (and to the page's edges) for `pad` texels of padding:
+ * a lookup inside a region reads the texels whose centres lie within one texel of it, so rectangles 2 + 2 c apart
+ * leave 2 c texels between two regions' footprints, as xatlas's packer leaves between charts' (xatlas_meshes.h). */
+static int region_gap(int pad) { return 2 + 2 * ms_chart_padding(pad); }
+
 /* The regions to pack into rs: the file's layout as a whole (all, the objects' union) when whole and it has
  * area, else one per object with a layout (ob[o].region, all->region say which); with a density T, sized at
  * T texels per world unit, a region larger than a page shrunk to fit one (and the whole layout given up for
@@ -222,7 +227,7 @@ static size_t make_regions(object_uv *ob, size_t nobj, object_uv *all, int whole
         for (size_t r = 0; r < nr; r++) {
             rs[r].w0 *= T;
             rs[r].h0 *= T;
-            const double f = fmin(1.0, (size - 2.0 * pad) / fmax(rs[r].w0, rs[r].h0));
+            const double f = fmin(1.0, (size - 2.0 * region_gap(pad)) / fmax(rs[r].w0, rs[r].h0));
             if (f < 1.0) { shrunk++; rs[r].w0 *= f; rs[r].h0 *= f; }
         }
         if (shrunk && whole) { whole = 0; continue; }   /* the whole layout does not fit: per object */
@@ -238,9 +243,7 @@ static size_t make_regions(object_uv *ob, size_t nobj, object_uv *all, int whole
  * (*pages_used), or at the largest common scale that fits one page. 0, or -1 with a message. */
 static int place_regions(ms_pack_rect *rs, size_t nr, int size, int pad, double T, int *pages_used, char *err, size_t errlen)
 {
-    /* A lookup inside a region reads the texels whose centres lie within one texel of it: rectangles 2 + 2 c
-     * apart leave 2 c texels between two regions' footprints, as xatlas's packer leaves between charts' */
-    const int gap = 2 + 2 * ms_chart_padding(pad);
+    const int gap = region_gap(pad);
     if (!(T > 0.0)) {
         double wmax = 0.0;
         for (size_t r = 0; r < nr; r++) wmax = fmax(wmax, rs[r].w0 * rs[r].h0);
