@@ -8,7 +8,7 @@ folder inside a built repository. The manual is docs/blender.md.
 bl_info = {
     "name": "microshadow",
     "author": "microshadow developers",
-    "version": (0, 11, 0),
+    "version": (0, 12, 0),
     "blender": (3, 4, 0),
     "location": "Render Properties > Render Engine; Render Properties > microshadow Bake; 3D View > Sidebar",
     "description": "Exact soft shadows from area lights: a render engine and a lightmap baker",

@@ -137,11 +137,12 @@ static inline ms_status ms_bake_layout(const ms_scene *scene, const ms_bake_opti
 /* V, S and front of the texels of rows [y0, y1) for every light of the accel (ms_visibility_points with
  * the texel keys, one call per light), their stats added to lm->frame.stats. lm is left as it was on an
  * error. */
-MS_API ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1, char *err,
-                       size_t errlen);
+static inline ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt, ms_lightmap *lm, int y0, int y1,
+                                     char *err, size_t errlen);
 /* Irradiance (rgb), exposure and dilation over the whole lightmap, once every row was baked; the stats'
  * image fields; total_s: the sum of the parts' seconds. */
-MS_API ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err, size_t errlen);
+static inline ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt, ms_lightmap *lm, char *err,
+                                       size_t errlen);
 
 /* The UV cache of a bake (docs/baking.md, "The unwrap cache"): lm's key, UVs, pages and per-object sets and
  * scale-offsets, which a later bake of the same geometry with the same UV options (lights, samples and

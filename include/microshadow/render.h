@@ -150,7 +150,9 @@ MS_API const char *const *ms_method_names(void);
 /* 1 if `name` is a known method compiled into this build, 0 if unknown, -1 if known but not compiled in. */
 MS_API int ms_method_available(const char *name);
 
-#define MS_MAX_COUNTERS 32
+/* Room for a method's named counters in ms_stats: a new figure is a new name here, never a new field of the
+ * struct (microshadow/abi.h, "The ABI check"). */
+#define MS_MAX_COUNTERS 64
 
 typedef struct ms_stats {
     size_t triangles;
@@ -169,7 +171,7 @@ typedef struct ms_stats {
     double shadow_factor_s;        /* part of shadow_s spent resolving V and S from the sample masks
                                     * (thread-seconds / threads) */
     double filter_s;               /* part of shadow_s spent in the interleaved pattern's filter (0: none) */
-    int n_counters;                /* method-specific counters */
+    int n_counters;                /* method-specific counters, by name (ms_stats_counter) */
     const char *counter_name[MS_MAX_COUNTERS];
     uint64_t counter[MS_MAX_COUNTERS];
     double shadow_cpu_s;           /* frames: the process's CPU seconds (all threads) during shadow_s, the
@@ -192,6 +194,9 @@ typedef struct ms_stats {
     int aa;                        /* frames: primary samples per pixel (1, 4, 9, 16); width and height above count
                                     * them (sqrt(aa) times the output's size); 0 from the points API and bakes */
 } ms_stats;
+
+/* 1 and *value (may be NULL) when st holds the counter `name`, else 0 (a method or build without it). */
+MS_API int ms_stats_counter(const ms_stats *st, const char *name, uint64_t *value);
 
 typedef struct ms_frame {
     int width, height;

@@ -5,7 +5,7 @@ import ctypes.util
 import os
 
 MAX_UV_SETS = 4
-MAX_COUNTERS = 32
+MAX_COUNTERS = 64
 NO_TRIANGLE = 0xFFFFFFFF
 NO_MATERIAL = 0xFFFFFFFF
 MAX_LIGHTS = 64
@@ -160,7 +160,7 @@ class _Abi(ctypes.Structure):
     library's checked entry points (the *_abi functions) with every call; 0 for a struct the module does not
     mirror (not compared), and no version (the mirrors were checked against the library with ms_layout)."""
     _fields_ = [(n, ctypes.c_uint32) for n in (
-        "abi_size", "version_major", "version_minor", "camera", "light", "procedural", "scene", "texture",
+        "abi_size", "abi_level", "version_minor", "camera", "light", "procedural", "scene", "texture",
         "texture_sampling", "material", "scene_load_options", "render_options", "stats", "frame", "output", "points",
         "points_options", "bake_options", "lightmap", "bake_gltf_options")]
 

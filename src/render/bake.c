@@ -247,11 +247,10 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
 {
     const ms_status ast = ms_abi_check(abi, "ms_bake_layout", err, errlen);
     if (ast) return ast;
+    ms_bake_options opt_copy;
+    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
     if (!out) { snprintf(err, errlen, "ms_bake: out is NULL"); return MS_ERR_INVALID; }
     memset(out, 0, sizeof *out);
-    ms_bake_options zero;
-    memset(&zero, 0, sizeof zero);
-    const ms_bake_options *o = opt_in ? opt_in : &zero;
     if (!scene) { snprintf(err, errlen, "ms_bake: no scene"); return MS_ERR_INVALID; }
     if (!scene->tri && scene->n_tris) {
         snprintf(err, errlen, "ms_bake: a procedural scene has no triangles in memory (only the streaming methods render it)");
@@ -350,12 +349,13 @@ static int light_progress(void *user, double f)
     return p->fn(p->user, ((double)p->light + f) / (double)p->n);
 }
 
-ms_status ms_bake_rows(const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *lm, int y0, int y1,
-                       char *err, size_t errlen)
+ms_status ms_bake_rows_abi(const ms_abi *abi, const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *lm,
+                           int y0, int y1, char *err, size_t errlen)
 {
-    ms_bake_options zero;
-    memset(&zero, 0, sizeof zero);
-    const ms_bake_options *o = opt_in ? opt_in : &zero;
+    const ms_status ast = ms_abi_check(abi, "ms_bake_rows", err, errlen);
+    if (ast) return ast;
+    ms_bake_options opt_copy;
+    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
     ms_frame *f = &lm->frame;
     const int size = f->width;
     if (!accel || !f->vis || y0 < 0 || y1 > f->height || y0 > y1) {
@@ -485,11 +485,13 @@ static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_light
     return MS_OK;
 }
 
-ms_status ms_bake_finish(const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *lm, char *err, size_t errlen)
+ms_status ms_bake_finish_abi(const ms_abi *abi, const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *lm,
+                             char *err, size_t errlen)
 {
-    ms_bake_options zero;
-    memset(&zero, 0, sizeof zero);
-    const ms_bake_options *o = opt_in ? opt_in : &zero;
+    const ms_status ast = ms_abi_check(abi, "ms_bake_finish", err, errlen);
+    if (ast) return ast;
+    ms_bake_options opt_copy;
+    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
     const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
     const double t_finish = omp_get_wtime();
     ms_frame *f = &lm->frame;
@@ -576,11 +578,10 @@ ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_accel *
 {
     const ms_status ast = ms_abi_check(abi, "ms_bake", err, errlen);
     if (ast) return ast;
+    ms_bake_options opt_copy;
+    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
     const double t_start = omp_get_wtime();
     if (out) memset(out, 0, sizeof *out);
-    ms_bake_options zero;
-    memset(&zero, 0, sizeof zero);
-    const ms_bake_options *o = opt_in ? opt_in : &zero;
     const int size = o->size ? o->size : 1024;
     uint64_t need = 0;
     if (scene && (scene->tri || !scene->n_tris) && size >= 1 && size <= MS_MAX_IMAGE_SIZE && o->uv_set >= -1 &&
@@ -588,17 +589,17 @@ ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_accel *
         ms_status bst = bake_budget(scene, o, size, 1, !accel, &need, err, errlen);
         if (bst) return bst;
     }
-    ms_status st = ms_bake_layout(scene, opt_in, out, err, errlen);
+    ms_status st = ms_bake_layout(scene, o, out, err, errlen);
     if (st) return st;
     ms_accel *own = NULL;
     if (!accel) {
         const double t_accel = omp_get_wtime();
-        st = ms_accel_build(scene, opt_in ? opt_in->points.threads : 0, &own, err, errlen);
+        st = ms_accel_build(scene, o->points.threads, &own, err, errlen);
         accel = own;
         if (!st && o->pass) o->pass(o->pass_user, "acceleration structure", omp_get_wtime() - t_accel);
     }
-    if (!st) st = ms_bake_rows(accel, opt_in, out, 0, out->frame.height, err, errlen);
-    if (!st) st = ms_bake_finish(scene, opt_in, out, err, errlen);
+    if (!st) st = ms_bake_rows(accel, o, out, 0, out->frame.height, err, errlen);
+    if (!st) st = ms_bake_finish(scene, o, out, err, errlen);
     ms_accel_free(own);
     if (st) { ms_lightmap_free(out); return st; }
     out->frame.stats.total_s = omp_get_wtime() - t_start + scene->load_s;

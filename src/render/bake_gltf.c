@@ -590,6 +590,8 @@ ms_status ms_bake_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms_light
 {
     const ms_status ast = ms_abi_check(abi, "ms_bake_gltf", err, errlen);
     if (ast) return ast;
+    ms_bake_gltf_options own;
+    opt = ms_abi_options(opt, MS_ABI_SIZE(abi, bake_gltf_options), &own, sizeof own);
     if (glb) *glb = NULL;
     if (len) *len = 0;
     if (!sc || !lm || !glb || !len) { snprintf(err, errlen, "ms_bake_gltf: NULL argument"); return MS_ERR_INVALID; }
@@ -680,6 +682,8 @@ ms_status ms_bake_write_gltf_abi(const ms_abi *abi, const ms_scene *sc, const ms
 {
     const ms_status ast = ms_abi_check(abi, "ms_bake_write_gltf", err, errlen);
     if (ast) return ast;
+    ms_bake_gltf_options own;
+    opt = ms_abi_options(opt, MS_ABI_SIZE(abi, bake_gltf_options), &own, sizeof own);
     static const char *const glb_suffix[] = { ".glb", NULL };
     ms_output o = { "glTF", path ? path : "", NULL, glb_suffix, NULL, 0 };
     if (ms_outputs_check(&o, 1, err, errlen)) return MS_ERR_IO;

@@ -472,6 +472,8 @@ ms_status ms_frame_job_create_abi(const ms_abi *abi, const ms_scene *scene, cons
     *out = NULL;
     const ms_status st = ms_abi_check(abi, "ms_frame_job_create", err, errlen);
     if (st) return st;
+    ms_render_options own;
+    opt = ms_abi_options(opt, MS_ABI_SIZE(abi, render_options), &own, sizeof own);
     return job_create(scene, opt, MS_STREAM_OFF, out, err, errlen);
 }
 

@@ -253,6 +253,8 @@ ms_status ms_render_outputs_abi(const ms_abi *abi, const ms_scene *scene, const 
 {
     const ms_status ast = ms_abi_check(abi, "ms_render_outputs", err, errlen);
     if (ast) return ast;
+    ms_render_options own;
+    opt = ms_abi_options(opt, MS_ABI_SIZE(abi, render_options), &own, sizeof own);
     if (stats) memset(stats, 0, sizeof *stats);
     int mode = (int)opt->stream;
     if (mode < MS_STREAM_AUTO || mode > MS_STREAM_OFF) { snprintf(err, errlen, "unknown stream mode %d", mode); return MS_ERR_INVALID; }

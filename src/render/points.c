@@ -214,6 +214,8 @@ ms_status ms_visibility_points_abi(const ms_abi *abi, const ms_accel *a, const m
 {
     const ms_status ast = ms_abi_check(abi, "ms_visibility_points", err, errlen);
     if (ast) return ast;
+    ms_points_options own;
+    opt = ms_abi_options(opt, MS_ABI_SIZE(abi, points_options), &own, sizeof own);
     /* World positions into the scene's frame (scene_frame.c): subtracted in double, which is exact for points
      * near the geometry (the origin is a multiple of a power of two above the floats' spacing there). */
     if (!a || !pts || !pts->position || !pts->n ||

@@ -12,6 +12,8 @@ ms_status ms_render_abi(const ms_abi *abi, const ms_scene *scene, const ms_rende
 {
     ms_status rc = ms_abi_check(abi, "ms_render", err, errlen);
     if (rc) return rc;
+    ms_render_options own;
+    opt = ms_abi_options(opt, MS_ABI_SIZE(abi, render_options), &own, sizeof own);
     memset(out, 0, sizeof *out);
     ms_frame_job *job;
     rc = ms_frame_job_create(scene, opt, &job, err, errlen);

@@ -403,6 +403,8 @@ ms_status ms_scene_load_abi(const ms_abi *abi, const char *json_path, const ms_s
 {
     const ms_status st = ms_abi_check(abi, "ms_scene_load", err, errlen);
     if (st) return st;
+    ms_scene_load_options own;
+    opt = ms_abi_options(opt, MS_ABI_SIZE(abi, scene_load_options), &own, sizeof own);
     memset(out, 0, sizeof *out);
     char *text;
     size_t len;
