@@ -4,8 +4,8 @@
  *
  * A group is the up to 16 rays of one cell of the light, one from each pixel of a 4x4 block (mft.c): 16
  * receivers close together to 16 points in 1/16 of the light (256 samples; 1/64 at 1024). Sixteen groups
- * are sixteen SIMD lanes of the multi-frusta traversal (block_traverse_loop.h's node test, our own loop,
- * mftg_traverse), each bounded by the box of its live rays' origins and the box of their sample points
+ * are sixteen SIMD lanes of the multi-frusta traversal (block_traverse_loop.h, with mftg_children carrying
+ * each lane's rays down the walk), each bounded by the box of its live rays' origins and the box of their sample points
  * (ms_block_frusta_set_lane_box; the 16 lanes at once where a group starts from its cell's box), tested
  * 16 lanes at once where 4 or more lanes reach a node (MFTG_FRUSTUM_MIN); below the frusta each lane's
  * rays take raytrace's slab test, 16 in one register, at every child its frustum reaches (the child's
@@ -173,13 +173,84 @@ static void mftg_lane_bounds(mftg_state *s, int l)
     mftg_lane_set(s, l, clo, chi, plo, phi);
 }
 
+static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const uint16_t *enter);
+
+/* Of the lanes m whose frustum reaches child n, those with rays entering it (out[l]: the rays; rays[l]:
+ * those that entered the parent). */
+static inline unsigned mftg_child_rays(const mftg_state *s, const ms_bvh_node *n, unsigned m, const uint16_t *rays,
+                                       uint16_t *out, uint64_t *ray_tests, uint64_t *culled)
+{
+    if (!m) return 0;
+    l16 A[3], B[3];
+    mftg_box_sides(s, n, A, B);
+    for (unsigned r = m; r; r &= r - 1) {
+        const int l = __builtin_ctz(r);
+        out[l] = (uint16_t)(mftg_ray_box(s, s->grp[l], A, B) & rays[l]);
+        ++*ray_tests;
+        if (!out[l]) { m &= ~(1u << l); ++*culled; }
+    }
+    return m;
+}
+
+/* The children of a node for the walk of block_traverse_loop.h, with each lane's rays: a child is visited for
+ * the lanes whose frustum may reach it (all 16 at once) and, of those, whose rays enter it (one 16-ray box test
+ * per lane, raytrace's). The frusta cull the upper levels for 16 groups at a time; the rays the lower ones,
+ * where a group's frustum, however thin on the light, is wide against small triangles (measured: when only
+ * the leaves tested the rays, about ten lane-leaf visits per leaf the rays enter). Departure from the paper
+ * (frusta only). */
+static inline void mftg_children(const mftg_state *s, const ms_bvh_node *c, unsigned mask, int order, unsigned *ml_out,
+                                 unsigned *mr_out, int *right_first, const uint16_t *rays, uint16_t *rl, uint16_t *rr,
+                                 uint64_t *tests, uint64_t *ray_tests, uint64_t *lanes_culled);
+
 #define BT_STATE mftg_state
 #define BT_FN mftg_traverse
-#define BT_NODE_ONLY
+#define BT_LEAF(s, n, mask) mftg_leaf(s, n, mask, rays)
+#define BT_CHILDREN(s, c, mask, order, ml, mr, right_first) \
+    mftg_children(s, c, mask, order, &(ml), &(mr), &(right_first), rays, rl, rr, &tests, &ray_tests, &lanes_culled)
+#define BT_RAYS
+#define BT_ROOT_RAYS(s, rays) \
+    for (int l_ = 0; l_ < MS_BLOCK_LANES; l_++) (rays)[l_] = (uint16_t)((s)->grp[l_] ? (s)->grp[l_]->live : 0u)
+#define BT_LOCALS uint64_t ray_tests = 0, lanes_culled = 0;
+#define BT_DONE(s) (cnt[MS_MFT_RAY_BOX] += ray_tests, cnt[MS_MFT_LEAF_LANES_CULLED] += lanes_culled)
 #include "shadow/microraster/block_traverse_loop.h"
 #undef BT_STATE
 #undef BT_FN
-#undef BT_NODE_ONLY
+#undef BT_LEAF
+#undef BT_CHILDREN
+#undef BT_RAYS
+#undef BT_ROOT_RAYS
+#undef BT_LOCALS
+#undef BT_DONE
+
+static inline void mftg_children(const mftg_state *s, const ms_bvh_node *c, unsigned mask, int order, unsigned *ml_out,
+                                 unsigned *mr_out, int *right_first, const uint16_t *rays, uint16_t *rl, uint16_t *rr,
+                                 uint64_t *tests, uint64_t *ray_tests, uint64_t *lanes_culled)
+{
+    const ms_block_frusta *f = s->fr;
+    l16 t0 = l16_set1(0.0f), t1 = t0;
+    const int fr_test = ms_bt_popcount16(mask) >= MFTG_FRUSTUM_MIN;
+    unsigned ml = mask, mr = mask;
+    if (fr_test) {
+        ml &= mftg_traverse_node(f, &c[0], &t0);
+        mr &= mftg_traverse_node(f, &c[1], &t1);
+        *tests += 2;
+    }
+    ml = mftg_child_rays(s, &c[0], ml, rays, rl, ray_tests, lanes_culled);
+    mr = mftg_child_rays(s, &c[1], mr, rays, rr, ray_tests, lanes_culled);
+    *right_first = 0;
+    if (ml && mr && order) {
+        if (!fr_test) {
+            float dot = 0.0f;
+            for (int x = 0; x < 3; x++) dot += (c[1].bmin[x] + c[1].bmax[x] - c[0].bmin[x] - c[0].bmax[x]) * s->dir[x];
+            *right_first = dot < 0.0f;
+        } else {
+            const unsigned both = ml & mr;
+            *right_first = 2 * ms_bt_popcount16(l16_lt(t1, t0) & both) > ms_bt_popcount16(both);
+        }
+    }
+    *ml_out = ml;
+    *mr_out = mr;
+}
 
 /* The triangle's rays of group g (bits: its live slots, less those whose own triangle this is) that it
  * blocks: raytrace's packet_triangle per ray, the same operations in the same order, with the ray's own
@@ -355,104 +426,6 @@ static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const 
     cnt[MS_MFT_PAIRS_TESTED] += tested;
     cnt[MS_MFT_ISEC16] += isec;
     cnt[MS_MFT_FRUSTA_EARLY_OUT] += early;
-}
-
-/* Of the lanes m whose frustum reaches child n, those with rays entering it (out[l]: the rays; rays[l]:
- * those that entered the parent). */
-static inline unsigned mftg_child_rays(const mftg_state *s, const ms_bvh_node *n, unsigned m, const uint16_t *rays,
-                                       uint16_t *out, uint64_t *ray_tests, uint64_t *culled)
-{
-    if (!m) return 0;
-    l16 A[3], B[3];
-    mftg_box_sides(s, n, A, B);
-    for (unsigned r = m; r; r &= r - 1) {
-        const int l = __builtin_ctz(r);
-        out[l] = (uint16_t)(mftg_ray_box(s, s->grp[l], A, B) & rays[l]);
-        ++*ray_tests;
-        if (!out[l]) { m &= ~(1u << l); ++*culled; }
-    }
-    return m;
-}
-
-/* Depth-first over the shallow BVH, as block_traverse_loop.h, with each lane's rays: a child is visited
- * for the lanes whose frustum may reach it (all 16 at once) and, of those, whose rays enter it (one 16-ray
- * box test per lane, raytrace's). The frusta cull the upper levels for 16 groups at a time; the rays the
- * lower ones, where a group's frustum, however thin on the light, is wide against small triangles
- * (measured: when only the leaves tested the rays, about ten lane-leaf visits per leaf the rays enter).
- * Departure from the paper (frusta only). */
-static void mftg_traverse(mftg_state *s, const ms_bvh_shallow *sh, int order)
-{
-    ms_block_frusta *f = s->fr;
-    uint64_t *cnt = s->bt_cnt;
-    l16 t0, t1;
-    cnt[MS_BT_BLOCKS]++;
-    cnt[MS_BT_AABB_TESTS]++;
-    unsigned mask = mftg_traverse_node(f, &sh->nodes[0], &t0) & f->live;
-    if (!mask) return;
-    t1 = t0;
-    uint32_t st_node[MS_BVH_STACK];
-    unsigned st_mask[MS_BVH_STACK];
-    uint16_t st_rays[MS_BVH_STACK][MS_BLOCK_LANES];
-    uint16_t rays[MS_BLOCK_LANES], rl[MS_BLOCK_LANES], rr[MS_BLOCK_LANES];
-    for (int l = 0; l < MS_BLOCK_LANES; l++) rays[l] = (uint16_t)(s->grp[l] ? s->grp[l]->live : 0u);
-    int sp = 0;
-    uint32_t ni = 0;
-    uint64_t tests = 0, ray_tests = 0, lanes_culled = 0;
-    for (;;) {
-        const ms_bvh_node *n = &sh->nodes[ni];
-        if (n->count) {
-            cnt[MS_BT_LEAVES]++;
-            cnt[MS_BT_TRIS_ACCESSED] += n->count;
-            mftg_leaf(s, n, mask, rays);
-            if (!f->live) { cnt[MS_BT_BLOCKS_EARLY_OUT]++; break; }
-        } else {
-            const uint32_t c0 = n->first;
-            mask &= f->live;
-            const int fr_test = ms_bt_popcount16(mask) >= MFTG_FRUSTUM_MIN;
-            unsigned ml = mask, mr = mask;
-            if (fr_test) {
-                ml &= mftg_traverse_node(f, &sh->nodes[c0], &t0);
-                mr &= mftg_traverse_node(f, &sh->nodes[c0 + 1], &t1);
-                tests += 2;
-            }
-            ml = mftg_child_rays(s, &sh->nodes[c0], ml, rays, rl, &ray_tests, &lanes_culled);
-            mr = mftg_child_rays(s, &sh->nodes[c0 + 1], mr, rays, rr, &ray_tests, &lanes_culled);
-            if (ml && mr) {
-                int right_first = 0;
-                if (order && !fr_test) {
-                    const ms_bvh_node *a = &sh->nodes[c0], *b = &sh->nodes[c0 + 1];
-                    float dot = 0.0f;
-                    for (int x = 0; x < 3; x++) dot += (b->bmin[x] + b->bmax[x] - a->bmin[x] - a->bmax[x]) * s->dir[x];
-                    right_first = dot < 0.0f;
-                } else if (order) {
-                    const unsigned both = ml & mr;
-                    right_first = 2 * ms_bt_popcount16(l16_lt(t1, t0) & both) > ms_bt_popcount16(both);
-                }
-                if (right_first) {
-                    st_node[sp] = c0; st_mask[sp] = ml; memcpy(st_rays[sp++], rl, sizeof rl);
-                    ni = c0 + 1; mask = mr; memcpy(rays, rr, sizeof rr);
-                } else {
-                    st_node[sp] = c0 + 1; st_mask[sp] = mr; memcpy(st_rays[sp++], rr, sizeof rr);
-                    ni = c0; mask = ml; memcpy(rays, rl, sizeof rl);
-                }
-                continue;
-            }
-            if (ml) { ni = c0; mask = ml; memcpy(rays, rl, sizeof rl); continue; }
-            if (mr) { ni = c0 + 1; mask = mr; memcpy(rays, rr, sizeof rr); continue; }
-        }
-        for (;;) {
-            if (sp == 0) goto done;
-            --sp;
-            mask = st_mask[sp] & f->live;
-            if (mask) break;
-        }
-        ni = st_node[sp];
-        memcpy(rays, st_rays[sp], sizeof rays);
-    }
-done:
-    cnt[MS_BT_AABB_TESTS] += tests;
-    cnt[MS_MFT_RAY_BOX] += ray_tests;
-    cnt[MS_MFT_LEAF_LANES_CULLED] += lanes_culled;
 }
 
 /* The rays of a block by set (rb->form_n, mft.c: mft_block_by_set), 16 slots at a time with raytrace's
