@@ -330,6 +330,58 @@ static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e,
     L->c_shared_clip += ne == 5;
 }
 
+/* The kernel's box of a projected triangle (xs, ys: its vertices in light-index space): its slack, its clamp,
+ * its rounding to sample indices; then within the rectangle [rx0, rx1] x [ry0, ry1]. */
+static inline void MS_KFN(br_sample_box)(const l16 xs[3], const l16 ys[3], l16 rx0, l16 rx1, l16 ry0, l16 ry1, l16 *bx0,
+                                         l16 *bx1, l16 *by0, l16 *by1)
+{
+    const l16 slack = l16_set1(MS_BOX_SLACK), lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+    const l16 xlo = l16_sub(l16_min(l16_min(xs[0], xs[1]), xs[2]), slack);
+    const l16 xhi = l16_add(l16_max(l16_max(xs[0], xs[1]), xs[2]), slack);
+    const l16 ylo = l16_sub(l16_min(l16_min(ys[0], ys[1]), ys[2]), slack);
+    const l16 yhi = l16_add(l16_max(l16_max(ys[0], ys[1]), ys[2]), slack);
+    *bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), rx0);
+    *bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), rx1);
+    *by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), ry0);
+    *by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), ry1);
+}
+
+/* Corner rays (the paper's corner-ray culling, in light-index space): a triangle whose box holds visible
+ * samples may still miss the whole rectangle box x rows (a long thin triangle across it). Its three edge
+ * planes through C (x, y, z: its vertices in the pixel's light frame), oriented towards the opposite vertex:
+ * the lanes where the four corners of the rectangle [cx0, cx1] x [cy0, cy1] lie outside one of them, so that
+ * no sample inside does (convexity). Worth its cost only for large rectangles, where the kernel call it saves
+ * is dear and the miss likely; a margin of 1e-5 of the terms' magnitudes leaves any doubt to the kernel. */
+static inline unsigned MS_KFN(br_corner_out)(const l16 x[3], const l16 y[3], const l16 z[3], l16 cx0, l16 cx1, l16 cy0,
+                                             l16 cy1)
+{
+    const l16 zero = l16_set1(0.0f), one = l16_set1(1.0f);
+    l16 n1[3];
+    for (int v = 0; v < 3; v++) n1[v] = l16_add(l16_add(l16_abs(x[v]), l16_abs(y[v])), l16_abs(z[v]));
+    const l16 pmax = l16_add(l16_add(cx1, cy1), one);   /* |i| + |j| + 1 at any corner */
+    unsigned out = 0;
+    for (int e = 0; e < 3; e++) {
+        const int va = (e + 1) % 3, vb = (e + 2) % 3;
+        const l16 ex = l16_sub(l16_mul(y[va], z[vb]), l16_mul(z[va], y[vb]));
+        const l16 ey = l16_sub(l16_mul(z[va], x[vb]), l16_mul(x[va], z[vb]));
+        const l16 ez = l16_sub(l16_mul(x[va], y[vb]), l16_mul(y[va], x[vb]));
+        const l16 tol = l16_mul(l16_mul(n1[va], n1[vb]), l16_set1(1e-5f));
+        const l16 side = l16_add(l16_add(l16_mul(ex, x[e]), l16_mul(ey, y[e])), l16_mul(ez, z[e]));
+        const l16 tc = l16_mul(tol, n1[e]);
+        const unsigned pos = l16_gt(side, tc), neg = l16_lt(side, l16_sub(zero, tc));
+        const l16 tp = l16_mul(tol, pmax), ntp = l16_sub(zero, tp);
+        unsigned pos_out = pos, neg_out = neg;
+        for (int corner = 0; corner < 4; corner++) {
+            const l16 pi = (corner & 1) ? cx1 : cx0, pj = (corner & 2) ? cy1 : cy0;
+            const l16 val = l16_add(l16_add(l16_mul(ex, pi), l16_mul(ey, pj)), ez);
+            pos_out &= l16_lt(val, ntp);   /* inside is positive: the corner is outside */
+            neg_out &= l16_gt(val, tp);
+        }
+        out |= pos_out | neg_out;
+    }
+    return out;
+}
+
 /* The leaf tests of a group of the leaf's triangles. Packed layout (BR_PACK): lane e is the (triangle,
  * pixel) pair (first + pt[e], pl[e]), e < np, the pairs sixteen to a vector. In a leaf a triangle reaches on
  * average a few of the block's pixels (3.4 of 16 on the big-light Sponza), so the per-triangle tests with
@@ -343,8 +395,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
 {
     const ms_block_input *in = s->in;
     const l16 near = l16_set1(s->fr->near), far = l16_set1(s->fr->far), zero = l16_set1(0.0f);
-    const l16 zrel = l16_set1(MS_Z_REL), slack = l16_set1(MS_BOX_SLACK), one = l16_set1(1.0f);
-    const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+    const l16 zrel = l16_set1(MS_Z_REL), one = l16_set1(1.0f);
 #if BR_PACK
     /* Lane e: pair e, pixel pl[e] and triangle first + pt[e]; lanes from np on are padding. */
     const unsigned lanes = np == MS_BLOCK_LANES ? 0xFFFFu : (1u << np) - 1u;
@@ -390,27 +441,14 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         xs[v] = l16_mul(x[v], inv);
         ys[v] = l16_mul(y[v], inv);
     }
-    /* The kernel's box: its slack, its clamp, its rounding to sample indices; then within the
-     * rectangle. */
-    const l16 xlo = l16_sub(l16_min(l16_min(xs[0], xs[1]), xs[2]), slack);
-    const l16 xhi = l16_add(l16_max(l16_max(xs[0], xs[1]), xs[2]), slack);
-    const l16 ylo = l16_sub(l16_min(l16_min(ys[0], ys[1]), ys[2]), slack);
-    const l16 yhi = l16_add(l16_max(l16_max(ys[0], ys[1]), ys[2]), slack);
-    const l16 bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), rx0);
-    const l16 bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), rx1);
-    const l16 by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), ry0);
-    const l16 by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), ry1);
+    l16 bx0, bx1, by0, by1;
+    MS_KFN(br_sample_box)(xs, ys, rx0, rx1, ry0, ry1, &bx0, &bx1, &by0, &by1);
     const unsigned miss = front & (l16_gt(bx0, bx1) | l16_gt(by0, by1));
     L->c_depth += (uint64_t)ms_bt_popcount16(lanes & ~depth_ok);
     L->c_rect += (uint64_t)ms_bt_popcount16(lanes & depth_ok & miss);
     unsigned pass = lanes & depth_ok & ~miss;
     if (!pass) return;
-    /* Corner rays (the paper's corner-ray culling, in light-index space): a triangle whose box holds
-     * visible samples may still miss the whole rectangle box x rows (a long thin triangle across
-     * it). Its three edge planes through C, oriented towards the opposite vertex: if the four
-     * corners of the rectangle lie outside one of them, no sample inside does (convexity). Worth
-     * its cost only for large rectangles, where the kernel call it saves is dear and the miss likely;
-     * a margin of 1e-5 of the terms' magnitudes leaves any doubt to the kernel. */
+    /* Corner rays (the paper's corner-ray culling, in light-index space): br_corner_out. */
     const l16 cx0 = l16_select(front, bx0, rx0), cx1 = l16_select(front, bx1, rx1);
     const l16 cy0 = l16_select(front, by0, ry0), cy1 = l16_select(front, by1, ry1);
     const l16 area = l16_mul(l16_add(l16_sub(cx1, cx0), one), l16_add(l16_sub(cy1, cy0), one));
@@ -418,30 +456,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
      * decision, and no counter. */
     const unsigned large = pass & l16_gt(area, l16_set1(BR_CORNER_AREA));
     if (large) {
-        l16 n1[3];
-        for (int v = 0; v < 3; v++) n1[v] = l16_add(l16_add(l16_abs(x[v]), l16_abs(y[v])), l16_abs(z[v]));
-        const l16 pmax = l16_add(l16_add(cx1, cy1), one);   /* |i| + |j| + 1 at any corner */
-        unsigned out = 0;
-        for (int e = 0; e < 3; e++) {
-            const int va = (e + 1) % 3, vb = (e + 2) % 3;
-            const l16 ex = l16_sub(l16_mul(y[va], z[vb]), l16_mul(z[va], y[vb]));
-            const l16 ey = l16_sub(l16_mul(z[va], x[vb]), l16_mul(x[va], z[vb]));
-            const l16 ez = l16_sub(l16_mul(x[va], y[vb]), l16_mul(y[va], x[vb]));
-            const l16 tol = l16_mul(l16_mul(n1[va], n1[vb]), l16_set1(1e-5f));
-            const l16 side = l16_add(l16_add(l16_mul(ex, x[e]), l16_mul(ey, y[e])), l16_mul(ez, z[e]));
-            const l16 tc = l16_mul(tol, n1[e]);
-            const unsigned pos = l16_gt(side, tc), neg = l16_lt(side, l16_sub(zero, tc));
-            const l16 tp = l16_mul(tol, pmax), ntp = l16_sub(zero, tp);
-            unsigned pos_out = pos, neg_out = neg;
-            for (int corner = 0; corner < 4; corner++) {
-                const l16 pi = (corner & 1) ? cx1 : cx0, pj = (corner & 2) ? cy1 : cy0;
-                const l16 val = l16_add(l16_add(l16_mul(ex, pi), l16_mul(ey, pj)), ez);
-                pos_out &= l16_lt(val, ntp);   /* inside is positive: the corner is outside */
-                neg_out &= l16_gt(val, tp);
-            }
-            out |= pos_out | neg_out;
-        }
-        out &= large;
+        const unsigned out = MS_KFN(br_corner_out)(x, y, z, cx0, cx1, cy0, cy1) & large;
         L->c_corner += (uint64_t)ms_bt_popcount16(out);
         pass &= ~out;
         if (!pass) return;
