@@ -34,9 +34,9 @@ enum { RT, SL, HPC, HPCS };
 
 static uint64_t counter(const ms_frame *f, const char *name)
 {
-    for (int c = 0; c < f->stats.n_counters; c++)
-        if (strcmp(f->stats.counter_name[c], name) == 0) return f->stats.counter[c];
-    return 0;
+    uint64_t v = 0;
+    ms_stats_counter(&f->stats, name, &v);
+    return v;
 }
 
 static int parse_list(char *s, int *out, int cap)

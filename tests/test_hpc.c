@@ -440,18 +440,11 @@ static void test_bars(void **st)
     ms_frame f;
     render_ok(&sc, "hpc", 256, 96, 0, &f);
     ms_hpc_switches = 0;
-    uint64_t in_vl = 0, to_fp = 0, leaf_culls = 0, culls_blocked = 0, rect_pairs = 0, sure = 0, tests = 0, lane_tests = 0, tsure = 0;
-    for (int c = 0; c < f.stats.n_counters; c++) {
-        if (!strcmp(f.stats.counter_name[c], "leaf_lane_tests")) lane_tests = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "samples_t_sure")) tsure = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "samples_sure")) sure = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "sample_tests")) tests = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "rect_pairs")) rect_pairs = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "pairs_in_vl")) in_vl = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "pairs_footprint")) to_fp = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "leaf_culls")) leaf_culls = f.stats.counter[c];
-        if (!strcmp(f.stats.counter_name[c], "leaf_culls_blocked")) culls_blocked = f.stats.counter[c];
-    }
+    const uint64_t lane_tests = tu_stat_counter(&f.stats, "leaf_lane_tests"), tsure = tu_stat_counter(&f.stats, "samples_t_sure");
+    const uint64_t sure = tu_stat_counter(&f.stats, "samples_sure"), tests = tu_stat_counter(&f.stats, "sample_tests");
+    const uint64_t rect_pairs = tu_stat_counter(&f.stats, "rect_pairs"), in_vl = tu_stat_counter(&f.stats, "pairs_in_vl");
+    const uint64_t to_fp = tu_stat_counter(&f.stats, "pairs_footprint"), leaf_culls = tu_stat_counter(&f.stats, "leaf_culls");
+    const uint64_t culls_blocked = tu_stat_counter(&f.stats, "leaf_culls_blocked");
     ms_frame_free(&f);
     const long differ = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_LEAF_BOUND, &ref);
     const long differ_rect = hpc_pixels_off(&sc, MS_HPC_ALL_LEAF_FOOTPRINT | MS_HPC_BREAK_RECT, &ref);

@@ -621,10 +621,9 @@ void tu_base64(const unsigned char *in, size_t n, char *out)
 
 uint64_t tu_stat_counter(const ms_stats *st, const char *name)
 {
-    for (int i = 0; i < st->n_counters; i++)
-        if (!strcmp(st->counter_name[i], name)) return st->counter[i];
-    fail_msg("no counter %s", name);
-    return 0;
+    uint64_t v = 0;
+    if (!ms_stats_counter(st, name, &v)) fail_msg("no counter %s", name);
+    return v;
 }
 
 struct ms_shadow_query *tu_frame_queries(const struct ms_render_ctx *ctx, int size, int *nq)
