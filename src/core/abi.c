@@ -12,18 +12,32 @@ static const char *const names[] = { "ms_camera", "ms_light", "ms_procedural", "
 _Static_assert(sizeof names / sizeof names[0] == (sizeof(ms_abi) - offsetof(ms_abi, camera)) / sizeof(uint32_t),
                "every size of ms_abi has its name");
 
-/* The option structs' sizes when this ABI level began: the least a program of the level passes. A field
- * appended within the level goes at or past these sizes (never into the struct's tail padding, which a
- * program of the level may not have zeroed), and these stay until MS_ABI_LEVEL changes. */
+/* The option structs' sizes when this ABI level began (LP64): the least a program of the level passes. They
+ * stay until MS_ABI_LEVEL changes; a field appended within the level goes at or past them (never into a
+ * struct's tail padding, which a program of the level may not have zeroed). */
+enum { FLOOR_SCENE_LOAD = 4, FLOOR_RENDER = 128, FLOOR_POINTS = 64, FLOOR_BAKE = 128, FLOOR_BAKE_GLTF = 8 };
+#if UINTPTR_MAX == UINT64_MAX
+_Static_assert(MS_ABI_LEVEL == 12, "a new ABI level: set the floors to the option structs' sizes");
+_Static_assert(sizeof(ms_scene_load_options) >= FLOOR_SCENE_LOAD && sizeof(ms_render_options) >= FLOOR_RENDER &&
+               sizeof(ms_points_options) >= FLOOR_POINTS && sizeof(ms_bake_options) >= FLOOR_BAKE &&
+               sizeof(ms_bake_gltf_options) >= FLOOR_BAKE_GLTF, "option structs only grow within a level");
+#endif
+
 static uint32_t level_floor(size_t i)
 {
 #define MS_AT(field) ((uint32_t)(offsetof(ms_abi, field) - offsetof(ms_abi, camera)) / (uint32_t)sizeof(uint32_t))
+#if UINTPTR_MAX == UINT64_MAX
+#define MS_FLOOR(n, type) (n)
+#else
+#define MS_FLOOR(n, type) sizeof(type)   /* no other data model has had a level of its own */
+#endif
     const uint32_t at = (uint32_t)i;
-    if (at == MS_AT(scene_load_options)) return (uint32_t)sizeof(ms_scene_load_options);
-    if (at == MS_AT(render_options)) return (uint32_t)sizeof(ms_render_options);
-    if (at == MS_AT(points_options)) return (uint32_t)sizeof(ms_points_options);
-    if (at == MS_AT(bake_options)) return (uint32_t)sizeof(ms_bake_options);
-    if (at == MS_AT(bake_gltf_options)) return (uint32_t)sizeof(ms_bake_gltf_options);
+    if (at == MS_AT(scene_load_options)) return (uint32_t)MS_FLOOR(FLOOR_SCENE_LOAD, ms_scene_load_options);
+    if (at == MS_AT(render_options)) return (uint32_t)MS_FLOOR(FLOOR_RENDER, ms_render_options);
+    if (at == MS_AT(points_options)) return (uint32_t)MS_FLOOR(FLOOR_POINTS, ms_points_options);
+    if (at == MS_AT(bake_options)) return (uint32_t)MS_FLOOR(FLOOR_BAKE, ms_bake_options);
+    if (at == MS_AT(bake_gltf_options)) return (uint32_t)MS_FLOOR(FLOOR_BAKE_GLTF, ms_bake_gltf_options);
+#undef MS_FLOOR
 #undef MS_AT
     return 0;   /* not an option struct: its size is fixed within the level */
 }
