@@ -12,6 +12,7 @@
 #include "shadow/method.h"
 #include "primary/primary.h"
 #include "light/pattern.h"
+#include "render/budget.h"
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -142,6 +143,10 @@ static void test_frame_agreement(void **st)
             assert_string_equal(stats.method, methods[m]);
             assert_int_equal(stats.visible_pixels, fp.n);
             assert_int_equal(stats.shadow_rays, fr.stats.shadow_rays);
+            /* The same occluders as the frame's: the closed-component cull where frames take it by default
+             * (the methods that take the queries a batch at a time; the frame-level ones, hpc, go without). */
+            if (!sm->visibility_all) assert_int_equal(stats.occluders_culled, fr.stats.occluders_culled);
+            else assert_int_equal(stats.occluders_culled, 0);
             ms_frame_free(&fr);
         }
     free(v);
@@ -366,17 +371,20 @@ static void test_invariance(void **st)
         assert_true(s1[i] == s0[n - 1 - i]);
     }
 
-    /* two calls at once on one accel, one thread each */
+    /* two calls at once on one new accel, one thread each: both want its culled occluder set, one builds it */
     float *va = malloc(sizeof(float) * n), *vb = malloc(sizeof(float) * n);
     assert_true(va && vb);
     int rc[2] = { -1, -1 };
     po.threads = 1;
+    ms_accel *fresh = NULL;
+    assert_int_equal(ms_accel_build(&sc, 0, &fresh, err, sizeof err), MS_OK);
 #pragma omp parallel num_threads(2)
     {
         char e2[256];
         const int t = omp_get_thread_num();
-        rc[t] = ms_visibility_points(acc, NULL, &pts, &po, t ? vb : va, NULL, NULL, NULL, e2, sizeof e2);
+        rc[t] = ms_visibility_points(fresh, NULL, &pts, &po, t ? vb : va, NULL, NULL, NULL, e2, sizeof e2);
     }
+    ms_accel_free(fresh);
     assert_int_equal(rc[0], MS_OK);
     assert_int_equal(rc[1], MS_OK);
     assert_memory_equal(va, v0, sizeof(float) * n);
@@ -419,6 +427,55 @@ static int on_progress(void *user, double f)
     p->backwards |= f < p->last;
     p->last = f;
     return ++p->calls >= p->cancel_at;
+}
+
+/* The closed-component cull's occluder set is the accel's to keep, and optional: under a budget that holds the
+ * call but not the set, the call goes without it and gives the same V, S and front; with room, the set is
+ * built (the frame's count of culled triangles) and kept for the next call. */
+static void test_cull_within_budget(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    assert_int_equal(ms_scene_default(&sc), 0);
+    frame_points fp;
+    frame_points_make(&fp, &sc, 48, 48);
+    ms_points pts = as_points(&fp);
+    char err[512] = "";
+    float *v[2], *s[2];
+    uint16_t *f[2];
+    uint64_t culled[2];
+    for (int tight = 0; tight < 2; tight++) {
+        ms_accel *acc = NULL;
+        assert_int_equal(ms_accel_build(&sc, 1, &acc, err, sizeof err), MS_OK);
+        ms_points_options po;
+        points_options(&po, "scanline", MS_PATTERN_GRID, 256);
+        po.threads = 1;
+        const uint64_t call = ms_points_need(fp.n, sc.n_tris, 0, 4, 1, NULL);
+        po.max_memory = tight ? call + ms_culled_sets_need(sc.n_tris, 0, 1) - 1 : 0;
+        v[tight] = malloc(sizeof(float) * fp.n);
+        s[tight] = malloc(sizeof(float) * fp.n);
+        f[tight] = malloc(sizeof(uint16_t) * fp.n);
+        assert_true(v[tight] && s[tight] && f[tight]);
+        ms_stats stats;
+        assert_int_equal(ms_visibility_points(acc, NULL, &pts, &po, v[tight], s[tight], f[tight], &stats, err, sizeof err),
+                         MS_OK);
+        culled[tight] = stats.occluders_culled;
+        if (!tight) {   /* kept: the second call finds it */
+            assert_int_equal(ms_visibility_points(acc, NULL, &pts, &po, v[0], s[0], f[0], &stats, err, sizeof err), MS_OK);
+            assert_int_equal(stats.occluders_culled, culled[0]);
+        }
+        ms_accel_free(acc);
+    }
+    printf("cull: %llu triangles culled with room, %llu under the tight budget\n", (unsigned long long)culled[0],
+           (unsigned long long)culled[1]);
+    assert_true(culled[0] > 0);
+    assert_int_equal(culled[1], 0);
+    assert_memory_equal(v[0], v[1], sizeof(float) * fp.n);
+    assert_memory_equal(s[0], s[1], sizeof(float) * fp.n);
+    assert_memory_equal(f[0], f[1], sizeof(uint16_t) * fp.n);
+    for (int i = 0; i < 2; i++) { free(v[i]); free(s[i]); free(f[i]); }
+    frame_points_free(&fp);
+    ms_scene_free(&sc);
 }
 
 static void test_progress_cancel(void **st)
@@ -518,6 +575,7 @@ int main(int argc, char **argv)
 #endif
         cmocka_unit_test(test_points_in_the_air),
         cmocka_unit_test(test_invariance),
+        cmocka_unit_test(test_cull_within_budget),
         cmocka_unit_test(test_progress_cancel),
         cmocka_unit_test(test_bad_input),
     };

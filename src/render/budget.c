@@ -336,6 +336,14 @@ uint64_t ms_points_need(size_t n, size_t n_tris, int whole_tri_copy, int mask_wo
     return need->total;
 }
 
+uint64_t ms_culled_sets_need(size_t n_tris, size_t held, int build)
+{
+    /* Each held set: a BVH over at most every triangle with its map; a build on top: the scene-order copy it
+     * culls from and the build's temporaries. */
+    return mul(mul(n_tris, OCCLUDERS_PER_TRI), held + (build ? 1u : 0u))
+           + (build ? mul(n_tris, OCCLUDERS_BUILD_PER_TRI + TRI_BYTES) : 0);
+}
+
 int ms_points_budget_check(size_t n, size_t n_tris, int whole_tri_copy, int mask_words, int threads, uint64_t budget,
                            char *err, size_t errlen)
 {

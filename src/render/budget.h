@@ -88,6 +88,10 @@ uint64_t ms_points_need(size_t n, size_t n_tris, int whole_tri_copy, int mask_wo
 int ms_points_budget_check(size_t n, size_t n_tris, int whole_tri_copy, int mask_words, int threads, uint64_t budget,
                            char *err, size_t errlen);
 
+/* The points calls' occluder sets with the closed-component cull kept in an accel (points.c): `held` of them
+ * over n_tris triangles, and one more being built when `build`. */
+uint64_t ms_culled_sets_need(size_t n_tris, size_t held, int build);
+
 /* ms_accel_build over n triangles at its peak: the BVH's build, or the closed components' search after it. */
 uint64_t ms_accel_need(size_t n_tris);
 

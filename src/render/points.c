@@ -32,11 +32,16 @@ struct ms_accel {
     size_t n_lights;
     int threads;
     /* The scene's closed surfaces and their interior boxes (occluders.h), found once: each call keeps those
-     * its light allows, for the methods that take them (the closed-component cull, which needs a BVH of its
-     * own per light, is for frames only). */
+     * its light allows, for the methods that take them; the culled sets below are built from them. */
     ms_closed closed;
     ms_interior interior;
     double interior_eps;
+    /* Per light of the scene, its occluders with the closed-component cull and the interior boxes (occluders.h),
+     * built by the first call that needs them (accel_culled) and kept: frames cull by default for the methods
+     * that gain (ms_shadow_method.occluders), and a bake calls once per light and row range. 0: not built; 1:
+     * built; -1: out of memory when tried (the call goes without). */
+    ms_occluders *culled;
+    int8_t *culled_state;
 };
 
 const char *ms_status_name(ms_status s)
@@ -99,6 +104,9 @@ ms_status ms_accel_build_abi(const ms_abi *abi, const ms_scene *scene, int threa
     a->lights = calloc(nl, sizeof *a->lights);
     if (!a->lights) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
     a->n_lights = nl;
+    a->culled = calloc(nl ? nl : 1, sizeof *a->culled);
+    a->culled_state = calloc(nl ? nl : 1, sizeof *a->culled_state);
+    if (!a->culled || !a->culled_state) { ms_accel_free(a); snprintf(err, errlen, "out of memory"); return MS_ERR_NO_MEMORY; }
     for (size_t l = 0; l < nl; l++) {
         a->lights[l] = src[l];
         a->lights[l].texture = NULL;
@@ -133,6 +141,10 @@ void ms_accel_free(ms_accel *a)
     free(a->leaf_of);
     ms_closed_free(&a->closed);
     ms_interior_free(&a->interior);
+    for (size_t l = 0; a->culled && a->culled_state && l < a->n_lights; l++)
+        if (a->culled_state[l] == 1) ms_occluders_free(&a->culled[l]);
+    free(a->culled);
+    free(a->culled_state);
     for (size_t l = 0; a->lights && l < a->n_lights; l++) free((void *)a->lights[l].texture);
     free(a->lights);
     free(a);
@@ -325,6 +337,7 @@ static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm,
     for (int j = 0; j < m; j++) {
         const size_t i = r->order[i0 + j].index;
         make_query(r->a, r->pts, i, &q[nq]);
+        q[nq].prim = ms_ctx_skip_prim(r->ctx, q[nq].prim);   /* its own triangle in the occluders' numbering */
         if (r->outlined && r->shape->outline(&r->ctx->light, q[nq].p, &qc.light)) {
             if (r->front_out) r->front_out[i] = 0;
             if (r->vis) r->vis[i] = 0.0f;
@@ -362,7 +375,7 @@ static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm,
 /* What a call measured: the timings and the counters summed over the threads. */
 typedef struct points_tally {
     double setup_s, shadow_s, resolve_thread_s, t_start;
-    uint64_t interior_boxes, penumbra, segments;
+    uint64_t interior_boxes, occluders_culled, penumbra, segments;
     const uint64_t *counters;
     ms_isa kisa, tisa;
 } points_tally;
@@ -378,6 +391,7 @@ static void points_stats(const ms_accel *a, const ms_shadow_method *sm, const ms
     stats->setup_s = t->setup_s;
     stats->shadow_s = t->shadow_s;
     stats->interior_boxes = t->interior_boxes;
+    stats->occluders_culled = t->occluders_culled;
     stats->samples = ctx->samples;
     stats->samples_per_pixel = ctx->samples;   /* every point gets all N (no interleaving here) */
     stats->threads = threads;
@@ -445,6 +459,48 @@ static float *scene_order_tris(const ms_accel *a)
     return tri;
 }
 
+/* The accel's light that `light` (placed) is, by its geometry (shape, corner, edges, centre, radius: what its
+ * occluders depend on); -1 when none is. */
+static long accel_light_index(const ms_accel *a, const ms_light *light)
+{
+    for (size_t l = 0; l < a->n_lights; l++) {
+        const ms_light *m = &a->lights[l];
+        if (m->shape == light->shape && m->radius == light->radius &&
+            !memcmp(&m->corner, &light->corner, sizeof m->corner) && !memcmp(&m->edge_s, &light->edge_s, sizeof m->edge_s) &&
+            !memcmp(&m->edge_t, &light->edge_t, sizeof m->edge_t) && !memcmp(&m->center, &light->center, sizeof m->center))
+            return (long)l;
+    }
+    return -1;
+}
+
+/* Light l's occluders with the closed-component cull and the interior boxes, as frames build them
+ * (frame_job_create.c), made on first use and kept in the accel: NULL when building it would take the sets the
+ * accel holds and the call's own need (call_need) past the budget, or when out of memory (the call then goes
+ * without: the same answer). The accel is shared by the caller's threads: one builds, under the lock, and the
+ * rest wait. */
+static const ms_occluders *accel_culled(const ms_accel *ac, size_t l, int threads, uint64_t call_need, uint64_t budget)
+{
+    ms_accel *a = (ms_accel *)ac;   /* the cache only: built once, then read */
+    const ms_occluders *o = NULL;
+#pragma omp critical(ms_accel_culled)
+    {
+        size_t held = 0;
+        for (size_t i = 0; i < a->n_lights; i++) held += a->culled_state[i] == 1;
+        if (!a->culled_state[l] && call_need + ms_culled_sets_need(a->view.n_tris, held, 1) <= budget) {
+            ms_scene view = a->view;
+            float *tri = a->view.n_tris ? scene_order_tris(a) : NULL;
+            view.tri = tri;
+            a->culled_state[l] = (a->view.n_tris && !tri) ||
+                                 ms_occluders_build(&a->culled[l], &view, &a->bvh, &a->closed, &a->interior, a->interior_eps,
+                                                    a->alpha, &a->lights[l], MS_OCC_CULL | MS_OCC_INTERIOR, threads)
+                                 ? -1 : 1;
+            free(tri);
+        }
+        if (a->culled_state[l] == 1) o = &a->culled[l];
+    }
+    return o;
+}
+
 ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, const ms_points *pts,
                                      const ms_points_options *opt_in, float *vis, float *shadow, uint16_t *front_out,
                                      ms_stats *stats, char *err, size_t errlen)
@@ -501,13 +557,31 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     void *sstate = NULL;
     const double t_setup = omp_get_wtime();
     ms_occluders occ = { 0 };
-    if ((sm->occluders & MS_OCC_INTERIOR) && a->interior.n_boxes && points_interior(a, &view, light, threads, &occ, &ctx)) {
+    /* The occluders frames use by default: for a method that culls closed meshes by default (and takes the
+     * queries one batch at a time), a light of the scene gets the accel's culled set; otherwise the scene's
+     * triangles, with the interior boxes this light allows. */
+    const long li = (sm->occluders & MS_OCC_CULL_BY_DEFAULT) && !sm->visibility_all && a->closed.n_cycles
+                    ? accel_light_index(a, light) : -1;
+    const uint64_t call_need = ms_points_need(pts->n, a->view.n_tris, sm->visibility_all != NULL, (k * k + 63) / 64, threads, NULL);
+    const ms_occluders *culled = li >= 0 ? accel_culled(a, (size_t)li, threads, call_need, budget) : NULL;
+    uint64_t occ_boxes = 0, occ_culled = 0;
+    if (culled) {
+        if (culled->active) {
+            ctx.bvh = &culled->bvh;
+            ctx.alpha = culled->alpha;
+            ctx.prim_map = culled->prim_map;
+        }
+        if ((sm->occluders & MS_OCC_INTERIOR) && culled->interior.n_tris) ctx.interior = &culled->interior;
+        occ_boxes = (sm->occluders & MS_OCC_INTERIOR) ? culled->interior_boxes : 0;
+        occ_culled = culled->culled;
+    } else if ((sm->occluders & MS_OCC_INTERIOR) && a->interior.n_boxes && points_interior(a, &view, light, threads, &occ, &ctx)) {
         free(order);
         free(scene_tri);
         snprintf(err, errlen, "out of memory for the interior boxes");
         return MS_ERR_NO_MEMORY;
+    } else {
+        occ_boxes = occ.interior_boxes;
     }
-    const uint64_t occ_boxes = occ.interior_boxes;
     if (sm->create(&ctx, &sstate, err, errlen)) { ms_occluders_free(&occ); free(order); free(scene_tri); return MS_ERR_METHOD; }
     bctx = ctx;
     bctx.outline_per_query = 1;
@@ -586,7 +660,8 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     st = points_finite(n, vis, shadow, err, errlen);
     if (st) return st;
     if (stats) {
-        const points_tally t = { setup_s, t1 - t0, resolve_thread_s, t_start, occ_boxes, penumbra, segments, counters, kisa, tisa };
+        const points_tally t = { setup_s, t1 - t0, resolve_thread_s, t_start, occ_boxes, occ_culled, penumbra, segments, counters,
+                                 kisa, tisa };
         points_stats(a, sm, &ctx, n, threads, budget, &t, stats);
     }
     return MS_OK;
