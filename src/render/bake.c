@@ -241,14 +241,24 @@ static ms_status bake_budget(const ms_scene *scene, const ms_bake_options *o, in
     return ms_bake_budget_check(&bs, ms_memory_budget(o->points.max_memory), err, errlen) ? MS_ERR_BUDGET : MS_OK;
 }
 
+/* A checked entry point's first steps: the ABI check, then the options as this library reads them (an earlier
+ * header's at its size, NULL as the defaults) in *o, which may point at copy. */
+static ms_status bake_entry(const ms_abi *abi, const char *fn, const ms_bake_options *in, ms_bake_options *copy,
+                            const ms_bake_options **o, char *err, size_t errlen)
+{
+    const ms_status st = ms_abi_check(abi, fn, err, errlen);
+    *o = st ? NULL : ms_abi_bake_options(abi, in, copy);
+    return st;
+}
+
 /* The layout of the lightmap (ms_bake_layout): checks, UVs, texel rasterization, the frame's arrays. */
 ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *out,
                              char *err, size_t errlen)
 {
-    const ms_status ast = ms_abi_check(abi, "ms_bake_layout", err, errlen);
-    if (ast) return ast;
     ms_bake_options opt_copy;
-    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
+    const ms_bake_options *o;
+    const ms_status ast = bake_entry(abi, "ms_bake_layout", opt_in, &opt_copy, &o, err, errlen);
+    if (ast) return ast;
     if (!out) { snprintf(err, errlen, "ms_bake: out is NULL"); return MS_ERR_INVALID; }
     memset(out, 0, sizeof *out);
     if (!scene) { snprintf(err, errlen, "ms_bake: no scene"); return MS_ERR_INVALID; }
@@ -352,10 +362,10 @@ static int light_progress(void *user, double f)
 ms_status ms_bake_rows_abi(const ms_abi *abi, const ms_accel *accel, const ms_bake_options *opt_in, ms_lightmap *lm,
                            int y0, int y1, char *err, size_t errlen)
 {
-    const ms_status ast = ms_abi_check(abi, "ms_bake_rows", err, errlen);
-    if (ast) return ast;
     ms_bake_options opt_copy;
-    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
+    const ms_bake_options *o;
+    const ms_status ast = bake_entry(abi, "ms_bake_rows", opt_in, &opt_copy, &o, err, errlen);
+    if (ast) return ast;
     ms_frame *f = &lm->frame;
     const int size = f->width;
     if (!accel || !f->vis || y0 < 0 || y1 > f->height || y0 > y1) {
@@ -488,10 +498,10 @@ static ms_status seams(const ms_scene *scene, const ms_bake_options *o, ms_light
 ms_status ms_bake_finish_abi(const ms_abi *abi, const ms_scene *scene, const ms_bake_options *opt_in, ms_lightmap *lm,
                              char *err, size_t errlen)
 {
-    const ms_status ast = ms_abi_check(abi, "ms_bake_finish", err, errlen);
-    if (ast) return ast;
     ms_bake_options opt_copy;
-    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
+    const ms_bake_options *o;
+    const ms_status ast = bake_entry(abi, "ms_bake_finish", opt_in, &opt_copy, &o, err, errlen);
+    if (ast) return ast;
     const int passes = o->dilate == 0 ? 4 : o->dilate < 0 ? 0 : o->dilate;
     const double t_finish = omp_get_wtime();
     ms_frame *f = &lm->frame;
@@ -576,10 +586,10 @@ ms_status ms_bake_finish_abi(const ms_abi *abi, const ms_scene *scene, const ms_
 ms_status ms_bake_abi(const ms_abi *abi, const ms_scene *scene, const ms_accel *accel, const ms_bake_options *opt_in,
                       ms_lightmap *out, char *err, size_t errlen)
 {
-    const ms_status ast = ms_abi_check(abi, "ms_bake", err, errlen);
-    if (ast) return ast;
     ms_bake_options opt_copy;
-    const ms_bake_options *o = ms_abi_bake_options(abi, opt_in, &opt_copy);
+    const ms_bake_options *o;
+    const ms_status ast = bake_entry(abi, "ms_bake", opt_in, &opt_copy, &o, err, errlen);
+    if (ast) return ast;
     const double t_start = omp_get_wtime();
     if (out) memset(out, 0, sizeof *out);
     const int size = o->size ? o->size : 1024;
