@@ -478,6 +478,87 @@ static void test_cull_within_budget(void **st)
     ms_scene_free(&sc);
 }
 
+/* A ball of 1280 triangles (closed: it gets interior boxes) over a ground, written as OBJ files and loaded. */
+static void ball_scene(ms_scene *sc)
+{
+    const char *dir = tu_tmpdir("test_points_ball");
+    char path[512];
+    double *v;
+    int *t;
+    size_t nv, nt;
+    tu_unit_icosphere(3, &v, &nv, &t, &nt);
+    FILE *f = fopen(tu_path(path, sizeof path, dir, "ball.obj"), "w");
+    assert_non_null(f);
+    for (size_t i = 0; i < nv; i++) fprintf(f, "v %.9g %.9g %.9g\n", 0.6 * v[3 * i], 1.0 + 0.6 * v[3 * i + 1], 0.6 * v[3 * i + 2]);
+    for (size_t i = 0; i < nt; i++) fprintf(f, "f %d %d %d\n", t[3 * i] + 1, t[3 * i + 1] + 1, t[3 * i + 2] + 1);
+    fclose(f);
+    free(v);
+    free(t);
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "ground.obj"),
+                                   "v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 3 2\nf 1 4 3\n"), 0);
+    tu_load_scene_text(dir,
+                       "{\"meshes\":[{\"file\":\"ball.obj\"},{\"file\":\"ground.obj\"}],"
+                       "\"camera\":{\"eye\":[2.5,3.5,2.5],\"target\":[0,0.6,0],\"up\":[0,1,0],\"fov_y\":50,\"width\":48,\"height\":48},"
+                       "\"light\":{\"corner\":[-1.2,3.2,-0.4],\"edge_s\":[0.8,0,0],\"edge_t\":[0,0,0.8]}}",
+                       sc);
+}
+
+/* mft leaves the interior boxes to the driver (MS_OCC_INTERIOR_PASS): the points API runs them first as frames
+ * do, with the frame's V, S and front on its hit points bit for bit, the same boxes and as many traversals. */
+static void test_interior_pass(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    ball_scene(&sc);
+    const int W = 48, H = 48;
+    frame_points fp;
+    frame_points_make(&fp, &sc, W, H);
+    ms_accel *acc = NULL;
+    char err[512] = "";
+    assert_int_equal(ms_accel_build(&sc, 0, &acc, err, sizeof err), MS_OK);
+    ms_points pts = as_points(&fp);
+    float *v = malloc(sizeof(float) * fp.n), *s = malloc(sizeof(float) * fp.n);
+    uint16_t *f = malloc(sizeof(uint16_t) * fp.n);
+    assert_true(v && s && f);
+    ms_render_options ro;
+    tu_render_options_default(&ro);
+    ro.method = "mft";
+    ro.samples = 256;
+    ro.width = W;
+    ro.height = H;
+    ms_frame fr;
+    assert_int_equal(ms_render(&sc, &ro, &fr, err, sizeof err), MS_OK);
+    ms_points_options po;
+    points_options(&po, "mft", MS_PATTERN_GRID, 256);
+    ms_stats stats;
+    assert_int_equal(ms_visibility_points(acc, NULL, &pts, &po, v, s, f, &stats, err, sizeof err), MS_OK);
+    long differ = 0, shadowed = 0;
+    for (size_t i = 0; i < fp.n; i++) {
+        const int p = fp.pixel[i];
+        differ += v[i] != fr.vis[p] || s[i] != fr.shadow[p] || f[i] != fr.front[p];
+        shadowed += v[i] < 1.0f;
+    }
+    printf("mft on the ball: %zu points, %ld shadowed, %ld differ from the frame; interior boxes %llu (frame %llu)\n",
+           fp.n, shadowed, differ, (unsigned long long)stats.interior_boxes, (unsigned long long)fr.stats.interior_boxes);
+    /* The pass shows in the traversals: each block walks the boxes, then (unless they left it nothing) the
+     * triangles, as in the frame, whose blocks differ only in how the receivers are grouped; without the pass
+     * the points would walk about half as many (measured: 97 against 194, the frame 207). */
+    const uint64_t blocks = tu_stat_counter(&stats, "blocks"), frame_blocks = tu_stat_counter(&fr.stats, "blocks");
+    printf("block traversals: points %llu, frame %llu\n", (unsigned long long)blocks, (unsigned long long)frame_blocks);
+    assert_true(blocks * 10 >= frame_blocks * 8);
+    assert_true(shadowed > 100);
+    assert_int_equal(differ, 0);
+    assert_true(stats.interior_boxes > 0);
+    assert_int_equal(stats.interior_boxes, fr.stats.interior_boxes);
+    ms_frame_free(&fr);
+    free(v);
+    free(s);
+    free(f);
+    ms_accel_free(acc);
+    frame_points_free(&fp);
+    ms_scene_free(&sc);
+}
+
 static void test_progress_cancel(void **st)
 {
     (void)st;
@@ -576,6 +657,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_points_in_the_air),
         cmocka_unit_test(test_invariance),
         cmocka_unit_test(test_cull_within_budget),
+        cmocka_unit_test(test_interior_pass),
         cmocka_unit_test(test_progress_cancel),
         cmocka_unit_test(test_bad_input),
     };

@@ -314,6 +314,9 @@ typedef struct points_run {
     const ms_shadow_method *sm;
     void *sstate;
     const ms_render_ctx *ctx, *bctx;   /* the call's context; the batch's when each query has its own outline */
+    void *istate;                      /* a method that does not rasterize the interior boxes itself (MS_OCC_INTERIOR_PASS):
+                                        * its state over the boxes, run first as frames do (frame_job_shadow.c); NULL: none */
+    const ms_render_ctx *ictx;
     const ms_light_shape_ops *shape;
     int outlined, batched;             /* a per-receiver light (the shape's outline); the method takes it by batch */
     size_t mw;
@@ -325,9 +328,9 @@ typedef struct points_run {
  * method's visible masks, V and S. A sphere or a sun: each point has its own light, the shape's outline seen
  * from it, and the method takes the batch with each point's outline (.outlines) or is called one point at a
  * time with it, exactly as frames do; a point inside a sphere has no sample in front (V = S = 0). Scratch: fm,
- * vm (BATCH masks each), spts (a pixel's samples, stratified patterns only), q (BATCH queries). Adds to the
+ * vm, im (BATCH masks each; im only with r->istate), spts (a pixel's samples, stratified patterns only), q (BATCH queries). Adds to the
  * thread's counters, segments, penumbra points and resolve seconds. 0, or -1 when the method failed. */
-static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm, uint64_t *vm, float *spts,
+static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm, uint64_t *vm, uint64_t *im, float *spts,
                         ms_shadow_query *q, uint64_t *counters, uint64_t *segments, uint64_t *penumbra, double *resolve_s)
 {
     const int m = (int)(i1 - i0);
@@ -351,7 +354,15 @@ static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm,
         where[nq++] = i;
     }
     int vfail = 0;
-    if (!r->outlined || r->batched) vfail = nq && r->sm->visibility(r->sstate, r->batched ? r->bctx : r->ctx, q, nq, fm, vm, counters);
+    if (r->istate && nq) {
+        /* The interior boxes first (no receiver on them: no prim to skip), then the triangles with the samples
+         * they left. */
+        uint32_t prim[BATCH];
+        for (int j = 0; j < nq; j++) { prim[j] = q[j].prim; q[j].prim = UINT32_MAX; }
+        vfail = r->sm->visibility(r->istate, r->ictx, q, nq, fm, im, counters);
+        for (int j = 0; j < nq; j++) q[j].prim = prim[j];
+        vfail = vfail || r->sm->visibility(r->sstate, r->ctx, q, nq, im, vm, counters);
+    } else if (!r->outlined || r->batched) vfail = nq && r->sm->visibility(r->sstate, r->batched ? r->bctx : r->ctx, q, nq, fm, vm, counters);
     else
         for (int j = 0; j < nq && !vfail; j++) {
             r->shape->outline(&r->ctx->light, q[j].p, &qc.light);
@@ -585,6 +596,24 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     if (sm->create(&ctx, &sstate, err, errlen)) { ms_occluders_free(&occ); free(order); free(scene_tri); return MS_ERR_METHOD; }
     bctx = ctx;
     bctx.outline_per_query = 1;
+    /* A method that leaves the interior boxes to the driver gets them in a pass of their own, as in frames
+     * (frame_job_create.c: not for a per-receiver light). */
+    void *istate = NULL;
+    ms_render_ctx ictx = ctx;
+    if ((sm->occluders & MS_OCC_INTERIOR_PASS) && ctx.interior && !outlined) {
+        ictx.bvh = ctx.interior;
+        ictx.interior = NULL;
+        ictx.alpha = NULL;
+        ictx.prim_map = NULL;
+        ictx.prim_merged = NULL;
+        if (sm->create(&ictx, &istate, err, errlen)) {
+            sm->destroy(sstate);
+            ms_occluders_free(&occ);
+            free(order);
+            free(scene_tri);
+            return MS_ERR_METHOD;
+        }
+    }
     const double setup_s = omp_get_wtime() - t_setup;
 
     const long nbatch = (long)((n + BATCH - 1) / BATCH);
@@ -595,7 +624,8 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     double resolve_thread_s = 0.0;
     long done = 0;
     int failed = 0, cancelled = 0;
-    const points_run run = { a, pts, order, sm, sstate, &ctx, &bctx, shape, outlined, batched, mw, vis, shadow, front_out };
+    const points_run run = { a, pts, order, sm, sstate, &ctx, &bctx, istate, &ictx, shape, outlined, batched, mw, vis, shadow,
+                             front_out };
     const double t0 = omp_get_wtime();
 #pragma omp parallel num_threads(threads)
     {
@@ -604,9 +634,10 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
         double local_resolve = 0.0;
         uint64_t *fm = aligned_alloc(64, BATCH * mw * sizeof *fm);
         uint64_t *vm = aligned_alloc(64, BATCH * mw * sizeof *vm);
+        uint64_t *im = istate ? aligned_alloc(64, BATCH * mw * sizeof *im) : NULL;
         float *spts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *spts) : NULL;
         ms_shadow_query *q = malloc(BATCH * sizeof *q);
-        int ok = fm && vm && q && (spts || !stratified);
+        int ok = fm && vm && q && (spts || !stratified) && (im || !istate);
         if (!ok) {
 #pragma omp atomic write
             failed = 1;
@@ -618,7 +649,7 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
             stop = cancelled;
             if (!ok || stop) continue;
             const size_t i0 = (size_t)b * BATCH, i1 = i0 + BATCH < n ? i0 + BATCH : n;
-            if (points_batch(&run, i0, i1, fm, vm, spts, q, local, &local_segments, &local_penumbra, &local_resolve)) {
+            if (points_batch(&run, i0, i1, fm, vm, im, spts, q, local, &local_segments, &local_penumbra, &local_resolve)) {
                 ok = 0;
 #pragma omp atomic write
                 failed = 1;
@@ -638,6 +669,7 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
         }
         free(fm);
         free(vm);
+        free(im);
         free(spts);
         free(q);
 #pragma omp critical(ms_points_counters)
@@ -653,6 +685,7 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
     if (sm->isa_used) sm->isa_used(sstate, &kisa, &tisa);
     sm->destroy(sstate);
+    if (istate) sm->destroy(istate);
     ms_occluders_free(&occ);
     free(scene_tri);
     if (failed) { snprintf(err, errlen, "out of memory in the shadow phase of method '%s'", sm->name); return MS_ERR_NO_MEMORY; }
