@@ -383,6 +383,82 @@ static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm,
     return 0;
 }
 
+/* What the batches of a call add up: the method's counters, penumbra points, segments, resolve thread-seconds,
+ * and whether the progress callback cancelled. */
+typedef struct points_sums {
+    uint64_t *counters;
+    uint64_t penumbra, segments;
+    double resolve_thread_s;
+    int cancelled;
+} points_sums;
+
+/* Every batch of the n points of run on `threads` threads (OpenMP, dynamic: costs vary), with the progress
+ * callback of opt after each; sums into *sums. 0, or 1 when out of memory or the method failed. */
+static int points_batches(const points_run *run, size_t n, int threads, const ms_points_options *opt, points_sums *sums)
+{
+    const ms_render_ctx *ctx = run->ctx;
+    const long nbatch = (long)((n + BATCH - 1) / BATCH);
+    const size_t mw = run->mw;
+    const int stratified = ctx->pattern != MS_PATTERN_GRID;
+    long done = 0;
+    int failed = 0, cancelled = 0;
+#pragma omp parallel num_threads(threads)
+    {
+        uint64_t local[MS_MAX_COUNTERS] = { 0 };
+        uint64_t local_penumbra = 0, local_segments = 0;
+        double local_resolve = 0.0;
+        uint64_t *fm = aligned_alloc(64, BATCH * mw * sizeof *fm);
+        uint64_t *vm = aligned_alloc(64, BATCH * mw * sizeof *vm);
+        uint64_t *im = run->istate ? aligned_alloc(64, BATCH * mw * sizeof *im) : NULL;
+        float *spts = stratified ? malloc((size_t)ctx->samples * 3 * sizeof *spts) : NULL;
+        ms_shadow_query *q = malloc(BATCH * sizeof *q);
+        int ok = fm && vm && q && (spts || !stratified) && (im || !run->istate);
+        if (!ok) {
+#pragma omp atomic write
+            failed = 1;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (long b = 0; b < nbatch; b++) {
+            int stop;
+#pragma omp atomic read
+            stop = cancelled;
+            if (!ok || stop) continue;
+            const size_t i0 = (size_t)b * BATCH, i1 = i0 + BATCH < n ? i0 + BATCH : n;
+            if (points_batch(run, i0, i1, fm, vm, im, spts, q, local, &local_segments, &local_penumbra, &local_resolve)) {
+                ok = 0;
+#pragma omp atomic write
+                failed = 1;
+                continue;
+            }
+            if (opt->progress) {
+                /* One caller at a time; its answer stops the remaining batches. */
+#pragma omp critical(ms_points_progress)
+                {
+                    done++;
+                    if (!cancelled && opt->progress(opt->progress_user, (double)done / (double)nbatch)) {
+#pragma omp atomic write
+                        cancelled = 1;
+                    }
+                }
+            }
+        }
+        free(fm);
+        free(vm);
+        free(im);
+        free(spts);
+        free(q);
+#pragma omp critical(ms_points_counters)
+        {
+            for (int c = 0; c < MS_MAX_COUNTERS; c++) sums->counters[c] += local[c];
+            sums->penumbra += local_penumbra;
+            sums->segments += local_segments;
+            sums->resolve_thread_s += local_resolve;
+        }
+    }
+    sums->cancelled = cancelled;
+    return failed;
+}
+
 /* What a call measured: the timings and the counters summed over the threads. */
 typedef struct points_tally {
     double setup_s, shadow_s, resolve_thread_s, t_start;
@@ -616,70 +692,16 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     }
     const double setup_s = omp_get_wtime() - t_setup;
 
-    const long nbatch = (long)((n + BATCH - 1) / BATCH);
     const size_t mw = (size_t)ctx.mask_words;
-    const int stratified = ctx.pattern != MS_PATTERN_GRID;
     uint64_t counters[MS_MAX_COUNTERS] = { 0 };
-    uint64_t penumbra = 0, segments = 0;
-    double resolve_thread_s = 0.0;
-    long done = 0;
-    int failed = 0, cancelled = 0;
+    points_sums sums = { counters, 0, 0, 0.0, 0 };
     const points_run run = { a, pts, order, sm, sstate, &ctx, &bctx, istate, &ictx, shape, outlined, batched, mw, vis, shadow,
                              front_out };
     const double t0 = omp_get_wtime();
-#pragma omp parallel num_threads(threads)
-    {
-        uint64_t local[MS_MAX_COUNTERS] = { 0 };
-        uint64_t local_penumbra = 0, local_segments = 0;
-        double local_resolve = 0.0;
-        uint64_t *fm = aligned_alloc(64, BATCH * mw * sizeof *fm);
-        uint64_t *vm = aligned_alloc(64, BATCH * mw * sizeof *vm);
-        uint64_t *im = istate ? aligned_alloc(64, BATCH * mw * sizeof *im) : NULL;
-        float *spts = stratified ? malloc((size_t)ctx.samples * 3 * sizeof *spts) : NULL;
-        ms_shadow_query *q = malloc(BATCH * sizeof *q);
-        int ok = fm && vm && q && (spts || !stratified) && (im || !istate);
-        if (!ok) {
-#pragma omp atomic write
-            failed = 1;
-        }
-#pragma omp for schedule(dynamic, 1)
-        for (long b = 0; b < nbatch; b++) {
-            int stop;
-#pragma omp atomic read
-            stop = cancelled;
-            if (!ok || stop) continue;
-            const size_t i0 = (size_t)b * BATCH, i1 = i0 + BATCH < n ? i0 + BATCH : n;
-            if (points_batch(&run, i0, i1, fm, vm, im, spts, q, local, &local_segments, &local_penumbra, &local_resolve)) {
-                ok = 0;
-#pragma omp atomic write
-                failed = 1;
-                continue;
-            }
-            if (opt->progress) {
-                /* One caller at a time; its answer stops the remaining batches. */
-#pragma omp critical(ms_points_progress)
-                {
-                    done++;
-                    if (!cancelled && opt->progress(opt->progress_user, (double)done / (double)nbatch)) {
-#pragma omp atomic write
-                        cancelled = 1;
-                    }
-                }
-            }
-        }
-        free(fm);
-        free(vm);
-        free(im);
-        free(spts);
-        free(q);
-#pragma omp critical(ms_points_counters)
-        {
-            for (int c = 0; c < MS_MAX_COUNTERS; c++) counters[c] += local[c];
-            penumbra += local_penumbra;
-            segments += local_segments;
-            resolve_thread_s += local_resolve;
-        }
-    }
+    const int failed = points_batches(&run, n, threads, opt, &sums);
+    const uint64_t penumbra = sums.penumbra, segments = sums.segments;
+    const double resolve_thread_s = sums.resolve_thread_s;
+    const int cancelled = sums.cancelled;
     const double t1 = omp_get_wtime();
     free(order);
     ms_isa kisa = MS_ISA_AUTO, tisa = MS_ISA_AUTO;
