@@ -328,8 +328,9 @@ typedef struct points_run {
  * method's visible masks, V and S. A sphere or a sun: each point has its own light, the shape's outline seen
  * from it, and the method takes the batch with each point's outline (.outlines) or is called one point at a
  * time with it, exactly as frames do; a point inside a sphere has no sample in front (V = S = 0). Scratch: fm,
- * vm, im (BATCH masks each; im only with r->istate), spts (a pixel's samples, stratified patterns only), q (BATCH queries). Adds to the
- * thread's counters, segments, penumbra points and resolve seconds. 0, or -1 when the method failed. */
+ * vm, im (BATCH masks each; im only with r->istate), spts (a pixel's samples, stratified patterns only), q
+ * (BATCH queries). Adds to the thread's counters, segments, penumbra points and resolve seconds. 0, or -1 when
+ * the method failed. */
 static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm, uint64_t *vm, uint64_t *im, float *spts,
                         ms_shadow_query *q, uint64_t *counters, uint64_t *segments, uint64_t *penumbra, double *resolve_s)
 {
@@ -362,7 +363,8 @@ static int points_batch(const points_run *r, size_t i0, size_t i1, uint64_t *fm,
         vfail = r->sm->visibility(r->istate, r->ictx, q, nq, fm, im, counters);
         for (int j = 0; j < nq; j++) q[j].prim = prim[j];
         vfail = vfail || r->sm->visibility(r->sstate, r->ctx, q, nq, im, vm, counters);
-    } else if (!r->outlined || r->batched) vfail = nq && r->sm->visibility(r->sstate, r->batched ? r->bctx : r->ctx, q, nq, fm, vm, counters);
+    } else if (!r->outlined || r->batched)
+        vfail = nq && r->sm->visibility(r->sstate, r->batched ? r->bctx : r->ctx, q, nq, fm, vm, counters);
     else
         for (int j = 0; j < nq && !vfail; j++) {
             r->shape->outline(&r->ctx->light, q[j].p, &qc.light);
