@@ -9,13 +9,7 @@ void fj_light_ctx(const ms_frame_job *j, size_t l, ms_render_ctx *c)
 {
     *c = j->ctx;
     c->light = j->lights[l];
-    if (j->occ && j->occ[l].active) {
-        c->bvh = &j->occ[l].bvh;
-        c->alpha = j->occ[l].alpha;
-        c->prim_map = j->occ[l].prim_map;
-        c->prim_merged = j->occ[l].prim_merged;
-    }
-    if (j->occ && j->occ[l].interior.n_tris) c->interior = &j->occ[l].interior;
+    if (j->occ) ms_occluders_ctx(&j->occ[l], c);
 }
 
 /* Light l's context over the scene's own triangles (its interior boxes kept: they are exact for any
@@ -64,10 +58,7 @@ void fj_light_split(const ms_frame_job *j, size_t l, ms_exact_split *sp)
  * (MS_OCC_INTERIOR_PASS): no receiver lies on them, none is alpha-tested. */
 void fj_light_interior_ctx(const ms_frame_job *j, size_t l, ms_render_ctx *c)
 {
-    fj_light_ctx(j, l, c);
-    c->bvh = c->interior;
-    c->interior = NULL;
-    c->alpha = NULL;
-    c->prim_map = NULL;
-    c->prim_merged = NULL;
+    ms_render_ctx lc;
+    fj_light_ctx(j, l, &lc);
+    ms_ctx_interior_pass(&lc, c);
 }

@@ -646,22 +646,17 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     void *sstate = NULL;
     const double t_setup = omp_get_wtime();
     ms_occluders occ = { 0 };
-    /* The occluders frames use by default: for a method that culls closed meshes by default (and takes the
-     * queries one batch at a time), a light of the scene gets the accel's culled set; otherwise the scene's
-     * triangles, with the interior boxes this light allows. */
-    const long li = (sm->occluders & MS_OCC_CULL_BY_DEFAULT) && !sm->visibility_all && a->closed.n_cycles
-                    ? accel_light_index(a, light) : -1;
+    /* The occluders frames use by default: for a method that culls closed meshes by default and takes the
+     * interior boxes (and the queries one batch at a time), a light of the scene gets the accel's culled set
+     * with its boxes; otherwise the scene's triangles, with the interior boxes this light allows. */
+    const long li = (sm->occluders & MS_OCC_CULL_BY_DEFAULT) && (sm->occluders & MS_OCC_INTERIOR) && !sm->visibility_all &&
+                    a->closed.n_cycles ? accel_light_index(a, light) : -1;
     const uint64_t call_need = ms_points_need(pts->n, a->view.n_tris, sm->visibility_all != NULL, (k * k + 63) / 64, threads, NULL);
     const ms_occluders *culled = li >= 0 ? accel_culled(a, (size_t)li, threads, call_need, budget) : NULL;
     uint64_t occ_boxes = 0, occ_culled = 0;
     if (culled) {
-        if (culled->active) {
-            ctx.bvh = &culled->bvh;
-            ctx.alpha = culled->alpha;
-            ctx.prim_map = culled->prim_map;
-        }
-        if ((sm->occluders & MS_OCC_INTERIOR) && culled->interior.n_tris) ctx.interior = &culled->interior;
-        occ_boxes = (sm->occluders & MS_OCC_INTERIOR) ? culled->interior_boxes : 0;
+        ms_occluders_ctx(culled, &ctx);
+        occ_boxes = culled->interior_boxes;
         occ_culled = culled->culled;
     } else if ((sm->occluders & MS_OCC_INTERIOR) && a->interior.n_boxes && points_interior(a, &view, light, threads, &occ, &ctx)) {
         free(order);
@@ -677,13 +672,9 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
     /* A method that leaves the interior boxes to the driver gets them in a pass of their own, as in frames
      * (frame_job_create.c: not for a per-receiver light). */
     void *istate = NULL;
-    ms_render_ctx ictx = ctx;
+    ms_render_ctx ictx;
+    ms_ctx_interior_pass(&ctx, &ictx);
     if ((sm->occluders & MS_OCC_INTERIOR_PASS) && ctx.interior && !outlined) {
-        ictx.bvh = ctx.interior;
-        ictx.interior = NULL;
-        ictx.alpha = NULL;
-        ictx.prim_map = NULL;
-        ictx.prim_merged = NULL;
         if (sm->create(&ictx, &istate, err, errlen)) {
             sm->destroy(sstate);
             ms_occluders_free(&occ);

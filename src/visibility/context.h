@@ -73,6 +73,18 @@ typedef struct ms_shadow_query {
 const ms_render_ctx *ms_ctx_for_query(const ms_render_ctx *ctx, const ms_shadow_query *q, ms_render_ctx *own);
 
 /* The prim id a shadow method skips for a receiver on the scene's triangle prim (ctx->prim_map). */
+/* The context of the interior boxes' own pass (a method that leaves them to the driver: MS_OCC_INTERIOR_PASS in
+ * occluders.h): c with its boxes as the occluders and nothing else (no receiver is on a box: no prim to skip). */
+static inline void ms_ctx_interior_pass(const ms_render_ctx *c, ms_render_ctx *out)
+{
+    *out = *c;
+    out->bvh = c->interior;
+    out->interior = NULL;
+    out->alpha = NULL;
+    out->prim_map = NULL;
+    out->prim_merged = NULL;
+}
+
 static inline uint32_t ms_ctx_skip_prim(const ms_render_ctx *ctx, uint32_t prim)
 {
     return ctx->prim_map && prim != UINT32_MAX ? ctx->prim_map[prim] : prim;

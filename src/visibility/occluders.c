@@ -39,6 +39,17 @@ int ms_light_hull(const ms_light *l, float pts[8][3], float box[6])
     return n;
 }
 
+void ms_occluders_ctx(const ms_occluders *o, ms_render_ctx *c)
+{
+    if (o->active) {
+        c->bvh = &o->bvh;
+        c->alpha = o->alpha;
+        c->prim_map = o->prim_map;
+        c->prim_merged = o->prim_merged;
+    }
+    if (o->interior.n_tris) c->interior = &o->interior;
+}
+
 void ms_occluders_free(ms_occluders *o)
 {
     for (int a = 0; a < 3; a++)

@@ -24,6 +24,7 @@
 #include "accel/bvh.h"
 #include "accel/closed.h"
 #include "accel/interior.h"
+#include "context.h"
 
 struct ms_alpha;
 
@@ -93,5 +94,8 @@ int ms_merged_receiver_ok_samples(const float tri[9], const float p[3], const fl
  * the lights' boxes together. */
 double ms_interior_clearance(const ms_bvh *scene_bvh, const ms_light *lights, size_t n_lights);
 void ms_occluders_free(ms_occluders *o);
+/* c over the set o, as frames and the points API hand it to a method: o's BVH, alpha table and maps when o is
+ * active (else c's, the scene's, stay), and o's interior boxes when it has any. */
+void ms_occluders_ctx(const ms_occluders *o, ms_render_ctx *c);
 
 #endif
