@@ -11,7 +11,11 @@
  *     their triangle counts, and the ways out; "lights_from_emissive": ["lamp"] makes the lamp material's
  *     quad the one light (the 70 glow without being lights, in one warning line); a name that is no
  *     emitting material's is an error listing those there are; the same choice by MTL name;
- *   - "lights_from_emissive": false and no light: the missing light named. */
+ *   - "lights_from_emissive": false and no light: the missing light named;
+ *   - an asset given as the scene (ms_scene_load on the mesh file): its own emitter is its light, its own
+ *     camera node its camera; one without
+ *     lights gets the default disk light above it, which casts a shadow the default camera sees, at the
+ *     origin and 1e5 from it alike, and every method gives raytrace's V and S there. */
 #include "testutil.h"
 #include <math.h>
 #include <stdio.h>
@@ -406,6 +410,125 @@ static void test_punctual(void **st)
     assert_non_null(strstr(errbuf, "the cone is not modelled"));
 }
 
+/* An asset given as the scene: the emitter glTF read directly is the scene file's scene (its quad the one
+ * rect light, the same triangles); an OBJ block on a ground without lights gets a camera looking at its box's
+ * centre (Y up) and one disk light above it, facing it, that shadows part of the ground the camera sees (some
+ * ground pixels in full light, some darkened), with every method's V and S raytrace's; the same OBJ moved 1e5
+ * away gives the same camera and light relative to the geometry. */
+static void test_asset_as_scene(void **st)
+{
+    (void)st;
+    const char *dir = tu_tmpdir("asset_as_scene");
+    const prim p[2] = { { &box[0][0], 10, white }, { &emitter[0][0], 2, glow } };
+    write_gltf(dir, "cb", p, 2, ext);
+    char path[4096], err[512];
+    ms_scene sc, ref_sc;
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "cb.gltf"), &sc, err, sizeof err), 0);
+    assert_int_equal(ms_scene_load(write_scene(dir, "cb.json", "cb.gltf", ""), &ref_sc, err, sizeof err), 0);
+    size_t n, n_ref;
+    const ms_light *L = ms_scene_lights(&sc, &n), *R = ms_scene_lights(&ref_sc, &n_ref);
+    assert_int_equal((int)n, 1);
+    assert_int_equal((int)n_ref, 1);
+    assert_int_equal(L[0].shape, MS_LIGHT_RECT);
+    assert_int_equal(R[0].shape, MS_LIGHT_RECT);
+    assert_memory_equal(&L[0].corner, &R[0].corner, sizeof L[0].corner);
+    assert_memory_equal(&L[0].edge_s, &R[0].edge_s, sizeof L[0].edge_s);
+    assert_memory_equal(&L[0].edge_t, &R[0].edge_t, sizeof L[0].edge_t);
+    assert_memory_equal(&L[0].emission, &R[0].emission, sizeof L[0].emission);
+    assert_int_equal((int)sc.n_tris, (int)ref_sc.n_tris);
+    assert_memory_equal(sc.tri, ref_sc.tri, 9 * sizeof(float) * sc.n_tris);
+    assert_float_equal(sc.camera.up.y, 1.0f, 0.0f);
+    ms_scene_free(&sc);
+    ms_scene_free(&ref_sc);
+    /* the asset's own camera: the first camera node's, turned 90 degrees about +Y (its -Z towards -X), with
+     * its field of view and aspect ratio */
+    write_gltf_ex(dir, "cam", p, 2, ext, ",{\"camera\":0,\"translation\":[2.5,1,0.5],"
+                  "\"rotation\":[0,0.70710678,0,0.70710678]},{\"camera\":0}", 2,
+                  "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1.0,\"aspectRatio\":1.5,"
+                  "\"znear\":0.1}}],");
+    assert_int_equal(ms_scene_load(tu_path(path, sizeof path, dir, "cam.gltf"), &sc, err, sizeof err), 0);
+    const ms_camera *cam = &sc.camera;
+    assert_int_equal(cam->type, MS_CAMERA_PINHOLE);
+    assert_float_equal(cam->eye.x, 2.5f, 1e-6f);
+    assert_float_equal(cam->eye.y, 1.0f, 1e-6f);
+    assert_float_equal(cam->eye.z, 0.5f, 1e-6f);
+    const float dx = cam->target.x - cam->eye.x, dy = cam->target.y - cam->eye.y, dz = cam->target.z - cam->eye.z;
+    assert_true(dx < 0.0f && fabsf(dy) < 1e-5f * fabsf(dx) && fabsf(dz) < 1e-5f * fabsf(dx));
+    assert_float_equal(cam->up.y, 1.0f, 1e-6f);
+    assert_float_equal(cam->fov_y, (float)(180.0 / M_PI), 1e-4f);
+    assert_int_equal(cam->width, 1024);
+    assert_int_equal(cam->height, 683);
+    ms_scene_free(&sc);
+
+    /* a 2 x 2 x 2 block on a 6 x 6 ground, at the origin and far from it */
+    for (int far = 0; far < 2; far++) {
+        const double off = far ? 1e5 : 0.0;
+        char obj[4096];
+        snprintf(obj, sizeof obj,
+                 "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n"
+                 "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 2 %g\nv %g 2 %g\nv %g 2 %g\nv %g 2 %g\n"
+                 "f 5 9 10 6\nf 6 10 11 7\nf 7 11 12 8\nf 8 12 9 5\nf 9 12 11 10\n",
+                 off - 3, off - 3, off - 3, off + 3, off + 3, off + 3, off + 3, off - 3,
+                 off - 1, off - 1, off + 1, off - 1, off + 1, off + 1, off - 1, off + 1,
+                 off - 1, off - 1, off + 1, off - 1, off + 1, off + 1, off - 1, off + 1);
+        const char *name = far ? "far.obj" : "block.obj";
+        assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, name), obj), 0);
+        if (ms_scene_load(path, &sc, err, sizeof err)) fail_msg("%s", err);
+        L = ms_scene_lights(&sc, &n);
+        assert_int_equal((int)n, 1);
+        assert_int_equal(L[0].shape, MS_LIGHT_DISK);
+        /* the box's centre in the scene's frame (origin: where the loader moved it) */
+        const float c[3] = { (float)(off - sc.origin[0]), (float)(1.0 - sc.origin[1]), (float)(off - sc.origin[2]) };
+        const float r = sqrtf(36.0f + 4.0f + 36.0f);
+        assert_float_equal(sc.camera.target.x, c[0], 1e-5f * r);
+        assert_float_equal(sc.camera.target.y, c[1], 1e-5f * r);
+        assert_float_equal(sc.camera.target.z, c[2], 1e-5f * r);
+        const float ex = sc.camera.eye.x - c[0], ey = sc.camera.eye.y - c[1], ez = sc.camera.eye.z - c[2];
+        assert_float_equal(sqrtf(ex * ex + ey * ey + ez * ez), 1.35f * r, 1e-4f * r);
+        assert_true(ey > 0.0f);
+        const float lc[3] = { L[0].corner.x + 0.5f * (L[0].edge_s.x + L[0].edge_t.x) - c[0],
+                              L[0].corner.y + 0.5f * (L[0].edge_s.y + L[0].edge_t.y) - c[1],
+                              L[0].corner.z + 0.5f * (L[0].edge_s.z + L[0].edge_t.z) - c[2] };
+        assert_true(lc[1] > 1.0f);   /* above the block */
+        /* it faces the centre: the block's top receives about pi cos(52 deg) of irradiance (the geometric factor
+         * times the radiance) */
+        const float top[3] = { c[0], c[1] + 1.0f, c[2] }, up[3] = { 0, 1, 0 };
+        const double E = ms_light_irradiance(&L[0], top, up) * L[0].emission.y;
+        assert_true(E > 1.5 && E < 3.0);
+        ms_render_options o;
+        tu_render_options_default(&o);
+        o.width = 64;
+        o.height = 48;
+        o.samples = 256;
+        o.threads = 2;
+        ms_frame ref;
+        tu_every_method_as_raytrace(&sc, &o, far ? "asset far from the origin" : "asset as the scene", &ref, NULL, NULL);
+        long full = 0, shaded = 0;
+        for (int i = 0; i < 64 * 48; i++) {
+            full += ref.vis[i] == 1.0f;
+            shaded += ref.vis[i] >= 0.0f && ref.vis[i] < 0.5f;
+        }
+        assert_true(full > 64 * 48 / 20);   /* the ground and block fill about a sixth of the frame */
+        assert_true(shaded > 20);
+        ms_frame_free(&ref);
+        ms_scene_free(&sc);
+    }
+    /* the CLI takes the asset where a scene file goes, and says what it chose */
+    char out[4096], errbuf[4096];
+    tu_path(out, sizeof out, dir, "block.png");
+    const char *args[] = { tu_path(path, sizeof path, dir, "block.obj"), "-o", out, "--width", "16", "--height", "12",
+                           "--samples", "256", NULL };
+    tu_run_result res;
+    assert_int_equal(tu_run_cli_ex(args, NULL, errbuf, sizeof errbuf, &res), 0);
+    assert_non_null(strstr(errbuf, "an asset given as the scene"));
+    assert_true(tu_file_exists(out));
+    /* a damaged asset: one line naming the file */
+    assert_int_equal(tu_write_file(tu_path(path, sizeof path, dir, "bad.glb"), "glTF but not binary"), 0);
+    assert_int_not_equal(ms_scene_load(path, &sc, err, sizeof err), MS_OK);
+    assert_non_null(strstr(err, "bad.glb"));
+    assert_null(strchr(err, '\n'));
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -413,6 +536,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_single_triangle_and_mtl),
         cmocka_unit_test(test_too_many_emitters),
         cmocka_unit_test(test_punctual),
+        cmocka_unit_test(test_asset_as_scene),
     };
     return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -112,7 +112,11 @@ static void test_files(void **st)
     expect_bad(tu_path(p, sizeof p, g_in, "malformed.json"), NULL, NEEDLES("malformed.json", "malformed JSON near line 3"));
     expect_bad(tu_path(p, sizeof p, g_in, "empty.json"), NULL, NEEDLES("empty.json", "malformed JSON"));
     expect_bad(tu_path(p, sizeof p, g_in, "array.json"), NULL, NEEDLES("array.json", "top level must be an object"));
-    expect_bad(tu_path(p, sizeof p, g_in, "ok.obj"), NULL, NEEDLES("ok.obj", "malformed JSON"));
+    expect_bad(tu_path(p, sizeof p, g_in, "junk.xyzzy"), NULL, NEEDLES("junk.xyzzy", "malformed JSON"));
+    /* a mesh file given as the scene is read as that asset alone: its own faults are named */
+    expect_bad(tu_path(p, sizeof p, g_in, "nan.obj"), NULL, NEEDLES("nan.obj", "NaN or infinite"));
+    expect_bad(tu_path(p, sizeof p, g_in, "junk.ply"), NULL, NEEDLES("junk.ply", "unknown PLY format"));
+    expect_bad(tu_path(p, sizeof p, g_in, "points.obj"), NULL, NEEDLES("points.obj", "no triangles"));
 }
 
 static void test_keys(void **st)

@@ -179,7 +179,12 @@ MS_API void ms_set_warning_verbose(int verbose);
 
 /* Loads a JSON scene file (meshes: OBJ, PLY, OFF, STL read by microshadow, glTF 2.0 through cgltf; paths
  * relative to the JSON file). Regular files only, at most 16 MiB of JSON; duplicate keys are errors,
- * unknown keys warnings. */
+ * unknown keys warnings. A path ending in a mesh format's extension (.gltf, .glb, .obj, .ply, .off, .stl, any
+ * case) loads that asset as the scene: what a scene file naming it alone gives (its own KHR_lights_punctual
+ * lights and emissive triangles as lights), with a pinhole camera looking at its bounding box's centre from
+ * the front, right and above (Y up, 45 degrees, 1024 x 768) and, when it has no light of its own, one disk
+ * light above it (radius 0.15 of the box's diagonal, 1.5 diagonals from the centre, radiance giving about pi
+ * of irradiance there); a warning says so. */
 static inline ms_status ms_scene_load(const char *json_path, ms_scene *out, char *err, size_t errlen);
 /* Options of ms_scene_load_ex; zero (or NULL) means ms_scene_load's behaviour. */
 typedef struct ms_scene_load_options {

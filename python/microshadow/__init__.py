@@ -260,9 +260,11 @@ class Scene:
 
 
 def load(path, allow_outside_paths=False):
-    """Loads a scene JSON file (meshes relative to it). Raises Error with the library's message. Files that
-    the meshes name (glTF buffers and images, MTL files and maps) must lie inside the folder of the file
-    naming them, unless allow_outside_paths (for trusted assets) or the scene file says so."""
+    """Loads a scene JSON file (meshes relative to it), or an asset alone (a .glb, .gltf, .obj, .ply, .off or
+    .stl path: its own lights and camera, else a camera looking at it and one disk light above it; see
+    ms_scene_load). Raises Error with the library's message. Files that the meshes name (glTF buffers and
+    images, MTL files and maps) must lie inside the folder of the file naming them, unless
+    allow_outside_paths (for trusted assets) or the scene file says so."""
     s, err = _Scene(), _errbuf()
     opt = _LoadOptions()
     opt.allow_outside_paths = 1 if allow_outside_paths else 0

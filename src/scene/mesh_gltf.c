@@ -540,6 +540,40 @@ static int push_punctual(ms_tri_soup *soup, const cgltf_light *cl, const float w
     return 0;
 }
 
+/* The node's camera as the asset's (the first one met), placed by its world matrix: eye its origin, looking
+ * along its -Z axis, up its +Y; one without a usable direction or field of view is passed over. */
+static void take_camera(ms_tri_soup *soup, const cgltf_camera *c, const float w[16])
+{
+    ms_asset_camera a;
+    memset(&a, 0, sizeof a);
+    double dl = 0.0, ul = 0.0;
+    for (int k = 0; k < 3; k++) {
+        a.eye[k] = w[12 + k];
+        a.dir[k] = -(double)w[8 + k];
+        a.up[k] = w[4 + k];
+        dl += a.dir[k] * a.dir[k];
+        ul += a.up[k] * a.up[k];
+    }
+    if (!(dl > 0.0) || !(ul > 0.0) || !isfinite(dl + ul) || !isfinite(a.eye[0] + a.eye[1] + a.eye[2])) return;
+    for (int k = 0; k < 3; k++) { a.dir[k] /= sqrt(dl); a.up[k] /= sqrt(ul); }
+    if (c->type == cgltf_camera_type_perspective) {
+        a.yfov_deg = (float)(c->data.perspective.yfov * 180.0 / M_PI);
+        if (!(a.yfov_deg > 0.0f && a.yfov_deg < 180.0f)) return;
+        const float ar = c->data.perspective.aspect_ratio;
+        a.aspect = c->data.perspective.has_aspect_ratio && ar > 1e-3f && ar < 1e3f ? ar : 0.0f;
+    } else if (c->type == cgltf_camera_type_orthographic) {
+        a.ortho = 1;
+        a.ymag = c->data.orthographic.ymag;
+        const float xm = c->data.orthographic.xmag;
+        if (!(a.ymag > 0.0f && a.ymag < 1e18f)) return;
+        a.aspect = xm > 0.0f && xm / a.ymag > 1e-3f && xm / a.ymag < 1e3f ? xm / a.ymag : 0.0f;
+    } else {
+        return;
+    }
+    a.present = 1;
+    soup->camera = a;
+}
+
 /* Depth-first over the node trees without recursion; every node at most once (glTF requires trees,
  * and a node listed twice would expand exponentially: 41 such nodes are 2^40 instances). */
 static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup, size_t *added, size_t max_tris,
@@ -569,6 +603,7 @@ static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup
             cgltf_node_transform_local(it.node, local);
             mat4_mul(world, it.parent, local);
             if (it.node->light && !rc) rc = push_punctual(soup, it.node->light, world, path, err, errlen);
+            if (it.node->camera && !soup->camera.present) take_camera(soup, it.node->camera, world);
             if (it.node->mesh) ms_soup_new_object(soup);   /* each node's mesh is an object (lightmap UVs per object) */
             if (it.node->mesh)
                 for (size_t p = 0; p < it.node->mesh->primitives_count && !rc; p++)

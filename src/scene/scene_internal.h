@@ -27,6 +27,14 @@ typedef struct ms_punctual {
     float angular_deg;           /* directional: extras.angular_diameter_deg; 0: not given */
     uint32_t mesh;               /* the scene file's mesh entry */
 } ms_punctual;
+/* A glTF file's first camera (in the order nodes are walked), in world coordinates: what an asset given as the
+ * scene (scene_asset.c) looks through. */
+typedef struct ms_asset_camera {
+    int present, ortho;
+    double eye[3], dir[3], up[3];   /* the node's origin, its -Z and +Y axes (unit) */
+    float yfov_deg, aspect;         /* perspective: its vertical field of view; aspect ratio (0: not given) */
+    float ymag;                     /* orthographic: half the view's height */
+} ms_asset_camera;
 /* rel resolved against the folder of json_path (absolute paths as they are) into out; -1 if too long. */
 int ms_path_beside(const char *json_path, const char *rel, char *out, size_t n);
 struct ms_light;
@@ -94,6 +102,7 @@ typedef struct ms_tri_soup {
     int allow_outside_paths;   /* files named by the meshes may lie outside their folders (ms_resolve_inside) */
     ms_punctual *punctual;     /* glTF KHR_lights_punctual lights (ms_soup_free frees them) */
     size_t n_punctual;
+    ms_asset_camera camera;    /* a glTF file's first camera */
 } ms_tri_soup;
 /* Tangents t12 (12 floats per triangle) of triangles [first, first + count); 0, or -1 out of memory. */
 int ms_soup_set_tangents(ms_tri_soup *soup, size_t first, size_t count, const float *t12);
@@ -205,6 +214,13 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
 /* The scene JSON from memory (text[len] == 0); json_path names it and locates the meshes. */
 int ms_scene_parse(const char *text, size_t len, const char *json_path, struct ms_scene *out, char *err,
                    size_t errlen);
+/* An asset given as the scene (scene_asset.c): 1 when path ends in a mesh format's extension (.gltf, .glb, .obj,
+ * .ply, .off, .stl), which ms_scene_load then reads as the scene of that one mesh. */
+int ms_scene_asset_path(const char *path);
+/* Such a scene's camera, the asset's own (cam, when present) or one from its triangles' box (Y up), and, when
+ * add_light, its one disk light; -1 with err set when the triangles have no extent. */
+int ms_scene_asset_view(struct ms_scene *s, const ms_asset_camera *cam, int add_light, const char *path, char *err,
+                        size_t errlen);
 /* Makes err one printable line: names taken from files may hold newlines or control characters. */
 void ms_one_line(char *err);
 /* Reports a warning through the handler set with ms_set_warning_handler. */

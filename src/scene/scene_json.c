@@ -294,7 +294,7 @@ static int parse_meshes(const cJSON *root, const cJSON *meshes, const ms_scene_l
 static void frame_camera_lights(const cJSON *cam, ms_scene *out, const light_pos *lp)
 {
     const double *o = out->origin;
-    if (o[0] == 0.0 && o[1] == 0.0 && o[2] == 0.0) return;
+    if (!cam || (o[0] == 0.0 && o[1] == 0.0 && o[2] == 0.0)) return;   /* no camera: an asset's (scene_asset.c) */
     double p[3];
     float f[3];
     ms_json_vec3_d(cam, "eye", p);
@@ -338,23 +338,24 @@ static void scene_from_soup(ms_scene *out, ms_tri_soup *soup, int n_meshes, cons
     out->n_textures = soup->n_tex;
 }
 
-static int scene_parse(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
-                       ms_scene *out, char *err, size_t errlen)
+/* The scene of the JSON tree root (the file json_path's; asset: a tree made for an asset given as the scene,
+ * ms_scene_asset_path, which has no camera and may have no light). Takes root. */
+static int scene_build(cJSON *root, const char *json_path, int asset, const ms_scene_load_options *opt, ms_scene *out,
+                       char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    cJSON *root = parse_text(text, len, json_path, err, errlen);
-    if (!root) return -1;
     int rc = -1;
     if (!cJSON_IsObject(root)) { snprintf(err, errlen, "%s: the top level must be an object", json_path); goto done; }
     if (ms_json_check_duplicates(root, "", json_path, err, errlen)) goto done;
     ms_json_warn_unknown(root, "", ms_json_top_keys, json_path);
 
-    const cJSON *cam = parse_camera(root, out, json_path, err, errlen);
-    if (!cam) goto done;
+    const cJSON *cam = asset ? NULL : parse_camera(root, out, json_path, err, errlen);
+    if (!cam && !asset) goto done;
     ms_json_light_opts lo;
     if (ms_json_light_options(root, &lo, json_path, err, errlen)) goto done;
+    lo.none_ok = asset;
     light_pos lpos[MS_MAX_LIGHTS];
     memset(lpos, 0, sizeof lpos);
     if (ms_json_parse_lights(root, out, lpos, lo.emitters || lo.punctuals, json_path, err, errlen)) goto done;
@@ -372,6 +373,13 @@ static int scene_parse(const char *text, size_t len, const char *json_path, cons
     if (parse_meshes(root, meshes, opt, out, &soup, &n_meshes, json_path, err, errlen)) goto done;
     scene_from_soup(out, &soup, n_meshes, cam, lpos);
     if (ms_json_asset_lights(out, &lo, &soup, json_path, err, errlen)) goto done;
+    if (asset) {
+        const int add_light = out->n_lights == 0;   /* the asset's own lights are appended (n_lights >= 1) */
+        if (ms_scene_asset_view(out, &soup.camera, add_light, json_path, err, errlen)) goto done;
+        ms_json_warn("%.200s: an asset given as the scene: %s%s; a scene file naming it sets its own (README, Scene "
+                     "file)", json_path, soup.camera.present ? "its own camera" : "a camera from its bounding box (Y up)",
+                     add_light ? " and, as it has no light of its own, one disk light above it" : "");
+    }
     rc = ms_scene_validate(out, json_path, err, errlen);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     out->load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
@@ -381,7 +389,32 @@ done:
     return rc;
 }
 
-/* One parse with its warnings kept (ms_json_warnings) until it succeeded. */
+static int scene_parse(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
+                       ms_scene *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    cJSON *root = parse_text(text, len, json_path, err, errlen);
+    return root ? scene_build(root, json_path, 0, opt, out, err, errlen) : -1;
+}
+
+/* The tree of a scene file naming the asset at path alone: {"meshes": [{"file": its name}]} (beside it). */
+static int scene_asset(const char *path, const ms_scene_load_options *opt, ms_scene *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    const char *slash = strrchr(path, '/');
+    cJSON *root = cJSON_CreateObject();
+    cJSON *meshes = root ? cJSON_AddArrayToObject(root, "meshes") : NULL, *m = meshes ? cJSON_CreateObject() : NULL;
+    if (m && !cJSON_AddItemToArray(meshes, m)) { cJSON_Delete(m); m = NULL; }
+    if (!m || !cJSON_AddStringToObject(m, "file", slash ? slash + 1 : path)) {
+        cJSON_Delete(root);
+        snprintf(err, errlen, "%s: out of memory", path);
+        return -1;
+    }
+    return scene_build(root, path, 1, opt, out, err, errlen);
+}
+
+/* One parse (text, or the asset at json_path when text is NULL) with its warnings kept (ms_json_warnings)
+ * until it succeeded. */
 static int parse_with(const char *text, size_t len, const char *json_path, const ms_scene_load_options *opt,
                       ms_scene *out, char *err, size_t errlen)
 {
@@ -389,7 +422,8 @@ static int parse_with(const char *text, size_t len, const char *json_path, const
     w.n = 0;
     ms_json_warnings = &w;
     ms_material_warnings_begin();
-    int rc = scene_parse(text, len, json_path, opt, out, err, errlen);
+    int rc = text ? scene_parse(text, len, json_path, opt, out, err, errlen)
+                  : scene_asset(json_path, opt, out, err, errlen);
     ms_json_warnings = NULL;
     if (rc) ms_one_line(err);
     else
@@ -406,6 +440,8 @@ ms_status ms_scene_load_abi(const ms_abi *abi, const char *json_path, const ms_s
     ms_scene_load_options own;
     opt = ms_abi_options(opt, MS_ABI_SIZE(abi, scene_load_options), &own, sizeof own);
     memset(out, 0, sizeof *out);
+    if (ms_scene_asset_path(json_path))
+        return parse_with(NULL, 0, json_path, opt, out, err, errlen) ? MS_ERR_INVALID : MS_OK;
     char *text;
     size_t len;
     if (ms_read_input(json_path, MS_MAX_SCENE_BYTES, MS_INPUT_SCENE, &text, &len, err, errlen)) {

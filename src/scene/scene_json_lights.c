@@ -308,8 +308,8 @@ static int choose_emitters(const ms_scene *out, const cJSON *list, char *const *
 /* The asset's own lights after those the file names (file_lights: it names some): its KHR_lights_punctual
  * lights (punct NULL: not wanted), then its emissive triangles of the chosen materials (emitters: wanted). */
 static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const ms_emitter_choice *choice,
-                            const ms_punctual *punct, size_t n_punct, double punctual_radius, const char *path, char *err,
-                            size_t errlen)
+                            const ms_punctual *punct, size_t n_punct, double punctual_radius, int none_ok,
+                            const char *path, char *err, size_t errlen)
 {
     size_t have = out->n_lights ? out->n_lights : file_lights ? 1 : 0;
     ms_light *add = NULL;
@@ -327,7 +327,7 @@ static int add_asset_lights(ms_scene *out, int file_lights, int emitters, const 
             return -1;
         have += n_add;
     }
-    if (!have) {
+    if (!have && !none_ok) {
         snprintf(err, errlen, "%s: \"light\" is missing: the scene file names no light (\"light\" or \"lights\") and its meshes have neither "
                  "emissive triangles (glTF emissiveFactor, MTL Ke) nor KHR_lights_punctual lights to light it",
                  path);
@@ -361,6 +361,7 @@ int ms_json_light_options(const cJSON *root, ms_json_light_opts *lo, const char 
     }
     lo->punctuals = from_punctual ? cJSON_IsTrue(from_punctual) : !lo->file_lights;
     lo->punctual_radius = 0.05;
+    lo->none_ok = 0;
     if (ms_json_number(root, "", "punctual_radius", 0, &lo->punctual_radius, path, err, errlen)) return -1;
     if (!(lo->punctual_radius > 0.0) || lo->punctual_radius > MS_MAX_COORD) {
         snprintf(err, errlen, "%s: \"punctual_radius\" must be in (0, %g]", path, (double)MS_MAX_COORD);
@@ -381,7 +382,7 @@ int ms_json_asset_lights(ms_scene *out, const ms_json_light_opts *lo, ms_tri_sou
     const ms_emitter_choice choice = { lit, soup->mat_names };
     const int lights_failed = add_asset_lights(out, lo->file_lights, lo->emitters, &choice,
                                                lo->punctuals ? soup->punctual : NULL, soup->n_punctual,
-                                               lo->punctual_radius, path, err, errlen);
+                                               lo->punctual_radius, lo->none_ok, path, err, errlen);
     const size_t n_unlisted = lit && !lights_failed ? ms_scene_emissive_triangles(out, NULL) -
                                                           ms_scene_emissive_triangles(out, &choice) : 0;
     ms_soup_free_names(soup);

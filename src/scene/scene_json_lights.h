@@ -22,6 +22,7 @@ typedef struct ms_json_light_opts {
     int emitters;                   /* the asset's emissive triangles become lights */
     int punctuals;                  /* its KHR_lights_punctual lights do */
     double punctual_radius;
+    int none_ok;                    /* no light at all is not an error (an asset given as the scene) */
 } ms_json_light_opts;
 
 int ms_json_light_options(const cJSON *root, ms_json_light_opts *lo, const char *path, char *err, size_t errlen);
@@ -37,7 +38,7 @@ int ms_json_light_build(ms_light *l, const light_pos *lp, const double o[3], cha
 void ms_json_punctual_transform(ms_punctual *p, const double m[12]);
 /* The asset's lights after the meshes were read into out (the soup's arrays already out's): the emitters
  * chosen by lo, the punctual lights, and the warnings about those left out. Frees the soup's material names
- * and punctual lights, also on failure. */
+ * and punctual lights, also on failure. With lo->none_ok, a scene left without any light is no error. */
 int ms_json_asset_lights(ms_scene *out, const ms_json_light_opts *lo, ms_tri_soup *soup, const char *path, char *err,
                          size_t errlen);
 
