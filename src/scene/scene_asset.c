@@ -1,8 +1,7 @@
 /* An asset given where a scene file is expected (ms_scene_load on a .gltf, .glb, .obj, .ply, .off or .stl file):
- * the scene of that one mesh, as a scene file naming it alone would give, plus what such a file must add,
- * chosen from the asset's bounding box: a camera (its own when a glTF file has one) and, when the asset has no
- * light of its own
- * (KHR_lights_punctual lights, emissive triangles), one disk light. Y is up, glTF's convention and that of
+ * the scene of that one mesh, as a scene file naming it alone would give, plus what such a file must add: a
+ * camera (a glTF file's own, else one from the asset's bounding box) and, when the asset has no light of its
+ * own (KHR_lights_punctual lights, emissive triangles), one disk light. Y is up, glTF's convention and that of
  * most scans; a scene file sets any other view. */
 #include "microshadow.h"
 #include "scene_internal.h"
