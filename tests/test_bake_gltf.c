@@ -12,7 +12,8 @@
  *     w = +-1), the others none; the Khronos glTF Validator (npm gltf-validator, viewer/validate.mjs) reports
  *     0 errors and 0 warnings (skipped with a message without node or the validator);
  *   - the CLI writes the glb with the EXR, and refuses a --gltf not ending in .glb with exit 2, writing nothing;
- *   - the scene's extras list the scene's lights, every shape, in world coordinates, with their radiance. */
+ *   - the scene's extras list the scene's lights, every shape, in world coordinates, with their radiance, and its
+ *     camera. */
 #include "testutil.h"
 #include "glb_read.h"
 #include <math.h>
@@ -518,7 +519,8 @@ static double num(const cJSON *o, const char *key, int i)
 
 /* The scene's lights in the glb (extras.microshadow.lights), for a viewer's live lights: every shape, in the scene's
  * order, in world coordinates although the scene lies 1e5 from the origin (so that it is loaded into a frame of its
- * own and the root node carries the origin), with their radiance ("power" converted: 40 W / (pi 4 m^2)). */
+ * own and the root node carries the origin), with their radiance ("power" converted: 40 W / (pi 4 m^2)); and the
+ * scene's camera (extras.microshadow.camera), likewise in world coordinates. */
 static void test_lights_listed(void **st)
 {
     (void)st;
@@ -570,6 +572,16 @@ static void test_lights_listed(void **st)
     assert_true(fabs(hypot(hypot(num(d, "edge_s", 0), num(d, "edge_s", 1)), num(d, "edge_s", 2)) - 1.0) < tol);
     assert_true(fabs(num(sp, "radius", -1) - 0.25) < 1e-7);
     assert_true(fabs(num(sun, "angular_diameter_deg", -1) - 2.0) < 1e-4);
+    /* the scene's camera beside them, in world coordinates too */
+    const cJSON *cam = cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(tu_glb_item(&g, "scenes", 0), "extras"),
+                                                                "microshadow"), "camera");
+    const double eye[3] = { 100000, 6, 6 }, target[3] = { 100000, 0, 0 }, up[3] = { 0, 1, 0 };
+    for (int c = 0; c < 3; c++) {
+        assert_true(fabs(num(cam, "eye", c) - eye[c]) < tol);
+        assert_true(fabs(num(cam, "target", c) - target[c]) < tol);
+        assert_true(fabs(num(cam, "up", c) - up[c]) < 1e-7);
+    }
+    assert_true(num(cam, "fov_y", -1) == 50.0 && num(cam, "width", -1) == 32.0 && num(cam, "height", -1) == 32.0);
     tu_glb_free(&g);
 }
 

@@ -164,6 +164,16 @@ static void test_viewer_exposes_as_frame(void **st)
     assert_true(ag.n > W * H / 3);
     assert_true(ag.corr >= 0.95);
     assert_true(ag.ratio >= 0.8 && ag.ratio <= 1.2);
+    /* no scene file: the camera the bake wrote into the glb, the same picture (its numbers went through floats) */
+    char alone[1024];
+    tu_path(alone, sizeof alone, dir, "alone.png");
+    tu_screenshot(glb, "", alone, "");
+    double *al = tu_png_luminance(alone, W, H);
+    long unlike = 0;
+    for (int i = 0; i < W * H; i++) unlike += fabs(al[i] - a[i]) > 0.02;
+    printf("viewer without the scene file: %ld of %d pixels unlike the screenshot with it\n", unlike, W * H);
+    assert_true(unlike <= W * H / 200);
+    free(al);
     /* the orbit and the mode key */
     char drag[1024], key[1024], std[1024];
     tu_path(drag, sizeof drag, dir, "drag.png");

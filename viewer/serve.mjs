@@ -1,7 +1,8 @@
 // A static file server for the viewer (ES modules do not load from file:// URLs): viewer/ (with its
 // node_modules) at /, and the folder of each file given on the command line at /data/. Used by
-// screenshot.mjs; run alone it prints the URL that shows OUT.glb with the scene file's camera:
-//   node viewer/serve.mjs OUT.glb SCENE.json     (then open the printed URL)
+// screenshot.mjs; run alone it prints the URL that shows OUT.glb with the scene file's camera (without one, the
+// camera the bake wrote into the glb):
+//   node viewer/serve.mjs OUT.glb [SCENE.json]     (then open the printed URL)
 import { createServer } from 'node:http';
 import { readFile } from 'node:fs/promises';
 import { extname, join, normalize, resolve, dirname, basename } from 'node:path';
@@ -37,8 +38,9 @@ export function serve(files) {
 
 if (process.argv[1] === fileURLToPath(import.meta.url)) {
   const [glb, scene] = process.argv.slice(2);
-  if (!glb || !scene) { console.error('usage: node viewer/serve.mjs OUT.glb SCENE.json'); process.exit(2); }
-  const server = await serve([glb, scene]);
+  if (!glb) { console.error('usage: node viewer/serve.mjs OUT.glb [SCENE.json]'); process.exit(2); }
+  const server = await serve(scene ? [glb, scene] : [glb]);
   const { port } = server.address();
-  console.log(`http://127.0.0.1:${port}/index.html?glb=/data/${encodeURIComponent(basename(glb))}&scene=/data/${encodeURIComponent(basename(scene))}`);
+  console.log(`http://127.0.0.1:${port}/index.html?glb=/data/${encodeURIComponent(basename(glb))}` +
+              (scene ? `&scene=/data/${encodeURIComponent(basename(scene))}` : ''));
 }

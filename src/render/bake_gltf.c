@@ -474,13 +474,14 @@ static cJSON *add_primitive(writer *w, const tri_key *keys, size_t n)
 }
 
 /* The scene's extras.microshadow (viewer/index.html: three.js puts them in gltf.scene.userData): the scene's
- * lights (bake_gltf_lights.h), and the exposures microshadow's frame of the scene's camera picks by itself
+ * lights and camera (bake_gltf_lights.h), and the exposures microshadow's frame of the scene's camera picks by itself
  * (frame_shade.h), standard and diffuse, so that a viewer shows the bake as the frame shows the scene by default.
  * The exposures are left out, with a warning, if they cannot be computed: the glb is still whole. */
 static void add_scene_extras(const ms_scene *sc, cJSON *scene0)
 {
     cJSON *ms = cJSON_AddObjectToObject(cJSON_AddObjectToObject(scene0, "extras"), "microshadow");
     ms_bake_gltf_lights(ms, sc);
+    ms_bake_gltf_camera(ms, sc);
     float e[2];
     char why[256] = "";
     for (int k = 0; k < 2; k++)

@@ -1,6 +1,7 @@
-/* The scene's lights written into the glb's scene extras (bake_gltf_lights.h): the lights exactly as the bake
- * lit the lightmap (units converted to radiance, the asset's emitters and punctual lights included, in the
- * order the shadowmask's channels name them), so that a viewer need not re-read the scene file. */
+/* The scene's lights and camera written into the glb's scene extras (bake_gltf_lights.h): the lights exactly as
+ * the bake lit the lightmap (units converted to radiance, the asset's emitters and punctual lights included, in
+ * the order the shadowmask's channels name them), and the camera, so that a viewer need not re-read the scene
+ * file (an asset baked alone has none). */
 #include "bake_gltf_lights.h"
 #include "light/light_shape.h"
 #include <math.h>
@@ -67,4 +68,17 @@ void ms_bake_gltf_lights(cJSON *ms, const ms_scene *sc)
         add_radiance(j, l);
         cJSON_AddItemToArray(arr, j);
     }
+}
+
+void ms_bake_gltf_camera(cJSON *ms, const ms_scene *sc)
+{
+    const ms_camera *c = &sc->camera;
+    if (c->type != MS_CAMERA_PINHOLE) return;
+    cJSON *j = cJSON_AddObjectToObject(ms, "camera");
+    add_point(j, "eye", c->eye, sc->origin);
+    add_point(j, "target", c->target, sc->origin);
+    add_dir(j, "up", c->up);
+    cJSON_AddNumberToObject(j, "fov_y", c->fov_y);
+    cJSON_AddNumberToObject(j, "width", c->width);
+    cJSON_AddNumberToObject(j, "height", c->height);
 }

@@ -7,8 +7,8 @@
 /* 1 when node, /usr/bin/chromium and MS_VIEWER_DIR/node_modules (three, puppeteer-core) are present; 0 with a
  * "skipped: ..." line naming what is missing (scripts/install-deps.sh installs them). */
 int tu_have_browser(void);
-/* The viewer's screenshot of glb under scene file json's camera into shot (a PNG), with screenshot.mjs's options
- * in extra ("" for none); fails the test when it does not exit 0. */
+/* The viewer's screenshot of glb under scene file json's camera (json "": the camera the bake wrote into the glb)
+ * into shot (a PNG), with screenshot.mjs's options in extra ("" for none); fails the test when it does not exit 0. */
 void tu_screenshot(const char *glb, const char *json, const char *shot, const char *extra);
 double tu_srgb_to_linear(double c);
 /* An sRGB PNG of W x H pixels as linear luminance per pixel (0.2126 R + 0.7152 G + 0.0722 B of the linearised
