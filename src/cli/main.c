@@ -23,6 +23,8 @@ static void usage(FILE *f)
         "usage: microshadow [SCENE.json] [options]\n"
         "       microshadow bake [SCENE.json] [options]   (a lightmap: microshadow bake --help)\n"
         "Renders soft shadows from the scene's area lights (rect, disk, sphere, triangle, sun, textured; the meshes' own emitters and glTF punctual lights when the scene file names none; the built-in scene without SCENE).\n"
+        "SCENE may be a mesh file (.glb .gltf .obj .ply .off .stl): that asset alone, with its own lights and camera or a\n"
+        "camera looking at it and one disk light above it.\n"
         "\n"
         "  --method M          shadow method:");
     for (const char *const *m = ms_method_names(); *m; m++) fprintf(f, " %s", *m);
