@@ -13,11 +13,10 @@
  * Island by island (MS_UV_PACK_ISLANDS, what the default does here), an object whose layout holds four small islands in the corners of its UV square: each
  * island moved as a whole (one scale for u and v, no rotation), one texel density for every island of both
  * objects, no texel centre in two islands, and the page far fuller than with one region per object.
- * Regions alone (no xatlas chart: the rectangle packer) at the default padding of 2 texels: the texels a
- * bilinear lookup inside each region reads (centres within one texel of its UV square) leave at least 2
- * texels between the two regions, which no lookup reads, so the dilation that fills a region's border texels
- * never averages in the other's; at a texel density that makes both larger than a page, each is shrunk to fit
- * one page with that space around it. */
+ * Regions alone (no xatlas chart: the rectangle packer): the texels a bilinear lookup inside each region reads
+ * (centres within one texel of its UV square) are never the other's; at the default padding (none) the two
+ * sets may touch, with --padding 2 they leave at least 2 texels between them, which no lookup reads; at a texel
+ * density that makes both larger than a page, each is shrunk to fit one page with that space around it. */
 #include "testutil.h"
 #include <math.h>
 #include <stdio.h>
@@ -261,30 +260,32 @@ static void test_regions_apart(void **st)
     ms_scene sc;
     ground_and_plate("bake_fill_apart", 0, &sc);
     ms_lightmap lm;
-    bake_uv0(&sc, 0, 0.0f, 0, &lm);
-    assert_int_equal(lm.pages, 1);
-    assert_int_equal(lm.charts, 0);   /* no xatlas: the regions' own packer */
-    int fp[2][2][2];   /* [object][axis][lo, hi] */
-    for (int m = 0; m < 2; m++) {
-        double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
-        for (size_t t = 0; t < sc.n_tris; t++)
-            if ((int)sc.tri_mesh[t] == m)
-                for (int k = 0; k < 6; k++) {
-                    lo[k & 1] = fmin(lo[k & 1], lm.uv[6 * t + k] * SIZE);
-                    hi[k & 1] = fmax(hi[k & 1], lm.uv[6 * t + k] * SIZE);
-                }
-        for (int d = 0; d < 2; d++) footprint(lo[d], hi[d], &fp[m][d][0], &fp[m][d][1]);
+    for (int padding = 0; padding <= 2; padding += 2) {
+        bake_uv0(&sc, 0, 0.0f, padding, &lm);
+        assert_int_equal(lm.pages, 1);
+        assert_int_equal(lm.charts, 0);   /* no xatlas: the regions' own packer */
+        int fp[2][2][2];   /* [object][axis][lo, hi] */
+        for (int m = 0; m < 2; m++) {
+            double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+            for (size_t t = 0; t < sc.n_tris; t++)
+                if ((int)sc.tri_mesh[t] == m)
+                    for (int k = 0; k < 6; k++) {
+                        lo[k & 1] = fmin(lo[k & 1], lm.uv[6 * t + k] * SIZE);
+                        hi[k & 1] = fmax(hi[k & 1], lm.uv[6 * t + k] * SIZE);
+                    }
+            for (int d = 0; d < 2; d++) footprint(lo[d], hi[d], &fp[m][d][0], &fp[m][d][1]);
+        }
+        int apart = -1;   /* texels between the two footprints along the axis that separates them */
+        for (int d = 0; d < 2; d++) {
+            const int gap = (fp[1][d][0] > fp[0][d][1] ? fp[1][d][0] - fp[0][d][1] : fp[0][d][0] - fp[1][d][1]) - 1;
+            if (gap > apart) apart = gap;
+        }
+        printf("regions, padding %d: footprints x %d..%d and %d..%d, y %d..%d and %d..%d: %d texels apart; page fill %.1f%%\n",
+               padding, fp[0][0][0], fp[0][0][1], fp[1][0][0], fp[1][0][1], fp[0][1][0], fp[0][1][1], fp[1][1][0], fp[1][1][1],
+               apart, 100.0 * lm.page_fill[0]);
+        assert_true(apart >= padding);   /* 0: the footprints may touch, never overlap */
+        ms_lightmap_free(&lm);
     }
-    int apart = -1;   /* texels between the two footprints along the axis that separates them */
-    for (int d = 0; d < 2; d++) {
-        const int gap = (fp[1][d][0] > fp[0][d][1] ? fp[1][d][0] - fp[0][d][1] : fp[0][d][0] - fp[1][d][1]) - 1;
-        if (gap > apart) apart = gap;
-    }
-    printf("regions: footprints x %d..%d and %d..%d, y %d..%d and %d..%d: %d texels apart; page fill %.1f%%\n",
-           fp[0][0][0], fp[0][0][1], fp[1][0][0], fp[1][0][1], fp[0][1][0], fp[0][1][1], fp[1][1][0], fp[1][1][1], apart,
-           100.0 * lm.page_fill[0]);
-    assert_true(apart >= 2);
-    ms_lightmap_free(&lm);
     /* at a density where both are larger than a page: each shrunk to fit one with that space around it */
     bake_uv0(&sc, 0, 300.0f, 0, &lm);
     assert_int_equal(lm.pages, 2);

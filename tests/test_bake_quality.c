@@ -3,9 +3,9 @@
  *     their footprint of its side are moved out (their points end outside the box), and at floor points just
  *     outside the box the bilinear lookup of the bake matches ms_visibility_points irradiance computed there
  *     (without the fix, the contact's black bleeds out: measured and reported, and worse);
- *   - padding: with the default 4 texels, no texel of one chart (connected triangles in UV space, found here)
- *     lies within 2 texels of another chart's texel, so bilinear lookups (1 texel around a chart) never mix
- *     charts once dilation has filled the gap from both sides;
+ *   - padding: with --padding 2, no texel of one chart (connected triangles in UV space, found here) lies
+ *     within 2 texels of another chart's texel, so bilinear lookups (1 texel around a chart) never mix charts
+ *     whatever fills the gap (the default, footprints touching, is tests/test_bake_padding.c's);
  *   - the seam error is measured (ms_lightmap.seam_*: smooth edges - the same shading normals on both sides,
  *     planes within 8 degrees without them - not creases) and agrees with the same measure taken here at
  *     the seam points from the lightmap's rgb (tests/test_bake_seams.c checks the stitching itself);
@@ -208,6 +208,7 @@ static void test_padding_and_seams(void **st)
     assert_int_equal(ms_scene_default(&sc), 0);
     ms_bake_options bo;
     tu_bake_options(&bo, 256, -1, 256);
+    bo.padding = 2;
     char err[512] = "";
     ms_lightmap lm;
     assert_int_equal(ms_bake(&sc, NULL, &bo, &lm, err, sizeof err), MS_OK);

@@ -33,7 +33,8 @@ class MicroshadowSettings(bpy.types.PropertyGroup):
     bake_texel_density: FloatProperty(name="Texel Density", default=0.0, min=0.0, soft_max=1024.0,
                                       description="Texels per world unit over as many pages as it takes (each "
                                                   "page Size x Size); 0: one page at the largest density that fits")
-    bake_padding: IntProperty(name="Padding", default=2, min=1, max=64, description="Texels between charts")
+    bake_padding: IntProperty(name="Padding", default=2, min=0, max=64,
+                              description="Texels between charts (0: touching; Blender's viewport mipmaps textures)")
     bake_whole_layouts: BoolProperty(name="Whole Layouts", default=False,
                                      description="Move each object's UV layout into the lightmap as one rectangle "
                                                  "(one scale and offset per object) instead of packing its islands "

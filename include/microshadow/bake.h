@@ -52,7 +52,9 @@ typedef struct ms_bake_options {
                                 * without one are charted by xatlas (docs/baking.md, "Charts"); -1: xatlas
                                 * for every triangle */
     int dilate;                /* texels of dilation; 0: 4; -1: none */
-    int padding;               /* texels between charts (xatlas's and the lightmap's regions); 0: 2 */
+    int padding;               /* texels between the charts' bilinear footprints (xatlas's charts and the
+                                * regions); 0: none, footprints touch but never share a texel (docs/baking.md,
+                                * "Padding"); 2 or more for an engine that mipmaps or block-compresses lightmaps */
     int no_leak_fix;           /* 1: texels inside geometry keep their points (docs/baking.md, "Quality"); 0: moved */
     ms_bake_pass_fn pass;      /* may be NULL */
     void *pass_user;

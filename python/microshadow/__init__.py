@@ -561,13 +561,14 @@ def light_irradiance(light, point, normal):
 
 
 def bake(scene, size=1024, uv=1, method=None, samples=1024, pattern="grid", seed=0, threads=0, isa="auto",
-         dilate=4, padding=2, accel=None, progress=None, max_memory=0, texel_density=0.0, uv_cache=None,
+         dilate=4, padding=0, accel=None, progress=None, max_memory=0, texel_density=0.0, uv_cache=None,
          uv_packing="default"):
     """A lightmap (ms_bake): dict of irradiance (size, size, 3) summed over the lights, vis and shadow
     (size, size; light 0; -1 where nothing reached), front, position and normal (size, size, 3; NaN off
     the triangles; position in the scene's frame: add scene.origin for world coordinates), triangle (size, size; NO_TRIANGLE off them), uv (n_triangles, 3, 2) the UVs baked
     into, lights: one dict per light with its vis, shadow and front, and counts and timings. uv: the UV
-    set (0..3) or None for xatlas everywhere; dilate 0: none; progress: fn(fraction) -> truthy to cancel
+    set (0..3) or None for xatlas everywhere; dilate 0: none; padding: texels between the charts' bilinear
+    footprints (0: touching, never sharing a texel; 2 or more for an engine that mipmaps); progress: fn(fraction) -> truthy to cancel
     (Error with status 3). texel_density: texels per world unit on as many pages as it takes (the images
     then hold the pages stacked: (size * pages, size), page p in rows p*size..; "page" the page of each
     triangle, "page_fill" each page's fraction of texel centres on triangles); uv_cache: a UV cache file

@@ -43,7 +43,8 @@ static void usage(FILE *f)
         "                      lights 0-3 in R, G, B, A; the materials' extras name them), one binary glTF\n"
         "  --stats OUT.json    timings and counters\n"
         "  --dilate N          texels of dilation around charts (default 4; 0: none)\n"
-        "  --padding N         texels between charts and regions (default 2)\n"
+        "  --padding N         texels between charts and regions (default 0: touching, never sharing a texel;\n"
+        "                      2 or more where an engine mipmaps or block-compresses the lightmap)\n"
         "  --no-leak-fix       keep the points of texels whose centre lies inside geometry\n"
         "  --texel-density T   texels per world unit (times each mesh's \"lightmap\" scale), on as many\n"
         "                      --size pages as it takes: page p > 0 of each image output is written with .p\n"
@@ -167,7 +168,7 @@ static int take_option(bake_request *r, ms_cli_parser *cli, int c)
         break;
     case O_SIZE: if (ms_cli_parse_long(cli, "--size", optarg, 1, MS_MAX_IMAGE_SIZE, &v)) return EXIT_BAD_INPUT; r->bo.size = (int)v; break;
     case O_DILATE: if (ms_cli_parse_long(cli, "--dilate", optarg, 0, 1 << 16, &v)) return EXIT_BAD_INPUT; r->bo.dilate = v ? (int)v : -1; break;
-    case O_PADDING: if (ms_cli_parse_long(cli, "--padding", optarg, 1, 256, &v)) return EXIT_BAD_INPUT; r->bo.padding = (int)v; break;
+    case O_PADDING: if (ms_cli_parse_long(cli, "--padding", optarg, 0, 256, &v)) return EXIT_BAD_INPUT; r->bo.padding = (int)v; break;
     case O_METHOD: r->bo.points.method = optarg; break;
     case O_PATTERN:
         if (!strcmp(optarg, "grid")) r->bo.points.pattern = MS_PATTERN_GRID;

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "xatlas_meshes.h"
+#include "atlas_footprints.h"
 
 typedef struct tkey_rec { uint32_t key; uint32_t tri; } tkey_rec;
 
@@ -30,8 +31,56 @@ static uint64_t hash_uv(const float *u)
     return h * 0xBF58476D1CE4E5B9ull;
 }
 
+/* The packed layout of x (pages used: pages) with no two footprints sharing a texel: the charts (triangles of one
+ * xatlas mesh joined by a shared vertex, as xatlas forms them) and regions moved where they did. The pages used;
+ * 0 when a chart found no room (x->grow: on the one page; else one larger than a page); -1 when out of memory. */
+static int separate(ms_xpack *x, int pages, const tkey_rec *ord, const size_t *seg, const size_t *vseg, const uint32_t *idx,
+                    size_t ng)
+{
+    const size_t nt = x->nt;
+    uint32_t *unit = malloc((nt ? nt : 1) * sizeof *unit), *first = malloc((vseg[ng] ? vseg[ng] : 1) * sizeof *first);
+    uint32_t *parent = malloc((nt ? nt : 1) * sizeof *parent);
+    int rc = -1;
+    if (!unit || !first || !parent) goto out;
+    for (size_t v = 0; v < vseg[ng]; v++) first[v] = UINT32_MAX;
+    for (size_t t = 0; t < nt; t++) parent[t] = (uint32_t)t;
+    for (size_t g = 0; g < ng; g++)
+        for (size_t t = seg[g]; t < seg[g + 1]; t++)
+            for (int k = 0; k < 3; k++) {
+                uint32_t *f = &first[vseg[g] + idx[3 * t + (size_t)k]];
+                if (*f == UINT32_MAX) { *f = (uint32_t)t; continue; }
+                uint32_t a = *f, b = (uint32_t)t;
+                while (parent[a] != a) a = parent[a] = parent[parent[a]];
+                while (parent[b] != b) b = parent[b] = parent[parent[b]];
+                if (a != b) parent[a > b ? a : b] = a > b ? b : a;
+            }
+    size_t nu = 0;   /* units numbered by their first triangle (sorted order) */
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t a = (uint32_t)t;
+        while (parent[a] != a) a = parent[a];
+        unit[ord[t].tri] = a == t ? (uint32_t)nu++ : unit[ord[a].tri];
+    }
+    ms_fp_layout l = { x->size, pages, !x->grow, x->nr, x->rx, x->ry, NULL, NULL, x->rpage, nt, nu, x->out_uv, x->tpage, unit, 0 };
+    double *rdim = malloc((x->nr ? x->nr : 1) * 2 * sizeof *rdim);
+    if (!rdim) goto out;
+    for (size_t i = 0; i < x->nr; i++) { rdim[i] = x->rw[i] * x->scale; rdim[x->nr + i] = x->rh[i] * x->scale; }
+    l.rw = rdim;
+    l.rh = rdim + x->nr;
+    const int fp = ms_fp_separate(&l);
+    free(rdim);
+    x->moved = l.moved;
+    if (fp < 0) goto out;
+    rc = fp ? 0 : l.pages;
+out:
+    free(unit);
+    free(first);
+    free(parent);
+    return rc;
+}
+
 int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
 {
+    x->scale = s;
     const size_t nt = x->nt, nr = x->nr;
     tkey_rec *ord = malloc((nt ? nt : 1) * sizeof *ord);
     float *vuv = malloc((nt ? 6 * nt : 1) * sizeof *vuv + 8 * (nr ? nr : 1) * sizeof(float));
@@ -148,11 +197,19 @@ int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
             lo[i & 1] = fmin(lo[i & 1], x->out_uv[i]);
             hi[i & 1] = fmax(hi[i & 1], x->out_uv[i]);
         }
-        for (size_t i = 0; i < nr; i++) { x->rx[i] += x->pad - lo[0]; x->ry[i] += x->pad - lo[1]; x->rpage[i] = 0; }
-        for (size_t i = 0; i < 6 * nt; i++) x->out_uv[i] = (float)(x->out_uv[i] + x->pad - lo[i & 1]);
+        /* by whole texels: xatlas puts chart edges on texel centres, where footprints end (footprint.h) */
+        const double sx = x->pad - floor(lo[0]), sy = x->pad - floor(lo[1]);
+        for (size_t i = 0; i < nr; i++) { x->rx[i] += sx; x->ry[i] += sy; x->rpage[i] = 0; }
+        for (size_t i = 0; i < 6 * nt; i++) x->out_uv[i] = (float)(x->out_uv[i] + ((i & 1) ? sy : sx));
         for (size_t t = 0; t < nt; t++) x->tpage[t] = 0;
         x->extent = fmax(hi[0] - lo[0], hi[1] - lo[1]);
-        rc = hi[0] - lo[0] + 2 * x->pad <= x->size && hi[1] - lo[1] + 2 * x->pad <= x->size ? 1 : 2;
+        rc = hi[0] + sx + x->pad <= x->size && hi[1] + sy + x->pad <= x->size ? 1 : 2;
+    }
+    if (!x->grow || rc == 1) {   /* footprints made disjoint (atlas_footprints.h) */
+        const int fp = separate(x, rc, ord, seg, vseg, idx, ng);
+        if (fp < 0) { snprintf(err, errlen, "out of memory packing the lightmap"); rc = -1; goto out; }
+        if (!fp && !x->grow) { snprintf(err, errlen, "a lightmap chart does not fit a %dx%d page", x->size, x->size); rc = -1; goto out; }
+        rc = fp ? fp : 2;
     }
 out:
     if (atlas) xatlasDestroy(atlas);

@@ -21,10 +21,12 @@ typedef struct ms_xpack {
     float *out_uv;
     uint32_t *tpage;
     double extent;   /* grow: the atlas's larger side, texels */
+    size_t moved;    /* charts and regions moved off xatlas's places so that no two footprints share a texel */
+    double scale;    /* the last run's */
 } ms_xpack;
 
 /* Packs everything at scale s (every size and UV times s) onto size x size pages, no rotation, `pad` texels
- * apart. Returns the pages used, or -1 with a message (out of memory, a region larger than a page). xatlas
+ * apart (0: footprints touching, never sharing a texel: atlas_footprints.h). Returns the pages used, or -1 with a message (out of memory, a region larger than a page). xatlas
  * places charts on a fixed-size page by random probing (4096 tries), which on a nearly full page sends a
  * small chart to the next one; the growing atlas (grow) never does, so one page is fitted with it. */
 int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen);

@@ -13,6 +13,7 @@
 #include "shade.h"
 #include "bake_unbaked.h"
 #include "bake_pages.h"
+#include "footprint.h"
 #include "budget.h"
 #include "light/pattern.h"
 #include "light/light_shape.h"
@@ -171,14 +172,22 @@ static ms_status rasterize(const ms_scene *sc, int size, int height, const float
 }
 
 /* Fills texels off the triangles from the average of their filled 8-neighbours, `passes` rings deep: the
- * irradiance and every light's V and S. */
-static int dilate(ms_frame *f, int passes)
+ * irradiance and every light's V and S. A texel of a chart's bilinear footprint takes only its own chart's
+ * (footprint.h: charts packed with no padding touch), which the first pass always finds: a point of the
+ * chart within one texel of its centre lies in the square of a neighbour, which the chart rasterized. */
+static int dilate(ms_frame *f, int passes, const ms_lightmap *lm)
 {
+    if (passes <= 0) return 0;
     const int W = f->width, H = f->height;
     const size_t nl = f->n_lights > 1 ? (size_t)f->n_lights : 1, np = (size_t)W * H;
     uint8_t *filled = malloc(np), *next = malloc(np);
     double *acc = malloc((3 + 2 * nl) * sizeof *acc);
-    if (!filled || !next || !acc) { free(filled); free(next); free(acc); return -1; }
+    uint32_t *owner = malloc(np * sizeof *owner);
+    if (!filled || !next || !acc || !owner ||
+        ms_footprint_owners(lm->uv, lm->page, lm->n_tris, W, lm->pages > 0 ? lm->pages : 1, owner)) {
+        free(filled); free(next); free(acc); free(owner);
+        return -1;
+    }
     for (size_t i = 0; i < np; i++) filled[i] = f->vis[i] >= 0.0f;
     for (int pass = 0; pass < passes; pass++) {
         memcpy(next, filled, np);
@@ -193,7 +202,7 @@ static int dilate(ms_frame *f, int passes)
                         const int xx = x + dx, yy = y + dy;
                         if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
                         const size_t j = (size_t)yy * W + xx;
-                        if (!filled[j]) continue;
+                        if (!filled[j] || (owner[i] != UINT32_MAX && owner[j] != owner[i])) continue;
                         for (int c = 0; c < 3; c++) acc[c] += f->rgb[3 * j + c];
                         for (size_t l = 0; l < nl; l++) {
                             acc[3 + 2 * l] += f->vis[l * np + j];
@@ -214,6 +223,7 @@ static int dilate(ms_frame *f, int passes)
     free(filled);
     free(next);
     free(acc);
+    free(owner);
     return 0;
 }
 
@@ -278,7 +288,7 @@ ms_status ms_bake_layout_abi(const ms_abi *abi, const ms_scene *scene, const ms_
     }
     ms_status bst = bake_budget(scene, o, size, 1, 0, NULL, err, errlen);
     if (bst) return bst;
-    const int padding = o->padding > 0 ? o->padding : 2;
+    const int padding = o->padding > 0 ? o->padding : 0;
     ms_status st = ms_bake_choose_uvs(scene, o, size, padding, out, err, errlen);
     if (!st && o->pass) o->pass(o->pass_user, out->uv_cached ? "UVs (from the cache)" : "UVs", out->unwrap_s);
     if (!st && out->pages > 1) st = bake_budget(scene, o, size, out->pages, 0, NULL, err, errlen);   /* known now */
@@ -566,7 +576,7 @@ ms_status ms_bake_finish_abi(const ms_abi *abi, const ms_scene *scene, const ms_
         if (p99 > 0.0f) f->exposure = 1.0f / p99;
     }
     free(lum);
-    if (dilate(f, passes)) { snprintf(err, errlen, "out of memory dilating the lightmap"); return MS_ERR_NO_MEMORY; }
+    if (dilate(f, passes, lm)) { snprintf(err, errlen, "out of memory dilating the lightmap"); return MS_ERR_NO_MEMORY; }
     /* A NaN or infinite texel is an error, never a lightmap (microshadow.h: MS_MAX_RADIANCE); checked before
      * the stitching would spread it. */
     if (ms_frame_check_finite(f, "the lightmap", err, errlen)) return MS_ERR_INVALID;

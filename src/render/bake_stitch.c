@@ -218,6 +218,14 @@ static int build_rows(const ms_frame *f, const ms_seam *seams, size_t n, int32_t
             double w[8];
             taps(W, H, sm->a0[0] + t * (sm->a1[0] - sm->a0[0]), sm->a0[1] + t * (sm->a1[1] - sm->a0[1]), idx, w);
             taps(W, H, sm->b0[0] + t * (sm->b1[0] - sm->b0[0]), sm->b0[1] + t * (sm->b1[1] - sm->b0[1]), idx + 4, w + 4);
+            /* a tap of weight 0 (the point on a texel centre's row or column: chart edges lie there) is no
+             * variable: the texel may be another chart's, and would join its system to this one */
+            for (int side = 0; side < 8; side += 4) {
+                int best = side;
+                for (int q = side + 1; q < side + 4; q++) best = w[q] > w[best] ? q : best;
+                for (int q = side; q < side + 4; q++)
+                    if (w[q] == 0.0) idx[q] = idx[best];
+            }
             int filled = 1;
             for (int q = 0; q < 8; q++) filled &= f->vis[idx[q]] >= 0.0f;
             if (!filled) continue;

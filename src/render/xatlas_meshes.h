@@ -16,11 +16,10 @@ xatlasAddMeshError ms_xatlas_add_meshes(xatlasAtlas *atlas, int dim, const float
 /* The padding of one chart for `padding` texels between charts, the one place that maps the bake's padding
  * to xatlas's and the regions' packer's: each chart's bilinear footprint (every texel a bilinear lookup inside
  * it reads, its centre within one texel of the chart's triangles) is packed grown by this many texels
- * without overlap, so two footprints lie at least `padding` texels apart. The bake's dilation fills a
- * footprint's texels from their filled neighbours whatever their chart, so footprints must not touch: at
- * least one texel each. (xatlas's footprint is found by testing the square about a texel against the
- * chart's boundary edges; packed with none, footprints overlapped: docs/baking.md, "Padding".) */
-static inline int ms_chart_padding(int padding) { return padding > 0 ? (padding + 1) / 2 : 1; }
+ * without overlap, so two footprints lie at least `padding` texels apart. With 0 they may touch: the packer
+ * then moves any chart whose exact footprint shares a texel with another's (atlas_footprints.h; xatlas's own
+ * footprint test is approximate), and the bake's dilation fills each footprint from its own chart. */
+static inline int ms_chart_padding(int padding) { return padding > 0 ? (padding + 1) / 2 : 0; }
 
 /* xatlas's pack options for `padding`: bilinear footprints grown by ms_chart_padding. */
 void ms_xatlas_pack_padding(xatlasPackOptions *po, int padding);

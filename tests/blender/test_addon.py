@@ -237,7 +237,7 @@ class BakeTest(unittest.TestCase):
             print("bake: the glTF validator is not installed (viewer/node_modules): the exported files not validated")
         cli_exr, cli_s = os.path.join(OUT, "cli_bake.exr"), os.path.join(OUT, "cli_s.exr")
         r = run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
-                            "256", "--threads", "2", "--quiet", "-o", cli_exr])
+                            "256", "--padding", "2", "--threads", "2", "--quiet", "-o", cli_exr])
         self.assertEqual(r.returncode, 0, r.stderr)
         img = bpy.data.images.load(cli_exr, check_existing=False)
         # Blender loads the EXR's rows (the lightmap's, from its top) as it shows the add-on's images
@@ -251,7 +251,7 @@ class BakeTest(unittest.TestCase):
         # light 0's S, bit for bit: the CLI's PFM against the add-on's shadowmask image
         s0 = os.path.join(OUT, "cli_s0.pfm")
         r = run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256", "--samples",
-                            "256", "--threads", "2", "--quiet", "-o", cli_exr, "--shadow", s0])
+                            "256", "--padding", "2", "--threads", "2", "--quiet", "-o", cli_exr, "--shadow", s0])
         self.assertEqual(r.returncode, 0, r.stderr)
         mask = np.array(bpy.data.images["microshadow_shadowmask_square"].pixels[:], np.float32).reshape(256, 256, 4)[..., 0]
         s = np.maximum(read_pfm(s0), 0.0)[::-1]  # rows from the bottom as Blender's; -1 (not baked) shown as 0
@@ -275,7 +275,8 @@ class BakeTest(unittest.TestCase):
         self.assertEqual(bpy.ops.microshadow.export_scene(directory=exported), {"FINISHED"})
         out = os.path.join(OUT, "cli_pages.exr")
         r = run([CLI, "bake", os.path.join(exported, "scene.json"), "--uv", "0", "--size", "256",
-                            "--texel-density", "28", "--uv-regions", "--samples", "256", "--threads", "2", "--quiet",
+                            "--texel-density", "28", "--uv-regions", "--samples", "256", "--padding", "2", "--threads", "2",
+                            "--quiet",
                             "-o", out])
         self.assertEqual(r.returncode, 0, r.stderr)
         for p in range(pages):

@@ -561,7 +561,11 @@ class BuiltSceneTest(unittest.TestCase):
             off = got[2 * q: 2 * q + 2] - a[0] * src[2 * q: 2 * q + 2]
             np.testing.assert_allclose(off - off[0, 0], 0, atol=1e-2)   # both triangles, every corner: one move
             density.append(a[0] / (2.0 if q == 0 else 2.5))
-        np.testing.assert_allclose(density, density[0], rtol=1e-3)
+        # one density, but for xatlas stretching each chart's extent up to whole texels (its packer aligns chart
+        # edges with texel centres): every island's side within one texel of the least density's
+        world = np.array([2.0, 0.5, 0.5, 0.5, 0.5])
+        spans = np.array(density) * world
+        np.testing.assert_array_less(spans - min(density) * world, 1.0 + 1e-6)
 
     def test_same_as_loaded(self):
         a = ms.render(self.loaded, samples=256)
