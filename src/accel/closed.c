@@ -1,5 +1,6 @@
 /* Closed components of a triangle soup and the light-facing cull they allow (closed.h, docs/culling.md). */
 #include "closed.h"
+#include "core/union_find.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,21 +23,6 @@ static size_t table_size(size_t n)
 }
 
 
-static uint32_t find_root(uint32_t *parent, uint32_t i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];   /* path halving */
-        i = parent[i];
-    }
-    return i;
-}
-
-static void unite(uint32_t *parent, uint32_t a, uint32_t b)
-{
-    a = find_root(parent, a);
-    b = find_root(parent, b);
-    if (a != b) parent[a < b ? b : a] = a < b ? a : b;
-}
 
 /* Numbers the sets of the union-find `parent` over n triangles into label (0, 1, ... in order of their
  * smallest member), a set with any flagged triangle MS_OPEN_COMPONENT; returns the number of sets kept.
@@ -44,13 +30,13 @@ static void unite(uint32_t *parent, uint32_t a, uint32_t b)
 static size_t label_sets(uint32_t *parent, uint8_t *flag, size_t n, uint32_t *label)
 {
     for (size_t t = 0; t < n; t++) {
-        const uint32_t r = find_root(parent, (uint32_t)t);
+        const uint32_t r = ms_uf_find(parent, (uint32_t)t);
         if (flag[t]) flag[r] = 1;
     }
     /* Roots are their set's smallest index (unite), so a root is numbered before its members. */
     size_t k = 0;
     for (size_t t = 0; t < n; t++) {
-        const uint32_t r = find_root(parent, (uint32_t)t);
+        const uint32_t r = ms_uf_find(parent, (uint32_t)t);
         if (flag[r]) label[t] = MS_OPEN_COMPONENT;
         else label[t] = r == t ? (uint32_t)k++ : label[r];
     }
@@ -150,13 +136,13 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
             /* the triangles walking a -> b (this one included) and b -> a */
             uint32_t same = 0, opp = 0, twin = 0;
             for (uint32_t j = start[a]; j < start[a + 1]; j++)
-                if (dst[j] == b) { same++; unite(cparent, t, etri[j]); }
+                if (dst[j] == b) { same++; ms_uf_union(cparent, t, etri[j]); }
             for (uint32_t j = start[b]; j < start[b + 1]; j++)
-                if (dst[j] == a) { opp++; twin = etri[j]; unite(cparent, t, twin); }
+                if (dst[j] == a) { opp++; twin = etri[j]; ms_uf_union(cparent, t, twin); }
             /* Exactly two triangles, walking the edge in opposite directions: neighbours on one consistently
              * oriented surface. Anything else (a boundary, a fin of three or more, two that walk it the same
              * way) leaves their component open. */
-            if (same == 1 && opp == 1) unite(parent, t, twin);
+            if (same == 1 && opp == 1) ms_uf_union(parent, t, twin);
             else bad[t] = 1;
             if ((same + opp) & 1) odd[t] = 1;
         }

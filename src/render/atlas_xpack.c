@@ -12,6 +12,7 @@
 #include <string.h>
 #include "xatlas_meshes.h"
 #include "atlas_footprints.h"
+#include "core/union_find.h"
 
 typedef struct tkey_rec { uint32_t key; uint32_t tri; } tkey_rec;
 
@@ -34,7 +35,7 @@ static uint64_t hash_uv(const float *u)
 /* The packed layout of x (pages used: pages) with no two footprints sharing a texel: the charts (triangles of one
  * xatlas mesh joined by a shared vertex, as xatlas forms them) and regions moved where they did. The pages used;
  * 0 when a chart found no room (x->grow: on the one page; else one larger than a page); -1 when out of memory. */
-static int separate(ms_xpack *x, int pages, const tkey_rec *ord, const size_t *seg, const size_t *vseg, const uint32_t *idx,
+static int separate(ms_xpack *x, double s, int pages, const tkey_rec *ord, const size_t *seg, const size_t *vseg, const uint32_t *idx,
                     size_t ng)
 {
     const size_t nt = x->nt;
@@ -48,27 +49,22 @@ static int separate(ms_xpack *x, int pages, const tkey_rec *ord, const size_t *s
         for (size_t t = seg[g]; t < seg[g + 1]; t++)
             for (int k = 0; k < 3; k++) {
                 uint32_t *f = &first[vseg[g] + idx[3 * t + (size_t)k]];
-                if (*f == UINT32_MAX) { *f = (uint32_t)t; continue; }
-                uint32_t a = *f, b = (uint32_t)t;
-                while (parent[a] != a) a = parent[a] = parent[parent[a]];
-                while (parent[b] != b) b = parent[b] = parent[parent[b]];
-                if (a != b) parent[a > b ? a : b] = a > b ? b : a;
+                if (*f == UINT32_MAX) *f = (uint32_t)t;
+                else ms_uf_union(parent, *f, (uint32_t)t);
             }
     size_t nu = 0;   /* units numbered by their first triangle (sorted order) */
     for (size_t t = 0; t < nt; t++) {
-        uint32_t a = (uint32_t)t;
-        while (parent[a] != a) a = parent[a];
+        const uint32_t a = ms_uf_find(parent, (uint32_t)t);
         unit[ord[t].tri] = a == t ? (uint32_t)nu++ : unit[ord[a].tri];
     }
     ms_fp_layout l = { x->size, pages, !x->grow, x->nr, x->rx, x->ry, NULL, NULL, x->rpage, nt, nu, x->out_uv, x->tpage, unit, 0 };
     double *rdim = malloc((x->nr ? x->nr : 1) * 2 * sizeof *rdim);
     if (!rdim) goto out;
-    for (size_t i = 0; i < x->nr; i++) { rdim[i] = x->rw[i] * x->scale; rdim[x->nr + i] = x->rh[i] * x->scale; }
+    for (size_t i = 0; i < x->nr; i++) { rdim[i] = x->rw[i] * s; rdim[x->nr + i] = x->rh[i] * s; }
     l.rw = rdim;
     l.rh = rdim + x->nr;
     const int fp = ms_fp_separate(&l);
     free(rdim);
-    x->moved = l.moved;
     if (fp < 0) goto out;
     rc = fp ? 0 : l.pages;
 out:
@@ -80,7 +76,6 @@ out:
 
 int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
 {
-    x->scale = s;
     const size_t nt = x->nt, nr = x->nr;
     tkey_rec *ord = malloc((nt ? nt : 1) * sizeof *ord);
     float *vuv = malloc((nt ? 6 * nt : 1) * sizeof *vuv + 8 * (nr ? nr : 1) * sizeof(float));
@@ -206,7 +201,7 @@ int ms_xpack_run(ms_xpack *x, double s, char *err, size_t errlen)
         rc = hi[0] + sx + x->pad <= x->size && hi[1] + sy + x->pad <= x->size ? 1 : 2;
     }
     if (!x->grow || rc == 1) {   /* footprints made disjoint (atlas_footprints.h) */
-        const int fp = separate(x, rc, ord, seg, vseg, idx, ng);
+        const int fp = separate(x, s, rc, ord, seg, vseg, idx, ng);
         if (fp < 0) { snprintf(err, errlen, "out of memory packing the lightmap"); rc = -1; goto out; }
         if (!fp && !x->grow) { snprintf(err, errlen, "a lightmap chart does not fit a %dx%d page", x->size, x->size); rc = -1; goto out; }
         rc = fp ? fp : 2;

@@ -21,8 +21,6 @@ typedef struct ms_xpack {
     float *out_uv;
     uint32_t *tpage;
     double extent;   /* grow: the atlas's larger side, texels */
-    size_t moved;    /* charts and regions moved off xatlas's places so that no two footprints share a texel */
-    double scale;    /* the last run's */
 } ms_xpack;
 
 /* Packs everything at scale s (every size and UV times s) onto size x size pages, no rotation, `pad` texels

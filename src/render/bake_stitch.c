@@ -14,6 +14,7 @@
  *   - the pull lam towards the baked value is weaker on texels whose centre lies off their triangle: the
  *     paper's texels are all equally trusted, ours off the triangles are stand-ins (see below). */
 #include "bake_stitch.h"
+#include "core/union_find.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -122,12 +123,6 @@ static void solve(const stitch_sys *s, size_t c, const double *x0, double *d, do
     }
 }
 
-static uint32_t find(uint32_t *par, uint32_t a)
-{
-    while (par[a] != a) a = par[a] = par[par[a]];
-    return a;
-}
-
 /* Splits the system into its connected components (texels joined by a row): renumbers the variables and
  * orders the rows so that each component's are contiguous, in the order of their first variable. */
 static int split(stitch_sys *s, size_t *texel_of)
@@ -142,12 +137,11 @@ static int split(stitch_sys *s, size_t *texel_of)
     for (size_t k = 0; k < nv; k++) par[k] = (uint32_t)k;
     for (size_t r = 0; r < nr; r++)
         for (int j = 1; j < 8; j++) {
-            const uint32_t a = find(par, (uint32_t)s->rows[r].var[0]), b = find(par, (uint32_t)s->rows[r].var[j]);
-            if (a < b) par[b] = a; else par[a] = b;
+            ms_uf_union(par, (uint32_t)s->rows[r].var[0], (uint32_t)s->rows[r].var[j]);
         }
     s->ncomp = 0;
     for (size_t k = 0; k < nv; k++) {   /* a root is its own smallest member: numbered when first met */
-        const uint32_t root = find(par, (uint32_t)k);
+        const uint32_t root = ms_uf_find(par, (uint32_t)k);
         comp[k] = root == k ? (uint32_t)s->ncomp++ : comp[root];
     }
     s->comp_v = calloc(s->ncomp + 1, sizeof *s->comp_v);

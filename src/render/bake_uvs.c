@@ -391,7 +391,7 @@ static int place_charts(const float *xtri, size_t n, const uint8_t *want, const 
         xtri_of[nx++] = t;
     }
     area += (double)info.charts * (2.0 * pad + 2.0) * (2.0 * pad + 2.0);   /* and their padding */
-    ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, !(T > 0.0), rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n, 0.0, 0, 1.0 };
+    ms_xpack xp = { nr, rdim, rdim + nr, nx, xin, xkey, size, pad, !(T > 0.0), rdim + 2 * nr, rdim + 3 * nr, rpage, xout, xkey + n, 0.0 };
     double scale = 1.0;
     if (T > 0.0) {
         const int pages = ms_xpack_run(&xp, 1.0, err, errlen);

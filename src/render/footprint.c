@@ -1,5 +1,6 @@
 /* Bilinear footprints of lightmap triangles (footprint.h). */
 #include "footprint.h"
+#include "core/union_find.h"
 #include <math.h>
 #include <stdlib.h>
 
@@ -39,12 +40,6 @@ void ms_footprint_triangle(const float uv[6], double reach, int w, int h, void (
         }
 }
 
-static uint32_t find(uint32_t *parent, uint32_t a)
-{
-    while (parent[a] != a) { parent[a] = parent[parent[a]]; a = parent[a]; }
-    return a;
-}
-
 typedef struct owners_ctx {
     uint32_t *owner, *parent;
     uint32_t t;
@@ -56,9 +51,8 @@ static void own_texel(void *user, int x, int y)
 {
     owners_ctx *c = user;
     uint32_t *o = c->owner + c->row0 + (size_t)y * c->size + x;
-    if (*o == UINT32_MAX) { *o = c->t; return; }
-    const uint32_t a = find(c->parent, *o), b = find(c->parent, c->t);
-    if (a != b) c->parent[a > b ? a : b] = a > b ? b : a;
+    if (*o == UINT32_MAX) *o = c->t;
+    else ms_uf_union(c->parent, *o, c->t);
 }
 
 /* Charts need no UV vertices of their own here: two triangles sharing a UV vertex (or an edge) have
@@ -82,7 +76,7 @@ int ms_footprint_owners(const float *uv, const uint32_t *page, size_t n, int siz
         ms_footprint_triangle(q, MS_FOOTPRINT_REACH_BAKE, size, size, own_texel, &c);
     }
     for (size_t i = 0; i < texels; i++)
-        if (owner[i] != UINT32_MAX) owner[i] = find(parent, owner[i]);
+        if (owner[i] != UINT32_MAX) owner[i] = ms_uf_find(parent, owner[i]);
     free(parent);
     return 0;
 }
