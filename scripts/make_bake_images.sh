@@ -5,8 +5,9 @@
 # (bake time, texels/s, seams) and the validator's verdict on its glb. With HELMET_DIR set to a folder holding
 # Khronos' FlightHelmet sample (FlightHelmet.gltf; fetched by hand, it is not in ../shared), the same three
 # pictures of it on a ground with two rect lights, baked with the default options; with MIXED_DIR set to
-# Bevy's assets/models/MixedLightingExample folder (MixedLightingExample.gltf), the same of it.
-# Usage: [HELMET_DIR=DIR] [MIXED_DIR=DIR] scripts/make_bake_images.sh [BUILD_DIR]   (a Release build: default build/; needs node, chromium and
+# Bevy's assets/models/MixedLightingExample folder (MixedLightingExample.gltf), the same of it; with SPONZA=1,
+# the same of Crytek's Sponza converted to glTF from ../shared (scripts/sponza_gltf.py; needs assimp-utils).
+# Usage: [HELMET_DIR=DIR] [MIXED_DIR=DIR] [SPONZA=1] scripts/make_bake_images.sh [BUILD_DIR]   (a Release build: default build/; needs node, chromium and
 # viewer/node_modules for the viewer's image: scripts/install-deps.sh)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -81,4 +82,15 @@ if [ -n "${MIXED_DIR:-}" ]; then
               { "corner": [-1.2, 0.4, -0.6], "edge_s": [0, 0, 0.5], "edge_t": [0, 0.5, 0], "power": 15 } ] }
 EOF
   asset_pictures mixed
+fi
+
+# Crytek's Sponza as glTF (scripts/sponza_gltf.py: the shared scene's OBJ parts in one glb, plain grey
+# materials), with the shared scene's camera and light, default bake options at 1024².
+if [ "${SPONZA:-0}" = 1 ]; then
+  /usr/bin/python3 "$root/scripts/sponza_gltf.py" "$scenes/crytek-sponza-partial" "$tmp/Sponza.glb"
+  /usr/bin/python3 -c "
+import json; s = json.load(open('$scenes/crytek-sponza-partial/crytek-sponza-partial.json'))
+s['meshes'] = [{'file': 'Sponza.glb'}]; s['camera']['width'] = s['camera']['height'] = 512
+json.dump(s, open('$tmp/sponza.json', 'w'), indent=1)"
+  asset_pictures sponza
 fi
