@@ -87,21 +87,21 @@ static inline void mftg_box_sides(const mftg_state *s, const ms_bvh_node *n, l16
     }
 }
 
-/* The rays of group g (bits) that enter the box whose sides are A, B (mftg_box_sides): method raytrace's
- * box test (raytrace_impl.h, packet_enters) per ray, its widened box and Ize's factor, so it never drops a
- * ray that raytrace's triangle test finds blocked by a triangle in the box. */
-static inline unsigned mftg_ray_box(const mftg_state *s, const ms_mft_group *g, const l16 A[3], const l16 B[3])
+/* Of the rays of group g (bits), those that enter the box whose sides are A, B (mftg_box_sides), given the
+ * group's reciprocal directions inv: method raytrace's box test (raytrace_impl.h, packet_enters) per ray, its
+ * widened box and Ize's factor, so it never drops a ray that raytrace's triangle test finds blocked by a
+ * triangle in the box. */
+static inline unsigned mftg_ray_box(const mftg_state *s, const l16 inv[3], const l16 A[3], const l16 B[3], unsigned bits)
 {
     l16 t0 = l16_set1(s->f->near), t1 = l16_set1(s->f->far);
     for (int a = 0; a < 3; a++) {
-        const l16 inv = l16_load(g->inv[a]);
-        const l16 x = l16_mul(A[a], inv), y = l16_mul(B[a], inv);
-        /* raytrace's compares: mn = x < y ? x : y, mx = x < y ? y : x; a NaN leaves t0, t1 as they were */
-        const l16 mn = l16_min(x, y), mx = l16_select(l16_lt(x, y), y, x);
-        t0 = l16_max(mn, t0);
-        t1 = l16_min(mx, t1);
+        const l16 x = l16_mul(A[a], inv[a]), y = l16_mul(B[a], inv[a]);
+        /* raytrace's compares: mn = x < y ? x : y, mx = x < y ? y : x (= y > x ? y : x, l16_max(y, x));
+         * a NaN leaves t0, t1 as they were */
+        t0 = l16_max(l16_min(x, y), t0);
+        t1 = l16_min(l16_max(y, x), t1);
     }
-    return l16_le(t0, l16_mul(t1, l16_set1(MS_WT_FAR_SCALE))) & g->live;
+    return l16_le(t0, l16_mul(t1, l16_set1(MS_WT_FAR_SCALE))) & bits;
 }
 
 /* Lane l's frustum from the box of its origins and the box of its points. */
@@ -175,21 +175,37 @@ static void mftg_lane_bounds(mftg_state *s, int l)
 
 static void mftg_leaf(mftg_state *s, const ms_bvh_node *n, unsigned mask, const uint16_t *enter);
 
-/* Of the lanes m whose frustum reaches child n, those with rays entering it (out[l]: the rays; rays[l]:
- * those that entered the parent). */
-static inline unsigned mftg_child_rays(const mftg_state *s, const ms_bvh_node *n, unsigned m, const uint16_t *rays,
-                                       uint16_t *out, uint64_t *ray_tests, uint64_t *culled)
+/* Of the lanes ml (mr) whose frustum reaches child c[0] (c[1]), those with rays entering it (rl[l], rr[l]: the
+ * rays; rays[l]: those that entered the parent). Both children in one pass over the lanes, which load their
+ * group's directions once. */
+static inline void mftg_child_rays(const mftg_state *s, const ms_bvh_node *c, unsigned *ml, unsigned *mr,
+                                   const uint16_t *rays, uint16_t *rl, uint16_t *rr, uint64_t *ray_tests, uint64_t *culled)
 {
-    if (!m) return 0;
-    l16 A[3], B[3];
-    mftg_box_sides(s, n, A, B);
-    for (unsigned r = m; r; r &= r - 1) {
+    const unsigned m0 = *ml, m1 = *mr;
+    if (!(m0 | m1)) return;
+    l16 A0[3], B0[3], A1[3], B1[3];
+    mftg_box_sides(s, &c[0], A0, B0);
+    mftg_box_sides(s, &c[1], A1, B1);
+    /* Both tests for every lane at either child, and no branch on their outcome: which lanes' rays enter
+     * is data, and a branch on it mispredicts; a lane at one child only costs one unneeded test. */
+    unsigned o0 = 0, o1 = 0;
+    for (unsigned r = m0 | m1; r; r &= r - 1) {
         const int l = __builtin_ctz(r);
-        out[l] = (uint16_t)(mftg_ray_box(s, s->grp[l], A, B) & rays[l]);
-        ++*ray_tests;
-        if (!out[l]) { m &= ~(1u << l); ++*culled; }
+        const ms_mft_group *g = s->grp[l];
+        const l16 inv[3] = { l16_load(g->inv[0]), l16_load(g->inv[1]), l16_load(g->inv[2]) };
+        const unsigned bits = g->live & rays[l];
+        const unsigned h0 = mftg_ray_box(s, inv, A0, B0, bits), h1 = mftg_ray_box(s, inv, A1, B1, bits);
+        rl[l] = (uint16_t)h0;
+        rr[l] = (uint16_t)h1;
+        o0 |= (unsigned)(h0 != 0) << l;
+        o1 |= (unsigned)(h1 != 0) << l;
     }
-    return m;
+    o0 &= m0;
+    o1 &= m1;
+    *ray_tests += (uint64_t)(ms_bt_popcount16(m0) + ms_bt_popcount16(m1));
+    *culled += (uint64_t)(ms_bt_popcount16(m0 & ~o0) + ms_bt_popcount16(m1 & ~o1));
+    *ml = o0;
+    *mr = o1;
 }
 
 /* The children of a node for the walk of block_traverse_loop.h, with each lane's rays: a child is visited for
@@ -235,8 +251,7 @@ static inline void mftg_children(const mftg_state *s, const ms_bvh_node *c, unsi
         mr &= mftg_traverse_node(f, &c[1], &t1);
         *tests += 2;
     }
-    ml = mftg_child_rays(s, &c[0], ml, rays, rl, ray_tests, lanes_culled);
-    mr = mftg_child_rays(s, &c[1], mr, rays, rr, ray_tests, lanes_culled);
+    mftg_child_rays(s, c, &ml, &mr, rays, rl, rr, ray_tests, lanes_culled);
     *right_first = 0;
     if (ml && mr && order) {
         if (!fr_test) {

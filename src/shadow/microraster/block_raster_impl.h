@@ -313,10 +313,13 @@ static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_nod
         cand &= ~empty;
         int32_t xa[MS_BLOCK_LANES], xb[MS_BLOCK_LANES], ya[MS_BLOCK_LANES], yb[MS_BLOCK_LANES];
         l16_store_int(xa, ax0); l16_store_int(xb, ax1); l16_store_int(ya, ay0); l16_store_int(yb, ay1);
+        /* No branch on the outcome (data: a branch on it mispredicts). */
+        unsigned covered = 0;
         for (; cand; cand &= cand - 1) {
             const int l = __builtin_ctz(cand);
-            if (!MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa[l], xb[l], ya[l], yb[l])) keep &= ~(1u << l);
+            covered |= (unsigned)MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa[l], xb[l], ya[l], yb[l]) << l;
         }
+        keep &= covered | ~(keep & front);
     }
     return keep;
 }
@@ -608,8 +611,11 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
             }
         }
         if (!np) continue;
-        if (in->lane_tests)
-            for (int e = 0; e < np; e++) in->lane_tests[pl[e]]++;
+        if (in->lane_tests) {   /* a pixel's pairs: the group's triangles, less its own */
+            for (unsigned p = live; p; p &= p - 1) in->lane_tests[__builtin_ctz(p)] += (uint32_t)nt;
+            for (int q = 0; q < nskip; q++)
+                if (skip_tri[q] - g < (uint32_t)nt && (live & skip_lane[q])) in->lane_tests[__builtin_ctz(skip_lane[q])]--;
+        }
         for (int e = np; e % MS_BLOCK_LANES; e++) { pt[e] = pt[0]; pl[e] = pl[0]; }   /* valid operands, unused */
         for (int e = 0; e < np; e += MS_BLOCK_LANES)
             MS_KFN(br_pairs)(s, &L, pt + e, pl + e, np - e < MS_BLOCK_LANES ? np - e : MS_BLOCK_LANES);
