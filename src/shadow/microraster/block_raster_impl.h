@@ -583,6 +583,12 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
     uint64_t tri_lanes = 0;
     /* The live pixels do not change within a leaf (a pixel retires after it, below). */
     const unsigned live = mask & fr->live;
+#if BR_PACK
+    /* The live pixels' indices in order, the pair lists' pixels of a triangle every live pixel meets. */
+    const __m512i live_list = _mm512_maskz_compress_epi32((__mmask16)live, _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11,
+                                                                                         12, 13, 14, 15));
+    const int n_live = ms_bt_popcount16(live);
+#endif
     const uint32_t end = n->first + n->count;
     for (uint32_t g = n->first; g < end; g += MS_BLOCK_LANES) {
         const int nt = end - g < MS_BLOCK_LANES ? (int)(end - g) : MS_BLOCK_LANES;
@@ -605,6 +611,12 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
             for (int q = 0; q < nskip; q++)
                 if (skip_tri[q] == g + (uint32_t)j) lanes &= ~skip_lane[q];
             tri_lanes += (uint64_t)ms_bt_popcount16(lanes);
+            if (lanes == live) {   /* the usual case: every live pixel, two vector stores (the tail is padding) */
+                _mm512_storeu_si512((void *)(pl + np), live_list);
+                _mm512_storeu_si512((void *)(pt + np), _mm512_set1_epi32(j));
+                np += n_live;
+                continue;
+            }
             for (; lanes; lanes &= lanes - 1) {
                 pt[np] = j;
                 pl[np++] = __builtin_ctz(lanes);
