@@ -585,8 +585,8 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
     const unsigned live = mask & fr->live;
 #if BR_PACK
     /* The live pixels' indices in order, the pair lists' pixels of a triangle every live pixel meets. */
-    const __m512i live_list = _mm512_maskz_compress_epi32((__mmask16)live, _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11,
-                                                                                         12, 13, 14, 15));
+    const __m512i lane_index = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m512i live_list = _mm512_maskz_compress_epi32((__mmask16)live, lane_index);
     const int n_live = ms_bt_popcount16(live);
 #endif
     const uint32_t end = n->first + n->count;
