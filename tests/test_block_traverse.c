@@ -79,7 +79,7 @@ static uint64_t counter(const masks *m, const char *name)
  * all_caps, also under every lower cap the CPU runs (Scanline only: the kernels' ISA variants are the
  * kernels' tests). */
 static void block_equals_pixel(const ms_scene *sc, const char *label, const int *ks, int nk, int size, int all_caps,
-                               int want_clipped)
+                               int want_clipped, int want_node_cull)
 {
     const int run_cap = (int)ms_isa_capped(tu_isa_cap());
     for (int cap = MS_ISA_SCALAR; cap <= MS_ISA_AVX512; cap++) {
@@ -111,6 +111,13 @@ static void block_equals_pixel(const ms_scene *sc, const char *label, const int 
                      * reach the near or far plane. */
                     if (want_clipped) assert_true(clipped > 0);
                 }
+                /* The coverage test at the nodes above the leaves, where the scene's blocks take it. */
+                if (want_node_cull && m == 0) {
+                    const uint64_t node = counter(&b, "node_pixels_culled");
+                    printf("%-22s %-12s k=%-2d %-6s: %llu pixels culled above the leaves\n", label, kernels[m], ks[ki],
+                           ms_isa_name((ms_isa)cap), (unsigned long long)node);
+                    assert_true(node > 0);
+                }
                 free(b.vis);
                 free(p.vis);
             }
@@ -123,7 +130,7 @@ static void test_default_scene(void **state)
     ms_scene sc;
     assert_int_equal(ms_scene_default(&sc), 0);
     const int ks[] = { 16, 32, 64 };
-    block_equals_pixel(&sc, "default", ks, 3, 48, 1, 1);
+    block_equals_pixel(&sc, "default", ks, 3, 48, 1, 1, 0);
     ms_scene_free(&sc);
 }
 
@@ -133,11 +140,11 @@ static void test_quad(void **state)
     ms_scene sc;
     tu_make_quad(&sc);
     const int ks[] = { 16, 32, 64 };
-    block_equals_pixel(&sc, "quad", ks, 3, 48, 1, 0);
+    block_equals_pixel(&sc, "quad", ks, 3, 48, 1, 0, 0);
     ms_scene_free(&sc);
 }
 
-static void real_scene(const char *rel, int size, int want_clipped)
+static void real_scene(const char *rel, int size, int want_clipped, int want_node_cull)
 {
     if (!tu_have_shared_scenes()) skip();
     char path[4096], err[512];
@@ -146,12 +153,12 @@ static void real_scene(const char *rel, int size, int want_clipped)
     if (rc) fprintf(stderr, "%s\n", err);
     assert_int_equal(rc, 0);
     const int ks[] = { 32 };
-    block_equals_pixel(&sc, rel, ks, 1, size, 0, want_clipped);
+    block_equals_pixel(&sc, rel, ks, 1, size, 0, want_clipped, want_node_cull);
     ms_scene_free(&sc);
 }
 
-static void test_bunny(void **state) { (void)state; real_scene("stanford-bunny/stanford-bunny.json", 64, 0); }
-static void test_biglight(void **state) { (void)state; real_scene("dabrovic-sponza/dabrovic-sponza-biglight.json", 64, 1); }
+static void test_bunny(void **state) { (void)state; real_scene("stanford-bunny/stanford-bunny.json", 64, 0, 1); }
+static void test_biglight(void **state) { (void)state; real_scene("dabrovic-sponza/dabrovic-sponza-biglight.json", 64, 1, 0); }
 
 /* The traversal's instances take the same decisions: under Bounds, whose kernels are bit for bit the
  * same on every ISA, the masks and every counter agree between the portable, AVX2 and AVX-512

@@ -30,6 +30,11 @@ typedef struct ms_block_leaf_cache {
     uint32_t next_node[MS_BLOCK_CACHE];
     uint64_t next_score[MS_BLOCK_CACHE];
     uint64_t *pre_bits;                 /* one bit per shallow node: processed before this block's traversal */
+    /* The coverage tests of node and leaf boxes (block_raster_impl.h, br_leaf_lanes) in the current block:
+     * lanes tested and lanes culled; and whether inner nodes take the test in this block (decided from the
+     * previous block's share culled). */
+    uint32_t cover_tested, cover_culled;
+    int node_cover;
 } ms_block_leaf_cache;
 
 /* The block as the caller hands it over: up to 16 pixels, each with its frame, its buffer (the front
@@ -53,6 +58,7 @@ enum {
     MS_BR_RASTERIZED, MS_BR_PIXELS_EARLY_OUT, MS_BR_RECT_SHRINKS,
     MS_BR_SHARED_SETUP,                /* of the rasterizations, those set up for several pixels at once */
     MS_BR_SHARED_SETUP_CLIP,           /* of those, the ones with a near or far clip edge */
+    MS_BR_NODE_LANES_CULLED,           /* pixels dropped just above the leaves by the coverage test */
     MS_BR_COUNTERS
 };
 

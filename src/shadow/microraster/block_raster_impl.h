@@ -34,6 +34,13 @@
 #define MS_BR_COMMON
 /* A leaf's triangles that are some pixel's own (never occluding): few, usually none. */
 #define BR_MAX_SKIP MS_BLOCK_LANES
+/* The coverage test at the nodes just above the leaves (br_node_lanes) pays where it culls: a block takes it
+ * when more than 2 in 10 of the previous block's coverage tests culled, and keeps it while more than 1 in 10
+ * do (on the scanned statues and game models a penumbra block's tests cull about half, on the bars and
+ * foliage almost none; at every inner node, or always, it cost more than it saved on those). */
+#define BR_NODE_COVER_ON 2
+#define BR_NODE_COVER_KEEP 1
+#define BR_NODE_COVER_DEN 10
 /* Smallest rectangle (in samples) for which the corner-ray test runs. */
 #define BR_CORNER_AREA 16.0f
 typedef struct br_state {
@@ -319,7 +326,12 @@ static inline unsigned MS_KFN(br_leaf_lanes)(const br_state *s, const ms_bvh_nod
             const int l = __builtin_ctz(cand);
             covered |= (unsigned)MS_KFN(br_covers)((const MS_WORD *)s->in->buf[l], xa[l], xb[l], ya[l], yb[l]) << l;
         }
-        keep &= covered | ~(keep & front);
+        const unsigned tested = keep & front;
+        keep &= covered | ~tested;
+        if (s->in->cache) {   /* the block's share culled: br_node_lanes */
+            s->in->cache->cover_tested += (uint32_t)ms_bt_popcount16(tested);
+            s->in->cache->cover_culled += (uint32_t)ms_bt_popcount16(tested & ~covered);
+        }
     }
     return keep;
 }
@@ -689,13 +701,41 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
     }
 }
 
+/* Of the lanes m, those whose pixel child n's box can change, where n lies just above the leaves and the
+ * block takes the test (BR_NODE_COVER_ON): the leaf's lane test (br_leaf_lanes: the pixel's rectangle frustum
+ * and, projected, its visible samples), so that a pixel whose visible samples the box misses skips both
+ * leaves' tests. Conservative as at a leaf: nothing in the box can clear a sample outside its projection.
+ * Departure from the paper, whose frusta test only the sides at inner nodes. */
+static inline unsigned MS_KFN(br_node_lanes)(const br_state *s, const ms_bvh_node *n, unsigned m)
+{
+    if (!m || n->count || !s->in->cache || !s->in->cache->node_cover) return m;
+    const ms_bvh_node *ch = &s->nodes[n->first];
+    if (!ch[0].count || !ch[1].count) return m;
+    l16 M[3][3], C[3];
+    for (int a = 0; a < 3; a++) {
+        C[a] = l16_load(s->fr->c[a]);
+        for (int r = 0; r < 3; r++) M[r][a] = l16_load(s->m[r][a]);
+    }
+    const unsigned keep = MS_KFN(br_leaf_lanes)(s, n, m, M, C);
+    s->bt_cnt[MS_BR_NODE_LANES_CULLED] += (uint64_t)ms_bt_popcount16(m & ~keep);
+    return keep;
+}
 #define BT_STATE br_state
 #define BT_LEAF(s, n, mask) MS_KFN(br_leaf)(s, n, mask, 0)
 #define BT_FN MS_KFN(br_traverse)
+#define BT_CHILDREN(s, c, mask, order, ml, mr, right_first) \
+    do { \
+        MS_CAT(BT_FN, _children)((s)->fr, c, mask, order, &(ml), &(mr), &(right_first)); \
+        tests += 2; \
+        (ml) = MS_KFN(br_node_lanes)(s, &(c)[0], ml); \
+        (mr) = MS_KFN(br_node_lanes)(s, &(c)[1], mr); \
+        if (!(ml) || !(mr)) (right_first) = 0; \
+    } while (0)
 #include "block_traverse_loop.h"
 #undef BT_STATE
 #undef BT_LEAF
 #undef BT_FN
+#undef BT_CHILDREN
 
 void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms_bvh_shallow *sh, ms_raster_fn raster,
                              float near, float far, uint64_t *cnt, int flags)
@@ -757,6 +797,10 @@ void MS_KFN(ms_block_raster)(const ms_block_input *in, const ms_bvh *b, const ms
     }
     MS_KFN(br_traverse)(&s, sh, flags & MS_BR_ORDER);
     if (ca) {
+        /* The next block's choice of the node coverage test, with hysteresis (runs of penumbra blocks). */
+        ca->node_cover = (uint64_t)ca->cover_culled * BR_NODE_COVER_DEN >
+                         (uint64_t)ca->cover_tested * (ca->node_cover ? BR_NODE_COVER_KEEP : BR_NODE_COVER_ON);
+        ca->cover_tested = ca->cover_culled = 0;
         for (int i = 0; i < ca->n; i++) ca->pre_bits[ca->node[i] >> 6] = 0;
         ca->n = ca->n_next;
         memcpy(ca->node, ca->next_node, sizeof ca->node);

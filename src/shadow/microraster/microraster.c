@@ -57,7 +57,7 @@ typedef struct mr_state {
 static const char *const block_counter_names[] = {
     "blocks", "aabb_tests", "leaves", "tris_accessed", "blocks_early_out", "leaf_pixels_culled", "tri_pixel_tests",
     "culled_depth", "culled_rect", "culled_corner_rays", "culled_coverage", "triangles_rasterized",
-    "pixels_early_out", "rect_shrinks", "shared_setups", "shared_setups_clipped", "pixels_traced_edge_on", "interior_rasterized", "interior_pixels_emptied",
+    "pixels_early_out", "rect_shrinks", "shared_setups", "shared_setups_clipped", "node_pixels_culled", "pixels_traced_edge_on", "interior_rasterized", "interior_pixels_emptied",
     "pixels_lit", "pixels_umbra", "pixels_penumbra", "pixels_facing_away", "tests_lit", "tests_umbra", "tests_penumbra",
     "rasterized_lit", "rasterized_umbra", "rasterized_penumbra", "lit_ns", "umbra_ns", "penumbra_ns"
 };
