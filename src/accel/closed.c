@@ -22,8 +22,6 @@ static size_t table_size(size_t n)
     return m;
 }
 
-
-
 /* Numbers the sets of the union-find `parent` over n triangles into label (0, 1, ... in order of their
  * smallest member), a set with any flagged triangle MS_OPEN_COMPONENT; returns the number of sets kept.
  * flag is overwritten (a set's flag gathers at its root). */

@@ -729,7 +729,6 @@ static inline unsigned MS_KFN(br_node_lanes)(const br_state *s, const ms_bvh_nod
         tests += 2; \
         (ml) = MS_KFN(br_node_lanes)(s, &(c)[0], ml); \
         (mr) = MS_KFN(br_node_lanes)(s, &(c)[1], mr); \
-        if (!(ml) || !(mr)) (right_first) = 0; \
     } while (0)
 #include "block_traverse_loop.h"
 #undef BT_STATE
