@@ -34,10 +34,9 @@
 #define MS_BR_COMMON
 /* A leaf's triangles that are some pixel's own (never occluding): few, usually none. */
 #define BR_MAX_SKIP MS_BLOCK_LANES
-/* The coverage test at the nodes just above the leaves (br_node_lanes) pays where it culls: a block takes it
- * when more than 2 in 10 of the previous block's coverage tests culled, and keeps it while more than 1 in 10
- * do (on the scanned statues and game models a penumbra block's tests cull about half, on the bars and
- * foliage almost none; at every inner node, or always, it cost more than it saved on those). */
+/* The coverage test at the nodes just above the leaves (br_node_lanes) pays only where it culls: a block takes
+ * it when more than 2 in 10 of the previous block's coverage tests culled, and keeps it while more than 1 in 10
+ * do (a penumbra block behind a scanned statue culls often; one behind thin bars or foliage almost never). */
 #define BR_NODE_COVER_ON 2
 #define BR_NODE_COVER_KEEP 1
 #define BR_NODE_COVER_DEN 10
