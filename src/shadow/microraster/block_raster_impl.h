@@ -77,10 +77,10 @@ typedef struct br_state {
 #else
 #define BR_PACK 0
 #endif
-/* Pixel layout only: the smallest number of a block's pixels that rasterize one triangle for which its
- * set-up is computed for them together (br_scan_setup) rather than by the kernel pixel by pixel: below it
- * the shared set-up's fixed cost outweighs the kernel calls it replaces. The packed layout sets up every
- * pair that passed the tests. */
+/* The smallest number of lanes (the pixel layout: a block's pixels that rasterize one triangle; the packed
+ * layout: a vector's pairs that pass the tests before coverage) for which the Scanline set-up is computed for
+ * them together (br_scan_setup) rather than by the kernel pair by pair: below it the shared set-up's fixed
+ * cost, the same for one lane as for sixteen, outweighs the kernel calls it replaces. */
 #define BR_LANE_SETUP_MIN 4
 
 /* The four corner directions of lane rectangle r (columns r[0]..r[1], rows r[2]..r[3]) from C: sample
@@ -350,8 +350,9 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
     su.rows = su.clip = su.kernel = 0;
 #if BR_PACK
     /* The Scanline set-up of every pair that passed, in one pass (the coverage test below may still drop
-     * a few: cheaper than a second pass over the ones that remain). */
-    if (s->rows) {
+     * a few: cheaper than a second pass over the ones that remain), when enough passed. */
+    const int shared = s->rows && ms_bt_popcount16(pass) >= BR_LANE_SETUP_MIN;
+    if (shared) {
         l16 mt[3][3];
         for (int r = 0; r < 3; r++)
             for (int a = 0; a < 3; a++) mt[r][a] = BR_PIX(L->mt[r][a]);
@@ -370,7 +371,7 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
         if (in->lane_rast) in->lane_rast[l]++;
         /* An alpha-tested triangle clears only its opaque samples (alpha.h): ms_alpha_raster's, per pixel;
          * a lane the set-up left to the kernel likewise. */
-        if (s->rows && !(su.kernel >> e & 1) && !ms_frame_alpha_tested(in->frame[l], t)) {
+        if (shared && !(su.kernel >> e & 1) && !ms_frame_alpha_tested(in->frame[l], t)) {
             if (su.rows >> e & 1) MS_KFN(br_rows)(s, &su, e, in->buf[l], L);
             continue;   /* else the set-up found nothing to clear, as the kernel would */
         }
