@@ -2,6 +2,7 @@
  * the rectangle of what is left, how many are left, whether any is left in a box of samples. Instantiated per
  * k with the includer (core/perk_each.h: MS_K, MS_WORD) for each ISA; no include guard for that reason. Every
  * instance returns the same answer as the portable loop it replaces. */
+
 /* The rectangle of the visible samples of a buffer within rows j0..j1 (the others known empty):
  * columns r[0]..r[1], rows r[2]..r[3]; 0 if none. */
 static inline int MS_KFN(br_live_rect)(const MS_WORD *buf, int j0, int j1, int r[4])
