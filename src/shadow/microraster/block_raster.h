@@ -20,10 +20,9 @@
  * the union of what its triangles clear, in any order, and every leaf is still processed once. What it
  * buys is order: the near-first traversal meets the big occluders late where they are near the light
  * (the big-light Sponza's shaft), and until then the rectangle and coverage tests have little to cull.
- * 128 leaves: a penumbra block behind a dense statue clears samples with well over a hundred leaves, and the
- * more of them come first, the more the later ones are culled; fewer cut fewer tests, and beyond that the
- * bookkeeping costs what it saves (figures in the lab notebook: 2026-11-26-block-traversal-row-scans-and-order.md,
- * 2026-11-30-ground-penumbra.md). */
+ * 128 leaves: with the coverage tests at the leaves and above them, every sample cleared early culls more, and
+ * the gain grew up to 128 leaves; beyond that the bookkeeping costs what it saves (figures in the lab notebook:
+ * 2026-11-26-block-traversal-row-scans-and-order.md, 2026-11-30-ground-penumbra.md). */
 #define MS_BLOCK_CACHE 128
 typedef struct ms_block_leaf_cache {
     int n;                              /* the leaves to process first (shallow node indices), best first */
