@@ -1,9 +1,11 @@
 #!/usr/bin/python3
 """Generates the dense-mesh benchmark scenes (issue 29): public scanned statues and a game model on a
 ground plane, a GRIDS-like scene of thin bars (after the hierarchical penumbra casting paper's GRIDS) and
-a 72K-triangle foliage scene, each as OUT/NAME/NAME.json with its meshes beside it.
+a 72K-triangle foliage scene, each as OUT/NAME/NAME.json with its meshes beside it; and an architectural
+interior with a big light (Dabrovic's Sponza from the shared scenes, --shared DIR, default ../shared/scenes
+beside the repository, referred to in place).
 
-    scripts/make_dense_scenes.py OUT [--assets DIR]
+    scripts/make_dense_scenes.py OUT [--assets DIR] [--shared DIR]
 
 The meshes are not part of the repository: DIR holds them as fetched from public repositories: the collection
 of common 3D test models (github alecjacobson/common-3d-test-models, data/): nefertiti.obj, ogre.obj,
@@ -21,6 +23,8 @@ import struct
 import sys
 
 import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 # name: (file, up axis of the file (0 x, 1 y, 2 z), sign of up, what it is)
 ASSETS = {
@@ -255,6 +259,25 @@ def make_foliage(out, triangles=72000):
     print("foliage: %d procedural triangles" % triangles)
 
 
+def make_interior(out, shared):
+    """An architectural interior with a big light: Dabrovic's Sponza (66K triangles) from the shared scenes
+    with the scene file's own big-light set-up (a 6 x 6 light under the roof: nearly every visible pixel in
+    penumbra). The mesh is referred to where it lies, not copied."""
+    src = os.path.join(shared, "dabrovic-sponza", "dabrovic-sponza-biglight.json")
+    if not os.path.exists(src):
+        print("interior: %s not found, skipped" % src)
+        return
+    with open(src) as f:
+        s = json.load(f)
+    for m in s["meshes"]:
+        m["file"] = os.path.abspath(os.path.join(os.path.dirname(src), m["file"]))
+    d = os.path.join(out, "sponza-biglight")
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, "sponza-biglight.json"), "w") as f:
+        json.dump(s, f, indent=1)
+    print("interior: Dabrovic's Sponza with its big light (%s)" % os.path.normpath(src))
+
+
 def main(argv):
     if len(argv) < 2 or argv[1].startswith("-"):
         print(__doc__)
@@ -265,6 +288,7 @@ def main(argv):
         make_asset(out, assets, name)
     make_grids(out)
     make_foliage(out)
+    make_interior(out, argv[argv.index("--shared") + 1] if "--shared" in argv else os.path.join(ROOT, "..", "shared", "scenes"))
     return 0
 
 
