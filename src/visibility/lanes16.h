@@ -39,7 +39,6 @@ typedef __m512i l16i;
 L16_INLINE l16i l16i_load(const int32_t *p) { return _mm512_loadu_si512((const void *)p); }
 L16_INLINE l16 l16_perm(l16 a, l16i p) { return _mm512_permutexvar_ps(p, a); }
 /* Lane i = base[p[i]]. */
-L16_INLINE l16 l16_gather(const float *base, l16i p) { return _mm512_i32gather_ps(p, base, 4); }
 /* Sixteen 64-bit words, one per lane (bit sets, e.g. 16 receivers' open samples of one mask word): which lanes
  * have bit b, and bit b cleared on lanes m. */
 typedef struct l16w { __m512i lo, hi; } l16w;
@@ -115,7 +114,6 @@ L16_INLINE l16 l16_perm(l16 a, l16i p)
     return (l16){ _mm256_blendv_ps(_mm256_permutevar8x32_ps(a.lo, p.lo), _mm256_permutevar8x32_ps(a.hi, p.lo), p.up_lo),
                   _mm256_blendv_ps(_mm256_permutevar8x32_ps(a.lo, p.hi), _mm256_permutevar8x32_ps(a.hi, p.hi), p.up_hi) };
 }
-L16_INLINE l16 l16_gather(const float *base, l16i p) { return (l16){ _mm256_i32gather_ps(base, p.lo, 4), _mm256_i32gather_ps(base, p.hi, 4) }; }
 #else
 #include <math.h>
 typedef struct l16 { float v[16]; } l16;
@@ -173,7 +171,6 @@ L16_INLINE l16 l16_select(unsigned m, l16 a, l16 b)
 typedef struct l16i { int32_t v[16]; } l16i;
 L16_INLINE l16i l16i_load(const int32_t *p) { l16i r; for (int i = 0; i < 16; i++) r.v[i] = p[i]; return r; }
 L16_INLINE l16 l16_perm(l16 a, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = a.v[p.v[i] & 15]; return r; }
-L16_INLINE l16 l16_gather(const float *base, l16i p) { l16 r; for (int i = 0; i < 16; i++) r.v[i] = base[p.v[i]]; return r; }
 #endif
 
 #if !defined(MS_TARGET_AVX512)

@@ -83,6 +83,36 @@ typedef struct br_state {
  * cost, the same for one lane as for sixteen, outweighs the kernel calls it replaces. */
 #define BR_LANE_SETUP_MIN 4
 
+#if BR_PACK
+/* A leaf group's vertices, lane = triangle (the packed layout's L->tv): the nt triangles (9 floats each) read
+ * as nine contiguous vectors and transposed by permutations; lanes from nt on are left as they fall (no pair
+ * refers to them). Nine gathers did the same slower: a gather loads lane by lane. Float q of triangle j is
+ * element 9j + q of the 144, in register (9j + q) >> 4; br_tv_from[q][p - 1] holds the lanes j whose element
+ * lies in registers 2p and 2p + 1 (p = 1..3) or in register 8 (p = 4), register pair 0 and 1 the rest. */
+static const uint16_t br_tv_from[9][4] = {
+    {0x00f0, 0x0700, 0x7800, 0x8000}, {0x0070, 0x0780, 0x7800, 0x8000}, {0x0070, 0x0780, 0x3800, 0xc000},
+    {0x0070, 0x0780, 0x3800, 0xc000}, {0x0070, 0x0780, 0x3800, 0xc000}, {0x0078, 0x0780, 0x3800, 0xc000},
+    {0x0078, 0x0380, 0x3c00, 0xc000}, {0x0078, 0x0380, 0x3c00, 0xc000}, {0x0078, 0x0380, 0x3c00, 0xc000}};
+
+static inline void br_group_vertices(const float *tri, int nt, l16 tv[9])
+{
+    __m512 r[9];
+    for (int i = 0; i < 9; i++) {   /* masked: nothing past the group's last float is read */
+        const int left = 9 * nt - 16 * i;
+        r[i] = _mm512_maskz_loadu_ps((__mmask16)(left >= 16 ? 0xFFFFu : left <= 0 ? 0u : (1u << left) - 1u), tri + 16 * i);
+    }
+    const __m512i idx0 = _mm512_setr_epi32(0, 9, 18, 27, 36, 45, 54, 63, 72, 81, 90, 99, 108, 117, 126, 135);
+    for (int q = 0; q < 9; q++) {
+        const __m512i idx = _mm512_add_epi32(idx0, _mm512_set1_epi32(q));
+        __m512 o = _mm512_permutex2var_ps(r[0], idx, r[1]);
+        o = _mm512_mask_mov_ps(o, br_tv_from[q][0], _mm512_permutex2var_ps(r[2], idx, r[3]));
+        o = _mm512_mask_mov_ps(o, br_tv_from[q][1], _mm512_permutex2var_ps(r[4], idx, r[5]));
+        o = _mm512_mask_mov_ps(o, br_tv_from[q][2], _mm512_permutex2var_ps(r[6], idx, r[7]));
+        tv[q] = _mm512_mask_mov_ps(o, br_tv_from[q][3], _mm512_permutexvar_ps(idx, r[8]));
+    }
+}
+#endif
+
 /* The four corner directions of lane rectangle r (columns r[0]..r[1], rows r[2]..r[3]) from C: sample
  * (i, j) is C + mt[2] + i mt[0] + j mt[1] (raster.h). */
 static inline void br_corner_dirs(const ms_raster_frame *f, const int r[4], float d[4][3])
@@ -475,12 +505,7 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
         const int nt = end - g < MS_BLOCK_LANES ? (int)(end - g) : MS_BLOCK_LANES;
         L.first = g;
 #if BR_PACK
-        /* The group's vertices, lane = triangle (lanes past the group repeat its first). */
-        int32_t off[MS_BLOCK_LANES];
-        for (int j = 0; j < MS_BLOCK_LANES; j++) off[j] = 9 * (j < nt ? j : 0);
-        const l16i O = l16i_load(off);
-        const float *tri0 = s->b->tri + 9 * (size_t)g;
-        for (int q = 0; q < 9; q++) L.tv[q] = l16_gather(tri0 + q, O);
+        br_group_vertices(s->b->tri + 9 * (size_t)g, nt, L.tv);
 #endif
 #if BR_PACK
         /* All the group's pairs first, then sixteen at a time: the index vectors are then loaded from
