@@ -38,7 +38,6 @@ L16_INLINE l16 l16_select(unsigned m, l16 a, l16 b) { return _mm512_mask_blend_p
 typedef __m512i l16i;
 L16_INLINE l16i l16i_load(const int32_t *p) { return _mm512_loadu_si512((const void *)p); }
 L16_INLINE l16 l16_perm(l16 a, l16i p) { return _mm512_permutexvar_ps(p, a); }
-/* Lane i = base[p[i]]. */
 /* Sixteen 64-bit words, one per lane (bit sets, e.g. 16 receivers' open samples of one mask word): which lanes
  * have bit b, and bit b cleared on lanes m. */
 typedef struct l16w { __m512i lo, hi; } l16w;

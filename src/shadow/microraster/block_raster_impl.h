@@ -506,8 +506,6 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
         L.first = g;
 #if BR_PACK
         br_group_vertices(s->b->tri + 9 * (size_t)g, nt, L.tv);
-#endif
-#if BR_PACK
         /* All the group's pairs first, then sixteen at a time: the index vectors are then loaded from
          * stores long done (loaded right after sixteen scalar stores, they waited on store forwarding). */
         int32_t pt[MS_BLOCK_LANES * MS_BLOCK_LANES + MS_BLOCK_LANES], pl[MS_BLOCK_LANES * MS_BLOCK_LANES + MS_BLOCK_LANES];
