@@ -573,7 +573,8 @@ static void test_interior_frames(void **st)
         if (light == 0) {
             assert_true(s_int.interior_boxes > 0);
             assert_true(tu_stat_counter(&s_int, "interior_rasterized") > 0);
-            assert_int_equal(s_mft.interior_boxes, s_int.interior_boxes);
+            /* mft takes them as triangles, on the coarser grid (occluders.h, ms_interior_res) */
+            assert_true(s_mft.interior_boxes > 0 && s_mft.interior_boxes <= s_int.interior_boxes);
             /* the pass ran: the blocks of the boxes' pass come before those of the triangles' */
             assert_true(tu_stat_counter(&s_mft, "blocks") > tu_stat_counter(&s_mft_no, "blocks"));
         } else {

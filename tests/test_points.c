@@ -504,7 +504,7 @@ static void ball_scene(ms_scene *sc)
 }
 
 /* mft leaves the interior boxes to the driver (MS_OCC_INTERIOR_PASS): the points API runs them first as frames
- * do, with the frame's V, S and front on its hit points bit for bit, the same boxes and as many traversals. */
+ * do, with the frame's V, S and front on its hit points bit for bit, and as many traversals. */
 static void test_interior_pass(void **st)
 {
     (void)st;
@@ -548,8 +548,10 @@ static void test_interior_pass(void **st)
     assert_true(blocks * 10 >= frame_blocks * 8);
     assert_true(shadowed > 100);
     assert_int_equal(differ, 0);
-    assert_true(stats.interior_boxes > 0);
-    assert_int_equal(stats.interior_boxes, fr.stats.interior_boxes);
+    /* The accel finds its boxes once for every method, on the silhouette grid; mft's frame on its own, coarser one
+     * (occluders.h, ms_interior_res): more boxes here, the same V. */
+    assert_true(fr.stats.interior_boxes > 0);
+    assert_true(stats.interior_boxes >= fr.stats.interior_boxes);
     ms_frame_free(&fr);
     free(v);
     free(s);

@@ -116,8 +116,11 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
     for (int a = 0; a < 3; a++) ext = fmax(ext, (double)cbox[3 + a] - cbox[a]);
     if (!(ext > 0.0) || res < 3) return 0;
     grid g;
+    /* Cells no wider than four clearances would leave little or nothing unmarked: a coarser grid, by halves,
+     * down to 16 cells (a far light's clearance is large beside a small cycle). */
+    while (!(ext / res > 4.0 * eps) && res >= 32) res /= 2;
     g.h = ext / res;
-    if (!(g.h > 4.0 * eps)) return 0;   /* cells no wider than the clearance: nothing would be left */
+    if (!(g.h > 4.0 * eps)) return 0;   /* still: nothing would be left */
     int dim[3];
     for (int a = 0; a < 3; a++) {
         dim[a] = (int)ceil(((double)cbox[3 + a] - cbox[a]) / g.h) + 3;   /* one border cell each side, one spare */
@@ -161,11 +164,14 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
         groups++;
     }
     free(stack);
-    /* Greedy boxes over the inside cells: along x, then whole rows along y, then whole slabs along z. */
+    /* Greedy boxes over the inside cells: along x, then whole rows along y, then whole slabs along z; at most
+     * (one per MS_INTERIOR_TRIS_PER_BOX triangles of the cycle, and one: a fragmented inside would otherwise give up to a box
+     * per cell; the cells left are simply not boxed). */
     int rc = 0;
-    for (int z = 0; z < g.nz && !rc; z++)
-        for (int y = 0; y < g.ny && !rc; y++)
-            for (int x = 0; x < g.nx && !rc; x++) {
+    const size_t limit = out->n_boxes + n / MS_INTERIOR_TRIS_PER_BOX + 1;
+    for (int z = 0; z < g.nz && !rc && out->n_boxes < limit; z++)
+        for (int y = 0; y < g.ny && !rc && out->n_boxes < limit; y++)
+            for (int x = 0; x < g.nx && !rc && out->n_boxes < limit; x++) {
                 if (g.cell[gidx(&g, x, y, z)] != CELL_INSIDE) continue;
                 int x1 = x, y1 = y, z1 = z;
                 while (x1 + 1 < g.nx && g.cell[gidx(&g, x1 + 1, y, z)] == CELL_INSIDE) x1++;

@@ -27,6 +27,9 @@
 #include <stdint.h>
 #include "closed.h"
 
+/* At most one box per this many triangles of a cycle, and one more (the memory budget counts them so). */
+#define MS_INTERIOR_TRIS_PER_BOX 64
+
 typedef struct ms_interior {
     size_t n_boxes;
     float (*box)[6];        /* min x, y, z, max x, y, z: every point at least eps (L-infinity) from the
@@ -35,7 +38,8 @@ typedef struct ms_interior {
 } ms_interior;
 
 /* The interior boxes of every cycle of the n triangles tri (9 floats each) with at least min_tris
- * triangles, on a grid of `res` cells along each cycle's longest side; eps: the clearance from the
+ * triangles, on a grid of `res` cells along each cycle's longest side (halved, down to 16, while a cell is no
+ * wider than four clearances); eps: the clearance from the
  * surface, in world units; threads: OpenMP threads of the parity rays. Work O(n + res^3 + groups * n), memory O(res^3). 0, or -1 when out
  * of memory (out zeroed). */
 int ms_interior_find(const float *tri, size_t n, const ms_closed *c, int res, size_t min_tris, double eps,

@@ -5,6 +5,7 @@
 #include "primary/primary.h"
 #include "shade.h"
 #include "visibility/context.h"
+#include "visibility/occluders.h"   /* MS_INTERIOR_RES_SILHOUETTE, MS_INTERIOR_TRIS_PER_BOX */
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -40,14 +41,21 @@
 /* Closed components (accel/closed.c, ms_closed_find) while they are found: the weld's hash table of a power
  * of two >= 6n vertex slots (4 bytes), corner ids 12, the directed edges grouped by first vertex (offsets at
  * most 12, targets 12, triangles 12), unions 8, flags 2, components and cycles 8 per triangle (kept while
- * the lights' occluders are built). The interior boxes' grid (accel/interior.c: 35^3 cells of 9 bytes at
- * most per cycle, one at a time) is in FIXED. */
+ * the lights' occluders are built), and the interior boxes' grid (accel/interior.c: (MS_INTERIOR_RES_SILHOUETTE + 4)^3 at most
+ * cells of 9 bytes at most per cycle, one at a time). */
 static uint64_t closed_find_bytes(uint64_t n)
 {
     uint64_t m = 16;
     while (m < 6 * n) m <<= 1;
-    return m * 4u + n * (12u + 36u + 8u + 2u + 8u);
+    const uint64_t side = MS_INTERIOR_RES_SILHOUETTE + 4u;   /* res cells, a border each side, a spare, rounding */
+    return m * 4u + n * (12u + 36u + 8u + 2u + 8u) + side * side * side * 9u;
 }
+/* A light's interior boxes (visibility/occluders.c, interior_build): at most one per MS_INTERIOR_TRIS_PER_BOX
+ * triangles of a cycle and one more, whose MS_INTERIOR_MIN_TRIS triangles or more bound the extra one
+ * (accel/interior.c); per box twelve face triangles and the box as one prim in two BVHs, built or building
+ * (the build's per-triangle bytes bound both), their shallow views, the box (24) and the faces' copy (432). */
+#define INTERIOR_PER_BOX (13u * (BVH_BUILD_PER_TRI + SHALLOW_PER_TRI) + 24u + 432u)
+#define INTERIOR_PER_TRI (INTERIOR_PER_BOX / MS_INTERIOR_TRIS_PER_BOX + INTERIOR_PER_BOX / MS_INTERIOR_MIN_TRIS + 1u)
 /* A light's occluders (visibility/occluders.c): a BVH over the kept triangles (at most all), the map from
  * the scene's prims (4) and the merged-face flags (1); while one is built, the kept triangles, sources,
  * map, flags and alpha leaf map (49), the merged copy with its maps and flags (45), and the build's
@@ -166,6 +174,7 @@ uint64_t ms_frame_need(const ms_frame_shape *s, ms_need *need)
     /* The lights' occluders stay; the closed components' search, or the last light's build, come on top. */
     if (s->bvh && s->occluders) {
         ms_need_add(need, "per-light occluder BVHs", mul(mul(n, OCCLUDERS_PER_TRI), s->nl));
+        ms_need_add(need, "per-light interior boxes", mul(mul(n, INTERIOR_PER_TRI), s->nl));
         /* the sets exact per axis: at most one per axis, each at most every triangle */
         if (s->exact_sets) ms_need_add(need, "per-light occluder sets exact per axis", mul(mul(n, 3u * OCCLUDERS_PER_TRI), s->nl));
         const uint64_t find = closed_find_bytes(n), build_occ = mul(n, 8u + OCCLUDERS_BUILD_PER_TRI);
@@ -338,9 +347,9 @@ uint64_t ms_points_need(size_t n, size_t n_tris, int whole_tri_copy, int mask_wo
 
 uint64_t ms_culled_sets_need(size_t n_tris, size_t held, int build)
 {
-    /* Each held set: a BVH over at most every triangle with its map; a build on top: the scene-order copy it
+    /* Each held set: a BVH over at most every triangle with its map, and its interior boxes; a build on top: the scene-order copy it
      * culls from and the build's temporaries. */
-    return mul(mul(n_tris, OCCLUDERS_PER_TRI), held + (build ? 1u : 0u))
+    return mul(mul(n_tris, OCCLUDERS_PER_TRI + INTERIOR_PER_TRI), held + (build ? 1u : 0u))
            + (build ? mul(n_tris, OCCLUDERS_BUILD_PER_TRI + TRI_BYTES) : 0);
 }
 

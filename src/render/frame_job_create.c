@@ -64,8 +64,10 @@ static int occluder_what(const ms_shadow_method *sm, const ms_render_options *op
 {
     const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
                      (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
-    return sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~(MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS) : ~0) &
-           (opt->no_merge ? ~MS_OCC_MERGE : ~0);
+    /* The per-pixel traversal rasterizes the boxes as triangles (microraster.c). */
+    return sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) &
+           (opt->no_interior ? ~(MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS | MS_OCC_INTERIOR_SILHOUETTE) : ~0) &
+           (opt->traversal == MS_TRAVERSAL_PIXEL ? ~MS_OCC_INTERIOR_SILHOUETTE : ~0) & (opt->no_merge ? ~MS_OCC_MERGE : ~0);
 }
 
 /* Every light's occluders (occluders.h) with what the method takes and the options allow: the scene's
@@ -80,7 +82,7 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
     if (closed.n_cycles || (what & MS_OCC_MERGE)) {
         const double eps = ms_interior_clearance(&j->bvh, j->lights, j->nlights);
         if ((what & MS_OCC_INTERIOR) && closed.n_cycles)
-            rc = ms_interior_find(j->scene->tri, j->scene->n_tris, &closed, MS_INTERIOR_RES, MS_INTERIOR_MIN_TRIS, eps, j->threads, &interior);
+            rc = ms_interior_find(j->scene->tri, j->scene->n_tris, &closed, ms_interior_res(what), MS_INTERIOR_MIN_TRIS, eps, j->threads, &interior);
         j->occ = rc ? NULL : calloc(j->nlights, sizeof *j->occ);
         rc = j->occ ? 0 : -1;
         for (size_t l = 0; l < j->nlights && !rc; l++) {

@@ -122,7 +122,7 @@ ms_status ms_accel_build_abi(const ms_abi *abi, const ms_scene *scene, int threa
     for (size_t l = 0; l < nl; l++) ms_light_sun_place(&a->lights[l], sbox);   /* the interior clearance's lights */
     a->view.light = a->lights[0];
     if (scene->n_tris && (ms_closed_find(scene->tri, scene->n_tris, &a->closed) ||
-                          ms_interior_find(scene->tri, scene->n_tris, &a->closed, MS_INTERIOR_RES, MS_INTERIOR_MIN_TRIS,
+                          ms_interior_find(scene->tri, scene->n_tris, &a->closed, MS_INTERIOR_RES_SILHOUETTE, MS_INTERIOR_MIN_TRIS,
                                            a->interior_eps = ms_interior_clearance(&a->bvh, a->lights, a->n_lights),
                                            a->threads, &a->interior))) {
         ms_accel_free(a);

@@ -48,6 +48,10 @@ typedef struct ms_render_ctx {
     /* The light's interior boxes (occluders.h, accel/interior.h) as triangles, NULL: none. Every segment
      * one of them meets is occluded; the micro-rasterization methods rasterize them first. */
     const ms_bvh *interior;
+    /* The same boxes whole (with interior): a BVH with one prim per box, and per prim (its leaf order) the box,
+     * min x, y, z, max x, y, z. */
+    const ms_bvh *interior_box_bvh;
+    const float (*interior_box)[6];
     int consistent_primary;            /* bvh primary: the 3D edge-function test (edge3d.h) in its leaves */
     /* 1: light is a shape with an outline (light_shape.h: the sun, the sphere) and each query's own light is
      * its outline seen from the query's point (ms_ctx_for_query). Set by the drivers only for a method that
@@ -80,6 +84,8 @@ static inline void ms_ctx_interior_pass(const ms_render_ctx *c, ms_render_ctx *o
     *out = *c;
     out->bvh = c->interior;
     out->interior = NULL;
+    out->interior_box_bvh = NULL;
+    out->interior_box = NULL;
     out->alpha = NULL;
     out->prim_map = NULL;
     out->prim_merged = NULL;

@@ -47,7 +47,11 @@ void ms_occluders_ctx(const ms_occluders *o, ms_render_ctx *c)
         c->prim_map = o->prim_map;
         c->prim_merged = o->prim_merged;
     }
-    if (o->interior.n_tris) c->interior = &o->interior;
+    if (o->interior.n_tris) {
+        c->interior = &o->interior;
+        c->interior_box_bvh = &o->interior_box_bvh;
+        c->interior_box = (const float (*)[6])o->interior_box;
+    }
 }
 
 void ms_occluders_free(ms_occluders *o)
@@ -59,6 +63,8 @@ void ms_occluders_free(ms_occluders *o)
     free(o->prim_map);
     free(o->prim_merged);
     ms_bvh_free(&o->interior);
+    ms_bvh_free(&o->interior_box_bvh);
+    free(o->interior_box);
     memset(o, 0, sizeof *o);
 }
 
@@ -113,7 +119,9 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
                           const float lbox[6], double margin, uint8_t *boxed, int threads)
 {
     float *tri = malloc((in->n_boxes ? in->n_boxes : 1) * 12 * 9 * sizeof *tri);
-    if (!tri) return -1;
+    float *btri = malloc((in->n_boxes ? in->n_boxes : 1) * 9 * sizeof *btri);
+    float (*kept)[6] = malloc((in->n_boxes ? in->n_boxes : 1) * sizeof *kept);
+    if (!tri || !btri || !kept) { free(tri); free(btri); free(kept); return -1; }
     size_t nb = 0, nt = 0;
     for (size_t i = 0; i < in->n_boxes; i++) {
         const uint32_t k = in->component[i];
@@ -125,6 +133,10 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
         if (!sep) continue;
         boxed[k] = 1;
         const float *b = in->box[i];
+        /* The whole box as one prim: a triangle from its low corner to its high one has the box as its bounds. */
+        memcpy(kept[nb], b, sizeof kept[nb]);
+        for (int a = 0; a < 3; a++) btri[9 * nb + a] = btri[9 * nb + 6 + a] = b[a];
+        for (int a = 0; a < 3; a++) btri[9 * nb + 3 + a] = b[3 + a];
         float v[8][3];
         for (int c = 0; c < 8; c++)
             for (int a = 0; a < 3; a++) v[c][a] = b[(c >> a & 1) ? 3 + a : a];
@@ -150,8 +162,14 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
     if (nt) {
         rc = ms_bvh_build(&o->interior, tri, nt, threads);
         o->interior_boxes = nb;
+        if (!rc) rc = ms_bvh_build(&o->interior_box_bvh, btri, nb, threads);
+        if (!rc && !(o->interior_box = malloc(nb * sizeof *o->interior_box))) rc = -1;
+        for (uint32_t i = 0; !rc && i < o->interior_box_bvh.n_tris; i++)
+            memcpy(o->interior_box[i], kept[o->interior_box_bvh.tri_source[i]], sizeof kept[0]);
     }
     free(tri);
+    free(btri);
+    free(kept);
     return rc;
 }
 

@@ -44,22 +44,36 @@ typedef struct ms_occluders {
                                  * own triangles serve them. Its receivers on merged faces are in prim_merged */
     int active;                 /* 0: nothing culled, use the scene's BVH (the fields above empty) */
     ms_bvh interior;            /* the interior boxes' triangles (n_tris 0: none) */
+    ms_bvh interior_box_bvh;    /* the same boxes whole, one prim each (a triangle from corner to corner) */
+    float (*interior_box)[6];   /* per prim of interior_box_bvh (its leaf order): the box */
     size_t interior_boxes;
 } ms_occluders;
 
 /* Interior boxes (accel/interior.h): grid cells along a component's longest side, and the smallest
- * component that gets them (a few boxes cannot pay for a few triangles). */
+ * component that gets them (a few boxes cannot pay for a few triangles). A method that rasterizes each box
+ * whole (MS_OCC_INTERIOR_SILHOUETTE) pays one row loop per box and pixel, so more, smaller boxes inside the
+ * surface pay there; as up to twelve triangles each they do not. */
 #define MS_INTERIOR_RES 32
+#define MS_INTERIOR_RES_SILHOUETTE 64
 #define MS_INTERIOR_MIN_TRIS 256
 
-/* What a light's occluders are built with (ms_shadow_method.occluders). MS_OCC_INTERIOR_PASS (with
+/* What a light's occluders are built with (ms_shadow_method.occluders). MS_OCC_INTERIOR_SILHOUETTE (with
+ * MS_OCC_INTERIOR): the method rasterizes the boxes whole, as their silhouettes (the block traversal with the
+ * SIMD Scanline kernel, shadow/microraster/block_box_impl.h), so the boxes are found on the finer grid.
+ * MS_OCC_INTERIOR_PASS (with
  * MS_OCC_INTERIOR): a method that does not rasterize the interior boxes itself is run by the frame's driver
  * over them first (a second state whose BVH is the boxes' triangles), then over the scene's triangles with
  * the samples the boxes left (frame_job.c).
  * MS_OCC_MERGE_EXACT (with MS_OCC_MERGE): the method must answer as raytrace does (mft, hpc), so the driver
  * gives each sample to the set exact for its segment's shear axis (for_axis; frame_job.c, shadow_frame.c). */
 enum { MS_OCC_CULL = 1, MS_OCC_INTERIOR = 2, MS_OCC_CULL_BY_DEFAULT = 4, MS_OCC_MERGE = 8, MS_OCC_INTERIOR_PASS = 16,
-       MS_OCC_MERGE_EXACT = 32 };
+       MS_OCC_MERGE_EXACT = 32, MS_OCC_INTERIOR_SILHOUETTE = 64 };
+
+/* The interior boxes' grid for occluders built with `what` (MS_OCC_*). */
+static inline int ms_interior_res(int what)
+{
+    return (what & MS_OCC_INTERIOR_SILHOUETTE) ? MS_INTERIOR_RES_SILHOUETTE : MS_INTERIOR_RES;
+}
 
 /* The occluders of light l (every shape: its hull is its parallelogram, or a sphere's box) for the scene
  * whose BVH is `scene_bvh` and closed components `closed` (found over scene->tri), with alpha-tested

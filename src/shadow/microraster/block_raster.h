@@ -47,6 +47,10 @@ typedef struct ms_block_input {
     void *buf[MS_BLOCK_LANES];
     uint32_t skip[MS_BLOCK_LANES];
     ms_block_leaf_cache *cache;   /* NULL: none */
+    /* The interior boxes' pass with silhouettes (block_box_impl.h): per prim of the BVH passed (its leaf order),
+     * the box it stands for (min x, y, z, max x, y, z); the kernel's row loop for five edges must exist (the
+     * SIMD Scanline). NULL: the BVH's triangles. */
+    const float (*box)[6];
     /* Per lane, added to (NULL: not counted): the (triangle, pixel) pairs that reached the leaf tests and the
      * triangles rasterized, for the cost of each pixel class (microraster.c). */
     uint32_t *lane_tests, *lane_rast;

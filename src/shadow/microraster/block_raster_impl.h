@@ -451,6 +451,8 @@ static inline void MS_KFN(br_pairs)(const br_state *s, br_leaf_ctx *L, const int
 #undef BR_TRI
 }
 
+#include "block_box_impl.h"   /* br_box: the interior boxes' pass */
+
 static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, int pre)
 {
     if (!pre && s->n_pre) {
@@ -501,7 +503,12 @@ static void MS_KFN(br_leaf)(br_state *s, const ms_bvh_node *n, unsigned mask, in
     const int n_live = ms_bt_popcount16(live);
 #endif
     const uint32_t end = n->first + n->count;
-    for (uint32_t g = n->first; g < end; g += MS_BLOCK_LANES) {
+    if (in->box) {   /* the interior boxes' pass: one silhouette per box and pixel */
+        for (uint32_t j = n->first; j < end; j++) MS_KFN(br_box)(s, &L, in->box[j], live);
+        tri_lanes = (uint64_t)n->count * (uint64_t)ms_bt_popcount16(live);
+        for (unsigned p = in->lane_tests ? live : 0; p; p &= p - 1) in->lane_tests[__builtin_ctz(p)] += n->count;
+    }
+    for (uint32_t g = in->box ? end : n->first; g < end; g += MS_BLOCK_LANES) {
         const int nt = end - g < MS_BLOCK_LANES ? (int)(end - g) : MS_BLOCK_LANES;
         L.first = g;
 #if BR_PACK
