@@ -19,6 +19,40 @@ typedef struct grid {
 
 static size_t gidx(const grid *g, int x, int y, int z) { return ((size_t)z * (size_t)g->ny + (size_t)y) * (size_t)g->nx + (size_t)x; }
 
+/* 0 when triangle t lies apart from the cube of centre c and half-side r by more than tol along one of the
+ * separating axes of a triangle and a box (Akenine-Moller, "Fast 3D triangle-box overlap testing", 2001, in
+ * double): the triangle's plane and the nine products of its edges with the cube's axes (the caller's cell
+ * range already holds the cube's own three). 1 otherwise: a doubt marks the cell. */
+static int tri_cube_overlap(const float *t, const double c[3], double r, double tol)
+{
+    double v[3][3], e[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) v[i][a] = (double)t[3 * i + a] - c[a];
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) e[i][a] = v[(i + 1) % 3][a] - v[i][a];
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) {
+            /* the axis unit_a x e_i */
+            double ax[3] = { 0.0, 0.0, 0.0 };
+            ax[(a + 1) % 3] = -e[i][(a + 2) % 3];
+            ax[(a + 2) % 3] = e[i][(a + 1) % 3];
+            double lo = INFINITY, hi = -INFINITY;
+            for (int j = 0; j < 3; j++) {
+                const double p = ax[0] * v[j][0] + ax[1] * v[j][1] + ax[2] * v[j][2];
+                lo = fmin(lo, p);
+                hi = fmax(hi, p);
+            }
+            const double len = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+            const double rad = r * (fabs(ax[0]) + fabs(ax[1]) + fabs(ax[2])) + tol * len;
+            if (lo > rad || hi < -rad) return 0;
+        }
+    const double n[3] = { e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                          e[0][0] * e[1][1] - e[0][1] * e[1][0] };
+    const double d = n[0] * v[0][0] + n[1] * v[0][1] + n[2] * v[0][2];
+    const double rad = r * (fabs(n[0]) + fabs(n[1]) + fabs(n[2])) + tol * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return !(fabs(d) > rad);
+}
+
 /* The parity of the crossings of the ray p + t d (t > 0) with the cycle's triangles (Moller-Trumbore in
  * double): 1 odd, 0 even, -1 when the ray passes too close to an edge, a vertex or a plane to be sure (the
  * caller tries another direction). p is at least half a cell from every triangle, so t > 0 is clear. */
@@ -131,8 +165,10 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
     g.cell = calloc(nc, 1);
     size_t *stack = malloc(nc * sizeof *stack);
     if (!g.cell || !stack) { free(g.cell); free(stack); return -1; }
-    /* Mark every cell whose closure comes within eps of a triangle's box (conservative: the box holds the
-     * triangle). The small relative slack covers the rounding of the cell coordinates. */
+    /* Mark every cell whose closure comes within eps (L-infinity) of a triangle: the cells of the triangle's box
+     * grown by eps that the triangle meets grown by eps (tri_cube_overlap; a cell whose box only the triangle's
+     * box meets stays free, so the boxes come closer to a surface that runs across the grid). The small relative
+     * slack covers the rounding of the cell coordinates. */
     const double slack = eps + 1e-9 * ext;
     for (size_t k = 0; k < n; k++) {
         const float *t = tri + 9 * (size_t)ids[k];
@@ -148,7 +184,12 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
         }
         for (int z = lo[2]; z <= hi[2]; z++)
             for (int y = lo[1]; y <= hi[1]; y++)
-                for (int x = lo[0]; x <= hi[0]; x++) g.cell[gidx(&g, x, y, z)] = CELL_MARKED;
+                for (int x = lo[0]; x <= hi[0]; x++) {
+                    const size_t ci = gidx(&g, x, y, z);
+                    if (g.cell[ci] == CELL_MARKED) continue;
+                    const double cc[3] = { g.o[0] + (x + 0.5) * g.h, g.o[1] + (y + 0.5) * g.h, g.o[2] + (z + 0.5) * g.h };
+                    if (tri_cube_overlap(t, cc, 0.5 * g.h + slack, 1e-9 * ext)) g.cell[ci] = CELL_MARKED;
+                }
     }
     /* Outside: reached from the border (which no triangle reaches: the box is a cell inside it). */
     flood(&g, 0, CELL_FREE, CELL_OUTSIDE, stack);

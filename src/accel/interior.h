@@ -16,8 +16,8 @@
  * outside crosses it. Scans with a flipped triangle or a fin are cycles, not closed components.
  *
  * The boxes: a grid over each cycle's box; cells whose closure comes within eps of one of the cycle's
- * triangles (by the triangle's box, conservatively) are marked; unmarked cells reached from the grid's
- * border through unmarked cells (26-connected) are outside; every other group of unmarked cells is
+ * triangles (L-infinity: a triangle-box overlap test with a margin, so a doubt marks) are marked; unmarked
+ * cells reached from the grid's border through unmarked cells (26-connected) are outside; every other group of unmarked cells is
  * entirely inside or entirely outside (no triangle crosses it), and the parity of a ray's crossings from a
  * cell centre at least half a cell from the surface (double; another direction when it passes near an
  * edge) says which. Interior cells are merged greedily into boxes. */

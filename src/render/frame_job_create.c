@@ -64,10 +64,8 @@ static int occluder_what(const ms_shadow_method *sm, const ms_render_options *op
 {
     const int cull = opt->closed_cull == MS_CLOSED_CULL_ON ||
                      (opt->closed_cull == MS_CLOSED_CULL_DEFAULT && (sm->occluders & MS_OCC_CULL_BY_DEFAULT));
-    /* The per-pixel traversal rasterizes the boxes as triangles (microraster.c). */
-    return sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) &
-           (opt->no_interior ? ~(MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS | MS_OCC_INTERIOR_SILHOUETTE) : ~0) &
-           (opt->traversal == MS_TRAVERSAL_PIXEL ? ~MS_OCC_INTERIOR_SILHOUETTE : ~0) & (opt->no_merge ? ~MS_OCC_MERGE : ~0);
+    return sm->occluders & (cull ? ~0 : ~MS_OCC_CULL) & (opt->no_interior ? ~(MS_OCC_INTERIOR | MS_OCC_INTERIOR_PASS) : ~0) &
+           (opt->no_merge ? ~MS_OCC_MERGE : ~0);
 }
 
 /* Every light's occluders (occluders.h) with what the method takes and the options allow: the scene's
@@ -398,7 +396,9 @@ static ms_status job_states(ms_frame_job *j, const ms_render_options *opt, const
     j->pstate = pstate;
     f->stats.primary_s = omp_get_wtime() - t_primary;
     const double t_setup = omp_get_wtime();
-    const int occ_what = occluder_what(sm, opt);
+    int occ_what = occluder_what(sm, opt);
+    if ((occ_what & MS_OCC_INTERIOR) && sm->interior_silhouettes && sm->interior_silhouettes(&j->ctx))
+        occ_what |= MS_OCC_INTERIOR_SILHOUETTE;   /* the boxes on the finer grid */
     if (occ_what && !j->streamed && occluders_build(j, occ_what, &f->stats)) {
         snprintf(err, errlen, "out of memory for the lights' occluders");
         return MS_ERR_NO_MEMORY;

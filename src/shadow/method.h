@@ -22,6 +22,10 @@ typedef struct ms_shadow_method {
                                    * in that BVH (ties may move). 0: the scene's
                                    * BVH alone (streamed or own-indexed methods, and Embree, the baseline as
                                    * its users run it) */
+    /* Optional (NULL: never): 1 when the method, created with ctx (its k, ISA cap and traversal), rasterizes the
+     * interior boxes whole (ctx->interior_box_bvh), for which the driver finds them on a finer grid
+     * (MS_OCC_INTERIOR_SILHOUETTE, visibility/occluders.h). */
+    int (*interior_silhouettes)(const ms_render_ctx *ctx);
     int n_counters;
     const char *counter_names[MS_MAX_COUNTERS];
     /* Per-frame set-up (shared, read-only afterwards); 0 or -1 with a message in err. */

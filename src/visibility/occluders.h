@@ -58,8 +58,9 @@ typedef struct ms_occluders {
 #define MS_INTERIOR_MIN_TRIS 256
 
 /* What a light's occluders are built with (ms_shadow_method.occluders). MS_OCC_INTERIOR_SILHOUETTE (with
- * MS_OCC_INTERIOR): the method rasterizes the boxes whole, as their silhouettes (the block traversal with the
- * SIMD Scanline kernel, shadow/microraster/block_box_impl.h), so the boxes are found on the finer grid.
+ * MS_OCC_INTERIOR; set by the driver from ms_shadow_method.interior_silhouettes): the method rasterizes the
+ * boxes whole, as their silhouettes (shadow/microraster/block_box_impl.h), so the boxes are found on the finer
+ * grid.
  * MS_OCC_INTERIOR_PASS (with
  * MS_OCC_INTERIOR): a method that does not rasterize the interior boxes itself is run by the frame's driver
  * over them first (a second state whose BVH is the boxes' triangles), then over the scene's triangles with

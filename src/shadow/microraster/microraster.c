@@ -91,7 +91,7 @@ static int mr_create_kernel(ms_kernel_id id, const ms_render_ctx *ctx, void **st
     }
     s->flags = (ctx->no_occlusion_cull ? 0 : MS_FT_CULL_OCCLUDED) | (ctx->no_child_order ? 0 : MS_FT_ORDER_CHILDREN);
     s->block_flags = (ctx->no_child_order ? 0 : MS_BR_ORDER) | (ctx->frustum_shrink ? MS_BR_FRUSTUM_SHRINK : 0);
-    s->box_pass = s->block && ctx->interior_box_bvh && ms_raster_rows(s->raster, ctx->k, 5);
+    s->box_pass = s->block && ctx->interior_box_bvh && ms_raster_rows(s->raster, ctx->k, 5);   /* mr_silhouettes */
     if (s->block && (ms_bvh_shallow_build(&s->shallow, ctx->bvh, MR_SHALLOW_LEAF) ||
                      (ctx->interior && ms_bvh_shallow_build(&s->interior_shallow, s->box_pass ? ctx->interior_box_bvh : ctx->interior,
                                                             s->box_pass ? MR_BOX_LEAF : MR_SHALLOW_LEAF)))) {
@@ -102,6 +102,14 @@ static int mr_create_kernel(ms_kernel_id id, const ms_render_ctx *ctx, void **st
     }
     *state = s;
     return 0;
+}
+
+/* Whether the block traversal rasterizes the interior boxes as silhouettes (block_box_impl.h): it borrows the
+ * SIMD Scanline kernel's row loop, which the portable kernel lacks; the per-pixel traversal takes triangles. */
+static int mr_silhouettes(const ms_render_ctx *ctx)
+{
+    return ctx->traversal != MS_TRAVERSAL_PIXEL &&
+           ms_raster_rows(ms_raster_kernel(MS_KERNEL_SCANLINE, ctx->k, ctx->isa_cap, NULL), ctx->k, 5) != NULL;
 }
 
 static int mr_create_scanline(const ms_render_ctx *c, void **s, char *e, size_t n) { return mr_create_kernel(MS_KERNEL_SCANLINE, c, s, e, n); }
@@ -326,17 +334,18 @@ static void mr_isa_used(const void *state, ms_isa *kernel, ms_isa *traversal)
     *traversal = s->trace_isa;
 }
 
-#define MICRORASTER_METHOD(ident, mname, create_fn, occ_more)                                         \
+#define MICRORASTER_METHOD(ident, mname, create_fn, silhouettes_fn)                                   \
     const ms_shadow_method ident = {                                                                  \
         .name = mname, .primary = "bvh", .needs_grid = 1, .n_counters = MS_FT_COUNTERS,               \
-        .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_INTERIOR | MS_OCC_MERGE | (occ_more), \
+        .occluders = MS_OCC_CULL | MS_OCC_CULL_BY_DEFAULT | MS_OCC_INTERIOR | MS_OCC_MERGE,            \
+        .interior_silhouettes = silhouettes_fn,                                                       \
         .counter_names = { "frusta", "nodes_visited", "nodes_culled_frustum", "nodes_culled_occluded", \
                            "triangles_rasterized", "pixels_early_out", "pixels_traced_edge_on" },    \
         .create = create_fn, .visibility = mr_visibility, .destroy = mr_destroy, .isa_used = mr_isa_used, \
         .counters_used = mr_counters_used, .outlines = 1 }
 
-/* Scanline's block traversal rasterizes the interior boxes as silhouettes (block_box_impl.h; with the portable
- * kernel, which has no row loop to lend, it takes them as triangles); the baselines' kernels take triangles. */
-MICRORASTER_METHOD(ms_shadow_scanline, "scanline", mr_create_scanline, MS_OCC_INTERIOR_SILHOUETTE);
-MICRORASTER_METHOD(ms_shadow_bounds, "bounds", mr_create_bounds, 0);
-MICRORASTER_METHOD(ms_shadow_hierarchical, "hierarchical", mr_create_hier, 0);
+/* Scanline's block traversal rasterizes the interior boxes as silhouettes (mr_silhouettes); the baselines' kernels
+ * take them as triangles. */
+MICRORASTER_METHOD(ms_shadow_scanline, "scanline", mr_create_scanline, mr_silhouettes);
+MICRORASTER_METHOD(ms_shadow_bounds, "bounds", mr_create_bounds, NULL);
+MICRORASTER_METHOD(ms_shadow_hierarchical, "hierarchical", mr_create_hier, NULL);
