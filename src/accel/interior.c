@@ -206,8 +206,8 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
     }
     free(stack);
     /* Greedy boxes over the inside cells: along x, then whole rows along y, then whole slabs along z; at most
-     * (one per MS_INTERIOR_TRIS_PER_BOX triangles of the cycle, and one: a fragmented inside would otherwise give up to a box
-     * per cell; the cells left are simply not boxed). */
+     * one per MS_INTERIOR_TRIS_PER_BOX triangles of the cycle, and one (a fragmented inside would otherwise give
+     * up to a box per cell; the cells left are simply not boxed). */
     int rc = 0;
     const size_t limit = out->n_boxes + n / MS_INTERIOR_TRIS_PER_BOX + 1;
     for (int z = 0; z < g.nz && !rc && out->n_boxes < limit; z++)

@@ -17,10 +17,10 @@
  *
  * The boxes: a grid over each cycle's box; cells whose closure comes within eps of one of the cycle's
  * triangles (L-infinity: a triangle-box overlap test with a margin, so a doubt marks) are marked; unmarked
- * cells reached from the grid's border through unmarked cells (26-connected) are outside; every other group of unmarked cells is
- * entirely inside or entirely outside (no triangle crosses it), and the parity of a ray's crossings from a
- * cell centre at least half a cell from the surface (double; another direction when it passes near an
- * edge) says which. Interior cells are merged greedily into boxes. */
+ * cells reached from the grid's border through unmarked cells (26-connected) are outside; every other group
+ * of unmarked cells is entirely inside or entirely outside (no triangle crosses it), and the parity of a
+ * ray's crossings from a cell centre at least half a cell from the surface (double; another direction when
+ * it passes near an edge) says which. Interior cells are merged greedily into boxes. */
 #ifndef MS_ACCEL_INTERIOR_H
 #define MS_ACCEL_INTERIOR_H
 #include <stddef.h>
@@ -39,8 +39,7 @@ typedef struct ms_interior {
 
 /* The interior boxes of every cycle of the n triangles tri (9 floats each) with at least min_tris
  * triangles, on a grid of `res` cells along each cycle's longest side (halved, down to 16, while a cell is no
- * wider than four clearances); eps: the clearance from the
- * surface, in world units; threads: OpenMP threads of the parity rays. Work O(n + res^3 + groups * n), memory O(res^3). 0, or -1 when out
+ * wider than four clearances); eps: the clearance from the surface, in world units; threads: OpenMP threads of the parity rays. Work O(n + res^3 + groups * n), memory O(res^3). 0, or -1 when out
  * of memory (out zeroed). */
 int ms_interior_find(const float *tri, size_t n, const ms_closed *c, int res, size_t min_tris, double eps,
                      int threads, ms_interior *out);

@@ -41,8 +41,8 @@
 /* Closed components (accel/closed.c, ms_closed_find) while they are found: the weld's hash table of a power
  * of two >= 6n vertex slots (4 bytes), corner ids 12, the directed edges grouped by first vertex (offsets at
  * most 12, targets 12, triangles 12), unions 8, flags 2, components and cycles 8 per triangle (kept while
- * the lights' occluders are built), and the interior boxes' grid (accel/interior.c: (MS_INTERIOR_RES_SILHOUETTE + 4)^3 at most
- * cells of 9 bytes at most per cycle, one at a time). */
+ * the lights' occluders are built), and the interior boxes' grid (accel/interior.c: at most
+ * (MS_INTERIOR_RES_SILHOUETTE + 4)^3 cells of 9 bytes, one cycle at a time). */
 static uint64_t closed_find_bytes(uint64_t n)
 {
     uint64_t m = 16;
@@ -347,8 +347,8 @@ uint64_t ms_points_need(size_t n, size_t n_tris, int whole_tri_copy, int mask_wo
 
 uint64_t ms_culled_sets_need(size_t n_tris, size_t held, int build)
 {
-    /* Each held set: a BVH over at most every triangle with its map, and its interior boxes; a build on top: the scene-order copy it
-     * culls from and the build's temporaries. */
+    /* Each held set: a BVH over at most every triangle with its map, and its interior boxes; a build on top: the
+     * scene-order copy it culls from and the build's temporaries. */
     return mul(mul(n_tris, OCCLUDERS_PER_TRI + INTERIOR_PER_TRI), held + (build ? 1u : 0u))
            + (build ? mul(n_tris, OCCLUDERS_BUILD_PER_TRI + TRI_BYTES) : 0);
 }

@@ -525,15 +525,16 @@ static ms_status points_light(const ms_accel *a, const ms_light *light, ms_light
     return MS_OK;
 }
 
-/* The interior boxes of the accel's closed surfaces that the light allows (occluders.h) into occ, and ctx->interior
- * pointing at them where there are any. 0, or -1 when out of memory. */
+/* The interior boxes of the accel's closed surfaces that the light allows (occluders.h) into occ, and ctx's
+ * interior fields pointing at them where there are any (ms_occluders_ctx: occ holds nothing else, so the scene's
+ * BVH stays). 0, or -1 when out of memory. */
 static int points_interior(const ms_accel *a, const ms_scene *view, const ms_light *light, int threads, ms_occluders *occ,
                            ms_render_ctx *ctx)
 {
     if (ms_occluders_build(occ, view, &a->bvh, &a->closed, &a->interior, a->interior_eps, a->alpha, light, MS_OCC_INTERIOR,
                            threads))
         return -1;
-    if (occ->interior.n_tris) ctx->interior = &occ->interior;
+    ms_occluders_ctx(occ, ctx);
     return 0;
 }
 

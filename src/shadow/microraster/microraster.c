@@ -91,7 +91,7 @@ static int mr_create_kernel(ms_kernel_id id, const ms_render_ctx *ctx, void **st
     }
     s->flags = (ctx->no_occlusion_cull ? 0 : MS_FT_CULL_OCCLUDED) | (ctx->no_child_order ? 0 : MS_FT_ORDER_CHILDREN);
     s->block_flags = (ctx->no_child_order ? 0 : MS_BR_ORDER) | (ctx->frustum_shrink ? MS_BR_FRUSTUM_SHRINK : 0);
-    s->box_pass = s->block && ctx->interior_box_bvh && ms_raster_rows(s->raster, ctx->k, 5);   /* mr_silhouettes */
+    s->box_pass = s->block && ctx->interior_box_bvh && ms_raster_rows(s->raster, ctx->k, 5);   /* as mr_silhouettes */
     if (s->block && (ms_bvh_shallow_build(&s->shallow, ctx->bvh, MR_SHALLOW_LEAF) ||
                      (ctx->interior && ms_bvh_shallow_build(&s->interior_shallow, s->box_pass ? ctx->interior_box_bvh : ctx->interior,
                                                             s->box_pass ? MR_BOX_LEAF : MR_SHALLOW_LEAF)))) {
