@@ -54,12 +54,9 @@ static __attribute__((noinline)) void MS_KFN(br_box)(const br_state *s, br_leaf_
         yhi = l16_max(yhi, ys);
     }
     const unsigned depth_ok = lanes & l16_le(l16_set1(s->fr->near), zmin) & l16_le(zmax, l16_set1(s->fr->far));
-    /* The samples the corners' projected box may hold, within the visible rectangle (clamped before rounding). */
-    const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
-    const l16 bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), L->rx0);
-    const l16 bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), L->rx1);
-    const l16 by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), L->ry0);
-    const l16 by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), L->ry1);
+    /* The samples the corners' projected box may hold, within the visible rectangle. */
+    l16 bx0, bx1, by0, by1;
+    MS_KFN(br_index_box)(xlo, xhi, ylo, yhi, L->rx0, L->rx1, L->ry0, L->ry1, &bx0, &bx1, &by0, &by1);
     const unsigned miss = l16_gt(bx0, bx1) | l16_gt(by0, by1);
     L->c_depth += (uint64_t)ms_bt_popcount16(lanes & ~depth_ok);
     L->c_rect += (uint64_t)ms_bt_popcount16(depth_ok & miss);

@@ -243,20 +243,29 @@ static inline void MS_KFN(br_rows)(const br_state *s, const br_setup *su, int e,
     L->c_shared_clip += ne == 5;
 }
 
+/* The sample indices of the light-index box [xlo, xhi] x [ylo, yhi], clamped before rounding, within the
+ * rectangle [rx0, rx1] x [ry0, ry1]. */
+static inline void MS_KFN(br_index_box)(l16 xlo, l16 xhi, l16 ylo, l16 yhi, l16 rx0, l16 rx1, l16 ry0, l16 ry1, l16 *bx0,
+                                        l16 *bx1, l16 *by0, l16 *by1)
+{
+    const l16 lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+    *bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), rx0);
+    *bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), rx1);
+    *by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), ry0);
+    *by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), ry1);
+}
+
 /* The kernel's box of a projected triangle (xs, ys: its vertices in light-index space): its slack, its clamp,
  * its rounding to sample indices; then within the rectangle [rx0, rx1] x [ry0, ry1]. */
 static inline void MS_KFN(br_sample_box)(const l16 xs[3], const l16 ys[3], l16 rx0, l16 rx1, l16 ry0, l16 ry1, l16 *bx0,
                                          l16 *bx1, l16 *by0, l16 *by1)
 {
-    const l16 slack = l16_set1(MS_BOX_SLACK), lo1 = l16_set1(-1.0f), hi1 = l16_set1((float)MS_K);
+    const l16 slack = l16_set1(MS_BOX_SLACK);
     const l16 xlo = l16_sub(l16_min(l16_min(xs[0], xs[1]), xs[2]), slack);
     const l16 xhi = l16_add(l16_max(l16_max(xs[0], xs[1]), xs[2]), slack);
     const l16 ylo = l16_sub(l16_min(l16_min(ys[0], ys[1]), ys[2]), slack);
     const l16 yhi = l16_add(l16_max(l16_max(ys[0], ys[1]), ys[2]), slack);
-    *bx0 = l16_max(l16_ceil(l16_min(l16_max(xlo, lo1), hi1)), rx0);
-    *bx1 = l16_min(l16_floor(l16_min(l16_max(xhi, lo1), hi1)), rx1);
-    *by0 = l16_max(l16_ceil(l16_min(l16_max(ylo, lo1), hi1)), ry0);
-    *by1 = l16_min(l16_floor(l16_min(l16_max(yhi, lo1), hi1)), ry1);
+    MS_KFN(br_index_box)(xlo, xhi, ylo, yhi, rx0, rx1, ry0, ry1, bx0, bx1, by0, by1);
 }
 
 /* Corner rays (the paper's corner-ray culling, in light-index space): a triangle whose box holds visible

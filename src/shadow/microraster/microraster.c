@@ -45,7 +45,7 @@
  * docs/notebook/2026-11-25-dense-meshes.md and 2026-11-29-penumbra-cost.md). */
 #define MR_SHALLOW_LEAF 16
 /* Largest leaf of the interior boxes' shallow BVH with the silhouette pass: a box costs a pixel more than a
- * triangle, so the node tests cull them in smaller groups (1, 2, 4 and 16 measured within 2% of each other). */
+ * triangle, so the node tests cull them in smaller groups (the sweep: docs/notebook/2026-11-30-box-silhouettes.md). */
 #define MR_BOX_LEAF 4
 
 typedef struct mr_state {
