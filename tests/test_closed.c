@@ -10,107 +10,18 @@
  *
  * Interior boxes (src/accel/interior.c): every point sampled in every box lies inside its component by a
  * ray-parity count written here, and at least the clearance from each of its triangles (point-triangle
- * distance, double); open meshes get none. Frames of a dense sphere over a ground: scanline with the boxes
- * and the cull (its default), without either, per pixel, hierarchical, raytrace with and without the cull,
- * mft with and without the boxes (the driver's interior pass) give the same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none);
- * the points API with the boxes equals raytrace point for point. */
+ * distance, double); an open mesh is no cycle (a holed one: test_holes.c). Frames of a dense sphere over a
+ * ground: scanline with the boxes and the cull (its default), without either, per pixel, hierarchical,
+ * raytrace with and without the cull, mft with and without the boxes (the driver's interior pass) give the
+ * same V bit for bit, for a light apart from the sphere (boxes used) and one inside its box (none); the points
+ * API with the boxes equals raytrace point for point. */
 #include "testutil.h"
 #include "accel/closed.h"
 #include "accel/interior.h"
+#include "test_mesh.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define NEAR 1e-4
-#define FAR (1.0 - 1e-4)
-
-/* ---- meshes ---- */
-
-typedef struct mesh { float *tri; size_t n, cap; } mesh;
-
-static void add_tri(mesh *m, const double a[3], const double b[3], const double c[3])
-{
-    if (m->n == m->cap) {
-        m->cap = m->cap ? 2 * m->cap : 64;
-        m->tri = realloc(m->tri, m->cap * 9 * sizeof(float));
-        assert_non_null(m->tri);
-    }
-    float *t = m->tri + 9 * m->n++;
-    for (int k = 0; k < 3; k++) { t[k] = (float)a[k]; t[3 + k] = (float)b[k]; t[6 + k] = (float)c[k]; }
-}
-
-/* An icosphere of radius r around c, subdivided s times, outward winding (flip: inward); the vertices
- * moved radially by up to jitter (shared vertices move alike: the surface stays closed). */
-static void icosphere(mesh *m, const double c[3], double r, int s, int flip, double jitter, unsigned seed)
-{
-    const double g = (1.0 + sqrt(5.0)) / 2.0;
-    double v[12][3] = { { -1, g, 0 }, { 1, g, 0 }, { -1, -g, 0 }, { 1, -g, 0 }, { 0, -1, g }, { 0, 1, g },
-                        { 0, -1, -g }, { 0, 1, -g }, { g, 0, -1 }, { g, 0, 1 }, { -g, 0, -1 }, { -g, 0, 1 } };
-    static const int f[20][3] = { { 0, 11, 5 }, { 0, 5, 1 }, { 0, 1, 7 }, { 0, 7, 10 }, { 0, 10, 11 }, { 1, 5, 9 },
-                                  { 5, 11, 4 }, { 11, 10, 2 }, { 10, 7, 6 }, { 7, 1, 8 }, { 3, 9, 4 }, { 3, 4, 2 },
-                                  { 3, 2, 6 }, { 3, 6, 8 }, { 3, 8, 9 }, { 4, 9, 5 }, { 2, 4, 11 }, { 6, 2, 10 },
-                                  { 8, 6, 7 }, { 9, 8, 1 } };
-    /* triangles on the unit sphere, each subdivided by edge midpoints; the jitter is a function of the
-     * (rounded) direction, so a vertex shared by neighbours lands at the same float position */
-    int nt = 20;
-    double (*t)[3][3] = malloc(sizeof *t * 20);
-    for (int i = 0; i < 20; i++)
-        for (int k = 0; k < 3; k++) {
-            const double *p = v[f[i][k]];
-            const double l = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-            for (int a = 0; a < 3; a++) t[i][k][a] = p[a] / l;
-        }
-    for (int level = 0; level < s; level++) {
-        double (*u)[3][3] = malloc(sizeof *u * (size_t)nt * 4);
-        for (int i = 0; i < nt; i++) {
-            double mid[3][3];
-            for (int k = 0; k < 3; k++) {
-                double l = 0;
-                for (int a = 0; a < 3; a++) { mid[k][a] = t[i][k][a] + t[i][(k + 1) % 3][a]; l += mid[k][a] * mid[k][a]; }
-                for (int a = 0; a < 3; a++) mid[k][a] /= sqrt(l);
-            }
-            const double *q[4][3] = { { t[i][0], mid[0], mid[2] }, { mid[0], t[i][1], mid[1] }, { mid[2], mid[1], t[i][2] },
-                                      { mid[0], mid[1], mid[2] } };
-            for (int j = 0; j < 4; j++)
-                for (int k = 0; k < 3; k++) memcpy(u[4 * i + j][k], q[j][k], sizeof(double[3]));
-        }
-        free(t);
-        t = u;
-        nt *= 4;
-    }
-    for (int i = 0; i < nt; i++) {
-        double p[3][3];
-        for (int k = 0; k < 3; k++) {
-            /* the jitter from the direction rounded to float: equal for the copies of a shared vertex */
-            unsigned h = seed;
-            for (int a = 0; a < 3; a++) {
-                float fa = (float)t[i][k][a];
-                unsigned bits;
-                memcpy(&bits, &fa, sizeof bits);
-                h = (h ^ bits) * 16777619u;
-            }
-            const double rr = r * (1.0 + jitter * ((double)(h % 10007) / 10007.0 - 0.5));
-            for (int a = 0; a < 3; a++) p[k][a] = c[a] + rr * (double)(float)t[i][k][a];
-        }
-        if (flip) add_tri(m, p[0], p[2], p[1]);
-        else add_tri(m, p[0], p[1], p[2]);
-    }
-    free(t);
-}
-
-/* An axis-aligned box [lo, hi], outward winding (flip: inward). */
-static void box(mesh *m, const double lo[3], const double hi[3], int flip)
-{
-    double v[8][3];
-    for (int i = 0; i < 8; i++)
-        for (int a = 0; a < 3; a++) v[i][a] = (i >> a & 1) ? hi[a] : lo[a];
-    static const int q[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 } };
-    for (int f = 0; f < 6; f++) {
-        const double *a = v[q[f][0]], *b = v[q[f][1]], *c = v[q[f][2]], *d = v[q[f][3]];
-        if (flip) { add_tri(m, a, c, b); add_tri(m, a, d, c); }
-        else { add_tri(m, a, b, c); add_tri(m, a, c, d); }
-    }
-}
 
 /* ---- topology ---- */
 
@@ -118,8 +29,8 @@ static void test_topology(void **st)
 {
     (void)st;
     const double o[3] = { 0, 0, 0 };
-    mesh m = { 0 };
-    icosphere(&m, o, 1.0, 2, 0, 0.0, 1);
+    tm_mesh m = { 0 };
+    tm_icosphere(&m, o, 1.0, 2, 0, 0.0, 1);
     ms_closed c;
     assert_int_equal(ms_closed_find(m.tri, m.n, &c), 0);
     assert_int_equal(c.n_components, 1);
@@ -128,8 +39,8 @@ static void test_topology(void **st)
     for (int a = 0; a < 3; a++) { assert_true(c.box[0][a] >= -1.0f && c.box[0][a] < -0.9f); assert_true(c.box[0][3 + a] <= 1.0f); }
     ms_closed_free(&c);
 
-    mesh f = { 0 };
-    icosphere(&f, o, 1.0, 2, 1, 0.0, 1);          /* wound inwards */
+    tm_mesh f = { 0 };
+    tm_icosphere(&f, o, 1.0, 2, 1, 0.0, 1);          /* wound inwards */
     assert_int_equal(ms_closed_find(f.tri, f.n, &c), 0);
     assert_int_equal(c.n_components, 1);
     assert_int_equal(c.outward[0], -1);
@@ -142,11 +53,11 @@ static void test_topology(void **st)
     ms_closed_free(&c);
 
     /* a fin: one triangle twice (three triangles on each of its edges) */
-    mesh g = { 0 };
-    icosphere(&g, o, 1.0, 1, 0, 0.0, 1);
+    tm_mesh g = { 0 };
+    tm_icosphere(&g, o, 1.0, 1, 0, 0.0, 1);
     double a[3], b[3], cc[3];
     for (int k = 0; k < 3; k++) { a[k] = g.tri[k]; b[k] = g.tri[3 + k]; cc[k] = g.tri[6 + k]; }
-    add_tri(&g, a, b, cc);
+    tm_add_tri(&g, a, b, cc);
     assert_int_equal(ms_closed_find(g.tri, g.n, &c), 0);
     assert_int_equal(c.n_components, 0);
     ms_closed_free(&c);
@@ -162,14 +73,14 @@ static void test_topology(void **st)
     ms_closed_free(&c);
 
     /* two boxes and an open quad: two closed components with their boxes; a degenerate triangle alone */
-    mesh h = { 0 };
+    tm_mesh h = { 0 };
     const double lo1[3] = { 0, 0, 0 }, hi1[3] = { 1, 2, 3 }, lo2[3] = { 5, 5, 5 }, hi2[3] = { 6, 6, 7 };
-    box(&h, lo1, hi1, 0);
-    box(&h, lo2, hi2, 1);
+    tm_box(&h, lo1, hi1, 0);
+    tm_box(&h, lo2, hi2, 1);
     const double q0[3] = { 10, 0, 0 }, q1[3] = { 11, 0, 0 }, q2[3] = { 11, 0, 1 }, q3[3] = { 10, 0, 1 };
-    add_tri(&h, q0, q1, q2);
-    add_tri(&h, q0, q2, q3);
-    add_tri(&h, q0, q0, q1);
+    tm_add_tri(&h, q0, q1, q2);
+    tm_add_tri(&h, q0, q2, q3);
+    tm_add_tri(&h, q0, q0, q1);
     assert_int_equal(ms_closed_find(h.tri, h.n, &c), 0);
     assert_int_equal(c.n_components, 2);
     assert_int_equal(c.closed_tris, 24);
@@ -184,36 +95,11 @@ static void test_topology(void **st)
 
 /* ---- the cull against a brute-force oracle ---- */
 
-/* Does the segment p + u (l - p), u in [NEAR, FAR], meet triangle t? Double precision, Moller-Trumbore;
- * an independent answer up to ties (a segment through an edge or vertex, which random cases avoid). */
-static int seg_hits(const float *t, const double p[3], const double l[3])
-{
-    double e1[3], e2[3], d[3], s[3], h[3], q[3];
-    for (int a = 0; a < 3; a++) { e1[a] = (double)t[3 + a] - t[a]; e2[a] = (double)t[6 + a] - t[a]; d[a] = l[a] - p[a]; s[a] = p[a] - t[a]; }
-    h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
-    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
-    if (det == 0.0) return 0;
-    const double inv = 1.0 / det;
-    const double u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) * inv;
-    if (u < 0.0 || u > 1.0) return 0;
-    q[0] = s[1] * e1[2] - s[2] * e1[1]; q[1] = s[2] * e1[0] - s[0] * e1[2]; q[2] = s[0] * e1[1] - s[1] * e1[0];
-    const double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) * inv;
-    if (v < 0.0 || u + v > 1.0) return 0;
-    const double w = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) * inv;
-    return w >= NEAR && w <= FAR;
-}
-
-static int occluded(const mesh *m, const uint8_t *keep, const double p[3], const double l[3])
+static int occluded(const tm_mesh *m, const uint8_t *keep, const double p[3], const double l[3])
 {
     for (size_t t = 0; t < m->n; t++)
-        if ((!keep || keep[t]) && seg_hits(m->tri + 9 * t, p, l)) return 1;
+        if ((!keep || keep[t]) && tm_seg_hits(m->tri + 9 * t, p, l)) return 1;
     return 0;
-}
-
-static double urand(unsigned *s)
-{
-    *s = *s * 1664525u + 1013904223u;
-    return (double)(*s >> 8) / 16777216.0;
 }
 
 /* A rect light: corner + s es + t et. Its corners for the cull, its box, and sample (s, t). */
@@ -231,14 +117,14 @@ static void light_hull(const rect *L, float pts[4][3], float box[6])
 
 /* Receivers (random points in the box [lo, hi]), samples on an 8x8 grid of the light: how many segments
  * the kept triangles answer differently from all triangles; *blocked counts the occluded ones. */
-static size_t differences(const mesh *m, const uint8_t *keep, const rect *L, const double lo[3], const double hi[3],
+static size_t differences(const tm_mesh *m, const uint8_t *keep, const rect *L, const double lo[3], const double hi[3],
                           int receivers, unsigned seed, size_t *blocked)
 {
     size_t diff = 0;
     *blocked = 0;
     for (int r = 0; r < receivers; r++) {
         double p[3];
-        for (int a = 0; a < 3; a++) p[a] = lo[a] + (hi[a] - lo[a]) * urand(&seed);
+        for (int a = 0; a < 3; a++) p[a] = lo[a] + (hi[a] - lo[a]) * tm_urand(&seed);
         for (int i = 0; i < 8; i++)
             for (int j = 0; j < 8; j++) {
                 double l[3];
@@ -251,31 +137,31 @@ static size_t differences(const mesh *m, const uint8_t *keep, const rect *L, con
     return diff;
 }
 
-static double far_margin(const mesh *m, const float lbox[6])
+static double far_margin(const tm_mesh *m, const float lbox[6])
 {
     /* the far range times the longest segment: the scene's and the light's boxes together */
     float b[6] = { lbox[0], lbox[1], lbox[2], lbox[3], lbox[4], lbox[5] };
     for (size_t i = 0; i < 3 * m->n; i++)
         for (int a = 0; a < 3; a++) { const float x = m->tri[3 * i + (size_t)a]; if (x < b[a]) b[a] = x; if (x > b[3 + a]) b[3 + a] = x; }
     const double dx = (double)b[3] - b[0], dy = (double)b[4] - b[1], dz = (double)b[5] - b[2];
-    return 2.0 * (1.0 - FAR) * sqrt(dx * dx + dy * dy + dz * dz);
+    return 2.0 * (1.0 - TM_FAR) * sqrt(dx * dx + dy * dy + dz * dz);
 }
 
 static void test_cull_exact(void **st)
 {
     (void)st;
     /* jittered icospheres (some wound inwards), boxes, and an open ground quad, under a light above */
-    mesh m = { 0 };
+    tm_mesh m = { 0 };
     unsigned seed = 7;
     for (int i = 0; i < 6; i++) {
-        const double c[3] = { -4 + 8 * urand(&seed), 0.8 + 2 * urand(&seed), -4 + 8 * urand(&seed) };
-        icosphere(&m, c, 0.5 + 0.7 * urand(&seed), 2, i == 3, 0.15, 100u + (unsigned)i);
+        const double c[3] = { -4 + 8 * tm_urand(&seed), 0.8 + 2 * tm_urand(&seed), -4 + 8 * tm_urand(&seed) };
+        tm_icosphere(&m, c, 0.5 + 0.7 * tm_urand(&seed), 2, i == 3, 0.15, 100u + (unsigned)i);
     }
     const double blo[3] = { 2, 0.2, -1 }, bhi[3] = { 3, 2.5, 1.5 };
-    box(&m, blo, bhi, 0);
+    tm_box(&m, blo, bhi, 0);
     const double g0[3] = { -8, 0, -8 }, g1[3] = { 8, 0, -8 }, g2[3] = { 8, 0, 8 }, g3[3] = { -8, 0, 8 };
-    add_tri(&m, g0, g2, g1);
-    add_tri(&m, g0, g3, g2);
+    tm_add_tri(&m, g0, g2, g1);
+    tm_add_tri(&m, g0, g3, g2);
     ms_closed c;
     assert_int_equal(ms_closed_find(m.tri, m.n, &c), 0);
     assert_int_equal(c.n_components, 7);
@@ -310,12 +196,12 @@ static void test_cull_guards(void **st)
     (void)st;
     /* A lamp inside a closed shade: the light's box meets the shade's, so nothing of it is culled; culling
      * its triangles facing away from the light anyway (the naive rule) lets light out. */
-    mesh m = { 0 };
+    tm_mesh m = { 0 };
     const double o[3] = { 0, 3, 0 };
-    icosphere(&m, o, 1.0, 2, 0, 0.0, 3);
+    tm_icosphere(&m, o, 1.0, 2, 0, 0.0, 3);
     const double g0[3] = { -8, 0, -8 }, g1[3] = { 8, 0, -8 }, g2[3] = { 8, 0, 8 }, g3[3] = { -8, 0, 8 };
-    add_tri(&m, g0, g2, g1);
-    add_tri(&m, g0, g3, g2);
+    tm_add_tri(&m, g0, g2, g1);
+    tm_add_tri(&m, g0, g3, g2);
     ms_closed c;
     assert_int_equal(ms_closed_find(m.tri, m.n, &c), 0);
     const rect lamp = { { -0.2, 2.9, -0.2 }, { 0.4, 0, 0 }, { 0, 0, 0.4 } };
@@ -340,9 +226,9 @@ static void test_cull_guards(void **st)
     /* A room modelled as one box wound inwards (its faces seen from inside), the sun outside: the
      * orientation from the signed volume makes the room's inside the solid, so the walls between a receiver
      * inside and the sun are kept; taking the winding as outward (the naive rule) culls them. */
-    mesh r = { 0 };
+    tm_mesh r = { 0 };
     const double rlo[3] = { -3, 0, -3 }, rhi[3] = { 3, 3, 3 };
-    box(&r, rlo, rhi, 1);
+    tm_box(&r, rlo, rhi, 1);
     assert_int_equal(ms_closed_find(r.tri, r.n, &c), 0);
     assert_int_equal(c.outward[0], -1);
     const rect sun = { { 10, 20, -5 }, { 4, 0, 0 }, { 0, 0, 4 } };
@@ -370,7 +256,7 @@ static void test_cull_guards(void **st)
 
 /* Crossings of the ray p + t d, t > 0, with the triangles (double Moller-Trumbore; d chosen irrational so
  * that edges and vertices are not met in these cases). */
-static int ray_crossings(const mesh *m, const double p[3], const double d[3])
+static int ray_crossings(const tm_mesh *m, const double p[3], const double d[3])
 {
     int n = 0;
     for (size_t i = 0; i < m->n; i++) {
@@ -431,23 +317,23 @@ done:;
 /* Every box of in: corners, centre and random points inside their cycle (odd crossings along two
  * directions) and at least eps from each of its triangles. The cycle's triangles are those of m's first n
  * with that cycle number. Returns the boxes checked. */
-static size_t check_boxes(const mesh *m, size_t n, const ms_closed *c, const ms_interior *in, double eps)
+static size_t check_boxes(const tm_mesh *m, size_t n, const ms_closed *c, const ms_interior *in, double eps)
 {
     unsigned seed = 5;
     for (size_t b = 0; b < in->n_boxes; b++) {
-        mesh comp = { 0 };
+        tm_mesh comp = { 0 };
         for (size_t t = 0; t < n; t++)
             if (c->cycle[t] == in->component[b]) {
                 const float *f = m->tri + 9 * t;
                 const double p0[3] = { f[0], f[1], f[2] }, p1[3] = { f[3], f[4], f[5] }, p2[3] = { f[6], f[7], f[8] };
-                add_tri(&comp, p0, p1, p2);
+                tm_add_tri(&comp, p0, p1, p2);
             }
         const float *bx = in->box[b];
         for (int a = 0; a < 3; a++) assert_true(bx[a] <= bx[3 + a]);
         for (int sidx = 0; sidx < 12; sidx++) {
             double p[3];
             for (int a = 0; a < 3; a++) {
-                const double f = sidx < 8 ? (double)(sidx >> a & 1) : sidx == 8 ? 0.5 : urand(&seed);
+                const double f = sidx < 8 ? (double)(sidx >> a & 1) : sidx == 8 ? 0.5 : tm_urand(&seed);
                 p[a] = bx[a] + f * ((double)bx[3 + a] - bx[a]);
             }
             const double d1[3] = { 0.5773, 0.6181, 0.5331 }, d2[3] = { -0.3119, 0.8423, -0.4397 };
@@ -468,13 +354,13 @@ static void test_interior_boxes(void **st)
     const double eps = 2e-3;
     /* a jittered sphere; a hollow shell (an outer sphere and an inner one wound inwards: two components,
      * each with its own inside); a box */
-    mesh m = { 0 };
+    tm_mesh m = { 0 };
     const double c0[3] = { 0, 0, 0 }, c1[3] = { 3, 0.5, -1 };
-    icosphere(&m, c0, 1.0, 4, 0, 0.1, 3);
-    icosphere(&m, c1, 1.0, 3, 0, 0.0, 0);
-    icosphere(&m, c1, 0.6, 3, 1, 0.0, 0);
+    tm_icosphere(&m, c0, 1.0, 4, 0, 0.1, 3);
+    tm_icosphere(&m, c1, 1.0, 3, 0, 0.0, 0);
+    tm_icosphere(&m, c1, 0.6, 3, 1, 0.0, 0);
     const double lo[3] = { -2, -3, 1.5 }, hi[3] = { -1, -2.5, 3 };
-    box(&m, lo, hi, 0);
+    tm_box(&m, lo, hi, 0);
     ms_closed c;
     assert_int_equal(ms_closed_find(m.tri, m.n, &c), 0);
     assert_int_equal(c.n_components, 4);
@@ -492,11 +378,12 @@ static void test_interior_boxes(void **st)
     assert_true(in.n_boxes > 0);
     ms_interior_free(&in);
     ms_closed_free(&c);
-    /* open: the sphere less one triangle has no inside */
+    /* open: the sphere less one triangle is no cycle; capped, a holed set (its boxes: test_holes.c) */
     assert_int_equal(ms_closed_find(m.tri, 5119, &c), 0);
     assert_int_equal(ms_interior_find(m.tri, 5119, &c, 24, 0, eps, 2, &in), 0);
     assert_int_equal(c.n_cycles, 0);
-    assert_int_equal(in.n_boxes, 0);
+    assert_int_equal(c.n_holed, 1);
+    for (size_t b = 0; b < in.n_boxes; b++) assert_int_equal(in.component[b], 0);
     ms_interior_free(&in);
     ms_closed_free(&c);
     /* a flipped triangle: no closed component any more, still a cycle with an inside */
@@ -535,15 +422,13 @@ static void test_interior_frames(void **st)
     ms_scene sc;
     tu_make_quad(&sc);
     /* the ground of the Quad, and a dense sphere (5120 triangles) instead of its occluder */
-    mesh m = { 0 };
-    const double g[4][3] = { { -10, 0, -10 }, { 10, 0, 10 }, { 10, 0, -10 }, { -10, 0, 10 } };
-    add_tri(&m, g[0], g[1], g[2]);
-    add_tri(&m, g[0], g[3], g[1]);
+    tm_mesh m = { 0 };
+    tm_ground(&m);
     const double c[3] = { 0.3, 1.6, -0.2 };
-    icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
+    tm_icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
     /* and a thin closed bar (12 triangles: no interior boxes, so the micro-raster methods cull its back) */
     const double blo[3] = { -2.5, 0.8, 1.3 }, bhi[3] = { 2.5, 0.9, 1.4 };
-    box(&m, blo, bhi, 0);
+    tm_box(&m, blo, bhi, 0);
     free(sc.tri);
     sc.tri = m.tri;
     sc.n_tris = m.n;
@@ -603,12 +488,10 @@ static void test_interior_frames(void **st)
 static void test_interior_points(void **st)
 {
     (void)st;
-    mesh m = { 0 };
-    const double g[4][3] = { { -10, 0, -10 }, { 10, 0, 10 }, { 10, 0, -10 }, { -10, 0, 10 } };
-    add_tri(&m, g[0], g[1], g[2]);
-    add_tri(&m, g[0], g[3], g[1]);
+    tm_mesh m = { 0 };
+    tm_ground(&m);
     const double c[3] = { 0.3, 1.6, -0.2 };
-    icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
+    tm_icosphere(&m, c, 1.2, 4, 0, 0.08, 11);
     ms_scene sc;
     tu_make_quad(&sc);
     free(sc.tri);
@@ -625,12 +508,12 @@ static void test_interior_points(void **st)
     unsigned seed = 77;
     for (size_t i = 0; i < n; i++) {
         if (i % 2) {
-            const double x = -2.7 + 6.0 * urand(&seed), z = -3.2 + 6.0 * urand(&seed);
+            const double x = -2.7 + 6.0 * tm_urand(&seed), z = -3.2 + 6.0 * tm_urand(&seed);
             pos[3 * i] = (float)x; pos[3 * i + 1] = 0.0f; pos[3 * i + 2] = (float)z;
             nrm[3 * i] = 0.0f; nrm[3 * i + 1] = 1.0f; nrm[3 * i + 2] = 0.0f;
             tri[i] = 0;   /* x, z on either ground triangle: both lie in the plane y = 0; 0 keeps its own out */
         } else {
-            const uint32_t t = 2 + (uint32_t)(urand(&seed) * 5120.0) % 5120;
+            const uint32_t t = 2 + (uint32_t)(tm_urand(&seed) * 5120.0) % 5120;
             const float *p = m.tri + 9 * (size_t)t;
             double e1[3], e2[3];
             for (int a = 0; a < 3; a++) {

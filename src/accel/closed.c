@@ -1,5 +1,6 @@
 /* Closed components of a triangle soup and the light-facing cull they allow (closed.h, docs/culling.md). */
 #include "closed.h"
+#include "holes.h"
 #include "core/union_find.h"
 #include <math.h>
 #include <stdlib.h>
@@ -70,6 +71,22 @@ static uint32_t float_key(float f)
     return u;
 }
 
+/* Appends to the rim the corner of triangle t where its edge a -> b starts (3 t + k). 0, or -1 when out of memory. */
+static int rim_push(uint32_t **rim, size_t *n, size_t *cap, const uint32_t *id, uint32_t t, uint32_t a, uint32_t b)
+{
+    if (*n == *cap) {
+        const size_t c = *cap ? 2 * *cap : 256;
+        uint32_t *r = realloc(*rim, c * sizeof *r);
+        if (!r) return -1;
+        *rim = r;
+        *cap = c;
+    }
+    uint32_t k = 0;
+    while (id[3 * t + k] != a || id[3 * t + (k + 1) % 3] != b) k++;
+    (*rim)[(*n)++] = 3 * t + k;
+    return 0;
+}
+
 int ms_closed_find(const float *tri, size_t n, ms_closed *out)
 {
     memset(out, 0, sizeof *out);
@@ -79,6 +96,8 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     const size_t vm = table_size(3 * n);
     uint32_t *vslot = malloc(vm * sizeof *vslot);       /* corner index + 1 of a vertex's first corner, 0: empty */
     uint32_t *id = malloc(3 * n * sizeof *id);          /* welded vertex of each corner, numbered densely */
+    uint32_t *rim = NULL;                               /* the edges used an odd number of times, once each: */
+    size_t n_rim = 0, rim_cap = 0;                      /* the corner that starts them (3 t + k) */
     uint32_t *start = NULL, *dst = NULL, *etri = NULL;  /* directed edges by their first vertex (CSR) */
     uint32_t *parent = malloc(n * sizeof *parent);
     uint32_t *cparent = malloc(n * sizeof *cparent);    /* the mod-2 cycles: any shared edge unites */
@@ -132,9 +151,9 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
         for (uint32_t i = start[a]; i < start[a + 1]; i++) {
             const uint32_t b = dst[i], t = etri[i];
             /* the triangles walking a -> b (this one included) and b -> a */
-            uint32_t same = 0, opp = 0, twin = 0;
+            uint32_t same = 0, opp = 0, twin = 0, earlier = 0;
             for (uint32_t j = start[a]; j < start[a + 1]; j++)
-                if (dst[j] == b) { same++; ms_uf_union(cparent, t, etri[j]); }
+                if (dst[j] == b) { same++; earlier += j < i; ms_uf_union(cparent, t, etri[j]); }
             for (uint32_t j = start[b]; j < start[b + 1]; j++)
                 if (dst[j] == a) { opp++; twin = etri[j]; ms_uf_union(cparent, t, twin); }
             /* Exactly two triangles, walking the edge in opposite directions: neighbours on one consistently
@@ -142,7 +161,11 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
              * way) leaves their component open. */
             if (same == 1 && opp == 1) ms_uf_union(parent, t, twin);
             else bad[t] = 1;
-            if ((same + opp) & 1) odd[t] = 1;
+            if ((same + opp) & 1) {
+                odd[t] = 1;
+                /* The rim edge once: at a's first a -> b, from the smaller end when both directions occur. */
+                if (!earlier && (a < b || !opp) && rim_push(&rim, &n_rim, &rim_cap, id, t, a, b)) goto oom;
+            }
         }
     free(start);
     start = NULL;
@@ -150,6 +173,10 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     dst = NULL;
     free(etri);
     etri = NULL;
+    /* The holed sets (label_sets below only compresses cparent's paths). */
+    if (ms_holes_cap(tri, n, id, rim, n_rim, cparent, out)) goto oom;
+    free(rim);
+    rim = NULL;
     free(id);
     id = NULL;
     const size_t nc = label_sets(parent, bad, n, out->component);   /* closed components */
@@ -196,6 +223,7 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
 oom:
     free(vslot);
     free(id);
+    free(rim);
     free(start);
     free(dst);
     free(etri);
@@ -214,6 +242,10 @@ void ms_closed_free(ms_closed *c)
     free(c->outward);
     free(c->cycle);
     free(c->cycle_box);
+    free(c->holed);
+    free(c->holed_box);
+    free(c->cap);
+    free(c->cap_start);
     memset(c, 0, sizeof *c);
 }
 

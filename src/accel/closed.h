@@ -31,7 +31,32 @@ typedef struct ms_closed {
     size_t n_cycles;
     float (*cycle_box)[6];
     size_t cycle_tris;
+    /* Holed sets (accel/holes.h): triangles connected through shared edges, not a cycle, with at least
+     * MS_HOLED_MIN_TRIS triangles and a short rim (the edges used an odd number of times: at most one per
+     * MS_HOLED_TRIS_PER_RIM_EDGE triangles), each made a mod-2 cycle by cap triangles across its rim. For the
+     * interior boxes only; they number after the cycles there (group n_cycles + h, ms_closed_group_box). */
+    uint32_t *holed;       /* per triangle: its holed set, or MS_OPEN_COMPONENT */
+    size_t n_holed;
+    float (*holed_box)[6]; /* per holed set, its caps included */
+    float *cap;            /* the cap triangles, 9 floats each, set by set */
+    size_t *cap_start;     /* holed set h's caps: cap_start[h] .. cap_start[h + 1] - 1 */
 } ms_closed;
+
+#define MS_HOLED_MIN_TRIS 256
+#define MS_HOLED_TRIS_PER_RIM_EDGE 16
+
+/* The interior boxes' groups: the cycles, then the holed sets. */
+static inline size_t ms_closed_groups(const ms_closed *c) { return c->n_cycles + c->n_holed; }
+static inline const float *ms_closed_group_box(const ms_closed *c, size_t k)
+{
+    return k < c->n_cycles ? c->cycle_box[k] : c->holed_box[k - c->n_cycles];
+}
+/* Triangle t's group, or MS_OPEN_COMPONENT. */
+static inline uint32_t ms_closed_group_of(const ms_closed *c, size_t t)
+{
+    if (c->cycle[t] != MS_OPEN_COMPONENT) return c->cycle[t];
+    return c->holed && c->holed[t] != MS_OPEN_COMPONENT ? (uint32_t)c->n_cycles + c->holed[t] : MS_OPEN_COMPONENT;
+}
 
 /* The closed components of n triangles (tri: 9 floats each). Work O(n log n), memory O(n). 0, or -1 when
  * out of memory (out zeroed). */

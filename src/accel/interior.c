@@ -11,6 +11,14 @@ enum { CELL_FREE = 0, CELL_MARKED = 1, CELL_OUTSIDE = 2, CELL_SEEN = 3, CELL_INS
 #define MAX_GROUPS 64
 #define MIN_GROUP_CELLS 8
 
+/* A group's triangles: ids below n_scene are the scene's (tri), the others a holed set's caps (cap). */
+typedef struct tri_src { const float *tri, *cap; size_t n_scene; } tri_src;
+
+static const float *src_tri(const tri_src *s, uint32_t id)
+{
+    return id < s->n_scene ? s->tri + 9 * (size_t)id : s->cap + 9 * ((size_t)id - s->n_scene);
+}
+
 typedef struct grid {
     int nx, ny, nz;
     double o[3], h;
@@ -56,12 +64,12 @@ static int tri_cube_overlap(const float *t, const double c[3], double r, double 
 /* The parity of the crossings of the ray p + t d (t > 0) with the cycle's triangles (Moller-Trumbore in
  * double): 1 odd, 0 even, -1 when the ray passes too close to an edge, a vertex or a plane to be sure (the
  * caller tries another direction). p is at least half a cell from every triangle, so t > 0 is clear. */
-static int ray_parity(const float *tri, const uint32_t *ids, size_t n, const double p[3], const double d[3], int threads)
+static int ray_parity(const tri_src *tri, const uint32_t *ids, size_t n, const double p[3], const double d[3], int threads)
 {
     int odd = 0, unsure = 0;
 #pragma omp parallel for reduction(^ : odd) reduction(| : unsure) schedule(static) num_threads(threads) if (n > 4096)
     for (size_t k = 0; k < n; k++) {
-        const float *t = tri + 9 * (size_t)ids[k];
+        const float *t = src_tri(tri, ids[k]);
         double e1[3], e2[3], s[3], h[3], q[3];
         for (int a = 0; a < 3; a++) { e1[a] = (double)t[3 + a] - t[a]; e2[a] = (double)t[6 + a] - t[a]; s[a] = p[a] - t[a]; }
         h[0] = d[1] * e2[2] - d[2] * e2[1]; h[1] = d[2] * e2[0] - d[0] * e2[2]; h[2] = d[0] * e2[1] - d[1] * e2[0];
@@ -89,7 +97,7 @@ static int ray_parity(const float *tri, const uint32_t *ids, size_t n, const dou
 
 /* Whether p is inside the cycle (odd crossings), by rays along fixed directions in turn until one is sure;
  * 0 when none is (the cells then stay out: always right). */
-static int inside_cycle(const float *tri, const uint32_t *ids, size_t n, const double p[3], int threads)
+static int inside_cycle(const tri_src *tri, const uint32_t *ids, size_t n, const double p[3], int threads)
 {
     static const double dirs[6][3] = { { 0.5773, 0.6181, 0.5331 }, { -0.3119, 0.8423, -0.4397 }, { 0.7071, -0.1234, 0.6963 },
                                        { -0.6513, -0.4455, 0.6142 }, { 0.1291, -0.9178, -0.3755 }, { -0.8236, 0.2468, -0.5107 } };
@@ -143,7 +151,7 @@ static int push_box(ms_interior *out, size_t *cap, const float b[6], uint32_t co
 }
 
 /* One cycle: its triangles ids[0..n), its box cbox. */
-static int component_boxes(const float *tri, const uint32_t *ids, size_t n, const float cbox[6], uint32_t comp,
+static int component_boxes(const tri_src *tri, const uint32_t *ids, size_t n, const float cbox[6], uint32_t comp,
                            int res, double eps, int threads, ms_interior *out, size_t *cap)
 {
     double ext = 0.0;
@@ -171,7 +179,7 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
      * slack covers the rounding of the cell coordinates. */
     const double slack = eps + 1e-9 * ext;
     for (size_t k = 0; k < n; k++) {
-        const float *t = tri + 9 * (size_t)ids[k];
+        const float *t = src_tri(tri, ids[k]);
         int lo[3], hi[3];
         for (int a = 0; a < 3; a++) {
             const double mn = fmin(fmin(t[a], t[3 + a]), t[6 + a]) - slack, mx = fmax(fmax(t[a], t[3 + a]), t[6 + a]) + slack;
@@ -245,11 +253,31 @@ static int component_boxes(const float *tri, const uint32_t *ids, size_t n, cons
     return rc;
 }
 
+/* Holed set h (closed.h) as a cycle: its triangles and its caps; its boxes numbered as group n_cycles + h. */
+static int holed_boxes(const tri_src *src, const ms_closed *c, uint32_t h, int res, size_t min_tris, double eps,
+                       int threads, ms_interior *out, size_t *cap)
+{
+    const size_t n = src->n_scene;
+    size_t m = 0;
+    for (size_t t = 0; t < n; t++) m += c->holed[t] == h;
+    if (m < min_tris) return 0;
+    const size_t nc = c->cap_start[h + 1] - c->cap_start[h];
+    uint32_t *ids = malloc((m + nc) * sizeof *ids);
+    if (!ids) return -1;
+    size_t k = 0;
+    for (size_t t = 0; t < n; t++)
+        if (c->holed[t] == h) ids[k++] = (uint32_t)t;
+    for (size_t i = 0; i < nc; i++) ids[k++] = (uint32_t)(n + c->cap_start[h] + i);
+    const int rc = component_boxes(src, ids, m + nc, c->holed_box[h], (uint32_t)(c->n_cycles + h), res, eps, threads, out, cap);
+    free(ids);
+    return rc;
+}
+
 int ms_interior_find(const float *tri, size_t n, const ms_closed *c, int res, size_t min_tris, double eps,
                      int threads, ms_interior *out)
 {
     memset(out, 0, sizeof *out);
-    if (!c->n_cycles || c->n_tris != n) return 0;
+    if (!ms_closed_groups(c) || c->n_tris != n) return 0;
     /* The triangles of each cycle, contiguous. */
     size_t *start = calloc(c->n_cycles + 1, sizeof *start);
     uint32_t *ids = malloc((c->cycle_tris ? c->cycle_tris : 1) * sizeof *ids);
@@ -265,13 +293,15 @@ int ms_interior_find(const float *tri, size_t n, const ms_closed *c, int res, si
     free(fill);
     size_t cap = 0;
     int rc = 0;
+    const tri_src src = { tri, c->cap, n };
     for (size_t k = 0; k < c->n_cycles && !rc; k++) {
         const size_t m = start[k + 1] - start[k];
         if (m < min_tris) continue;
-        rc = component_boxes(tri, ids + start[k], m, c->cycle_box[k], (uint32_t)k, res, eps, threads, out, &cap);
+        rc = component_boxes(&src, ids + start[k], m, c->cycle_box[k], (uint32_t)k, res, eps, threads, out, &cap);
     }
     free(start);
     free(ids);
+    for (size_t h = 0; h < c->n_holed && !rc; h++) rc = holed_boxes(&src, c, (uint32_t)h, res, min_tris, eps, threads, out, &cap);
     if (rc) ms_interior_free(out);
     return rc;
 }

@@ -34,7 +34,7 @@ typedef struct ms_interior {
     size_t n_boxes;
     float (*box)[6];        /* min x, y, z, max x, y, z: every point at least eps (L-infinity) from the
                              * cycle's triangles, inside it */
-    uint32_t *component;    /* per box: its cycle (ms_closed.cycle numbering) */
+    uint32_t *component;    /* per box: its group (closed.h: a cycle, or n_cycles + a holed set) */
 } ms_interior;
 
 /* The interior boxes of every cycle of the n triangles tri (9 floats each) with at least min_tris

@@ -42,13 +42,16 @@
  * of two >= 6n vertex slots (4 bytes), corner ids 12, the directed edges grouped by first vertex (offsets at
  * most 12, targets 12, triangles 12), unions 8, flags 2, components and cycles 8 per triangle (kept while
  * the lights' occluders are built), and the interior boxes' grid (accel/interior.c: at most
- * (MS_INTERIOR_RES_SILHOUETTE + 4)^3 cells of 9 bytes, one cycle at a time). */
+ * (MS_INTERIOR_RES_SILHOUETTE + 4)^3 cells of 9 bytes, one cycle at a time). The holed sets (accel/holes.c)
+ * take the rim's corners (at most 12 per triangle) while the edges are matched, within the sum above, then their
+ * sizes, rim counts, numbers, rim edges, ends and caps (at most 12 + 4 + 5) once the hash table and the edges
+ * are freed, within what those held; what stays is their labels (4) and one group's ids for its grid (4). */
 static uint64_t closed_find_bytes(uint64_t n)
 {
     uint64_t m = 16;
     while (m < 6 * n) m <<= 1;
     const uint64_t side = MS_INTERIOR_RES_SILHOUETTE + 4u;   /* res cells, a border each side, a spare, rounding */
-    return m * 4u + n * (12u + 36u + 8u + 2u + 8u) + side * side * side * 9u;
+    return m * 4u + n * (12u + 36u + 8u + 2u + 8u + 4u + 4u) + side * side * side * 9u;
 }
 /* A light's interior boxes (visibility/occluders.c, interior_build): at most one per MS_INTERIOR_TRIS_PER_BOX
  * triangles of a cycle and one more, whose MS_INTERIOR_MIN_TRIS triangles or more bound the extra one

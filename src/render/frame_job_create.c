@@ -77,9 +77,9 @@ static int occluders_build(ms_frame_job *j, int what, ms_stats *st)
     ms_interior interior = { 0 };
     if (ms_closed_find(j->scene->tri, j->scene->n_tris, &closed)) return -1;
     int rc = 0;
-    if (closed.n_cycles || (what & MS_OCC_MERGE)) {
+    if (ms_closed_groups(&closed) || (what & MS_OCC_MERGE)) {
         const double eps = ms_interior_clearance(&j->bvh, j->lights, j->nlights);
-        if ((what & MS_OCC_INTERIOR) && closed.n_cycles)
+        if ((what & MS_OCC_INTERIOR) && ms_closed_groups(&closed))
             rc = ms_interior_find(j->scene->tri, j->scene->n_tris, &closed, ms_interior_res(what), MS_INTERIOR_MIN_TRIS, eps, j->threads, &interior);
         j->occ = rc ? NULL : calloc(j->nlights, sizeof *j->occ);
         rc = j->occ ? 0 : -1;

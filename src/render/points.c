@@ -651,7 +651,7 @@ ms_status ms_visibility_points_local(const ms_accel *a, const ms_light *light, c
      * interior boxes (and the queries one batch at a time), a light of the scene gets the accel's culled set
      * with its boxes; otherwise the scene's triangles, with the interior boxes this light allows. */
     const long li = (sm->occluders & MS_OCC_CULL_BY_DEFAULT) && (sm->occluders & MS_OCC_INTERIOR) && !sm->visibility_all &&
-                    a->closed.n_cycles ? accel_light_index(a, light) : -1;
+                    ms_closed_groups(&a->closed) ? accel_light_index(a, light) : -1;
     const uint64_t call_need = ms_points_need(pts->n, a->view.n_tris, sm->visibility_all != NULL, (k * k + 63) / 64, threads, NULL);
     const ms_occluders *culled = li >= 0 ? accel_culled(a, (size_t)li, threads, call_need, budget) : NULL;
     uint64_t occ_boxes = 0, occ_culled = 0;

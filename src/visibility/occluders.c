@@ -6,6 +6,7 @@
 #include "light/light_shape.h"
 #include "light/light_frame.h"
 #include "accel/coplanar.h"
+#include "accel/holes.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -97,26 +98,39 @@ double ms_interior_clearance(const ms_bvh *scene_bvh, const ms_light *lights, si
     return 2.5 * (double)MS_SEGMENT_NEAR * d;
 }
 
-/* Per closed component (cycle: per mod-2 cycle): 1 when it holds an alpha-tested triangle (its surface is
- * porous: neither the cull nor the interior boxes hold), or NULL when the scene is opaque. */
-static uint8_t *porous_of(const ms_closed *closed, int cycle, const ms_bvh *scene_bvh, const struct ms_alpha *alpha, int *oom)
+/* Per closed component (group: per interior boxes' group, a mod-2 cycle or a holed set): 1 when it holds an
+ * alpha-tested triangle (its surface is porous: neither the cull nor the interior boxes hold), or NULL when the
+ * scene is opaque. */
+static uint8_t *porous_of(const ms_closed *closed, int group, const ms_bvh *scene_bvh, const struct ms_alpha *alpha, int *oom)
 {
     *oom = 0;
-    const size_t n = cycle ? closed->n_cycles : closed->n_components;
-    const uint32_t *of = cycle ? closed->cycle : closed->component;
+    const size_t n = group ? ms_closed_groups(closed) : closed->n_components;
     if (!alpha || !alpha->n_alpha || !n) return NULL;
     uint8_t *porous = calloc(n, 1);
     if (!porous) { *oom = 1; return NULL; }
     for (uint32_t i = 0; i < scene_bvh->n_tris; i++) {
-        const uint32_t c = of[scene_bvh->tri_source[i]];
+        const uint32_t t = scene_bvh->tri_source[i];
+        const uint32_t c = group ? ms_closed_group_of(closed, t) : closed->component[t];
         if (ms_alpha_tested(alpha, i) && c != MS_OPEN_COMPONENT) porous[c] = 1;
     }
     return porous;
 }
 
+/* 1 when box b of group k holds for the light: a cycle's always; a holed set's when no segment from the box to
+ * the light can pass through one of its caps (holes.h, ms_cap_hidden), so that every segment from inside it to
+ * the light leaves through the real surface (docs/culling.md, "Holes"). tol: the light points' rounding. */
+static int box_holds(const ms_closed *closed, size_t k, const float b[6], const float (*pts)[3], int np, double tol)
+{
+    if (k < closed->n_cycles) return 1;
+    const size_t h = k - closed->n_cycles;
+    for (size_t i = closed->cap_start[h]; i < closed->cap_start[h + 1]; i++)
+        if (!ms_cap_hidden(b, pts, np, closed->cap + 9 * i, tol)) return 0;
+    return 1;
+}
+
 /* The interior boxes whose cycle is apart from the light by `margin`, as up to 12 triangles each. */
 static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_interior *in, const uint8_t *porous,
-                          const float lbox[6], double margin, uint8_t *boxed, int threads)
+                          const float (*pts)[3], int np, const float lbox[6], double margin, uint8_t *boxed, int threads)
 {
     float *tri = malloc((in->n_boxes ? in->n_boxes : 1) * 12 * 9 * sizeof *tri);
     float *btri = malloc((in->n_boxes ? in->n_boxes : 1) * 9 * sizeof *btri);
@@ -126,13 +140,14 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
     for (size_t i = 0; i < in->n_boxes; i++) {
         const uint32_t k = in->component[i];
         if (porous && porous[k]) continue;
-        const float *cb = closed->cycle_box[k];
+        const float *cb = ms_closed_group_box(closed, k);
         int sep = 0;
         for (int a = 0; a < 3; a++)
             sep |= (double)lbox[a] > (double)cb[3 + a] + margin || (double)lbox[3 + a] < (double)cb[a] - margin;
         if (!sep) continue;
-        boxed[k] = 1;
         const float *b = in->box[i];
+        if (!box_holds(closed, k, b, pts, np, margin)) continue;
+        boxed[k] = 1;
         /* The whole box as one prim: a triangle from its low corner to its high one has the box as its bounds. */
         memcpy(kept[nb], b, sizeof kept[nb]);
         for (int a = 0; a < 3; a++) btri[9 * nb + a] = btri[9 * nb + 6 + a] = b[a];
@@ -309,7 +324,7 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
 {
     memset(o, 0, sizeof *o);
     const size_t n = scene->n_tris;
-    if (closed->n_tris != n || !scene_bvh->n_nodes || (!closed->n_cycles && !(what & MS_OCC_MERGE))) return 0;
+    if (closed->n_tris != n || !scene_bvh->n_nodes || (!ms_closed_groups(closed) && !(what & MS_OCC_MERGE))) return 0;
     float pts[8][3], lbox[6], sbox[6];
     const int np = ms_light_hull(l, pts, lbox);
     for (int i = 0; i < 6; i++)
@@ -325,8 +340,8 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
      * segment (docs/culling.md). */
     if ((what & MS_OCC_INTERIOR) && interior && interior->n_boxes && interior_eps >= 2.0 * (double)MS_SEGMENT_NEAR * diag) {
         uint8_t *porous = porous_of(closed, 1, scene_bvh, scene_alpha, &oom);
-        boxed = oom ? NULL : calloc(closed->n_cycles, 1);
-        rc = !boxed ? -1 : interior_build(o, closed, interior, porous, lbox, margin, boxed, threads);
+        boxed = oom ? NULL : calloc(ms_closed_groups(closed), 1);
+        rc = !boxed ? -1 : interior_build(o, closed, interior, porous, (const float (*)[3])pts, np, lbox, margin, boxed, threads);
         free(porous);
     }
     uint8_t *keep = NULL;
