@@ -23,6 +23,9 @@
 int ms_holes_cap(const float *tri, size_t n, const uint32_t *id, const uint32_t *rim, size_t n_rim, uint32_t *parent,
                  ms_closed *out);
 
+/* The most cap tests a light's boxes take (visibility/occluders.c): a few tens of milliseconds. */
+#define MS_CAP_TESTS_PER_LIGHT (1u << 21)
+
 /* 1 when no segment from a point of box b (min x, y, z, max x, y, z) to a point of the convex hull of the n_pts
  * light points pts comes within tol of the triangle cap (9 floats): a plane found (in double) with the box and
  * the light on one side and the cap beyond tol on the other. 0 when none of the candidate planes separates them:

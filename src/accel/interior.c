@@ -253,55 +253,42 @@ static int component_boxes(const tri_src *tri, const uint32_t *ids, size_t n, co
     return rc;
 }
 
-/* Holed set h (closed.h) as a cycle: its triangles and its caps; its boxes numbered as group n_cycles + h. */
-static int holed_boxes(const tri_src *src, const ms_closed *c, uint32_t h, int res, size_t min_tris, double eps,
-                       int threads, ms_interior *out, size_t *cap)
-{
-    const size_t n = src->n_scene;
-    size_t m = 0;
-    for (size_t t = 0; t < n; t++) m += c->holed[t] == h;
-    if (m < min_tris) return 0;
-    const size_t nc = c->cap_start[h + 1] - c->cap_start[h];
-    uint32_t *ids = malloc((m + nc) * sizeof *ids);
-    if (!ids) return -1;
-    size_t k = 0;
-    for (size_t t = 0; t < n; t++)
-        if (c->holed[t] == h) ids[k++] = (uint32_t)t;
-    for (size_t i = 0; i < nc; i++) ids[k++] = (uint32_t)(n + c->cap_start[h] + i);
-    const int rc = component_boxes(src, ids, m + nc, c->holed_box[h], (uint32_t)(c->n_cycles + h), res, eps, threads, out, cap);
-    free(ids);
-    return rc;
-}
-
 int ms_interior_find(const float *tri, size_t n, const ms_closed *c, int res, size_t min_tris, double eps,
                      int threads, ms_interior *out)
 {
     memset(out, 0, sizeof *out);
-    if (!ms_closed_groups(c) || c->n_tris != n) return 0;
-    /* The triangles of each cycle, contiguous. */
-    size_t *start = calloc(c->n_cycles + 1, sizeof *start);
-    uint32_t *ids = malloc((c->cycle_tris ? c->cycle_tris : 1) * sizeof *ids);
-    if (!start || !ids) { free(start); free(ids); return -1; }
-    for (size_t t = 0; t < n; t++)
-        if (c->cycle[t] != MS_OPEN_COMPONENT) start[c->cycle[t] + 1]++;
-    for (size_t k = 0; k < c->n_cycles; k++) start[k + 1] += start[k];
-    size_t *fill = malloc(c->n_cycles * sizeof *fill);
-    if (!fill) { free(start); free(ids); return -1; }
-    memcpy(fill, start, c->n_cycles * sizeof *fill);
-    for (size_t t = 0; t < n; t++)
-        if (c->cycle[t] != MS_OPEN_COMPONENT) ids[fill[c->cycle[t]]++] = (uint32_t)t;
+    const size_t ng = ms_closed_groups(c), n_caps = c->n_holed ? c->cap_start[c->n_holed] : 0;
+    if (!ng || c->n_tris != n) return 0;
+    /* The triangles of each group (a cycle, or a holed set followed by its caps, ids from n on), contiguous. */
+    size_t *start = calloc(ng + 1, sizeof *start), *fill = malloc(ng * sizeof *fill);
+    size_t total = n_caps;
+    for (size_t t = 0; start && t < n; t++) {
+        const uint32_t g = ms_closed_group_of(c, t);
+        if (g != MS_OPEN_COMPONENT) { start[g + 1]++; total++; }
+    }
+    uint32_t *ids = malloc((total ? total : 1) * sizeof *ids);
+    if (!start || !fill || !ids) { free(start); free(fill); free(ids); return -1; }
+    for (size_t h = 0; h < c->n_holed; h++) start[c->n_cycles + h + 1] += c->cap_start[h + 1] - c->cap_start[h];
+    for (size_t g = 0; g < ng; g++) start[g + 1] += start[g];
+    memcpy(fill, start, ng * sizeof *fill);
+    for (size_t t = 0; t < n; t++) {
+        const uint32_t g = ms_closed_group_of(c, t);
+        if (g != MS_OPEN_COMPONENT) ids[fill[g]++] = (uint32_t)t;
+    }
+    for (size_t h = 0; h < c->n_holed; h++)
+        for (size_t i = c->cap_start[h]; i < c->cap_start[h + 1]; i++) ids[fill[c->n_cycles + h]++] = (uint32_t)(n + i);
     free(fill);
     size_t cap = 0;
     int rc = 0;
     const tri_src src = { tri, c->cap, n };
-    for (size_t k = 0; k < c->n_cycles && !rc; k++) {
-        const size_t m = start[k + 1] - start[k];
-        if (m < min_tris) continue;
-        rc = component_boxes(&src, ids + start[k], m, c->cycle_box[k], (uint32_t)k, res, eps, threads, out, &cap);
+    for (size_t g = 0; g < ng && !rc; g++) {
+        const size_t m = start[g + 1] - start[g];
+        const size_t real = g < c->n_cycles ? m : m - (c->cap_start[g - c->n_cycles + 1] - c->cap_start[g - c->n_cycles]);
+        if (real < min_tris) continue;
+        rc = component_boxes(&src, ids + start[g], m, ms_closed_group_box(c, g), (uint32_t)g, res, eps, threads, out, &cap);
     }
     free(start);
     free(ids);
-    for (size_t h = 0; h < c->n_holed && !rc; h++) rc = holed_boxes(&src, c, (uint32_t)h, res, min_tris, eps, threads, out, &cap);
     if (rc) ms_interior_free(out);
     return rc;
 }

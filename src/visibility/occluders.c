@@ -118,11 +118,16 @@ static uint8_t *porous_of(const ms_closed *closed, int group, const ms_bvh *scen
 
 /* 1 when box b of group k holds for the light: a cycle's always; a holed set's when no segment from the box to
  * the light can pass through one of its caps (holes.h, ms_cap_hidden), so that every segment from inside it to
- * the light leaves through the real surface (docs/culling.md, "Holes"). tol: the light points' rounding. */
-static int box_holds(const ms_closed *closed, size_t k, const float b[6], const float (*pts)[3], int np, double tol)
+ * the light leaves through the real surface (docs/culling.md, "Holes"). tol: the light points' rounding. *tests
+ * counts the cap tests of the light: past MS_CAP_TESTS_PER_LIGHT the holed sets' boxes left are left out (a
+ * long rim and many boxes would otherwise cost boxes times caps). */
+static int box_holds(const ms_closed *closed, size_t k, const float b[6], const float (*pts)[3], int np, double tol,
+                     size_t *tests)
 {
     if (k < closed->n_cycles) return 1;
-    const size_t h = k - closed->n_cycles;
+    const size_t h = k - closed->n_cycles, n_caps = closed->cap_start[h + 1] - closed->cap_start[h];
+    if (*tests + n_caps > MS_CAP_TESTS_PER_LIGHT) return 0;
+    *tests += n_caps;
     for (size_t i = closed->cap_start[h]; i < closed->cap_start[h + 1]; i++)
         if (!ms_cap_hidden(b, pts, np, closed->cap + 9 * i, tol)) return 0;
     return 1;
@@ -136,7 +141,7 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
     float *btri = malloc((in->n_boxes ? in->n_boxes : 1) * 9 * sizeof *btri);
     float (*kept)[6] = malloc((in->n_boxes ? in->n_boxes : 1) * sizeof *kept);
     if (!tri || !btri || !kept) { free(tri); free(btri); free(kept); return -1; }
-    size_t nb = 0, nt = 0;
+    size_t nb = 0, nt = 0, cap_tests = 0;
     for (size_t i = 0; i < in->n_boxes; i++) {
         const uint32_t k = in->component[i];
         if (porous && porous[k]) continue;
@@ -146,7 +151,7 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
             sep |= (double)lbox[a] > (double)cb[3 + a] + margin || (double)lbox[3 + a] < (double)cb[a] - margin;
         if (!sep) continue;
         const float *b = in->box[i];
-        if (!box_holds(closed, k, b, pts, np, margin)) continue;
+        if (!box_holds(closed, k, b, pts, np, margin, &cap_tests)) continue;
         boxed[k] = 1;
         /* The whole box as one prim: a triangle from its low corner to its high one has the box as its bounds. */
         memcpy(kept[nb], b, sizeof kept[nb]);
