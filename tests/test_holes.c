@@ -8,7 +8,8 @@
  * (the driver's rule, occluders.c): every segment sampled from a kept box to the light meets a real triangle,
  * so it is occluded whatever the receiver; a light that looks into the hole keeps fewer. Frames of a holed
  * sphere over a ground: every method that takes the boxes (scanline by block and by pixel, hierarchical, mft)
- * equals raytrace bit for bit, for a light above (the hole on the side) and one that sees into the hole. */
+ * equals raytrace bit for bit, for a light above (the hole on the side) and one that sees into the hole; so does the
+ * points API (a bake's path) on the ground and on every sphere triangle, facing out and in. */
 #include "testutil.h"
 #include "accel/closed.h"
 #include "accel/holes.h"
@@ -307,37 +308,48 @@ static void test_boxes_exact(void **st)
 
 /* ---- frames ---- */
 
-static void test_holed_frames(void **st)
+/* The Quad with a ground and a holed sphere (5120 triangles less a cap on the +x side, which the camera sees into)
+ * instead of its occluder; the sphere's triangles from index 2 on. */
+static void holed_scene(ms_scene *sc)
 {
-    (void)st;
-    ms_scene sc;
-    tu_make_quad(&sc);
+    tu_make_quad(sc);
     tm_mesh m = { 0 };
     tm_ground(&m);
     tm_mesh sphere = { 0 };
     const double c[3] = { 0.3, 1.6, -0.2 };
     tm_icosphere(&sphere, c, 1.2, 4, 0, 0.08, 11);
-    cut(&sphere, 0, 0.3 + 0.85 * 1.2, 10.0);   /* a hole on the +x side, which the camera sees into */
+    cut(&sphere, 0, 0.3 + 0.85 * 1.2, 10.0);
     for (size_t t = 0; t < sphere.n; t++) {
         const float *p = sphere.tri + 9 * t;
         const double a[3] = { p[0], p[1], p[2] }, b[3] = { p[3], p[4], p[5] }, d[3] = { p[6], p[7], p[8] };
         tm_add_tri(&m, a, b, d);
     }
     free(sphere.tri);
-    free(sc.tri);
-    sc.tri = m.tri;
-    sc.n_tris = m.n;
-    sc.camera.width = sc.camera.height = 64;
-    sc.camera.eye = (ms_vec3){ 4, 4, 4 };
-    sc.camera.target = (ms_vec3){ 0, 0.8f, 0 };
+    free(sc->tri);
+    sc->tri = m.tri;
+    sc->n_tris = m.n;
+    sc->camera.width = sc->camera.height = 64;
+    sc->camera.eye = (ms_vec3){ 4, 4, 4 };
+    sc->camera.target = (ms_vec3){ 0, 0.8f, 0 };
+}
+
+/* The second light: above the hole's side, so that the boxes near the hole see it through the hole. */
+static void light_above_hole(ms_light *l)
+{
+    l->corner = (ms_vec3){ 2.1f, 3.6f, -0.7f };
+    l->edge_s = (ms_vec3){ 1, 0, 0 };
+    l->edge_t = (ms_vec3){ 0, 0, 1 };
+}
+
+static void test_holed_frames(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    holed_scene(&sc);
     const int npix = 64 * 64;
     uint64_t boxes[2];
     for (int light = 0; light < 2; light++) {
-        if (light == 1) {   /* above the hole's side: the boxes near the hole see it through the hole */
-            sc.light.corner = (ms_vec3){ 2.1f, 3.6f, -0.7f };
-            sc.light.edge_s = (ms_vec3){ 1, 0, 0 };
-            sc.light.edge_t = (ms_vec3){ 0, 0, 1 };
-        }
+        if (light == 1) light_above_hole(&sc.light);
         ms_render_options o;
         tu_render_options_default(&o);
         o.threads = 2;
@@ -370,6 +382,71 @@ static void test_holed_frames(void **st)
     ms_scene_free(&sc);
 }
 
+/* The points API (a bake's path) with the holed sphere's boxes: raytrace's V point for point, on the ground around
+ * the sphere and at the centroid of every sphere triangle, every other one facing inwards (the inside, lit through
+ * the hole). */
+static void test_holed_points(void **st)
+{
+    (void)st;
+    ms_scene sc;
+    holed_scene(&sc);
+    ms_accel *acc;
+    char err[256];
+    assert_int_equal(ms_accel_build(&sc, 2, &acc, err, sizeof err), MS_OK);
+    const size_t n_sphere = sc.n_tris - 2, n = n_sphere + 1000;
+    float *pos = malloc(n * 3 * sizeof *pos), *nrm = malloc(n * 3 * sizeof *nrm);
+    uint32_t *tri = malloc(n * sizeof *tri);
+    assert_true(pos && nrm && tri);
+    unsigned seed = 5;
+    for (size_t i = 0; i < n; i++) {
+        if (i >= n_sphere) {
+            pos[3 * i] = (float)(-2.7 + 6.0 * tm_urand(&seed));
+            pos[3 * i + 1] = 0.0f;
+            pos[3 * i + 2] = (float)(-3.2 + 6.0 * tm_urand(&seed));
+            nrm[3 * i] = 0.0f; nrm[3 * i + 1] = 1.0f; nrm[3 * i + 2] = 0.0f;
+            tri[i] = 0;   /* either ground triangle: both lie in y = 0 */
+            continue;
+        }
+        const float *p = sc.tri + 9 * (i + 2);
+        double e1[3], e2[3];
+        for (int a = 0; a < 3; a++) {
+            pos[3 * i + (size_t)a] = (p[a] + p[3 + a] + p[6 + a]) / 3.0f;
+            e1[a] = (double)p[3 + a] - p[a];
+            e2[a] = (double)p[6 + a] - p[a];
+        }
+        /* every other one facing inwards: the inside seen through the hole, whose segments cross the boxes */
+        const float sgn = i % 2 ? -1.0f : 1.0f;
+        nrm[3 * i] = sgn * (float)(e1[1] * e2[2] - e1[2] * e2[1]);
+        nrm[3 * i + 1] = sgn * (float)(e1[2] * e2[0] - e1[0] * e2[2]);
+        nrm[3 * i + 2] = sgn * (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+        tri[i] = (uint32_t)(i + 2);
+    }
+    const ms_points pts = { n, pos, nrm, tri, NULL };
+    float *v_sl = malloc(n * sizeof *v_sl), *v_rt = malloc(n * sizeof *v_rt);
+    assert_true(v_sl && v_rt);
+    ms_points_options o = { 0 };
+    o.threads = 2;
+    o.isa = tu_isa_cap();
+    for (int light = 0; light < 2; light++) {
+        ms_light l = sc.light;
+        if (light == 1) light_above_hole(&l);
+        ms_stats s_sl;
+        o.method = "scanline";
+        assert_int_equal(ms_visibility_points(acc, &l, &pts, &o, v_sl, NULL, NULL, &s_sl, err, sizeof err), MS_OK);
+        o.method = "raytrace";
+        assert_int_equal(ms_visibility_points(acc, &l, &pts, &o, v_rt, NULL, NULL, NULL, err, sizeof err), MS_OK);
+        int shadowed = 0;
+        for (size_t i = 0; i < n; i++) shadowed += v_rt[i] >= 0.0f && v_rt[i] < 1.0f;
+        print_message("points, light %d: %d shadowed, %llu boxes\n", light, shadowed, (unsigned long long)s_sl.interior_boxes);
+        assert_true(shadowed > 500);
+        assert_true(s_sl.interior_boxes > 0);
+        assert_memory_equal(v_sl, v_rt, n * sizeof *v_sl);
+    }
+    free(v_sl); free(v_rt); free(pos); free(nrm); free(tri);
+    ms_accel_free(acc);
+    ms_scene_free(&sc);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -377,6 +454,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_cap_hidden_sampled),
         cmocka_unit_test(test_boxes_exact),
         cmocka_unit_test(test_holed_frames),
+        cmocka_unit_test(test_holed_points),
     };
     return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }
