@@ -514,16 +514,7 @@ static void test_interior_points(void **st)
             tri[i] = 0;   /* x, z on either ground triangle: both lie in the plane y = 0; 0 keeps its own out */
         } else {
             const uint32_t t = 2 + (uint32_t)(tm_urand(&seed) * 5120.0) % 5120;
-            const float *p = m.tri + 9 * (size_t)t;
-            double e1[3], e2[3];
-            for (int a = 0; a < 3; a++) {
-                pos[3 * i + (size_t)a] = (p[a] + p[3 + a] + p[6 + a]) / 3.0f;
-                e1[a] = (double)p[3 + a] - p[a];
-                e2[a] = (double)p[6 + a] - p[a];
-            }
-            nrm[3 * i] = (float)(e1[1] * e2[2] - e1[2] * e2[1]);
-            nrm[3 * i + 1] = (float)(e1[2] * e2[0] - e1[0] * e2[2]);
-            nrm[3 * i + 2] = (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+            tm_centroid_normal(m.tri + 9 * (size_t)t, pos + 3 * i, nrm + 3 * i);
             tri[i] = t;
         }
     }

@@ -407,18 +407,10 @@ static void test_holed_points(void **st)
             tri[i] = 0;   /* either ground triangle: both lie in y = 0 */
             continue;
         }
-        const float *p = sc.tri + 9 * (i + 2);
-        double e1[3], e2[3];
-        for (int a = 0; a < 3; a++) {
-            pos[3 * i + (size_t)a] = (p[a] + p[3 + a] + p[6 + a]) / 3.0f;
-            e1[a] = (double)p[3 + a] - p[a];
-            e2[a] = (double)p[6 + a] - p[a];
-        }
+        tm_centroid_normal(sc.tri + 9 * (i + 2), pos + 3 * i, nrm + 3 * i);
         /* every other one facing inwards: the inside seen through the hole, whose segments cross the boxes */
-        const float sgn = i % 2 ? -1.0f : 1.0f;
-        nrm[3 * i] = sgn * (float)(e1[1] * e2[2] - e1[2] * e2[1]);
-        nrm[3 * i + 1] = sgn * (float)(e1[2] * e2[0] - e1[0] * e2[2]);
-        nrm[3 * i + 2] = sgn * (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+        if (i % 2)
+            for (int a = 0; a < 3; a++) nrm[3 * i + (size_t)a] = -nrm[3 * i + (size_t)a];
         tri[i] = (uint32_t)(i + 2);
     }
     const ms_points pts = { n, pos, nrm, tri, NULL };

@@ -58,8 +58,8 @@ static inline uint32_t ms_closed_group_of(const ms_closed *c, size_t t)
     return c->holed && c->holed[t] != MS_OPEN_COMPONENT ? (uint32_t)c->n_cycles + c->holed[t] : MS_OPEN_COMPONENT;
 }
 
-/* The closed components of n triangles (tri: 9 floats each). Work O(n log n), memory O(n). 0, or -1 when
- * out of memory (out zeroed). */
+/* The closed components, the mod-2 cycles and the holed sets with their caps of n triangles (tri: 9 floats
+ * each). Work O(n log n), memory O(n). 0, or -1 when out of memory (out zeroed). */
 int ms_closed_find(const float *tri, size_t n, ms_closed *out);
 void ms_closed_free(ms_closed *c);
 

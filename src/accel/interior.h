@@ -37,10 +37,12 @@ typedef struct ms_interior {
     uint32_t *component;    /* per box: its group (closed.h: a cycle, or n_cycles + a holed set) */
 } ms_interior;
 
-/* The interior boxes of every cycle of the n triangles tri (9 floats each) with at least min_tris
- * triangles, on a grid of `res` cells along each cycle's longest side (halved, down to 16, while a cell is no
- * wider than four clearances); eps: the clearance from the surface, in world units; threads: OpenMP threads of the parity rays. Work O(n + res^3 + groups * n), memory O(res^3). 0, or -1 when out
- * of memory (out zeroed). */
+/* The interior boxes of every group of c (closed.h: each cycle, and each holed set with its caps) of the n
+ * triangles tri (9 floats each) with at least min_tris triangles of the scene, on a grid of `res` cells along
+ * each group's longest side (halved, down to 16, while a cell is no wider than four clearances); eps: the
+ * clearance from the surface, caps included, in world units; threads: OpenMP threads of the parity rays. Work
+ * O(n + res^3 + groups * n), memory O(res^3). 0, or -1 when out of memory (out zeroed). A holed set's box holds
+ * for a light only where its caps hide it (visibility/occluders.c). */
 int ms_interior_find(const float *tri, size_t n, const ms_closed *c, int res, size_t min_tris, double eps,
                      int threads, ms_interior *out);
 void ms_interior_free(ms_interior *in);

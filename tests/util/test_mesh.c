@@ -98,6 +98,19 @@ void tm_box(tm_mesh *m, const double lo[3], const double hi[3], int flip)
 
 /* Does the segment p + u (l - p), u in [TM_NEAR, TM_FAR], meet triangle t? Double precision, Moller-Trumbore;
  * an independent answer up to ties (a segment through an edge or vertex, which random cases avoid). */
+void tm_centroid_normal(const float *t, float pos[3], float nrm[3])
+{
+    double e1[3], e2[3];
+    for (int a = 0; a < 3; a++) {
+        pos[a] = (t[a] + t[3 + a] + t[6 + a]) / 3.0f;
+        e1[a] = (double)t[3 + a] - t[a];
+        e2[a] = (double)t[6 + a] - t[a];
+    }
+    nrm[0] = (float)(e1[1] * e2[2] - e1[2] * e2[1]);
+    nrm[1] = (float)(e1[2] * e2[0] - e1[0] * e2[2]);
+    nrm[2] = (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+}
+
 int tm_seg_hits(const float *t, const double p[3], const double l[3])
 {
     double e1[3], e2[3], d[3], s[3], h[3], q[3];

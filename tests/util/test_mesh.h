@@ -19,6 +19,8 @@ void tm_icosphere(tm_mesh *m, const double c[3], double r, int s, int flip, doub
 void tm_ground(tm_mesh *m);
 /* An axis-aligned box [lo, hi], outward winding (flip: inward). */
 void tm_box(tm_mesh *m, const double lo[3], const double hi[3], int flip);
+/* The centroid of triangle t into pos and its winding's normal (not normalised) into nrm. */
+void tm_centroid_normal(const float *t, float pos[3], float nrm[3]);
 /* Does the segment p + u (l - p), u in [TM_NEAR, TM_FAR], meet triangle t? Double precision, Moller-Trumbore. */
 int tm_seg_hits(const float *t, const double p[3], const double l[3]);
 /* A uniform number in [0, 1) from the state s. */
