@@ -23,7 +23,8 @@
 int ms_holes_cap(const float *tri, size_t n, const uint32_t *id, const uint32_t *rim, size_t n_rim, uint32_t *parent,
                  ms_closed *out);
 
-/* The most cap tests a light's boxes take (visibility/occluders.c): a few tens of milliseconds. */
+/* The most cap tests a light's boxes take (visibility/occluders.c): a bound on the set-up that does not grow with
+ * boxes times caps. */
 #define MS_CAP_TESTS_PER_LIGHT (1u << 21)
 
 /* 1 when no segment from a point of box b (min x, y, z, max x, y, z) to a point of the convex hull of the n_pts
