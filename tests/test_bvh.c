@@ -4,7 +4,8 @@
  * ms_intersect_triangle, so that the traversal (box culling, ordering, early exits, the stack) is what
  * is under test. ms_intersect_triangle itself is checked separately against a double-precision
  * barycentric test on rays that are not near any edge. Rays: thousands per soup, random, axis-parallel,
- * along triangle edges, through vertices, and finite segments with random skip triangles. */
+ * along triangle edges, through vertices, and finite segments with random skip triangles. The same for a BVH
+ * pruned to a subset of its triangles (ms_bvh_filter), against brute force over that subset. */
 #include "testutil.h"
 #include "accel/bvh.h"
 #include <math.h>
@@ -189,14 +190,10 @@ static void random_dir(tu_rng *g, float d[3])
     } while (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < 0.01f);
 }
 
-static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
+/* nrays rays of six kinds aimed at the soup's triangles, through b and brute force over the soup. */
+static void run_rays(const ms_bvh *b, const float *soup, size_t m, tu_rng *gp, int nrays, int kind)
 {
-    tu_rng g = { seed };
-    size_t m;
-    float *soup = make_soup(kind, n, &g, &m);
-    ms_bvh b;
-    assert_int_equal(ms_bvh_build(&b, soup, m, 0), 0);
-    check_structure(&b, soup, m);
+    tu_rng g = *gp;
     counts cs[6];
     memset(cs, 0, sizeof cs);
     for (int i = 0; i < nrays; i++) {
@@ -245,7 +242,7 @@ static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
         if (r.d[0] == 0 && r.d[1] == 0 && r.d[2] == 0) continue;
         char what[64];
         snprintf(what, sizeof what, "soup kind %d, ray %d (type %d)", kind, i, type);
-        check_ray(&b, soup, m, &r, &g, &cs[type], what);
+        check_ray(b, soup, m, &r, &g, &cs[type], what);
     }
     counts c = { 0, 0, 0, 0, 0 };
     static const char *const type_name[6] = { "random", "to a vertex", "along an edge", "axis-parallel through a vertex",
@@ -264,8 +261,103 @@ static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
     assert_true(c.rays > nrays * 9 / 10);
     assert_true(c.closest_hits > c.rays / 10);
     assert_true(c.closest_hits < c.rays);
+    *gp = g;
+}
+
+static void run_soup(int kind, size_t n, uint64_t seed, int nrays)
+{
+    tu_rng g = { seed };
+    size_t m;
+    float *soup = make_soup(kind, n, &g, &m);
+    ms_bvh b;
+    assert_int_equal(ms_bvh_build(&b, soup, m, 0), 0);
+    check_structure(&b, soup, m);
+    run_rays(&b, soup, m, &g, nrays, kind);
     ms_bvh_free(&b);
     free(soup);
+}
+
+/* Leaves of nd's subtree; every box is asserted to be exactly its contents' (leaves: their triangles' vertices;
+ * interior nodes: the union of their children's), i.e. refitted, not the source's. */
+static uint32_t check_tight(const ms_bvh *b, uint32_t ni, float lo[3], float hi[3])
+{
+    const ms_bvh_node *nd = &b->nodes[ni];
+    uint32_t leaves = 1;
+    for (int a = 0; a < 3; a++) { lo[a] = INFINITY; hi[a] = -INFINITY; }
+    if (nd->count) {
+        for (uint32_t i = nd->first; i < nd->first + nd->count; i++)
+            for (int v = 0; v < 3; v++)
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fminf(lo[a], b->tri[9 * (size_t)i + 3 * v + a]);
+                    hi[a] = fmaxf(hi[a], b->tri[9 * (size_t)i + 3 * v + a]);
+                }
+    } else {
+        float l2[3], h2[3];
+        leaves = check_tight(b, nd->first, lo, hi) + check_tight(b, nd->first + 1, l2, h2);
+        for (int a = 0; a < 3; a++) { lo[a] = fminf(lo[a], l2[a]); hi[a] = fmaxf(hi[a], h2[a]); }
+    }
+    for (int a = 0; a < 3; a++) assert_true(nd->bmin[a] == lo[a] && nd->bmax[a] == hi[a]);
+    return leaves;
+}
+
+/* ms_bvh_filter: the kept triangles of a built BVH (every other one at random, one half-space of the soup as a
+ * cull keeps one side of a solid, all but one, a single one) against brute force over the kept soup; the tree is
+ * the source's pruned (no more nodes than a binary tree over its leaves needs, boxes refitted, the kept
+ * triangles in the source's order). */
+static void run_filtered(int kind, size_t n, uint64_t seed, int nrays)
+{
+    tu_rng g = { seed };
+    size_t m;
+    float *soup = make_soup(kind, n, &g, &m);
+    ms_bvh b;
+    assert_int_equal(ms_bvh_build(&b, soup, m, 0), 0);
+    uint8_t *keep = malloc(m);
+    float *kept_soup = malloc(9 * m * sizeof(float));
+    float xlo = INFINITY, xhi = -INFINITY;   /* the soup's extent along x, for the half-space */
+    for (size_t i = 0; i < 3 * m; i++) { xlo = fminf(xlo, soup[3 * i]); xhi = fmaxf(xhi, soup[3 * i]); }
+    for (int mode = 0; mode < 4; mode++) {
+        size_t nk = 0;
+        for (uint32_t i = 0; i < b.n_tris; i++) {
+            const float *t = b.tri + 9 * (size_t)i;
+            keep[i] = mode == 0 ? (uint8_t)(tu_rng_next(&g) & 1) : mode == 1 ? t[0] + t[3] + t[6] < 1.5f * (xlo + xhi)
+                    : mode == 2 ? i != b.n_tris / 2 : i == b.n_tris / 3;
+            nk += keep[i];
+        }
+        ms_bvh f;
+        assert_int_equal(ms_bvh_filter(&f, &b, keep), 0);
+        /* The kept triangles in source leaf order, and f's tri_source renumbered to index them. */
+        uint32_t *rank = malloc(m * sizeof *rank);
+        size_t r = 0;
+        for (uint32_t i = 0; i < b.n_tris; i++)
+            if (keep[i]) { rank[i] = (uint32_t)r; memcpy(kept_soup + 9 * r++, b.tri + 9 * (size_t)i, 9 * sizeof(float)); }
+        for (uint32_t i = 0; i < f.n_tris; i++) {
+            assert_true(f.tri_source[i] < b.n_tris && keep[f.tri_source[i]]);
+            assert_true(i == 0 || f.tri_source[i] > f.tri_source[i - 1]);   /* the source's order */
+            assert_memory_equal(f.tri_n + 3 * (size_t)i, b.tri_n + 3 * (size_t)f.tri_source[i], 3 * sizeof(float));
+            f.tri_source[i] = rank[f.tri_source[i]];
+        }
+        check_structure(&f, kept_soup, nk);
+        float lo[3], hi[3];
+        assert_int_equal(f.n_nodes, 2 * check_tight(&f, 0, lo, hi) - 1);
+        if (nk > 1) run_rays(&f, kept_soup, nk, &g, nrays, kind);
+        free(rank);
+        ms_bvh_free(&f);
+    }
+    memset(keep, 0, m);
+    ms_bvh f;
+    assert_int_equal(ms_bvh_filter(&f, &b, keep), -1);   /* nothing kept */
+    free(keep);
+    free(kept_soup);
+    ms_bvh_free(&b);
+    free(soup);
+}
+
+static void test_filtered(void **st)
+{
+    (void)st;
+    run_filtered(SOUP_RANDOM, 3000, 11, 1500);
+    run_filtered(SOUP_GRID, 10000, 12, 1500);
+    run_filtered(SOUP_CLUSTER, 3000, 13, 800);
 }
 
 static void test_random_soups(void **st)
@@ -403,6 +495,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_axis_aligned_grid),
         cmocka_unit_test(test_grid_edges_and_vertices),
         cmocka_unit_test(test_cluster_and_slivers),
+        cmocka_unit_test(test_filtered),
     };
     return tu_run_group_tests(tests, NULL, NULL, argc, argv);
 }

@@ -38,6 +38,11 @@ typedef struct ms_ray_hit {
 /* threads: OpenMP threads for the build (0: all cores); the caller's OpenMP settings are left alone. */
 int ms_bvh_build(ms_bvh *b, const float *tri, size_t n, int threads);
 void ms_bvh_free(ms_bvh *b);
+/* The BVH of the triangles of src with keep[i] != 0 (i in src's leaf order), pruned from src's tree
+ * (bvh_filter.c) rather than built anew: the same nodes less the emptied ones, boxes refitted, the kept
+ * triangles in src's order. out->tri_source[j] is the src leaf-order index of out's triangle j. Returns 0,
+ * or -1 when out of memory or nothing is kept (out zeroed). */
+int ms_bvh_filter(ms_bvh *out, const ms_bvh *src, const uint8_t *keep);
 
 /* 1 and the nearest hit in (tmin, tmax), or 0. */
 int ms_bvh_closest(const ms_bvh *b, const ms_ray *r, ms_ray_hit *hit);

@@ -135,7 +135,7 @@ static int box_holds(const ms_closed *closed, size_t k, const float b[6], const 
 
 /* The interior boxes whose cycle is apart from the light by `margin`, as up to 12 triangles each. */
 static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_interior *in, const uint8_t *porous,
-                          const float (*pts)[3], int np, const float lbox[6], double margin, uint8_t *boxed, int threads)
+                          const float (*pts)[3], int np, const float lbox[6], double margin, int threads)
 {
     float *tri = malloc((in->n_boxes ? in->n_boxes : 1) * 12 * 9 * sizeof *tri);
     float *btri = malloc((in->n_boxes ? in->n_boxes : 1) * 9 * sizeof *btri);
@@ -152,7 +152,6 @@ static int interior_build(ms_occluders *o, const ms_closed *closed, const ms_int
         if (!sep) continue;
         const float *b = in->box[i];
         if (!box_holds(closed, k, b, pts, np, margin, &cap_tests)) continue;
-        boxed[k] = 1;
         /* The whole box as one prim: a triangle from its low corner to its high one has the box as its bounds. */
         memcpy(kept[nb], b, sizeof kept[nb]);
         for (int a = 0; a < 3; a++) btri[9 * nb + a] = btri[9 * nb + 6 + a] = b[a];
@@ -226,20 +225,37 @@ static int set_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *scene
         o->merged = nk - nb;
     }
     o->prim_map = malloc((size_t)scene_bvh->n_tris * sizeof *o->prim_map);
-    if (!o->prim_map || ms_bvh_build(&o->bvh, btri, nb, threads)) goto done;
-    /* The occluder BVH's tri_source indexes its input list: composed back to the scene's triangles (a
-     * merged rectangle names one of its halves), and each scene triangle's occluder prim (a merged one:
-     * its rectangle's first triangle; the near range keeps a receiver off the coplanar second). */
-    uint32_t *leaf_of_set = malloc((nb ? nb : 1) * sizeof *leaf_of_set);
-    if (!leaf_of_set) goto done;
-    for (uint32_t i = 0; i < o->bvh.n_tris; i++) {
-        const uint32_t in = o->bvh.tri_source[i];
-        leaf_of_set[in] = i;
-        o->bvh.tri_source[i] = src[merge ? msrc[in] : in];
-    }
+    if (!o->prim_map) goto done;
     for (size_t t = 0; t < n; t++) occ_of_tri[t] = UINT32_MAX;
-    for (size_t k = 0; k < nk; k++) occ_of_tri[src[k]] = leaf_of_set[merge ? of_kept[k] : k];
-    free(leaf_of_set);
+    if (nb == nk) {
+        /* Nothing merged: the scene's tree pruned to the kept triangles (ms_bvh_filter), a pass over it
+         * where a build would sort them again; its tri_source (scene leaf order) composed back to the
+         * scene's triangles. */
+        uint8_t *keep_leaf = malloc(scene_bvh->n_tris ? scene_bvh->n_tris : 1);
+        if (!keep_leaf) goto done;
+        for (uint32_t i = 0; i < scene_bvh->n_tris; i++) keep_leaf[i] = keep[scene_bvh->tri_source[i]];
+        const int frc = ms_bvh_filter(&o->bvh, scene_bvh, keep_leaf);
+        free(keep_leaf);
+        if (frc) goto done;
+        for (uint32_t i = 0; i < o->bvh.n_tris; i++) {
+            o->bvh.tri_source[i] = scene_bvh->tri_source[o->bvh.tri_source[i]];
+            occ_of_tri[o->bvh.tri_source[i]] = i;
+        }
+    } else {
+        if (ms_bvh_build(&o->bvh, btri, nb, threads)) goto done;
+        /* The occluder BVH's tri_source indexes its input list: composed back to the scene's triangles (a
+         * merged rectangle names one of its halves), and each scene triangle's occluder prim (a merged one:
+         * its rectangle's first triangle; the near range keeps a receiver off the coplanar second). */
+        uint32_t *leaf_of_set = malloc((nb ? nb : 1) * sizeof *leaf_of_set);
+        if (!leaf_of_set) goto done;
+        for (uint32_t i = 0; i < o->bvh.n_tris; i++) {
+            const uint32_t in = o->bvh.tri_source[i];
+            leaf_of_set[in] = i;
+            o->bvh.tri_source[i] = src[merge ? msrc[in] : in];
+        }
+        for (size_t k = 0; k < nk; k++) occ_of_tri[src[k]] = leaf_of_set[merge ? of_kept[k] : k];
+        free(leaf_of_set);
+    }
     for (uint32_t i = 0; i < scene_bvh->n_tris; i++) o->prim_map[i] = occ_of_tri[scene_bvh->tri_source[i]];
     if (o->merged) {
         /* Receivers on merged faces (coplanar.h) are answered on the scene's own triangles. */
@@ -296,7 +312,7 @@ static int axis_sets_build(ms_occluders *o, const ms_scene *scene, const ms_bvh 
 }
 
 /* The cull's keep flags (docs/culling.md); returns the triangles culled (0 with *keep NULL when nothing). */
-static int cull_keep(const ms_scene *scene, const ms_closed *closed, const uint8_t *porous, const uint8_t *boxed,
+static int cull_keep(const ms_scene *scene, const ms_closed *closed, const uint8_t *porous,
                      const float (*pts)[3], int np, const float lbox[6], double margin, uint8_t **keep_out, size_t *culled_out)
 {
     const size_t n = scene->n_tris;
@@ -305,12 +321,6 @@ static int cull_keep(const ms_scene *scene, const ms_closed *closed, const uint8
     uint8_t *keep = malloc(n ? n : 1);
     if (!keep) return -1;
     size_t culled = ms_closed_cull(closed, scene->tri, pts, np, lbox, margin, keep);
-    /* Components with interior boxes for this light keep both sides: there the cull was measured neutral
-     * (the boxes already fill the umbra the near side used to), and it would cost a BVH of its own
-     * (docs/culling.md); it pays on thin closed parts, which get no boxes. A closed component is its own
-     * mod-2 cycle. */
-    for (size_t t = 0; boxed && culled && t < n; t++)
-        if (!keep[t] && boxed[closed->cycle[t]]) { keep[t] = 1; culled--; }
     /* Condition 2 of the proof: an alpha-tested triangle makes its component porous; keep the whole
      * component two-sided. */
     for (size_t t = 0; porous && culled && t < n; t++) {
@@ -340,20 +350,18 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
     const double diag = joint_diag(sbox, lbox);
     const double margin = 2.0 * (1.0 - (double)MS_SEGMENT_FAR) * diag;
     int rc = 0, oom;
-    uint8_t *boxed = NULL;   /* per cycle: 1 when it has interior boxes for this light */
     /* Interior boxes hold for this light when their clearance covers the near range of its longest
      * segment (docs/culling.md). */
     if ((what & MS_OCC_INTERIOR) && interior && interior->n_boxes && interior_eps >= 2.0 * (double)MS_SEGMENT_NEAR * diag) {
         uint8_t *porous = porous_of(closed, 1, scene_bvh, scene_alpha, &oom);
-        boxed = oom ? NULL : calloc(ms_closed_groups(closed), 1);
-        rc = !boxed ? -1 : interior_build(o, closed, interior, porous, (const float (*)[3])pts, np, lbox, margin, boxed, threads);
+        rc = oom ? -1 : interior_build(o, closed, interior, porous, (const float (*)[3])pts, np, lbox, margin, threads);
         free(porous);
     }
     uint8_t *keep = NULL;
     size_t culled = 0;
     if (!rc && (what & MS_OCC_CULL) && closed->n_components) {
         uint8_t *porous = porous_of(closed, 0, scene_bvh, scene_alpha, &oom);
-        rc = oom ? -1 : cull_keep(scene, closed, porous, boxed, (const float (*)[3])pts, np, lbox, margin, &keep, &culled);
+        rc = oom ? -1 : cull_keep(scene, closed, porous, (const float (*)[3])pts, np, lbox, margin, &keep, &culled);
         free(porous);
     }
     if (!rc && (culled || (what & MS_OCC_MERGE)))
@@ -364,7 +372,6 @@ int ms_occluders_build(ms_occluders *o, const ms_scene *scene, const ms_bvh *sce
     if (!rc && (what & MS_OCC_MERGE_EXACT) && o->merged_axes)
         rc = axis_sets_build(o, scene, scene_bvh, keep, culled, scene_alpha, threads);
     free(keep);
-    free(boxed);
     if (rc) ms_occluders_free(o);
     return rc;
 }
