@@ -2,7 +2,7 @@
  *
  * Topology against hand-built cases: a closed icosphere is one outward component, mirrored it is inward,
  * a hole, a fin, a flipped triangle or a repeated vertex open it; several solids are several components
- * with their boxes. The cull against a brute-force oracle written here (double-precision segment-triangle
+ * with their boxes, also where two touch along an edge; pyramids meeting along an edge loop are not closed. The cull against a brute-force oracle written here (double-precision segment-triangle
  * test, no BVH, no code of the library): for random solids, lights and receivers — outside the solids,
  * inside them, on them — every sample's occlusion by the kept triangles equals its occlusion by all
  * triangles. The cases that break the naive argument are shown to break it (the oracle finds leaks when
@@ -90,7 +90,40 @@ static void test_topology(void **st)
     const float want[6] = { 5, 5, 5, 6, 6, 7 };
     for (int k = 0; k < 6; k++) assert_true(c.box[c.component[12]][k] == want[k]);
     ms_closed_free(&c);
-    free(m.tri); free(f.tri); free(g.tri); free(h.tri);
+
+    /* two boxes touching along an edge (walked twice each way): two closed components, one of them wound
+     * inwards; no union through the edge, so each keeps its own orientation */
+    tm_mesh e = { 0 };
+    const double e1lo[3] = { 0, 0, 0 }, e1hi[3] = { 1, 1, 1 }, e2lo[3] = { 1, 1, 0 }, e2hi[3] = { 2, 2, 1 };
+    tm_box(&e, e1lo, e1hi, 0);
+    tm_box(&e, e2lo, e2hi, 1);
+    assert_int_equal(ms_closed_find(e.tri, e.n, &c), 0);
+    assert_int_equal(c.n_components, 2);
+    assert_int_equal(c.closed_tris, 24);
+    assert_int_equal(c.outward[c.component[0]], 1);
+    assert_int_equal(c.outward[c.component[12]], -1);
+    ms_closed_free(&c);
+
+    /* two octahedra sharing their equator (each of its edges walked twice each way): an octahedron alone is
+     * closed, but here every pyramid is a component of its own (nothing unites through the equator) whose own
+     * triangles walk the equator one way only: none is closed, though the edges balance */
+    tm_mesh q = { 0 };
+    const double eq[4][3] = { { 1, 0, 0 }, { 0, 0, -1 }, { -1, 0, 0 }, { 0, 0, 1 } };
+    for (int s2 = 1; s2 <= 2; s2++) {
+        const double top[3] = { 0, s2, 0 }, bot[3] = { 0, -s2, 0 };
+        for (int i = 0; i < 4; i++) {
+            tm_add_tri(&q, top, eq[i], eq[(i + 1) % 4]);
+            tm_add_tri(&q, bot, eq[(i + 1) % 4], eq[i]);
+        }
+    }
+    assert_int_equal(ms_closed_find(q.tri, 8, &c), 0);
+    assert_int_equal(c.n_components, 1);
+    assert_int_equal(c.outward[0], 1);
+    ms_closed_free(&c);
+    assert_int_equal(ms_closed_find(q.tri, q.n, &c), 0);
+    assert_int_equal(c.n_components, 0);
+    ms_closed_free(&c);
+    free(m.tri); free(f.tri); free(g.tri); free(h.tri); free(e.tri); free(q.tri);
 }
 
 /* ---- the cull against a brute-force oracle ---- */
@@ -159,12 +192,16 @@ static void test_cull_exact(void **st)
     }
     const double blo[3] = { 2, 0.2, -1 }, bhi[3] = { 3, 2.5, 1.5 };
     tm_box(&m, blo, bhi, 0);
+    /* two boxes touching along an edge, one wound inwards */
+    const double plo[3] = { -3, 0.5, 2 }, phi[3] = { -2, 1.5, 3 }, qlo[3] = { -2, 1.5, 2 }, qhi[3] = { -1, 2.5, 3 };
+    tm_box(&m, plo, phi, 0);
+    tm_box(&m, qlo, qhi, 1);
     const double g0[3] = { -8, 0, -8 }, g1[3] = { 8, 0, -8 }, g2[3] = { 8, 0, 8 }, g3[3] = { -8, 0, 8 };
     tm_add_tri(&m, g0, g2, g1);
     tm_add_tri(&m, g0, g3, g2);
     ms_closed c;
     assert_int_equal(ms_closed_find(m.tri, m.n, &c), 0);
-    assert_int_equal(c.n_components, 7);
+    assert_int_equal(c.n_components, 9);
     assert_int_equal(c.closed_tris, m.n - 2);
     const rect lights[2] = { { { -1.5, 7, -1.5 }, { 3, 0, 0 }, { 0, 0.5, 3 } },     /* above, tilted */
                              { { 9, 1, -2 }, { 0, 3, 0 }, { 0, 0, 4 } } };          /* to the side */

@@ -87,6 +87,31 @@ static int rim_push(uint32_t **rim, size_t *n, size_t *cap, const uint32_t *id, 
     return 0;
 }
 
+/* Appends directed edge i to the touching edges. 0, or -1 when out of memory. */
+static int pinch_push(uint32_t **list, size_t *n, size_t *cap, uint32_t i)
+{
+    if (*n == *cap) {
+        const size_t c = *cap ? 2 * *cap : 64;
+        uint32_t *r = realloc(*list, c * sizeof *r);
+        if (!r) return -1;
+        *list = r;
+        *cap = c;
+    }
+    (*list)[(*n)++] = i;
+    return 0;
+}
+
+/* The first vertex of directed edge i of the CSR lists (start: nv + 1 offsets). */
+static uint32_t edge_start(const uint32_t *start, uint32_t nv, uint32_t i)
+{
+    uint32_t lo = 0, hi = nv;   /* the a with start[a] <= i < start[a + 1] */
+    while (hi - lo > 1) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        if (start[mid] <= i) lo = mid; else hi = mid;
+    }
+    return lo;
+}
+
 int ms_closed_find(const float *tri, size_t n, ms_closed *out)
 {
     memset(out, 0, sizeof *out);
@@ -96,6 +121,8 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     const size_t vm = table_size(3 * n);
     uint32_t *vslot = malloc(vm * sizeof *vslot);       /* corner index + 1 of a vertex's first corner, 0: empty */
     uint32_t *id = malloc(3 * n * sizeof *id);          /* welded vertex of each corner, numbered densely */
+    uint32_t *pinch = NULL;                             /* directed edges of touching edges (index into dst) */
+    size_t n_pinch = 0, pinch_cap = 0;
     uint32_t *rim = NULL;                               /* the edges used an odd number of times, once each: */
     size_t n_rim = 0, rim_cap = 0;                      /* the corner that starts them (3 t + k) */
     uint32_t *start = NULL, *dst = NULL, *etri = NULL;  /* directed edges by their first vertex (CSR) */
@@ -157,9 +184,11 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
             for (uint32_t j = start[b]; j < start[b + 1]; j++)
                 if (dst[j] == a) { opp++; twin = etri[j]; ms_uf_union(cparent, t, twin); }
             /* Exactly two triangles, walking the edge in opposite directions: neighbours on one consistently
-             * oriented surface. Anything else (a boundary, a fin of three or more, two that walk it the same
-             * way) leaves their component open. */
+             * oriented surface. As many each way but more than one (two solids, or two parts of one, touching
+             * along the edge): no union through it, each component's own walks checked below. Anything else
+             * (a boundary, a fin of three, two that walk it the same way) leaves their component open. */
             if (same == 1 && opp == 1) ms_uf_union(parent, t, twin);
+            else if (same == opp) { if (pinch_push(&pinch, &n_pinch, &pinch_cap, i)) goto oom; }
             else bad[t] = 1;
             if ((same + opp) & 1) {
                 odd[t] = 1;
@@ -167,6 +196,18 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
                 if (!earlier && (a < b || !opp) && rim_push(&rim, &n_rim, &rim_cap, id, t, a, b)) goto oom;
             }
         }
+    /* A touching edge closes a component only where the component's own triangles walk it as often each way
+     * (the whole edge does: two consistently oriented parts meet there, not a part and a flipped one). */
+    for (size_t e = 0; e < n_pinch; e++) {
+        const uint32_t i = pinch[e], t = etri[i], a = edge_start(start, nv, i), b = dst[i];
+        const uint32_t r = ms_uf_find(parent, t);
+        long walk = 0;
+        for (uint32_t j = start[a]; j < start[a + 1]; j++) walk += dst[j] == b && ms_uf_find(parent, etri[j]) == r;
+        for (uint32_t j = start[b]; j < start[b + 1]; j++) walk -= dst[j] == a && ms_uf_find(parent, etri[j]) == r;
+        if (walk) bad[t] = 1;
+    }
+    free(pinch);
+    pinch = NULL;
     free(start);
     start = NULL;
     free(dst);
@@ -221,6 +262,7 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     }
     return 0;
 oom:
+    free(pinch);
     free(vslot);
     free(id);
     free(rim);

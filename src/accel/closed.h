@@ -1,8 +1,9 @@
 /* Closed components of a triangle soup, for exact back-face culling of shadow occluders (docs/culling.md).
  *
- * A component (triangles connected through shared edges) is closed when every one of its edges is shared
- * by exactly two of its triangles that traverse it in opposite directions (consistently oriented, no
- * boundary, no fin). Vertices are shared when their three coordinates are bitwise equal, as a loader that
+ * A component (triangles connected through edges shared by exactly two triangles that traverse it in
+ * opposite directions) is closed when each of its edges is traversed by its triangles as often in one
+ * direction as in the other (consistently oriented, no boundary, no fin; two solids, or two parts of one,
+ * may touch along an edge). Vertices are shared when their three coordinates are bitwise equal, as a loader that
  * reads an indexed mesh leaves them. A closed component bounds a solid; its orientation (outward when the
  * signed volume is positive, inward otherwise) says which side is inside. A segment from a point to a light
  * sample outside that solid's box leaves the solid through a triangle whose outward side faces the sample,
