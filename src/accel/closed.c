@@ -112,6 +112,51 @@ static uint32_t edge_start(const uint32_t *start, uint32_t nv, uint32_t i)
     return lo;
 }
 
+/* A touching edge (pinch: its directed edges, indices into the CSR lists start, dst, etri) closes a component only
+ * where the component's own triangles walk it as often each way (the whole edge does: two consistently oriented
+ * parts meet there, not a part and a flipped one); bad marks the others' triangles. */
+static void touching_walks(const uint32_t *pinch, size_t n_pinch, const uint32_t *start, uint32_t nv,
+                           const uint32_t *dst, const uint32_t *etri, uint32_t *parent, uint8_t *bad)
+{
+    for (size_t e = 0; e < n_pinch; e++) {
+        const uint32_t i = pinch[e], t = etri[i], a = edge_start(start, nv, i), b = dst[i];
+        const uint32_t r = ms_uf_find(parent, t);
+        long walk = 0;
+        for (uint32_t j = start[a]; j < start[a + 1]; j++) walk += dst[j] == b && ms_uf_find(parent, etri[j]) == r;
+        for (uint32_t j = start[b]; j < start[b + 1]; j++) walk -= dst[j] == a && ms_uf_find(parent, etri[j]) == r;
+        if (walk) bad[t] = 1;
+    }
+}
+
+/* The closed components' boxes and orientations (out->component labelled, n_components set). 0, or -1 when out
+ * of memory. */
+static int component_boxes_and_sides(const float *tri, ms_closed *out)
+{
+    const size_t n = out->n_tris, nc = out->n_components;
+    out->box = malloc(nc * sizeof *out->box);
+    out->outward = malloc(nc);
+    double *vol = calloc(nc, sizeof *vol);
+    if (!out->box || !out->outward || !vol) { free(vol); return -1; }
+    out->closed_tris = set_boxes(tri, n, out->component, nc, out->box);
+    for (size_t t = 0; t < n; t++) {
+        const uint32_t c = out->component[t];
+        if (c == MS_OPEN_COMPONENT) continue;
+        const float *p = tri + 9 * t, *ref = out->box[c];   /* any point will do: the box's low corner, near */
+        double a[3], b[3], d[3];
+        for (int k = 0; k < 3; k++) {
+            a[k] = (double)p[k] - ref[k];
+            b[k] = (double)p[3 + k] - ref[k];
+            d[k] = (double)p[6 + k] - ref[k];
+        }
+        /* six times the signed volume of the tetrahedron (ref, a, b, c): summed over a closed surface,
+         * positive when its winding points outwards */
+        vol[c] += a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0]);
+    }
+    for (size_t c = 0; c < nc; c++) out->outward[c] = vol[c] >= 0.0 ? 1 : -1;
+    free(vol);
+    return 0;
+}
+
 int ms_closed_find(const float *tri, size_t n, ms_closed *out)
 {
     memset(out, 0, sizeof *out);
@@ -196,16 +241,7 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
                 if (!earlier && (a < b || !opp) && rim_push(&rim, &n_rim, &rim_cap, id, t, a, b)) goto oom;
             }
         }
-    /* A touching edge closes a component only where the component's own triangles walk it as often each way
-     * (the whole edge does: two consistently oriented parts meet there, not a part and a flipped one). */
-    for (size_t e = 0; e < n_pinch; e++) {
-        const uint32_t i = pinch[e], t = etri[i], a = edge_start(start, nv, i), b = dst[i];
-        const uint32_t r = ms_uf_find(parent, t);
-        long walk = 0;
-        for (uint32_t j = start[a]; j < start[a + 1]; j++) walk += dst[j] == b && ms_uf_find(parent, etri[j]) == r;
-        for (uint32_t j = start[b]; j < start[b + 1]; j++) walk -= dst[j] == a && ms_uf_find(parent, etri[j]) == r;
-        if (walk) bad[t] = 1;
-    }
+    touching_walks(pinch, n_pinch, start, nv, dst, etri, parent, bad);
     free(pinch);
     pinch = NULL;
     free(start);
@@ -237,29 +273,7 @@ int ms_closed_find(const float *tri, size_t n, ms_closed *out)
     free(odd);
     odd = NULL;
     out->n_components = nc;
-    if (nc) {
-        out->box = malloc(nc * sizeof *out->box);
-        out->outward = malloc(nc);
-        double *vol = calloc(nc, sizeof *vol);
-        if (!out->box || !out->outward || !vol) { free(vol); goto oom; }
-        out->closed_tris = set_boxes(tri, n, out->component, nc, out->box);
-        for (size_t t = 0; t < n; t++) {
-            const uint32_t c = out->component[t];
-            if (c == MS_OPEN_COMPONENT) continue;
-            const float *p = tri + 9 * t, *ref = out->box[c];   /* any point will do: the box's low corner, near */
-            double a[3], b[3], d[3];
-            for (int k = 0; k < 3; k++) {
-                a[k] = (double)p[k] - ref[k];
-                b[k] = (double)p[3 + k] - ref[k];
-                d[k] = (double)p[6 + k] - ref[k];
-            }
-            /* six times the signed volume of the tetrahedron (ref, a, b, c): summed over a closed surface,
-             * positive when its winding points outwards */
-            vol[c] += a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0]);
-        }
-        for (size_t c = 0; c < nc; c++) out->outward[c] = vol[c] >= 0.0 ? 1 : -1;
-        free(vol);
-    }
+    if (nc && component_boxes_and_sides(tri, out)) goto oom;
     return 0;
 oom:
     free(pinch);
