@@ -2,8 +2,9 @@
  *
  * Topology against hand-built cases: a closed icosphere is one outward component, mirrored it is inward,
  * a hole, a fin, a flipped triangle or a repeated vertex open it; several solids are several components
- * with their boxes, also where two touch along an edge; pyramids meeting along an edge loop are not closed. The cull against a brute-force oracle written here (double-precision segment-triangle
- * test, no BVH, no code of the library): for random solids, lights and receivers — outside the solids,
+ * with their boxes, also where two touch along an edge; pyramids meeting along an edge loop are not closed.
+ * The cull against a brute-force oracle written here (double-precision segment-triangle test, no BVH, no
+ * code of the library): for random solids, lights and receivers — outside the solids,
  * inside them, on them — every sample's occlusion by the kept triangles equals its occlusion by all
  * triangles. The cases that break the naive argument are shown to break it (the oracle finds leaks when
  * the guards are bypassed): a lamp inside a closed shade, and a room wound inwards with the sun outside.

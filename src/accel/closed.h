@@ -3,13 +3,13 @@
  * A component (triangles connected through edges shared by exactly two triangles that traverse it in
  * opposite directions) is closed when each of its edges is traversed by its triangles as often in one
  * direction as in the other (consistently oriented, no boundary, no fin; two solids, or two parts of one,
- * may touch along an edge). Vertices are shared when their three coordinates are bitwise equal, as a loader that
- * reads an indexed mesh leaves them. A closed component bounds a solid; its orientation (outward when the
- * signed volume is positive, inward otherwise) says which side is inside. A segment from a point to a light
- * sample outside that solid's box leaves the solid through a triangle whose outward side faces the sample,
- * so a triangle that has the whole light behind its outward side never decides whether such a segment is
- * occluded (docs/culling.md proves it, with the cases it needs: the light outside the component's box by
- * more than the far range, no alpha-tested triangle, no self-intersection). */
+ * may touch along an edge). Vertices are shared when their three coordinates are bitwise equal, as a
+ * loader that reads an indexed mesh leaves them. A closed component bounds a solid; its orientation
+ * (outward when the signed volume is positive, inward otherwise) says which side is inside. A segment from
+ * a point to a light sample outside that solid's box leaves the solid through a triangle whose outward side
+ * faces the sample, so a triangle that has the whole light behind its outward side never decides whether
+ * such a segment is occluded (docs/culling.md proves it, with the cases it needs: the light outside the
+ * component's box by more than the far range, no alpha-tested triangle, no self-intersection). */
 #ifndef MS_ACCEL_CLOSED_H
 #define MS_ACCEL_CLOSED_H
 #include <stddef.h>
