@@ -25,6 +25,7 @@ string(REGEX REPLACE "/$" "" MS_PC_TO_PREFIX "${MS_PC_TO_PREFIX}")
 set(MS_PC_REQUIRES "libcjson libpng libturbojpeg libzstd OpenEXR")
 get_filename_component(MS_EXRCORE_NAME ${OPENEXRCORE_LIB} NAME_WE)
 string(REGEX REPLACE "^lib" "-l" MS_PC_LIBS_PRIVATE "${MS_EXRCORE_NAME}")
+string(APPEND MS_PC_LIBS_PRIVATE " -lmeshoptimizer -ldraco")   # meshoptimizer has no .pc of its own
 if(MS_HAVE_EMBREE)
   string(APPEND MS_PC_LIBS_PRIVATE " -lembree3")
 endif()

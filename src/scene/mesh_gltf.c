@@ -4,6 +4,7 @@
 #include "scene_internal.h"
 #include "microshadow.h"
 #include "cgltf.h"
+#include "gltf_decode.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -72,29 +73,32 @@ static const char *result_text(cgltf_result r)
     }
 }
 
-/* a + b <= lim without overflow. */
-static int fits(size_t a, size_t b, size_t lim) { return a <= lim && b <= lim - a; }
-
-/* The accessor can be read element by element without leaving its buffer's data. */
+/* The accessor can be read element by element without leaving its buffer's data (a decoded or dense view's
+ * data is exactly its size; ms_gltf_sparse_ok checks a sparse accessor's own parts). */
 static int accessor_ok(const cgltf_accessor *a, char *why, size_t n)
 {
-    if (a->is_sparse) { snprintf(why, n, "sparse accessors are not supported"); return 0; }
     if (a->count == 0) { snprintf(why, n, "an accessor has no elements"); return 0; }
     const cgltf_buffer_view *v = a->buffer_view;
     if (!v) return 1;   /* no view: all zeros, read without touching memory */
-    if (v->has_meshopt_compression) { snprintf(why, n, "meshopt-compressed buffers are not supported"); return 0; }
-    if (!v->buffer || !v->buffer->data) { snprintf(why, n, "an accessor's buffer has no data"); return 0; }
+    const unsigned char *base;
+    if (v->data) {
+        base = v->data;
+    } else {
+        if (v->has_meshopt_compression) { snprintf(why, n, "a meshopt-compressed buffer view was not decoded"); return 0; }
+        if (!v->buffer || !v->buffer->data) { snprintf(why, n, "an accessor's buffer has no data"); return 0; }
+        if (!ms_fits(v->offset, v->size, v->buffer->size)) { snprintf(why, n, "a buffer view exceeds its buffer"); return 0; }
+        base = (const unsigned char *)v->buffer->data + v->offset;
+    }
     size_t elem = cgltf_calc_size(a->type, a->component_type);
     if (elem == 0 || (a->stride < elem && a->count > 1)) { snprintf(why, n, "an accessor has an invalid stride"); return 0; }
-    if (!fits(v->offset, v->size, v->buffer->size)) { snprintf(why, n, "a buffer view exceeds its buffer"); return 0; }
     /* cgltf reads components through typed pointers: they must be aligned (glTF requires it too). */
     size_t comp = cgltf_component_size(a->component_type);
-    if (comp == 0 || ((uintptr_t)v->buffer->data + v->offset + a->offset) % comp || a->stride % comp) {
+    if (comp == 0 || ((uintptr_t)base + a->offset) % comp || a->stride % comp) {
         snprintf(why, n, "an accessor is not aligned to its component size");
         return 0;
     }
     if (a->count - 1 > (SIZE_MAX - elem) / (a->stride ? a->stride : 1) ||
-        !fits(a->offset, (a->count - 1) * a->stride + elem, v->size)) {
+        !ms_fits(a->offset, (a->count - 1) * a->stride + elem, v->size)) {
         snprintf(why, n, "an accessor exceeds its buffer view");
         return 0;
     }
@@ -120,7 +124,6 @@ static int emit_primitive(const cgltf_data *d, const long *mat_of, const cgltf_p
         pr->type != cgltf_primitive_type_triangle_fan)
         return 0;   /* points and lines cast no shadow */
     char why[128];
-    if (pr->has_draco_mesh_compression) { snprintf(err, errlen, "%s: Draco-compressed meshes are not supported", path); return -1; }
     const cgltf_accessor *pos = NULL;
     for (size_t i = 0; i < pr->attributes_count; i++)
         if (pr->attributes[i].type == cgltf_attribute_type_position && pr->attributes[i].index == 0) pos = pr->attributes[i].data;
@@ -289,7 +292,7 @@ static long load_image(const cgltf_data *d, const cgltf_options *opt, size_t i, 
     snprintf(full, sizeof full, "%.500s: %s", path, what);
     if (im->buffer_view) {
         const cgltf_buffer_view *v = im->buffer_view;
-        if (!v->buffer || !v->buffer->data || !fits(v->offset, v->size, v->buffer->size)) {
+        if (!v->buffer || !v->buffer->data || !ms_fits(v->offset, v->size, v->buffer->size)) {
             snprintf(err, errlen, "%s: its buffer view exceeds its buffer", full);
             return -1;
         }
@@ -384,18 +387,18 @@ static long texture_of(const cgltf_data *d, const cgltf_options *opt, const cglt
 }
 
 /* Extensions microshadow implements (KHR_texture_basisu: the fallback source, else its KTX2 image, 8-bit
- * plain or Zstandard levels decoded, Basis payloads named in a warning); any other in extensionsRequired is
- * an error, in extensionsUsed one warning each saying what is left out. */
+ * plain or Zstandard levels decoded, Basis payloads named in a warning; EXT_meshopt_compression and
+ * KHR_draco_mesh_compression: decoded, gltf_decode.c; EXT_mesh_gpu_instancing: every instance drawn,
+ * walk_nodes); any other in extensionsRequired is an error, in extensionsUsed one warning each saying what is
+ * left out. */
 static const char *const known_ext[] = { "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_texture_basisu",
-                                         "KHR_mesh_quantization", "KHR_lights_punctual" };
+                                         "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_meshopt_compression",
+                                         "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression" };
 static const struct { const char *name, *left_out; } ext_left_out[] = {
     { "KHR_materials_unlit", "unlit materials are shaded as lit" },
     { "KHR_materials_pbrSpecularGlossiness", "specular-glossiness is ignored (metallic-roughness or the defaults shade)" },
     { "KHR_materials_variants", "only the default materials are used" },
-    { "EXT_mesh_gpu_instancing", "instances are not expanded (each instanced mesh is drawn once, at its node)" },
     { "EXT_texture_webp", "WebP images are not decoded (a PNG/JPEG fallback source is used)" },
-    { "KHR_draco_mesh_compression", "Draco-compressed primitives cannot be read" },
-    { "EXT_meshopt_compression", "meshopt-compressed buffers cannot be read" },
 };
 
 static int check_extensions(const cgltf_data *d, const char *path, char *err, size_t errlen)
@@ -574,6 +577,45 @@ static void take_camera(ms_tri_soup *soup, const cgltf_camera *c, const float w[
     soup->camera = a;
 }
 
+/* The node's EXT_mesh_gpu_instancing attributes are the extension's: TRANSLATION and SCALE VEC3, ROTATION VEC4
+ * (float, or normalized integers for ROTATION, as KHR_mesh_quantization allows), others ignored. 1, or 0 with
+ * why. */
+static int instancing_ok(const cgltf_node *n, char *why, size_t len)
+{
+    for (size_t a = 0; a < n->mesh_gpu_instancing.attributes_count; a++) {
+        const cgltf_attribute *at = &n->mesh_gpu_instancing.attributes[a];
+        const int vec4 = at->name && !strcmp(at->name, "ROTATION");
+        const int vec3 = at->name && (!strcmp(at->name, "TRANSLATION") || !strcmp(at->name, "SCALE"));
+        if (!at->data) { snprintf(why, len, "an instance attribute has no accessor"); return 0; }
+        if ((vec4 && at->data->type != cgltf_type_vec4) || (vec3 && at->data->type != cgltf_type_vec3)) {
+            snprintf(why, len, "instance attribute %.40s is not a %s", at->name, vec4 ? "VEC4" : "VEC3");
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* world x T R S of instance i (EXT_mesh_gpu_instancing): the node's TRANSLATION, ROTATION (x, y, z, w) and
+ * SCALE at i, identity where absent; the same matrix cgltf_node_transform_local makes of a node's TRS. */
+static void instance_matrix(const cgltf_node *n, size_t i, const float world[16], float out[16])
+{
+    cgltf_node tmp;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.rotation[3] = 1.0f;
+    tmp.scale[0] = tmp.scale[1] = tmp.scale[2] = 1.0f;
+    tmp.has_translation = tmp.has_rotation = tmp.has_scale = 1;
+    for (size_t a = 0; a < n->mesh_gpu_instancing.attributes_count; a++) {
+        const cgltf_attribute *at = &n->mesh_gpu_instancing.attributes[a];
+        if (!at->name) continue;
+        if (!strcmp(at->name, "TRANSLATION")) cgltf_accessor_read_float(at->data, i, tmp.translation, 3);
+        else if (!strcmp(at->name, "ROTATION")) cgltf_accessor_read_float(at->data, i, tmp.rotation, 4);
+        else if (!strcmp(at->name, "SCALE")) cgltf_accessor_read_float(at->data, i, tmp.scale, 3);
+    }
+    float local[16];
+    cgltf_node_transform_local(&tmp, local);
+    mat4_mul(out, world, local);
+}
+
 /* Depth-first over the node trees without recursion; every node at most once (glTF requires trees,
  * and a node listed twice would expand exponentially: 41 such nodes are 2^40 instances). */
 static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup, size_t *added, size_t max_tris,
@@ -604,11 +646,31 @@ static int walk_nodes(const cgltf_data *d, const long *mat_of, ms_tri_soup *soup
             mat4_mul(world, it.parent, local);
             if (it.node->light && !rc) rc = push_punctual(soup, it.node->light, world, path, err, errlen);
             if (it.node->camera && !soup->camera.present) take_camera(soup, it.node->camera, world);
-            if (it.node->mesh) ms_soup_new_object(soup);   /* each node's mesh is an object (lightmap UVs per object) */
-            if (it.node->mesh)
-                for (size_t p = 0; p < it.node->mesh->primitives_count && !rc; p++)
-                    rc = emit_primitive(d, mat_of, &it.node->mesh->primitives[p], world, soup, added, max_tris, path, err,
-                                        errlen);
+            const cgltf_node *nd = it.node;
+            char why[128];
+            if (nd->mesh && nd->has_mesh_gpu_instancing && !instancing_ok(nd, why, sizeof why)) {
+                snprintf(err, errlen, "%s: node %zu: %s", path, (size_t)(nd - d->nodes), why);
+                rc = -1;
+                break;
+            }
+            /* GPU instances (EXT_mesh_gpu_instancing; cgltf_validate: every attribute has the same count). Each
+             * instance of a mesh emits a triangle or more, so more instances than triangles allowed is an
+             * error rather than a long loop (accessors without a view declare any count). */
+            const size_t instances = !nd->mesh ? 0 : nd->has_mesh_gpu_instancing ? nd->mesh_gpu_instancing.attributes[0].data->count : 1;
+            if (instances > max_tris) {
+                snprintf(err, errlen, "%s: node %zu has more GPU instances than the scene may have triangles (%zu)", path,
+                         (size_t)(nd - d->nodes), max_tris);
+                rc = -1;
+                break;
+            }
+            for (size_t i = 0; i < instances && !rc; i++) {
+                float m[16];
+                if (nd->has_mesh_gpu_instancing) instance_matrix(nd, i, world, m);
+                else memcpy(m, world, sizeof m);
+                ms_soup_new_object(soup);   /* each node's mesh, each instance of it, is an object (lightmap UVs per object) */
+                for (size_t p = 0; p < nd->mesh->primitives_count && !rc; p++)
+                    rc = emit_primitive(d, mat_of, &nd->mesh->primitives[p], m, soup, added, max_tris, path, err, errlen);
+            }
             for (size_t c = 0; c < it.node->children_count && !rc; c++) {
                 size_t ci = (size_t)(it.node->children[c] - d->nodes);
                 if (seen[ci]) {
@@ -643,6 +705,7 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
     opt.file.user_data = &g;
     cgltf_data *d = NULL;
     long *mat_of = NULL;   /* glTF material -> soup material */
+    ms_gltf_dense dense = { 0 };
     cgltf_result r = cgltf_parse(&opt, buf, len, &d);
     if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); return -1; }
     int rc = -1;
@@ -673,25 +736,29 @@ int ms_mesh_gltf(const char *buf, size_t len, const char *path, ms_tri_soup *sou
         else snprintf(err, errlen, "%s: %s", path, result_text(r));
         goto out;
     }
+    char why[160];
+    if (ms_gltf_meshopt_decode(d, g.limit, why, sizeof why)) { snprintf(err, errlen, "%s: %s", path, why); goto out; }
     /* cgltf_validate reads index data through accessor bounds it computes with wrapping arithmetic:
      * check every accessor with data here first. */
     for (size_t i = 0; i < d->accessors_count; i++) {
         const cgltf_accessor *a = &d->accessors[i];
-        char why[128];
-        if (a->is_sparse || (a->count && a->buffer_view && a->buffer_view->buffer && a->buffer_view->buffer->data &&
-                             !accessor_ok(a, why, sizeof why))) {
-            snprintf(err, errlen, "%s: accessor %zu: %s", path, i, a->is_sparse ? "sparse accessors are not supported" : why);
+        const cgltf_buffer_view *v = a->buffer_view;
+        if ((a->is_sparse && !ms_gltf_sparse_ok(a, why, sizeof why)) ||
+            (a->count && v && (v->data || (v->buffer && v->buffer->data)) && !accessor_ok(a, why, sizeof why))) {
+            snprintf(err, errlen, "%s: accessor %zu: %s", path, i, why);
             goto out;
         }
     }
     r = cgltf_validate(d);
     if (r != cgltf_result_success) { snprintf(err, errlen, "%s: %s", path, result_text(r)); goto out; }
+    if (ms_gltf_densify(d, g.limit, &dense, why, sizeof why)) { snprintf(err, errlen, "%s: %s", path, why); goto out; }
     mat_of = malloc((d->materials_count ? d->materials_count : 1) * sizeof *mat_of);
     if (!mat_of) { snprintf(err, errlen, "%s: out of memory", path); goto out; }
     if (load_materials(d, &opt, path, soup, mat_of, err, errlen)) goto out;
     rc = walk_nodes(d, mat_of, soup, added, (g.input + 64) * MS_MAX_TRIS_PER_BYTE, path, err, errlen);
 out:
     free(mat_of);
+    ms_gltf_dense_undo(d, &dense);
     cgltf_free(d);
     return rc;
 }
