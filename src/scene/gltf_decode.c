@@ -124,15 +124,6 @@ int ms_gltf_sparse_ok(const cgltf_accessor *a, char *why, size_t n)
     return 1;
 }
 
-/* Appends accessor a to the list when sparse and not in it yet. */
-static void add_sparse(cgltf_accessor *a, cgltf_accessor **list, size_t *k)
-{
-    if (!a || !a->is_sparse) return;
-    for (size_t i = 0; i < *k; i++)
-        if (list[i] == a) return;
-    list[(*k)++] = a;
-}
-
 /* Accessor a written out dense into out (count * elem bytes). 0, or -1 with why. */
 static int dense_copy(const cgltf_accessor *a, size_t elem, uint8_t *out, char *why, size_t n)
 {
@@ -165,6 +156,7 @@ static void install(ms_gltf_dense *ds, cgltf_accessor *a, void *out, size_t size
     v->size = size;
     ds->acc[i] = a;
     ds->saved[i] = *a;
+    ds->done[a - ds->first] = 1;
     a->buffer_view = v;
     a->offset = 0;
     a->stride = elem;
@@ -172,11 +164,12 @@ static void install(ms_gltf_dense *ds, cgltf_accessor *a, void *out, size_t size
 }
 
 /* Accessor a as installed already (a Draco primitive's accessors may be shared). */
-static int installed(const ms_gltf_dense *ds, const cgltf_accessor *a)
+static int installed(const ms_gltf_dense *ds, const cgltf_accessor *a) { return ds->done[a - ds->first]; }
+
+/* Marks accessor a (may be NULL) as read by triangles. */
+static void mark_read(const cgltf_data *d, unsigned char *read, const cgltf_accessor *a)
 {
-    for (size_t i = 0; i < ds->n; i++)
-        if (ds->acc[i] == a) return 1;
-    return 0;
+    if (a) read[a - d->accessors] = 1;
 }
 
 /* Primitive pr's Draco data decoded into its indices and the attributes the Draco map names. 0, or -1. */
@@ -270,33 +263,40 @@ int ms_gltf_densify(cgltf_data *d, size_t max_bytes, ms_gltf_dense *ds, char *wh
         for (size_t p = 0; p < d->meshes[m].primitives_count; p++)
             if (d->meshes[m].primitives[p].has_draco_mesh_compression) cap += d->meshes[m].primitives[p].attributes_count + 1;
     if (!cap) return 0;
+    ds->first = d->accessors;
     ds->acc = mem_alloc(d, cap * sizeof *ds->acc);
     ds->saved = mem_alloc(d, cap * sizeof *ds->saved);
     ds->views = mem_alloc(d, cap * sizeof *ds->views);
-    if (!ds->acc || !ds->saved || !ds->views) { snprintf(why, n, "out of memory"); return -1; }
+    const size_t na = d->accessors_count ? d->accessors_count : 1;
+    ds->done = mem_alloc(d, na);
+    unsigned char *read = mem_alloc(d, na);
+    if (!ds->acc || !ds->saved || !ds->views || !ds->done || !read) {
+        mem_free(d, read);
+        snprintf(why, n, "out of memory");
+        return -1;
+    }
+    memset(ds->done, 0, na);
+    memset(read, 0, na);
     size_t used = 0;
-    for (size_t m = 0; m < d->meshes_count; m++)
-        for (size_t p = 0; p < d->meshes[m].primitives_count; p++)
-            if (d->meshes[m].primitives[p].has_draco_mesh_compression &&
-                draco_primitive(d, &d->meshes[m].primitives[p], max_bytes, &used, ds, why, n))
-                return -1;
+    int rc = 0;
+    for (size_t m = 0; m < d->meshes_count && !rc; m++)
+        for (size_t p = 0; p < d->meshes[m].primitives_count && !rc; p++)
+            if (d->meshes[m].primitives[p].has_draco_mesh_compression)
+                rc = draco_primitive(d, &d->meshes[m].primitives[p], max_bytes, &used, ds, why, n);
     /* The sparse accessors triangles read: every primitive's attributes and indices, every node's instances. */
-    cgltf_accessor **todo = mem_alloc(d, cap * sizeof *todo);
-    if (!todo) { snprintf(why, n, "out of memory"); return -1; }
-    size_t k = 0;
     for (size_t m = 0; m < d->meshes_count; m++)
         for (size_t p = 0; p < d->meshes[m].primitives_count; p++) {
             const cgltf_primitive *pr = &d->meshes[m].primitives[p];
-            add_sparse(pr->indices, todo, &k);
-            for (size_t a = 0; a < pr->attributes_count; a++) add_sparse(pr->attributes[a].data, todo, &k);
+            mark_read(d, read, pr->indices);
+            for (size_t a = 0; a < pr->attributes_count; a++) mark_read(d, read, pr->attributes[a].data);
         }
     for (size_t i = 0; i < d->nodes_count; i++)
         if (d->nodes[i].has_mesh_gpu_instancing)
             for (size_t a = 0; a < d->nodes[i].mesh_gpu_instancing.attributes_count; a++)
-                add_sparse(d->nodes[i].mesh_gpu_instancing.attributes[a].data, todo, &k);
-    int rc = 0;
-    for (size_t i = 0; i < k && !rc; i++) {
-        cgltf_accessor *a = todo[i];
+                mark_read(d, read, d->nodes[i].mesh_gpu_instancing.attributes[a].data);
+    for (size_t i = 0; i < d->accessors_count && !rc; i++) {
+        cgltf_accessor *a = &d->accessors[i];
+        if (!read[i] || !a->is_sparse) continue;
         const size_t elem = cgltf_calc_size(a->type, a->component_type);
         if (elem == 0 || a->count > (max_bytes - used) / elem) {
             snprintf(why, n, "sparse accessors expand to more than %zu bytes", max_bytes);
@@ -309,7 +309,7 @@ int ms_gltf_densify(cgltf_data *d, size_t max_bytes, ms_gltf_dense *ds, char *wh
         used += a->count * elem;
         install(ds, a, out, a->count * elem, elem);
     }
-    mem_free(d, todo);
+    mem_free(d, read);
     return rc;
 }
 
@@ -322,5 +322,6 @@ void ms_gltf_dense_undo(cgltf_data *d, ms_gltf_dense *ds)
     mem_free(d, ds->acc);
     mem_free(d, ds->saved);
     mem_free(d, ds->views);
+    mem_free(d, ds->done);
     memset(ds, 0, sizeof *ds);
 }

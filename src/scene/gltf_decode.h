@@ -27,6 +27,8 @@ typedef struct ms_gltf_dense {
     cgltf_accessor *saved;
     cgltf_buffer_view *views;   /* the dense copies' views, one per accessor */
     size_t n;
+    const cgltf_accessor *first;   /* d->accessors */
+    unsigned char *done;           /* per accessor of d: made dense */
 } ms_gltf_dense;
 
 /* The accessors triangles read whose data is not plainly in a buffer view, replaced by dense copies (float
