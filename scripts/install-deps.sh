@@ -13,8 +13,8 @@ set -euo pipefail
 # Cycles as the light units' reference). lld: the sanitized test build links its test programs with it
 # (CMakeLists.txt; GNU ld when it is absent).
 pkgs=(build-essential cmake pkg-config libcjson-dev libpng-dev libturbojpeg0-dev libzstd-dev libmeshoptimizer-dev
-      libdraco-dev libopenexr-dev libembree-dev libcmocka-dev gnuplot-nox clang lld libclang-rt-dev libomp-dev python3-numpy python3-pip python3-setuptools
-      libopenmpi-dev openmpi-bin nodejs npm chromium blender)
+      libdraco-dev libopenexr-dev libembree-dev libcmocka-dev gnuplot-nox clang lld libclang-rt-dev libomp-dev
+      python3-numpy python3-pip python3-setuptools libopenmpi-dev openmpi-bin nodejs npm chromium blender)
 missing=()
 for p in "${pkgs[@]}"; do
   # Node.js from elsewhere (e.g. NodeSource's nodejs, which bundles npm and conflicts with Debian's npm
