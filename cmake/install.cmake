@@ -22,7 +22,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/microshadowConfig.cmake
 # pkg-config: prefix relative to the .pc file's own folder, so an install under any --prefix works.
 file(RELATIVE_PATH MS_PC_TO_PREFIX "/p/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/p")
 string(REGEX REPLACE "/$" "" MS_PC_TO_PREFIX "${MS_PC_TO_PREFIX}")
-set(MS_PC_REQUIRES "libcjson libpng libturbojpeg libzstd OpenEXR")
+set(MS_PC_REQUIRES "libcjson libpng libturbojpeg libzstd libwebp OpenEXR")
 get_filename_component(MS_EXRCORE_NAME ${OPENEXRCORE_LIB} NAME_WE)
 string(REGEX REPLACE "^lib" "-l" MS_PC_LIBS_PRIVATE "${MS_EXRCORE_NAME}")
 string(APPEND MS_PC_LIBS_PRIVATE " -lmeshoptimizer -ldraco")   # meshoptimizer has no .pc of its own

@@ -8,13 +8,14 @@ set -euo pipefail
 # nodejs, npm and chromium: the baked glTF's tests (the Khronos validator, the three.js viewer in headless
 # chromium); their npm packages (viewer/package.json: three, gltf-validator, puppeteer-core) go into
 # viewer/node_modules, never committed. libzstd-dev: KTX2 textures with Zstandard supercompression.
-# libmeshoptimizer-dev and libdraco-dev: glTF buffer views with EXT_meshopt_compression and primitives with
-# KHR_draco_mesh_compression. blender: the Blender add-on's test (blender/, tests/blender; headless, with
-# Cycles as the light units' reference). lld: the sanitized test build links its test programs with it
-# (CMakeLists.txt; GNU ld when it is absent).
-pkgs=(build-essential cmake pkg-config libcjson-dev libpng-dev libturbojpeg0-dev libzstd-dev libmeshoptimizer-dev
-      libdraco-dev libopenexr-dev libembree-dev libcmocka-dev gnuplot-nox clang lld libclang-rt-dev libomp-dev
-      python3-numpy python3-pip python3-setuptools libopenmpi-dev openmpi-bin nodejs npm chromium blender)
+# libwebp-dev: WebP textures (EXT_texture_webp). libmeshoptimizer-dev and libdraco-dev: glTF buffer views with
+# EXT_meshopt_compression and primitives with KHR_draco_mesh_compression. blender: the Blender add-on's test
+# (blender/, tests/blender; headless, with Cycles as the light units' reference). lld: the sanitized test
+# build links its test programs with it (CMakeLists.txt; GNU ld when it is absent).
+pkgs=(build-essential cmake pkg-config libcjson-dev libpng-dev libturbojpeg0-dev libzstd-dev libwebp-dev
+      libmeshoptimizer-dev libdraco-dev libopenexr-dev libembree-dev libcmocka-dev gnuplot-nox clang lld
+      libclang-rt-dev libomp-dev python3-numpy python3-pip python3-setuptools libopenmpi-dev openmpi-bin nodejs
+      npm chromium blender)
 missing=()
 for p in "${pkgs[@]}"; do
   # Node.js from elsewhere (e.g. NodeSource's nodejs, which bundles npm and conflicts with Debian's npm

@@ -71,7 +71,8 @@ static int harness(const char *target, const char *p)
              : !strcmp(target, "png") ? ms_fuzz_png(b, n)
              : !strcmp(target, "mtl") ? ms_fuzz_mtl(b, n)
              : !strcmp(target, "jpeg") ? ms_fuzz_jpeg(b, n)
-             : !strcmp(target, "ktx2") ? ms_fuzz_ktx2(b, n) : ms_fuzz_mesh(target, b, n);
+             : !strcmp(target, "ktx2") ? ms_fuzz_ktx2(b, n)
+             : !strcmp(target, "webp") ? ms_fuzz_webp(b, n) : ms_fuzz_mesh(target, b, n);
     free(b);
     return rc ? 1 : 0;
 }

@@ -9,11 +9,16 @@
  * compressed streams are written by meshoptimizer's and Draco's encoders, independent of the decoders the
  * reader uses. Broken variants (a sparse index past the accessor, sparse values past their view, a
  * compressed view whose count and stride do not make its length, corrupt or cut compressed data, an accessor that
- * does not hold the Draco mesh's points) are refused with one line naming the file. */
+ * does not hold the Draco mesh's points) are refused with one line naming the file. Textures: WebP images
+ * (EXT_texture_webp, written by libwebp's encoder) decode to the test's own texels, lossless exactly, lossy
+ * with its alpha exact; a texture with both a PNG `source` and a WebP takes the PNG; a cut WebP is refused
+ * with one line. */
 #include "testutil.h"
 #include "draco_encode.h"
 #include <math.h>
 #include <meshoptimizer.h>
+#include <webp/encode.h>
+#include "scene/scene_internal.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -386,6 +391,100 @@ static void test_draco(void **st)
     }
 }
 
+/* A 5 x 3 RGBA image whose texels all differ, alpha included. */
+static void webp_texels(unsigned char rgba[5 * 3 * 4])
+{
+    for (int i = 0; i < 15; i++) {
+        rgba[4 * i] = (unsigned char)(17 * i);
+        rgba[4 * i + 1] = (unsigned char)(255 - 13 * i);
+        rgba[4 * i + 2] = (unsigned char)((i * 97) & 255);
+        rgba[4 * i + 3] = (unsigned char)(40 + 10 * i);
+    }
+}
+
+/* The glTF of one textured triangle whose base colour texture has the given `source` part and an
+ * EXT_texture_webp image (image 1, a data URI); image 0 a PNG data URI. */
+static void webp_gltf(char *out, size_t n, const char *source, const char *png64, const char *webp64)
+{
+    static const float tri[15] = { 0, 0, 0, 0, 0, 4, 0, 0, 1, 0, 0, 0, 4, 0, 1 };   /* xyz then uv, as two accessors */
+    float pos[9], uv[6];
+    for (int v = 0; v < 3; v++) {
+        memcpy(pos + 3 * v, tri + 5 * v, 12);
+        memcpy(uv + 2 * v, tri + 5 * v + 3, 8);
+    }
+    unsigned char b[60];
+    memcpy(b, pos, 36);
+    memcpy(b + 36, uv, 24);
+    char b64[128];
+    tu_base64(b, sizeof b, b64);
+    snprintf(out, n,
+             "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"EXT_texture_webp\"],\n"
+             " \"buffers\": [{\"uri\": \"data:application/octet-stream;base64,%s\", \"byteLength\": 60}],\n"
+             " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 24}],\n"
+             " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [4, 0, 4]},"
+             " {\"bufferView\": 1, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC2\"}],\n"
+             " \"images\": [{\"uri\": \"data:image/png;base64,%s\"}, {\"uri\": \"data:image/webp;base64,%s\"}],\n"
+             " \"textures\": [{%s\"extensions\": {\"EXT_texture_webp\": {\"source\": 1}}}],\n"
+             " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}}}],\n"
+             " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"material\": 0}]}],\n"
+             " \"nodes\": [{\"mesh\": 0}], \"scenes\": [{\"nodes\": [0]}], \"scene\": 0}\n",
+             b64, png64, webp64, source);
+}
+
+static void test_webp(void **st)
+{
+    (void)st;
+    unsigned char rgba[60];
+    webp_texels(rgba);
+    uint8_t *lossless = NULL, *lossy = NULL;
+    const size_t nl = WebPEncodeLosslessRGBA(rgba, 5, 3, 20, &lossless), ny = WebPEncodeRGBA(rgba, 5, 3, 20, 90.0f, &lossy);
+    assert_true(nl > 0 && ny > 0);
+    ms_texture t;
+    char err[512];
+    for (int flip = 0; flip < 2; flip++) {   /* lossless: every texel, rows in either order */
+        if (ms_texture_decode(lossless, nl, "x.webp", flip, (size_t)1 << 20, &t, err, sizeof err)) fail_msg("%s", err);
+        assert_int_equal(t.width, 5);
+        assert_int_equal(t.height, 3);
+        for (int y = 0; y < 3; y++) assert_memory_equal(t.rgba + 20 * (flip ? 2 - y : y), rgba + 20 * y, 20);
+        free(t.rgba);
+    }
+    if (ms_texture_decode(lossy, ny, "x.webp", 0, (size_t)1 << 20, &t, err, sizeof err)) fail_msg("%s", err);
+    for (int i = 0; i < 15; i++) assert_int_equal(t.rgba[4 * i + 3], rgba[4 * i + 3]);   /* its alpha is lossless */
+    free(t.rgba);
+    /* Cut: one line naming the file; too large for the budget: refused before decoding. */
+    assert_int_equal(ms_texture_decode(lossless, nl / 2, "cut.webp", 0, (size_t)1 << 20, &t, err, sizeof err), -1);
+    assert_null(strchr(err, '\n'));
+    assert_non_null(strstr(err, "cut.webp: "));
+    assert_int_equal(ms_texture_decode(lossless, nl, "big.webp", 0, 59, &t, err, sizeof err), -1);
+    assert_non_null(strstr(err, "exceed"));
+    /* Through a glTF: the WebP where the texture has no source; the PNG source where it has one. */
+    static char webp64[512], png64[4096], text[8192];
+    tu_base64(lossless, nl, webp64);
+    unsigned char grey[15 * 3];
+    memset(grey, 200, sizeof grey);
+    tu_png_base64(grey, 5, 3, png64, sizeof png64);
+    for (int with_source = 0; with_source < 2; with_source++) {
+        webp_gltf(text, sizeof text, with_source ? "\"source\": 0, " : "", png64, webp64);
+        bin b = { .n = 0 };
+        put(&b, "unused", 6);
+        ms_scene sc;
+        char name[32];
+        snprintf(name, sizeof name, "webp%d", with_source);
+        assert_null(strchr(text, '%'));   /* load() formats the text with the bin file's name, which this glTF does not use */
+        if (load(name, &b, text, &sc, err, sizeof err)) fail_msg("%s", err);
+        assert_int_equal((int)sc.n_textures, 1);
+        assert_int_equal(sc.textures[0].width, 5);
+        assert_int_equal(sc.textures[0].height, 3);
+        if (with_source)
+            for (int i = 0; i < 15; i++) assert_int_equal(sc.textures[0].rgba[4 * i], 200);
+        else
+            assert_memory_equal(sc.textures[0].rgba, rgba, 60);
+        ms_scene_free(&sc);
+    }
+    WebPFree(lossless);
+    WebPFree(lossy);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -393,6 +492,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_meshopt),
         cmocka_unit_test(test_draco),
         cmocka_unit_test(test_instancing),
+        cmocka_unit_test(test_webp),
     };
     return tu_run_group_tests(tests, setup, NULL, argc, argv);
 }

@@ -329,7 +329,7 @@ static void test_bad_textures(void **st)
     size_t cn = tiny_png(one, 1, 1, cut) - 20;   /* ends inside IDAT */
     const struct { const uint8_t *b; size_t n; const char *needle; } cases[4] = {
         { jpeg, sizeof jpeg, "bad JPEG" },
-        { (const uint8_t *)"not an image at all", 19, "not a PNG, JPEG or KTX2 image" },
+        { (const uint8_t *)"not an image at all", 19, "not a PNG, JPEG, WebP or KTX2 image" },
         { big, bn, "a 20000x1 texture (at most 16384 a side)" },
         { cut, cn, "bad PNG" },
     };

@@ -345,14 +345,15 @@ static long texture_of(const cgltf_data *d, const cgltf_options *opt, const cglt
 {
     const cgltf_texture *tx = tv->texture;
     if (!tx) return -1;
-    /* KHR_texture_basisu's KTX2 image only where the texture has no fallback `source`: the extension's
-     * payloads are Basis Universal (ETC1S, UASTC), which microshadow does not transcode (docs/shading.md),
-     * so a PNG/JPEG fallback is the image that can be shown. Without one the KTX2 is tried: 8-bit levels,
-     * plain or Zstandard, decode (texture_ktx2.c); a Basis payload is one warning naming the file. */
-    const cgltf_image *img = tx->image ? tx->image : tx->has_basisu ? tx->basisu_image : NULL;
+    /* The texture's `source` first (the extensions' fallback, PNG or JPEG, which any reader decodes), then
+     * EXT_texture_webp's WebP (texture.c, libwebp), then KHR_texture_basisu's KTX2: its payloads are mostly
+     * Basis Universal (ETC1S, UASTC), which microshadow does not transcode (docs/shading.md); 8-bit levels,
+     * plain or Zstandard, decode (texture_ktx2.c), and a Basis payload is one warning naming the file. */
+    const cgltf_image *img = tx->image ? tx->image : tx->has_webp && tx->webp_image ? tx->webp_image
+                             : tx->has_basisu ? tx->basisu_image : NULL;
     if (!img) {
-        ms_warn_material("%s: material %zu: %s: texture %zu has no PNG, JPEG or KTX2 image%s: texture ignored", path, mi, slot,
-                         (size_t)(tx - d->textures), tx->has_webp ? " (EXT_texture_webp: WebP is not decoded)" : "");
+        ms_warn_material("%s: material %zu: %s: texture %zu has no PNG, JPEG, WebP or KTX2 image: texture ignored", path, mi,
+                         slot, (size_t)(tx - d->textures));
         return -1;
     }
     int32_t set = (int32_t)tv->texcoord;
@@ -387,18 +388,17 @@ static long texture_of(const cgltf_data *d, const cgltf_options *opt, const cglt
 }
 
 /* Extensions microshadow implements (KHR_texture_basisu: the fallback source, else its KTX2 image, 8-bit
- * plain or Zstandard levels decoded, Basis payloads named in a warning; EXT_meshopt_compression and
- * KHR_draco_mesh_compression: decoded, gltf_decode.c; EXT_mesh_gpu_instancing: every instance drawn,
+ * plain or Zstandard levels decoded, Basis payloads named in a warning; EXT_texture_webp: decoded, texture.c;
+ * EXT_meshopt_compression and KHR_draco_mesh_compression: decoded, gltf_decode.c; EXT_mesh_gpu_instancing: every instance drawn,
  * walk_nodes); any other in extensionsRequired is an error, in extensionsUsed one warning each saying what is
  * left out. */
 static const char *const known_ext[] = { "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_texture_basisu",
                                          "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_meshopt_compression",
-                                         "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression" };
+                                         "EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression", "EXT_texture_webp" };
 static const struct { const char *name, *left_out; } ext_left_out[] = {
     { "KHR_materials_unlit", "unlit materials are shaded as lit" },
     { "KHR_materials_pbrSpecularGlossiness", "specular-glossiness is ignored (metallic-roughness or the defaults shade)" },
     { "KHR_materials_variants", "only the default materials are used" },
-    { "EXT_texture_webp", "WebP images are not decoded (a PNG/JPEG fallback source is used)" },
 };
 
 static int check_extensions(const cgltf_data *d, const char *path, char *err, size_t errlen)

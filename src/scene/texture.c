@@ -1,11 +1,12 @@
 /* Material textures into RGBA8, told apart by content: PNG (libpng's simplified API: 8- and 16-bit,
- * paletted, grey), JPEG (libjpeg-turbo's TurboJPEG API, which reports errors and never exits) and KTX2
- * (texture_ktx2.c). The size is checked against the limits from the header before any pixel memory is
- * allocated. */
+ * paletted, grey), JPEG (libjpeg-turbo's TurboJPEG API, which reports errors and never exits), WebP
+ * (libwebp: lossy and lossless, with or without alpha; glTF's EXT_texture_webp) and KTX2 (texture_ktx2.c).
+ * The size is checked against the limits from the header before any pixel memory is allocated. */
 #include "scene_internal.h"
 #include "microshadow.h"
 #include <png.h>
 #include <turbojpeg.h>
+#include <webp/decode.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -98,6 +99,33 @@ out:
     return rc;
 }
 
+/* A WebP image (a still one: animated files are refused by the simple decoder) into RGBA8; its rows top first, or
+ * reversed with flip_rows. */
+static int decode_webp(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
+                       ms_texture *out, char *err, size_t errlen)
+{
+    int w = 0, h = 0;
+    if (!WebPGetInfo(buf, len, &w, &h)) { snprintf(err, errlen, "%s: not a WebP image libwebp can decode", what); return -1; }
+    if (!ms_texture_size_ok((unsigned)w, (unsigned)h, budget, what, err, errlen)) return -1;
+    const size_t row = (size_t)w * 4;
+    unsigned char *px = malloc(row * (size_t)h);
+    if (!px) { snprintf(err, errlen, "%s: out of memory for a %dx%d texture", what, w, h); return -1; }
+    if (!WebPDecodeRGBAInto(buf, len, px, row * (size_t)h, (int)row)) {
+        free(px);
+        snprintf(err, errlen, "%s: corrupt WebP data", what);
+        return -1;
+    }
+    if (flip_rows)
+        for (size_t y = 0; y < (size_t)h / 2; y++) {
+            unsigned char *a = px + y * row, *b = px + ((size_t)h - 1 - y) * row;
+            for (size_t i = 0; i < row; i++) { const unsigned char t = a[i]; a[i] = b[i]; b[i] = t; }
+        }
+    out->rgba = px;
+    out->width = w;
+    out->height = h;
+    return 0;
+}
+
 static const unsigned char ktx2_id[12] = { 0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n' };
 
 int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, int flip_rows, size_t budget,
@@ -108,7 +136,9 @@ int ms_texture_decode(const unsigned char *buf, size_t len, const char *what, in
         return decode_jpeg(buf, len, what, flip_rows, budget, out, err, errlen);
     if (len >= 12 && !memcmp(buf, ktx2_id, 12)) return ms_texture_decode_ktx2(buf, len, what, flip_rows, budget, out, err, errlen);
     if (len >= 8 && !png_sig_cmp(buf, 0, 8)) return decode_png(buf, len, what, flip_rows, budget, out, err, errlen);
-    snprintf(err, errlen, "%s: not a PNG, JPEG or KTX2 image", what);
+    if (len >= 12 && !memcmp(buf, "RIFF", 4) && !memcmp(buf + 8, "WEBP", 4))
+        return decode_webp(buf, len, what, flip_rows, budget, out, err, errlen);
+    snprintf(err, errlen, "%s: not a PNG, JPEG, WebP or KTX2 image", what);
     return -1;
 }
 

@@ -88,12 +88,11 @@ static inline int ms_fuzz_jpeg(const uint8_t *data, size_t size)
     return rc;
 }
 
-/* A KTX2 texture (src/scene/texture_ktx2.c: the container, uncompressed and Zstandard levels), from bytes;
- * 0 if it decoded. Decoded twice, rows top-down and bottom-up: success means both decode, each within the
- * size limit and the 16 MiB budget of ms_fuzz_jpeg, the same image with its rows reversed. */
-static inline int ms_fuzz_ktx2(const uint8_t *data, size_t size)
+/* A material texture decoded from bytes by content (src/scene/texture.c), named path in messages; 0 if it
+ * decoded. Decoded twice, rows top-down and bottom-up: success means both decode, each within the size limit
+ * and the 16 MiB budget of ms_fuzz_jpeg, the same image with its rows reversed. */
+static inline int ms_fuzz_texture_both_ways(const char *path, const uint8_t *data, size_t size)
 {
-    const char *path = MS_FUZZ_MESH_PATH "ktx2";
     const size_t budget = (size_t)16 << 20;
     ms_texture t[2];
     char err[1024] = "";
@@ -117,6 +116,18 @@ static inline int ms_fuzz_ktx2(const uint8_t *data, size_t size)
     free(t[0].rgba);
     free(t[1].rgba);
     return rc;
+}
+
+/* A KTX2 texture (src/scene/texture_ktx2.c: the container, uncompressed and Zstandard levels). */
+static inline int ms_fuzz_ktx2(const uint8_t *data, size_t size)
+{
+    return ms_fuzz_texture_both_ways(MS_FUZZ_MESH_PATH "ktx2", data, size);
+}
+
+/* A WebP texture (src/scene/texture.c through libwebp: lossy, lossless, alpha; animated files refused). */
+static inline int ms_fuzz_webp(const uint8_t *data, size_t size)
+{
+    return ms_fuzz_texture_both_ways(MS_FUZZ_MESH_PATH "webp", data, size);
 }
 
 static inline void ms_fuzz_ignore_warning(void *user, const char *msg) { (void)user; (void)msg; }
