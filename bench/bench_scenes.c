@@ -194,12 +194,12 @@ int main(int argc, char **argv)
     const char *dir = "../shared/scenes", *out_md = NULL;
     int samples[4] = { 1024 }, n_samples = 1, size = 1024, threads = 0;
     /* A method may name a variant after a colon: scanline:pixel (the per-pixel traversal), scanline:fs
-     * (block traversal with frustum shrinking), embree:packet16 and embree:stream (its two ways of being
-     * handed rays; the "/ embree" ratios are against the faster of the embree variants run). Plain names
-     * run the defaults. */
-    const char *methods[MAX_METHODS] = { "raytrace", "embree:packet16", "embree:stream", "mft", "bounds", "hierarchical",
-                                         "scanline:pixel", "scanline" };
-    int n_methods = 8, quality_only = 0, no_quality = 0, repeat = 1;
+     * (block traversal with frustum shrinking), embree:packet16, embree:packet8 and embree:stream (its ways
+     * of being handed rays; the "/ embree" ratios are against the fastest of the embree variants run).
+     * Plain names run the defaults. */
+    const char *methods[MAX_METHODS] = { "raytrace", "embree:packet16", "embree:packet8", "embree:stream", "mft",
+                                         "bounds", "hierarchical", "scanline:pixel", "scanline" };
+    int n_methods = 9, quality_only = 0, no_quality = 0, repeat = 1;
     ms_pattern pattern = MS_PATTERN_GRID;   /* --pattern: the main table's samples (interleaved: filtered, as rendered) */
     const char *pattern_name = "grid";
     /* The command line as given, for the header (strtok below cuts the lists). */
@@ -232,7 +232,7 @@ int main(int argc, char **argv)
             for (char *t = strtok(argv[++i], ","); t && n_methods < MAX_METHODS; t = strtok(NULL, ",")) methods[n_methods++] = t;
         } else {
             fprintf(stderr, "usage: bench_scenes [--scenes DIR] [--samples 256,1024,4096] [--size S] [--threads T] "
-                            "[--methods raytrace,embree:packet16,embree:stream,mft,bounds,hierarchical,scanline:pixel,scanline] "
+                            "[--methods raytrace,embree:packet16,embree:packet8,embree:stream,mft,bounds,hierarchical,scanline:pixel,scanline] "
                             "[--pattern grid|interleaved|stratified] [--repeat N] [--quality-only | --no-quality] "
                             "[--out FILE.md]\n");
             return 2;
@@ -321,6 +321,7 @@ int main(int argc, char **argv)
                 if (variant && !strcmp(variant + 1, "fs")) opt.frustum_shrink = 1;
                 if (variant && !strcmp(variant + 1, "packet16")) opt.embree_mode = MS_EMBREE_PACKET16;
                 if (variant && !strcmp(variant + 1, "stream")) opt.embree_mode = MS_EMBREE_STREAM;
+                if (variant && !strcmp(variant + 1, "packet8")) opt.embree_mode = MS_EMBREE_PACKET8;
                 opt.samples = N;
                 opt.pattern = pattern;
                 opt.width = opt.height = size;

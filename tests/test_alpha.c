@@ -53,14 +53,16 @@ static void every_method(const char *format)
             const int embree = !strcmp(names[m], "embree");
             for (int cap = embree ? MS_ISA_AUTO : MS_ISA_SCALAR; cap <= (embree ? MS_ISA_AUTO : MS_ISA_AVX512); cap++) {
                 if (cap && (!tu_isa_allowed((ms_isa)cap) || cap > (int)ms_cpu_isa())) continue;
-                for (int v = 0; v < (micro ? 2 : embree ? 2 : 1); v++) {
+                for (int v = 0; v < (micro ? 2 : embree ? 3 : 1); v++) {
                     ms_render_ctx c = ctx;
                     c.isa_cap = (ms_isa)cap;
                     if (micro) c.traversal = v ? MS_TRAVERSAL_PIXEL : MS_TRAVERSAL_BLOCK;
-                    if (embree) c.embree_mode = v ? MS_EMBREE_STREAM : MS_EMBREE_PACKET16;
+                    static const ms_embree_mode modes[3] = { MS_EMBREE_PACKET16, MS_EMBREE_STREAM, MS_EMBREE_PACKET8 };
+                    static const char *const mode_names[3] = { " packet16", " stream", " packet8" };
+                    if (embree) c.embree_mode = modes[v];
                     char label[128];
                     snprintf(label, sizeof label, "%s %s %s%s", names[m], pat_names[p], cap ? ms_isa_name((ms_isa)cap) : "",
-                             micro ? (v ? " pixel" : " block") : embree ? (v ? " stream" : " packet16") : "");
+                             micro ? (v ? " pixel" : " block") : embree ? mode_names[v] : "");
                     total_differ += al_method_vs_oracle(&s, &c, names[m], &om, label);
                 }
             }

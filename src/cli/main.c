@@ -64,7 +64,7 @@ static void usage(FILE *f)
         "                      answer, docs/culling.md); default: on for the micro-raster methods\n"
         "  --no-interior       micro-raster methods: no interior boxes (docs/culling.md; to measure)\n"
         "  --no-merge          micro-raster methods: do not merge coplanar rectangles (docs/culling.md)\n"
-        "  --embree-mode M     embree method: packet16 (default: rtcOccluded16) or stream (docs/embree.md)\n"
+        "  --embree-mode M     embree method: packet16 (default: rtcOccluded16), packet8 or stream (docs/embree.md)\n"
         "  --embree-filter F   embree method: when the receiver's triangle is filtered out: plane (default),\n"
         "                      always, none (to measure only: the receiver then shadows itself)\n"
         "  --max-memory SIZE   memory budget (e.g. 512M, 8G; default %d%% of physical memory): a frame that\n"
@@ -219,8 +219,9 @@ static int take_option(cli_request *r, ms_cli_parser *cli, int c)
     case O_NO_MERGE: r->opt.no_merge = 1; break;
     case O_EMBREE_MODE:
         if (!strcmp(optarg, "packet16")) r->opt.embree_mode = MS_EMBREE_PACKET16;
+        else if (!strcmp(optarg, "packet8")) r->opt.embree_mode = MS_EMBREE_PACKET8;
         else if (!strcmp(optarg, "stream")) r->opt.embree_mode = MS_EMBREE_STREAM;
-        else { fprintf(stderr, "microshadow: --embree-mode: '%s' is not packet16 or stream\n", optarg); return EXIT_BAD_INPUT; }
+        else { fprintf(stderr, "microshadow: --embree-mode: '%s' is not packet16, packet8 or stream\n", optarg); return EXIT_BAD_INPUT; }
         break;
     case O_EMBREE_FILTER:
         if (!strcmp(optarg, "plane")) r->opt.embree_filter = MS_EMBREE_FILTER_PLANE;

@@ -95,6 +95,10 @@ static int eb_build(const ms_render_ctx *ctx, ms_embree_scene *s, char *err, siz
         snprintf(err, errlen, "this Embree has no 16-wide packets on this CPU; try the stream mode");
         return -1;
     }
+    if (s->mode == MS_EMBREE_PACKET8 && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) {
+        snprintf(err, errlen, "this Embree has no 8-wide packets on this CPU; try the stream mode");
+        return -1;
+    }
     if (s->mode == MS_EMBREE_STREAM && !rtcGetDeviceProperty(s->dev, RTC_DEVICE_PROPERTY_RAY_STREAM_SUPPORTED)) {
         snprintf(err, errlen, "this Embree has no ray streams; try the packet16 mode");
         return -1;
@@ -144,7 +148,7 @@ out:
 int ms_embree_scene_acquire(const ms_render_ctx *ctx, void **state, char *err, size_t errlen)
 {
     *state = NULL;
-    if ((unsigned)ctx->embree_mode > MS_EMBREE_STREAM || (unsigned)ctx->embree_filter > MS_EMBREE_FILTER_NONE) {
+    if ((unsigned)ctx->embree_mode > MS_EMBREE_PACKET8 || (unsigned)ctx->embree_filter > MS_EMBREE_FILTER_NONE) {
         snprintf(err, errlen, "embree: unknown mode %d or filter %d", (int)ctx->embree_mode, (int)ctx->embree_filter);
         return -1;
     }

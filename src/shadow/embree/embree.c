@@ -7,9 +7,9 @@
  * Shadow rays: per pixel the segments to the samples of the chosen pattern (ms_pattern_points) that are
  * in front of the receiver's plane (the front mask, receiver.h), origin q.p, direction sample - q.p
  * unnormalised, tnear = ctx->near, tfar = ctx->far, exactly as raytrace.
- * Traced either as 16-wide packets (rtcOccluded16) or as one coherent stream per pixel (rtcOccluded1M
- * with RTC_INTERSECT_CONTEXT_FLAG_COHERENT), chosen by ms_render_options.embree_mode (default packet16:
- * the faster here, docs/embree.md).
+ * Traced as 16-wide packets (rtcOccluded16), 8-wide packets (rtcOccluded8) or one coherent stream per
+ * pixel (rtcOccluded1M with RTC_INTERSECT_CONTEXT_FLAG_COHERENT), chosen by ms_render_options.embree_mode
+ * (default packet16; which is fastest depends on the CPU, docs/embree.md).
  *
  * The hit triangle q.prim never occludes. Embree excludes it through a context filter function that
  * rejects primID == q.prim, the prim passed in an extension of RTCIntersectContext. The filter is
@@ -71,7 +71,7 @@ static int eb_needs_filter(const ms_render_ctx *ctx, const ms_shadow_query *q)
 typedef struct eb_scratch {
     float *pts;
     struct RTCRay *rays;       /* stream: the front samples' rays */
-    struct RTCRay16 *r16;      /* packet16: one packet */
+    void *packet;              /* packet8 / packet16: one packet (struct RTCRay8 or RTCRay16) */
 } eb_scratch;
 
 static void eb_ray_init(struct RTCRay *r, const ms_render_ctx *ctx, const float p[3], const float *pt, int id)
@@ -105,37 +105,44 @@ static void eb_trace_stream(ms_embree_scene *s, ms_embree_ictx *ic, const ms_ren
         if (r[i].tfar >= 0.0f) vis[r[i].id >> 6] |= UINT64_C(1) << (r[i].id & 63);   /* occluded: -inf */
 }
 
-static void eb_trace_packet16(ms_embree_scene *s, ms_embree_ictx *ic, const ms_render_ctx *ctx, const ms_shadow_query *q,
-                              const eb_scratch *w, const uint64_t *front, uint64_t *vis, uint64_t *cnt)
-{
-    _Alignas(64) int valid[16];
-    const int ns = ctx->samples;
-    struct RTCRay16 *r = w->r16;
-    for (int base = 0; base < ns; base += 16) {
-        const unsigned lanes = (unsigned)(front[base >> 6] >> (base & 63) & 0xFFFFu);
-        if (!lanes) continue;
-        const float *pt = w->pts + 3 * base;
-        for (int l = 0; l < 16; l++) {
-            valid[l] = lanes >> l & 1u ? -1 : 0;
-            r->org_x[l] = q->p[0]; r->org_y[l] = q->p[1]; r->org_z[l] = q->p[2];
-            r->tnear[l] = ctx->near;
-            r->dir_x[l] = pt[3 * l] - q->p[0];
-            r->dir_y[l] = pt[3 * l + 1] - q->p[1];
-            r->dir_z[l] = pt[3 * l + 2] - q->p[2];
-            r->time[l] = 0.0f;
-            r->tfar[l] = ctx->far;
-            r->mask[l] = 0xFFFFFFFFu;
-            r->id[l] = (unsigned)(base + l);
-            r->flags[l] = 0;
-        }
-        rtcOccluded16(valid, s->scene, &ic->c, r);
-        cnt[C_CALLS]++;
-        cnt[C_RAYS] += (uint64_t)__builtin_popcount(lanes);
-        uint64_t bits = 0;
-        for (int l = 0; l < 16; l++) bits |= (uint64_t)((lanes >> l & 1u) && r->tfar[l] >= 0.0f) << l;
-        vis[base >> 6] |= bits << (base & 63);
+/* Packets of W = 8 or 16 rays (rtcOccluded8 / rtcOccluded16), written once for both widths: which is
+ * faster depends on the CPU (a core that runs 512-bit operations as two halves favours 8). */
+#define EB_TRACE_PACKET(W)                                                                                          \
+    static void eb_trace_packet##W(ms_embree_scene *s, ms_embree_ictx *ic, const ms_render_ctx *ctx,               \
+                                   const ms_shadow_query *q, const eb_scratch *w, const uint64_t *front,            \
+                                   uint64_t *vis, uint64_t *cnt)                                                    \
+    {                                                                                                               \
+        _Alignas(64) int valid[W];                                                                                  \
+        const int ns = ctx->samples;                                                                                \
+        struct RTCRay##W *r = (struct RTCRay##W *)w->packet;                                                        \
+        for (int base = 0; base < ns; base += W) {                                                                  \
+            const unsigned lanes = (unsigned)(front[base >> 6] >> (base & 63) & ((1u << W) - 1u));                 \
+            if (!lanes) continue;                                                                                   \
+            const float *pt = w->pts + 3 * base;                                                                    \
+            for (int l = 0; l < W; l++) {                                                                           \
+                valid[l] = lanes >> l & 1u ? -1 : 0;                                                                \
+                r->org_x[l] = q->p[0]; r->org_y[l] = q->p[1]; r->org_z[l] = q->p[2];                                \
+                r->tnear[l] = ctx->near;                                                                            \
+                r->dir_x[l] = pt[3 * l] - q->p[0];                                                                  \
+                r->dir_y[l] = pt[3 * l + 1] - q->p[1];                                                              \
+                r->dir_z[l] = pt[3 * l + 2] - q->p[2];                                                              \
+                r->time[l] = 0.0f;                                                                                  \
+                r->tfar[l] = ctx->far;                                                                              \
+                r->mask[l] = 0xFFFFFFFFu;                                                                           \
+                r->id[l] = (unsigned)(base + l);                                                                    \
+                r->flags[l] = 0;                                                                                    \
+            }                                                                                                       \
+            rtcOccluded##W(valid, s->scene, &ic->c, r);                                                             \
+            cnt[C_CALLS]++;                                                                                         \
+            cnt[C_RAYS] += (uint64_t)__builtin_popcount(lanes);                                                     \
+            uint64_t bits = 0;                                                                                      \
+            for (int l = 0; l < W; l++) bits |= (uint64_t)((lanes >> l & 1u) && r->tfar[l] >= 0.0f) << l;          \
+            vis[base >> 6] |= bits << (base & 63);                                                                  \
+        }                                                                                                           \
     }
-}
+EB_TRACE_PACKET(8)
+EB_TRACE_PACKET(16)
+#undef EB_TRACE_PACKET
 
 static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_query *q, int nq,
                          const uint64_t *front, uint64_t *vis, uint64_t *cnt)
@@ -148,8 +155,8 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
     eb_scratch w = { 0 };
     w.pts = malloc((size_t)ns * 3 * sizeof(float));
     if (s->mode == MS_EMBREE_STREAM) w.rays = aligned_alloc(64, (size_t)ns * sizeof *w.rays);
-    else w.r16 = aligned_alloc(64, sizeof *w.r16);
-    if (!w.pts || (!w.rays && !w.r16)) { free(w.pts); free(w.rays); free(w.r16); return -1; }
+    else w.packet = aligned_alloc(64, sizeof(struct RTCRay16));
+    if (!w.pts || (!w.rays && !w.packet)) { free(w.pts); free(w.rays); free(w.packet); return -1; }
 
     unsigned mx = ms_embree_enter();
     ms_embree_ictx ic;
@@ -171,12 +178,13 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
         ic.p = q[qi].p;
         cnt[C_FILTERED_PIXELS] += (uint64_t)filt;
         if (s->mode == MS_EMBREE_STREAM) eb_trace_stream(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
+        else if (s->mode == MS_EMBREE_PACKET8) eb_trace_packet8(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
         else eb_trace_packet16(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
     }
     ms_embree_leave(mx);
     free(w.pts);
     free(w.rays);
-    free(w.r16);
+    free(w.packet);
     return 0;
 }
 
