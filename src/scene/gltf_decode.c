@@ -114,9 +114,10 @@ int ms_gltf_sparse_ok(const cgltf_accessor *a, char *why, size_t n)
         return 0;
     }
     const uint8_t *ip = view_bytes(iv) + s->indices_byte_offset;
-    /* cgltf_validate reads the indices through typed pointers; glTF requires both parts aligned. */
+    /* cgltf_validate reads the indices through typed pointers; glTF requires both parts aligned (comp > 0:
+     * elem is). */
     const size_t comp = cgltf_component_size(a->component_type);
-    if ((uintptr_t)ip % ic || !comp || (uintptr_t)(view_bytes(vv) + s->values_byte_offset) % comp) {
+    if ((uintptr_t)ip % ic || (uintptr_t)(view_bytes(vv) + s->values_byte_offset) % comp) {
         snprintf(why, n, "a sparse accessor's indices or values are not aligned to their component size");
         return 0;
     }

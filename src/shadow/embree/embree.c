@@ -157,6 +157,9 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
     if (s->mode == MS_EMBREE_STREAM) w.rays = aligned_alloc(64, (size_t)ns * sizeof *w.rays);
     else w.packet = aligned_alloc(64, sizeof(struct RTCRay16));
     if (!w.pts || (!w.rays && !w.packet)) { free(w.pts); free(w.rays); free(w.packet); return -1; }
+    void (*trace)(ms_embree_scene *, ms_embree_ictx *, const ms_render_ctx *, const ms_shadow_query *,
+                  const eb_scratch *, const uint64_t *, uint64_t *, uint64_t *) =
+        s->mode == MS_EMBREE_STREAM ? eb_trace_stream : s->mode == MS_EMBREE_PACKET8 ? eb_trace_packet8 : eb_trace_packet16;
 
     unsigned mx = ms_embree_enter();
     ms_embree_ictx ic;
@@ -177,9 +180,7 @@ static int eb_visibility(void *state, const ms_render_ctx *ctx, const ms_shadow_
         ic.skip = filt ? q[qi].prim : UINT32_MAX;
         ic.p = q[qi].p;
         cnt[C_FILTERED_PIXELS] += (uint64_t)filt;
-        if (s->mode == MS_EMBREE_STREAM) eb_trace_stream(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
-        else if (s->mode == MS_EMBREE_PACKET8) eb_trace_packet8(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
-        else eb_trace_packet16(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
+        trace(s, &ic, ctx, &q[qi], &w, fm, vm, cnt);
     }
     ms_embree_leave(mx);
     free(w.pts);
