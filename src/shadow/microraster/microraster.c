@@ -178,10 +178,10 @@ static int mr_visibility_pixel(const mr_state *s, const ms_render_ctx *ctx, cons
 /* The block's pass over the interior boxes (occluders.h): the same traversal over their BVH, with no
  * receiver's triangle to skip and no alpha test; the pixels it empties leave the block. */
 static void interior_pass(const mr_state *s, const ms_render_ctx *ctx, ms_block_input *in, int *orig, size_t mw,
-                          uint64_t *cnt)
+                          uint64_t *cnt, ms_block_leaf_cache *box_cache)
 {
     ms_block_input vin = *in;
-    vin.cache = NULL;   /* the cache's leaves are the scene BVH's */
+    vin.cache = box_cache;   /* its own: the scene's cache holds leaves of the scene's BVH */
     vin.box = s->box_pass ? ctx->interior_box : NULL;
     const void *alpha[MS_BLOCK_LANES];
     for (int l = 0; l < in->n; l++) {
@@ -238,9 +238,12 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
     int *order = malloc((size_t)nq * sizeof *order);
     if (!order) return -1;
     ms_block_order(ctx, q, nq, order);
-    ms_block_leaf_cache cache = { 0 };
+    /* One leaf cache per tree: the scene's, and the interior boxes' (an umbra pixel rasterizes the boxes until its
+     * buffer is empty, and the previous block's best boxes empty it with fewer). */
+    ms_block_leaf_cache cache = { 0 }, box_cache = { 0 };
     cache.pre_bits = calloc(((size_t)s->shallow.n_nodes + 63) / 64, sizeof *cache.pre_bits);
-    if (!cache.pre_bits) { free(order); return -1; }
+    box_cache.pre_bits = calloc(((size_t)s->interior_shallow.n_nodes + 63) / 64 + 1, sizeof *box_cache.pre_bits);
+    if (!cache.pre_bits || !box_cache.pre_bits) { free(cache.pre_bits); free(box_cache.pre_bits); free(order); return -1; }
     int rc = 0;
     for (int g = 0; g < nq && !rc;) {
         ms_block_input in;
@@ -280,7 +283,7 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
         const int formed = in.n;
         const double t0 = formed ? omp_get_wtime() : 0.0;
         if (!rc && in.n && ctx->interior) {
-            interior_pass(s, ctx, &in, orig, mw, cnt);   /* lanes counted as formed, then compacted */
+            interior_pass(s, ctx, &in, orig, mw, cnt, &box_cache);   /* lanes counted as formed, then compacted */
             for (int l = 0; l < formed; l++) {
                 all_tests[l] = tests[l];
                 all_rast[l] = rast[l];
@@ -300,6 +303,7 @@ static int mr_visibility_block(const mr_state *s, const ms_render_ctx *ctx, cons
     free(order);
     free(pts);
     free(cache.pre_bits);
+    free(box_cache.pre_bits);
     return rc;
 }
 
